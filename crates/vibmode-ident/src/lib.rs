@@ -1,0 +1,1 @@
+//! vibmode-ident (work in progress).

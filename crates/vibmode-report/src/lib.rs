@@ -1,0 +1,1 @@
+//! vibmode-report (work in progress).

@@ -1,0 +1,1 @@
+//! vibmode-signal (work in progress).

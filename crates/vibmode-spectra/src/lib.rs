@@ -1,0 +1,1 @@
+//! vibmode-spectra (work in progress).

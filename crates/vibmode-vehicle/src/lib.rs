@@ -1,0 +1,1 @@
+//! vibmode-vehicle (work in progress).
