@@ -1,0 +1,1 @@
+//! vibmode-modal (work in progress).
