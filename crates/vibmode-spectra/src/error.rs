@@ -1,0 +1,117 @@
+//! The error type of this crate.
+
+/// Everything that can go wrong when computing a spectrum.
+///
+/// Every message is one line that names the offending value and says how to fix it.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SpectraError {
+    /// The sampling rate is zero, negative, NaN or infinite.
+    #[error("sampling rate fs_hz = {fs_hz} must be positive and finite; check the recording's sample rate (e.g. --fs 100)")]
+    InvalidSampleRate {
+        /// The rejected sampling rate, Hz.
+        fs_hz: f64,
+    },
+    /// An input signal has no samples.
+    #[error("{name} is empty (0 samples); a spectrum needs at least one sample")]
+    EmptyInput {
+        /// Which input ("x" or "y").
+        name: &'static str,
+    },
+    /// An input sample is NaN or infinite.
+    #[error("{name}[{index}] = {value} is not finite; remove or interpolate NaN/Inf samples before computing spectra")]
+    NonFiniteSample {
+        /// Which input ("x" or "y").
+        name: &'static str,
+        /// Index (0-based) of the first non-finite sample.
+        index: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// `nperseg` is zero.
+    #[error("nperseg must be at least 1 (got 0); use --nperseg 256")]
+    ZeroNperseg,
+    /// `noverlap >= nperseg` (after clamping `nperseg` to the record length, as scipy does).
+    #[error("noverlap ({noverlap}) must be smaller than nperseg ({nperseg}); use --noverlap {suggested}")]
+    NoverlapTooLarge {
+        /// The requested overlap, samples.
+        noverlap: usize,
+        /// The segment length in force, samples.
+        nperseg: usize,
+        /// A valid overlap to suggest (nperseg / 2), samples.
+        suggested: usize,
+    },
+    /// `nfft < nperseg`.
+    #[error("nfft ({nfft}) must be at least nperseg ({nperseg}); use --nfft {nperseg} or larger")]
+    NfftTooSmall {
+        /// The requested FFT length, samples.
+        nfft: usize,
+        /// The segment length in force, samples.
+        nperseg: usize,
+    },
+    /// `nfft` is zero.
+    #[error("nfft must be at least 1 (got 0); omit --nfft to use the default")]
+    ZeroNfft,
+    /// `x` and `y` of a cross-spectrum have different lengths.
+    #[error("x has {len_x} samples but y has {len_y}; csd and coherence need records of equal length, trim the longer one to {min}", min = .len_x.min(.len_y))]
+    LengthMismatch {
+        /// Samples in x.
+        len_x: usize,
+        /// Samples in y.
+        len_y: usize,
+    },
+    /// The record is shorter than one segment and [`crate::ShortRecord::Error`] was asked for.
+    #[error("record has {n_samples} samples, shorter than one segment (nperseg = {nperseg}); use --nperseg <= {n_samples}")]
+    ShortRecord {
+        /// Samples in the record.
+        n_samples: usize,
+        /// The requested segment length, samples.
+        nperseg: usize,
+    },
+    /// A Tukey window's alpha is outside [0, 1] or not finite.
+    #[error("tukey alpha ({alpha}) must be in [0, 1]; use e.g. tukey:0.5")]
+    InvalidTukeyAlpha {
+        /// The rejected alpha.
+        alpha: f64,
+    },
+    /// A window name that [`crate::Window`]'s `FromStr` does not know.
+    #[error("unknown window '{name}'; valid windows: hann, hamming, blackman, boxcar (or rect), flattop, tukey (alpha 0.5), tukey:ALPHA with ALPHA in [0, 1]")]
+    UnknownWindow {
+        /// The rejected name.
+        name: String,
+    },
+    /// An unknown detrend name.
+    #[error("unknown detrend '{name}'; valid values: none, constant, linear")]
+    UnknownDetrend {
+        /// The rejected name.
+        name: String,
+    },
+    /// An unknown scaling name.
+    #[error("unknown scaling '{name}'; valid values: density, spectrum")]
+    UnknownScaling {
+        /// The rejected name.
+        name: String,
+    },
+    /// An unknown average name.
+    #[error("unknown average '{name}'; valid values: mean, median")]
+    UnknownAverage {
+        /// The rejected name.
+        name: String,
+    },
+    /// An unknown short-record policy name.
+    #[error("unknown short-record policy '{name}'; valid values: clamp, error")]
+    UnknownShortRecord {
+        /// The rejected name.
+        name: String,
+    },
+    /// A [`crate::WelchPlan`] was given a record of another length than it was built for.
+    #[error("the WelchPlan was built for {expected} samples but {name} has {got}; build a new plan for this record length")]
+    PlanLengthMismatch {
+        /// Which input ("x" or "y").
+        name: &'static str,
+        /// Samples the plan was built for.
+        expected: usize,
+        /// Samples received.
+        got: usize,
+    },
+}
