@@ -14,6 +14,8 @@
 //! and a record shorter than `nperseg` if [`ShortRecord::Error`] is chosen (the default
 //! [`ShortRecord::Clamp`] does what scipy does and adds a note to the result).
 //!
+//! No function panics on input data; every problem is a [`SpectraError`].
+//!
 //! # Example
 //!
 //! A sine of amplitude 2 at a bin frequency has power A^2/2 = 2 at its peak in the power

@@ -160,7 +160,8 @@ pub enum Average {
     Mean,
     /// Median, divided by scipy's bias factor `1 + sum_{i=1}^{(K-1)/2} (1/(2i+1) - 1/(2i))`
     /// for K segments. For cross-spectra the real and imaginary parts are medians taken
-    /// separately, as in scipy.
+    /// separately, as in scipy. Keeps every segment's periodogram: memory
+    /// `n_segments * (nfft / 2 + 1) * 8` bytes (16 for cross-spectra).
     Median,
 }
 

@@ -190,3 +190,38 @@ fn defaults_are_scipys() {
     // A constant signal has nothing left after the constant detrend.
     assert!(s.psd.iter().all(|v| v.abs() < 1e-28));
 }
+
+#[test]
+fn results_serialize_to_json_and_back() {
+    let x = [1.0, 0.0, -1.0, 0.0, 2.0, 0.5];
+    let s = periodogram(&x, 2.0, &PeriodogramParams::default()).unwrap();
+    let j = serde_json::to_string(&s).unwrap();
+    assert!(j.contains("\"freq_hz\"") && j.contains("\"psd\""));
+    // serde_json (without its float_roundtrip feature) may be off by one ulp on parsing.
+    let back: vibmode_spectra::Spectrum = serde_json::from_str(&j).unwrap();
+    close(&back.psd, &s.psd, 1e-15);
+    close(&back.freq_hz, &s.freq_hz, 1e-15);
+    assert_eq!((back.nperseg, back.nfft, back.n_segments), (6, 6, 1));
+    let p = WelchParams {
+        nperseg: Some(4),
+        ..Default::default()
+    };
+    let c = vibmode_spectra::csd(
+        &x,
+        &x[..].iter().rev().copied().collect::<Vec<_>>(),
+        2.0,
+        &p,
+    )
+    .unwrap();
+    let back: vibmode_spectra::CrossSpectrum =
+        serde_json::from_str(&serde_json::to_string(&c).unwrap()).unwrap();
+    assert_eq!(back.csd.len(), c.csd.len());
+    for (a, b) in back.csd.iter().zip(&c.csd) {
+        assert!((a - b).norm() <= 1e-15 * b.norm().max(1e-300));
+    }
+    let pj = serde_json::to_string(&WelchParams::default()).unwrap();
+    assert!(
+        pj.contains("\"hann\"") && pj.contains("\"constant\""),
+        "{pj}"
+    );
+}

@@ -306,3 +306,30 @@ fn median_is_robust_to_a_burst() {
     assert!((m_med / level - 1.0).abs() < 0.15, "median level {m_med}");
     assert!(m_mean > 5.0 * level, "mean level {m_mean}");
 }
+
+#[test]
+fn coherence_ignores_median_like_scipy() {
+    let x = noise(81, 3000, 1.0);
+    let y: Vec<f64> = x
+        .iter()
+        .zip(noise(82, 3000, 1.0))
+        .map(|(a, b)| a + b)
+        .collect();
+    let mean = coherence(&x, &y, 10.0, &WelchParams::default()).unwrap();
+    let med = coherence(
+        &x,
+        &y,
+        10.0,
+        &WelchParams {
+            average: Average::Median,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(mean.coherence, med.coherence);
+    assert!(mean.notes.is_empty());
+    assert!(med.notes.iter().any(|n| n.contains("median")));
+    // Half the power of y is coherent with x: coherence about 0.5 on average.
+    let avg = mean.coherence.iter().sum::<f64>() / mean.coherence.len() as f64;
+    assert!((avg - 0.5).abs() < 0.1, "{avg}");
+}
