@@ -1,0 +1,409 @@
+//! Density-based clustering of pooled poles and classification of the clusters.
+
+use std::collections::{HashMap, HashSet};
+
+use serde::{Deserialize, Serialize};
+
+use crate::stats::{mean_std, median, percentile_sorted};
+use crate::{ClusterParams, InvariantMode, ModalError, ModeClass, PoleObservation};
+
+/// Full result of [`analyse_poles`]: the clusters plus the per-pole assignment, for plotting
+/// (e.g. colouring a stabilisation diagram by cluster).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModalAnalysis {
+    /// All clusters (Structural, PeriodicDisturbance and Spurious), sorted by ascending
+    /// `frequency_hz`.
+    pub modes: Vec<InvariantMode>,
+    /// For every input pole (same order as the input slice), the index into `modes` of its
+    /// cluster, or `None` (ignored by the filters, noise, or a duplicate of its fit in the cluster).
+    pub labels: Vec<Option<usize>>,
+    /// Number of poles that passed the frequency/damping filters and took part in the clustering.
+    pub n_used: usize,
+    /// Number of poles ignored by the filters (`freq_min_hz`, `freq_max_hz`, `max_damping_ratio`,
+    /// negative damping).
+    pub n_ignored: usize,
+    /// `n_records * orders.len() * n_channels` (distinct channels among the used poles).
+    pub n_fits: usize,
+    /// Core threshold actually used: `max(min_points, ceil(min_density_share * n_fits))` poles.
+    pub core_threshold: usize,
+}
+
+/// Pool the poles of all records, channels and model orders and return the clusters (invariant
+/// modes, periodic disturbances and spurious clusters, flagged by `class`), sorted by frequency.
+///
+/// * `n_records`: number of records the poles come from (record indices must be `< n_records`);
+///   records that produced no pole still count in `record_share`.
+/// * `orders`: the model orders that were fitted (every pole's order must be listed; duplicates
+///   are ignored); orders that produced no pole still count in `order_share`.
+///
+/// Empty `poles` gives `Ok(vec![])`. Errors: non-finite frequency/damping (with the pole index),
+/// record or order out of range, `n_records == 0` or empty `orders` with poles, invalid params.
+/// Never panics.
+pub fn find_invariant_modes(
+    poles: &[PoleObservation],
+    n_records: usize,
+    orders: &[usize],
+    p: &ClusterParams,
+) -> Result<Vec<InvariantMode>, ModalError> {
+    Ok(analyse_poles(poles, n_records, orders, p)?.modes)
+}
+
+/// Same as [`find_invariant_modes`] but also returns the per-pole cluster labels and counts.
+pub fn analyse_poles(
+    poles: &[PoleObservation],
+    n_records: usize,
+    orders: &[usize],
+    p: &ClusterParams,
+) -> Result<ModalAnalysis, ModalError> {
+    p.validate()?;
+    let mut labels = vec![None; poles.len()];
+    if poles.is_empty() {
+        return Ok(ModalAnalysis {
+            modes: Vec::new(),
+            labels,
+            n_used: 0,
+            n_ignored: 0,
+            n_fits: 0,
+            core_threshold: p.min_points,
+        });
+    }
+    if n_records == 0 {
+        return Err(ModalError::EmptySupport {
+            what: "n_records",
+            n_poles: poles.len(),
+        });
+    }
+    let mut orders: Vec<usize> = orders.to_vec();
+    orders.sort_unstable();
+    orders.dedup();
+    if orders.is_empty() {
+        return Err(ModalError::EmptySupport {
+            what: "orders",
+            n_poles: poles.len(),
+        });
+    }
+    validate_poles(poles, n_records, &orders)?;
+
+    // Filter and map to the scaled plane.
+    let lu = (1.0 + p.freq_tol_rel).ln();
+    let mut pts: Vec<Pt> = Vec::with_capacity(poles.len());
+    let mut channel_ids: HashMap<&str, usize> = HashMap::new();
+    for (i, pole) in poles.iter().enumerate() {
+        let f = pole.frequency_hz;
+        let z = pole.damping_ratio;
+        if !(f >= p.freq_min_hz && f <= p.freq_max_hz && z >= 0.0 && z <= p.max_damping_ratio) {
+            continue;
+        }
+        let n_ch = channel_ids.len();
+        let ch = *channel_ids.entry(pole.channel.as_str()).or_insert(n_ch);
+        let u = f.ln() / lu;
+        let v = z.max(p.min_damping_ratio).log10() / p.log_damping_tol;
+        pts.push(Pt {
+            u,
+            v,
+            cell: (u.floor() as i64, v.floor() as i64),
+            idx: i,
+            ch,
+        });
+    }
+    let n_used = pts.len();
+    let n_fits = n_records * orders.len() * channel_ids.len();
+    let core_threshold = p
+        .min_points
+        .max((p.min_density_share * n_fits as f64).ceil() as usize);
+    let mut out = ModalAnalysis {
+        modes: Vec::new(),
+        labels: Vec::new(),
+        n_used,
+        n_ignored: poles.len() - n_used,
+        n_fits,
+        core_threshold,
+    };
+    if pts.is_empty() {
+        out.labels = labels;
+        return Ok(out);
+    }
+
+    // Grid of unit cells, points sorted by cell.
+    pts.sort_by(|a, b| a.cell.cmp(&b.cell).then(a.idx.cmp(&b.idx)));
+    let mut cells: HashMap<(i64, i64), (usize, usize)> = HashMap::new();
+    let mut start = 0;
+    for k in 1..=pts.len() {
+        if k == pts.len() || pts[k].cell != pts[start].cell {
+            cells.insert(pts[start].cell, (start, k));
+            start = k;
+        }
+    }
+    let grid = Grid { pts: &pts, cells };
+
+    // 1. Core poles.
+    let core: Vec<bool> = (0..pts.len())
+        .map(|i| grid.count_neighbours_upto(i, core_threshold) >= core_threshold)
+        .collect();
+
+    // 2. Connect core poles that are neighbours (union-find).
+    let mut uf = UnionFind::new(pts.len());
+    for i in 0..pts.len() {
+        if !core[i] {
+            continue;
+        }
+        grid.for_each_neighbour(i, |j, _| {
+            if j > i && core[j] {
+                uf.union(i, j);
+            }
+        });
+    }
+
+    // 3. Border poles join the cluster of their nearest core neighbour.
+    let mut root_of: Vec<Option<usize>> = vec![None; pts.len()];
+    for i in 0..pts.len() {
+        if core[i] {
+            root_of[i] = Some(uf.find(i));
+        } else {
+            let mut best: Option<(f64, usize)> = None;
+            grid.for_each_neighbour(i, |j, d2| {
+                if core[j] && best.map_or(true, |(bd, _)| d2 < bd) {
+                    best = Some((d2, j));
+                }
+            });
+            if let Some((_, j)) = best {
+                root_of[i] = Some(uf.find(j));
+            }
+        }
+    }
+    let mut members: HashMap<usize, Vec<usize>> = HashMap::new();
+    for (i, r) in root_of.iter().enumerate() {
+        if let Some(r) = r {
+            members.entry(*r).or_default().push(i);
+        }
+    }
+
+    // 4. Summarise each cluster.
+    let mut clusters: Vec<(InvariantMode, Vec<usize>)> = members
+        .into_values()
+        .map(|m| summarise(&pts, &m, poles, n_records, orders.len(), p))
+        .collect();
+    clusters.sort_by(|a, b| {
+        a.0.frequency_hz
+            .total_cmp(&b.0.frequency_hz)
+            .then(a.0.damping_ratio.total_cmp(&b.0.damping_ratio))
+    });
+    for (k, (mode, kept)) in clusters.into_iter().enumerate() {
+        for idx in kept {
+            labels[idx] = Some(k);
+        }
+        out.modes.push(mode);
+    }
+    out.labels = labels;
+    Ok(out)
+}
+
+fn validate_poles(
+    poles: &[PoleObservation],
+    n_records: usize,
+    orders: &[usize],
+) -> Result<(), ModalError> {
+    for (index, pole) in poles.iter().enumerate() {
+        if !pole.frequency_hz.is_finite() {
+            return Err(ModalError::NonFiniteFrequency {
+                index,
+                value: pole.frequency_hz,
+            });
+        }
+        if !pole.damping_ratio.is_finite() {
+            return Err(ModalError::NonFiniteDamping {
+                index,
+                value: pole.damping_ratio,
+            });
+        }
+        if pole.record >= n_records {
+            let needed = poles.iter().map(|q| q.record).max().unwrap_or(0) + 1;
+            return Err(ModalError::RecordOutOfRange {
+                index,
+                record: pole.record,
+                n_records,
+                needed,
+            });
+        }
+        if orders.binary_search(&pole.order).is_err() {
+            let orders_desc = match (orders.first(), orders.last()) {
+                (Some(a), Some(b)) => format!("{} orders from {} to {}", orders.len(), a, b),
+                _ => "empty".to_string(),
+            };
+            return Err(ModalError::OrderNotListed {
+                index,
+                order: pole.order,
+                orders_desc,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Dedup per fit, compute statistics and class. Returns the mode and the kept input indices.
+fn summarise(
+    pts: &[Pt],
+    members: &[usize],
+    poles: &[PoleObservation],
+    n_records: usize,
+    n_orders: usize,
+    p: &ClusterParams,
+) -> (InvariantMode, Vec<usize>) {
+    let cu = median(&members.iter().map(|&i| pts[i].u).collect::<Vec<_>>());
+    let cv = median(&members.iter().map(|&i| pts[i].v).collect::<Vec<_>>());
+    // At most one pole per (record, channel, order): the nearest to the cluster centre.
+    let mut best: HashMap<(usize, usize, usize), (f64, usize)> = HashMap::new();
+    for &i in members {
+        let pt = &pts[i];
+        let pole = &poles[pt.idx];
+        let d2 = (pt.u - cu).powi(2) + (pt.v - cv).powi(2);
+        let key = (pole.record, pt.ch, pole.order);
+        match best.get(&key) {
+            Some(&(bd, bidx)) if bd < d2 || (bd == d2 && bidx < pt.idx) => {}
+            _ => {
+                best.insert(key, (d2, pt.idx));
+            }
+        }
+    }
+    let mut kept: Vec<usize> = best.values().map(|&(_, idx)| idx).collect();
+    kept.sort_unstable();
+
+    let freqs: Vec<f64> = kept.iter().map(|&i| poles[i].frequency_hz).collect();
+    let mut damps: Vec<f64> = kept.iter().map(|&i| poles[i].damping_ratio).collect();
+    damps.sort_by(f64::total_cmp);
+    let (f_mean, f_std) = mean_std(&freqs);
+    let records: HashSet<usize> = kept.iter().map(|&i| poles[i].record).collect();
+    let rec_orders: HashSet<(usize, usize)> = kept
+        .iter()
+        .map(|&i| (poles[i].record, poles[i].order))
+        .collect();
+    let mut channels: Vec<String> = kept.iter().map(|&i| poles[i].channel.clone()).collect();
+    channels.sort();
+    channels.dedup();
+    let mut roles: Vec<String> = kept.iter().filter_map(|&i| poles[i].role.clone()).collect();
+    roles.sort();
+    roles.dedup();
+    let record_share = records.len() as f64 / n_records as f64;
+    let order_share = rec_orders.len() as f64 / (n_records * n_orders) as f64;
+    let damping_ratio = percentile_sorted(&damps, 0.5);
+    let supported =
+        (n_records <= 1 || record_share >= p.min_record_share) && order_share >= p.min_order_share;
+    let class = if !supported {
+        ModeClass::Spurious
+    } else if damping_ratio < p.disturbance_damping_max
+        && f_std < p.disturbance_freq_spread_max * f_mean
+    {
+        ModeClass::PeriodicDisturbance
+    } else {
+        ModeClass::Structural
+    };
+    let mode = InvariantMode {
+        frequency_hz: f_mean,
+        frequency_std_hz: f_std,
+        damping_ratio,
+        damping_iqr: (
+            percentile_sorted(&damps, 0.25),
+            percentile_sorted(&damps, 0.75),
+        ),
+        order_share,
+        record_share,
+        n_poles: kept.len(),
+        channels,
+        roles,
+        min_order: kept.iter().map(|&i| poles[i].order).min().unwrap_or(0),
+        class,
+    };
+    (mode, kept)
+}
+
+struct Pt {
+    u: f64,
+    v: f64,
+    cell: (i64, i64),
+    idx: usize,
+    ch: usize,
+}
+
+struct Grid<'a> {
+    pts: &'a [Pt],
+    cells: HashMap<(i64, i64), (usize, usize)>,
+}
+
+impl Grid<'_> {
+    /// Calls `f(j, squared_distance)` for every neighbour j (distance <= 1), i itself included.
+    fn for_each_neighbour(&self, i: usize, mut f: impl FnMut(usize, f64)) {
+        let pi = &self.pts[i];
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                if let Some(&(a, b)) = self.cells.get(&(pi.cell.0 + dx, pi.cell.1 + dy)) {
+                    for (j, pj) in self.pts[a..b].iter().enumerate() {
+                        let d2 = (pj.u - pi.u).powi(2) + (pj.v - pi.v).powi(2);
+                        if d2 <= 1.0 {
+                            f(a + j, d2);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Number of neighbours (i included), counting stops at `limit`.
+    fn count_neighbours_upto(&self, i: usize, limit: usize) -> usize {
+        let pi = &self.pts[i];
+        let mut n = 0;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                if let Some(&(a, b)) = self.cells.get(&(pi.cell.0 + dx, pi.cell.1 + dy)) {
+                    for pj in &self.pts[a..b] {
+                        if (pj.u - pi.u).powi(2) + (pj.v - pi.v).powi(2) <= 1.0 {
+                            n += 1;
+                            if n >= limit {
+                                return n;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        n
+    }
+}
+
+struct UnionFind {
+    parent: Vec<usize>,
+    size: Vec<usize>,
+}
+
+impl UnionFind {
+    fn new(n: usize) -> Self {
+        UnionFind {
+            parent: (0..n).collect(),
+            size: vec![1; n],
+        }
+    }
+    fn find(&mut self, mut x: usize) -> usize {
+        let mut root = x;
+        while self.parent[root] != root {
+            root = self.parent[root];
+        }
+        while self.parent[x] != root {
+            let next = self.parent[x];
+            self.parent[x] = root;
+            x = next;
+        }
+        root
+    }
+    fn union(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra == rb {
+            return;
+        }
+        let (big, small) = if self.size[ra] >= self.size[rb] {
+            (ra, rb)
+        } else {
+            (rb, ra)
+        };
+        self.parent[small] = big;
+        self.size[big] += self.size[small];
+    }
+}
