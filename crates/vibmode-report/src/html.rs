@@ -1,0 +1,137 @@
+//! A self-contained HTML5 report: inline CSS, inline SVG figures, no scripts, no external links.
+
+use crate::error::ReportError;
+use crate::model::Figure;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Escape text for HTML element content and attribute values (`& < > " '`).
+pub fn escape_html(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            _ => out.push(c),
+        }
+    }
+    out
+}
+
+const CSS: &str = "body{font-family:\"DejaVu Sans\",Verdana,Arial,sans-serif;max-width:1100px;\
+margin:2em auto;padding:0 1em;color:#222;line-height:1.45}\
+h1,h2,h3,h4,h5,h6{color:#113;margin-top:1.4em}\
+figure{margin:1.5em 0;text-align:center}\
+figure svg{max-width:100%;height:auto;border:1px solid #ddd}\
+figcaption{font-size:0.92em;color:#444;margin-top:0.4em}\
+table{border-collapse:collapse;margin:1em 0;font-size:0.95em}\
+th,td{border:1px solid #bbb;padding:0.25em 0.6em;text-align:right}\
+th{background:#eef}tr:nth-child(even) td{background:#f7f7f7}\
+pre{background:#f4f4f4;border:1px solid #ddd;padding:0.6em;overflow-x:auto}";
+
+/// Builder of a self-contained HTML5 report. Blocks appear in the order they are added; all
+/// text is HTML-escaped.
+#[derive(Debug, Clone, Default)]
+pub struct HtmlReport {
+    title: String,
+    body: String,
+    n_figures: usize,
+    n_tables: usize,
+}
+
+impl HtmlReport {
+    /// A new, empty report; `title` goes into `<title>` and a top-level `<h1>`.
+    pub fn new(title: &str) -> Self {
+        HtmlReport {
+            title: title.to_string(),
+            ..Default::default()
+        }
+    }
+
+    /// Add a heading; `level` is clamped to 1..=6.
+    pub fn heading(&mut self, level: u8, text: &str) {
+        let l = level.clamp(1, 6);
+        let _ = writeln!(self.body, "<h{l}>{}</h{l}>", escape_html(text));
+    }
+
+    /// Add a paragraph of plain text (blank lines are kept as line breaks).
+    pub fn paragraph(&mut self, text: &str) {
+        let html = escape_html(text).replace('\n', "<br>\n");
+        let _ = writeln!(self.body, "<p>{html}</p>");
+    }
+
+    /// Add a figure as inline SVG with a numbered caption ("Figure N. caption").
+    pub fn figure(&mut self, fig: &Figure, caption: &str) -> Result<(), ReportError> {
+        let svg = fig.to_svg_string()?;
+        // Drop any XML prolog so the SVG is a plain inline element.
+        let svg = match svg.find("<svg") {
+            Some(i) => &svg[i..],
+            None => svg.as_str(),
+        };
+        self.n_figures += 1;
+        let _ = writeln!(
+            self.body,
+            "<figure>\n{}\n<figcaption>Figure {}. {}</figcaption>\n</figure>",
+            svg.trim(),
+            self.n_figures,
+            escape_html(caption)
+        );
+        Ok(())
+    }
+
+    /// Add a table. Rows shorter than `headers` are padded with empty cells; longer rows are kept
+    /// whole.
+    pub fn table(&mut self, headers: &[&str], rows: &[Vec<String>]) {
+        self.n_tables += 1;
+        let mut t = String::from("<table>\n<thead><tr>");
+        for h in headers {
+            let _ = write!(t, "<th>{}</th>", escape_html(h));
+        }
+        t.push_str("</tr></thead>\n<tbody>\n");
+        for row in rows {
+            t.push_str("<tr>");
+            for cell in row {
+                let _ = write!(t, "<td>{}</td>", escape_html(cell));
+            }
+            for _ in row.len()..headers.len() {
+                t.push_str("<td></td>");
+            }
+            t.push_str("</tr>\n");
+        }
+        t.push_str("</tbody>\n</table>\n");
+        self.body.push_str(&t);
+    }
+
+    /// Add preformatted text (e.g. a parameter dump) in `<pre>`.
+    pub fn preformatted(&mut self, text: &str) {
+        let _ = writeln!(self.body, "<pre>{}</pre>", escape_html(text));
+    }
+
+    /// Number of figures added so far.
+    pub fn figure_count(&self) -> usize {
+        self.n_figures
+    }
+
+    /// The complete HTML5 document.
+    pub fn to_html(&self) -> String {
+        let t = escape_html(&self.title);
+        format!(
+            "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
+<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
+<title>{t}</title>\n<style>{CSS}</style>\n</head>\n<body>\n<h1>{t}</h1>\n{}</body>\n</html>\n",
+            self.body
+        )
+    }
+
+    /// Write the document to `path` (UTF-8).
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<(), ReportError> {
+        let path = path.as_ref();
+        std::fs::write(path, self.to_html()).map_err(|e| ReportError::Write {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })
+    }
+}
