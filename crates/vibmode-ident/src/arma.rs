@@ -1,0 +1,699 @@
+//! ARMA(p, q) by (robust) prediction-error minimisation. See docs/identification.md.
+
+use std::fmt;
+use std::str::FromStr;
+
+use num_complex::Complex64;
+use serde::{Deserialize, Serialize};
+
+use crate::ar::burg;
+use crate::linalg::{
+    check_signal, cholesky_solve, filter_inv_c, is_min_phase, lagged_dot, lagged_gram,
+    predict_errors, robust_std, spd_inverse_diag,
+};
+use crate::model::{information_criteria, ArmaModel, Estimator, StopReason};
+use crate::roots::polynomial_roots;
+use crate::IdentError;
+
+/// Robustification of the prediction-error criterion.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Robust {
+    /// Purely quadratic criterion `l(e) = e^2`.
+    Off,
+    /// Huber criterion: `l(e) = e^2` for `|e| <= rho`, `2 rho |e| - rho^2` beyond, with
+    /// `rho = factor * MAD/0.6745` of the initial residuals (dimensionless factor), fixed during the
+    /// search.
+    Huber {
+        /// Threshold in robust standard deviations (dimensionless, > 0).
+        factor: f64,
+    },
+}
+
+impl Default for Robust {
+    /// `Huber { factor: 1.6 }` (as in MATLAB's pem).
+    fn default() -> Self {
+        Robust::Huber { factor: 1.6 }
+    }
+}
+
+impl FromStr for Robust {
+    type Err = IdentError;
+    /// Accepts `off` (also `none`, `quadratic`), `huber` (factor 1.6) or a positive number (the
+    /// Huber factor).
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let t = s.trim().to_ascii_lowercase();
+        match t.as_str() {
+            "off" | "none" | "quadratic" => Ok(Robust::Off),
+            "huber" | "on" => Ok(Robust::default()),
+            _ => match t.parse::<f64>() {
+                Ok(f) if f.is_finite() && f > 0.0 => Ok(Robust::Huber { factor: f }),
+                _ => Err(IdentError::ParseRobust(s.to_string())),
+            },
+        }
+    }
+}
+
+impl fmt::Display for Robust {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Robust::Off => f.write_str("off"),
+            Robust::Huber { factor } => write!(f, "{factor}"),
+        }
+    }
+}
+
+/// Settings of the prediction-error search.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ArmaParams {
+    /// Criterion. Default `Robust::Huber { factor: 1.6 }`.
+    pub robust: Robust,
+    /// Maximum Gauss-Newton iterations. Default 100.
+    pub max_iter: usize,
+    /// Stopping tolerance on the predicted relative improvement of a Gauss-Newton step
+    /// (`(V - V_pred) / V`, dimensionless). Default 1e-7.
+    pub tol: f64,
+    /// Maximum step halvings per direction. Default 10.
+    pub max_halvings: usize,
+    /// Subtract the mean of `y` before fitting. Default true.
+    pub demean: bool,
+}
+
+impl Default for ArmaParams {
+    fn default() -> Self {
+        ArmaParams {
+            robust: Robust::default(),
+            max_iter: 100,
+            tol: 1e-7,
+            max_halvings: 10,
+            demean: true,
+        }
+    }
+}
+
+impl ArmaParams {
+    fn validate(&self) -> Result<(), IdentError> {
+        if !(self.tol.is_finite() && self.tol > 0.0) {
+            return Err(IdentError::InvalidParam {
+                name: "tol",
+                value: self.tol.to_string(),
+                fix: "use a small positive number such as 1e-7",
+            });
+        }
+        if let Robust::Huber { factor } = self.robust {
+            if !(factor.is_finite() && factor > 0.0) {
+                return Err(IdentError::InvalidParam {
+                    name: "Huber factor",
+                    value: factor.to_string(),
+                    fix: "use a positive factor such as 1.6, or Robust::Off",
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Largest `p + q` allowed for `n` samples: `n / 3`.
+pub fn max_arma_order(n: usize) -> usize {
+    n / 3
+}
+
+/// Fits ARMA(p, q) `A(q) y_t = C(q) e_t` by minimising `V = (1/N) sum l(eps_t)`,
+/// `eps = (A/C) y` with zero initial conditions (see docs/identification.md for every detail).
+///
+/// Starts from the best (by the residuals' robust scale, or mean square when `Robust::Off`) of a
+/// Hannan-Rissanen estimate and a Burg AR(p) model, then runs damped Gauss-Newton. A fit that hits
+/// `max_iter` is returned with `converged: false`. `q = 0` is allowed (robust AR by prediction
+/// error); `p = 0` is an error (no poles, no modes).
+///
+/// Errors: empty, non-finite or constant input; `p = 0`; `p + q > N/3`; invalid params.
+pub fn fit_arma(
+    y: &[f64],
+    p: usize,
+    q: usize,
+    params: &ArmaParams,
+) -> Result<ArmaModel, IdentError> {
+    fit_impl(y, p, q, None, params)
+}
+
+/// As [`fit_arma`], with `init` (a model of orders `init.p <= p`, `init.q <= q`, e.g. the
+/// previous order of a sweep, zero-padded) as an extra starting candidate.
+pub fn fit_arma_warm(
+    y: &[f64],
+    p: usize,
+    q: usize,
+    init: &ArmaModel,
+    params: &ArmaParams,
+) -> Result<ArmaModel, IdentError> {
+    fit_impl(y, p, q, Some(init), params)
+}
+
+/// Order sweep: fits ARMA(o, o) for every `o` in `orders`, in the given order, each warm-started
+/// from the previous successful fit of lower or equal order (ascending `orders` is best).
+pub fn sweep_arma(
+    y: &[f64],
+    orders: &[usize],
+    params: &ArmaParams,
+) -> Vec<Result<ArmaModel, IdentError>> {
+    let mut out: Vec<Result<ArmaModel, IdentError>> = Vec::with_capacity(orders.len());
+    let mut prev: Option<ArmaModel> = None;
+    for &o in orders {
+        let init = prev.as_ref().filter(|m| m.p <= o && m.q <= o);
+        let r = fit_impl(y, o, o, init, params);
+        if let Ok(m) = &r {
+            prev = Some(m.clone());
+        }
+        out.push(r);
+    }
+    out
+}
+
+/// Huber loss (or quadratic when `rho` is None).
+#[inline]
+fn loss_of(e: f64, rho: Option<f64>) -> f64 {
+    match rho {
+        Some(r) if e.abs() > r => 2.0 * r * e.abs() - r * r,
+        _ => e * e,
+    }
+}
+
+fn mean_loss(eps: &[f64], rho: Option<f64>) -> f64 {
+    eps.iter().map(|&e| loss_of(e, rho)).sum::<f64>() / eps.len() as f64
+}
+
+/// Monic polynomial (z^-1 form, leading 1) from its roots.
+fn poly_from_roots(roots: &[Complex64]) -> Vec<f64> {
+    let mut c = vec![Complex64::new(1.0, 0.0)];
+    for &r in roots {
+        let mut next = vec![Complex64::new(0.0, 0.0); c.len() + 1];
+        for (i, &ci) in c.iter().enumerate() {
+            next[i] += ci;
+            next[i + 1] -= ci * r;
+        }
+        c = next;
+    }
+    c.iter().map(|z| z.re).collect()
+}
+
+/// Makes C minimum phase by reflecting roots outside the unit circle (z -> 1/conj z).
+fn stabilise(c: &mut [f64]) {
+    if c.len() <= 1 || is_min_phase(c) {
+        return;
+    }
+    if let Ok(roots) = polynomial_roots(c) {
+        let refl: Vec<Complex64> = roots
+            .iter()
+            .map(|&z| {
+                let m = z.norm();
+                if m > 1.0 {
+                    z / (m * m)
+                } else {
+                    z
+                }
+            })
+            .collect();
+        let new = poly_from_roots(&refl);
+        if new.len() == c.len() && new.iter().all(|v| v.is_finite()) {
+            c.copy_from_slice(&new);
+        }
+    }
+    // Fallback (roots on the unit circle or failed root finding): shrink all roots.
+    let mut guard = 0;
+    while !is_min_phase(c) && guard < 200 {
+        let mut r = 1.0;
+        for ck in c.iter_mut().skip(1) {
+            r *= 0.999;
+            *ck *= r;
+        }
+        guard += 1;
+    }
+}
+
+struct Candidate {
+    a: Vec<f64>,
+    c: Vec<f64>,
+    eps: Vec<f64>,
+    score: f64,
+}
+
+fn make_candidate(ys: &[f64], a: Vec<f64>, mut c: Vec<f64>, robust: bool) -> Option<Candidate> {
+    if !(a.iter().all(|v| v.is_finite()) && c.iter().all(|v| v.is_finite())) {
+        return None;
+    }
+    stabilise(&mut c);
+    let mut eps = vec![0.0; ys.len()];
+    predict_errors(ys, &a, &c, &mut eps);
+    let score = if robust {
+        robust_std(&eps)
+    } else {
+        mean_loss(&eps, None)
+    };
+    if !score.is_finite() {
+        return None;
+    }
+    Some(Candidate { a, c, eps, score })
+}
+
+/// Hannan-Rissanen initial estimate on the scaled signal.
+fn hannan_rissanen(ys: &[f64], p: usize, q: usize) -> (Vec<f64>, Vec<f64>) {
+    let n = ys.len();
+    let k = p + q;
+    let (ehat, t0) = if q > 0 {
+        let m = (p + 4 * q).min(n / 3).max(k);
+        let (a_long, _, _) = burg(ys, m);
+        let mut e = vec![0.0; n];
+        predict_errors(ys, &a_long, &[1.0], &mut e);
+        (e, m)
+    } else {
+        (Vec::new(), p)
+    };
+    let mut g = vec![0.0; k * k];
+    lagged_gram(ys, p, ys, p, t0, &mut g, k, 0, 0, 1.0);
+    if q > 0 {
+        lagged_gram(ys, p, &ehat, q, t0, &mut g, k, 0, p, -1.0);
+        lagged_gram(&ehat, q, &ehat, q, t0, &mut g, k, p, p, 1.0);
+        for i in 0..p {
+            for j in p..k {
+                g[j * k + i] = g[i * k + j];
+            }
+        }
+    }
+    let mut rhs = vec![0.0; k];
+    for i in 1..=p {
+        rhs[i - 1] = -lagged_dot(ys, i, ys, 0, t0);
+    }
+    for j in 1..=q {
+        rhs[p + j - 1] = lagged_dot(&ehat, j, ys, 0, t0);
+    }
+    let theta = solve_scaled(&g, &rhs, k, 1e-10).unwrap_or_else(|| vec![0.0; k]);
+    let mut a = vec![1.0];
+    a.extend_from_slice(&theta[..p]);
+    let mut c = vec![1.0];
+    c.extend_from_slice(&theta[p..]);
+    (a, c)
+}
+
+/// Solves `h x = b` after Jacobi scaling, with relative ridge `mu` (added to the unit diagonal),
+/// escalating the ridge if the factorisation fails.
+fn solve_scaled(h: &[f64], b: &[f64], k: usize, mu: f64) -> Option<Vec<f64>> {
+    let d: Vec<f64> = (0..k)
+        .map(|i| {
+            let v = h[i * k + i];
+            if v > 0.0 && v.is_finite() {
+                v.sqrt()
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let mut hs = vec![0.0; k * k];
+    for i in 0..k {
+        for j in 0..k {
+            hs[i * k + j] = h[i * k + j] / (d[i] * d[j]);
+        }
+    }
+    let bs: Vec<f64> = (0..k).map(|i| b[i] / d[i]).collect();
+    let mut ridge = mu;
+    for _ in 0..8 {
+        if let Some(x) = cholesky_solve(&hs, &bs, k, ridge) {
+            return Some(x.iter().zip(&d).map(|(v, di)| v / di).collect());
+        }
+        ridge = if ridge > 0.0 { ridge * 100.0 } else { 1e-12 };
+    }
+    None
+}
+
+/// Scratch buffers and fixed data of one search.
+struct Search<'a> {
+    ys: &'a [f64],
+    p: usize,
+    q: usize,
+    rho: Option<f64>,
+    yf: Vec<f64>,
+    ef: Vec<f64>,
+}
+
+impl Search<'_> {
+    /// Gradient `sum w eps psi` and matrix `sum w psi psi^T` (raw sums; Huber weights applied
+    /// exactly through a sparse correction of the unweighted Toeplitz-structured Gram), plus the
+    /// unweighted Gram.
+    fn normal_equations(
+        &mut self,
+        a: &[f64],
+        c: &[f64],
+        eps: &[f64],
+    ) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let _ = a;
+        let (p, q, n) = (self.p, self.q, self.ys.len());
+        let k = p + q;
+        filter_inv_c(self.ys, c, &mut self.yf);
+        filter_inv_c(eps, c, &mut self.ef);
+        let mut h = vec![0.0; k * k];
+        lagged_gram(&self.yf, p, &self.yf, p, 0, &mut h, k, 0, 0, 1.0);
+        if q > 0 {
+            lagged_gram(&self.yf, p, &self.ef, q, 0, &mut h, k, 0, p, -1.0);
+            lagged_gram(&self.ef, q, &self.ef, q, 0, &mut h, k, p, p, 1.0);
+            for i in 0..p {
+                for j in p..k {
+                    h[j * k + i] = h[i * k + j];
+                }
+            }
+        }
+        let h_unweighted = h.clone();
+        // Weighted residuals w_t eps_t (= clip(eps_t, rho)).
+        let we: Vec<f64> = match self.rho {
+            Some(r) => eps.iter().map(|&e| e.clamp(-r, r)).collect(),
+            None => eps.to_vec(),
+        };
+        let mut g = vec![0.0; k];
+        for i in 1..=p {
+            g[i - 1] = lagged_dot(&self.yf, i, &we, 0, 0);
+        }
+        for j in 1..=q {
+            g[p + j - 1] = -lagged_dot(&self.ef, j, &we, 0, 0);
+        }
+        if let Some(r) = self.rho {
+            let mut psi = vec![0.0; k];
+            for t in 0..n {
+                let e = eps[t].abs();
+                if e <= r {
+                    continue;
+                }
+                let w = r / e;
+                for i in 1..=p {
+                    psi[i - 1] = if t >= i { self.yf[t - i] } else { 0.0 };
+                }
+                for j in 1..=q {
+                    psi[p + j - 1] = if t >= j { -self.ef[t - j] } else { 0.0 };
+                }
+                let f = w - 1.0;
+                for i in 0..k {
+                    let fi = f * psi[i];
+                    if fi == 0.0 {
+                        continue;
+                    }
+                    for j in 0..k {
+                        h[i * k + j] += fi * psi[j];
+                    }
+                }
+            }
+        }
+        (g, h, h_unweighted)
+    }
+}
+
+fn fit_impl(
+    y: &[f64],
+    p: usize,
+    q: usize,
+    init: Option<&ArmaModel>,
+    params: &ArmaParams,
+) -> Result<ArmaModel, IdentError> {
+    params.validate()?;
+    let mean = check_signal(y, 3)?;
+    if p == 0 {
+        return Err(IdentError::ZeroOrder {
+            what: "ARMA AR order p",
+            fix: "modes come from A(z); choose p >= 1 (e.g. p = q)",
+        });
+    }
+    let n = y.len();
+    if p + q > max_arma_order(n) {
+        return Err(IdentError::OrderTooHigh {
+            what: "ARMA order p + q",
+            order: p + q,
+            n_samples: n,
+            max_order: max_arma_order(n),
+        });
+    }
+    if let Some(m) = init {
+        if m.p > p || m.q > q || m.a.len() != m.p + 1 || m.c.len() != m.q + 1 {
+            return Err(IdentError::InitMismatch {
+                p,
+                q,
+                init_p: m.p,
+                init_q: m.q,
+            });
+        }
+    }
+    let offset = if params.demean { mean } else { 0.0 };
+    let centred: Vec<f64> = y.iter().map(|v| v - offset).collect();
+    let scale = (centred.iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt();
+    if !(scale > 0.0 && scale.is_finite()) {
+        return Err(IdentError::Constant { value: y[0] });
+    }
+    let ys: Vec<f64> = centred.iter().map(|v| v / scale).collect();
+    let robust = matches!(params.robust, Robust::Huber { .. });
+
+    // Starting candidates.
+    let mut cands: Vec<Candidate> = Vec::new();
+    let (ha, hc) = hannan_rissanen(&ys, p, q);
+    cands.extend(make_candidate(&ys, ha, hc, robust));
+    let (ba, _, _) = burg(&ys, p);
+    let mut c0 = vec![0.0; q + 1];
+    c0[0] = 1.0;
+    cands.extend(make_candidate(&ys, ba, c0, robust));
+    if let Some(m) = init {
+        let mut a = m.a.clone();
+        a.resize(p + 1, 0.0);
+        let mut c = m.c.clone();
+        c.resize(q + 1, 0.0);
+        cands.extend(make_candidate(&ys, a, c, robust));
+    }
+    let best = cands
+        .into_iter()
+        .min_by(|x, y| x.score.total_cmp(&y.score));
+    let Candidate { mut a, mut c, mut eps, .. } = match best {
+        Some(b) => b,
+        None => {
+            // Unreachable in practice (Burg on finite data is finite); start from white noise.
+            let mut a = vec![0.0; p + 1];
+            a[0] = 1.0;
+            let mut c = vec![0.0; q + 1];
+            c[0] = 1.0;
+            Candidate { a, c, eps: ys.clone(), score: 0.0 }
+        }
+    };
+    let rho = match params.robust {
+        Robust::Off => None,
+        Robust::Huber { factor } => {
+            let mut s = robust_std(&eps);
+            if !(s > 0.0) {
+                s = (mean_loss(&eps, None)).sqrt();
+            }
+            if s > 0.0 {
+                Some(factor * s)
+            } else {
+                None
+            }
+        }
+    };
+
+    let k = p + q;
+    let mut search = Search {
+        ys: &ys,
+        p,
+        q,
+        rho,
+        yf: vec![0.0; n],
+        ef: vec![0.0; n],
+    };
+    let mut v = mean_loss(&eps, rho);
+    let mut mu = 1e-6;
+    let mut iterations = 0;
+    let mut stop = StopReason::MaxIterations;
+    let mut converged = false;
+    let mut trial_eps = vec![0.0; n];
+    let apply = |a: &[f64], c: &[f64], d: &[f64], s: f64| -> (Vec<f64>, Vec<f64>) {
+        let mut na = a.to_vec();
+        let mut nc = c.to_vec();
+        for i in 0..p {
+            na[i + 1] += s * d[i];
+        }
+        for j in 0..q {
+            nc[j + 1] += s * d[p + j];
+        }
+        stabilise(&mut nc);
+        (na, nc)
+    };
+    while iterations < params.max_iter {
+        let (g, h, _) = search.normal_equations(&a, &c, &eps);
+        let neg_g: Vec<f64> = g.iter().map(|v| -v).collect();
+        // Newton decrement (predicted decrease of V) with a negligible ridge.
+        let Some(d0) = solve_scaled(&h, &neg_g, k, 1e-12) else {
+            stop = StopReason::NoImprovement;
+            break;
+        };
+        let pred = d0.iter().zip(&neg_g).map(|(x, y)| x * y).sum::<f64>() / n as f64;
+        if !(pred > params.tol * v) {
+            stop = StopReason::Converged;
+            converged = true;
+            break;
+        }
+        iterations += 1;
+        let dir = if mu > 1e-12 {
+            solve_scaled(&h, &neg_g, k, mu).unwrap_or(d0)
+        } else {
+            d0
+        };
+        let mut accepted = None;
+        let mut s = 1.0;
+        for hv in 0..=params.max_halvings {
+            let (na, nc) = apply(&a, &c, &dir, s);
+            predict_errors(&ys, &na, &nc, &mut trial_eps);
+            let vt = mean_loss(&trial_eps, rho);
+            if vt.is_finite() && vt < v {
+                accepted = Some((na, nc, vt, hv));
+                break;
+            }
+            s *= 0.5;
+        }
+        if accepted.is_none() {
+            // Gradient fallback: Jacobi-scaled steepest descent with the exact line minimiser of
+            // the quadratic model as first step.
+            let dg: Vec<f64> = (0..k)
+                .map(|i| {
+                    let hd = h[i * k + i];
+                    if hd > 0.0 {
+                        neg_g[i] / hd
+                    } else {
+                        neg_g[i]
+                    }
+                })
+                .collect();
+            let gd: f64 = dg.iter().zip(&neg_g).map(|(x, y)| x * y).sum();
+            let mut hdd = 0.0;
+            for i in 0..k {
+                let mut row = 0.0;
+                for j in 0..k {
+                    row += h[i * k + j] * dg[j];
+                }
+                hdd += dg[i] * row;
+            }
+            let mut s = if hdd > 0.0 { gd / hdd } else { 1.0 };
+            for hv in 0..=params.max_halvings {
+                let (na, nc) = apply(&a, &c, &dg, s);
+                predict_errors(&ys, &na, &nc, &mut trial_eps);
+                let vt = mean_loss(&trial_eps, rho);
+                if vt.is_finite() && vt < v {
+                    accepted = Some((na, nc, vt, hv + params.max_halvings + 1));
+                    break;
+                }
+                s *= 0.5;
+            }
+        }
+        match accepted {
+            Some((na, nc, vt, hv)) => {
+                a = na;
+                c = nc;
+                v = vt;
+                std::mem::swap(&mut eps, &mut trial_eps);
+                mu = if hv == 0 {
+                    (mu * 0.1).max(1e-12)
+                } else {
+                    (mu * 10.0).min(1e6)
+                };
+            }
+            None => {
+                stop = StopReason::NoImprovement;
+                converged = pred <= 100.0 * params.tol * v;
+                break;
+            }
+        }
+    }
+
+    // Final quantities.
+    let (_, _, h_u) = search.normal_equations(&a, &c, &eps);
+    let lambda_s = mean_loss(&eps, None);
+    let kappa = match rho {
+        None => lambda_s,
+        Some(r) => {
+            let num = eps.iter().map(|e| e.clamp(-r, r).powi(2)).sum::<f64>() / n as f64;
+            let inside = eps.iter().filter(|e| e.abs() <= r).count() as f64 / n as f64;
+            if inside > 0.0 {
+                num / (inside * inside)
+            } else {
+                f64::NAN
+            }
+        }
+    };
+    let std_errors = match spd_inverse_diag(&h_u, k) {
+        Some(d) => d.iter().map(|v| (kappa * v).sqrt()).collect(),
+        None => vec![f64::NAN; k],
+    };
+    let s2 = scale * scale;
+    let lambda = lambda_s * s2;
+    let (aic, bic, fpe) = information_criteria(lambda, n, k);
+    Ok(ArmaModel {
+        p,
+        q,
+        a,
+        c,
+        noise_variance: lambda,
+        loss: v * s2,
+        iterations,
+        converged,
+        stop_reason: stop,
+        aic,
+        bic,
+        fpe,
+        std_errors,
+        reflection_coefficients: Vec::new(),
+        robust_rho: rho.map(|r| r * scale),
+        n_samples: n,
+        mean: offset,
+        estimator: Estimator::PredictionError,
+    })
+}
+
+/// Mean squared one-step prediction error `(1/N) sum eps_t^2` of the model `(a, c)` on `y`
+/// (signal units squared), `eps = (A/C) y` with zero initial conditions, after subtracting `mean`.
+/// This is how [`ArmaModel::noise_variance`] is defined for prediction-error fits; use it to
+/// compare models from other tools on equal terms.
+pub fn prediction_error_variance(y: &[f64], mean: f64, a: &[f64], c: &[f64]) -> f64 {
+    let x: Vec<f64> = y.iter().map(|v| v - mean).collect();
+    let mut eps = vec![0.0; x.len()];
+    predict_errors(&x, a, c, &mut eps);
+    if eps.is_empty() {
+        return f64::NAN;
+    }
+    mean_loss(&eps, None)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn robust_parse_display() {
+        assert_eq!("off".parse::<Robust>().unwrap(), Robust::Off);
+        assert_eq!("2.5".parse::<Robust>().unwrap(), Robust::Huber { factor: 2.5 });
+        assert_eq!(Robust::default(), Robust::Huber { factor: 1.6 });
+        assert_eq!(Robust::default().to_string(), "1.6");
+        let e = "-1".parse::<Robust>().unwrap_err().to_string();
+        assert!(e.contains("'-1'") && e.contains("off"));
+    }
+
+    #[test]
+    fn huber_loss_by_hand() {
+        assert_eq!(loss_of(0.5, Some(1.0)), 0.25);
+        assert_eq!(loss_of(3.0, Some(1.0)), 5.0);
+        assert_eq!(loss_of(-3.0, None), 9.0);
+    }
+
+    #[test]
+    fn reflect_roots_outside() {
+        // C = (1 - 2 z^-1)(1 - 0.5 z^-1) = 1 - 2.5 z^-1 + z^-2 -> root 2 reflected to 0.5.
+        let mut c = vec![1.0, -2.5, 1.0];
+        stabilise(&mut c);
+        assert!((c[1] + 1.0).abs() < 1e-12 && (c[2] - 0.25).abs() < 1e-12, "{c:?}");
+    }
+
+    #[test]
+    fn prediction_errors_by_hand() {
+        // A = 1 - 0.5 z^-1, C = 1 + 0.5 z^-1, y = [1, 0, 0]:
+        // eps0 = 1; eps1 = 0 - 0.5*1 - 0.5*1 = -1; eps2 = 0 - 0 - 0.5*(-1) = 0.5.
+        let mut e = vec![0.0; 3];
+        predict_errors(&[1.0, 0.0, 0.0], &[1.0, -0.5], &[1.0, 0.5], &mut e);
+        assert_eq!(e, vec![1.0, -1.0, 0.5]);
+    }
+}

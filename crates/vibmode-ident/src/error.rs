@@ -1,0 +1,101 @@
+//! Error type of the crate.
+
+/// Everything that can go wrong in identification. Every message is one line naming the offending
+/// value and how to fix it.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum IdentError {
+    /// The input signal has no samples.
+    #[error("input signal is empty; pass at least {min_len} samples")]
+    Empty {
+        /// Smallest useful length for the requested model (samples).
+        min_len: usize,
+    },
+    /// A sample is NaN or infinite.
+    #[error("sample {index} is {value} (not finite); remove or interpolate non-finite samples first")]
+    NonFinite {
+        /// Index of the first offending sample.
+        index: usize,
+        /// Its value.
+        value: f64,
+    },
+    /// The signal is constant (all samples equal), so it carries no dynamics.
+    #[error("signal is constant (every sample equals {value}); identification needs a varying signal")]
+    Constant {
+        /// The constant value.
+        value: f64,
+    },
+    /// The requested order is too large for the number of samples.
+    #[error("{what} = {order} is too high for {n_samples} samples; the largest allowed is {max_order} (N/3); lower the order or use a longer record")]
+    OrderTooHigh {
+        /// Which order ("AR order p" or "ARMA order p + q").
+        what: &'static str,
+        /// Requested order.
+        order: usize,
+        /// Number of samples.
+        n_samples: usize,
+        /// Largest allowed order for this number of samples.
+        max_order: usize,
+    },
+    /// An order of zero where it is meaningless.
+    #[error("{what} must be at least 1 (got 0); {fix}")]
+    ZeroOrder {
+        /// Which order.
+        what: &'static str,
+        /// How to fix it.
+        fix: &'static str,
+    },
+    /// A polynomial coefficient is NaN or infinite.
+    #[error("polynomial coefficient {index} is {value} (not finite); all coefficients must be finite")]
+    BadCoefficient {
+        /// Index of the coefficient.
+        index: usize,
+        /// Its value.
+        value: f64,
+    },
+    /// The leading coefficient of a polynomial is zero (or the polynomial is empty).
+    #[error("leading polynomial coefficient is {value}; pass coefficients (highest power first) with a nonzero first entry")]
+    ZeroLeading {
+        /// The leading coefficient.
+        value: f64,
+    },
+    /// The eigenvalue iteration for polynomial roots did not converge.
+    #[error("root finding did not converge for the degree-{degree} polynomial; check the coefficients for extreme magnitudes")]
+    RootsNotConverged {
+        /// Polynomial degree.
+        degree: usize,
+    },
+    /// A parameter value is out of range.
+    #[error("invalid {name} = {value}; {fix}")]
+    InvalidParam {
+        /// Parameter name.
+        name: &'static str,
+        /// Offending value (formatted).
+        value: String,
+        /// How to fix it.
+        fix: &'static str,
+    },
+    /// An unknown AR method name was given.
+    #[error("unknown AR method '{0}'; valid values: yule-walker (or yw), burg, ls")]
+    ParseArMethod(String),
+    /// An invalid robustification setting was given.
+    #[error("invalid robust setting '{0}'; use 'off' or a positive Huber factor such as 1.6")]
+    ParseRobust(String),
+    /// A warm-start model has orders that do not fit the requested ones.
+    #[error("warm-start model has orders (p={init_p}, q={init_q}) larger than the requested (p={p}, q={q}); pass a lower-order model or none")]
+    InitMismatch {
+        /// Requested AR order.
+        p: usize,
+        /// Requested MA order.
+        q: usize,
+        /// AR order of the initial model.
+        init_p: usize,
+        /// MA order of the initial model.
+        init_q: usize,
+    },
+    /// Simulation of an unstable model was requested.
+    #[error("A(z) has a root of modulus {modulus} >= 1 (unstable); simulation needs every root of A inside the unit circle")]
+    UnstableModel {
+        /// Largest root modulus of A.
+        modulus: f64,
+    },
+}

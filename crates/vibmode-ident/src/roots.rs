@@ -1,0 +1,147 @@
+//! Polynomial roots via the eigenvalues of a balanced companion matrix.
+
+use nalgebra::{linalg::balancing::balance_parlett_reinsch, DMatrix, Schur};
+use num_complex::Complex64;
+
+use crate::IdentError;
+
+/// Roots of the polynomial `coeffs[0] z^n + coeffs[1] z^(n-1) + ... + coeffs[n]` (highest power
+/// first, as `numpy.roots`). For `A = [1, a1, ..., ap]` these are the model poles.
+///
+/// Method: companion matrix, Parlett-Reinsch balancing (nalgebra's
+/// `linalg::balancing::balance_parlett_reinsch`), real Schur decomposition, then at most three
+/// guarded Newton polishing steps per root on the original polynomial (a step is kept only if it
+/// lowers |p(z)| and is small against the distance to the nearest other root). Trailing zero
+/// coefficients give exact roots at zero. Roots come in exact conjugate pairs; order is unspecified.
+///
+/// Errors: empty input or zero leading coefficient, non-finite coefficients, or (very unlikely)
+/// non-convergence of the Schur iteration.
+pub fn polynomial_roots(coeffs: &[f64]) -> Result<Vec<Complex64>, IdentError> {
+    let lead = match coeffs.first() {
+        Some(&v) => v,
+        None => return Err(IdentError::ZeroLeading { value: 0.0 }),
+    };
+    if let Some((index, &value)) = coeffs.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        return Err(IdentError::BadCoefficient { index, value });
+    }
+    if lead == 0.0 {
+        return Err(IdentError::ZeroLeading { value: lead });
+    }
+    // Strip trailing zeros: roots at the origin.
+    let mut end = coeffs.len();
+    while end > 1 && coeffs[end - 1] == 0.0 {
+        end -= 1;
+    }
+    let zeros_at_origin = coeffs.len() - end;
+    let c: Vec<f64> = coeffs[..end].iter().map(|v| v / lead).collect();
+    let n = c.len() - 1;
+    let mut roots: Vec<Complex64> = Vec::with_capacity(coeffs.len() - 1);
+    if n == 1 {
+        roots.push(Complex64::new(-c[1], 0.0));
+    } else if n >= 2 {
+        let mut m = DMatrix::<f64>::zeros(n, n);
+        for j in 0..n {
+            m[(0, j)] = -c[j + 1];
+        }
+        for i in 1..n {
+            m[(i, i - 1)] = 1.0;
+        }
+        balance_parlett_reinsch(&mut m);
+        let schur = Schur::try_new(m, f64::EPSILON, 100 * n.max(10))
+            .ok_or(IdentError::RootsNotConverged { degree: n })?;
+        let eig = schur.complex_eigenvalues();
+        let raw: Vec<Complex64> = eig.iter().map(|z| Complex64::new(z.re, z.im)).collect();
+        for i in 0..raw.len() {
+            roots.push(polish(&c, raw[i], &raw, i));
+        }
+    }
+    roots.extend(std::iter::repeat(Complex64::new(0.0, 0.0)).take(zeros_at_origin));
+    Ok(roots)
+}
+
+/// Value and derivative of the monic polynomial `c` (highest power first) at z (Horner).
+fn horner(c: &[f64], z: Complex64) -> (Complex64, Complex64) {
+    let mut p = Complex64::new(c[0], 0.0);
+    let mut dp = Complex64::new(0.0, 0.0);
+    for &ck in &c[1..] {
+        dp = dp * z + p;
+        p = p * z + ck;
+    }
+    (p, dp)
+}
+
+fn polish(c: &[f64], z0: Complex64, all: &[Complex64], idx: usize) -> Complex64 {
+    let min_dist = all
+        .iter()
+        .enumerate()
+        .filter(|(j, _)| *j != idx)
+        .map(|(_, w)| (w - z0).norm())
+        .fold(f64::INFINITY, f64::min);
+    let mut z = z0;
+    let (mut pz, _) = horner(c, z);
+    for _ in 0..3 {
+        let (p, dp) = horner(c, z);
+        if dp.norm() == 0.0 || p.norm() == 0.0 {
+            break;
+        }
+        let step = p / dp;
+        if !(step.norm() < 0.1 * min_dist) {
+            break;
+        }
+        let mut zn = z - step;
+        if z.im == 0.0 {
+            zn.im = 0.0;
+        }
+        let (pn, _) = horner(c, zn);
+        if pn.norm() < pz.norm() {
+            z = zn;
+            pz = pn;
+        } else {
+            break;
+        }
+    }
+    z
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sorted(mut r: Vec<Complex64>) -> Vec<Complex64> {
+        r.sort_by(|a, b| a.re.total_cmp(&b.re).then(a.im.total_cmp(&b.im)));
+        r
+    }
+
+    #[test]
+    fn quadratic_by_hand() {
+        // z^2 - 3z + 2 = (z-1)(z-2)
+        let r = sorted(polynomial_roots(&[1.0, -3.0, 2.0]).unwrap());
+        assert!((r[0].re - 1.0).abs() < 1e-14 && (r[1].re - 2.0).abs() < 1e-14);
+        // 2z^2 + 2 = 0 -> +-i
+        let r = sorted(polynomial_roots(&[2.0, 0.0, 2.0]).unwrap());
+        assert!(r[0].re.abs() < 1e-14 && (r[0].im + 1.0).abs() < 1e-14);
+        assert!((r[1].im - 1.0).abs() < 1e-14);
+        // z^3 - z^2 = z^2 (z - 1): two zeros at the origin
+        let r = sorted(polynomial_roots(&[1.0, -1.0, 0.0, 0.0]).unwrap());
+        assert_eq!(r.len(), 3);
+        assert!((r[2].re - 1.0).abs() < 1e-14 && r[0].norm() == 0.0);
+        let r = polynomial_roots(&[4.0, 2.0]).unwrap();
+        assert_eq!(r, vec![Complex64::new(-0.5, 0.0)]);
+        assert!(polynomial_roots(&[5.0]).unwrap().is_empty());
+    }
+
+    #[test]
+    fn bad_inputs() {
+        assert!(matches!(
+            polynomial_roots(&[]),
+            Err(IdentError::ZeroLeading { .. })
+        ));
+        assert!(matches!(
+            polynomial_roots(&[0.0, 1.0]),
+            Err(IdentError::ZeroLeading { .. })
+        ));
+        let e = polynomial_roots(&[1.0, f64::NAN]).unwrap_err();
+        assert!(matches!(e, IdentError::BadCoefficient { index: 1, .. }));
+        assert!(e.to_string().contains("coefficient 1"));
+    }
+}
