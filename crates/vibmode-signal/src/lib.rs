@@ -1,1 +1,53 @@
-//! vibmode-signal (work in progress).
+//! # vibmode-signal
+//!
+//! Reading and writing multichannel acceleration records, and the paper's ideal anti-alias
+//! resampling (METHOD.md section 2).
+//!
+//! - [`read_path`] reads delimited text (separator, header, units, decimal commas and a time
+//!   column detected automatically), WAV (PCM integer or 32-bit float) and raw little-endian
+//!   f32/f64 with a JSON sidecar into a [`Recording`]. The conventions are documented in
+//!   `docs/formats.md`. [`DelimitedReader`] streams text files as blocks of rows.
+//! - [`write_path`] writes CSV (with a `time_s` column), 32-bit float WAV or raw + sidecar.
+//! - [`resample()`], [`Resampler`] and [`Recording::resample`] implement the ideal DFT low-pass
+//!   followed by decimation (integer ratios) or Fourier resampling (other ratios, equal to
+//!   `scipy.signal.resample`); see the [`resample`](mod@resample) module.
+//!
+//! Errors are [`SignalError`]; every message is one line naming the offending value and the fix.
+//! No function panics on input data.
+//!
+//! ```
+//! use vibmode_signal::{read_delimited, ReadOptions, ResampleParams};
+//! // A semicolon file with decimal commas, a time column in ms and a trailing separator.
+//! let mut text = String::from("Time (ms);Z-Axis [m/s^2];\n");
+//! for i in 0..1000 {
+//!     // 10 Hz tone at 1000 Hz sampling, written with decimal commas.
+//!     let z = (2.0 * std::f64::consts::PI * 10.0 * i as f64 / 1000.0).sin();
+//!     text.push_str(&format!("{};{};\n", i, z).replace('.', ","));
+//! }
+//! let rec = read_delimited(text.as_bytes(), "example.csv", &ReadOptions::default()).unwrap();
+//! assert!((rec.fs_hz - 1000.0).abs() < 1e-9);
+//! assert_eq!(rec.channels[0].name, "Z-Axis");
+//! assert_eq!(rec.channels[0].unit, "m/s^2");
+//!
+//! // Ideal anti-alias filter at 25 Hz, then keep every 10th sample (1000 Hz -> 100 Hz):
+//! // the 10 Hz tone passes unchanged.
+//! let p = ResampleParams { to_hz: 100.0, cutoff_hz: Some(25.0), filter: true };
+//! let low = rec.resample(&p).unwrap();
+//! assert_eq!(low.len(), 100);
+//! let expected = (2.0 * std::f64::consts::PI * 10.0 * 7.0 / 100.0).sin();
+//! assert!((low.channels[0].samples[7] - expected).abs() < 1e-9);
+//! ```
+
+pub mod delimited;
+pub mod error;
+pub mod read;
+pub mod recording;
+pub mod resample;
+pub mod write;
+
+pub use delimited::{Block, ColumnInfo, DelimitedReader, Separator};
+pub use error::SignalError;
+pub use read::{read_delimited, read_path, sidecar_candidates, Format, ReadOptions, Sidecar};
+pub use recording::{Channel, ChannelSelector, Recording, TimeAxis};
+pub use resample::{resample, ResampleMethod, ResampleParams, Resampler};
+pub use write::write_path;

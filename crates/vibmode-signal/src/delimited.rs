@@ -1,0 +1,514 @@
+//! Delimited text (CSV, semicolon, tab, whitespace), read as a stream of row blocks.
+//!
+//! [`DelimitedReader`] sniffs the layout from the first lines (separator, header, decimal comma,
+//! time column) and then yields [`Block`]s of at most `max_rows` rows, so that hours-long files can
+//! be processed in bounded memory. [`crate::read_path`] uses it with one block for the whole file.
+//!
+//! Conventions (see `docs/formats.md`):
+//! - blank lines are skipped everywhere; lines starting with `#` or `%` are skipped before the first
+//!   row (comments, MATLAB-style preambles);
+//! - separator: tab if the first row has a tab, else `;` if it has one, else `,` if it has one,
+//!   else runs of spaces/tabs;
+//! - the first row is a header if any of its cells is not a number; otherwise columns are named
+//!   `ch0`, `ch1`, ...;
+//! - with `;`, tab or whitespace separators, a comma inside a number is a decimal comma
+//!   (`1,5;2,25`);
+//! - empty cells at the end of a row are ignored (a trailing separator on every row);
+//! - cells may be surrounded by spaces and double quotes;
+//! - header cells `name (unit)` or `name [unit]` give a name and a unit.
+
+use crate::error::{Result, SignalError};
+use serde::{Deserialize, Serialize};
+use std::io::BufRead;
+
+/// The cell separator of a delimited text file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Separator {
+    /// `,`
+    Comma,
+    /// `;`
+    Semicolon,
+    /// A single tab.
+    Tab,
+    /// One or more spaces or tabs.
+    Whitespace,
+}
+
+impl Separator {
+    fn sniff(line: &[u8]) -> Separator {
+        if line.contains(&b'\t') {
+            Separator::Tab
+        } else if line.contains(&b';') {
+            Separator::Semicolon
+        } else if line.contains(&b',') {
+            Separator::Comma
+        } else {
+            Separator::Whitespace
+        }
+    }
+}
+
+/// One column of a delimited file, as described by its header.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ColumnInfo {
+    /// Column name without the unit (`X-Axis` from `X-Axis (m/s2)`), or `chN` without header.
+    pub name: String,
+    /// Unit from the header (`m/s2`), empty if none.
+    pub unit: String,
+    /// `Some(seconds per unit)` if this is recognised as the time column (name `time`, `t`,
+    /// `time_s`, `t_s`, `time_ms`, `t_ms`, `timestamp`, case-insensitive; unit s, ms, us, ns, min, h).
+    pub time_scale_s: Option<f64>,
+}
+
+/// A block of consecutive data rows, stored column by column.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Block {
+    /// 1-based line number of the first row of the block.
+    pub first_line: usize,
+    /// `columns[c][r]` is the value of column `c` (as in [`DelimitedReader::columns`]) on row `r`
+    /// of the block. Values are as written in the file (time not yet scaled to seconds).
+    pub columns: Vec<Vec<f64>>,
+    /// 1-based line number of each row (needed for error messages about the time column).
+    pub lines: Vec<usize>,
+}
+
+impl Block {
+    /// Number of rows in the block.
+    pub fn n_rows(&self) -> usize {
+        self.lines.len()
+    }
+}
+
+/// Streaming reader of delimited numeric text. See the module documentation for the conventions.
+pub struct DelimitedReader<R: BufRead> {
+    reader: R,
+    path: String,
+    sep: Separator,
+    decimal_comma: bool,
+    columns: Vec<ColumnInfo>,
+    has_header: bool,
+    /// The line the column count comes from (header or first data row), 1-based.
+    reference_line: usize,
+    line_no: usize,
+    pending: Option<(usize, Vec<u8>)>,
+    buf: Vec<u8>,
+    spans: Vec<(usize, usize)>,
+    scratch: Vec<u8>,
+}
+
+impl<R: BufRead> std::fmt::Debug for DelimitedReader<R> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("DelimitedReader")
+            .field("path", &self.path)
+            .field("sep", &self.sep)
+            .field("decimal_comma", &self.decimal_comma)
+            .field("columns", &self.columns)
+            .field("line_no", &self.line_no)
+            .finish()
+    }
+}
+
+fn trim_cell(mut s: &[u8]) -> &[u8] {
+    while let [first, rest @ ..] = s {
+        if first.is_ascii_whitespace() || *first == b'"' {
+            s = rest;
+        } else {
+            break;
+        }
+    }
+    while let [rest @ .., last] = s {
+        if last.is_ascii_whitespace() || *last == b'"' {
+            s = rest;
+        } else {
+            break;
+        }
+    }
+    s
+}
+
+/// Splits `line` into cell spans (trimmed of spaces and quotes); trailing empty cells removed.
+fn split_spans(line: &[u8], sep: Separator, spans: &mut Vec<(usize, usize)>) {
+    spans.clear();
+    let push = |spans: &mut Vec<(usize, usize)>, a: usize, b: usize| {
+        let cell = &line[a..b];
+        let t = trim_cell(cell);
+        let start = a + (t.as_ptr() as usize - cell.as_ptr() as usize);
+        spans.push((start, start + t.len()));
+    };
+    match sep {
+        Separator::Whitespace => {
+            let mut i = 0;
+            let n = line.len();
+            while i < n {
+                while i < n && (line[i] == b' ' || line[i] == b'\t') {
+                    i += 1;
+                }
+                if i >= n {
+                    break;
+                }
+                let a = i;
+                while i < n && line[i] != b' ' && line[i] != b'\t' {
+                    i += 1;
+                }
+                push(spans, a, i);
+            }
+        }
+        _ => {
+            let c = match sep {
+                Separator::Comma => b',',
+                Separator::Semicolon => b';',
+                _ => b'\t',
+            };
+            let mut a = 0;
+            for (i, &b) in line.iter().enumerate() {
+                if b == c {
+                    push(spans, a, i);
+                    a = i + 1;
+                }
+            }
+            push(spans, a, line.len());
+        }
+    }
+    while let Some(&(a, b)) = spans.last() {
+        if a == b {
+            spans.pop();
+        } else {
+            break;
+        }
+    }
+}
+
+fn parse_num(cell: &[u8], decimal_comma: bool, scratch: &mut Vec<u8>) -> Option<f64> {
+    let bytes: &[u8] = if decimal_comma && cell.contains(&b',') {
+        scratch.clear();
+        scratch.extend(cell.iter().map(|&b| if b == b',' { b'.' } else { b }));
+        scratch
+    } else {
+        cell
+    };
+    std::str::from_utf8(bytes).ok()?.parse::<f64>().ok()
+}
+
+/// Splits `X-Axis (m/s2)` into (`X-Axis`, `m/s2`) and `Z [m/s^2]` into (`Z`, `m/s^2`).
+pub fn split_name_unit(header: &str) -> (String, String) {
+    let h = header.trim();
+    for (open, close) in [('(', ')'), ('[', ']')] {
+        if h.ends_with(close) {
+            if let Some(pos) = h.rfind(open) {
+                let name = h[..pos].trim();
+                let unit = h[pos + 1..h.len() - 1].trim();
+                if !name.is_empty() {
+                    return (name.to_string(), unit.to_string());
+                }
+            }
+        }
+    }
+    (h.to_string(), String::new())
+}
+
+/// Seconds per unit if `name`/`unit` denote a time column.
+fn time_scale(name: &str, unit: &str) -> Option<f64> {
+    let n = name.trim().to_ascii_lowercase();
+    let implied = match n.as_str() {
+        "time" | "t" | "timestamp" | "zeit" => None,
+        "time_s" | "t_s" | "time_sec" => Some(1.0),
+        "time_ms" | "t_ms" => Some(1e-3),
+        "time_us" | "t_us" => Some(1e-6),
+        _ => return None,
+    };
+    let u = unit.trim().to_ascii_lowercase();
+    let from_unit = match u.as_str() {
+        "" => None,
+        "s" | "sec" | "secs" | "second" | "seconds" => Some(1.0),
+        "ms" | "msec" => Some(1e-3),
+        "us" | "µs" | "μs" | "usec" => Some(1e-6),
+        "ns" => Some(1e-9),
+        "min" => Some(60.0),
+        "h" | "hr" => Some(3600.0),
+        _ => return None,
+    };
+    Some(from_unit.or(implied).unwrap_or(1.0))
+}
+
+impl<R: BufRead> DelimitedReader<R> {
+    /// Opens a stream: reads the first row(s) to find the separator, the header and the time
+    /// column. `path` is only used in error messages.
+    ///
+    /// Errors: empty file, header without data rows, unreadable stream.
+    pub fn new(reader: R, path: &str) -> Result<Self> {
+        let mut r = DelimitedReader {
+            reader,
+            path: path.to_string(),
+            sep: Separator::Whitespace,
+            decimal_comma: false,
+            columns: Vec::new(),
+            has_header: false,
+            reference_line: 0,
+            line_no: 0,
+            pending: None,
+            buf: Vec::new(),
+            spans: Vec::new(),
+            scratch: Vec::new(),
+        };
+        // First content line (skipping blanks and comment lines).
+        let first = loop {
+            match r.next_line()? {
+                None => {
+                    return Err(SignalError::EmptyFile {
+                        path: r.path.clone(),
+                    })
+                }
+                Some(n) => {
+                    let l = &r.buf;
+                    let l = if n == 1 && l.starts_with(&[0xEF, 0xBB, 0xBF]) {
+                        &l[3..]
+                    } else {
+                        &l[..]
+                    };
+                    let t = trim_cell(l);
+                    if t.is_empty() || t[0] == b'#' || t[0] == b'%' {
+                        continue;
+                    }
+                    break (n, l.to_vec());
+                }
+            }
+        };
+        r.sep = Separator::sniff(&first.1);
+        let mut spans = Vec::new();
+        split_spans(&first.1, r.sep, &mut spans);
+        let allow_comma = r.sep != Separator::Comma;
+        let mut scratch = Vec::new();
+        let is_header = spans
+            .iter()
+            .any(|&(a, b)| parse_num(&first.1[a..b], allow_comma, &mut scratch).is_none());
+        if is_header {
+            r.has_header = true;
+            r.reference_line = first.0;
+            r.columns = spans
+                .iter()
+                .enumerate()
+                .map(|(i, &(a, b))| {
+                    let text = String::from_utf8_lossy(&first.1[a..b]).to_string();
+                    let (name, unit) = split_name_unit(&text);
+                    let name = if name.is_empty() {
+                        format!("ch{i}")
+                    } else {
+                        name
+                    };
+                    let time_scale_s = time_scale(&name, &unit);
+                    ColumnInfo {
+                        name,
+                        unit,
+                        time_scale_s,
+                    }
+                })
+                .collect();
+            // Peek the first data row for decimal commas.
+            loop {
+                match r.next_line()? {
+                    None => {
+                        return Err(SignalError::NoDataRows {
+                            path: r.path.clone(),
+                        })
+                    }
+                    Some(n) => {
+                        if trim_cell(&r.buf).is_empty() {
+                            continue;
+                        }
+                        r.pending = Some((n, r.buf.clone()));
+                        break;
+                    }
+                }
+            }
+        } else {
+            r.reference_line = first.0;
+            r.columns = (0..spans.len())
+                .map(|i| ColumnInfo {
+                    name: format!("ch{i}"),
+                    unit: String::new(),
+                    time_scale_s: None,
+                })
+                .collect();
+            r.pending = Some(first);
+        }
+        r.decimal_comma = allow_comma;
+        r.spans = spans;
+        Ok(r)
+    }
+
+    /// Reads the next raw line into `self.buf` (without the line ending); returns its number.
+    fn next_line(&mut self) -> Result<Option<usize>> {
+        self.buf.clear();
+        let n = self
+            .reader
+            .read_until(b'\n', &mut self.buf)
+            .map_err(|e| SignalError::Io {
+                action: "read",
+                path: self.path.clone(),
+                message: e.to_string(),
+            })?;
+        if n == 0 {
+            return Ok(None);
+        }
+        if self.buf.last() == Some(&b'\n') {
+            self.buf.pop();
+        }
+        if self.buf.last() == Some(&b'\r') {
+            self.buf.pop();
+        }
+        self.line_no += 1;
+        Ok(Some(self.line_no))
+    }
+
+    /// The columns (including the time column, if any), in file order.
+    pub fn columns(&self) -> &[ColumnInfo] {
+        &self.columns
+    }
+
+    /// The detected separator.
+    pub fn separator(&self) -> Separator {
+        self.sep
+    }
+
+    /// True if numbers may use a decimal comma (`1,5`): the separator is not a comma.
+    pub fn decimal_comma(&self) -> bool {
+        self.decimal_comma
+    }
+
+    /// True if the first row was a header.
+    pub fn has_header(&self) -> bool {
+        self.has_header
+    }
+
+    /// The file name used in error messages.
+    pub fn path(&self) -> &str {
+        &self.path
+    }
+
+    /// Index of the first column recognised as time, if any.
+    pub fn time_column(&self) -> Option<usize> {
+        self.columns.iter().position(|c| c.time_scale_s.is_some())
+    }
+
+    /// Reads at most `max_rows` data rows (blank lines skipped). Returns `Ok(None)` at the end of
+    /// the stream. Errors on ragged rows and non-numeric cells, naming line and column.
+    /// Values are not checked for NaN/Inf here.
+    pub fn next_block(&mut self, max_rows: usize) -> Result<Option<Block>> {
+        let nc = self.columns.len();
+        let mut block = Block {
+            first_line: 0,
+            columns: vec![Vec::new(); nc],
+            lines: Vec::new(),
+        };
+        while block.lines.len() < max_rows {
+            let line_no = if let Some((n, line)) = self.pending.take() {
+                self.buf = line;
+                n
+            } else {
+                match self.next_line()? {
+                    None => break,
+                    Some(n) => n,
+                }
+            };
+            let mut spans = std::mem::take(&mut self.spans);
+            split_spans(&self.buf, self.sep, &mut spans);
+            if spans.is_empty() {
+                self.spans = spans;
+                continue;
+            }
+            if spans.len() != nc {
+                return Err(SignalError::RaggedRow {
+                    path: self.path.clone(),
+                    line: line_no,
+                    found: spans.len(),
+                    expected: nc,
+                    reference_line: self.reference_line,
+                });
+            }
+            for (c, &(a, b)) in spans.iter().enumerate() {
+                let cell = &self.buf[a..b];
+                match parse_num(cell, self.decimal_comma, &mut self.scratch) {
+                    Some(v) => block.columns[c].push(v),
+                    None => {
+                        let text: String = String::from_utf8_lossy(cell).chars().take(40).collect();
+                        return Err(SignalError::NotNumeric {
+                            path: self.path.clone(),
+                            line: line_no,
+                            column: c + 1,
+                            column_name: self.columns[c].name.clone(),
+                            text,
+                        });
+                    }
+                }
+            }
+            if block.lines.is_empty() {
+                block.first_line = line_no;
+            }
+            block.lines.push(line_no);
+            self.spans = spans;
+        }
+        if block.lines.is_empty() {
+            Ok(None)
+        } else {
+            Ok(Some(block))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spans_of(line: &str, sep: Separator) -> Vec<String> {
+        let mut s = Vec::new();
+        split_spans(line.as_bytes(), sep, &mut s);
+        s.iter().map(|&(a, b)| line[a..b].to_string()).collect()
+    }
+
+    #[test]
+    fn splitting_by_hand() {
+        assert_eq!(spans_of("1,2,3,", Separator::Comma), ["1", "2", "3"]);
+        assert_eq!(spans_of("1, 2 ,,", Separator::Comma), ["1", "2"]);
+        assert_eq!(spans_of("1,,3", Separator::Comma), ["1", "", "3"]);
+        assert_eq!(
+            spans_of("  1   2\t 3  ", Separator::Whitespace),
+            ["1", "2", "3"]
+        );
+        assert_eq!(spans_of("\"a\";\"b\"", Separator::Semicolon), ["a", "b"]);
+        assert_eq!(spans_of("1\t2\t", Separator::Tab), ["1", "2"]);
+        assert!(spans_of("   ", Separator::Whitespace).is_empty());
+    }
+
+    #[test]
+    fn name_unit_and_time() {
+        assert_eq!(
+            split_name_unit("X-Axis (m/s2)"),
+            ("X-Axis".into(), "m/s2".into())
+        );
+        assert_eq!(split_name_unit("Z [m/s^2]"), ("Z".into(), "m/s^2".into()));
+        assert_eq!(split_name_unit("plain"), ("plain".into(), "".into()));
+        assert_eq!(split_name_unit("(odd)"), ("(odd)".into(), "".into()));
+        assert_eq!(time_scale("Time", "s"), Some(1.0));
+        assert_eq!(time_scale("TIME", "ms"), Some(1e-3));
+        assert_eq!(time_scale("time_ms", ""), Some(1e-3));
+        assert_eq!(time_scale("t", ""), Some(1.0));
+        assert_eq!(time_scale("timestamp", ""), Some(1.0));
+        assert_eq!(time_scale("Time", "furlongs"), None);
+        assert_eq!(time_scale("x", "s"), None);
+    }
+
+    #[test]
+    fn blocks_stream_in_bounded_pieces() {
+        let text = "a;b\n1,5;2,25\n\n3;4\n5;6\n";
+        let mut r = DelimitedReader::new(text.as_bytes(), "mem").unwrap();
+        assert_eq!(r.separator(), Separator::Semicolon);
+        assert!(r.decimal_comma());
+        let b1 = r.next_block(2).unwrap().unwrap();
+        assert_eq!(b1.columns, vec![vec![1.5, 3.0], vec![2.25, 4.0]]);
+        assert_eq!(b1.lines, vec![2, 4]);
+        let b2 = r.next_block(2).unwrap().unwrap();
+        assert_eq!(b2.columns, vec![vec![5.0], vec![6.0]]);
+        assert_eq!(b2.first_line, 5);
+        assert!(r.next_block(2).unwrap().is_none());
+    }
+}

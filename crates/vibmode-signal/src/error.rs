@@ -1,0 +1,235 @@
+//! The error type of this crate. Every message is one line that names the offending value and
+//! says how to fix it.
+
+/// Everything that can go wrong while reading, selecting, writing or resampling a recording.
+#[derive(Debug, thiserror::Error)]
+pub enum SignalError {
+    /// The file could not be opened, read or written.
+    #[error("cannot {action} {path}: {message}; check the path and permissions")]
+    Io {
+        /// "read" or "write".
+        action: &'static str,
+        /// The file.
+        path: String,
+        /// The operating system's message.
+        message: String,
+    },
+    /// The file has no content at all.
+    #[error("{path} is empty; expected numeric rows (optionally after one header row)")]
+    EmptyFile {
+        /// The file.
+        path: String,
+    },
+    /// A header row but no data rows.
+    #[error("{path} has a header row but no data rows; check that the file was fully exported")]
+    NoDataRows {
+        /// The file.
+        path: String,
+    },
+    /// A data row whose number of cells differs from the header (or first row).
+    #[error("line {line} of {path} has {found} columns but {expected} were expected (from line {reference_line}); fix or delete that row")]
+    RaggedRow {
+        /// The file.
+        path: String,
+        /// 1-based line number of the bad row.
+        line: usize,
+        /// Number of cells found on that row.
+        found: usize,
+        /// Number of cells expected.
+        expected: usize,
+        /// 1-based line the expected count comes from.
+        reference_line: usize,
+    },
+    /// A cell that is not a number.
+    #[error("line {line}, column {column} ('{column_name}') of {path}: '{text}' is not a number; fix the cell or delete the row")]
+    NotNumeric {
+        /// The file.
+        path: String,
+        /// 1-based line number.
+        line: usize,
+        /// 1-based column number.
+        column: usize,
+        /// Column name (from the header or `chN`).
+        column_name: String,
+        /// The offending text (truncated to 40 characters).
+        text: String,
+    },
+    /// A NaN or infinite sample.
+    #[error("channel '{channel}' sample {index} is {value}; clean the data first (remove or interpolate the bad samples)")]
+    NonFinite {
+        /// Channel name.
+        channel: String,
+        /// 0-based sample index.
+        index: usize,
+        /// The value (NaN, inf or -inf).
+        value: f64,
+    },
+    /// No time column and no `fs_hz` given.
+    #[error("no time column in {path}; give the sampling rate with --fs HZ")]
+    NoSampleRate {
+        /// The file.
+        path: String,
+    },
+    /// A sampling rate that is not a positive finite number.
+    #[error(
+        "sampling rate {fs_hz} Hz ({what}) must be a positive finite number; give e.g. --fs 500"
+    )]
+    InvalidSampleRate {
+        /// Where the rate came from.
+        what: String,
+        /// The value.
+        fs_hz: f64,
+    },
+    /// The rate given by the user and the one found in the file disagree by more than 1 %.
+    #[error("{path}: the sampling rate from {source_name} is {file_fs_hz} Hz but --fs gives {given_fs_hz} Hz (more than 1% apart); drop --fs or fix the file")]
+    SampleRateMismatch {
+        /// The file.
+        path: String,
+        /// "the time column 'Time'", "the WAV header", "the sidecar".
+        source_name: String,
+        /// Rate found in the file, Hz.
+        file_fs_hz: f64,
+        /// Rate given in the options, Hz.
+        given_fs_hz: f64,
+    },
+    /// The time column is not uniform enough.
+    #[error("time column '{column}' of {path} is not uniform: jitter {jitter_rel:.3e} of the mean step exceeds {max_jitter_rel:.3e}; pass --resample-nonuniform to interpolate onto a uniform grid at {mean_fs_hz:.6} Hz")]
+    NonUniformTime {
+        /// The file.
+        path: String,
+        /// Time column name.
+        column: String,
+        /// max |dt - mean dt| / mean dt.
+        jitter_rel: f64,
+        /// The allowed maximum.
+        max_jitter_rel: f64,
+        /// The mean rate, Hz.
+        mean_fs_hz: f64,
+    },
+    /// The time column does not strictly increase.
+    #[error("time column '{column}' of {path} does not increase at line {line} ({previous} then {value}); sort the rows or remove duplicates")]
+    TimeNotIncreasing {
+        /// The file.
+        path: String,
+        /// Time column name.
+        column: String,
+        /// 1-based line number.
+        line: usize,
+        /// Previous time value, s.
+        previous: f64,
+        /// This time value, s.
+        value: f64,
+    },
+    /// The file has no data channel (e.g. only a time column).
+    #[error("{path} has no data channels (only a time column?); check the file")]
+    NoChannels {
+        /// The file.
+        path: String,
+    },
+    /// A channel name not present in the recording.
+    #[error("no channel named '{name}'; available: {available}")]
+    UnknownChannel {
+        /// The requested name.
+        name: String,
+        /// Comma-separated list of the available names.
+        available: String,
+    },
+    /// A channel index out of range.
+    #[error(
+        "channel index {index} is out of range: there are {count} channels (0-based: {available})"
+    )]
+    ChannelIndex {
+        /// The requested 0-based index.
+        index: usize,
+        /// Number of channels.
+        count: usize,
+        /// "0=x, 1=y, 2=z".
+        available: String,
+    },
+    /// An empty channel selector string.
+    #[error("empty channel selector; give a channel name or a 0-based index, e.g. --channel 0")]
+    EmptySelector,
+    /// Channels of different lengths in one recording.
+    #[error("channel '{channel}' has {found} samples but '{first}' has {expected}; all channels must have the same length")]
+    LengthMismatch {
+        /// Offending channel.
+        channel: String,
+        /// Its length.
+        found: usize,
+        /// The first channel's name.
+        first: String,
+        /// The first channel's length.
+        expected: usize,
+    },
+    /// A missing or malformed JSON sidecar of a raw binary file.
+    #[error("sidecar {path}: {reason}")]
+    Sidecar {
+        /// The sidecar file (or the expected names).
+        path: String,
+        /// What is wrong and how to fix it.
+        reason: String,
+    },
+    /// A binary (raw) file whose size does not fit the sidecar.
+    #[error("{path} has {bytes} bytes, not a multiple of {frame_bytes} (= {channels} channels x {dtype_bytes} bytes); check dtype and channels in the sidecar")]
+    RawSize {
+        /// The file.
+        path: String,
+        /// File size.
+        bytes: usize,
+        /// Bytes per frame.
+        frame_bytes: usize,
+        /// Channels.
+        channels: usize,
+        /// Bytes per value.
+        dtype_bytes: usize,
+    },
+    /// A WAV file that cannot be used.
+    #[error("WAV {path}: {reason}")]
+    Wav {
+        /// The file.
+        path: String,
+        /// What is wrong and how to fix it.
+        reason: String,
+    },
+    /// A file extension or format name that is not known.
+    #[error("unknown format '{given}'; valid formats: delimited (.csv/.txt/.tsv/.dat), wav (.wav), raw (.f32/.f64/.bin/.raw + .json sidecar)")]
+    UnknownFormat {
+        /// The name or extension given.
+        given: String,
+    },
+    /// An invalid parameter value (resampling, read options...).
+    #[error("{name} = {value} is invalid: {fix}")]
+    InvalidParam {
+        /// Parameter name, e.g. "to_hz".
+        name: &'static str,
+        /// The value as text.
+        value: String,
+        /// The rule and a suggested fix.
+        fix: String,
+    },
+    /// Too few samples for the requested operation.
+    #[error("{what}: {n} samples is too few; {fix}")]
+    TooShort {
+        /// The operation.
+        what: String,
+        /// Number of samples available.
+        n: usize,
+        /// What is needed.
+        fix: String,
+    },
+}
+
+/// Convenient alias.
+pub type Result<T> = std::result::Result<T, SignalError>;
+
+pub(crate) fn io_err(
+    action: &'static str,
+    path: &std::path::Path,
+    e: &std::io::Error,
+) -> SignalError {
+    SignalError::Io {
+        action,
+        path: path.display().to_string(),
+        message: e.to_string(),
+    }
+}

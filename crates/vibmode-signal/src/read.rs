@@ -1,0 +1,527 @@
+//! Reading recordings from delimited text, WAV and raw binary files.
+
+use crate::delimited::DelimitedReader;
+use crate::error::{io_err, Result, SignalError};
+use crate::recording::{check_finite, check_fs, Channel, Recording, TimeAxis};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::io::BufRead;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+/// File format. Detected from the extension when not given (see [`Format::from_path`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Format {
+    /// Delimited text: `.csv`, `.txt`, `.tsv`, `.dat`, `.asc` (and unknown extensions).
+    Delimited,
+    /// WAV, PCM integer 8/16/24/32-bit or 32-bit float: `.wav`.
+    Wav,
+    /// Raw interleaved little-endian f32/f64 with a JSON sidecar: `.f32`, `.f64`, `.bin`, `.raw`.
+    Raw,
+}
+
+impl Format {
+    /// The format implied by a file extension (case-insensitive); `None` if the extension is not
+    /// one of the known ones.
+    pub fn from_extension(ext: &str) -> Option<Format> {
+        match ext.to_ascii_lowercase().as_str() {
+            "csv" | "txt" | "tsv" | "dat" | "asc" => Some(Format::Delimited),
+            "wav" | "wave" => Some(Format::Wav),
+            "f32" | "f64" | "bin" | "raw" => Some(Format::Raw),
+            _ => None,
+        }
+    }
+
+    /// The format of `path` from its extension; unknown extensions are read as delimited text
+    /// unless the file starts with `RIFF` (WAV) or a sidecar exists (raw).
+    pub fn from_path(path: &Path) -> Format {
+        if let Some(f) = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .and_then(Format::from_extension)
+        {
+            return f;
+        }
+        if let Ok(mut f) = std::fs::File::open(path) {
+            let mut magic = [0u8; 4];
+            if std::io::Read::read_exact(&mut f, &mut magic).is_ok() && &magic == b"RIFF" {
+                return Format::Wav;
+            }
+        }
+        if sidecar_candidates(path).iter().any(|p| p.is_file()) {
+            return Format::Raw;
+        }
+        Format::Delimited
+    }
+}
+
+impl FromStr for Format {
+    type Err = SignalError;
+    fn from_str(s: &str) -> Result<Format> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "delimited" | "csv" | "text" | "txt" => Ok(Format::Delimited),
+            "wav" => Ok(Format::Wav),
+            "raw" | "bin" | "binary" => Ok(Format::Raw),
+            _ => Err(SignalError::UnknownFormat {
+                given: s.to_string(),
+            }),
+        }
+    }
+}
+
+impl fmt::Display for Format {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Format::Delimited => "delimited",
+            Format::Wav => "wav",
+            Format::Raw => "raw",
+        })
+    }
+}
+
+/// Options for [`read_path`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ReadOptions {
+    /// Sampling rate, Hz. Required for text files without a time column; when the file also has
+    /// a rate (time column, WAV header, sidecar) they must agree within 1 % and this value wins.
+    /// Default `None`.
+    pub fs_hz: Option<f64>,
+    /// Format; default `None` = from the extension ([`Format::from_path`]).
+    pub format: Option<Format>,
+    /// Multiplier for WAV integer samples after scaling them to [-1, 1) full scale, e.g. the
+    /// sensor's full-scale range in m/s^2. Default 1.0 (full scale = 1.0).
+    pub scale: f64,
+    /// Accept a non-uniform time column by linear interpolation onto a uniform grid at the mean
+    /// rate (CLI `--resample-nonuniform`). Default false.
+    pub allow_nonuniform: bool,
+    /// Largest accepted time-step jitter, max |dt - mean dt| / mean dt. Default 0.01.
+    pub max_jitter_rel: f64,
+    /// Unit given to channels whose file does not state one (e.g. `m/s^2`). Default `None`.
+    pub unit: Option<String>,
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        ReadOptions {
+            fs_hz: None,
+            format: None,
+            scale: 1.0,
+            allow_nonuniform: false,
+            max_jitter_rel: 0.01,
+            unit: None,
+        }
+    }
+}
+
+/// Reads a recording from `path` (delimited text, WAV or raw + sidecar; see `docs/formats.md`).
+///
+/// All samples are checked to be finite; channel order is file order (time column removed).
+pub fn read_path(path: &Path, opts: &ReadOptions) -> Result<Recording> {
+    if let Some(fs) = opts.fs_hz {
+        check_fs(fs, "--fs")?;
+    }
+    if !(opts.max_jitter_rel.is_finite() && opts.max_jitter_rel >= 0.0) {
+        return Err(SignalError::InvalidParam {
+            name: "max_jitter_rel",
+            value: opts.max_jitter_rel.to_string(),
+            fix: "must be a finite number >= 0, e.g. 0.01".into(),
+        });
+    }
+    let format = opts.format.unwrap_or_else(|| Format::from_path(path));
+    let mut rec = match format {
+        Format::Delimited => {
+            let bytes = std::fs::read(path).map_err(|e| io_err("read", path, &e))?;
+            read_delimited(&bytes[..], &path.display().to_string(), opts)?
+        }
+        Format::Wav => read_wav(path, opts)?,
+        Format::Raw => read_raw(path, opts)?,
+    };
+    if let Some(u) = &opts.unit {
+        for c in &mut rec.channels {
+            if c.unit.is_empty() {
+                c.unit = u.clone();
+            }
+        }
+    }
+    Ok(rec)
+}
+
+fn reconcile_fs(path: &str, source_name: String, file_fs: f64, given: Option<f64>) -> Result<f64> {
+    check_fs(file_fs, &source_name)?;
+    match given {
+        None => Ok(file_fs),
+        Some(g) => {
+            if (g - file_fs).abs() > 0.01 * file_fs {
+                Err(SignalError::SampleRateMismatch {
+                    path: path.to_string(),
+                    source_name,
+                    file_fs_hz: file_fs,
+                    given_fs_hz: g,
+                })
+            } else {
+                Ok(g)
+            }
+        }
+    }
+}
+
+/// Reads delimited text from any buffered reader (the whole stream). `path` is used in messages.
+/// Same rules as [`read_path`] for time columns, rates and units (except `opts.unit`, which
+/// [`read_path`] applies afterwards).
+pub fn read_delimited<R: BufRead>(reader: R, path: &str, opts: &ReadOptions) -> Result<Recording> {
+    let mut r = DelimitedReader::new(reader, path)?;
+    let cols = r.columns().to_vec();
+    let tcol = r.time_column();
+    let mut data: Vec<Vec<f64>> = vec![Vec::new(); cols.len()];
+    let mut lines: Vec<usize> = Vec::new();
+    while let Some(block) = r.next_block(1 << 16)? {
+        for (d, b) in data.iter_mut().zip(block.columns) {
+            if d.is_empty() {
+                *d = b;
+            } else {
+                d.extend_from_slice(&b);
+            }
+        }
+        if tcol.is_some() {
+            lines.extend_from_slice(&block.lines);
+        }
+    }
+    if data.first().map_or(true, |d| d.is_empty()) {
+        return Err(SignalError::NoDataRows {
+            path: path.to_string(),
+        });
+    }
+    let mut time: Option<Vec<f64>> = None;
+    let mut channels = Vec::with_capacity(cols.len());
+    for (i, (c, d)) in cols.iter().zip(data).enumerate() {
+        if Some(i) == tcol {
+            let scale = c.time_scale_s.unwrap_or(1.0);
+            time = Some(d.into_iter().map(|v| v * scale).collect());
+        } else {
+            channels.push(Channel {
+                name: c.name.clone(),
+                unit: c.unit.clone(),
+                samples: d,
+            });
+        }
+    }
+    if channels.is_empty() {
+        return Err(SignalError::NoChannels {
+            path: path.to_string(),
+        });
+    }
+    check_finite(&channels)?;
+    let (fs_hz, time_axis) = match (time, tcol) {
+        (Some(t), Some(ti)) => {
+            let name = cols[ti].name.clone();
+            let n = t.len();
+            if let Some(k) = t.iter().position(|v| !v.is_finite()) {
+                return Err(SignalError::NonFinite {
+                    channel: name,
+                    index: k,
+                    value: t[k],
+                });
+            }
+            if n < 2 {
+                return Err(SignalError::TooShort {
+                    what: format!("time column '{name}' of {path}"),
+                    n,
+                    fix: "need at least 2 rows to derive the sampling rate; or drop the time column and give --fs HZ".into(),
+                });
+            }
+            for k in 1..n {
+                if t[k] <= t[k - 1] {
+                    return Err(SignalError::TimeNotIncreasing {
+                        path: path.to_string(),
+                        column: name,
+                        line: lines.get(k).copied().unwrap_or(0),
+                        previous: t[k - 1],
+                        value: t[k],
+                    });
+                }
+            }
+            let mean_dt = (t[n - 1] - t[0]) / (n - 1) as f64;
+            let jitter = t
+                .windows(2)
+                .map(|w| ((w[1] - w[0]) - mean_dt).abs())
+                .fold(0.0f64, f64::max)
+                / mean_dt;
+            let mean_fs = 1.0 / mean_dt;
+            if jitter > opts.max_jitter_rel {
+                if !opts.allow_nonuniform {
+                    return Err(SignalError::NonUniformTime {
+                        path: path.to_string(),
+                        column: name,
+                        jitter_rel: jitter,
+                        max_jitter_rel: opts.max_jitter_rel,
+                        mean_fs_hz: mean_fs,
+                    });
+                }
+                for c in &mut channels {
+                    c.samples = interp_uniform(&t, &c.samples, t[0], mean_dt);
+                }
+            }
+            let fs = reconcile_fs(
+                path,
+                format!("the time column '{name}'"),
+                mean_fs,
+                opts.fs_hz,
+            )?;
+            (
+                fs,
+                Some(TimeAxis {
+                    column: name,
+                    fs_hz: mean_fs,
+                    jitter_rel: jitter,
+                    start_s: t[0],
+                }),
+            )
+        }
+        _ => match opts.fs_hz {
+            Some(fs) => (fs, None),
+            None => {
+                return Err(SignalError::NoSampleRate {
+                    path: path.to_string(),
+                })
+            }
+        },
+    };
+    Ok(Recording {
+        fs_hz,
+        channels,
+        time_axis,
+    })
+}
+
+/// Linear interpolation of (t, y) (t strictly increasing) at `t0 + i * dt`, i = 0..t.len().
+pub(crate) fn interp_uniform(t: &[f64], y: &[f64], t0: f64, dt: f64) -> Vec<f64> {
+    let n = t.len();
+    let mut out = Vec::with_capacity(n);
+    let mut k = 0usize;
+    for i in 0..n {
+        let ti = t0 + i as f64 * dt;
+        while k + 2 < n && t[k + 1] < ti {
+            k += 1;
+        }
+        let (ta, tb) = (t[k], t[k + 1]);
+        let w = ((ti - ta) / (tb - ta)).clamp(0.0, 1.0);
+        out.push(y[k] + w * (y[k + 1] - y[k]));
+    }
+    out
+}
+
+fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Recording> {
+    let p = path.display().to_string();
+    let wav_err = |reason: String| SignalError::Wav {
+        path: p.clone(),
+        reason,
+    };
+    if !path.exists() {
+        return Err(io_err(
+            "read",
+            path,
+            &std::io::Error::from(std::io::ErrorKind::NotFound),
+        ));
+    }
+    let reader = hound::WavReader::open(path)
+        .map_err(|e| wav_err(format!("{e}; check that it is a valid WAV file")))?;
+    let spec = reader.spec();
+    let nch = spec.channels as usize;
+    if nch == 0 {
+        return Err(wav_err(
+            "the header declares 0 channels; re-export the file".into(),
+        ));
+    }
+    if !(opts.scale.is_finite() && opts.scale != 0.0) {
+        return Err(SignalError::InvalidParam {
+            name: "scale",
+            value: opts.scale.to_string(),
+            fix: "the WAV scale must be a finite non-zero number, e.g. --scale 19.62".into(),
+        });
+    }
+    let interleaved: Vec<f64> = match spec.sample_format {
+        hound::SampleFormat::Float => {
+            if spec.bits_per_sample != 32 {
+                return Err(wav_err(format!(
+                    "{}-bit float samples are not supported; convert to 32-bit float or PCM",
+                    spec.bits_per_sample
+                )));
+            }
+            reader
+                .into_samples::<f32>()
+                .map(|s| s.map(|v| v as f64 * opts.scale))
+                .collect::<std::result::Result<_, _>>()
+                .map_err(|e| wav_err(format!("{e}; the file may be truncated")))?
+        }
+        hound::SampleFormat::Int => {
+            let bits = spec.bits_per_sample;
+            if !(1..=32).contains(&bits) {
+                return Err(wav_err(format!(
+                    "{bits}-bit integer samples are not supported; use 8, 16, 24 or 32 bits"
+                )));
+            }
+            let k = opts.scale / f64::powi(2.0, bits as i32 - 1);
+            reader
+                .into_samples::<i32>()
+                .map(|s| s.map(|v| v as f64 * k))
+                .collect::<std::result::Result<_, _>>()
+                .map_err(|e| wav_err(format!("{e}; the file may be truncated")))?
+        }
+    };
+    let n = interleaved.len() / nch;
+    if n == 0 {
+        return Err(wav_err(
+            "it contains zero samples; check the recording".into(),
+        ));
+    }
+    let fs = reconcile_fs(
+        &p,
+        "the WAV header".into(),
+        spec.sample_rate as f64,
+        opts.fs_hz,
+    )?;
+    let channels: Vec<Channel> = (0..nch)
+        .map(|c| Channel {
+            name: format!("ch{c}"),
+            unit: String::new(),
+            samples: interleaved
+                .iter()
+                .skip(c)
+                .step_by(nch)
+                .take(n)
+                .copied()
+                .collect(),
+        })
+        .collect();
+    check_finite(&channels)?;
+    Ok(Recording {
+        fs_hz: fs,
+        channels,
+        time_axis: None,
+    })
+}
+
+/// The JSON sidecar of a raw binary file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Sidecar {
+    /// Sampling rate, Hz.
+    pub fs_hz: f64,
+    /// `"f32"` or `"f64"` (little-endian).
+    pub dtype: String,
+    /// Channel names, in interleaving order; their count is the channel count.
+    pub channels: Vec<String>,
+    /// Units per channel (optional; same length as `channels`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub units: Option<Vec<String>>,
+}
+
+/// The sidecar paths tried for a raw file, in order: `<path>.json`, then `<stem>.json`.
+pub fn sidecar_candidates(path: &Path) -> Vec<PathBuf> {
+    let mut full = path.as_os_str().to_owned();
+    full.push(".json");
+    let mut v = vec![PathBuf::from(full)];
+    if path.extension().is_some() {
+        v.push(path.with_extension("json"));
+    }
+    v
+}
+
+fn read_raw(path: &Path, opts: &ReadOptions) -> Result<Recording> {
+    let p = path.display().to_string();
+    let cands = sidecar_candidates(path);
+    let side_path = cands.iter().find(|c| c.is_file()).ok_or_else(|| SignalError::Sidecar {
+        path: cands
+            .iter()
+            .map(|c| c.display().to_string())
+            .collect::<Vec<_>>()
+            .join(" or "),
+        reason: "not found; a raw file needs a JSON sidecar like {\"fs_hz\": 20000, \"dtype\": \"f32\", \"channels\": [\"FL\"]}".into(),
+    })?;
+    let sp = side_path.display().to_string();
+    let text = std::fs::read_to_string(side_path).map_err(|e| io_err("read", side_path, &e))?;
+    let side: Sidecar = serde_json::from_str(&text).map_err(|e| SignalError::Sidecar {
+        path: sp.clone(),
+        reason: format!(
+            "{e}; expected {{\"fs_hz\": 20000, \"dtype\": \"f32\"|\"f64\", \"channels\": [\"FL\", ...], \"units\": [\"m/s^2\", ...]}}"
+        ),
+    })?;
+    let side_err = |reason: String| SignalError::Sidecar {
+        path: sp.clone(),
+        reason,
+    };
+    let width = match side.dtype.as_str() {
+        "f32" | "float32" => 4,
+        "f64" | "float64" => 8,
+        other => {
+            return Err(side_err(format!(
+                "dtype '{other}' is not supported; use \"f32\" or \"f64\""
+            )))
+        }
+    };
+    let nch = side.channels.len();
+    if nch == 0 {
+        return Err(side_err(
+            "\"channels\" is empty; list one name per interleaved channel".into(),
+        ));
+    }
+    if let Some(u) = &side.units {
+        if u.len() != nch {
+            return Err(side_err(format!(
+                "\"units\" has {} entries but \"channels\" has {nch}; give one unit per channel or omit \"units\"",
+                u.len()
+            )));
+        }
+    }
+    if !(side.fs_hz.is_finite() && side.fs_hz > 0.0) {
+        return Err(side_err(format!(
+            "fs_hz {} must be a positive finite number, e.g. 20000",
+            side.fs_hz
+        )));
+    }
+    let bytes = std::fs::read(path).map_err(|e| io_err("read", path, &e))?;
+    let frame = width * nch;
+    if bytes.len() % frame != 0 {
+        return Err(SignalError::RawSize {
+            path: p,
+            bytes: bytes.len(),
+            frame_bytes: frame,
+            channels: nch,
+            dtype_bytes: width,
+        });
+    }
+    let n = bytes.len() / frame;
+    if n == 0 {
+        return Err(SignalError::EmptyFile { path: p });
+    }
+    let fs = reconcile_fs(&p, format!("the sidecar {sp}"), side.fs_hz, opts.fs_hz)?;
+    let mut channels: Vec<Channel> = side
+        .channels
+        .iter()
+        .enumerate()
+        .map(|(i, name)| Channel {
+            name: name.clone(),
+            unit: side
+                .units
+                .as_ref()
+                .and_then(|u| u.get(i).cloned())
+                .unwrap_or_default(),
+            samples: Vec::with_capacity(n),
+        })
+        .collect();
+    for (k, chunk) in bytes.chunks_exact(width).enumerate() {
+        let v = if width == 4 {
+            f32::from_le_bytes([chunk[0], chunk[1], chunk[2], chunk[3]]) as f64
+        } else {
+            f64::from_le_bytes([
+                chunk[0], chunk[1], chunk[2], chunk[3], chunk[4], chunk[5], chunk[6], chunk[7],
+            ])
+        };
+        channels[k % nch].samples.push(v);
+    }
+    check_finite(&channels)?;
+    Ok(Recording {
+        fs_hz: fs,
+        channels,
+        time_axis: None,
+    })
+}
