@@ -101,7 +101,10 @@ pub fn analyse_poles(
         pts.push(Pt {
             u,
             v,
-            cell: (u.floor() as i64, v.floor() as i64),
+            cell: (
+                (u * CELLS_PER_UNIT).floor() as i64,
+                (v * CELLS_PER_UNIT).floor() as i64,
+            ),
             idx: i,
             ch,
         });
@@ -124,34 +127,72 @@ pub fn analyse_poles(
         return Ok(out);
     }
 
-    // Grid of unit cells, points sorted by cell.
+    // Grid of cells of side 1/sqrt(2) (any two poles in one cell are neighbours), poles sorted
+    // by cell.
     pts.sort_by(|a, b| a.cell.cmp(&b.cell).then(a.idx.cmp(&b.idx)));
     let mut cells: HashMap<(i64, i64), (usize, usize)> = HashMap::new();
+    let mut cell_list: Vec<(usize, usize)> = Vec::new();
     let mut start = 0;
     for k in 1..=pts.len() {
         if k == pts.len() || pts[k].cell != pts[start].cell {
             cells.insert(pts[start].cell, (start, k));
+            cell_list.push((start, k));
             start = k;
         }
     }
     let grid = Grid { pts: &pts, cells };
 
-    // 1. Core poles.
-    let core: Vec<bool> = (0..pts.len())
-        .map(|i| grid.count_neighbours_upto(i, core_threshold) >= core_threshold)
-        .collect();
-
-    // 2. Connect core poles that are neighbours (union-find).
-    let mut uf = UnionFind::new(pts.len());
-    for i in 0..pts.len() {
-        if !core[i] {
-            continue;
+    // 1. Core poles (a cell holding at least core_threshold poles is all core).
+    let mut core = vec![false; pts.len()];
+    for &(a, b) in &cell_list {
+        for (i, c) in core.iter_mut().enumerate().take(b).skip(a) {
+            *c = b - a >= core_threshold
+                || grid.count_neighbours_upto(i, core_threshold) >= core_threshold;
         }
-        grid.for_each_neighbour(i, |j, _| {
-            if j > i && core[j] {
-                uf.union(i, j);
+    }
+
+    // 2. Connect core poles that are neighbours (union-find): all core poles of a cell together,
+    //    then one neighbouring core pair per pair of cells is enough.
+    let mut uf = UnionFind::new(pts.len());
+    let mut first_core: HashMap<(i64, i64), usize> = HashMap::new();
+    for &(a, b) in &cell_list {
+        if let Some(f) = (a..b).find(|&i| core[i]) {
+            for i in (f + 1..b).filter(|&i| core[i]) {
+                uf.union(f, i);
             }
-        });
+            first_core.insert(pts[f].cell, f);
+        }
+    }
+    for &(a, b) in &cell_list {
+        let Some(&fa) = first_core.get(&pts[a].cell) else {
+            continue;
+        };
+        let c = pts[a].cell;
+        for dx in -REACH..=REACH {
+            for dy in -REACH..=REACH {
+                let d = (c.0 + dx, c.1 + dy);
+                if d <= c {
+                    continue; // each unordered pair of cells once
+                }
+                let Some(&fd) = first_core.get(&d) else {
+                    continue;
+                };
+                if uf.find(fa) == uf.find(fd) {
+                    continue;
+                }
+                let Some(&(da, db)) = grid.cells.get(&d) else {
+                    continue;
+                };
+                'pairs: for i in (a..b).filter(|&i| core[i]) {
+                    for j in (da..db).filter(|&j| core[j]) {
+                        if dist2(&pts[i], &pts[j]) <= 1.0 {
+                            uf.union(i, j);
+                            break 'pairs;
+                        }
+                    }
+                }
+            }
+        }
     }
 
     // 3. Border poles join the cluster of their nearest core neighbour.
@@ -272,18 +313,26 @@ fn summarise(
     let mut damps: Vec<f64> = kept.iter().map(|&i| poles[i].damping_ratio).collect();
     damps.sort_by(f64::total_cmp);
     let (f_mean, f_std) = mean_std(&freqs);
-    let records: HashSet<usize> = kept.iter().map(|&i| poles[i].record).collect();
     let rec_orders: HashSet<(usize, usize)> = kept
         .iter()
         .map(|&i| (poles[i].record, poles[i].order))
         .collect();
+    let mut orders_per_record: HashMap<usize, usize> = HashMap::new();
+    for &(r, _) in &rec_orders {
+        *orders_per_record.entry(r).or_insert(0) += 1;
+    }
+    let min_orders = ((p.record_min_order_share * n_orders as f64).ceil() as usize).max(1);
+    let n_supporting = orders_per_record
+        .values()
+        .filter(|&&n| n >= min_orders)
+        .count();
     let mut channels: Vec<String> = kept.iter().map(|&i| poles[i].channel.clone()).collect();
     channels.sort();
     channels.dedup();
     let mut roles: Vec<String> = kept.iter().filter_map(|&i| poles[i].role.clone()).collect();
     roles.sort();
     roles.dedup();
-    let record_share = records.len() as f64 / n_records as f64;
+    let record_share = n_supporting as f64 / n_records as f64;
     let order_share = rec_orders.len() as f64 / (n_records * n_orders) as f64;
     let damping_ratio = percentile_sorted(&damps, 0.5);
     let supported =
@@ -316,6 +365,15 @@ fn summarise(
     (mode, kept)
 }
 
+/// Grid cells per unit of the scaled plane: side 1/sqrt(2), so a cell's diagonal is 1.
+const CELLS_PER_UNIT: f64 = std::f64::consts::SQRT_2;
+/// Neighbouring cells to search on each side (ceil(sqrt(2)) = 2).
+const REACH: i64 = 2;
+
+fn dist2(a: &Pt, b: &Pt) -> f64 {
+    (a.u - b.u) * (a.u - b.u) + (a.v - b.v) * (a.v - b.v)
+}
+
 struct Pt {
     u: f64,
     v: f64,
@@ -333,11 +391,11 @@ impl Grid<'_> {
     /// Calls `f(j, squared_distance)` for every neighbour j (distance <= 1), i itself included.
     fn for_each_neighbour(&self, i: usize, mut f: impl FnMut(usize, f64)) {
         let pi = &self.pts[i];
-        for dx in -1..=1 {
-            for dy in -1..=1 {
+        for dx in -REACH..=REACH {
+            for dy in -REACH..=REACH {
                 if let Some(&(a, b)) = self.cells.get(&(pi.cell.0 + dx, pi.cell.1 + dy)) {
                     for (j, pj) in self.pts[a..b].iter().enumerate() {
-                        let d2 = (pj.u - pi.u).powi(2) + (pj.v - pi.v).powi(2);
+                        let d2 = dist2(pi, pj);
                         if d2 <= 1.0 {
                             f(a + j, d2);
                         }
@@ -351,11 +409,11 @@ impl Grid<'_> {
     fn count_neighbours_upto(&self, i: usize, limit: usize) -> usize {
         let pi = &self.pts[i];
         let mut n = 0;
-        for dx in -1..=1 {
-            for dy in -1..=1 {
+        for dx in -REACH..=REACH {
+            for dy in -REACH..=REACH {
                 if let Some(&(a, b)) = self.cells.get(&(pi.cell.0 + dx, pi.cell.1 + dy)) {
                     for pj in &self.pts[a..b] {
-                        if (pj.u - pi.u).powi(2) + (pj.v - pi.v).powi(2) <= 1.0 {
+                        if dist2(pi, pj) <= 1.0 {
                             n += 1;
                             if n >= limit {
                                 return n;

@@ -23,13 +23,18 @@ pub struct ClusterParams {
     pub min_points: usize,
     /// Relative core threshold: a neighbourhood must also hold at least
     /// `min_density_share * n_fits` poles, where `n_fits = n_records * orders.len() * n_channels`.
-    /// The core threshold is `max(min_points, ceil(min_density_share * n_fits))`. Default 0.02.
+    /// The core threshold is `max(min_points, ceil(min_density_share * n_fits))`. Default 0.03.
     pub min_density_share: f64,
     /// Minimum share (0..1) of the records in which a cluster must appear to be invariant (ignored
     /// when `n_records == 1`). Default 0.5.
     pub min_record_share: f64,
+    /// A record counts as containing a cluster (for `record_share`) only when the cluster has poles
+    /// in at least `max(1, ceil(record_min_order_share * orders.len()))` of that record's model
+    /// orders (any channel), so that a few stray poles do not make a record "support" a mode.
+    /// Default 0.1.
+    pub record_min_order_share: f64,
     /// Minimum `order_share` (0..1) of the (record, order) fits in which a cluster must appear to be
-    /// invariant. Default 0.1.
+    /// invariant. Default 0.25.
     pub min_order_share: f64,
     /// A cluster is a periodic disturbance when its median damping ratio is below this value
     /// (dimensionless) and its frequency spread is below `disturbance_freq_spread_max`.
@@ -57,9 +62,10 @@ impl Default for ClusterParams {
             freq_tol_rel: 0.02,
             log_damping_tol: 0.2,
             min_points: 5,
-            min_density_share: 0.02,
+            min_density_share: 0.03,
             min_record_share: 0.5,
-            min_order_share: 0.1,
+            record_min_order_share: 0.1,
+            min_order_share: 0.25,
             disturbance_damping_max: 5e-3,
             disturbance_freq_spread_max: 0.01,
             freq_min_hz: 0.1,
@@ -118,6 +124,11 @@ impl ClusterParams {
             "min_record_share",
             self.min_record_share,
             d.min_record_share,
+        )?;
+        share(
+            "record_min_order_share",
+            self.record_min_order_share,
+            d.record_min_order_share,
         )?;
         share("min_order_share", self.min_order_share, d.min_order_share)?;
         positive(

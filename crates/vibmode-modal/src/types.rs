@@ -111,7 +111,9 @@ pub struct InvariantMode {
     /// Share (0..1) of the `n_records x orders.len()` (record, order) fits in which the cluster has
     /// at least one pole (in any channel) = mean over records of the share of orders.
     pub order_share: f64,
-    /// Share (0..1) of the `n_records` records in which the cluster has at least one pole.
+    /// Share (0..1) of the `n_records` records that contain the cluster, a record counting when the
+    /// cluster has poles in at least `max(1, ceil(record_min_order_share * orders.len()))` of its
+    /// orders.
     pub record_share: f64,
     /// Number of poles in the cluster (at most one per (record, channel, order)).
     pub n_poles: usize,
