@@ -1,0 +1,488 @@
+//! Vehicle parameters read from TOML (units in every key name).
+
+use crate::error::{invalid, Result, VehicleError};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::str::FromStr;
+
+/// One wheel station. Coordinates: x forward from the centre of gravity, y to the left.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Corner {
+    /// Front left.
+    FL,
+    /// Front right.
+    FR,
+    /// Rear left.
+    RL,
+    /// Rear right.
+    RR,
+}
+
+impl Corner {
+    /// All corners in model order (FL, FR, RL, RR): the order of road inputs and wheel DOFs.
+    pub const ALL: [Corner; 4] = [Corner::FL, Corner::FR, Corner::RL, Corner::RR];
+
+    /// Index 0..4 in model order.
+    pub fn index(self) -> usize {
+        match self {
+            Corner::FL => 0,
+            Corner::FR => 1,
+            Corner::RL => 2,
+            Corner::RR => 3,
+        }
+    }
+
+    /// True for FL and FR.
+    pub fn is_front(self) -> bool {
+        matches!(self, Corner::FL | Corner::FR)
+    }
+}
+
+impl fmt::Display for Corner {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let s = match self {
+            Corner::FL => "FL",
+            Corner::FR => "FR",
+            Corner::RL => "RL",
+            Corner::RR => "RR",
+        };
+        f.write_str(s)
+    }
+}
+
+impl FromStr for Corner {
+    type Err = VehicleError;
+    fn from_str(s: &str) -> Result<Self> {
+        match s.trim().to_ascii_uppercase().as_str() {
+            "FL" => Ok(Corner::FL),
+            "FR" => Ok(Corner::FR),
+            "RL" => Ok(Corner::RL),
+            "RR" => Ok(Corner::RR),
+            _ => Err(VehicleError::UnknownName {
+                what: "corner",
+                value: s.to_string(),
+                valid: "FL, FR, RL, RR",
+            }),
+        }
+    }
+}
+
+/// Where an accelerometer sits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SensorKind {
+    /// On the body (sprung mass), at a body point (x_m, y_m) or above a corner.
+    Sprung,
+    /// On a wheel spindle (unsprung mass) of a corner.
+    Unsprung,
+}
+
+impl fmt::Display for SensorKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            SensorKind::Sprung => "sprung",
+            SensorKind::Unsprung => "unsprung",
+        })
+    }
+}
+
+impl FromStr for SensorKind {
+    type Err = VehicleError;
+    fn from_str(s: &str) -> Result<Self> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "sprung" => Ok(SensorKind::Sprung),
+            "unsprung" => Ok(SensorKind::Unsprung),
+            _ => Err(VehicleError::UnknownName {
+                what: "sensor kind",
+                value: s.to_string(),
+                valid: "sprung, unsprung",
+            }),
+        }
+    }
+}
+
+/// `[body]`: the rigid sprung mass.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Body {
+    /// Sprung mass, kg.
+    pub mass_kg: f64,
+    /// Pitch moment of inertia about the lateral axis through the centre of gravity, kg m^2.
+    pub pitch_inertia_kgm2: f64,
+    /// Roll moment of inertia about the longitudinal axis through the centre of gravity, kg m^2.
+    pub roll_inertia_kgm2: f64,
+    /// Height of the sprung centre of gravity above the roll/pitch axes, m (manoeuvre moments
+    /// m a h). Default 1.0 m.
+    #[serde(default = "default_cg_height")]
+    pub cg_height_m: f64,
+}
+
+fn default_cg_height() -> f64 {
+    1.0
+}
+
+/// `[geometry]`: wheel positions.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Geometry {
+    /// Distance front axle to rear axle, m.
+    pub wheelbase_m: f64,
+    /// Longitudinal distance from the centre of gravity to the front axle, m (0 < a < wheelbase).
+    pub cg_to_front_axle_m: f64,
+    /// Lateral distance between the front wheel centres, m.
+    pub track_front_m: f64,
+    /// Lateral distance between the rear wheel stations, m (centre of the twin tyres).
+    pub track_rear_m: f64,
+}
+
+/// `[front]` / `[rear]`: one axle; values per wheel station.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Axle {
+    /// Unsprung mass per wheel station, kg.
+    pub unsprung_mass_kg: f64,
+    /// Suspension spring rate per wheel, at the wheel, N/m.
+    pub spring_stiffness_n_per_m: f64,
+    /// Suspension damping per wheel, at the wheel, N s/m (0 allowed).
+    pub damper_n_s_per_m: f64,
+    /// Vertical tyre stiffness per wheel station (both tyres of a twin pair together), N/m.
+    pub tyre_stiffness_n_per_m: f64,
+    /// Tyre damping per wheel station, N s/m (0 allowed). Default 0.
+    #[serde(default)]
+    pub tyre_damping_n_s_per_m: f64,
+    /// Anti-roll bar stiffness: moment per radian of body roll relative to the axle, N m/rad.
+    /// Default 0 (no bar).
+    #[serde(default)]
+    pub anti_roll_stiffness_nm_per_rad: f64,
+}
+
+/// `[bending]` (optional): first vertical bending mode of the body, added as one modal DOF.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Bending {
+    /// Frequency of the free (unsupported) body bending mode, Hz.
+    pub frequency_hz: f64,
+    /// Structural damping ratio of that mode (0 allowed).
+    pub damping_ratio: f64,
+    /// Modal mass for the shape values given below, kg.
+    pub modal_mass_kg: f64,
+    /// Mode-shape value at the four suspension attachment points [FL, FR, RL, RR] (dimensionless;
+    /// body displacement = shape * modal coordinate). This is how the road excites the mode.
+    pub corner_shape: [f64; 4],
+}
+
+/// `[[sensors]]`: one accelerometer (vertical).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorSpec {
+    /// Channel name, e.g. "FR_sprung".
+    pub name: String,
+    /// `"sprung"` or `"unsprung"`.
+    pub kind: SensorKind,
+    /// Corner: the wheel for an unsprung sensor, or the body point above that wheel for a sprung one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub corner: Option<Corner>,
+    /// Body x coordinate (forward from the centre of gravity), m; sprung sensors without `corner`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub x_m: Option<f64>,
+    /// Body y coordinate (to the left of the centre of gravity), m; sprung sensors without `corner`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub y_m: Option<f64>,
+    /// Body bending mode-shape value at the sensor (dimensionless, default 0; sprung sensors only).
+    #[serde(default)]
+    pub bending_shape: f64,
+}
+
+impl SensorSpec {
+    /// A sensor at a corner.
+    pub fn at_corner(name: &str, kind: SensorKind, corner: Corner) -> Self {
+        SensorSpec {
+            name: name.to_string(),
+            kind,
+            corner: Some(corner),
+            x_m: None,
+            y_m: None,
+            bending_shape: 0.0,
+        }
+    }
+}
+
+/// The paper's 7 sensors in this order: FL_unsprung, FR_unsprung, RL_unsprung, RR_unsprung
+/// (wheel spindles), FR_sprung, RL_sprung, RR_sprung (body floor above those wheels).
+pub fn default_sensors() -> Vec<SensorSpec> {
+    use Corner::*;
+    use SensorKind::*;
+    vec![
+        SensorSpec::at_corner("FL_unsprung", Unsprung, FL),
+        SensorSpec::at_corner("FR_unsprung", Unsprung, FR),
+        SensorSpec::at_corner("RL_unsprung", Unsprung, RL),
+        SensorSpec::at_corner("RR_unsprung", Unsprung, RR),
+        SensorSpec::at_corner("FR_sprung", Sprung, FR),
+        SensorSpec::at_corner("RL_sprung", Sprung, RL),
+        SensorSpec::at_corner("RR_sprung", Sprung, RR),
+    ]
+}
+
+/// Full parameter set of the 7-DOF (or 8 with bending) vehicle model, as read from TOML.
+/// See docs/vehicle.md for the file format. When `sensors` is empty the 7 default sensors
+/// ([`default_sensors`]) are used.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VehicleParams {
+    /// Free-text name of the vehicle.
+    #[serde(default)]
+    pub name: String,
+    /// Sprung mass.
+    pub body: Body,
+    /// Wheel positions.
+    pub geometry: Geometry,
+    /// Front axle (per wheel).
+    pub front: Axle,
+    /// Rear axle (per wheel station).
+    pub rear: Axle,
+    /// Optional body bending mode.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bending: Option<Bending>,
+    /// Accelerometers; empty means the 7 defaults.
+    #[serde(default)]
+    pub sensors: Vec<SensorSpec>,
+}
+
+const CITY_BUS_TOML: &str = include_str!("../../../examples/city_bus.toml");
+const PASSENGER_CAR_TOML: &str = include_str!("../../../examples/passenger_car.toml");
+
+impl Default for VehicleParams {
+    /// The 12 m city bus of `examples/city_bus.toml`.
+    fn default() -> Self {
+        Self::city_bus()
+    }
+}
+
+impl VehicleParams {
+    /// The 12 m city bus shipped in `examples/city_bus.toml` (compiled in).
+    pub fn city_bus() -> Self {
+        // The shipped file is checked by the unit tests, so parsing cannot fail.
+        Self::from_toml_str(CITY_BUS_TOML)
+            .unwrap_or_else(|e| panic!("examples/city_bus.toml is invalid: {e}"))
+    }
+
+    /// The passenger car shipped in `examples/passenger_car.toml` (compiled in).
+    pub fn passenger_car() -> Self {
+        Self::from_toml_str(PASSENGER_CAR_TOML)
+            .unwrap_or_else(|e| panic!("examples/passenger_car.toml is invalid: {e}"))
+    }
+
+    /// Parse and validate TOML text. Missing sensors are replaced by the 7 defaults.
+    pub fn from_toml_str(text: &str) -> Result<Self> {
+        let mut p: VehicleParams = toml::from_str(text).map_err(|e| {
+            let location = match e.span() {
+                Some(span) => format!(
+                    " at line {}",
+                    text[..span.start.min(text.len())].matches('\n').count() + 1
+                ),
+                None => String::new(),
+            };
+            VehicleError::Toml {
+                location,
+                message: e.message().replace('\n', " ").trim().to_string(),
+            }
+        })?;
+        if p.sensors.is_empty() {
+            p.sensors = default_sensors();
+        }
+        p.validate()?;
+        Ok(p)
+    }
+
+    /// Read, parse and validate a TOML file.
+    pub fn from_path(path: impl AsRef<std::path::Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| VehicleError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Self::from_toml_str(&text)
+    }
+
+    /// Serialise to TOML text (round-trips through [`VehicleParams::from_toml_str`]).
+    pub fn to_toml_string(&self) -> Result<String> {
+        toml::to_string(self)
+            .map_err(|e| VehicleError::Numerical(format!("cannot serialise parameters: {e}")))
+    }
+
+    /// Sensors actually used: `sensors`, or the 7 defaults when empty.
+    pub fn effective_sensors(&self) -> Vec<SensorSpec> {
+        if self.sensors.is_empty() {
+            default_sensors()
+        } else {
+            self.sensors.clone()
+        }
+    }
+
+    /// Check every value; the error names the key, e.g.
+    /// "front.spring_stiffness_n_per_m = -100000 must be positive (N/m)".
+    pub fn validate(&self) -> Result<()> {
+        fn pos(key: &str, v: f64, unit: &str) -> Result<()> {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(invalid(
+                    key,
+                    v,
+                    format!("must be positive and finite ({unit})"),
+                ))
+            }
+        }
+        fn nonneg(key: &str, v: f64, unit: &str) -> Result<()> {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                Err(invalid(
+                    key,
+                    v,
+                    format!("must be zero or positive ({unit})"),
+                ))
+            }
+        }
+        let b = &self.body;
+        pos("body.mass_kg", b.mass_kg, "kg")?;
+        pos("body.pitch_inertia_kgm2", b.pitch_inertia_kgm2, "kg m^2")?;
+        pos("body.roll_inertia_kgm2", b.roll_inertia_kgm2, "kg m^2")?;
+        nonneg("body.cg_height_m", b.cg_height_m, "m")?;
+        let g = &self.geometry;
+        pos("geometry.wheelbase_m", g.wheelbase_m, "m")?;
+        pos("geometry.cg_to_front_axle_m", g.cg_to_front_axle_m, "m")?;
+        pos("geometry.track_front_m", g.track_front_m, "m")?;
+        pos("geometry.track_rear_m", g.track_rear_m, "m")?;
+        if g.cg_to_front_axle_m >= g.wheelbase_m {
+            return Err(invalid(
+                "geometry.cg_to_front_axle_m",
+                g.cg_to_front_axle_m,
+                format!(
+                    "must be smaller than geometry.wheelbase_m = {}",
+                    g.wheelbase_m
+                ),
+            ));
+        }
+        for (name, a) in [("front", &self.front), ("rear", &self.rear)] {
+            pos(
+                &format!("{name}.unsprung_mass_kg"),
+                a.unsprung_mass_kg,
+                "kg",
+            )?;
+            pos(
+                &format!("{name}.spring_stiffness_n_per_m"),
+                a.spring_stiffness_n_per_m,
+                "N/m",
+            )?;
+            nonneg(
+                &format!("{name}.damper_n_s_per_m"),
+                a.damper_n_s_per_m,
+                "N s/m",
+            )?;
+            pos(
+                &format!("{name}.tyre_stiffness_n_per_m"),
+                a.tyre_stiffness_n_per_m,
+                "N/m",
+            )?;
+            nonneg(
+                &format!("{name}.tyre_damping_n_s_per_m"),
+                a.tyre_damping_n_s_per_m,
+                "N s/m",
+            )?;
+            nonneg(
+                &format!("{name}.anti_roll_stiffness_nm_per_rad"),
+                a.anti_roll_stiffness_nm_per_rad,
+                "N m/rad",
+            )?;
+        }
+        if let Some(bd) = &self.bending {
+            pos("bending.frequency_hz", bd.frequency_hz, "Hz")?;
+            nonneg("bending.damping_ratio", bd.damping_ratio, "dimensionless")?;
+            pos("bending.modal_mass_kg", bd.modal_mass_kg, "kg")?;
+            if bd.corner_shape.iter().any(|v| !v.is_finite()) {
+                return Err(invalid(
+                    "bending.corner_shape",
+                    format!("{:?}", bd.corner_shape),
+                    "must be 4 finite numbers [FL, FR, RL, RR]",
+                ));
+            }
+        }
+        let mut seen = std::collections::HashSet::new();
+        for (i, s) in self.effective_sensors().iter().enumerate() {
+            let key = format!("sensors[{i}]");
+            if s.name.trim().is_empty() {
+                return Err(invalid(
+                    format!("{key}.name"),
+                    "\"\"",
+                    "must not be empty; give a channel name like \"FR_sprung\"",
+                ));
+            }
+            if !seen.insert(s.name.clone()) {
+                return Err(invalid(
+                    format!("{key}.name"),
+                    &s.name,
+                    "is used twice; give every sensor a unique name",
+                ));
+            }
+            match s.kind {
+                SensorKind::Unsprung => {
+                    if s.corner.is_none() {
+                        return Err(invalid(format!("{key}.corner"), "(missing)", "is required for an unsprung sensor; use corner = \"FL\", \"FR\", \"RL\" or \"RR\""));
+                    }
+                    if s.x_m.is_some() || s.y_m.is_some() {
+                        return Err(invalid(format!("{key}.x_m"), "(given)", "is only allowed for sprung sensors; an unsprung sensor sits at its corner"));
+                    }
+                    if s.bending_shape != 0.0 {
+                        return Err(invalid(format!("{key}.bending_shape"), s.bending_shape, "is only allowed for sprung sensors; remove it"));
+                    }
+                }
+                SensorKind::Sprung => match (s.corner, s.x_m, s.y_m) {
+                    (Some(_), None, None) => {}
+                    (None, Some(x), Some(y)) => {
+                        if !x.is_finite() || !y.is_finite() {
+                            return Err(invalid(format!("{key}.x_m"), format!("{x}, y_m = {y}"), "must be finite (m)"));
+                        }
+                    }
+                    _ => {
+                        return Err(invalid(
+                            format!("{key}.corner"),
+                            format!("{:?}", s.corner.map(|c| c.to_string())),
+                            "a sprung sensor needs either corner = \"FR\" or both x_m and y_m, not a mix",
+                        ))
+                    }
+                },
+            }
+            if !s.bending_shape.is_finite() {
+                return Err(invalid(
+                    format!("{key}.bending_shape"),
+                    s.bending_shape,
+                    "must be finite",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Body coordinates (x forward, y left from the centre of gravity, m) of a wheel station.
+    pub fn corner_position_m(&self, c: Corner) -> (f64, f64) {
+        let g = &self.geometry;
+        let a = g.cg_to_front_axle_m;
+        let b = g.wheelbase_m - a;
+        match c {
+            Corner::FL => (a, 0.5 * g.track_front_m),
+            Corner::FR => (a, -0.5 * g.track_front_m),
+            Corner::RL => (-b, 0.5 * g.track_rear_m),
+            Corner::RR => (-b, -0.5 * g.track_rear_m),
+        }
+    }
+
+    /// The axle parameters of a corner.
+    pub fn axle(&self, c: Corner) -> &Axle {
+        if c.is_front() {
+            &self.front
+        } else {
+            &self.rear
+        }
+    }
+}

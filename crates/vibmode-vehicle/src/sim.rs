@@ -1,0 +1,805 @@
+//! Exact (first-order-hold) discretisation and the measurement-campaign simulator.
+
+use crate::error::{invalid, Result, VehicleError};
+use crate::model::{FullCar, ModeInfo, DOF_HEAVE, DOF_PITCH, DOF_ROLL};
+use crate::params::{Corner, VehicleParams};
+use crate::road::{
+    LateralCoherence, RoadClass, RoadInput, RoadProfile, DEFAULT_TYRE_ENVELOPE_CYCLES_PER_M,
+};
+use nalgebra::DMatrix;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rand_distr::StandardNormal;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// A periodic engine / driveline line: a vertical force on the body.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EngineLine {
+    /// Nominal frequency, Hz.
+    pub frequency_hz: f64,
+    /// Force amplitude, N (vertical, applied to the body at (x_m, y_m)).
+    pub force_n: f64,
+    /// Peak slow frequency deviation, Hz (0 = constant frequency).
+    pub drift_hz: f64,
+    /// Period of the sinusoidal frequency drift, s.
+    pub drift_period_s: f64,
+    /// Body x of the force (forward from the centre of gravity), m.
+    pub x_m: f64,
+    /// Body y of the force (to the left of the centre of gravity), m.
+    pub y_m: f64,
+}
+
+/// A sinusoidal tone added to every channel (models pick-up above the anti-alias cutoff).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Tone {
+    /// Frequency, Hz (may exceed fs_hz / 2: it is then sampled, i.e. aliased, like a real ADC
+    /// without analogue filter would).
+    pub frequency_hz: f64,
+    /// Amplitude, m/s^2.
+    pub amplitude_m_s2: f64,
+}
+
+/// Switchable non-road effects. `Default` switches everything off.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct Disturbances {
+    /// Engine / gear lines entering the body (default none).
+    pub engine_lines: Vec<EngineLine>,
+    /// Broadband white sensor noise, standard deviation per sample, m/s^2 (default 0).
+    pub sensor_noise_std_m_s2: f64,
+    /// Sensor bias: each channel gets a constant drawn uniformly from +-this value, m/s^2
+    /// (default 0). The drawn values are in [`Truth::sensor_bias_m_s2`].
+    pub sensor_bias_max_m_s2: f64,
+    /// High-frequency tones added to every channel (random phase per channel; default none).
+    pub hf_tones: Vec<Tone>,
+}
+
+impl Disturbances {
+    /// In-service preset: engine/gear lines at 7, 11 and 12 Hz (the paper's periodic poles;
+    /// 11 Hz drifting by +-0.2 Hz), sensor noise 0.02 m/s^2, bias up to 0.05 m/s^2, tones at
+    /// 150 Hz, 1.3 kHz and 6 kHz (0.05, 0.1, 0.2 m/s^2).
+    pub fn in_service() -> Self {
+        let line = |f: f64, force: f64, drift: f64| EngineLine {
+            frequency_hz: f,
+            force_n: force,
+            drift_hz: drift,
+            drift_period_s: 20.0,
+            x_m: -3.0,
+            y_m: 0.3,
+        };
+        Disturbances {
+            engine_lines: vec![
+                line(7.0, 400.0, 0.0),
+                line(11.0, 300.0, 0.2),
+                line(12.0, 300.0, 0.0),
+            ],
+            sensor_noise_std_m_s2: 0.02,
+            sensor_bias_max_m_s2: 0.05,
+            hf_tones: vec![
+                Tone {
+                    frequency_hz: 150.0,
+                    amplitude_m_s2: 0.05,
+                },
+                Tone {
+                    frequency_hz: 1300.0,
+                    amplitude_m_s2: 0.1,
+                },
+                Tone {
+                    frequency_hz: 6000.0,
+                    amplitude_m_s2: 0.2,
+                },
+            ],
+        }
+    }
+}
+
+/// A braking/acceleration and/or turning event. Accelerations follow a sin^2 pulse of the
+/// given peak over `duration_s`, starting `start_s` after the start of the first record.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Manoeuvre {
+    /// Start time from the beginning of record 0, s.
+    pub start_s: f64,
+    /// Duration, s (> 0).
+    pub duration_s: f64,
+    /// Peak longitudinal acceleration, m/s^2 (negative = braking). Changes the speed and
+    /// gives a pitch moment m a h_cg (nose down when braking).
+    pub longitudinal_accel_m_s2: f64,
+    /// Peak lateral acceleration, m/s^2 (positive = turning left). Gives a roll moment
+    /// m a h_cg (body rolls towards the outside of the turn).
+    pub lateral_accel_m_s2: f64,
+}
+
+impl Manoeuvre {
+    fn pulse(&self, t: f64) -> f64 {
+        if t < self.start_s || t > self.start_s + self.duration_s {
+            0.0
+        } else {
+            (PI * (t - self.start_s) / self.duration_s).sin().powi(2)
+        }
+    }
+}
+
+/// Simulator settings. Defaults: road C, default coherence (exponential, 0.2 cycles/m),
+/// tyre enveloping 3 cycles/m,
+/// 40 km/h, 8 records of 10.24 s at 20 kHz, seed 0, no manoeuvres, no disturbances,
+/// automatic warm-up.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SimParams {
+    /// ISO 8608 road class (default C).
+    pub road: RoadClass,
+    /// Left/right track coherence (default exponential, cutoff 0.2 cycles/m).
+    pub coherence: LateralCoherence,
+    /// Tyre-enveloping cutoff of the road, cycles/m (default Some(3.0); see [`RoadInput`]).
+    pub tyre_envelope_cycles_per_m: Option<f64>,
+    /// Nominal (initial) speed, km/h (default 40).
+    pub speed_kmh: f64,
+    /// Length of one record, s (default 10.24).
+    pub duration_s: f64,
+    /// Sampling rate, Hz (default 20000).
+    pub fs_hz: f64,
+    /// Number of records (default 8): successive segments of one continuous drive.
+    pub records: usize,
+    /// Random seed (ChaCha8); the same seed gives bit-identical output (default 0).
+    pub seed: u64,
+    /// Braking / acceleration / turning events (default none).
+    pub manoeuvres: Vec<Manoeuvre>,
+    /// Engine lines, sensor noise and bias, HF tones (default all off).
+    pub disturbances: Disturbances,
+    /// Warm-up driven before record 0 and discarded, s. `None` (default): 5 times the slowest
+    /// modal decay time 1/(zeta omega), clamped to 2..30 s.
+    pub warmup_s: Option<f64>,
+}
+
+impl Default for SimParams {
+    fn default() -> Self {
+        SimParams {
+            road: RoadClass::C,
+            coherence: LateralCoherence::default(),
+            tyre_envelope_cycles_per_m: Some(DEFAULT_TYRE_ENVELOPE_CYCLES_PER_M),
+            speed_kmh: 40.0,
+            duration_s: 10.24,
+            fs_hz: 20000.0,
+            records: 8,
+            seed: 0,
+            manoeuvres: Vec::new(),
+            disturbances: Disturbances::default(),
+            warmup_s: None,
+        }
+    }
+}
+
+impl SimParams {
+    /// In-service preset: defaults plus [`Disturbances::in_service`], a braking event in
+    /// record 1 (-1.5 m/s^2 over 3 s), an acceleration in record 3 (+1 m/s^2 over 4 s) and a
+    /// left turn in record 5 (2 m/s^2 lateral over 5 s).
+    pub fn in_service() -> Self {
+        SimParams {
+            disturbances: Disturbances::in_service(),
+            manoeuvres: vec![
+                Manoeuvre {
+                    start_s: 13.0,
+                    duration_s: 3.0,
+                    longitudinal_accel_m_s2: -1.5,
+                    lateral_accel_m_s2: 0.0,
+                },
+                Manoeuvre {
+                    start_s: 33.0,
+                    duration_s: 4.0,
+                    longitudinal_accel_m_s2: 1.0,
+                    lateral_accel_m_s2: 0.0,
+                },
+                Manoeuvre {
+                    start_s: 53.0,
+                    duration_s: 5.0,
+                    longitudinal_accel_m_s2: 0.0,
+                    lateral_accel_m_s2: 2.0,
+                },
+            ],
+            ..SimParams::default()
+        }
+    }
+
+    /// The road as seen by the wheels (for [`FullCar::acceleration_psd`]).
+    pub fn road_input(&self) -> RoadInput {
+        RoadInput {
+            class: self.road,
+            coherence: self.coherence,
+            tyre_envelope_cycles_per_m: self.tyre_envelope_cycles_per_m,
+        }
+    }
+
+    /// Check every value; errors name the field and the fix.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.speed_kmh.is_finite() && self.speed_kmh >= 1.0) {
+            return Err(invalid(
+                "speed_kmh",
+                self.speed_kmh,
+                "must be at least 1 km/h, e.g. 40",
+            ));
+        }
+        if !(self.fs_hz.is_finite() && self.fs_hz > 0.0) {
+            return Err(invalid(
+                "fs_hz",
+                self.fs_hz,
+                "must be positive (Hz), e.g. 20000",
+            ));
+        }
+        if !(self.duration_s.is_finite() && self.duration_s > 0.0)
+            || self.duration_s * self.fs_hz < 16.0
+        {
+            return Err(invalid(
+                "duration_s",
+                self.duration_s,
+                format!(
+                    "must give at least 16 samples at fs_hz = {}, e.g. 10.24",
+                    self.fs_hz
+                ),
+            ));
+        }
+        if self.records == 0 {
+            return Err(invalid("records", 0, "must be at least 1, e.g. 8"));
+        }
+        let total = (self.duration_s * self.fs_hz).round() * self.records as f64;
+        if total > 50e6 {
+            return Err(invalid(
+                "records * duration_s * fs_hz",
+                total,
+                "is more than 50 million samples per channel; reduce records, duration_s or fs_hz",
+            ));
+        }
+        self.road_input().validate()?;
+        if let Some(w) = self.warmup_s {
+            if !(w.is_finite() && (0.0..=600.0).contains(&w)) {
+                return Err(invalid("warmup_s", w, "must be between 0 and 600 s"));
+            }
+        }
+        for (i, m) in self.manoeuvres.iter().enumerate() {
+            if !(m.start_s.is_finite() && m.start_s >= 0.0) {
+                return Err(invalid(
+                    format!("manoeuvres[{i}].start_s"),
+                    m.start_s,
+                    "must be >= 0 (s)",
+                ));
+            }
+            if !(m.duration_s.is_finite() && m.duration_s > 0.0) {
+                return Err(invalid(
+                    format!("manoeuvres[{i}].duration_s"),
+                    m.duration_s,
+                    "must be positive (s)",
+                ));
+            }
+            if !m.longitudinal_accel_m_s2.is_finite() || m.longitudinal_accel_m_s2.abs() > 10.0 {
+                return Err(invalid(
+                    format!("manoeuvres[{i}].longitudinal_accel_m_s2"),
+                    m.longitudinal_accel_m_s2,
+                    "must be within +-10 m/s^2",
+                ));
+            }
+            if !m.lateral_accel_m_s2.is_finite() || m.lateral_accel_m_s2.abs() > 10.0 {
+                return Err(invalid(
+                    format!("manoeuvres[{i}].lateral_accel_m_s2"),
+                    m.lateral_accel_m_s2,
+                    "must be within +-10 m/s^2",
+                ));
+            }
+        }
+        let d = &self.disturbances;
+        for (i, l) in d.engine_lines.iter().enumerate() {
+            if !(l.frequency_hz.is_finite() && l.frequency_hz > 0.0) {
+                return Err(invalid(
+                    format!("engine_lines[{i}].frequency_hz"),
+                    l.frequency_hz,
+                    "must be positive (Hz)",
+                ));
+            }
+            if !(l.drift_hz.is_finite() && l.drift_hz >= 0.0 && l.drift_hz < l.frequency_hz) {
+                return Err(invalid(
+                    format!("engine_lines[{i}].drift_hz"),
+                    l.drift_hz,
+                    "must be >= 0 and below frequency_hz",
+                ));
+            }
+            if !(l.drift_period_s.is_finite() && l.drift_period_s > 0.0) {
+                return Err(invalid(
+                    format!("engine_lines[{i}].drift_period_s"),
+                    l.drift_period_s,
+                    "must be positive (s)",
+                ));
+            }
+            if !(l.force_n.is_finite() && l.x_m.is_finite() && l.y_m.is_finite()) {
+                return Err(invalid(
+                    format!("engine_lines[{i}].force_n"),
+                    l.force_n,
+                    "force_n, x_m and y_m must be finite",
+                ));
+            }
+        }
+        if !(d.sensor_noise_std_m_s2.is_finite() && d.sensor_noise_std_m_s2 >= 0.0) {
+            return Err(invalid(
+                "sensor_noise_std_m_s2",
+                d.sensor_noise_std_m_s2,
+                "must be >= 0 (m/s^2)",
+            ));
+        }
+        if !(d.sensor_bias_max_m_s2.is_finite() && d.sensor_bias_max_m_s2 >= 0.0) {
+            return Err(invalid(
+                "sensor_bias_max_m_s2",
+                d.sensor_bias_max_m_s2,
+                "must be >= 0 (m/s^2)",
+            ));
+        }
+        for (i, t) in d.hf_tones.iter().enumerate() {
+            if !(t.frequency_hz.is_finite() && t.frequency_hz > 0.0 && t.amplitude_m_s2.is_finite())
+            {
+                return Err(invalid(
+                    format!("hf_tones[{i}].frequency_hz"),
+                    t.frequency_hz,
+                    "must be positive with a finite amplitude_m_s2",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One record: successive segment of the drive.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SimRecord {
+    /// Sampling rate, Hz.
+    pub fs_hz: f64,
+    /// Time of the first sample from the start of record 0, s.
+    pub start_time_s: f64,
+    /// Mean speed during the record, km/h.
+    pub mean_speed_kmh: f64,
+    /// Channel names (sensor names).
+    pub channel_names: Vec<String>,
+    /// Vertical acceleration per channel, m/s^2 (`samples[channel][sample]`).
+    pub samples: Vec<Vec<f64>>,
+}
+
+/// Ground truth of a simulation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Truth {
+    /// Modes of the vehicle model.
+    pub modes: Vec<ModeInfo>,
+    /// Nominal frequencies of the engine / gear lines, Hz.
+    pub disturbance_lines_hz: Vec<f64>,
+    /// Frequencies of the added high-frequency tones, Hz.
+    pub hf_tones_hz: Vec<f64>,
+    /// Bias drawn for each channel, m/s^2.
+    pub sensor_bias_m_s2: Vec<f64>,
+    /// Sensor noise standard deviation, m/s^2.
+    pub sensor_noise_std_m_s2: f64,
+    /// Road class.
+    pub road_class: RoadClass,
+    /// Gd(n0) of the road class, m^3.
+    pub road_gd_n0_m3: f64,
+    /// Road as seen by the wheels (class, coherence, enveloping).
+    pub road: RoadInput,
+    /// Nominal speed, km/h.
+    pub speed_kmh: f64,
+    /// Warm-up actually used, s.
+    pub warmup_s: f64,
+    /// Seed.
+    pub seed: u64,
+}
+
+/// Result of [`simulate`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Simulation {
+    /// Records in time order.
+    pub records: Vec<SimRecord>,
+    /// What the identification should find.
+    pub truth: Truth,
+}
+
+/// Exact discretisation with first-order hold on the inputs u = [r (4), f (n)].
+pub(crate) struct Discrete {
+    ns: usize,
+    nu: usize,
+    np: usize,
+    phi: Vec<f64>,
+    ga: Vec<f64>,
+    gb: Vec<f64>,
+    cy: Vec<f64>,
+    dy: Vec<f64>,
+    ey: Vec<f64>,
+    /// Static state for a road height vector (x = S r), ns x 4.
+    x_static: DMatrix<f64>,
+}
+
+fn flat(m: &DMatrix<f64>) -> Vec<f64> {
+    let mut v = Vec::with_capacity(m.nrows() * m.ncols());
+    for i in 0..m.nrows() {
+        for j in 0..m.ncols() {
+            v.push(m[(i, j)]);
+        }
+    }
+    v
+}
+
+impl Discrete {
+    /// States x1 = q, x2 = q' - M^-1 Ct r (removes the road-velocity input from the state
+    /// equation); the road velocity then only enters the acceleration output directly.
+    pub(crate) fn new(car: &FullCar, fs_hz: f64) -> Result<Self> {
+        let n = car.n;
+        let ns = 2 * n;
+        let nu = 4 + n;
+        let h = 1.0 / fs_hz;
+        let minv = DMatrix::from_fn(n, n, |i, j| if i == j { 1.0 / car.mass[i] } else { 0.0 });
+        let mk = &minv * &car.k;
+        let mc = &minv * &car.c;
+        let mct = &minv * &car.ct;
+        let br = &minv * (&car.kt - &car.c * &mct);
+        let mut a = DMatrix::zeros(ns, ns);
+        let mut b = DMatrix::zeros(ns, nu);
+        for i in 0..n {
+            a[(i, n + i)] = 1.0;
+            for j in 0..n {
+                a[(n + i, j)] = -mk[(i, j)];
+                a[(n + i, n + j)] = -mc[(i, j)];
+            }
+            for j in 0..4 {
+                b[(i, j)] = mct[(i, j)];
+                b[(n + i, j)] = br[(i, j)];
+            }
+            b[(n + i, 4 + i)] = minv[(i, i)];
+        }
+        let na = ns + 2 * nu;
+        let mut aug = DMatrix::zeros(na, na);
+        aug.view_mut((0, 0), (ns, ns)).copy_from(&(&a * h));
+        aug.view_mut((0, ns), (ns, nu)).copy_from(&(&b * h));
+        for i in 0..nu {
+            aug[(ns + i, ns + nu + i)] = 1.0;
+        }
+        let e = aug.exp();
+        if e.iter().any(|v| !v.is_finite()) {
+            return Err(VehicleError::Numerical(format!(
+                "matrix exponential overflowed at fs_hz = {fs_hz}"
+            )));
+        }
+        let phi = e.view((0, 0), (ns, ns)).into_owned();
+        let e12 = e.view((0, ns), (ns, nu)).into_owned();
+        let e13 = e.view((0, ns + nu), (ns, nu)).into_owned();
+        let ga = &e12 - &e13;
+        // Outputs.
+        let p = car.sensors.len();
+        let o = DMatrix::from_fn(p, n, |s, i| car.sensors[s].row[i]);
+        let mut cy = DMatrix::zeros(p, ns);
+        cy.view_mut((0, 0), (p, n)).copy_from(&(-(&o * &mk)));
+        cy.view_mut((0, n), (p, n)).copy_from(&(-(&o * &mc)));
+        let dy = &o * b.view((n, 0), (n, nu));
+        let ey = &o * &mct;
+        // Static equilibrium for road heights r: K q = Kt r, q' = 0 -> x2 = -M^-1 Ct r.
+        let qs = car
+            .k
+            .clone()
+            .lu()
+            .solve(&car.kt)
+            .ok_or_else(|| VehicleError::Numerical("stiffness matrix is singular".into()))?;
+        let mut x_static = DMatrix::zeros(ns, 4);
+        x_static.view_mut((0, 0), (n, 4)).copy_from(&qs);
+        x_static.view_mut((n, 0), (n, 4)).copy_from(&(-&mct));
+        Ok(Discrete {
+            ns,
+            nu,
+            np: p,
+            phi: flat(&phi),
+            ga: flat(&ga),
+            gb: flat(&e13),
+            cy: flat(&cy),
+            dy: flat(&dy),
+            ey: flat(&ey),
+            x_static,
+        })
+    }
+
+    fn initial_state(&self, r0: &[f64]) -> Vec<f64> {
+        (0..self.ns)
+            .map(|i| (0..4).map(|j| self.x_static[(i, j)] * r0[j]).sum())
+            .collect()
+    }
+
+    /// Run over `len` samples. `input(k, u)` fills u (len nu) for sample k in 0..=len;
+    /// `rdot(k)` gives the road velocity at sample k; `sink(k, y)` receives the outputs.
+    fn run(
+        &self,
+        len: usize,
+        mut input: impl FnMut(usize, &mut [f64]),
+        mut rdot: impl FnMut(usize) -> [f64; 4],
+        mut sink: impl FnMut(usize, &[f64]),
+    ) {
+        let (ns, nu, np) = (self.ns, self.nu, self.np);
+        let mut u0 = vec![0.0; nu];
+        let mut u1 = vec![0.0; nu];
+        input(0, &mut u0);
+        let mut x = self.initial_state(&u0[..4]);
+        let mut xn = vec![0.0; ns];
+        let mut y = vec![0.0; np];
+        for k in 0..len {
+            let rd = rdot(k);
+            for (s, ys) in y.iter_mut().enumerate() {
+                let c = &self.cy[s * ns..(s + 1) * ns];
+                let d = &self.dy[s * nu..(s + 1) * nu];
+                let e = &self.ey[s * 4..(s + 1) * 4];
+                let mut acc = 0.0;
+                for i in 0..ns {
+                    acc += c[i] * x[i];
+                }
+                for i in 0..nu {
+                    acc += d[i] * u0[i];
+                }
+                for i in 0..4 {
+                    acc += e[i] * rd[i];
+                }
+                *ys = acc;
+            }
+            sink(k, &y);
+            input(k + 1, &mut u1);
+            for (i, xi) in xn.iter_mut().enumerate() {
+                let p = &self.phi[i * ns..(i + 1) * ns];
+                let a = &self.ga[i * nu..(i + 1) * nu];
+                let b = &self.gb[i * nu..(i + 1) * nu];
+                let mut acc = 0.0;
+                for j in 0..ns {
+                    acc += p[j] * x[j];
+                }
+                for j in 0..nu {
+                    acc += a[j] * u0[j] + b[j] * u1[j];
+                }
+                *xi = acc;
+            }
+            std::mem::swap(&mut x, &mut xn);
+            std::mem::swap(&mut u0, &mut u1);
+        }
+    }
+}
+
+impl FullCar {
+    /// Time response of the sensor accelerations (m/s^2) to given road heights
+    /// `road_m[k] = [FL, FR, RL, RR]` (m) sampled at `fs_hz`, starting at rest in static
+    /// equilibrium on `road_m[0]`. Exact for road heights linear between samples (first-order
+    /// hold); the road velocity in the tyre-damper term is the central difference.
+    /// Returns `out[channel][sample]`.
+    pub fn response(&self, road_m: &[[f64; 4]], fs_hz: f64) -> Result<Vec<Vec<f64>>> {
+        if !(fs_hz.is_finite() && fs_hz > 0.0) {
+            return Err(invalid("fs_hz", fs_hz, "must be positive (Hz)"));
+        }
+        if road_m.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(invalid(
+                "road_m",
+                "non-finite value",
+                "road heights must be finite (m)",
+            ));
+        }
+        let len = road_m.len();
+        let mut out = vec![vec![0.0; len]; self.sensors.len()];
+        if len == 0 {
+            return Ok(out);
+        }
+        let d = Discrete::new(self, fs_hz)?;
+        let at = |k: usize| road_m[k.min(len - 1)];
+        d.run(
+            len,
+            |k, u| {
+                u.iter_mut().for_each(|v| *v = 0.0);
+                u[..4].copy_from_slice(&at(k));
+            },
+            |k| {
+                let (a, b, span) = if len < 2 {
+                    (0, 0, 1.0)
+                } else if k == 0 {
+                    (0, 1, 1.0)
+                } else if k + 1 >= len {
+                    (len - 2, len - 1, 1.0)
+                } else {
+                    (k - 1, k + 1, 2.0)
+                };
+                let (ra, rb) = (road_m[a], road_m[b]);
+                std::array::from_fn(|i| (rb[i] - ra[i]) * fs_hz / span)
+            },
+            |k, y| {
+                for (o, v) in out.iter_mut().zip(y) {
+                    o[k] = *v;
+                }
+            },
+        );
+        Ok(out)
+    }
+}
+
+/// Simulate the measurement campaign: one continuous drive over an ISO 8608 road, cut into
+/// `records` successive records, with the optional manoeuvres and disturbances.
+///
+/// Same parameters and seed give bit-identical output.
+pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> {
+    sim.validate()?;
+    let car = FullCar::new(vehicle)?;
+    let modes = car.modes()?;
+    let fs = sim.fs_hz;
+    let dt = 1.0 / fs;
+    let warmup_s = match sim.warmup_s {
+        Some(w) => w,
+        None => {
+            let tmax = modes
+                .iter()
+                .map(|m| 1.0 / (m.damping_ratio * 2.0 * PI * m.frequency_hz).max(1e-9))
+                .fold(0.0, f64::max);
+            (5.0 * tmax).clamp(2.0, 30.0)
+        }
+    };
+    let n_warm = (warmup_s * fs).round() as usize;
+    let n_rec = (sim.duration_s * fs).round() as usize;
+    let n_total = n_warm + n_rec * sim.records;
+    // Speed and position per sample (index k covers t = (k - n_warm) dt), one extra at each end.
+    let v0 = sim.speed_kmh / 3.6;
+    let body_m = vehicle.body.mass_kg;
+    let h_cg = vehicle.body.cg_height_m;
+    let time = |k: usize| (k as f64 - n_warm as f64 - 1.0) * dt; // index shifted by one
+    let ax = |t: f64| {
+        sim.manoeuvres
+            .iter()
+            .map(|m| m.longitudinal_accel_m_s2 * m.pulse(t))
+            .sum::<f64>()
+    };
+    let ay = |t: f64| {
+        sim.manoeuvres
+            .iter()
+            .map(|m| m.lateral_accel_m_s2 * m.pulse(t))
+            .sum::<f64>()
+    };
+    let nk = n_total + 2;
+    let mut speed = vec![v0; nk];
+    for k in 1..nk {
+        let t0 = time(k - 1);
+        let t1 = time(k);
+        speed[k] = speed[k - 1] + 0.5 * (ax(t0) + ax(t1)) * dt;
+        if speed[k] < 0.5 {
+            return Err(invalid(
+                "manoeuvres",
+                format!("speed {:.2} m/s at t = {:.2} s", speed[k], t1),
+                "brakes the vehicle below 0.5 m/s; reduce the braking longitudinal_accel_m_s2 or raise speed_kmh",
+            ));
+        }
+    }
+    let wb = vehicle.geometry.wheelbase_m;
+    let vmax = speed.iter().copied().fold(0.0, f64::max);
+    let dx = vmax * dt;
+    let mut pos = vec![dx; nk];
+    for k in 1..nk {
+        pos[k] = pos[k - 1] + 0.5 * (speed[k - 1] + speed[k]) * dt;
+    }
+    let length = pos[nk - 1] + wb + 4.0 * dx;
+    let mut rng = ChaCha8Rng::seed_from_u64(sim.seed);
+    rng.set_stream(1);
+    let road = RoadProfile::generate(&sim.road_input(), length, dx, &mut rng)?;
+    let mut rng2 = ChaCha8Rng::seed_from_u64(sim.seed);
+    rng2.set_stream(2);
+    // Road heights for every index: front axle at pos + wb, rear at pos.
+    let corners: Vec<(usize, f64)> = Corner::ALL
+        .iter()
+        .map(|c| {
+            (
+                if matches!(c, Corner::FL | Corner::RL) {
+                    0
+                } else {
+                    1
+                },
+                if c.is_front() { wb } else { 0.0 },
+            )
+        })
+        .collect();
+    let road_at = |k: usize| -> [f64; 4] {
+        std::array::from_fn(|i| road.height_m(corners[i].0, pos[k] + corners[i].1))
+    };
+    // Generalised forces.
+    let n = car.n;
+    let lines: Vec<(EngineLine, f64)> = sim
+        .disturbances
+        .engine_lines
+        .iter()
+        .map(|l| (l.clone(), rng2.gen_range(0.0..2.0 * PI)))
+        .collect();
+    let d = Discrete::new(&car, fs)?;
+    let p = car.sensors.len();
+    let names = car.sensor_names();
+    let mut samples: Vec<Vec<f64>> = vec![vec![0.0; n_rec * sim.records]; p];
+    // State index k of `run` corresponds to array index k + 1.
+    d.run(
+        n_total,
+        |k, u| {
+            let idx = k + 1;
+            let r = road_at(idx);
+            u.iter_mut().for_each(|v| *v = 0.0);
+            u[..4].copy_from_slice(&r);
+            let t = time(idx);
+            let f = &mut u[4..4 + n];
+            for (l, ph0) in &lines {
+                let phase = ph0
+                    + 2.0 * PI * l.frequency_hz * t
+                    + l.drift_hz
+                        * l.drift_period_s
+                        * (1.0 - (2.0 * PI * t / l.drift_period_s).cos());
+                let force = l.force_n * phase.sin();
+                f[DOF_HEAVE] += force;
+                f[DOF_PITCH] += force * l.x_m;
+                f[DOF_ROLL] += force * l.y_m;
+            }
+            if !sim.manoeuvres.is_empty() {
+                f[DOF_PITCH] += body_m * ax(t) * h_cg;
+                f[DOF_ROLL] += body_m * ay(t) * h_cg;
+            }
+        },
+        |k| {
+            let (a, b) = (road_at(k), road_at(k + 2));
+            std::array::from_fn(|i| (b[i] - a[i]) / (2.0 * dt))
+        },
+        |k, y| {
+            if k >= n_warm {
+                let j = k - n_warm;
+                for (s, v) in samples.iter_mut().zip(y) {
+                    s[j] = *v;
+                }
+            }
+        },
+    );
+    // Sensor effects.
+    let dist = &sim.disturbances;
+    let bias: Vec<f64> = (0..p)
+        .map(|_| {
+            if dist.sensor_bias_max_m_s2 > 0.0 {
+                rng2.gen_range(-1.0..1.0) * dist.sensor_bias_max_m_s2
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    for (c, s) in samples.iter_mut().enumerate() {
+        let phases: Vec<f64> = dist
+            .hf_tones
+            .iter()
+            .map(|_| rng2.gen_range(0.0..2.0 * PI))
+            .collect();
+        for (j, v) in s.iter_mut().enumerate() {
+            let t = j as f64 * dt;
+            let mut add = bias[c];
+            for (tone, ph) in dist.hf_tones.iter().zip(&phases) {
+                add += tone.amplitude_m_s2 * (2.0 * PI * tone.frequency_hz * t + ph).sin();
+            }
+            if dist.sensor_noise_std_m_s2 > 0.0 {
+                let g: f64 = rng2.sample(StandardNormal);
+                add += g * dist.sensor_noise_std_m_s2;
+            }
+            *v += add;
+        }
+    }
+    let mut records = Vec::with_capacity(sim.records);
+    for r in 0..sim.records {
+        let a = r * n_rec;
+        let i0 = n_warm + a + 1;
+        let mean_v = speed[i0..i0 + n_rec].iter().sum::<f64>() / n_rec as f64;
+        records.push(SimRecord {
+            fs_hz: fs,
+            start_time_s: a as f64 * dt,
+            mean_speed_kmh: mean_v * 3.6,
+            channel_names: names.clone(),
+            samples: samples.iter().map(|s| s[a..a + n_rec].to_vec()).collect(),
+        });
+    }
+    Ok(Simulation {
+        records,
+        truth: Truth {
+            modes,
+            disturbance_lines_hz: dist.engine_lines.iter().map(|l| l.frequency_hz).collect(),
+            hf_tones_hz: dist.hf_tones.iter().map(|t| t.frequency_hz).collect(),
+            sensor_bias_m_s2: bias,
+            sensor_noise_std_m_s2: dist.sensor_noise_std_m_s2,
+            road_class: sim.road,
+            road_gd_n0_m3: sim.road.gd_n0_m3(),
+            road: sim.road_input(),
+            speed_kmh: sim.speed_kmh,
+            warmup_s,
+            seed: sim.seed,
+        },
+    })
+}
