@@ -140,7 +140,7 @@ pub fn log_ticks(lo: f64, hi: f64, max_ticks: usize) -> (Vec<f64>, Vec<f64>) {
             let mut v = Vec::new();
             for d in (d0 - 1)..=d1 {
                 for &m in mantissas {
-                    let t = m * 10f64.powi(d as i32);
+                    let t = mantissa_pow10(m, d);
                     if t >= lo * (1.0 - 1e-12) && t <= hi * (1.0 + 1e-12) {
                         v.push(t);
                     }
@@ -171,15 +171,15 @@ pub fn log_ticks(lo: f64, hi: f64, max_ticks: usize) -> (Vec<f64>, Vec<f64>) {
     let mut minor = Vec::new();
     for d in d0..=d1 {
         if d.rem_euclid(step) == 0 {
-            major.push(10f64.powi(d as i32));
+            major.push(mantissa_pow10(1.0, d));
         } else if n <= 400 {
-            minor.push(10f64.powi(d as i32));
+            minor.push(mantissa_pow10(1.0, d));
         }
     }
     if step == 1 && b - a <= 10.0 {
         for d in (d0 - 1)..=d1 {
             for m in 2..=9 {
-                let v = m as f64 * 10f64.powi(d as i32);
+                let v = mantissa_pow10(f64::from(m), d);
                 if v >= lo * (1.0 - 1e-12) && v <= hi * (1.0 + 1e-12) {
                     minor.push(v);
                 }
@@ -187,6 +187,11 @@ pub fn log_ticks(lo: f64, hi: f64, max_ticks: usize) -> (Vec<f64>, Vec<f64>) {
         }
     }
     (major, minor)
+}
+
+/// `m · 10^d`, correctly rounded (so 6·10⁻¹ is exactly the double nearest 0.6).
+fn mantissa_pow10(m: f64, d: i64) -> f64 {
+    format!("{m}e{d}").parse().unwrap_or(f64::NAN)
 }
 
 /// Tick label text: plain decimal with up to 6 significant digits and no trailing zeros
