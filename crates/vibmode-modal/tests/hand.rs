@@ -1,0 +1,449 @@
+//! Small cases checkable by hand: clustering, matching, stabilisation, and the bad-input paths.
+
+use vibmode_modal::{
+    analyse_poles, find_invariant_modes, match_reference, stabilisation, ClusterParams,
+    InvariantMode, ModalError, ModeClass, ModeMatch, PoleObservation, ReferenceMode,
+    StabilisationParams, Stability,
+};
+
+fn pole(f: f64, z: f64, order: usize, record: usize) -> PoleObservation {
+    PoleObservation::new(f, z, order, record, "RL")
+}
+
+/// 2 records x orders {4, 6} x 1 channel = 4 fits; core threshold = min_points = 2.
+fn hand_poles() -> Vec<PoleObservation> {
+    vec![
+        pole(1.000, 0.20, 4, 0),   // 0  mode A
+        pole(1.012, 0.20, 4, 0),   // 1  duplicate of fit (0,4): farther from the centre -> dropped
+        pole(1.005, 0.21, 6, 0),   // 2
+        pole(0.995, 0.19, 4, 1),   // 3
+        pole(1.010, 0.22, 6, 1),   // 4
+        pole(5.000, 1.0e-3, 4, 0), // 5  line
+        pole(5.001, 1.1e-3, 6, 0), // 6
+        pole(4.999, 0.9e-3, 6, 1), // 7
+        pole(2.00, 0.10, 4, 1),    // 8  mode B, record 1 only
+        pole(2.02, 0.10, 6, 1),    // 9
+        pole(3.00, 0.10, 6, 0),    // 10 isolated -> noise
+        pole(40.0, 0.10, 6, 0),    // 11 above freq_max_hz -> ignored
+        pole(1.00, 0.80, 6, 0),    // 12 above max_damping_ratio -> ignored
+    ]
+}
+
+fn hand_params() -> ClusterParams {
+    ClusterParams {
+        min_points: 2,
+        min_density_share: 0.0,
+        min_record_share: 0.6,
+        ..ClusterParams::default()
+    }
+}
+
+fn close(a: f64, b: f64, tol: f64) {
+    assert!((a - b).abs() <= tol, "{a} vs {b}");
+}
+
+#[test]
+fn hand_clusters_shares_and_classes() {
+    let a = analyse_poles(&hand_poles(), 2, &[4, 6], &hand_params()).unwrap();
+    assert_eq!(
+        (a.n_used, a.n_ignored, a.n_fits, a.core_threshold),
+        (11, 2, 4, 2)
+    );
+    assert_eq!(a.modes.len(), 3);
+    let m = &a.modes[0];
+    // kept 1.000, 1.005, 0.995, 1.010: mean 1.0025, deviations +-0.0025, +-0.0075
+    close(m.frequency_hz, 1.0025, 1e-12);
+    close(m.frequency_std_hz, (1.25e-4f64 / 3.0).sqrt(), 1e-12);
+    // damping 0.19 0.20 0.21 0.22: median 0.205, q25 at position 0.75, q75 at 2.25
+    close(m.damping_ratio, 0.205, 1e-12);
+    close(m.damping_iqr.0, 0.1975, 1e-12);
+    close(m.damping_iqr.1, 0.2125, 1e-12);
+    assert_eq!((m.n_poles, m.record_share, m.order_share), (4, 1.0, 1.0));
+    assert_eq!(m.class, ModeClass::Structural);
+    assert_eq!(m.channels, vec!["RL".to_string()]);
+    assert_eq!(m.min_order, 4);
+
+    let b = &a.modes[1]; // 2 Hz, record 1 only: 1 of 2 records < 0.6
+    close(b.frequency_hz, 2.01, 1e-12);
+    assert_eq!((b.n_poles, b.record_share, b.order_share), (2, 0.5, 0.5));
+    assert_eq!(b.class, ModeClass::Spurious);
+
+    let l = &a.modes[2]; // line: 3 of 4 fits
+    close(l.frequency_hz, 5.0, 1e-12);
+    close(l.frequency_std_hz, 0.001, 1e-12);
+    close(l.damping_ratio, 1.0e-3, 1e-15);
+    close(l.damping_iqr.0, 0.95e-3, 1e-15);
+    close(l.damping_iqr.1, 1.05e-3, 1e-15);
+    assert_eq!((l.record_share, l.order_share), (1.0, 0.75));
+    assert_eq!(l.class, ModeClass::PeriodicDisturbance);
+
+    let expected_labels = [
+        Some(0),
+        None,
+        Some(0),
+        Some(0),
+        Some(0),
+        Some(2),
+        Some(2),
+        Some(2),
+        Some(1),
+        Some(1),
+        None,
+        None,
+        None,
+    ];
+    assert_eq!(a.labels, expected_labels);
+
+    // With a lower record-share requirement the 2 Hz cluster becomes invariant.
+    let p = ClusterParams {
+        min_record_share: 0.5,
+        ..hand_params()
+    };
+    let modes = find_invariant_modes(&hand_poles(), 2, &[4, 6], &p).unwrap();
+    assert_eq!(modes[1].class, ModeClass::Structural);
+    // A tighter frequency tolerance (0.5 %) splits the 2 Hz pair (1 % apart) into noise.
+    let p = ClusterParams {
+        freq_tol_rel: 0.005,
+        ..hand_params()
+    };
+    let modes = find_invariant_modes(&hand_poles(), 2, &[4, 6], &p).unwrap();
+    assert!(modes.iter().all(|m| (m.frequency_hz - 2.01).abs() > 0.05));
+    // A line whose frequency spread is too large is not a disturbance.
+    let p = ClusterParams {
+        disturbance_freq_spread_max: 1e-4,
+        ..hand_params()
+    };
+    let modes = find_invariant_modes(&hand_poles(), 2, &[4, 6], &p).unwrap();
+    assert_eq!(modes[2].class, ModeClass::Structural);
+}
+
+#[test]
+fn single_record_skips_record_test() {
+    let poles: Vec<_> = hand_poles().into_iter().filter(|q| q.record == 1).collect();
+    let p = ClusterParams {
+        min_record_share: 1.0,
+        ..hand_params()
+    };
+    let poles: Vec<_> = poles
+        .into_iter()
+        .map(|mut q| {
+            q.record = 0;
+            q
+        })
+        .collect();
+    let modes = find_invariant_modes(&poles, 1, &[4, 6], &p).unwrap();
+    assert!(!modes.is_empty());
+    assert!(modes.iter().all(|m| m.class == ModeClass::Structural));
+}
+
+fn mode(f: f64, z: f64, class: ModeClass) -> InvariantMode {
+    InvariantMode {
+        frequency_hz: f,
+        frequency_std_hz: 0.01,
+        damping_ratio: z,
+        damping_iqr: (z * 0.8, z * 1.2),
+        order_share: 0.9,
+        record_share: 1.0,
+        n_poles: 100,
+        channels: vec!["RL".into()],
+        roles: vec![],
+        min_order: 4,
+        class,
+    }
+}
+
+fn reference(f: f64, z: f64, label: &str) -> ReferenceMode {
+    ReferenceMode {
+        frequency_hz: f,
+        damping_ratio: z,
+        label: label.into(),
+    }
+}
+
+#[test]
+fn hand_match_reference() {
+    let modes = vec![
+        mode(1.0, 0.2, ModeClass::Structural),
+        mode(3.0, 0.1, ModeClass::Spurious),
+        mode(5.0, 1e-3, ModeClass::PeriodicDisturbance),
+        mode(10.0, 0.15, ModeClass::Structural),
+    ];
+    let refs = vec![
+        reference(1.05, 0.3, "heave"),
+        reference(5.0, 0.1, "at the line"),
+        reference(3.0, 0.1, "at the spurious cluster"),
+        reference(9.8, 0.25, "hop FL"),
+        reference(10.3, 0.2, "hop RR"),
+    ];
+    let m = match_reference(&modes, &refs, 0.1);
+    assert_eq!(m.len(), 5);
+    assert_eq!(m[0].invariant, Some(0));
+    close(m[0].freq_diff_rel, (1.0 - 1.05) / 1.05, 1e-12);
+    close(m[0].damping_diff, -0.1, 1e-12);
+    // the line and the spurious cluster are never matched; the nearest structural mode is 1 Hz
+    assert_eq!(m[1].invariant, None);
+    close(m[1].freq_diff_rel, -0.8, 1e-12);
+    assert_eq!(m[2].invariant, None);
+    close(m[2].freq_diff_rel, (1.0 - 3.0) / 3.0, 1e-12);
+    // two reference modes may share one invariant mode
+    assert_eq!((m[3].invariant, m[4].invariant), (Some(3), Some(3)));
+    close(m[3].damping_diff, -0.1, 1e-12);
+    assert_eq!(m[4].reference.label, "hop RR");
+    // a tighter tolerance leaves 10.3 Hz (2.9 % away) unmatched but keeps 9.8 Hz (2.0 %)
+    let m = match_reference(&modes, &refs, 0.025);
+    assert_eq!((m[3].invariant, m[4].invariant), (Some(3), None));
+    // no structural modes at all: NaN differences, which survive a JSON round trip as null
+    let m = match_reference(&modes[1..3], &refs[..1], 0.1);
+    assert!(m[0].invariant.is_none() && m[0].freq_diff_rel.is_nan() && m[0].damping_diff.is_nan());
+    let json = serde_json::to_string(&m[0]).unwrap();
+    let back: ModeMatch = serde_json::from_str(&json).unwrap();
+    assert!(back.freq_diff_rel.is_nan());
+    // NaN tolerance or NaN reference frequency match nothing
+    assert!(match_reference(&modes, &refs, f64::NAN)
+        .iter()
+        .all(|x| x.invariant.is_none()));
+    let m = match_reference(&modes, &[reference(f64::NAN, 0.1, "bad")], 0.1);
+    assert!(m[0].invariant.is_none());
+    assert!(match_reference(&modes, &[], 0.1).is_empty());
+}
+
+#[test]
+fn hand_stabilisation() {
+    let mk = |f: f64, z: f64, order: usize, ch: &str| PoleObservation::new(f, z, order, 0, ch);
+    let poles = vec![
+        mk(1.0, 0.2, 2, "A"),     // first order -> new
+        mk(1.005, 0.205, 4, "A"), // 0.5 %, 2.5 % -> s
+        mk(3.0, 0.1, 4, "A"),     // new
+        mk(1.02, 0.2, 6, "A"),    // 1.49 % from 1.005 -> new
+        mk(3.01, 0.13, 6, "A"),   // 0.33 %, 30 % -> f
+        mk(5.0, 0.01, 6, "A"),    // new
+        mk(1.005, 0.205, 4, "B"), // other sweep, first order -> new
+        mk(1.0, 0.2, 6, "B"),     // 0.5 %, 2.4 % -> s
+    ];
+    let s = stabilisation(&poles, &StabilisationParams::default()).unwrap();
+    use Stability::*;
+    assert_eq!(
+        s,
+        vec![
+            New,
+            FrequencyAndDamping,
+            New,
+            New,
+            Frequency,
+            New,
+            New,
+            FrequencyAndDamping
+        ]
+    );
+    let symbols: String = s.iter().map(|x| x.symbol()).collect();
+    assert_eq!(symbols, "osoofoos");
+    // looser frequency tolerance: 1.02 vs 1.005 becomes frequency-stable (damping 2.4 % -> s)
+    let p = StabilisationParams {
+        freq_tol_rel: 0.02,
+        ..StabilisationParams::default()
+    };
+    assert_eq!(stabilisation(&poles, &p).unwrap()[3], FrequencyAndDamping);
+    assert_eq!("s".parse::<Stability>().unwrap(), FrequencyAndDamping);
+    assert_eq!(
+        Frequency.to_string().parse::<Stability>().unwrap(),
+        Frequency
+    );
+    assert!("x"
+        .parse::<Stability>()
+        .unwrap_err()
+        .to_string()
+        .contains("frequency-and-damping"));
+    assert!(stabilisation(&[], &p).unwrap().is_empty());
+}
+
+#[test]
+fn empty_input_is_ok_empty() {
+    let p = ClusterParams::default();
+    assert!(find_invariant_modes(&[], 8, &[2, 3], &p)
+        .unwrap()
+        .is_empty());
+    // even with no records/orders: nothing to check
+    assert!(find_invariant_modes(&[], 0, &[], &p).unwrap().is_empty());
+    // only filtered poles -> empty, counted as ignored
+    let a = analyse_poles(&[pole(50.0, 0.1, 2, 0)], 1, &[2], &p).unwrap();
+    assert!(a.modes.is_empty());
+    assert_eq!(
+        (a.n_used, a.n_ignored, a.labels.clone()),
+        (0, 1, vec![None])
+    );
+}
+
+#[test]
+fn bad_inputs_are_errors_naming_the_value() {
+    let p = ClusterParams::default();
+    let mut poles = hand_poles();
+    poles[7].frequency_hz = f64::NAN;
+    let e = find_invariant_modes(&poles, 2, &[4, 6], &p).unwrap_err();
+    assert!(
+        matches!(e, ModalError::NonFiniteFrequency { index: 7, .. }),
+        "{e}"
+    );
+    assert!(e.to_string().contains("pole 7"));
+    assert!(!e.to_string().contains('\n'));
+
+    let mut poles = hand_poles();
+    poles[3].damping_ratio = f64::INFINITY;
+    let e = find_invariant_modes(&poles, 2, &[4, 6], &p).unwrap_err();
+    assert!(
+        matches!(e, ModalError::NonFiniteDamping { index: 3, .. }),
+        "{e}"
+    );
+    let e = stabilisation(&poles, &StabilisationParams::default()).unwrap_err();
+    assert!(
+        matches!(e, ModalError::NonFiniteDamping { index: 3, .. }),
+        "{e}"
+    );
+
+    let e = find_invariant_modes(&hand_poles(), 1, &[4, 6], &p).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ModalError::RecordOutOfRange {
+                index: 3,
+                record: 1,
+                n_records: 1,
+                needed: 2
+            }
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("n_records >= 2"), "{e}");
+
+    let e = find_invariant_modes(&hand_poles(), 2, &[4], &p).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ModalError::OrderNotListed {
+                index: 2,
+                order: 6,
+                ..
+            }
+        ),
+        "{e}"
+    );
+
+    let e = find_invariant_modes(&hand_poles(), 0, &[4, 6], &p).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ModalError::EmptySupport {
+                what: "n_records",
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let e = find_invariant_modes(&hand_poles(), 2, &[], &p).unwrap_err();
+    assert!(
+        matches!(e, ModalError::EmptySupport { what: "orders", .. }),
+        "{e}"
+    );
+}
+
+#[test]
+fn invalid_params_are_errors() {
+    let bad = [
+        ClusterParams {
+            freq_tol_rel: 0.0,
+            ..ClusterParams::default()
+        },
+        ClusterParams {
+            freq_tol_rel: -0.01,
+            ..ClusterParams::default()
+        },
+        ClusterParams {
+            log_damping_tol: 0.0,
+            ..ClusterParams::default()
+        },
+        ClusterParams {
+            log_damping_tol: f64::NAN,
+            ..ClusterParams::default()
+        },
+        ClusterParams {
+            min_points: 0,
+            ..ClusterParams::default()
+        },
+        ClusterParams {
+            min_record_share: 1.5,
+            ..ClusterParams::default()
+        },
+        ClusterParams {
+            min_order_share: -0.1,
+            ..ClusterParams::default()
+        },
+        ClusterParams {
+            min_density_share: f64::NAN,
+            ..ClusterParams::default()
+        },
+        ClusterParams {
+            disturbance_damping_max: 0.0,
+            ..ClusterParams::default()
+        },
+        ClusterParams {
+            freq_min_hz: 0.0,
+            ..ClusterParams::default()
+        },
+        ClusterParams {
+            freq_max_hz: 0.05,
+            ..ClusterParams::default()
+        },
+        ClusterParams {
+            max_damping_ratio: -1.0,
+            ..ClusterParams::default()
+        },
+        ClusterParams {
+            min_damping_ratio: 0.7,
+            ..ClusterParams::default()
+        },
+    ];
+    for p in &bad {
+        let e = find_invariant_modes(&hand_poles(), 2, &[4, 6], p).unwrap_err();
+        assert!(matches!(e, ModalError::InvalidParam { .. }), "{e}");
+        assert!(e.to_string().contains("use e.g."), "{e}");
+        // even empty input reports bad params
+        assert!(find_invariant_modes(&[], 2, &[4, 6], p).is_err());
+    }
+    let e = find_invariant_modes(&[], 2, &[4, 6], &bad[0]).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "freq_tol_rel (0) must be finite and > 0; use e.g. freq_tol_rel = 0.02"
+    );
+    let sp = StabilisationParams {
+        damping_tol_rel: 0.0,
+        ..StabilisationParams::default()
+    };
+    assert!(matches!(
+        stabilisation(&hand_poles(), &sp),
+        Err(ModalError::InvalidParam { .. })
+    ));
+}
+
+#[test]
+fn mode_class_parse_display_serde() {
+    for c in [
+        ModeClass::Structural,
+        ModeClass::PeriodicDisturbance,
+        ModeClass::Spurious,
+    ] {
+        assert_eq!(c.to_string().parse::<ModeClass>().unwrap(), c);
+        let j = serde_json::to_string(&c).unwrap();
+        assert_eq!(j, format!("\"{c}\""));
+    }
+    assert_eq!(
+        "Periodic_Disturbance".parse::<ModeClass>().unwrap(),
+        ModeClass::PeriodicDisturbance
+    );
+    let e = "bogus".parse::<ModeClass>().unwrap_err().to_string();
+    assert!(
+        e.contains("bogus") && e.contains("structural, periodic-disturbance, spurious"),
+        "{e}"
+    );
+    let m = mode(1.0, 0.2, ModeClass::Structural);
+    let back: InvariantMode = serde_json::from_str(&serde_json::to_string(&m).unwrap()).unwrap();
+    assert_eq!(back, m);
+}
