@@ -38,6 +38,8 @@
 //! assert!((modes[1].frequency_hz - 7.0).abs() < 1e-3);
 //! ```
 
+#![warn(missing_docs)]
+
 mod cluster;
 mod error;
 mod matching;
