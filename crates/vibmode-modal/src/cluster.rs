@@ -110,7 +110,9 @@ pub fn analyse_poles(
         });
     }
     let n_used = pts.len();
-    let n_fits = n_records * orders.len() * channel_ids.len();
+    let n_fits = n_records
+        .saturating_mul(orders.len())
+        .saturating_mul(channel_ids.len());
     let core_threshold = p
         .min_points
         .max((p.min_density_share * n_fits as f64).ceil() as usize);
@@ -333,7 +335,7 @@ fn summarise(
     roles.sort();
     roles.dedup();
     let record_share = n_supporting as f64 / n_records as f64;
-    let order_share = rec_orders.len() as f64 / (n_records * n_orders) as f64;
+    let order_share = rec_orders.len() as f64 / (n_records as f64 * n_orders as f64);
     let damping_ratio = percentile_sorted(&damps, 0.5);
     let supported =
         (n_records <= 1 || record_share >= p.min_record_share) && order_share >= p.min_order_share;
