@@ -1,8 +1,10 @@
 """Reference values for crates/vibmode-ident (AR and ARMA identification).
 
-Writes tools/reference/data/ident.json. Run from the repository root:
+Writes tools/reference/data/ident.json and ident_roots.json. Run from the repository root:
 
-    python3 tools/reference/ident.py
+    python3 tools/reference/ident.py          # everything (the ARMA(20,20) statsmodels fit takes minutes)
+    python3 tools/reference/ident.py ar       # only the AR section of ident.json (+ roots)
+    python3 tools/reference/ident.py roots    # only ident_roots.json
 
 Pinned versions (tools/reference/requirements.txt): Python 3.11, numpy 2.1.3, scipy 1.14.1,
 statsmodels 0.14.4.
@@ -14,6 +16,12 @@ Contents
       (we store sigma**2); A-convention coefficients are [1, -rho].
     - statsmodels.regression.linear_model.burg(x, order) -> rho, sigma2, and the Burg partial
       autocorrelations from statsmodels.tsa.stattools.pacf_burg.
+    - Burg recomputed independently in numpy long double (80-bit) with the denominators summed
+      directly ("burg_a_ld", "burg_var_ld"). statsmodels updates the Burg denominator by the
+      recursion d_{m+1} = (1 - k_m^2) d_m - ..., which loses up to 2.6e-8 relative on the lightly
+      damped "two_modes" signal; the long-double values agree with a direct float64 computation to
+      5e-13. Rust tolerance: 1e-8 vs statsmodels where statsmodels agrees with the long-double
+      reference to 1e-9, else 1e-7; 1e-10 vs the long-double reference everywhere.
     - forward-backward least squares solved independently with numpy.linalg.lstsq on the stacked
       forward and backward regression (x demeaned; rows t = p..N-1), noise variance = residual sum
       of squares / (2 (N - p)).
@@ -26,6 +34,15 @@ Contents
   statsmodels parameters evaluated by the same predictor as vibmode (eps = (A/C) y with zero initial
   conditions: scipy.signal.lfilter(a, c, y)), so the Rust test can compare like with like.
   Rust requirement: vibmode's quadratic prediction-error lambda <= 1.001 * lambda_cond.
+  (Fit times were measured on a shared 2-core machine while other jobs ran; indicative only.)
+* ident_roots.json (written by `python3 tools/reference/ident.py roots`, which skips the slow ARMA
+  part): an order-60 A(z) built in double precision from modes at 0.5, 1.0, 2.0 Hz (fs = 200 Hz),
+  25 lightly damped modes between 25 and 97 Hz and 4 real poles, and the roots of exactly those
+  double coefficients computed by mpmath.polyroots at 50 digits (mpmath 1.3.0). The rounded
+  coefficients move the intended 0.5-2 Hz roots by up to 2e-3 relative (intrinsic ill-conditioning
+  of the monomial basis), so the reference is the exact roots of the stored coefficients, not the
+  intended modes. Rust tolerance: 1e-6 relative on every mode frequency (numpy.roots, a balanced
+  companion + LAPACK, achieves 4e-11).
 """
 
 import json
@@ -75,6 +92,28 @@ def fb_ls(x, p):
     return np.concatenate([[1.0], sol]), float(res @ res / (2 * (n - p)))
 
 
+def burg_longdouble(x, p):
+    x = np.asarray(x, dtype=np.longdouble)
+    x = x - x.mean()
+    n = len(x)
+    f = x.copy()
+    b = x.copy()
+    a = np.zeros(p + 1, dtype=np.longdouble)
+    a[0] = 1
+    for m in range(1, p + 1):
+        fm = f[m:n].copy()
+        bm = b[m - 1 : n - 1].copy()
+        k = -2 * np.dot(fm, bm) / (np.dot(fm, fm) + np.dot(bm, bm))
+        f[m:n] = fm + k * bm
+        b[m:n] = bm + k * fm
+        prev = a.copy()
+        for i in range(1, m):
+            a[i] = prev[i] + k * prev[m - i]
+        a[m] = k
+    var = (np.dot(f[p:], f[p:]) + np.dot(b[p:], b[p:])) / (2 * (n - p))
+    return [float(v) for v in a], float(var)
+
+
 def ar_cases():
     rng = np.random.default_rng(20240601)
     fs = 200.0
@@ -91,6 +130,7 @@ def ar_cases():
             brho, bsig2 = burg(x, order=p)
             pacf, _ = pacf_burg(x, nlags=p)
             ls_a, ls_var = fb_ls(x, p)
+            ld_a, ld_var = burg_longdouble(x, p)
             out.append(
                 {
                     "name": name,
@@ -101,6 +141,8 @@ def ar_cases():
                     "burg_a": [1.0] + (-brho).tolist(),
                     "burg_var": float(bsig2),
                     "burg_pacf": pacf[1:].tolist(),
+                    "burg_a_ld": ld_a,
+                    "burg_var_ld": ld_var,
                     "ls_a": ls_a.tolist(),
                     "ls_var": ls_var,
                 }
@@ -159,7 +201,46 @@ def arma_cases():
     return cases
 
 
+def roots_case():
+    import mpmath
+
+    mpmath.mp.dps = 50
+    fs = 200.0
+    modes = [(0.5, 0.1), (1.0, 0.05), (2.0, 0.05)] + [(f, 0.02) for f in np.linspace(25, 97, 25)]
+    a = np.array([1.0])
+    for f, zeta in modes:
+        a = np.convolve(a, modes_poly([(f, zeta)], fs))
+    for r in [0.5, -0.3, 0.8, 0.1]:
+        a = np.convolve(a, [1.0, -r])
+    roots = mpmath.polyroots([mpmath.mpf(float(x)) for x in a], maxsteps=800, extraprec=800)
+    return {
+        "mpmath": mpmath.__version__,
+        "fs_hz": fs,
+        "intended_modes": [list(m) for m in modes],
+        "a": a.tolist(),
+        "roots_re": [float(mpmath.re(r)) for r in roots],
+        "roots_im": [float(mpmath.im(r)) for r in roots],
+    }
+
+
 def main():
+    import sys
+
+    out_roots = os.path.join(os.path.dirname(OUT), "ident_roots.json")
+    with open(out_roots, "w") as f:
+        json.dump(roots_case(), f)
+    print("wrote", out_roots, os.path.getsize(out_roots), "bytes")
+    if len(sys.argv) > 1 and sys.argv[1] == "roots":
+        return
+    if len(sys.argv) > 1 and sys.argv[1] == "ar":
+        # Regenerate only the AR section (deterministic), keep the slow ARMA section.
+        with open(OUT) as f:
+            data = json.load(f)
+        data["ar"] = ar_cases()
+        with open(OUT, "w") as f:
+            json.dump(data, f)
+        print("rewrote the AR section of", OUT)
+        return
     data = {
         "versions": {
             "numpy": np.__version__,

@@ -218,21 +218,44 @@ pub(crate) fn fb_least_squares(x: &[f64], p: usize) -> (Vec<f64>, f64) {
     for (gi, bi) in g.iter_mut().zip(&gb) {
         *gi += bi;
     }
-    let sol = cholesky_solve(&g, &rhs, p, 0.0)
-        .or_else(|| cholesky_solve(&g, &rhs, p, 1e-12))
-        .or_else(|| cholesky_solve(&g, &rhs, p, 1e-8))
-        .unwrap_or_else(|| vec![0.0; p]);
+    let solve = |b: &[f64]| {
+        cholesky_solve(&g, b, p, 0.0)
+            .or_else(|| cholesky_solve(&g, b, p, 1e-12))
+            .or_else(|| cholesky_solve(&g, b, p, 1e-8))
+    };
     let mut a = vec![1.0];
-    a.extend(sol);
+    a.extend(solve(&rhs).unwrap_or_else(|| vec![0.0; p]));
+    // The normal equations square the condition number: refine with the exact gradient
+    // (corrected semi-normal equations), O(N p) per step.
+    let mut fe = vec![0.0; n];
+    let mut be = vec![0.0; n];
     let mut ss = 0.0;
-    for t in p..n {
-        let mut fe = 0.0;
-        let mut be = 0.0;
-        for k in 0..=p {
-            fe += a[k] * x[t - k];
-            be += a[k] * x[t - p + k];
+    for step in 0..4 {
+        ss = 0.0;
+        for t in p..n {
+            let (mut f, mut b) = (0.0, 0.0);
+            for k in 0..=p {
+                f += a[k] * x[t - k];
+                b += a[k] * x[t - p + k];
+            }
+            fe[t] = f;
+            be[t] = b;
+            ss += f * f + b * b;
         }
-        ss += fe * fe + be * be;
+        if step == 3 {
+            break;
+        }
+        let grad: Vec<f64> = (1..=p)
+            .map(|k| -(dot(&fe[p..n], &x[p - k..n - k]) + dot(&be[p..n], &x[k..n - p + k])))
+            .collect();
+        match solve(&grad) {
+            Some(d) => {
+                for k in 0..p {
+                    a[k + 1] += d[k];
+                }
+            }
+            None => break,
+        }
     }
     (a, ss / (2.0 * (n - p) as f64))
 }

@@ -69,8 +69,9 @@ pub struct ArmaParams {
     pub robust: Robust,
     /// Maximum Gauss-Newton iterations. Default 100.
     pub max_iter: usize,
-    /// Stopping tolerance on the predicted relative improvement of a Gauss-Newton step
-    /// (`(V - V_pred) / V`, dimensionless). Default 1e-7.
+    /// Stopping tolerance (dimensionless): the search stops when the predicted relative
+    /// improvement of a Gauss-Newton step `(V - V_pred) / V` is below `tol`, or when the loss
+    /// dropped by less than `tol` (relative) over the last 5 iterations. Default 1e-5.
     pub tol: f64,
     /// Maximum step halvings per direction. Default 10.
     pub max_halvings: usize,
@@ -83,7 +84,7 @@ impl Default for ArmaParams {
         ArmaParams {
             robust: Robust::default(),
             max_iter: 100,
-            tol: 1e-7,
+            tol: 1e-5,
             max_halvings: 10,
             demean: true,
         }
@@ -96,7 +97,7 @@ impl ArmaParams {
             return Err(IdentError::InvalidParam {
                 name: "tol",
                 value: self.tol.to_string(),
-                fix: "use a small positive number such as 1e-7",
+                fix: "use a small positive number such as 1e-5",
             });
         }
         if let Robust::Huber { factor } = self.robust {
@@ -111,6 +112,9 @@ impl ArmaParams {
         Ok(())
     }
 }
+
+/// Iterations over which the stall rule measures progress.
+const STALL_WINDOW: usize = 5;
 
 /// Largest `p + q` allowed for `n` samples: `n / 3`.
 pub fn max_arma_order(n: usize) -> usize {
@@ -503,6 +507,8 @@ fn fit_impl(
     let mut stop = StopReason::MaxIterations;
     let mut converged = false;
     let mut trial_eps = vec![0.0; n];
+    // Loss history for the stall rule.
+    let mut history: Vec<f64> = vec![v];
     let apply = |a: &[f64], c: &[f64], d: &[f64], s: f64| -> (Vec<f64>, Vec<f64>) {
         let mut na = a.to_vec();
         let mut nc = c.to_vec();
@@ -587,6 +593,14 @@ fn fit_impl(
                 c = nc;
                 v = vt;
                 std::mem::swap(&mut eps, &mut trial_eps);
+                history.push(v);
+                if history.len() > STALL_WINDOW
+                    && history[history.len() - 1 - STALL_WINDOW] - v < params.tol * v
+                {
+                    stop = StopReason::Stalled;
+                    converged = true;
+                    break;
+                }
                 mu = if hv == 0 {
                     (mu * 0.1).max(1e-12)
                 } else {

@@ -25,6 +25,9 @@ pub enum StopReason {
     ClosedForm,
     /// The predicted relative improvement of a Gauss-Newton step fell below `tol`.
     Converged,
+    /// The loss dropped by less than `tol` (relative) over the last 5 iterations; counted as
+    /// converged.
+    Stalled,
     /// No trial step (Gauss-Newton with halvings, then gradient) lowered the loss.
     NoImprovement,
     /// `max_iter` reached.
