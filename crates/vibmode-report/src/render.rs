@@ -352,8 +352,8 @@ fn draw_panel<DB: DrawingBackend>(
     panel: &Panel,
 ) -> Result<(), ReportError> {
     let (w, h) = area.dim_in_pixel();
-    let sc = (f64::from(w.min(h)) / 400.0).clamp(0.75, 1.6);
-    let (tick_px, label_px, title_px) = (12.0 * sc, 14.0 * sc, 16.0 * sc);
+    let sc = (f64::from(w.min(h)) / 360.0).clamp(0.85, 1.8);
+    let (tick_px, label_px, title_px) = (13.0 * sc, 14.5 * sc, 16.0 * sc);
 
     let prepared = prepare_panel(panel, w)?;
     let (xs, ys) = (panel.x_scale, panel.y_scale);
