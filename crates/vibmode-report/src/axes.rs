@@ -8,10 +8,15 @@ use crate::model::Scale;
 /// measured in decades).
 pub const PAD_FRACTION: f64 = 0.05;
 
-/// Is `v` drawable on an axis of this scale (finite, and > 0 on log axes)?
+/// Largest magnitude drawn on a linear axis; beyond it values are skipped like NaN (so that
+/// spans and paddings stay finite).
+pub const MAX_LINEAR_ABS: f64 = 1e300;
+
+/// Is `v` drawable on an axis of this scale (finite with `|v| <= 1e300` on linear axes; finite
+/// and > 0 on log axes)?
 pub fn is_valid(v: f64, scale: Scale) -> bool {
     match scale {
-        Scale::Linear => v.is_finite(),
+        Scale::Linear => v.is_finite() && v.abs() <= MAX_LINEAR_ABS,
         Scale::Log => v.is_finite() && v > 0.0,
     }
 }
@@ -118,7 +123,8 @@ pub fn nice_ticks(lo: f64, hi: f64, max_ticks: usize) -> Vec<f64> {
 /// Tick positions (data units) for a log axis over `[lo, hi]` (both > 0): `(major, minor)`.
 ///
 /// * At least two whole decades inside: majors at `10^d` for every `step`-th decade, where
-///   `step = ceil(decades / max_ticks)`; minors at `m·10^d`, m = 2..9, when `step == 1` and the
+///   `step` is the smallest of 1, 2, 3, 5, 10, 20, 25, 50, 100, ... that is at least
+///   `ceil(decades / max_ticks)` (decades = number of whole decades inside); minors at `m·10^d`, m = 2..9, when `step == 1` and the
 ///   range spans at most 10 decades, otherwise at the skipped decades.
 /// * Fewer: majors at the 1-2-5 values `{1, 2, 5}·10^d` inside the range if that gives 3 to
 ///   `max_ticks` ticks (minors at the other mantissas 3, 4, 6..9); else at every mantissa 1..9 if
@@ -166,7 +172,8 @@ pub fn log_ticks(lo: f64, hi: f64, max_ticks: usize) -> (Vec<f64>, Vec<f64>) {
             .collect();
         return (major, Vec::new());
     }
-    let step = (n as usize).div_ceil(max_ticks).max(1) as i64;
+    let needed = (n as usize).div_ceil(max_ticks).max(1) as i64;
+    let step = nice_decade_step(needed);
     let mut major = Vec::new();
     let mut minor = Vec::new();
     for d in d0..=d1 {
@@ -187,6 +194,25 @@ pub fn log_ticks(lo: f64, hi: f64, max_ticks: usize) -> (Vec<f64>, Vec<f64>) {
         }
     }
     (major, minor)
+}
+
+/// Smallest decade step in 1, 2, 3, 5, 10, 20, 25, 50, 100, 200, 250, 500, ... that is ≥ `needed`.
+fn nice_decade_step(needed: i64) -> i64 {
+    for c in [1, 2, 3, 5] {
+        if c >= needed {
+            return c;
+        }
+    }
+    let mut scale = 10i64;
+    while scale < 1_000_000 {
+        for c in [scale, 2 * scale, 5 * scale / 2, 5 * scale] {
+            if c >= needed {
+                return c;
+            }
+        }
+        scale *= 10;
+    }
+    needed
 }
 
 /// `m · 10^d`, correctly rounded (so 6·10⁻¹ is exactly the double nearest 0.6).

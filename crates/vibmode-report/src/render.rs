@@ -83,6 +83,14 @@ fn check_range(
             ),
         ));
     }
+    if scale == Scale::Linear
+        && (lo.abs() > crate::axes::MAX_LINEAR_ABS || hi.abs() > crate::axes::MAX_LINEAR_ABS)
+    {
+        return Err(err(
+            "linear bounds must be within ±1e300",
+            format!("use a smaller {axis}_range or a log scale"),
+        ));
+    }
     if scale == Scale::Log && lo <= 0.0 {
         return Err(err(
             "a log axis needs lo > 0",
@@ -278,7 +286,16 @@ fn prepare_panel(panel: &Panel, plot_width_px: u32) -> Result<PreparedPanel, Rep
 /// Tick positions (axis coordinates) `(major, minor)` for an axis range in axis coordinates.
 fn ticks(axis: (f64, f64), scale: Scale, max_ticks: usize) -> (Vec<f64>, Vec<f64>) {
     match scale {
-        Scale::Linear => (nice_ticks(axis.0, axis.1, max_ticks), Vec::new()),
+        Scale::Linear => {
+            // Prefer at least two labelled ticks, allowing a few more than max_ticks for that.
+            let mut t = nice_ticks(axis.0, axis.1, max_ticks);
+            let mut m = max_ticks;
+            while t.len() < 2 && m < max_ticks + 4 {
+                m += 1;
+                t = nice_ticks(axis.0, axis.1, m);
+            }
+            (t, Vec::new())
+        }
         Scale::Log => {
             let (ma, mi) = log_ticks(
                 from_axis(axis.0, scale),

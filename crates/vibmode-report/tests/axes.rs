@@ -80,12 +80,22 @@ fn log_ticks_by_hand() {
     assert_eq!(major, vec![1.0, 10.0, 100.0, 1000.0]);
     assert!(minor.contains(&0.6) && minor.contains(&2000.0) && minor.contains(&20.0));
     assert!(!minor.contains(&0.4));
-    // 31 whole decades, at most 7 ticks: step ceil(31/7) = 5 decades; at most 6: step 6.
+    // 31 whole decades, at most 7 ticks: step ceil(31/7) = 5 decades.
     let (major, minor) = log_ticks(1e-30, 1.0, 7);
     assert_eq!(major, vec![1e-30, 1e-25, 1e-20, 1e-15, 1e-10, 1e-5, 1.0]);
     assert_eq!(minor.len(), 31 - 7);
     let (major, _) = log_ticks(1e-30, 1.0, 6);
-    assert_eq!(major, vec![1e-30, 1e-24, 1e-18, 1e-12, 1e-6, 1.0]);
+    assert_eq!(
+        major,
+        vec![1e-30, 1e-20, 1e-10, 1.0],
+        "ceil(31/6) = 6 rounds up to 10"
+    );
+    let (major, _) = log_ticks(1e-200, 1.0, 2);
+    assert_eq!(
+        major,
+        vec![1e-200, 1.0],
+        "ceil(201/2) = 101 rounds up to 200"
+    );
     // Less than two decades: 1-2-5 series.
     let (major, minor) = log_ticks(0.013, 0.25, 8);
     assert_eq!(major, vec![0.02, 0.05, 0.1, 0.2]);

@@ -83,6 +83,17 @@ fn svg_contains_title_axis_labels_and_font_family() {
         "title escaped in SVG"
     );
     assert!(svg.contains("font-family=\"DejaVu Sans, Verdana, sans-serif\""));
+    // Every text element uses the embedded family.
+    let fams: Vec<&str> = svg
+        .split("font-family=\"")
+        .skip(1)
+        .map(|r| r.split('"').next().unwrap())
+        .collect();
+    assert!(fams.len() > 8);
+    assert!(
+        fams.iter().all(|f| *f == vibmode_report::FONT_FAMILY),
+        "{fams:?}"
+    );
     // Legend labels and log tick labels.
     assert!(svg.contains(">\nWelch\n<") && svg.contains(">\nmodes\n<"));
     assert!(
@@ -466,4 +477,91 @@ fn enum_and_colour_parsing() {
     let e = "#12345".parse::<Rgb>().unwrap_err().to_string();
     assert!(e.contains("'#12345'") && e.contains("#rrggbb"), "{e}");
     assert!("#12345g".parse::<Rgb>().is_err());
+}
+
+#[test]
+fn random_awkward_figures_always_render() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2024);
+    let specials = [
+        0.0,
+        -0.0,
+        f64::NAN,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        1e-320,
+        -1e300,
+        1e308,
+        f64::MAX,
+        f64::MIN_POSITIVE,
+    ];
+    let mut value = |rng: &mut rand_chacha::ChaCha8Rng| -> f64 {
+        if rng.gen_bool(0.1) {
+            specials[rng.gen_range(0..specials.len())]
+        } else {
+            let mag = 10f64.powf(rng.gen_range(-40.0..40.0));
+            rng.gen_range(-1.0..1.0) * mag
+        }
+    };
+    let scales = [Scale::Linear, Scale::Log];
+    for case in 0..60 {
+        let n_panels = rng.gen_range(1..5);
+        let mut panels = Vec::new();
+        for _ in 0..n_panels {
+            let mut p = Panel::new("random ζ", "x [?]", "y [?]")
+                .with_scales(scales[rng.gen_range(0..2)], scales[rng.gen_range(0..2)]);
+            p.legend = rng.gen_bool(0.5);
+            if rng.gen_bool(0.2) {
+                let a = rng.gen_range(0.001..10.0);
+                p.x_range = Some((a, a * rng.gen_range(1.0001..1e6)));
+            }
+            for k in 0..rng.gen_range(0..4) {
+                let n = if rng.gen_bool(0.1) {
+                    rng.gen_range(5000..20000)
+                } else {
+                    rng.gen_range(0..50)
+                };
+                let constant = rng.gen_bool(0.15);
+                let c = value(&mut rng);
+                let x: Vec<f64> = (0..n)
+                    .map(|_| if constant { c } else { value(&mut rng) })
+                    .collect();
+                let y: Vec<f64> = (0..n).map(|_| value(&mut rng)).collect();
+                let style = match rng.gen_range(0..3) {
+                    0 => SeriesStyle::Line {
+                        width: rng.gen_range(1..5),
+                        dashed: rng.gen_bool(0.3),
+                    },
+                    1 => SeriesStyle::Points {
+                        size: rng.gen_range(1..8),
+                        marker: Marker::Diamond,
+                    },
+                    _ => SeriesStyle::VLines {
+                        dotted: rng.gen_bool(0.5),
+                    },
+                };
+                let mut s = Series::line(x, y)
+                    .with_style(style)
+                    .with_alpha(rng.gen_range(0.0..=1.0));
+                if rng.gen_bool(0.5) {
+                    s.label = Some(format!("s{k} <&>"));
+                }
+                p.series.push(s);
+            }
+            panels.push(p);
+        }
+        let mut fig = Figure::grid(None, panels, rng.gen_range(1..4));
+        // Cells from the smallest allowed size upwards.
+        let (rows, cols) = fig.grid_shape();
+        fig.width_px = (cols as u32 * rng.gen_range(160..500)).max(100);
+        fig.height_px = (rows as u32 * rng.gen_range(120..400)).max(100);
+        let svg = fig
+            .to_svg_string()
+            .unwrap_or_else(|e| panic!("case {case}: {e}"));
+        assert!(!svg.contains("NaN"), "case {case}: NaN coordinate in SVG");
+        if case % 6 == 0 {
+            fig.render_rgb()
+                .unwrap_or_else(|e| panic!("case {case}: {e}"));
+        }
+    }
 }
