@@ -495,7 +495,7 @@ fn random_awkward_figures_always_render() {
         f64::MAX,
         f64::MIN_POSITIVE,
     ];
-    let mut value = |rng: &mut rand_chacha::ChaCha8Rng| -> f64 {
+    let value = |rng: &mut rand_chacha::ChaCha8Rng| -> f64 {
         if rng.gen_bool(0.1) {
             specials[rng.gen_range(0..specials.len())]
         } else {
