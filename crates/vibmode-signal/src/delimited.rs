@@ -7,8 +7,8 @@
 //! Conventions (see `docs/formats.md`):
 //! - blank lines are skipped everywhere; lines starting with `#` or `%` are skipped before the first
 //!   row (comments, MATLAB-style preambles);
-//! - separator: tab if the first row has a tab, else `;` if it has one, else `,` if it has one,
-//!   else runs of spaces/tabs;
+//! - separator: tab if the first row has a tab (unless the rows are numbers aligned with a mix of
+//!   spaces and tabs), else `;` if it has one, else `,` if it has one, else runs of spaces/tabs;
 //! - the first row is a header if any of its cells is not a number; otherwise columns are named
 //!   `ch0`, `ch1`, ...;
 //! - with `;`, tab or whitespace separators, a comma inside a number is a decimal comma
@@ -34,9 +34,25 @@ pub enum Separator {
     Whitespace,
 }
 
+/// True if `line` has tab-separated cells that contain spaces while all its whitespace-separated
+/// tokens are numbers: a numeric row aligned with a mix of spaces and tabs.
+fn mixed_whitespace_numbers(line: &[u8]) -> bool {
+    let mut spans = Vec::new();
+    split_spans(line, Separator::Tab, &mut spans);
+    let spaced = spans.iter().any(|&(a, b)| line[a..b].contains(&b' '));
+    if !spaced {
+        return false;
+    }
+    split_spans(line, Separator::Whitespace, &mut spans);
+    let mut scratch = Vec::new();
+    spans
+        .iter()
+        .all(|&(a, b)| parse_num(&line[a..b], true, &mut scratch).is_some())
+}
+
 impl Separator {
     fn sniff(line: &[u8]) -> Separator {
-        if line.contains(&b'\t') {
+        if line.contains(&b'\t') && !mixed_whitespace_numbers(line) {
             Separator::Tab
         } else if line.contains(&b';') {
             Separator::Semicolon
@@ -108,7 +124,14 @@ impl<R: BufRead> std::fmt::Debug for DelimitedReader<R> {
     }
 }
 
+#[inline]
 fn trim_cell(mut s: &[u8]) -> &[u8] {
+    let plain = |b: &u8| !b.is_ascii_whitespace() && *b != b'"';
+    match (s.first(), s.last()) {
+        (Some(f), Some(l)) if plain(f) && plain(l) => return s,
+        (None, _) => return s,
+        _ => {}
+    }
     while let [first, rest @ ..] = s {
         if first.is_ascii_whitespace() || *first == b'"' {
             s = rest;
@@ -160,11 +183,9 @@ fn split_spans(line: &[u8], sep: Separator, spans: &mut Vec<(usize, usize)>) {
                 _ => b'\t',
             };
             let mut a = 0;
-            for (i, &b) in line.iter().enumerate() {
-                if b == c {
-                    push(spans, a, i);
-                    a = i + 1;
-                }
+            while let Some(i) = line[a..].iter().position(|&b| b == c) {
+                push(spans, a, a + i);
+                a += i + 1;
             }
             push(spans, a, line.len());
         }
@@ -230,6 +251,28 @@ fn time_scale(name: &str, unit: &str) -> Option<f64> {
     Some(from_unit.or(implied).unwrap_or(1.0))
 }
 
+fn header_columns(line: &[u8], spans: &[(usize, usize)]) -> Vec<ColumnInfo> {
+    spans
+        .iter()
+        .enumerate()
+        .map(|(i, &(a, b))| {
+            let text = String::from_utf8_lossy(&line[a..b]).to_string();
+            let (name, unit) = split_name_unit(&text);
+            let name = if name.is_empty() {
+                format!("ch{i}")
+            } else {
+                name
+            };
+            let time_scale_s = time_scale(&name, &unit);
+            ColumnInfo {
+                name,
+                unit,
+                time_scale_s,
+            }
+        })
+        .collect()
+}
+
 impl<R: BufRead> DelimitedReader<R> {
     /// Opens a stream: reads the first row(s) to find the separator, the header and the time
     /// column. `path` is only used in error messages.
@@ -284,25 +327,7 @@ impl<R: BufRead> DelimitedReader<R> {
         if is_header {
             r.has_header = true;
             r.reference_line = first.0;
-            r.columns = spans
-                .iter()
-                .enumerate()
-                .map(|(i, &(a, b))| {
-                    let text = String::from_utf8_lossy(&first.1[a..b]).to_string();
-                    let (name, unit) = split_name_unit(&text);
-                    let name = if name.is_empty() {
-                        format!("ch{i}")
-                    } else {
-                        name
-                    };
-                    let time_scale_s = time_scale(&name, &unit);
-                    ColumnInfo {
-                        name,
-                        unit,
-                        time_scale_s,
-                    }
-                })
-                .collect();
+            r.columns = header_columns(&first.1, &spans);
             // Peek the first data row for decimal commas.
             loop {
                 match r.next_line()? {
@@ -314,6 +339,12 @@ impl<R: BufRead> DelimitedReader<R> {
                     Some(n) => {
                         if trim_cell(&r.buf).is_empty() {
                             continue;
+                        }
+                        if r.sep == Separator::Tab && mixed_whitespace_numbers(&r.buf) {
+                            // Data aligned with spaces and tabs: split header and rows on runs.
+                            r.sep = Separator::Whitespace;
+                            split_spans(&first.1, r.sep, &mut spans);
+                            r.columns = header_columns(&first.1, &spans);
                         }
                         r.pending = Some((n, r.buf.clone()));
                         break;
@@ -392,66 +423,278 @@ impl<R: BufRead> DelimitedReader<R> {
 
     /// Reads at most `max_rows` data rows (blank lines skipped). Returns `Ok(None)` at the end of
     /// the stream. Errors on ragged rows and non-numeric cells, naming line and column.
-    /// Values are not checked for NaN/Inf here.
+    /// Values are not checked for NaN/Inf here. Errors if `max_rows` is 0.
     pub fn next_block(&mut self, max_rows: usize) -> Result<Option<Block>> {
+        if max_rows == 0 {
+            return Err(SignalError::InvalidParam {
+                name: "max_rows",
+                value: "0".into(),
+                fix: "ask for at least 1 row per block".into(),
+            });
+        }
         let nc = self.columns.len();
         let mut block = Block {
             first_line: 0,
             columns: vec![Vec::new(); nc],
             lines: Vec::new(),
         };
+        let mut ctx = RowCtx {
+            path: &self.path,
+            sep: self.sep,
+            decimal_comma: self.decimal_comma,
+            columns: &self.columns,
+            reference_line: self.reference_line,
+            spans: &mut self.spans,
+            scratch: &mut self.scratch,
+        };
+        if let Some((n, line)) = self.pending.take() {
+            ctx.parse_row(&line, n, &mut block)?;
+        }
         while block.lines.len() < max_rows {
-            let line_no = if let Some((n, line)) = self.pending.take() {
-                self.buf = line;
-                n
+            // Fast path: parse the complete lines of the reader's buffer in place (for an
+            // in-memory slice that is the whole rest of the file).
+            let avail = self.reader.fill_buf().map_err(|e| SignalError::Io {
+                action: "read",
+                path: ctx.path.to_string(),
+                message: e.to_string(),
+            })?;
+            if avail.is_empty() {
+                break;
+            }
+            let mut consumed = 0;
+            while block.lines.len() < max_rows {
+                let rest = &avail[consumed..];
+                let Some(i) = rest.iter().position(|&b| b == b'\n') else {
+                    break;
+                };
+                let mut line = &rest[..i];
+                if let [head @ .., b'\r'] = line {
+                    line = head;
+                }
+                self.line_no += 1;
+                consumed += i + 1;
+                ctx.parse_row(line, self.line_no, &mut block)?;
+            }
+            if consumed > 0 {
+                self.reader.consume(consumed);
             } else {
-                match self.next_line()? {
-                    None => break,
-                    Some(n) => n,
+                // A line longer than the buffer, or the last line without a newline.
+                self.buf.clear();
+                let n =
+                    self.reader
+                        .read_until(b'\n', &mut self.buf)
+                        .map_err(|e| SignalError::Io {
+                            action: "read",
+                            path: ctx.path.to_string(),
+                            message: e.to_string(),
+                        })?;
+                if n == 0 {
+                    break;
                 }
-            };
-            let mut spans = std::mem::take(&mut self.spans);
-            split_spans(&self.buf, self.sep, &mut spans);
-            if spans.is_empty() {
-                self.spans = spans;
-                continue;
-            }
-            if spans.len() != nc {
-                return Err(SignalError::RaggedRow {
-                    path: self.path.clone(),
-                    line: line_no,
-                    found: spans.len(),
-                    expected: nc,
-                    reference_line: self.reference_line,
-                });
-            }
-            for (c, &(a, b)) in spans.iter().enumerate() {
-                let cell = &self.buf[a..b];
-                match parse_num(cell, self.decimal_comma, &mut self.scratch) {
-                    Some(v) => block.columns[c].push(v),
-                    None => {
-                        let text: String = String::from_utf8_lossy(cell).chars().take(40).collect();
-                        return Err(SignalError::NotNumeric {
-                            path: self.path.clone(),
-                            line: line_no,
-                            column: c + 1,
-                            column_name: self.columns[c].name.clone(),
-                            text,
-                        });
-                    }
+                if self.buf.last() == Some(&b'\n') {
+                    self.buf.pop();
                 }
+                if self.buf.last() == Some(&b'\r') {
+                    self.buf.pop();
+                }
+                self.line_no += 1;
+                ctx.parse_row(&self.buf, self.line_no, &mut block)?;
             }
-            if block.lines.is_empty() {
-                block.first_line = line_no;
-            }
-            block.lines.push(line_no);
-            self.spans = spans;
         }
         if block.lines.is_empty() {
             Ok(None)
         } else {
             Ok(Some(block))
         }
+    }
+}
+
+impl<'s> DelimitedReader<&'s [u8]> {
+    /// Reads all remaining rows of an in-memory file, splitting the work across up to `threads`
+    /// threads (chunks cut at line boundaries; line numbers in errors stay exact). Gives the same
+    /// result as one [`DelimitedReader::next_block`] call with `usize::MAX` rows, or `Ok(None)`
+    /// if there are no rows.
+    pub fn read_all_parallel(&mut self, threads: usize) -> Result<Option<Block>> {
+        let rest: &'s [u8] = self.reader;
+        let threads = threads.clamp(1, 64);
+        if threads == 1 || rest.len() < (1 << 20) {
+            return self.next_block(usize::MAX);
+        }
+        // Cut points just after a newline.
+        let mut cuts = vec![0usize];
+        for k in 1..threads {
+            let target = rest.len() * k / threads;
+            let prev = *cuts.last().unwrap_or(&0);
+            if target <= prev {
+                continue;
+            }
+            if let Some(i) = rest[target..].iter().position(|&b| b == b'\n') {
+                cuts.push(target + i + 1);
+            }
+        }
+        cuts.push(rest.len());
+        cuts.dedup();
+        // Line number before each chunk.
+        let mut starts = Vec::with_capacity(cuts.len());
+        let mut line = self.line_no;
+        for w in cuts.windows(2) {
+            starts.push(line);
+            line += rest[w[0]..w[1]].iter().filter(|&&b| b == b'\n').count();
+        }
+        let nc = self.columns.len();
+        let mut first = Block {
+            first_line: 0,
+            columns: vec![Vec::new(); nc],
+            lines: Vec::new(),
+        };
+        if let Some((n, l)) = self.pending.take() {
+            let mut ctx = RowCtx {
+                path: &self.path,
+                sep: self.sep,
+                decimal_comma: self.decimal_comma,
+                columns: &self.columns,
+                reference_line: self.reference_line,
+                spans: &mut self.spans,
+                scratch: &mut self.scratch,
+            };
+            ctx.parse_row(&l, n, &mut first)?;
+        }
+        let (path, sep, dc, cols, refl) = (
+            self.path.as_str(),
+            self.sep,
+            self.decimal_comma,
+            self.columns.as_slice(),
+            self.reference_line,
+        );
+        let results: Vec<Result<Block>> = std::thread::scope(|sc| {
+            let handles: Vec<_> = cuts
+                .windows(2)
+                .zip(&starts)
+                .map(|(w, &start_line)| {
+                    let chunk = &rest[w[0]..w[1]];
+                    sc.spawn(move || {
+                        let mut spans = Vec::new();
+                        let mut scratch = Vec::new();
+                        let mut ctx = RowCtx {
+                            path,
+                            sep,
+                            decimal_comma: dc,
+                            columns: cols,
+                            reference_line: refl,
+                            spans: &mut spans,
+                            scratch: &mut scratch,
+                        };
+                        let mut b = Block {
+                            first_line: 0,
+                            columns: vec![Vec::new(); cols.len()],
+                            lines: Vec::new(),
+                        };
+                        let mut ln = start_line;
+                        for l in chunk.split(|&c| c == b'\n') {
+                            let l = match l {
+                                [head @ .., b'\r'] => head,
+                                _ => l,
+                            };
+                            ln += 1;
+                            ctx.parse_row(l, ln, &mut b)?;
+                        }
+                        Ok(b)
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| {
+                    h.join().unwrap_or_else(|_| {
+                        Err(SignalError::InvalidParam {
+                            name: "parser thread",
+                            value: "panicked".into(),
+                            fix: "internal error; please report this as a bug".into(),
+                        })
+                    })
+                })
+                .collect()
+        });
+        self.reader = &rest[rest.len()..];
+        self.line_no = line;
+        for r in results {
+            let b = r?;
+            if first.lines.is_empty() && !b.lines.is_empty() {
+                first.first_line = b.first_line;
+            }
+            for (d, c) in first.columns.iter_mut().zip(b.columns) {
+                if d.is_empty() {
+                    *d = c;
+                } else {
+                    d.extend_from_slice(&c);
+                }
+            }
+            first.lines.extend_from_slice(&b.lines);
+        }
+        if first.lines.is_empty() {
+            Ok(None)
+        } else {
+            Ok(Some(first))
+        }
+    }
+}
+
+/// What parsing one row needs (borrowed from the reader, so that rows can be parsed directly
+/// from the reader's buffer).
+struct RowCtx<'a> {
+    path: &'a str,
+    sep: Separator,
+    decimal_comma: bool,
+    columns: &'a [ColumnInfo],
+    reference_line: usize,
+    spans: &'a mut Vec<(usize, usize)>,
+    scratch: &'a mut Vec<u8>,
+}
+
+impl RowCtx<'_> {
+    /// Parses one line into `block` (blank lines are skipped).
+    fn parse_row(&mut self, line: &[u8], line_no: usize, block: &mut Block) -> Result<()> {
+        let nc = self.columns.len();
+        split_spans(line, self.sep, self.spans);
+        if self.spans.is_empty() {
+            return Ok(());
+        }
+        if self.spans.len() != nc {
+            return Err(SignalError::RaggedRow {
+                path: self.path.to_string(),
+                line: line_no,
+                found: self.spans.len(),
+                expected: nc,
+                reference_line: self.reference_line,
+            });
+        }
+        // One UTF-8 check per line (not per cell); cells are then cut at ASCII separators.
+        let text = std::str::from_utf8(line).ok();
+        for (c, &(a, b)) in self.spans.iter().enumerate() {
+            let cell = &line[a..b];
+            let parsed = match text.and_then(|t| t.get(a..b)) {
+                Some(t) if !self.decimal_comma => t.parse::<f64>().ok(),
+                _ => parse_num(cell, self.decimal_comma, self.scratch),
+            };
+            match parsed {
+                Some(v) => block.columns[c].push(v),
+                None => {
+                    let text: String = String::from_utf8_lossy(cell).chars().take(40).collect();
+                    return Err(SignalError::NotNumeric {
+                        path: self.path.to_string(),
+                        line: line_no,
+                        column: c + 1,
+                        column_name: self.columns[c].name.clone(),
+                        text,
+                    });
+                }
+            }
+        }
+        if block.lines.is_empty() {
+            block.first_line = line_no;
+        }
+        block.lines.push(line_no);
+        Ok(())
     }
 }
 

@@ -47,7 +47,10 @@ pub mod write;
 
 pub use delimited::{Block, ColumnInfo, DelimitedReader, Separator};
 pub use error::SignalError;
-pub use read::{read_delimited, read_path, sidecar_candidates, Format, ReadOptions, Sidecar};
+pub use read::{
+    read_delimited, read_delimited_bytes, read_path, sidecar_candidates, Format, ReadOptions,
+    Sidecar,
+};
 pub use recording::{Channel, ChannelSelector, Recording, TimeAxis};
 pub use resample::{resample, ResampleMethod, ResampleParams, Resampler};
 pub use write::write_path;

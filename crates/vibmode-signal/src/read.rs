@@ -1,6 +1,6 @@
 //! Reading recordings from delimited text, WAV and raw binary files.
 
-use crate::delimited::DelimitedReader;
+use crate::delimited::{Block, ColumnInfo, DelimitedReader};
 use crate::error::{io_err, Result, SignalError};
 use crate::recording::{check_finite, check_fs, Channel, Recording, TimeAxis};
 use serde::{Deserialize, Serialize};
@@ -131,7 +131,7 @@ pub fn read_path(path: &Path, opts: &ReadOptions) -> Result<Recording> {
     let mut rec = match format {
         Format::Delimited => {
             let bytes = std::fs::read(path).map_err(|e| io_err("read", path, &e))?;
-            read_delimited(&bytes[..], &path.display().to_string(), opts)?
+            read_delimited_bytes(&bytes, &path.display().to_string(), opts)?
         }
         Format::Wav => read_wav(path, opts)?,
         Format::Raw => read_raw(path, opts)?,
@@ -170,22 +170,51 @@ fn reconcile_fs(path: &str, source_name: String, file_fs: f64, given: Option<f64
 /// [`read_path`] applies afterwards).
 pub fn read_delimited<R: BufRead>(reader: R, path: &str, opts: &ReadOptions) -> Result<Recording> {
     let mut r = DelimitedReader::new(reader, path)?;
-    let cols = r.columns().to_vec();
-    let tcol = r.time_column();
-    let mut data: Vec<Vec<f64>> = vec![Vec::new(); cols.len()];
+    let mut data: Vec<Vec<f64>> = vec![Vec::new(); r.columns().len()];
     let mut lines: Vec<usize> = Vec::new();
+    let keep_lines = r.time_column().is_some();
     while let Some(block) = r.next_block(1 << 16)? {
-        for (d, b) in data.iter_mut().zip(block.columns) {
-            if d.is_empty() {
-                *d = b;
-            } else {
-                d.extend_from_slice(&b);
-            }
-        }
-        if tcol.is_some() {
-            lines.extend_from_slice(&block.lines);
+        append_block(&mut data, &mut lines, block, keep_lines);
+    }
+    let cols = r.columns().to_vec();
+    finish_delimited(path, opts, &cols, data, lines)
+}
+
+/// Reads delimited text held in memory, parsing with several threads for large files.
+pub fn read_delimited_bytes(bytes: &[u8], path: &str, opts: &ReadOptions) -> Result<Recording> {
+    let mut r = DelimitedReader::new(bytes, path)?;
+    let mut data: Vec<Vec<f64>> = vec![Vec::new(); r.columns().len()];
+    let mut lines: Vec<usize> = Vec::new();
+    let keep_lines = r.time_column().is_some();
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get().min(8));
+    if let Some(block) = r.read_all_parallel(threads)? {
+        append_block(&mut data, &mut lines, block, keep_lines);
+    }
+    let cols = r.columns().to_vec();
+    finish_delimited(path, opts, &cols, data, lines)
+}
+
+fn append_block(data: &mut [Vec<f64>], lines: &mut Vec<usize>, block: Block, keep_lines: bool) {
+    for (d, b) in data.iter_mut().zip(block.columns) {
+        if d.is_empty() {
+            *d = b;
+        } else {
+            d.extend_from_slice(&b);
         }
     }
+    if keep_lines {
+        lines.extend_from_slice(&block.lines);
+    }
+}
+
+fn finish_delimited(
+    path: &str,
+    opts: &ReadOptions,
+    cols: &[ColumnInfo],
+    data: Vec<Vec<f64>>,
+    lines: Vec<usize>,
+) -> Result<Recording> {
+    let tcol = cols.iter().position(|c| c.time_scale_s.is_some());
     if data.first().map_or(true, |d| d.is_empty()) {
         return Err(SignalError::NoDataRows {
             path: path.to_string(),
