@@ -293,11 +293,15 @@ impl RoadProfile {
         let half = nfft / 2;
         let mut planner = realfft::RealFftPlanner::<f64>::new();
         let inv = planner.plan_fft_inverse(nfft);
-        let mut specs = [
-            vec![Complex::new(0.0, 0.0); half + 1],
-            vec![Complex::new(0.0, 0.0); half + 1],
-        ];
-        for k in 1..half {
+        let mut left = vec![Complex::new(0.0, 0.0); half + 1];
+        let mut right = vec![Complex::new(0.0, 0.0); half + 1];
+        for (k, (l, r)) in left
+            .iter_mut()
+            .zip(right.iter_mut())
+            .enumerate()
+            .take(half)
+            .skip(1)
+        {
             let n = k as f64 * dn;
             let sigma = (road.displacement_psd_m3(n) * dn / 4.0).sqrt();
             let mut draw = || {
@@ -308,11 +312,11 @@ impl RoadProfile {
             let w1 = draw();
             let w2 = draw();
             let g = coherence.gamma(n);
-            specs[0][k] = w1;
-            specs[1][k] = w1 * g + w2 * (1.0 - g * g).max(0.0).sqrt();
+            *l = w1;
+            *r = w1 * g + w2 * (1.0 - g * g).max(0.0).sqrt();
         }
         let mut out = Vec::with_capacity(2);
-        for spec in specs.iter_mut() {
+        for spec in [&mut left, &mut right] {
             let mut x = vec![0.0; nfft];
             inv.process(spec, &mut x)
                 .map_err(|e| VehicleError::Numerical(format!("inverse FFT failed: {e}")))?;
