@@ -260,6 +260,9 @@ impl Default for VehicleParams {
 
 impl VehicleParams {
     /// The 12 m city bus shipped in `examples/city_bus.toml` (compiled in).
+    ///
+    /// # Panics
+    /// Only if the compiled-in example file were invalid; the test suite parses it.
     pub fn city_bus() -> Self {
         // The shipped file is checked by the unit tests, so parsing cannot fail.
         Self::from_toml_str(CITY_BUS_TOML)
@@ -267,6 +270,9 @@ impl VehicleParams {
     }
 
     /// The passenger car shipped in `examples/passenger_car.toml` (compiled in).
+    ///
+    /// # Panics
+    /// Only if the compiled-in example file were invalid; the test suite parses it.
     pub fn passenger_car() -> Self {
         Self::from_toml_str(PASSENGER_CAR_TOML)
             .unwrap_or_else(|e| panic!("examples/passenger_car.toml is invalid: {e}"))
