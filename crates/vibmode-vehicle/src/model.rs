@@ -59,6 +59,34 @@ impl fmt::Display for ModeLabel {
     }
 }
 
+impl std::str::FromStr for ModeLabel {
+    type Err = VehicleError;
+    /// Parses the [`Display`](fmt::Display) form, e.g. "body heave", "FL wheel hop"
+    /// (case-insensitive; '_' and '-' accepted for spaces).
+    fn from_str(s: &str) -> Result<Self> {
+        let t = s.trim().to_ascii_lowercase().replace(['_', '-'], " ");
+        let all = [
+            ModeLabel::BodyHeave,
+            ModeLabel::BodyPitch,
+            ModeLabel::BodyRoll,
+            ModeLabel::FrontAxleBounce,
+            ModeLabel::FrontAxleTramp,
+            ModeLabel::RearAxleBounce,
+            ModeLabel::RearAxleTramp,
+            ModeLabel::WheelHop(Corner::FL),
+            ModeLabel::WheelHop(Corner::FR),
+            ModeLabel::WheelHop(Corner::RL),
+            ModeLabel::WheelHop(Corner::RR),
+            ModeLabel::BodyBending,
+        ];
+        all.into_iter().find(|l| l.to_string().to_ascii_lowercase() == t).ok_or_else(|| VehicleError::UnknownName {
+            what: "mode label",
+            value: s.to_string(),
+            valid: "body heave, body pitch, body roll, front axle bounce, front axle tramp, rear axle bounce, rear axle tramp, FL/FR/RL/RR wheel hop, body bending",
+        })
+    }
+}
+
 /// One vibration mode (one complex-conjugate eigenvalue pair of the first-order system).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ModeInfo {
@@ -494,5 +522,67 @@ fn label_mode(energy: &[f64], shape: &[Complex64]) -> ModeLabel {
         (true, false) => ModeLabel::FrontAxleTramp,
         (false, true) => ModeLabel::RearAxleBounce,
         (false, false) => ModeLabel::RearAxleTramp,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn c(re: f64) -> Complex64 {
+        Complex64::new(re, 0.0)
+    }
+
+    #[test]
+    fn labels_from_energy() {
+        let shape = |v: [f64; 7]| v.map(c).to_vec();
+        // heave dominant
+        let e = [0.6, 0.2, 0.0, 0.05, 0.05, 0.05, 0.05];
+        assert_eq!(label_mode(&e, &shape([1.0; 7])), ModeLabel::BodyHeave);
+        // roll dominant
+        let e = [0.1, 0.2, 0.5, 0.05, 0.05, 0.05, 0.05];
+        assert_eq!(label_mode(&e, &shape([1.0; 7])), ModeLabel::BodyRoll);
+        // front wheels anti-phase -> tramp
+        let e = [0.01, 0.01, 0.02, 0.48, 0.48, 0.0, 0.0];
+        assert_eq!(
+            label_mode(&e, &shape([0.0, 0.0, 0.1, 1.0, -1.0, 0.0, 0.0])),
+            ModeLabel::FrontAxleTramp
+        );
+        // rear wheels in phase -> bounce
+        let e = [0.01, 0.01, 0.0, 0.0, 0.0, 0.49, 0.49];
+        assert_eq!(
+            label_mode(&e, &shape([0.1, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0])),
+            ModeLabel::RearAxleBounce
+        );
+        // one wheel alone -> wheel hop
+        let e = [0.01, 0.01, 0.0, 0.0, 0.0, 0.95, 0.03];
+        assert_eq!(
+            label_mode(&e, &shape([0.1, 0.0, 0.0, 0.0, 0.0, 1.0, 0.18])),
+            ModeLabel::WheelHop(Corner::RL)
+        );
+        // bending dominant
+        let e = [0.1, 0.1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.8];
+        assert_eq!(label_mode(&e, &[c(1.0); 8]), ModeLabel::BodyBending);
+    }
+
+    #[test]
+    fn label_display_round_trip() {
+        for l in [
+            ModeLabel::BodyPitch,
+            ModeLabel::RearAxleTramp,
+            ModeLabel::WheelHop(Corner::FR),
+            ModeLabel::BodyBending,
+        ] {
+            assert_eq!(l.to_string().parse::<ModeLabel>().unwrap(), l);
+        }
+        assert_eq!(
+            "front_axle_bounce".parse::<ModeLabel>().unwrap(),
+            ModeLabel::FrontAxleBounce
+        );
+        assert!("wobble"
+            .parse::<ModeLabel>()
+            .unwrap_err()
+            .to_string()
+            .contains("body heave"));
     }
 }

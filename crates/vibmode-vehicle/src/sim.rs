@@ -14,24 +14,35 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 /// A periodic engine / driveline line: a vertical force on the body.
+/// In serialised form `drift_hz` (0), `drift_period_s` (30), `x_m` and `y_m` (0) may be omitted.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct EngineLine {
     /// Nominal frequency, Hz.
     pub frequency_hz: f64,
     /// Force amplitude, N (vertical, applied to the body at (x_m, y_m)).
     pub force_n: f64,
     /// Peak slow frequency deviation, Hz (0 = constant frequency).
+    #[serde(default)]
     pub drift_hz: f64,
     /// Period of the sinusoidal frequency drift, s.
+    #[serde(default = "default_drift_period")]
     pub drift_period_s: f64,
     /// Body x of the force (forward from the centre of gravity), m.
+    #[serde(default)]
     pub x_m: f64,
     /// Body y of the force (to the left of the centre of gravity), m.
+    #[serde(default)]
     pub y_m: f64,
+}
+
+fn default_drift_period() -> f64 {
+    30.0
 }
 
 /// A sinusoidal tone added to every channel (models pick-up above the anti-alias cutoff).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Tone {
     /// Frequency, Hz (may exceed fs_hz / 2: it is then sampled, i.e. aliased, like a real ADC
     /// without analogue filter would).
@@ -40,8 +51,10 @@ pub struct Tone {
     pub amplitude_m_s2: f64,
 }
 
-/// Switchable non-road effects. `Default` switches everything off.
+/// Switchable non-road effects. `Default` switches everything off. Missing fields take their
+/// defaults when deserialised.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Disturbances {
     /// Engine / gear lines entering the body (default none).
     pub engine_lines: Vec<EngineLine>,
@@ -96,6 +109,7 @@ impl Disturbances {
 /// A braking/acceleration and/or turning event. Accelerations follow a sin^2 pulse of the
 /// given peak over `duration_s`, starting `start_s` after the start of the first record.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Manoeuvre {
     /// Start time from the beginning of record 0, s.
     pub start_s: f64,
@@ -122,8 +136,10 @@ impl Manoeuvre {
 /// Simulator settings. Defaults: road C, default coherence (exponential, 0.2 cycles/m),
 /// tyre enveloping 3 cycles/m,
 /// 40 km/h, 8 records of 10.24 s at 20 kHz, seed 0, no manoeuvres, no disturbances,
-/// automatic warm-up.
+/// automatic warm-up. Missing fields take these defaults when deserialised (e.g. from a TOML
+/// or JSON config); unknown fields are errors.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct SimParams {
     /// ISO 8608 road class (default C).
     pub road: RoadClass,

@@ -478,3 +478,20 @@ fn braking_pitches_the_body_nose_down() {
     );
     assert!(a.records[0].mean_speed_kmh < 40.0);
 }
+
+#[test]
+fn sim_params_deserialise_with_defaults_and_reject_unknown_keys() {
+    let sp: SimParams = toml::from_str("speed_kmh = 60.0\nroad = \"D\"\n[disturbances]\nsensor_noise_std_m_s2 = 0.1\n[[disturbances.engine_lines]]\nfrequency_hz = 7.0\nforce_n = 100.0\n").unwrap();
+    assert_eq!(sp.speed_kmh, 60.0);
+    assert_eq!(sp.road, RoadClass::D);
+    assert_eq!(sp.fs_hz, 20000.0);
+    assert_eq!(sp.records, 8);
+    assert_eq!(sp.disturbances.engine_lines[0].drift_period_s, 30.0);
+    let e = toml::from_str::<SimParams>("speed_kmhh = 60.0")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("speed_kmhh"), "{e}");
+    let back: SimParams =
+        serde_json::from_str(&serde_json::to_string(&SimParams::in_service()).unwrap()).unwrap();
+    assert_eq!(back, SimParams::in_service());
+}
