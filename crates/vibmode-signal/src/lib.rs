@@ -38,6 +38,8 @@
 //! assert!((low.channels[0].samples[7] - expected).abs() < 1e-9);
 //! ```
 
+#![warn(missing_docs)]
+
 pub mod delimited;
 pub mod error;
 pub mod read;
