@@ -126,21 +126,14 @@ impl Default for SeriesStyle {
     }
 }
 
-/// An sRGB colour, 8 bits per channel.
+/// An sRGB colour, 8 bits per channel: `Rgb(red, green, blue)`, each 0-255.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-pub struct Rgb {
-    /// Red 0-255.
-    pub r: u8,
-    /// Green 0-255.
-    pub g: u8,
-    /// Blue 0-255.
-    pub b: u8,
-}
+pub struct Rgb(pub u8, pub u8, pub u8);
 
 impl Rgb {
-    /// Build a colour from its channels.
+    /// Build a colour from its channels (same as `Rgb(r, g, b)`).
     pub const fn new(r: u8, g: u8, b: u8) -> Self {
-        Rgb { r, g, b }
+        Rgb(r, g, b)
     }
     /// Black `#000000`.
     pub const BLACK: Rgb = Rgb::new(0, 0, 0);
@@ -178,7 +171,7 @@ pub const PALETTE: [Rgb; 10] = [
 impl fmt::Display for Rgb {
     /// `#rrggbb`.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "#{:02x}{:02x}{:02x}", self.r, self.g, self.b)
+        write!(f, "#{:02x}{:02x}{:02x}", self.0, self.1, self.2)
     }
 }
 

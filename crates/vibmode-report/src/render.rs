@@ -217,7 +217,7 @@ fn prepare_panel(panel: &Panel, plot_width_px: u32) -> Result<PreparedPanel, Rep
     let mut series = Vec::with_capacity(panel.series.len());
     for (i, s) in panel.series.iter().enumerate() {
         let base = s.color.unwrap_or(PALETTE[i % PALETTE.len()]);
-        let color = RGBColor(base.r, base.g, base.b).mix(s.alpha);
+        let color = RGBColor(base.0, base.1, base.2).mix(s.alpha);
         let geometry = match s.style {
             SeriesStyle::VLines { .. } => Geometry::VLines(
                 s.x.iter()
