@@ -9,33 +9,33 @@ pub enum ReportError {
     /// Figure size outside the supported range (pixels).
     #[error("figure size {width_px}x{height_px} px is out of range; use width_px and height_px between {min_px} and {max_px}")]
     InvalidSize {
-        /// Requested width [px].
+        /// Requested width (px).
         width_px: u32,
-        /// Requested height [px].
+        /// Requested height (px).
         height_px: u32,
-        /// Smallest allowed side [px].
+        /// Smallest allowed side (px).
         min_px: u32,
-        /// Largest allowed side [px].
+        /// Largest allowed side (px).
         max_px: u32,
     },
     /// A grid cell (one panel) would be too small to draw axes in.
     #[error("each panel would be only {cell_width_px}x{cell_height_px} px ({rows} rows x {columns} columns in {width_px}x{height_px} px); use a larger figure (at least {min_cell_w_px}x{min_cell_h_px} px per panel) or fewer panels")]
     CellTooSmall {
-        /// Cell width [px].
+        /// Cell width (px).
         cell_width_px: u32,
-        /// Cell height [px].
+        /// Cell height (px).
         cell_height_px: u32,
         /// Grid rows.
         rows: usize,
         /// Grid columns.
         columns: usize,
-        /// Figure width [px].
+        /// Figure width (px).
         width_px: u32,
-        /// Figure height [px].
+        /// Figure height (px).
         height_px: u32,
-        /// Minimum cell width [px].
+        /// Minimum cell width (px).
         min_cell_w_px: u32,
-        /// Minimum cell height [px].
+        /// Minimum cell height (px).
         min_cell_h_px: u32,
     },
     /// `Figure::columns` was zero.
@@ -75,9 +75,9 @@ pub enum ReportError {
         series: String,
         /// "width" or "size".
         what: &'static str,
-        /// The offending value [px].
+        /// The offending value (px).
         value: u32,
-        /// Largest allowed value [px].
+        /// Largest allowed value (px).
         max: u32,
     },
     /// An explicit axis range is unusable.

@@ -96,14 +96,14 @@ pub enum SeriesStyle {
     /// Polyline through the points in order; NaN/Inf (and non-positive values on log axes) break
     /// the line. `width` in pixels (1..=20), `dashed` draws a dashed line.
     Line {
-        /// Stroke width [px].
+        /// Stroke width (px).
         width: u32,
         /// Dashed instead of solid.
         dashed: bool,
     },
     /// One marker per point. `size` is the marker half-size (radius) in pixels (1..=30).
     Points {
-        /// Marker radius [px].
+        /// Marker radius (px).
         size: u32,
         /// Marker shape.
         marker: Marker,
@@ -292,9 +292,9 @@ impl Series {
 pub struct Panel {
     /// Title drawn above the axes (empty: none).
     pub title: String,
-    /// x-axis label with units, e.g. "Frequency [Hz]".
+    /// x-axis label with units, e.g. `"Frequency [Hz]"`.
     pub x_label: String,
-    /// y-axis label with units, e.g. "PSD [(m/s²)²/Hz]".
+    /// y-axis label with units, e.g. `"PSD [(m/s²)²/Hz]"`.
     pub y_label: String,
     /// x-axis scale.
     pub x_scale: Scale,
@@ -329,7 +329,7 @@ impl Default for Panel {
 }
 
 impl Panel {
-    /// A panel with a title and axis labels (give units, e.g. "Time [s]"), otherwise default.
+    /// A panel with a title and axis labels (give units, e.g. `"Time [s]"`), otherwise default.
     pub fn new(
         title: impl Into<String>,
         x_label: impl Into<String>,
@@ -374,9 +374,9 @@ pub struct Figure {
     pub panels: Vec<Panel>,
     /// Number of grid columns (≥ 1; values above the number of panels are reduced to it).
     pub columns: usize,
-    /// Width of the image [px] (100..=16384).
+    /// Width of the image in px (100..=16384).
     pub width_px: u32,
-    /// Height of the image [px] (100..=16384).
+    /// Height of the image in px (100..=16384).
     pub height_px: u32,
 }
 

@@ -14,13 +14,13 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
-/// Smallest figure side [px].
+/// Smallest figure side (px).
 pub const MIN_SIDE_PX: u32 = 100;
-/// Largest figure side [px].
+/// Largest figure side (px).
 pub const MAX_SIDE_PX: u32 = 16384;
-/// Smallest panel cell width [px].
+/// Smallest panel cell width (px).
 pub const MIN_CELL_WIDTH_PX: u32 = 160;
-/// Smallest panel cell height [px].
+/// Smallest panel cell height (px).
 pub const MIN_CELL_HEIGHT_PX: u32 = 120;
 /// Line series longer than this are decimated (min/max per pixel column) before drawing.
 pub const MAX_POINTS_PER_SERIES: usize = 4000;
@@ -575,7 +575,7 @@ impl Figure {
         (self.panels.len().div_ceil(cols).max(1), cols)
     }
 
-    /// Height of the overall title band [px] for an image `height_px` tall (0 without title).
+    /// Height of the overall title band (px) for an image `height_px` tall (0 without title).
     fn title_band_px(&self, width_px: u32, height_px: u32) -> u32 {
         match &self.title {
             Some(t) if !t.is_empty() => {
