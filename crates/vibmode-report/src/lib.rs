@@ -37,7 +37,25 @@
 //! assert_eq!(html.matches("<figure>").count(), 1);
 //! ```
 //!
-//! Panics: none on input data; all problems are returned as [`ReportError`].
+//! ## Figures the CLI draws
+//! * time records: [`Series::line`] per channel, `Scale::Linear` axes;
+//! * raw vs resampled in time and frequency: [`Figure::grid`] with 2 columns;
+//! * periodogram / Welch / model PSD on a log y axis, mode frequencies as [`Series::vlines`];
+//! * stabilisation diagram: [`Series::points`] of (frequency, order) with a faint PSD behind,
+//!   mapped onto the order axis with [`axes::rescale_to`] (`alpha` ≈ 0.3-0.6);
+//! * frequency vs damping ratio on a log y axis, physical-model modes as red
+//!   [`Marker::Diamond`] points.
+//!
+//! ## Text and fonts
+//! All text uses [`FONT_FAMILY`]. PNG text is rasterised from the embedded DejaVu Sans (no
+//! system font needed); SVG files name the same family (with `Verdana, sans-serif` fallbacks)
+//! and leave rendering to the viewer. plotters writes SVG font sizes as `size / 1.24`, so SVG
+//! text looks slightly smaller than PNG text.
+//!
+//! ## Panics
+//! None on input data: every problem is returned as a [`ReportError`]. The only panics left are
+//! plotters' internal ones on a poisoned font-table lock (only possible after another thread
+//! panicked while drawing) and allocation failure.
 
 #![warn(missing_docs)]
 

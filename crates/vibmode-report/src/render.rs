@@ -606,8 +606,9 @@ impl Figure {
             return Err(ReportError::NoPanels);
         }
         let (rows, cols) = self.grid_shape();
-        let cell_w = w / cols as u32;
-        let cell_h = (h - self.title_band_px(w, h).min(h)) / rows as u32;
+        let as_u32 = |n: usize| u32::try_from(n).unwrap_or(u32::MAX).max(1);
+        let cell_w = w / as_u32(cols);
+        let cell_h = (h - self.title_band_px(w, h).min(h)) / as_u32(rows);
         if cell_w < MIN_CELL_WIDTH_PX || cell_h < MIN_CELL_HEIGHT_PX {
             return Err(ReportError::CellTooSmall {
                 cell_width_px: cell_w,
