@@ -8,8 +8,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::ar::burg;
 use crate::linalg::{
-    check_signal, cholesky_solve, filter_inv_c, is_min_phase, lagged_dot, lagged_gram,
-    predict_errors, robust_std, spd_inverse_diag,
+    check_signal, cholesky_solve, dot, filter_inv_c, filter_inv_c_adjoint, is_min_phase,
+    lagged_dot, lagged_gram, predict_errors, robust_std, spd_inverse_diag,
 };
 use crate::model::{information_criteria, ArmaModel, Estimator, StopReason};
 use crate::roots::polynomial_roots;
@@ -112,6 +112,10 @@ impl ArmaParams {
         Ok(())
     }
 }
+
+/// Largest N p (p + q) for which the AR columns of the Jacobian are filtered exactly
+/// (O(N p (p + q)) per iteration); beyond it delayed copies of y/C are used.
+const EXACT_JACOBIAN_BUDGET: f64 = 2.0e7;
 
 /// Iterations over which the stall rule measures progress.
 const STALL_WINDOW: usize = 5;
@@ -246,10 +250,11 @@ fn make_candidate(ys: &[f64], a: Vec<f64>, mut c: Vec<f64>, robust: bool) -> Opt
     stabilise(&mut c);
     let mut eps = vec![0.0; ys.len()];
     predict_errors(ys, &a, &c, &mut eps);
+    let t0 = a.len() - 1;
     let score = if robust {
-        robust_std(&eps)
+        robust_std(&eps[t0..])
     } else {
-        mean_loss(&eps, None)
+        mean_loss(&eps[t0..], None)
     };
     if !score.is_finite() {
         return None;
@@ -266,7 +271,7 @@ fn hannan_rissanen(ys: &[f64], p: usize, q: usize) -> (Vec<f64>, Vec<f64>) {
         let (a_long, _, _) = burg(ys, m);
         let mut e = vec![0.0; n];
         predict_errors(ys, &a_long, &[1.0], &mut e);
-        (e, m)
+        (e, m + q)
     } else {
         (Vec::new(), p)
     };
@@ -334,6 +339,8 @@ struct Search<'a> {
     rho: Option<f64>,
     yf: Vec<f64>,
     ef: Vec<f64>,
+    u: Vec<f64>,
+    cols: Vec<Vec<f64>>,
 }
 
 impl Search<'_> {
@@ -347,15 +354,44 @@ impl Search<'_> {
         eps: &[f64],
     ) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
         let _ = a;
-        let (p, q, n) = (self.p, self.q, self.ys.len());
+        let (p, q) = (self.p, self.q);
         let k = p + q;
         filter_inv_c(self.ys, c, &mut self.yf);
         filter_inv_c(eps, c, &mut self.ef);
+        let n = self.ys.len();
         let mut h = vec![0.0; k * k];
-        lagged_gram(&self.yf, p, &self.yf, p, 0, &mut h, k, 0, 0, 1.0);
+        // Exact a-columns (1/C)[y_{t-k} 1{t >= p}] when affordable; otherwise delayed copies of y/C
+        // (ignores that A(q) y is only formed from t = p on: a transient-only approximation).
+        let exact = (n as f64) * (p as f64) * (k as f64) <= EXACT_JACOBIAN_BUDGET;
+        self.cols.clear();
+        if exact {
+            let mut z = vec![0.0; n];
+            for i in 1..=p {
+                for (t, zt) in z.iter_mut().enumerate() {
+                    *zt = if t >= p { self.ys[t - i] } else { 0.0 };
+                }
+                let mut col = vec![0.0; n];
+                filter_inv_c(&z, c, &mut col);
+                self.cols.push(col);
+            }
+            for i in 0..p {
+                for j in i..p {
+                    let v = dot(&self.cols[i][p..], &self.cols[j][p..]);
+                    h[i * k + j] = v;
+                    h[j * k + i] = v;
+                }
+                for j in 1..=q {
+                    h[i * k + p + j - 1] = -dot(&self.cols[i][p..n], &self.ef[p - j..n - j]);
+                }
+            }
+        } else {
+            lagged_gram(&self.yf, p, &self.yf, p, p, &mut h, k, 0, 0, 1.0);
+            if q > 0 {
+                lagged_gram(&self.yf, p, &self.ef, q, p, &mut h, k, 0, p, -1.0);
+            }
+        }
         if q > 0 {
-            lagged_gram(&self.yf, p, &self.ef, q, 0, &mut h, k, 0, p, -1.0);
-            lagged_gram(&self.ef, q, &self.ef, q, 0, &mut h, k, p, p, 1.0);
+            lagged_gram(&self.ef, q, &self.ef, q, p, &mut h, k, p, p, 1.0);
             for i in 0..p {
                 for j in p..k {
                     h[j * k + i] = h[i * k + j];
@@ -363,28 +399,36 @@ impl Search<'_> {
             }
         }
         let h_unweighted = h.clone();
-        // Weighted residuals w_t eps_t (= clip(eps_t, rho)).
+        // Exact gradient by the adjoint filter: with v_t = w_t eps_t (= clip(eps_t, rho)),
+        // sum_t v_t d(eps_t)/d(theta) = sum_t u_t d(w_t)/d(theta), u = adjoint(1/C) v.
         let we: Vec<f64> = match self.rho {
             Some(r) => eps.iter().map(|&e| e.clamp(-r, r)).collect(),
             None => eps.to_vec(),
         };
+        filter_inv_c_adjoint(&we, c, &mut self.u);
         let mut g = vec![0.0; k];
         for i in 1..=p {
-            g[i - 1] = lagged_dot(&self.yf, i, &we, 0, 0);
+            g[i - 1] = lagged_dot(self.ys, i, &self.u, 0, p);
         }
         for j in 1..=q {
-            g[p + j - 1] = -lagged_dot(&self.ef, j, &we, 0, 0);
+            g[p + j - 1] = -lagged_dot(eps, j, &self.u, 0, p);
         }
         if let Some(r) = self.rho {
             let mut psi = vec![0.0; k];
-            for t in 0..n {
-                let e = eps[t].abs();
+            for (t, &et) in eps.iter().enumerate().skip(p) {
+                let e = et.abs();
                 if e <= r {
                     continue;
                 }
                 let w = r / e;
                 for i in 1..=p {
-                    psi[i - 1] = if t >= i { self.yf[t - i] } else { 0.0 };
+                    psi[i - 1] = if !self.cols.is_empty() {
+                        self.cols[i - 1][t]
+                    } else if t >= i {
+                        self.yf[t - i]
+                    } else {
+                        0.0
+                    };
                 }
                 for j in 1..=q {
                     psi[p + j - 1] = if t >= j { -self.ef[t - j] } else { 0.0 };
@@ -402,6 +446,218 @@ impl Search<'_> {
             }
         }
         (g, h, h_unweighted)
+    }
+}
+
+/// Result of one prediction-error search on the scaled signal.
+struct SearchOut {
+    a: Vec<f64>,
+    c: Vec<f64>,
+    eps: Vec<f64>,
+    v: f64,
+    rho: Option<f64>,
+    iterations: usize,
+    stop: StopReason,
+    converged: bool,
+}
+
+/// Candidates, rho, then damped Gauss-Newton on the scaled signal `ys`.
+fn search(
+    ys: &[f64],
+    p: usize,
+    q: usize,
+    init: Option<(&[f64], &[f64])>,
+    params: &ArmaParams,
+) -> SearchOut {
+    let n = ys.len();
+    let robust = matches!(params.robust, Robust::Huber { .. });
+    // Starting candidates.
+    let mut cands: Vec<Candidate> = Vec::new();
+    let (ha, hc) = hannan_rissanen(ys, p, q);
+    cands.extend(make_candidate(ys, ha, hc, robust));
+    let (ba, _, _) = burg(ys, p);
+    let mut c0 = vec![0.0; q + 1];
+    c0[0] = 1.0;
+    cands.extend(make_candidate(ys, ba, c0, robust));
+    if let Some((a0, c0)) = init {
+        let mut a = a0.to_vec();
+        a.resize(p + 1, 0.0);
+        let mut c = c0.to_vec();
+        c.resize(q + 1, 0.0);
+        cands.extend(make_candidate(ys, a, c, robust));
+    }
+    let best = cands.into_iter().min_by(|x, y| x.score.total_cmp(&y.score));
+    let Candidate {
+        mut a,
+        mut c,
+        mut eps,
+        ..
+    } = match best {
+        Some(b) => b,
+        None => {
+            // Unreachable in practice (Burg on finite data is finite); start from white noise.
+            let mut a = vec![0.0; p + 1];
+            a[0] = 1.0;
+            let mut c = vec![0.0; q + 1];
+            c[0] = 1.0;
+            Candidate {
+                a,
+                c,
+                eps: ys.to_vec(),
+                score: 0.0,
+            }
+        }
+    };
+    let rho = match params.robust {
+        Robust::Off => None,
+        Robust::Huber { factor } => {
+            let mut s = robust_std(&eps[p..]);
+            if s.is_nan() || s <= 0.0 {
+                s = (mean_loss(&eps[p..], None)).sqrt();
+            }
+            if s > 0.0 {
+                Some(factor * s)
+            } else {
+                None
+            }
+        }
+    };
+
+    let k = p + q;
+    let mut search = Search {
+        ys,
+        p,
+        q,
+        rho,
+        yf: vec![0.0; n],
+        ef: vec![0.0; n],
+        u: vec![0.0; n],
+        cols: Vec::new(),
+    };
+    let n_eff = n - p;
+    let mut v = mean_loss(&eps[p..], rho);
+    let mut mu = 1e-6;
+    let mut iterations = 0;
+    let mut stop = StopReason::MaxIterations;
+    let mut converged = false;
+    let mut trial_eps = vec![0.0; n];
+    // Loss history for the stall rule.
+    let mut history: Vec<f64> = vec![v];
+    let apply = |a: &[f64], c: &[f64], d: &[f64], s: f64| -> (Vec<f64>, Vec<f64>) {
+        let mut na = a.to_vec();
+        let mut nc = c.to_vec();
+        for i in 0..p {
+            na[i + 1] += s * d[i];
+        }
+        for j in 0..q {
+            nc[j + 1] += s * d[p + j];
+        }
+        stabilise(&mut nc);
+        (na, nc)
+    };
+    while iterations < params.max_iter {
+        let (g, h, _) = search.normal_equations(&a, &c, &eps);
+        let neg_g: Vec<f64> = g.iter().map(|v| -v).collect();
+        // Newton decrement (predicted decrease of V) with a negligible ridge.
+        let Some(d0) = solve_scaled(&h, &neg_g, k, 1e-12) else {
+            stop = StopReason::NoImprovement;
+            break;
+        };
+        let pred = d0.iter().zip(&neg_g).map(|(x, y)| x * y).sum::<f64>() / n_eff as f64;
+        if pred.is_nan() || pred <= params.tol * v {
+            stop = StopReason::Converged;
+            converged = true;
+            break;
+        }
+        iterations += 1;
+        let dir = if mu > 1e-12 {
+            solve_scaled(&h, &neg_g, k, mu).unwrap_or(d0)
+        } else {
+            d0
+        };
+        let mut accepted = None;
+        let mut s = 1.0;
+        for hv in 0..=params.max_halvings {
+            let (na, nc) = apply(&a, &c, &dir, s);
+            predict_errors(ys, &na, &nc, &mut trial_eps);
+            let vt = mean_loss(&trial_eps[p..], rho);
+            if vt.is_finite() && vt < v {
+                accepted = Some((na, nc, vt, hv));
+                break;
+            }
+            s *= 0.5;
+        }
+        if accepted.is_none() {
+            // Gradient fallback: Jacobi-scaled steepest descent with the exact line minimiser of
+            // the quadratic model as first step.
+            let dg: Vec<f64> = (0..k)
+                .map(|i| {
+                    let hd = h[i * k + i];
+                    if hd > 0.0 {
+                        neg_g[i] / hd
+                    } else {
+                        neg_g[i]
+                    }
+                })
+                .collect();
+            let gd: f64 = dg.iter().zip(&neg_g).map(|(x, y)| x * y).sum();
+            let mut hdd = 0.0;
+            for i in 0..k {
+                let mut row = 0.0;
+                for j in 0..k {
+                    row += h[i * k + j] * dg[j];
+                }
+                hdd += dg[i] * row;
+            }
+            let mut s = if hdd > 0.0 { gd / hdd } else { 1.0 };
+            for hv in 0..=params.max_halvings {
+                let (na, nc) = apply(&a, &c, &dg, s);
+                predict_errors(ys, &na, &nc, &mut trial_eps);
+                let vt = mean_loss(&trial_eps[p..], rho);
+                if vt.is_finite() && vt < v {
+                    accepted = Some((na, nc, vt, hv + params.max_halvings + 1));
+                    break;
+                }
+                s *= 0.5;
+            }
+        }
+        match accepted {
+            Some((na, nc, vt, hv)) => {
+                a = na;
+                c = nc;
+                v = vt;
+                std::mem::swap(&mut eps, &mut trial_eps);
+                history.push(v);
+                if history.len() > STALL_WINDOW
+                    && history[history.len() - 1 - STALL_WINDOW] - v < params.tol * v
+                {
+                    stop = StopReason::Stalled;
+                    converged = true;
+                    break;
+                }
+                mu = if hv == 0 {
+                    (mu * 0.1).max(1e-12)
+                } else {
+                    (mu * 10.0).min(1e6)
+                };
+            }
+            None => {
+                stop = StopReason::NoImprovement;
+                converged = pred <= 100.0 * params.tol * v;
+                break;
+            }
+        }
+    }
+
+    SearchOut {
+        a,
+        c,
+        eps,
+        v,
+        rho,
+        iterations,
+        stop,
+        converged,
     }
 }
 
@@ -446,53 +702,20 @@ fn fit_impl(
         return Err(IdentError::Constant { value: y[0] });
     }
     let ys: Vec<f64> = centred.iter().map(|v| v / scale).collect();
-    let robust = matches!(params.robust, Robust::Huber { .. });
 
-    // Starting candidates.
-    let mut cands: Vec<Candidate> = Vec::new();
-    let (ha, hc) = hannan_rissanen(&ys, p, q);
-    cands.extend(make_candidate(&ys, ha, hc, robust));
-    let (ba, _, _) = burg(&ys, p);
-    let mut c0 = vec![0.0; q + 1];
-    c0[0] = 1.0;
-    cands.extend(make_candidate(&ys, ba, c0, robust));
-    if let Some(m) = init {
-        let mut a = m.a.clone();
-        a.resize(p + 1, 0.0);
-        let mut c = m.c.clone();
-        c.resize(q + 1, 0.0);
-        cands.extend(make_candidate(&ys, a, c, robust));
-    }
-    let best = cands
-        .into_iter()
-        .min_by(|x, y| x.score.total_cmp(&y.score));
-    let Candidate { mut a, mut c, mut eps, .. } = match best {
-        Some(b) => b,
-        None => {
-            // Unreachable in practice (Burg on finite data is finite); start from white noise.
-            let mut a = vec![0.0; p + 1];
-            a[0] = 1.0;
-            let mut c = vec![0.0; q + 1];
-            c[0] = 1.0;
-            Candidate { a, c, eps: ys.clone(), score: 0.0 }
-        }
-    };
-    let rho = match params.robust {
-        Robust::Off => None,
-        Robust::Huber { factor } => {
-            let mut s = robust_std(&eps);
-            if !(s > 0.0) {
-                s = (mean_loss(&eps, None)).sqrt();
-            }
-            if s > 0.0 {
-                Some(factor * s)
-            } else {
-                None
-            }
-        }
-    };
-
+    let out = search(&ys, p, q, init.map(|m| (&m.a[..], &m.c[..])), params);
+    let SearchOut {
+        a,
+        c,
+        eps,
+        v,
+        rho,
+        iterations,
+        stop,
+        converged,
+    } = out;
     let k = p + q;
+    let n_eff = n - p;
     let mut search = Search {
         ys: &ys,
         p,
@@ -500,129 +723,18 @@ fn fit_impl(
         rho,
         yf: vec![0.0; n],
         ef: vec![0.0; n],
+        u: vec![0.0; n],
+        cols: Vec::new(),
     };
-    let mut v = mean_loss(&eps, rho);
-    let mut mu = 1e-6;
-    let mut iterations = 0;
-    let mut stop = StopReason::MaxIterations;
-    let mut converged = false;
-    let mut trial_eps = vec![0.0; n];
-    // Loss history for the stall rule.
-    let mut history: Vec<f64> = vec![v];
-    let apply = |a: &[f64], c: &[f64], d: &[f64], s: f64| -> (Vec<f64>, Vec<f64>) {
-        let mut na = a.to_vec();
-        let mut nc = c.to_vec();
-        for i in 0..p {
-            na[i + 1] += s * d[i];
-        }
-        for j in 0..q {
-            nc[j + 1] += s * d[p + j];
-        }
-        stabilise(&mut nc);
-        (na, nc)
-    };
-    while iterations < params.max_iter {
-        let (g, h, _) = search.normal_equations(&a, &c, &eps);
-        let neg_g: Vec<f64> = g.iter().map(|v| -v).collect();
-        // Newton decrement (predicted decrease of V) with a negligible ridge.
-        let Some(d0) = solve_scaled(&h, &neg_g, k, 1e-12) else {
-            stop = StopReason::NoImprovement;
-            break;
-        };
-        let pred = d0.iter().zip(&neg_g).map(|(x, y)| x * y).sum::<f64>() / n as f64;
-        if !(pred > params.tol * v) {
-            stop = StopReason::Converged;
-            converged = true;
-            break;
-        }
-        iterations += 1;
-        let dir = if mu > 1e-12 {
-            solve_scaled(&h, &neg_g, k, mu).unwrap_or(d0)
-        } else {
-            d0
-        };
-        let mut accepted = None;
-        let mut s = 1.0;
-        for hv in 0..=params.max_halvings {
-            let (na, nc) = apply(&a, &c, &dir, s);
-            predict_errors(&ys, &na, &nc, &mut trial_eps);
-            let vt = mean_loss(&trial_eps, rho);
-            if vt.is_finite() && vt < v {
-                accepted = Some((na, nc, vt, hv));
-                break;
-            }
-            s *= 0.5;
-        }
-        if accepted.is_none() {
-            // Gradient fallback: Jacobi-scaled steepest descent with the exact line minimiser of
-            // the quadratic model as first step.
-            let dg: Vec<f64> = (0..k)
-                .map(|i| {
-                    let hd = h[i * k + i];
-                    if hd > 0.0 {
-                        neg_g[i] / hd
-                    } else {
-                        neg_g[i]
-                    }
-                })
-                .collect();
-            let gd: f64 = dg.iter().zip(&neg_g).map(|(x, y)| x * y).sum();
-            let mut hdd = 0.0;
-            for i in 0..k {
-                let mut row = 0.0;
-                for j in 0..k {
-                    row += h[i * k + j] * dg[j];
-                }
-                hdd += dg[i] * row;
-            }
-            let mut s = if hdd > 0.0 { gd / hdd } else { 1.0 };
-            for hv in 0..=params.max_halvings {
-                let (na, nc) = apply(&a, &c, &dg, s);
-                predict_errors(&ys, &na, &nc, &mut trial_eps);
-                let vt = mean_loss(&trial_eps, rho);
-                if vt.is_finite() && vt < v {
-                    accepted = Some((na, nc, vt, hv + params.max_halvings + 1));
-                    break;
-                }
-                s *= 0.5;
-            }
-        }
-        match accepted {
-            Some((na, nc, vt, hv)) => {
-                a = na;
-                c = nc;
-                v = vt;
-                std::mem::swap(&mut eps, &mut trial_eps);
-                history.push(v);
-                if history.len() > STALL_WINDOW
-                    && history[history.len() - 1 - STALL_WINDOW] - v < params.tol * v
-                {
-                    stop = StopReason::Stalled;
-                    converged = true;
-                    break;
-                }
-                mu = if hv == 0 {
-                    (mu * 0.1).max(1e-12)
-                } else {
-                    (mu * 10.0).min(1e6)
-                };
-            }
-            None => {
-                stop = StopReason::NoImprovement;
-                converged = pred <= 100.0 * params.tol * v;
-                break;
-            }
-        }
-    }
-
     // Final quantities.
     let (_, _, h_u) = search.normal_equations(&a, &c, &eps);
-    let lambda_s = mean_loss(&eps, None);
+    let lambda_s = mean_loss(&eps[p..], None);
     let kappa = match rho {
         None => lambda_s,
         Some(r) => {
-            let num = eps.iter().map(|e| e.clamp(-r, r).powi(2)).sum::<f64>() / n as f64;
-            let inside = eps.iter().filter(|e| e.abs() <= r).count() as f64 / n as f64;
+            let tail = &eps[p..];
+            let num = tail.iter().map(|e| e.clamp(-r, r).powi(2)).sum::<f64>() / n_eff as f64;
+            let inside = tail.iter().filter(|e| e.abs() <= r).count() as f64 / n_eff as f64;
             if inside > 0.0 {
                 num / (inside * inside)
             } else {
@@ -659,18 +771,20 @@ fn fit_impl(
     })
 }
 
-/// Mean squared one-step prediction error `(1/N) sum eps_t^2` of the model `(a, c)` on `y`
-/// (signal units squared), `eps = (A/C) y` with zero initial conditions, after subtracting `mean`.
-/// This is how [`ArmaModel::noise_variance`] is defined for prediction-error fits; use it to
-/// compare models from other tools on equal terms.
+/// Mean squared one-step prediction error `(1/(N-p)) sum_{t=p}^{N-1} eps_t^2` of the model
+/// `(a, c)` on `y` (signal units squared), with the conditional predictor of [`fit_arma`]
+/// (`eps = w / C`, `w_t = A(q) y_t` for t >= p, zero initial conditions of the noise filter), after
+/// subtracting `mean`. This is how [`ArmaModel::noise_variance`] is defined for prediction-error
+/// fits; use it to compare models from other tools on equal terms. NaN if `y` has at most p samples.
 pub fn prediction_error_variance(y: &[f64], mean: f64, a: &[f64], c: &[f64]) -> f64 {
+    let p = a.len().saturating_sub(1);
+    if y.len() <= p {
+        return f64::NAN;
+    }
     let x: Vec<f64> = y.iter().map(|v| v - mean).collect();
     let mut eps = vec![0.0; x.len()];
     predict_errors(&x, a, c, &mut eps);
-    if eps.is_empty() {
-        return f64::NAN;
-    }
-    mean_loss(&eps, None)
+    mean_loss(&eps[p..], None)
 }
 
 #[cfg(test)]
@@ -680,7 +794,10 @@ mod tests {
     #[test]
     fn robust_parse_display() {
         assert_eq!("off".parse::<Robust>().unwrap(), Robust::Off);
-        assert_eq!("2.5".parse::<Robust>().unwrap(), Robust::Huber { factor: 2.5 });
+        assert_eq!(
+            "2.5".parse::<Robust>().unwrap(),
+            Robust::Huber { factor: 2.5 }
+        );
         assert_eq!(Robust::default(), Robust::Huber { factor: 1.6 });
         assert_eq!(Robust::default().to_string(), "1.6");
         let e = "-1".parse::<Robust>().unwrap_err().to_string();
@@ -699,15 +816,18 @@ mod tests {
         // C = (1 - 2 z^-1)(1 - 0.5 z^-1) = 1 - 2.5 z^-1 + z^-2 -> root 2 reflected to 0.5.
         let mut c = vec![1.0, -2.5, 1.0];
         stabilise(&mut c);
-        assert!((c[1] + 1.0).abs() < 1e-12 && (c[2] - 0.25).abs() < 1e-12, "{c:?}");
+        assert!(
+            (c[1] + 1.0).abs() < 1e-12 && (c[2] - 0.25).abs() < 1e-12,
+            "{c:?}"
+        );
     }
 
     #[test]
     fn prediction_errors_by_hand() {
-        // A = 1 - 0.5 z^-1, C = 1 + 0.5 z^-1, y = [1, 0, 0]:
-        // eps0 = 1; eps1 = 0 - 0.5*1 - 0.5*1 = -1; eps2 = 0 - 0 - 0.5*(-1) = 0.5.
+        // A = 1 - 0.5 z^-1, C = 1 + 0.5 z^-1, y = [1, 0, 0]: eps0 = 0 (conditional on y0);
+        // eps1 = 0 - 0.5*1 - 0.5*0 = -0.5; eps2 = 0 - 0 - 0.5*(-0.5) = 0.25.
         let mut e = vec![0.0; 3];
         predict_errors(&[1.0, 0.0, 0.0], &[1.0, -0.5], &[1.0, 0.5], &mut e);
-        assert_eq!(e, vec![1.0, -1.0, 0.5]);
+        assert_eq!(e, vec![0.0, -0.5, 0.25]);
     }
 }

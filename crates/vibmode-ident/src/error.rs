@@ -11,7 +11,9 @@ pub enum IdentError {
         min_len: usize,
     },
     /// A sample is NaN or infinite.
-    #[error("sample {index} is {value} (not finite); remove or interpolate non-finite samples first")]
+    #[error(
+        "sample {index} is {value} (not finite); remove or interpolate non-finite samples first"
+    )]
     NonFinite {
         /// Index of the first offending sample.
         index: usize,
@@ -19,7 +21,9 @@ pub enum IdentError {
         value: f64,
     },
     /// The signal is constant (all samples equal), so it carries no dynamics.
-    #[error("signal is constant (every sample equals {value}); identification needs a varying signal")]
+    #[error(
+        "signal is constant (every sample equals {value}); identification needs a varying signal"
+    )]
     Constant {
         /// The constant value.
         value: f64,
@@ -45,7 +49,9 @@ pub enum IdentError {
         fix: &'static str,
     },
     /// A polynomial coefficient is NaN or infinite.
-    #[error("polynomial coefficient {index} is {value} (not finite); all coefficients must be finite")]
+    #[error(
+        "polynomial coefficient {index} is {value} (not finite); all coefficients must be finite"
+    )]
     BadCoefficient {
         /// Index of the coefficient.
         index: usize,

@@ -124,19 +124,39 @@ pub(crate) fn filter_inv_c(x: &[f64], c: &[f64], out: &mut [f64]) {
     }
 }
 
-/// Prediction errors `eps = (A/C) y` with zero initial conditions.
+/// Conditional prediction errors: `eps_t = 0` for `t < p`, and for `t >= p`
+/// `eps_t = y_t + sum_{k=1}^{p} a_k y_{t-k} - sum_{k=1}^{q} c_k eps_{t-k}`, i.e. `eps = w / C` with
+/// zero initial conditions where `w_t = A(q) y_t` uses measured samples only.
 pub(crate) fn predict_errors(y: &[f64], a: &[f64], c: &[f64], eps: &mut [f64]) {
     let p = a.len().saturating_sub(1);
     let q = c.len().saturating_sub(1);
-    for t in 0..y.len() {
+    for e in eps.iter_mut().take(p.min(y.len())) {
+        *e = 0.0;
+    }
+    for t in p..y.len() {
         let mut v = y[t];
-        for k in 1..=p.min(t) {
+        for k in 1..=p {
             v += a[k] * y[t - k];
         }
         for k in 1..=q.min(t) {
             v -= c[k] * eps[t - k];
         }
         eps[t] = v;
+    }
+}
+
+/// Adjoint of `x -> x / C`: `u_t = v_t - sum_{k=1}^{q} c_k u_{t+k}` (run backwards).
+pub(crate) fn filter_inv_c_adjoint(v: &[f64], c: &[f64], out: &mut [f64]) {
+    let q = c.len().saturating_sub(1);
+    let n = v.len();
+    for t in (0..n).rev() {
+        let mut s = v[t];
+        for k in 1..=q {
+            if t + k < n {
+                s -= c[k] * out[t + k];
+            }
+        }
+        out[t] = s;
     }
 }
 
@@ -237,7 +257,7 @@ pub(crate) fn is_min_phase(c: &[f64]) -> bool {
     let mut m = a.len().saturating_sub(1);
     while m >= 1 {
         let k = a[m];
-        if !(k.abs() < 1.0) {
+        if k.is_nan() || k.abs() >= 1.0 {
             return false;
         }
         let den = 1.0 - k * k;
@@ -271,7 +291,10 @@ mod tests {
                             s += x[t - i] * z[t - j];
                         }
                     }
-                    assert!((out[(i - 1) * lz + j - 1] - s).abs() < 1e-12, "t0={t0} i={i} j={j}");
+                    assert!(
+                        (out[(i - 1) * lz + j - 1] - s).abs() < 1e-12,
+                        "t0={t0} i={i} j={j}"
+                    );
                 }
             }
         }
@@ -293,6 +316,19 @@ mod tests {
         assert!(is_min_phase(&[1.0, -1.7, 0.72]));
         // (1 - 1.1 z^-1)(1 - 0.5 z^-1) = 1 - 1.6 z^-1 + 0.55 z^-2
         assert!(!is_min_phase(&[1.0, -1.6, 0.55]));
+    }
+
+    #[test]
+    fn adjoint_filter_is_the_transpose() {
+        // <x / C, v> == <x, adjoint(v)>
+        let c = [1.0, -0.6, 0.2];
+        let x: Vec<f64> = (0..20).map(|t| ((t * 3 % 7) as f64) - 3.0).collect();
+        let v: Vec<f64> = (0..20).map(|t| ((t * 5 % 11) as f64) * 0.1 - 0.5).collect();
+        let mut fx = vec![0.0; 20];
+        let mut av = vec![0.0; 20];
+        filter_inv_c(&x, &c, &mut fx);
+        filter_inv_c_adjoint(&v, &c, &mut av);
+        assert!((dot(&fx, &v) - dot(&x, &av)).abs() < 1e-12);
     }
 
     #[test]

@@ -51,11 +51,13 @@ pub struct ArmaModel {
     /// C coefficients, leading 1 included (length q + 1), dimensionless.
     pub c: Vec<f64>,
     /// Innovation variance lambda (signal units squared). For prediction-error fits: the mean
-    /// squared one-step prediction error `(1/N) sum eps_t^2` with zero initial conditions, also for
-    /// robust fits. For AR fits: the method's own estimate (see `fit_ar`).
+    /// squared one-step prediction error `(1/(N-p)) sum_{t>=p} eps_t^2` of the conditional
+    /// predictor (see [`crate::prediction_error_variance`]), also for robust fits. For AR fits: the
+    /// method's own estimate (see `fit_ar`).
     pub noise_variance: f64,
     /// Value of the minimised criterion V (signal units squared): equal to `noise_variance` for the
-    /// quadratic criterion and AR fits; `(1/N) sum l(eps_t)` with the Huber loss otherwise.
+    /// quadratic criterion and AR fits; `(1/(N-p)) sum_{t>=p} l(eps_t)` with the Huber loss
+    /// otherwise.
     pub loss: f64,
     /// Gauss-Newton iterations taken (0 for AR methods).
     pub iterations: usize,

@@ -85,7 +85,7 @@ fn polish(c: &[f64], z0: Complex64, all: &[Complex64], idx: usize) -> Complex64 
             break;
         }
         let step = p / dp;
-        if !(step.norm() < 0.1 * min_dist) {
+        if step.norm().is_nan() || step.norm() >= 0.1 * min_dist {
             break;
         }
         let mut zn = z - step;

@@ -131,7 +131,10 @@ mod tests {
         let var = y.iter().map(|v| v * v).sum::<f64>() / y.len() as f64;
         assert!((var - 4.0).abs() < 0.15, "{var}");
         // Same seed, same output.
-        assert_eq!(y[..10], simulate_arma(&[1.0], &[1.0], 4.0, 10, 3).unwrap()[..]);
+        assert_eq!(
+            y[..10],
+            simulate_arma(&[1.0], &[1.0], 4.0, 10, 3).unwrap()[..]
+        );
         assert!(matches!(
             simulate_arma(&[1.0, -1.5], &[1.0], 1.0, 10, 0),
             Err(IdentError::UnstableModel { .. })
