@@ -18,6 +18,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let bus = VehicleParams::city_bus();
     for (label, sim) in [
         (
+            "1 record, quiet, no warm-up",
+            SimParams {
+                records: 1,
+                warmup_s: Some(0.0),
+                ..SimParams::default()
+            },
+        ),
+        (
             "1 record, quiet",
             SimParams {
                 records: 1,
