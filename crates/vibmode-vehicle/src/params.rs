@@ -282,10 +282,17 @@ impl VehicleParams {
     pub fn from_toml_str(text: &str) -> Result<Self> {
         let mut p: VehicleParams = toml::from_str(text).map_err(|e| {
             let location = match e.span() {
-                Some(span) => format!(
-                    " at line {}",
-                    text[..span.start.min(text.len())].matches('\n').count() + 1
-                ),
+                Some(span) => {
+                    let start = span.start.min(text.len());
+                    let line_no = text[..start].matches('\n').count() + 1;
+                    let line = text.lines().nth(line_no - 1).unwrap_or("").trim();
+                    let line: String = line.chars().take(80).collect();
+                    if line.is_empty() {
+                        format!(" at line {line_no}")
+                    } else {
+                        format!(" at line {line_no} (`{line}`)")
+                    }
+                }
                 None => String::new(),
             };
             VehicleError::Toml {

@@ -95,6 +95,11 @@ fn unknown_and_missing_keys_are_named() {
     );
     let e = err_of(&BUS.replace("pitch_inertia_kgm2 = 95000.0", ""));
     assert!(e.contains("pitch_inertia_kgm2"), "{e}");
+    let e = err_of(&BUS.replace("mass_kg = 11000.0", "mass_kg = \"heavy\""));
+    assert!(
+        e.contains("mass_kg = \"heavy\"") && e.contains("invalid type"),
+        "{e}"
+    );
     let e = err_of(&BUS.replace("[geometry]", "[geometri]"));
     assert!(e.contains("geometri"), "{e}");
 }
