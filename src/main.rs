@@ -1,1 +1,73 @@
-fn main() {}
+//! `vibmode`: the command line over the vibmode library crates.
+//!
+//! The binary is thin: it parses arguments, reads files through `vibmode-signal`, calls the
+//! numerical crates and writes JSON, CSV and figures. Every error is printed as one line on
+//! standard error and exits with code 2.
+
+mod cmd_analyze;
+mod cmd_fit;
+mod cmd_psd;
+mod cmd_resample;
+mod cmd_sweep;
+mod cmd_vehicle;
+mod figures;
+mod input;
+mod output;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Vibration modes of vehicle suspensions from in-service accelerations.
+#[derive(Parser, Debug)]
+#[command(name = "vibmode", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Power spectral density (Welch and/or periodogram) of one or more channels.
+    Psd(cmd_psd::PsdArgs),
+    /// Ideal DFT anti-alias filter and resampling to a new rate.
+    Resample(cmd_resample::ResampleArgs),
+    /// Fit an AR or ARMA model to each channel and report its modes.
+    Fit(cmd_fit::FitArgs),
+    /// Fit every model order and collect every mode (stabilisation diagram).
+    Sweep(cmd_sweep::SweepArgs),
+    /// The paper's whole analysis over many records, with an HTML report.
+    Analyze(cmd_analyze::AnalyzeArgs),
+    /// Simulate a city bus and run the whole analysis, writing a report.
+    Demo(cmd_analyze::DemoArgs),
+    /// Modes of a 7-DOF full-car model given by a TOML parameter file.
+    Fullcar(cmd_vehicle::FullcarArgs),
+    /// Simulate in-service acceleration records of a vehicle on an ISO 8608 road.
+    Simulate(cmd_vehicle::SimulateArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Psd(a) => cmd_psd::run(&a),
+        Command::Resample(a) => cmd_resample::run(&a),
+        Command::Fit(a) => cmd_fit::run(&a),
+        Command::Sweep(a) => cmd_sweep::run(&a),
+        Command::Analyze(a) => cmd_analyze::run(&a),
+        Command::Demo(a) => cmd_analyze::run_demo(&a),
+        Command::Fullcar(a) => cmd_vehicle::run_fullcar(&a),
+        Command::Simulate(a) => cmd_vehicle::run_simulate(&a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            // One line: the chain of causes joined, never a backtrace.
+            let msg = e
+                .chain()
+                .map(|c| c.to_string())
+                .collect::<Vec<_>>()
+                .join(": ");
+            eprintln!("vibmode: error: {}", msg.replace('\n', " "));
+            ExitCode::from(2)
+        }
+    }
+}

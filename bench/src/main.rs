@@ -1,1 +1,249 @@
-fn main() {}
+//! `vibmode-bench`: times vibmode's kernels on inputs shared with the Python peers.
+//!
+//! `vibmode-bench gen DIR` writes the inputs; `vibmode-bench run DIR [--quick]` prints a JSON
+//! object `{case: {implementation: median_seconds}}`. Driven by `bench/run.py`, which times
+//! scipy / numpy / pandas / statsmodels on the same files in the same run.
+
+use anyhow::{bail, Context, Result};
+use serde_json::{json, Map, Value};
+use std::io::Write;
+use std::path::Path;
+use std::time::Instant;
+
+const ARMA_ORDERS: [usize; 3] = [4, 10, 20];
+
+/// Deterministic pseudo-random numbers (xorshift64*), so that inputs need no RNG crate.
+struct Rng(u64);
+impl Rng {
+    fn uniform(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545F4914F6CDD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn normal(&mut self) -> f64 {
+        let u1 = self.uniform().max(1e-300);
+        let u2 = self.uniform();
+        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+    }
+}
+
+fn write_f64(path: &Path, x: &[f64]) -> Result<()> {
+    let mut b = Vec::with_capacity(x.len() * 8);
+    for v in x {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    std::fs::write(path, b).with_context(|| format!("writing {}", path.display()))
+}
+
+/// A lightly damped ARMA(p,p) test signal: poles at several modes, MA zeros inside the circle.
+fn arma_signal(p: usize, n: usize, rng: &mut Rng) -> Vec<f64> {
+    // AR part: p/2 pole pairs spread over 0.5-40 Hz at fs = 200 Hz, radii 0.97-0.995.
+    let fs = 200.0;
+    let mut a = vec![1.0];
+    for k in 0..p / 2 {
+        let f = 0.5 + 39.5 * (k as f64 + 0.5) / (p / 2) as f64;
+        let r: f64 = 0.97 + 0.025 * ((k * 7) % 5) as f64 / 4.0;
+        let w = 2.0 * std::f64::consts::PI * f / fs;
+        let quad = [1.0, -2.0 * r * w.cos(), r * r];
+        let mut na = vec![0.0; a.len() + 2];
+        for (i, ai) in a.iter().enumerate() {
+            for (j, qj) in quad.iter().enumerate() {
+                na[i + j] += ai * qj;
+            }
+        }
+        a = na;
+    }
+    let c: Vec<f64> = (0..=p)
+        .map(|i| {
+            if i == 0 {
+                1.0
+            } else {
+                0.5f64.powi(i as i32) * if i % 2 == 0 { 1.0 } else { -1.0 }
+            }
+        })
+        .collect();
+    let burn = 2000;
+    let e: Vec<f64> = (0..n + burn).map(|_| rng.normal()).collect();
+    let mut y = vec![0.0; n + burn];
+    for t in 0..n + burn {
+        let mut v = 0.0;
+        for (j, cj) in c.iter().enumerate() {
+            if t >= j {
+                v += cj * e[t - j];
+            }
+        }
+        for (j, aj) in a.iter().enumerate().skip(1) {
+            if t >= j {
+                v -= aj * y[t - j];
+            }
+        }
+        y[t] = v;
+    }
+    y[burn..].to_vec()
+}
+
+fn gen(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir)?;
+    let mut rng = Rng(0x9E3779B97F4A7C15);
+    let n = 204_800;
+    // Welch input: noise plus two tones.
+    let x: Vec<f64> = (0..n)
+        .map(|i| {
+            let t = i as f64 / 20000.0;
+            (2.0 * std::f64::consts::PI * 9.0 * t).sin()
+                + 0.5 * (2.0 * std::f64::consts::PI * 1.1 * t).sin()
+                + rng.normal()
+        })
+        .collect();
+    write_f64(&dir.join("welch.f64"), &x)?;
+    // 7 channels at 20 kHz, interleaved, and the same as a CSV with a header.
+    let raw: Vec<f64> = (0..n * 7).map(|_| rng.normal()).collect();
+    write_f64(&dir.join("raw7.f64"), &raw)?;
+    let mut csv = std::io::BufWriter::new(std::fs::File::create(dir.join("seven_channels.csv"))?);
+    writeln!(csv, "FL,FR,RL,RR,FR_body,RL_body,RR_body")?;
+    for row in raw.chunks(7) {
+        let cells: Vec<String> = row.iter().map(|v| format!("{v:.6}")).collect();
+        writeln!(csv, "{}", cells.join(","))?;
+    }
+    csv.flush()?;
+    for p in ARMA_ORDERS {
+        write_f64(
+            &dir.join(format!("arma{p}.f64")),
+            &arma_signal(p, 2048, &mut rng),
+        )?;
+    }
+    std::fs::write(
+        dir.join("meta.json"),
+        json!({"arma_orders": ARMA_ORDERS, "n": n, "fs_hz": 20000.0}).to_string(),
+    )?;
+    Ok(())
+}
+
+fn read_f64(path: &Path) -> Result<Vec<f64>> {
+    let b = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    Ok(b.chunks_exact(8)
+        .map(|c| f64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]]))
+        .collect())
+}
+
+fn median_time<F: FnMut() -> Result<()>>(repeat: usize, mut f: F) -> Result<f64> {
+    let mut t = Vec::with_capacity(repeat);
+    for _ in 0..repeat {
+        let t0 = Instant::now();
+        f()?;
+        t.push(t0.elapsed().as_secs_f64());
+    }
+    t.sort_by(|a, b| a.total_cmp(b));
+    Ok(t[t.len() / 2])
+}
+
+fn run(dir: &Path, quick: bool) -> Result<Value> {
+    let r = if quick { 3 } else { 15 };
+    let mut out = Map::new();
+    let x = read_f64(&dir.join("welch.f64"))?;
+    for nperseg in [256usize, 4096] {
+        let wp = vibmode_spectra::WelchParams {
+            nperseg: Some(nperseg),
+            ..Default::default()
+        };
+        let simple = median_time(r, || {
+            vibmode_spectra::welch(&x, 20000.0, &wp)?;
+            Ok(())
+        })?;
+        let mut plan = vibmode_spectra::WelchPlan::new(x.len(), 20000.0, &wp)?;
+        let planned = median_time(r, || {
+            plan.welch(&x)?;
+            Ok(())
+        })?;
+        out.insert(
+            format!("welch_204800_nperseg{nperseg}"),
+            json!({"vibmode_spectra::welch": simple, "WelchPlan::welch (reused plan)": planned}),
+        );
+    }
+    // Resampling 7 x 204 800 from 20 kHz to 200 Hz with the ideal filter.
+    let raw = read_f64(&dir.join("raw7.f64"))?;
+    let chans: Vec<Vec<f64>> = (0..7)
+        .map(|c| raw.iter().skip(c).step_by(7).copied().collect())
+        .collect();
+    let rec = vibmode_signal::Recording {
+        fs_hz: 20000.0,
+        channels: chans
+            .iter()
+            .enumerate()
+            .map(|(i, s)| vibmode_signal::Channel {
+                name: format!("ch{i}"),
+                unit: "m/s^2".into(),
+                samples: s.clone(),
+            })
+            .collect(),
+        time_axis: None,
+    };
+    let rp = vibmode_signal::ResampleParams {
+        to_hz: 200.0,
+        cutoff_hz: None,
+        filter: true,
+    };
+    let t_res = median_time(r, || {
+        rec.resample(&rp)?;
+        Ok(())
+    })?;
+    out.insert(
+        "resample_7x204800_20k_to_200".into(),
+        json!({"Recording::resample (ideal DFT filter)": t_res}),
+    );
+    // Reading the CSV.
+    let csv_path = dir.join("seven_channels.csv");
+    let opts = vibmode_signal::ReadOptions {
+        fs_hz: Some(20000.0),
+        ..Default::default()
+    };
+    let t_csv = median_time(if quick { 2 } else { 7 }, || {
+        let rec = vibmode_signal::read_path(&csv_path, &opts)?;
+        if rec.channels.len() != 7 || rec.len() != 204_800 {
+            bail!("read {} channels x {} rows", rec.channels.len(), rec.len());
+        }
+        Ok(())
+    })?;
+    out.insert(
+        "read_csv_7x204800".into(),
+        json!({"vibmode_signal::read_path": t_csv}),
+    );
+    // ARMA fits, quadratic criterion (as statsmodels), N = 2048.
+    for p in ARMA_ORDERS {
+        let y = read_f64(&dir.join(format!("arma{p}.f64")))?;
+        let params = vibmode_ident::ArmaParams {
+            robust: vibmode_ident::Robust::Off,
+            ..Default::default()
+        };
+        let mut lambda = f64::NAN;
+        let t = median_time(if quick { 3 } else { 11 }, || {
+            let m = vibmode_ident::fit_arma(&y, p, p, &params)?;
+            lambda = m.noise_variance;
+            Ok(())
+        })?;
+        out.insert(
+            format!("arma_{p}_{p}_n2048"),
+            json!({"vibmode_ident::fit_arma (quadratic)": t, "_lambda_vibmode": lambda}),
+        );
+    }
+    Ok(Value::Object(out))
+}
+
+fn main() -> Result<()> {
+    let args: Vec<String> = std::env::args().collect();
+    match args.get(1).map(String::as_str) {
+        Some("gen") => gen(Path::new(
+            args.get(2).context("usage: vibmode-bench gen DIR")?,
+        )),
+        Some("run") => {
+            let dir = args
+                .get(2)
+                .context("usage: vibmode-bench run DIR [--quick]")?;
+            let quick = args.iter().any(|a| a == "--quick");
+            println!("{}", run(Path::new(dir), quick)?);
+            Ok(())
+        }
+        _ => bail!("usage: vibmode-bench gen DIR | vibmode-bench run DIR [--quick]"),
+    }
+}

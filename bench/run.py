@@ -1,0 +1,144 @@
+#!/usr/bin/env python3
+"""Side-by-side benchmark: vibmode (Rust, release build) against scipy / numpy / pandas / statsmodels.
+
+Usage (from the repository root):
+    python3 -m pip install -r tools/reference/requirements.txt
+    python3 bench/run.py [--quick] [--out bench-results.json]
+
+What it does, in one run:
+1. builds `vibmode-bench` in release mode;
+2. `vibmode-bench gen DIR` writes the shared inputs (a 7-channel 204 800-row CSV, the ARMA data);
+3. `vibmode-bench run DIR` times vibmode's kernels and prints medians as JSON;
+4. times the Python peers on the same inputs in this process;
+5. prints a Markdown table (median seconds and vibmode/peer ratios) for BENCHMARKS.md.
+Medians over repeated runs; wall-clock time on whatever machine runs it.
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+import warnings
+
+import numpy as np
+import scipy
+import scipy.signal as ss
+
+
+def median_time(fn, repeat, min_time=0.0):
+    times = []
+    t_start = time.perf_counter()
+    while len(times) < repeat or (time.perf_counter() - t_start) < min_time:
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+        if len(times) >= 200:
+            break
+    return statistics.median(times)
+
+
+def peers(data_dir, quick):
+    res = {}
+    meta = json.load(open(os.path.join(data_dir, "meta.json")))
+    csv_path = os.path.join(data_dir, "seven_channels.csv")
+    x = np.fromfile(os.path.join(data_dir, "welch.f64"), dtype="<f8")
+    r = 3 if quick else 7
+    res["welch_204800_nperseg256"] = {"scipy.signal.welch": median_time(lambda: ss.welch(x, fs=20000.0, nperseg=256), r)}
+    res["welch_204800_nperseg4096"] = {"scipy.signal.welch": median_time(lambda: ss.welch(x, fs=20000.0, nperseg=4096), r)}
+    raw = np.fromfile(os.path.join(data_dir, "raw7.f64"), dtype="<f8").reshape(-1, 7)
+
+    def ideal_numpy():
+        X = np.fft.rfft(raw, axis=0)
+        f = np.fft.rfftfreq(raw.shape[0], 1 / 20000.0)
+        X[f > 100.0, :] = 0
+        return np.fft.irfft(X, n=raw.shape[0], axis=0)[::100]
+
+    res["resample_7x204800_20k_to_200"] = {
+        "scipy.signal.resample": median_time(lambda: ss.resample(raw, 2048, axis=0), r),
+        "numpy rfft ideal filter + decimate": median_time(ideal_numpy, r),
+        "scipy.signal.resample_poly": median_time(lambda: ss.resample_poly(raw, 1, 100, axis=0), r),
+    }
+    rr = 1 if quick else 3
+    csv = {"numpy.loadtxt": median_time(lambda: np.loadtxt(csv_path, delimiter=",", skiprows=1), rr)}
+    try:
+        import pandas as pd
+        csv["pandas.read_csv"] = median_time(lambda: pd.read_csv(csv_path), rr)
+    except ImportError:
+        pass
+    res["read_csv_7x204800"] = csv
+    # ARMA fits (statsmodels exact-likelihood ARIMA), same data as vibmode.
+    try:
+        import statsmodels
+        from statsmodels.tsa.arima.model import ARIMA
+        for p in meta["arma_orders"]:
+            y = np.fromfile(os.path.join(data_dir, f"arma{p}.f64"), dtype="<f8")
+            lam = {}
+
+            def fit():
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    m = ARIMA(y, order=(p, 0, p), trend="n").fit()
+                lam["sigma2"] = float(m.params[-1])
+                lam["params"] = m.params
+            t = median_time(fit, 1)
+            # lambda of the statsmodels parameters evaluated by vibmode's predictor definition
+            # (mean squared one-step error with zero initial conditions), computed here in numpy.
+            ar = lam["params"][:p]
+            ma = lam["params"][p:2 * p]
+            a = np.r_[1.0, -ar]
+            c = np.r_[1.0, ma]
+            eps = ss.lfilter(a, c, y)
+            res[f"arma_{p}_{p}_n2048"] = {"statsmodels ARIMA": t, "_lambda_statsmodels": float(np.mean(eps ** 2))}
+        res["_versions"] = {"statsmodels": statsmodels.__version__}
+    except ImportError:
+        pass
+    res.setdefault("_versions", {}).update({"numpy": np.__version__, "scipy": scipy.__version__, "python": sys.version.split()[0]})
+    return res
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--quick", action="store_true", help="fewer repetitions")
+    ap.add_argument("--out", default=None, help="also write all figures to this JSON file")
+    args = ap.parse_args()
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    subprocess.run(["cargo", "build", "--release", "-q", "-p", "vibmode-bench"], cwd=root, check=True)
+    target = os.environ.get("CARGO_TARGET_DIR", os.path.join(root, "target"))
+    exe = os.path.join(target, "release", "vibmode-bench")
+    with tempfile.TemporaryDirectory() as d:
+        subprocess.run([exe, "gen", d], check=True)
+        out = subprocess.run([exe, "run", d] + (["--quick"] if args.quick else []), check=True, capture_output=True, text=True)
+        rust = json.loads(out.stdout)
+        py = peers(d, args.quick)
+    rows = []
+    for case, rs in rust.items():
+        if case.startswith("_"):
+            continue
+        for impl_name, t in rs.items():
+            if impl_name.startswith("_"):
+                continue
+            pe = {k: v for k, v in py.get(case, {}).items() if not k.startswith("_")}
+            best = min(pe.items(), key=lambda kv: kv[1]) if pe else None
+            for pname, pt in pe.items():
+                rows.append((case, impl_name, t, pname, pt, t / pt, "fastest peer" if best and pname == best[0] else ""))
+    print(f"| case | vibmode | median [s] | peer | median [s] | ratio vibmode/peer | |")
+    print("|---|---|---|---|---|---|---|")
+    for r in rows:
+        print(f"| {r[0]} | {r[1]} | {r[2]:.5f} | {r[3]} | {r[4]:.5f} | {r[5]:.4f} | {r[6]} |")
+    extra = {k: v for k, v in rust.items() if k.startswith("_")}
+    for case in py:
+        if case.startswith("arma_"):
+            lr = rust.get(case, {}).get("_lambda_vibmode")
+            ls = py[case].get("_lambda_statsmodels")
+            if lr is not None and ls is not None:
+                print(f"\n{case}: lambda vibmode {lr:.6e}, statsmodels (evaluated by the same predictor) {ls:.6e}, ratio {lr / ls:.5f}")
+    print("\nversions:", json.dumps(py.get("_versions", {})), json.dumps(extra))
+    if args.out:
+        json.dump({"vibmode": rust, "peers": py}, open(args.out, "w"), indent=1, default=float)
+
+
+if __name__ == "__main__":
+    main()

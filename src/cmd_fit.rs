@@ -1,0 +1,364 @@
+//! `vibmode fit`: AR / ARMA identification of each channel, model spectra and modes.
+
+use crate::cmd_psd::SpectralArgs;
+use crate::input::InputArgs;
+use crate::output::{ensure_parent, write_json};
+use anyhow::{bail, Context, Result};
+use clap::{Args, ValueEnum};
+use serde::Serialize;
+use std::path::PathBuf;
+use vibmode_ident::{ArMethod, ArmaModel, ArmaParams, Robust};
+use vibmode_report::{Figure, Panel, Scale, Series, SeriesStyle};
+
+/// Model structure.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ModelKind {
+    /// Autoregressive model A(q) y = e.
+    Ar,
+    /// ARMA model A(q) y = C(q) e, fitted by prediction-error minimisation.
+    Arma,
+}
+
+/// Estimation method.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FitMethod {
+    /// Yule-Walker (AR only).
+    YuleWalker,
+    /// Burg (AR only).
+    Burg,
+    /// Forward-backward least squares (AR only).
+    Ls,
+    /// Prediction-error minimisation (ARMA; the default for --model arma).
+    Pem,
+}
+
+/// Arguments of `vibmode fit`.
+#[derive(Args, Debug)]
+pub struct FitArgs {
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// Model structure: ar or arma.
+    #[arg(long, value_enum, default_value_t = ModelKind::Arma)]
+    pub model: ModelKind,
+    /// AR order p (number of poles).
+    #[arg(long)]
+    pub order: usize,
+    /// MA order q for ARMA (default: p, the paper's ARMA(p,p)).
+    #[arg(long = "ma-order")]
+    pub ma_order: Option<usize>,
+    /// Estimation method (default: burg for AR, pem for ARMA).
+    #[arg(long, value_enum)]
+    pub method: Option<FitMethod>,
+    /// Robust criterion for PEM: a factor (default 1.6, times the robust std of the initial
+    /// residuals) or `off` for the purely quadratic criterion.
+    #[arg(long, default_value = "1.6")]
+    pub robust: String,
+    /// Write JSON results to this path (`-` for standard output).
+    #[arg(long)]
+    pub json: Option<String>,
+    /// Plot periodogram, Welch and the model PSD with the modes (.svg or .png), paper Fig. 6-7.
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// Modes with damping ratio below this are marked in the plot and the table.
+    #[arg(long = "mark-damping-max", default_value_t = 0.3)]
+    pub mark_damping_max: f64,
+    #[command(flatten)]
+    pub spectral: SpectralArgs,
+}
+
+/// One mode in the JSON output.
+#[derive(Serialize, Clone, Debug)]
+pub struct ModeOut {
+    /// Natural frequency, Hz.
+    pub frequency_hz: f64,
+    /// Damping ratio (dimensionless).
+    pub damping_ratio: f64,
+    /// Damped frequency, Hz.
+    pub damped_frequency_hz: f64,
+    /// Real part of the discrete-time pole.
+    pub pole_re: f64,
+    /// Imaginary part of the discrete-time pole.
+    pub pole_im: f64,
+}
+
+/// One channel's fitted model in the JSON output.
+#[derive(Serialize, Clone, Debug)]
+pub struct ChannelFit {
+    name: String,
+    unit: String,
+    model: ModelKind,
+    method: String,
+    p: usize,
+    q: usize,
+    a: Vec<f64>,
+    c: Vec<f64>,
+    noise_variance: f64,
+    loss: f64,
+    iterations: usize,
+    converged: bool,
+    aic: f64,
+    bic: f64,
+    fpe: f64,
+    std_errors: Vec<f64>,
+    modes: Vec<ModeOut>,
+    real_poles: Vec<f64>,
+    unstable_poles: Vec<[f64; 2]>,
+}
+
+#[derive(Serialize)]
+struct FitOutput {
+    source: String,
+    fs_hz: f64,
+    n_samples: usize,
+    robust: String,
+    channels: Vec<ChannelFit>,
+}
+
+fn parse_robust(s: &str) -> Result<Robust> {
+    Ok(s.parse::<Robust>()?)
+}
+
+/// Fits one channel. Shared with other commands.
+pub fn fit_channel(
+    y: &[f64],
+    kind: ModelKind,
+    method: Option<FitMethod>,
+    p: usize,
+    q: usize,
+    params: &ArmaParams,
+) -> Result<(ArmaModel, String)> {
+    match kind {
+        ModelKind::Ar => {
+            let m = match method.unwrap_or(FitMethod::Burg) {
+                FitMethod::YuleWalker => ArMethod::YuleWalker,
+                FitMethod::Burg => ArMethod::Burg,
+                FitMethod::Ls => ArMethod::LeastSquares,
+                FitMethod::Pem => {
+                    bail!("--method pem is for --model arma; for AR use yule-walker, burg or ls")
+                }
+            };
+            Ok((vibmode_ident::fit_ar(y, p, m)?, m.to_string()))
+        }
+        ModelKind::Arma => {
+            if let Some(m) = method {
+                if m != FitMethod::Pem {
+                    bail!("--model arma is fitted by --method pem; {m:?} applies to --model ar");
+                }
+            }
+            Ok((vibmode_ident::fit_arma(y, p, q, params)?, "pem".into()))
+        }
+    }
+}
+
+/// Converts a fitted model to its JSON form.
+pub fn channel_fit(
+    name: &str,
+    unit: &str,
+    kind: ModelKind,
+    method: String,
+    m: &ArmaModel,
+    fs_hz: f64,
+) -> ChannelFit {
+    let ms = m.modes(fs_hz);
+    ChannelFit {
+        name: name.to_string(),
+        unit: unit.to_string(),
+        model: kind,
+        method,
+        p: m.p,
+        q: m.q,
+        a: m.a.clone(),
+        c: m.c.clone(),
+        noise_variance: m.noise_variance,
+        loss: m.loss,
+        iterations: m.iterations,
+        converged: m.converged,
+        aic: m.aic,
+        bic: m.bic,
+        fpe: m.fpe,
+        std_errors: m.std_errors.clone(),
+        modes: ms
+            .modes
+            .iter()
+            .map(|md| ModeOut {
+                frequency_hz: md.frequency_hz,
+                damping_ratio: md.damping_ratio,
+                damped_frequency_hz: md.damped_frequency_hz,
+                pole_re: md.pole_re,
+                pole_im: md.pole_im,
+            })
+            .collect(),
+        real_poles: ms.real_poles.clone(),
+        unstable_poles: ms.unstable_poles.iter().map(|z| [z.re, z.im]).collect(),
+    }
+}
+
+/// Runs `vibmode fit`.
+pub fn run(a: &FitArgs) -> Result<()> {
+    let rec = a.input.load()?;
+    let robust = parse_robust(&a.robust)?;
+    let params = ArmaParams {
+        robust,
+        ..ArmaParams::default()
+    };
+    let q = match a.model {
+        ModelKind::Ar => 0,
+        ModelKind::Arma => a.ma_order.unwrap_or(a.order),
+    };
+    if a.model == ModelKind::Ar && a.ma_order.is_some_and(|q| q > 0) {
+        bail!("--ma-order applies to --model arma; drop it or use --model arma");
+    }
+    let mut channels = Vec::new();
+    let mut models = Vec::new();
+    for ch in &rec.channels {
+        let (m, method) = fit_channel(&ch.samples, a.model, a.method, a.order, q, &params)
+            .with_context(|| format!("channel '{}'", ch.name))?;
+        channels.push(channel_fit(
+            &ch.name, &ch.unit, a.model, method, &m, rec.fs_hz,
+        ));
+        models.push(m);
+    }
+    let out = FitOutput {
+        source: a.input.input.display().to_string(),
+        fs_hz: rec.fs_hz,
+        n_samples: rec.len(),
+        robust: a.robust.clone(),
+        channels,
+    };
+    if let Some(path) = &a.plot {
+        let fig = fit_figure(&rec, &models, &out.channels, a)?;
+        ensure_parent(path)?;
+        fig.save(path)
+            .with_context(|| format!("writing plot {}", path.display()))?;
+    }
+    match &a.json {
+        Some(dest) => write_json(dest, &out)?,
+        None => print_table(&out, a.mark_damping_max),
+    }
+    Ok(())
+}
+
+fn print_table(o: &FitOutput, zmax: f64) {
+    for c in &o.channels {
+        println!(
+            "{}: {}({}{}) by {}, {} iterations{}, noise variance {:.6e}, loss {:.6e}, AIC {:.2}",
+            c.name,
+            if c.model == ModelKind::Ar {
+                "AR"
+            } else {
+                "ARMA"
+            },
+            c.p,
+            if c.model == ModelKind::Arma {
+                format!(",{}", c.q)
+            } else {
+                String::new()
+            },
+            c.method,
+            c.iterations,
+            if c.converged { "" } else { " (NOT converged)" },
+            c.noise_variance,
+            c.loss,
+            c.aic
+        );
+        println!("  {:>12} {:>14}  ", "freq_hz", "damping_ratio");
+        for m in &c.modes {
+            println!(
+                "  {:>12.4} {:>14.5}  {}",
+                m.frequency_hz,
+                m.damping_ratio,
+                if m.damping_ratio < zmax { "*" } else { "" }
+            );
+        }
+        if !c.unstable_poles.is_empty() {
+            println!("  {} unstable pole(s)", c.unstable_poles.len());
+        }
+    }
+}
+
+fn fit_figure(
+    rec: &vibmode_signal::Recording,
+    models: &[ArmaModel],
+    fits: &[ChannelFit],
+    a: &FitArgs,
+) -> Result<Figure> {
+    let wp = a.spectral.welch_params()?;
+    let pp = a.spectral.periodogram_params()?;
+    let mut panels = Vec::new();
+    for ((ch, m), f) in rec.channels.iter().zip(models).zip(fits) {
+        let per = vibmode_spectra::periodogram(&ch.samples, rec.fs_hz, &pp)?;
+        let wel = vibmode_spectra::welch(&ch.samples, rec.fs_hz, &wp)?;
+        let grid: Vec<f64> = (1..=1000)
+            .map(|i| i as f64 * rec.fs_hz / 2.0 / 1000.0)
+            .collect();
+        let mpsd = m.model_psd(&grid, rec.fs_hz);
+        let marks: Vec<f64> = f
+            .modes
+            .iter()
+            .filter(|md| md.damping_ratio < a.mark_damping_max)
+            .map(|md| md.frequency_hz)
+            .collect();
+        let line = |label: &str, x: Vec<f64>, y: Vec<f64>, width: u32, alpha: f64| Series {
+            label: Some(label.to_string()),
+            x,
+            y,
+            style: SeriesStyle::Line {
+                width,
+                dashed: false,
+            },
+            color: None,
+            alpha,
+        };
+        let u = if ch.unit.is_empty() {
+            "unit".to_string()
+        } else {
+            ch.unit.clone()
+        };
+        panels.push(Panel {
+            title: format!(
+                "{}: {}({}{})",
+                ch.name,
+                if f.model == ModelKind::Ar {
+                    "AR"
+                } else {
+                    "ARMA"
+                },
+                f.p,
+                if f.model == ModelKind::Arma {
+                    format!(",{}", f.q)
+                } else {
+                    String::new()
+                }
+            ),
+            x_label: "Frequency [Hz]".into(),
+            y_label: format!("PSD [({u})^2/Hz]"),
+            x_scale: Scale::Linear,
+            y_scale: Scale::Log,
+            x_range: Some((0.0, rec.fs_hz / 2.0)),
+            y_range: None,
+            series: vec![
+                line("periodogram", per.freq_hz, per.psd, 1, 0.4),
+                line("Welch", wel.freq_hz, wel.psd, 2, 1.0),
+                line("model", grid, mpsd, 2, 1.0),
+                Series {
+                    label: Some(format!("modes, damping < {}", a.mark_damping_max)),
+                    x: marks,
+                    y: vec![],
+                    style: SeriesStyle::VLines { dotted: true },
+                    color: None,
+                    alpha: 0.8,
+                },
+            ],
+            legend: true,
+        });
+    }
+    let n = panels.len();
+    Ok(Figure {
+        title: None,
+        panels,
+        columns: 1,
+        width_px: 1000,
+        height_px: (500 * n.max(1)) as u32,
+    })
+}

@@ -1,0 +1,238 @@
+//! `vibmode sweep`: fit every model order and collect every mode (stabilisation diagram).
+
+use crate::cmd_fit::{FitMethod, ModelKind};
+use crate::figures;
+use crate::input::InputArgs;
+use crate::output::{ensure_parent, write_json};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use serde::Serialize;
+use std::path::PathBuf;
+use vibmode_ident::{ArMethod, ArmaParams, Robust};
+
+/// Arguments of `vibmode sweep`.
+#[derive(Args, Debug)]
+pub struct SweepArgs {
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// Model orders: `2:60` (inclusive range), `2:60:2` (with step) or a list `4,8,16`.
+    #[arg(long, default_value = "2:60")]
+    pub orders: String,
+    /// Model structure: arma (ARMA(p,p)) or ar.
+    #[arg(long, value_enum, default_value_t = ModelKind::Arma)]
+    pub model: ModelKind,
+    /// Estimation method (default: burg for AR, pem for ARMA).
+    #[arg(long, value_enum)]
+    pub method: Option<FitMethod>,
+    /// Robust criterion factor for PEM, or `off`.
+    #[arg(long, default_value = "1.6")]
+    pub robust: String,
+    /// Write JSON results to this path (`-` for standard output).
+    #[arg(long)]
+    pub json: Option<String>,
+    /// Write the stabilisation diagram (.svg or .png); a frequency-damping plot is written
+    /// beside it with `-damping` appended to the file stem.
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+}
+
+/// Parses `2:60`, `2:60:2` or `4,8,16`.
+pub fn parse_orders(s: &str) -> Result<Vec<usize>> {
+    let bad = || {
+        anyhow::anyhow!("invalid --orders '{s}'; use a range like 2:60, a stepped range 2:60:2, or a list 4,8,16")
+    };
+    let v: Vec<usize> = if s.contains(':') {
+        let parts: Vec<usize> = s
+            .split(':')
+            .map(|p| p.trim().parse::<usize>().map_err(|_| bad()))
+            .collect::<Result<_>>()?;
+        let (lo, hi, step) = match parts.as_slice() {
+            [lo, hi] => (*lo, *hi, 1),
+            [lo, hi, st] => (*lo, *hi, *st),
+            _ => return Err(bad()),
+        };
+        if step == 0 || hi < lo {
+            return Err(bad());
+        }
+        (lo..=hi).step_by(step).collect()
+    } else {
+        s.split(',')
+            .map(|p| p.trim().parse::<usize>().map_err(|_| bad()))
+            .collect::<Result<_>>()?
+    };
+    if v.is_empty() || v.contains(&0) {
+        bail!("--orders '{s}' must list orders >= 1");
+    }
+    Ok(v)
+}
+
+/// One pole pair of the sweep.
+#[derive(Serialize, Clone, Copy, Debug)]
+pub struct SweepMode {
+    /// Model order p.
+    pub order: usize,
+    /// Natural frequency, Hz.
+    pub frequency_hz: f64,
+    /// Damping ratio.
+    pub damping_ratio: f64,
+}
+
+#[derive(Serialize)]
+struct SweepChannel {
+    name: String,
+    unit: String,
+    orders: Vec<usize>,
+    loss: Vec<f64>,
+    converged: Vec<bool>,
+    errors: Vec<Option<String>>,
+    modes: Vec<SweepMode>,
+    welch_freq_hz: Vec<f64>,
+    welch_psd: Vec<f64>,
+}
+
+#[derive(Serialize)]
+struct SweepOutput {
+    source: String,
+    fs_hz: f64,
+    n_samples: usize,
+    model: ModelKind,
+    channels: Vec<SweepChannel>,
+}
+
+/// Runs `vibmode sweep`.
+pub fn run(a: &SweepArgs) -> Result<()> {
+    let rec = a.input.load()?;
+    let orders = parse_orders(&a.orders)?;
+    let robust: Robust = a.robust.parse()?;
+    let params = ArmaParams {
+        robust,
+        ..ArmaParams::default()
+    };
+    let ar_method = match (a.model, a.method) {
+        (ModelKind::Ar, None | Some(FitMethod::Burg)) => ArMethod::Burg,
+        (ModelKind::Ar, Some(FitMethod::YuleWalker)) => ArMethod::YuleWalker,
+        (ModelKind::Ar, Some(FitMethod::Ls)) => ArMethod::LeastSquares,
+        (ModelKind::Ar, Some(FitMethod::Pem)) => {
+            bail!("--method pem is for --model arma; for AR use yule-walker, burg or ls")
+        }
+        (ModelKind::Arma, None | Some(FitMethod::Pem)) => ArMethod::Burg,
+        (ModelKind::Arma, Some(m)) => {
+            bail!("--model arma is fitted by --method pem; {m:?} applies to --model ar")
+        }
+    };
+    // Fail early, with the fit's own message, if the highest order cannot be fitted at all.
+    let max_order = orders.iter().copied().max().unwrap_or(1);
+    let mut channels = Vec::new();
+    for ch in &rec.channels {
+        let fits = match a.model {
+            ModelKind::Arma => vibmode_ident::sweep_arma(&ch.samples, &orders, &params),
+            ModelKind::Ar => orders
+                .iter()
+                .map(|&p| vibmode_ident::fit_ar(&ch.samples, p, ar_method))
+                .collect(),
+        };
+        if fits.iter().all(|f| f.is_err()) {
+            if let Some(Err(e)) = fits.into_iter().last() {
+                return Err(e).with_context(|| format!("channel '{}', order {max_order}", ch.name));
+            }
+            bail!("no fits for channel '{}'", ch.name);
+        }
+        let mut out = SweepChannel {
+            name: ch.name.clone(),
+            unit: ch.unit.clone(),
+            orders: orders.clone(),
+            loss: vec![],
+            converged: vec![],
+            errors: vec![],
+            modes: vec![],
+            welch_freq_hz: vec![],
+            welch_psd: vec![],
+        };
+        for (&p, f) in orders.iter().zip(fits) {
+            match f {
+                Ok(m) => {
+                    out.loss.push(m.loss);
+                    out.converged.push(m.converged);
+                    out.errors.push(None);
+                    for md in m.modes(rec.fs_hz).modes {
+                        out.modes.push(SweepMode {
+                            order: p,
+                            frequency_hz: md.frequency_hz,
+                            damping_ratio: md.damping_ratio,
+                        });
+                    }
+                }
+                Err(e) => {
+                    out.loss.push(f64::NAN);
+                    out.converged.push(false);
+                    out.errors.push(Some(e.to_string()));
+                }
+            }
+        }
+        let wp = vibmode_spectra::WelchParams {
+            nperseg: Some(256.min(ch.samples.len())),
+            ..Default::default()
+        };
+        let w = vibmode_spectra::welch(&ch.samples, rec.fs_hz, &wp)?;
+        out.welch_freq_hz = w.freq_hz;
+        out.welch_psd = w.psd;
+        channels.push(out);
+    }
+    let out = SweepOutput {
+        source: a.input.input.display().to_string(),
+        fs_hz: rec.fs_hz,
+        n_samples: rec.len(),
+        model: a.model,
+        channels,
+    };
+    if let Some(path) = &a.plot {
+        ensure_parent(path)?;
+        let mut stab = Vec::new();
+        let mut damp = Vec::new();
+        for c in &out.channels {
+            let pts: Vec<(usize, f64, f64)> = c
+                .modes
+                .iter()
+                .map(|m| (m.order, m.frequency_hz, m.damping_ratio))
+                .collect();
+            stab.push(figures::stabilisation_panel(
+                &format!("{}: stabilisation diagram", c.name),
+                &pts,
+                &c.welch_freq_hz,
+                &c.welch_psd,
+                out.fs_hz / 2.0,
+            ));
+            damp.push(figures::damping_panel(
+                &format!("{}: frequency vs damping", c.name),
+                &pts,
+                &[],
+                out.fs_hz / 2.0,
+            ));
+        }
+        figures::grid(stab, 1, 1000, 520)
+            .save(path)
+            .with_context(|| format!("writing plot {}", path.display()))?;
+        let dpath = figures::sibling(path, "-damping");
+        figures::grid(damp, 1, 1000, 520)
+            .save(&dpath)
+            .with_context(|| format!("writing plot {}", dpath.display()))?;
+        eprintln!("wrote {} and {}", path.display(), dpath.display());
+    }
+    match &a.json {
+        Some(dest) => write_json(dest, &out)?,
+        None => {
+            for c in &out.channels {
+                let nc = c.converged.iter().filter(|x| !**x).count();
+                println!(
+                    "{}: {} orders, {} pole pairs, {} fits not converged, {} failed",
+                    c.name,
+                    c.orders.len(),
+                    c.modes.len(),
+                    nc,
+                    c.errors.iter().filter(|e| e.is_some()).count()
+                );
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,78 @@
+//! Shared input options: which file, which channels, which rate, optional resampling.
+
+use anyhow::{Context, Result};
+use clap::Args;
+use std::path::PathBuf;
+use vibmode_signal::{ChannelSelector, ReadOptions, Recording, ResampleParams};
+
+/// Options every analysis command shares for reading its input.
+#[derive(Args, Debug, Clone)]
+pub struct InputArgs {
+    /// Input file: delimited text (.csv, .txt, .tsv), WAV (.wav), or raw f32/f64 with a JSON sidecar.
+    pub input: PathBuf,
+    /// Channel to analyse, by name or 0-based index; repeat for several (default: all but time).
+    #[arg(long = "channel", short = 'c')]
+    pub channels: Vec<String>,
+    /// Sampling rate in Hz, required when the file has no time column and no header rate.
+    #[arg(long = "fs")]
+    pub fs_hz: Option<f64>,
+    /// Multiplier applied to WAV integer samples after scaling to [-1, 1) full scale.
+    #[arg(long, default_value_t = 1.0)]
+    pub scale: f64,
+    /// Unit of the samples when the file does not say (e.g. m/s^2).
+    #[arg(long)]
+    pub unit: Option<String>,
+    /// Accept a non-uniform time column by interpolating onto a uniform grid at the mean rate.
+    #[arg(long)]
+    pub resample_nonuniform: bool,
+    /// Resample to this rate in Hz (ideal DFT anti-alias filter first) before analysis.
+    #[arg(long = "resample-to")]
+    pub resample_to_hz: Option<f64>,
+    /// Cutoff of the ideal anti-alias filter in Hz (default: the new Nyquist frequency).
+    #[arg(long = "cutoff")]
+    pub cutoff_hz: Option<f64>,
+}
+
+impl InputArgs {
+    /// Reads the file, selects channels and optionally resamples.
+    pub fn load(&self) -> Result<Recording> {
+        let rec = self.load_raw()?;
+        match self.resample_to_hz {
+            Some(to_hz) => {
+                let p = ResampleParams {
+                    to_hz,
+                    cutoff_hz: self.cutoff_hz,
+                    filter: true,
+                };
+                rec.resample(&p).context("resampling")
+            }
+            None => {
+                if let Some(c) = self.cutoff_hz {
+                    anyhow::bail!("--cutoff {c} needs --resample-to HZ (the rate to resample to)");
+                }
+                Ok(rec)
+            }
+        }
+    }
+
+    /// Reads the file and selects channels, without resampling.
+    pub fn load_raw(&self) -> Result<Recording> {
+        let opts = ReadOptions {
+            fs_hz: self.fs_hz,
+            scale: self.scale,
+            allow_nonuniform: self.resample_nonuniform,
+            unit: self.unit.clone(),
+            ..ReadOptions::default()
+        };
+        let rec = vibmode_signal::read_path(&self.input, &opts)?;
+        if self.channels.is_empty() {
+            return Ok(rec);
+        }
+        let sel = self
+            .channels
+            .iter()
+            .map(|s| s.parse::<ChannelSelector>())
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(rec.select(&sel)?)
+    }
+}
