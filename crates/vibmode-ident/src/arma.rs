@@ -117,6 +117,9 @@ impl ArmaParams {
 /// (O(N p (p + q)) per iteration); beyond it delayed copies of y/C are used.
 const EXACT_JACOBIAN_BUDGET: f64 = 2.0e7;
 
+/// Largest p + q searched from every starting candidate (multi-start).
+const MULTISTART_MAX_ORDER: usize = 16;
+
 /// Iterations over which the stall rule measures progress.
 const STALL_WINDOW: usize = 5;
 
@@ -486,34 +489,13 @@ fn search(
         c.resize(q + 1, 0.0);
         cands.extend(make_candidate(ys, a, c, robust));
     }
-    let best = cands.into_iter().min_by(|x, y| x.score.total_cmp(&y.score));
-    let Candidate {
-        mut a,
-        mut c,
-        mut eps,
-        ..
-    } = match best {
-        Some(b) => b,
-        None => {
-            // Unreachable in practice (Burg on finite data is finite); start from white noise.
-            let mut a = vec![0.0; p + 1];
-            a[0] = 1.0;
-            let mut c = vec![0.0; q + 1];
-            c[0] = 1.0;
-            Candidate {
-                a,
-                c,
-                eps: ys.to_vec(),
-                score: 0.0,
-            }
-        }
-    };
-    let rho = match params.robust {
-        Robust::Off => None,
-        Robust::Huber { factor } => {
-            let mut s = robust_std(&eps[p..]);
+    cands.sort_by(|x, y| x.score.total_cmp(&y.score));
+    let rho = match (params.robust, cands.first()) {
+        (Robust::Huber { factor }, Some(best)) => {
+            let eps = &best.eps[p..];
+            let mut s = robust_std(eps);
             if s.is_nan() || s <= 0.0 {
-                s = (mean_loss(&eps[p..], None)).sqrt();
+                s = (mean_loss(eps, None)).sqrt();
             }
             if s > 0.0 {
                 Some(factor * s)
@@ -521,8 +503,78 @@ fn search(
                 None
             }
         }
+        _ => None,
     };
+    if cands.is_empty() {
+        // Unreachable in practice (Burg on finite data is finite); start from white noise.
+        let mut a = vec![0.0; p + 1];
+        a[0] = 1.0;
+        let mut c = vec![0.0; q + 1];
+        c[0] = 1.0;
+        let mut eps = vec![0.0; n];
+        predict_errors(ys, &a, &c, &mut eps);
+        cands.push(Candidate {
+            a,
+            c,
+            eps,
+            score: 0.0,
+        });
+    }
+    // Small models: search from every candidate and keep the best end point (guards against
+    // neighbouring local minima); larger models: from the best-scored candidate only.
+    let starts = if p + q <= MULTISTART_MAX_ORDER {
+        cands.len()
+    } else {
+        1
+    };
+    let mut best: Option<SearchOut> = None;
+    for cand in cands.into_iter().take(starts) {
+        let out = gauss_newton(ys, p, q, cand, rho, params);
+        let better = match &best {
+            None => true,
+            Some(b) => out.v < b.v,
+        };
+        if better {
+            if let Some(b) = &best {
+                let mut out = out;
+                out.iterations += b.iterations;
+                best = Some(out);
+            } else {
+                best = Some(out);
+            }
+        } else if let Some(b) = best.as_mut() {
+            b.iterations += out.iterations;
+        }
+    }
+    // `cands` is never empty here, so `best` is set.
+    best.unwrap_or(SearchOut {
+        a: Vec::new(),
+        c: Vec::new(),
+        eps: Vec::new(),
+        v: f64::NAN,
+        rho,
+        iterations: 0,
+        stop: StopReason::NoImprovement,
+        converged: false,
+    })
+}
 
+/// Damped Gauss-Newton from one starting candidate (see docs/identification.md).
+fn gauss_newton(
+    ys: &[f64],
+    p: usize,
+    q: usize,
+    start: Candidate,
+    rho: Option<f64>,
+    params: &ArmaParams,
+) -> SearchOut {
+    let n = ys.len();
+    let Candidate {
+        mut a,
+        mut c,
+        mut eps,
+        ..
+    } = start;
     let k = p + q;
     let mut search = Search {
         ys,

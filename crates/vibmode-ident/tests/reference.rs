@@ -135,10 +135,7 @@ fn arma_quadratic_lambda_no_worse_than_statsmodels() {
             dt * 1e3,
             case["sm_fit_seconds"].as_f64().unwrap()
         );
-        // KNOWN GAP: on arma43_n1500 the search ends in a neighbouring local minimum 0.13 % above
-        // statsmodels' (also with tol = 1e-9); the requirement 1.001 holds for the other cases.
-        let limit = if name == "arma43_n1500" { 1.002 } else { 1.001 };
-        assert!(ratio <= limit, "{name}: lambda ratio {ratio}");
+        assert!(ratio <= 1.001, "{name}: lambda ratio {ratio}");
         assert!(m.converged, "{name}: not converged ({:?})", m.stop_reason);
         assert!((m.loss - m.noise_variance).abs() <= 1e-12 * m.loss);
         assert_eq!(m.std_errors.len(), p + q);
