@@ -90,7 +90,11 @@ def peers(data_dir, quick):
             ma = lam["params"][p:2 * p]
             a = np.r_[1.0, -ar]
             c = np.r_[1.0, ma]
-            eps = ss.lfilter(a, c, y)
+            # vibmode's definition (docs/identification.md): demeaned y, conditional on the first
+            # p samples: w_t = A(q) y_t for t >= p, eps = w / C with zero initial conditions.
+            yd = y - y.mean()
+            w = ss.lfilter(a, [1.0], yd)[p:]
+            eps = ss.lfilter([1.0], c, w)
             res[f"arma_{p}_{p}_n2048"] = {"statsmodels ARIMA": t, "_lambda_statsmodels": float(np.mean(eps ** 2))}
         res["_versions"] = {"statsmodels": statsmodels.__version__}
     except ImportError:

@@ -330,30 +330,20 @@ pub fn write_report(
             x_range: Some((0.0, fmax)),
             y_range: None,
             series: vec![
-                line(
-                    "periodogram",
-                    ch.periodogram_freq_hz.clone(),
-                    ch.periodogram_psd.clone(),
-                    1,
-                    0.4,
-                ),
-                line(
-                    "Welch",
-                    ch.welch_freq_hz.clone(),
-                    ch.welch_psd_first.clone(),
-                    2,
-                    1.0,
-                ),
+                {
+                    let (x, y) =
+                        figures::positive_freq(&ch.periodogram_freq_hz, &ch.periodogram_psd);
+                    line("periodogram", x, y, 1, 0.4)
+                },
+                {
+                    let (x, y) = figures::positive_freq(&ch.welch_freq_hz, &ch.welch_psd_first);
+                    line("Welch", x, y, 2, 1.0)
+                },
             ],
             legend: true,
         });
-        let mut s67 = vec![line(
-            "Welch",
-            ch.welch_freq_hz.clone(),
-            ch.welch_psd_first.clone(),
-            2,
-            0.7,
-        )];
+        let (wx, wy) = figures::positive_freq(&ch.welch_freq_hz, &ch.welch_psd_first);
+        let mut s67 = vec![line("Welch", wx, wy, 2, 0.7)];
         for m in &ch.model_psd_first {
             s67.push(line(
                 &format!("ARMA({},{})", m.order, m.order),

@@ -338,8 +338,14 @@ fn fit_figure(
             x_range: Some((0.0, rec.fs_hz / 2.0)),
             y_range: None,
             series: vec![
-                line("periodogram", per.freq_hz, per.psd, 1, 0.4),
-                line("Welch", wel.freq_hz, wel.psd, 2, 1.0),
+                {
+                    let (x, y) = crate::figures::positive_freq(&per.freq_hz, &per.psd);
+                    line("periodogram", x, y, 1, 0.4)
+                },
+                {
+                    let (x, y) = crate::figures::positive_freq(&wel.freq_hz, &wel.psd);
+                    line("Welch", x, y, 2, 1.0)
+                },
                 line("model", grid, mpsd, 2, 1.0),
                 Series {
                     label: Some(format!("modes, damping < {}", a.mark_damping_max)),

@@ -361,6 +361,14 @@ fn write_csv(path: &std::path::Path, o: &PsdOutput) -> Result<()> {
 fn psd_figure(o: &PsdOutput, xs: Scale, ys: Scale, fmax: Option<f64>) -> Figure {
     let mut series = Vec::new();
     let several = o.channels.len() > 1;
+    // The DC bin of a detrended spectrum is ~0 and would stretch a log axis over 20 decades.
+    let skip_dc = |f: &[f64], p: &[f64]| -> (Vec<f64>, Vec<f64>) {
+        f.iter()
+            .zip(p)
+            .filter(|(f, _)| ys != Scale::Log || **f > 0.0)
+            .map(|(f, p)| (*f, *p))
+            .unzip()
+    };
     for c in &o.channels {
         if let Some(p) = &c.periodogram {
             series.push(Series {
@@ -369,8 +377,8 @@ fn psd_figure(o: &PsdOutput, xs: Scale, ys: Scale, fmax: Option<f64>) -> Figure 
                 } else {
                     "periodogram".into()
                 }),
-                x: p.frequency_hz.clone(),
-                y: p.psd.clone(),
+                x: skip_dc(&p.frequency_hz, &p.psd).0,
+                y: skip_dc(&p.frequency_hz, &p.psd).1,
                 style: SeriesStyle::Line {
                     width: 1,
                     dashed: false,
@@ -387,8 +395,8 @@ fn psd_figure(o: &PsdOutput, xs: Scale, ys: Scale, fmax: Option<f64>) -> Figure 
         };
         series.push(Series {
             label: Some(label),
-            x: c.frequency_hz.clone(),
-            y: c.psd.clone(),
+            x: skip_dc(&c.frequency_hz, &c.psd).0,
+            y: skip_dc(&c.frequency_hz, &c.psd).1,
             style: SeriesStyle::Line {
                 width: 2,
                 dashed: false,
@@ -411,7 +419,13 @@ fn psd_figure(o: &PsdOutput, xs: Scale, ys: Scale, fmax: Option<f64>) -> Figure 
     Figure {
         title: None,
         panels: vec![Panel {
-            title: format!("Power spectral density: {}", o.source),
+            title: format!(
+                "Power spectral density: {}",
+                std::path::Path::new(&o.source)
+                    .file_name()
+                    .map(|s| s.to_string_lossy().to_string())
+                    .unwrap_or_else(|| o.source.clone())
+            ),
             x_label: "Frequency [Hz]".into(),
             y_label: format!("PSD [{unit}]"),
             x_scale: xs,

@@ -146,3 +146,13 @@ pub fn damping_panel(
         legend: true,
     }
 }
+
+/// Drops the DC bin (and any non-positive frequency) so a log PSD axis is not stretched by a
+/// detrended, near-zero DC value.
+pub fn positive_freq(f: &[f64], p: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    f.iter()
+        .zip(p)
+        .filter(|(f, _)| **f > 0.0)
+        .map(|(f, p)| (*f, *p))
+        .unzip()
+}
