@@ -183,8 +183,8 @@ pub fn print_modes(r: &AnalysisResults, truth: Option<&[(String, f64, f64)]>) {
             role.channels.join(", ")
         );
         println!(
-            "  {:>9} {:>8} {:>9} {:>7} {:>7}  {}",
-            "freq_hz", "std_hz", "damping", "orders", "records", "class"
+            "  {:>9} {:>8} {:>9} {:>7} {:>7}  class",
+            "freq_hz", "std_hz", "damping", "orders", "records"
         );
         for m in role
             .invariant_modes
@@ -204,7 +204,7 @@ pub fn print_modes(r: &AnalysisResults, truth: Option<&[(String, f64, f64)]>) {
     }
     if let Some(t) = truth {
         println!("\nTrue values (simulation):");
-        println!("  {:>9} {:>9}  {}", "freq_hz", "damping", "what");
+        println!("  {:>9} {:>9}  what", "freq_hz", "damping");
         for (label, f, z) in t {
             println!("  {f:>9.3} {z:>9.4}  {label}");
         }
@@ -225,9 +225,9 @@ fn fmt_mode_row(m: &InvariantMode) -> Vec<String> {
 }
 
 fn save_fig(dir: &Path, name: &str, fig: &Figure) -> Result<()> {
-    fig.save(&dir.join(format!("{name}.svg")))
+    fig.save(dir.join(format!("{name}.svg")))
         .with_context(|| format!("writing figure {name}.svg"))?;
-    fig.save(&dir.join(format!("{name}.png")))
+    fig.save(dir.join(format!("{name}.png")))
         .with_context(|| format!("writing figure {name}.png"))?;
     Ok(())
 }
@@ -498,7 +498,7 @@ pub fn write_report(
     }
     html.heading(2, "Settings");
     html.preformatted(&toml::to_string(&r.config).unwrap_or_default());
-    html.save(&dir.join("index.html"))
+    html.save(dir.join("index.html"))
         .with_context(|| format!("writing {}", dir.join("index.html").display()))?;
     Ok(())
 }
