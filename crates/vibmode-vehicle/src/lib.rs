@@ -28,6 +28,8 @@
 //! # Ok::<(), vibmode_vehicle::VehicleError>(())
 //! ```
 
+#![warn(missing_docs)]
+
 pub mod error;
 pub mod model;
 pub mod params;
