@@ -574,21 +574,14 @@ pub struct DemoArgs {
 
 /// Runs `vibmode demo`: simulate the shipped city bus and analyse it.
 pub fn run_demo(a: &DemoArgs) -> Result<()> {
-    use crate::cmd_vehicle::{sim_params, to_recording, write_simulation, Effects, RecordFormat};
+    use crate::cmd_vehicle::{to_recording, write_simulation, RecordFormat};
     if a.records == 0 {
         bail!("--records 0: give at least one record");
     }
     let cfg = load_config(None, a.preset.as_deref())?;
     let vehicle = vibmode_vehicle::VehicleParams::city_bus();
-    let p = sim_params(
-        "B",
-        30.0,
-        10.24,
-        a.records,
-        20000.0,
-        a.seed,
-        Effects::InService,
-    )?;
+    let p = vibmode_vehicle::SimParams::demo(a.records, a.seed);
+    p.validate()?;
     eprintln!(
         "simulating {} records of 10.24 s at 20 kHz: 12 m city bus, ISO 8608 class B road, 30 km/h, engine/gear lines, sensor noise, braking, a turn, tones up to 6 kHz ...",
         a.records

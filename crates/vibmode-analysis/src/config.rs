@@ -89,12 +89,22 @@ pub struct ClusterConfig {
     pub log_damping_tol: f64,
     /// Share of records a mode must appear in to be invariant (default 0.5).
     pub min_record_share: f64,
+    /// Share of the model orders (per record) a mode must appear in (default 0.5: a vehicle
+    /// mode shows at most orders of a sweep, a spurious pole at a few).
+    pub min_order_share: f64,
     /// Median damping ratio below which a stable line is a periodic disturbance (default 0.005).
     pub disturbance_damping_max: f64,
     /// Poles with damping above this are ignored (default 0.6).
     pub max_damping_ratio: f64,
     /// Lowest frequency considered, Hz (default 0.3).
     pub freq_min_hz: f64,
+    /// Largest relative frequency spread (std / mean) of a periodic disturbance (default 0.02:
+    /// engine lines drift slowly with engine speed).
+    pub disturbance_freq_spread_max: f64,
+    /// Pole-zero cancellation: a pole z_p of an ARMA fit is dropped when a zero z_c of C lies
+    /// within `pole_zero_tol * (1 - |z_p|)` of it (the pole's own bandwidth in the z-plane),
+    /// since such a pair shapes the spectrum locally but is no mode. 0 disables (default 1.0).
+    pub pole_zero_tol: f64,
 }
 
 impl Default for ClusterConfig {
@@ -103,9 +113,12 @@ impl Default for ClusterConfig {
             freq_tol_rel: 0.02,
             log_damping_tol: 0.2,
             min_record_share: 0.5,
+            min_order_share: 0.5,
             disturbance_damping_max: 0.005,
             max_damping_ratio: 0.6,
             freq_min_hz: 0.3,
+            disturbance_freq_spread_max: 0.02,
+            pole_zero_tol: 1.0,
         }
     }
 }

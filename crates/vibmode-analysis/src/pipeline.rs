@@ -187,10 +187,12 @@ fn cluster_params(cfg: &AnalysisConfig) -> ClusterParams {
         freq_tol_rel: cfg.cluster.freq_tol_rel,
         log_damping_tol: cfg.cluster.log_damping_tol,
         min_record_share: cfg.cluster.min_record_share,
+        min_order_share: cfg.cluster.min_order_share,
         disturbance_damping_max: cfg.cluster.disturbance_damping_max,
         max_damping_ratio: cfg.cluster.max_damping_ratio,
         freq_min_hz: cfg.cluster.freq_min_hz,
         freq_max_hz: cfg.cutoff_hz,
+        disturbance_freq_spread_max: cfg.cluster.disturbance_freq_spread_max,
         ..ClusterParams::default()
     }
 }
@@ -376,6 +378,15 @@ fn to_observations(poles: &[PoleOut], channel: &str, role: Role) -> Vec<PoleObse
         .collect()
 }
 
+/// Whether the pole (re, im) has a zero within `tol * (1 - |pole|)` of it.
+fn cancelled(re: f64, im: f64, zeros: &[vibmode_ident::Complex64], tol: f64) -> bool {
+    let r = (re * re + im * im).sqrt();
+    let radius = tol * (1.0 - r).max(0.0);
+    zeros
+        .iter()
+        .any(|z| ((z.re - re).powi(2) + (z.im - im).powi(2)).sqrt() < radius)
+}
+
 fn run_task(
     y: &[f64],
     fs: f64,
@@ -421,7 +432,15 @@ fn run_task(
         match fit {
             Ok(m) => {
                 let ms = m.modes(fs);
+                let zeros = if cfg.cluster.pole_zero_tol > 0.0 {
+                    m.zeros()
+                } else {
+                    Vec::new()
+                };
                 for md in &ms.modes {
+                    if cancelled(md.pole_re, md.pole_im, &zeros, cfg.cluster.pole_zero_tol) {
+                        continue;
+                    }
                     poles.push(PoleOut {
                         record,
                         order,

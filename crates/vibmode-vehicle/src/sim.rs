@@ -185,6 +185,23 @@ impl Default for SimParams {
 }
 
 impl SimParams {
+    /// The settings of `vibmode demo`: [`SimParams::in_service`] on an ISO 8608 class B road
+    /// at 30 km/h, `records` records of 10.24 s at 20 kHz, engine/gear lines of 3 kN each
+    /// (strong enough to stand out of the body response, as on the paper's bus).
+    pub fn demo(records: usize, seed: u64) -> Self {
+        let mut p = SimParams {
+            road: RoadClass::B,
+            speed_kmh: 30.0,
+            records,
+            seed,
+            ..SimParams::in_service()
+        };
+        for line in &mut p.disturbances.engine_lines {
+            line.force_n = 3000.0;
+        }
+        p
+    }
+
     /// In-service preset: defaults plus [`Disturbances::in_service`], a braking event in
     /// record 1 (-1.5 m/s^2 over 3 s), an acceleration in record 3 (+1 m/s^2 over 4 s) and a
     /// left turn in record 5 (2 m/s^2 lateral over 5 s).

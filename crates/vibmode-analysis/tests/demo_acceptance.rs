@@ -1,0 +1,154 @@
+//! Acceptance on the project's own simulator, with the default settings (the demo's data):
+//! the periodic lines are found within 0.05 Hz and classed as disturbances, the wheel-hop modes
+//! within 5 %, the body modes within 10 %, and no structural mode is classed as a disturbance.
+
+use vibmode_analysis::{analyze, AnalysisConfig, RecordInput, Role};
+use vibmode_modal::{ModeClass, ReferenceMode};
+use vibmode_signal::{Channel, Recording};
+use vibmode_vehicle::{simulate, ModeLabel, SimParams, VehicleParams};
+
+#[test]
+fn demo_data_gives_the_true_modes_and_lines() {
+    let vehicle = VehicleParams::city_bus();
+    let sim = simulate(&vehicle, &SimParams::demo(8, 1)).expect("simulation");
+    let records: Vec<RecordInput> = sim
+        .records
+        .iter()
+        .enumerate()
+        .map(|(i, r)| RecordInput {
+            name: format!("record {i}"),
+            recording: Recording {
+                fs_hz: r.fs_hz,
+                channels: r
+                    .channel_names
+                    .iter()
+                    .zip(&r.samples)
+                    .map(|(n, s)| Channel {
+                        name: n.clone(),
+                        unit: "m/s^2".into(),
+                        samples: s.clone(),
+                    })
+                    .collect(),
+                time_axis: None,
+            },
+        })
+        .collect();
+    let reference: Vec<ReferenceMode> = sim
+        .truth
+        .modes
+        .iter()
+        .map(|m| ReferenceMode {
+            frequency_hz: m.frequency_hz,
+            damping_ratio: m.damping_ratio,
+            label: m.label.to_string(),
+        })
+        .collect();
+    let cfg = AnalysisConfig::default();
+    let res = analyze(&records, &cfg, &reference, &|_, _| {}).expect("analysis");
+    let role = |r: Role| {
+        res.roles
+            .iter()
+            .find(|x| x.role == r)
+            .expect("role present")
+    };
+    let body: Vec<f64> = sim
+        .truth
+        .modes
+        .iter()
+        .filter(|m| {
+            matches!(
+                m.label,
+                ModeLabel::BodyHeave | ModeLabel::BodyPitch | ModeLabel::BodyRoll
+            )
+        })
+        .map(|m| m.frequency_hz)
+        .collect();
+    let hop: Vec<f64> = sim
+        .truth
+        .modes
+        .iter()
+        .filter(|m| m.frequency_hz > 5.0)
+        .map(|m| m.frequency_hz)
+        .collect();
+    let lines = &sim.truth.disturbance_lines_hz;
+    assert_eq!(lines.len(), 3);
+    let near = |f: f64, set: &[f64], rel: f64| set.iter().any(|t| (f - t).abs() <= rel * t);
+    for r in [Role::Sprung, Role::Unsprung] {
+        for m in &role(r).invariant_modes {
+            eprintln!(
+                "{r}: {:.3} Hz zeta {:.4} {:?} orders {:.2} records {:.2}",
+                m.frequency_hz, m.damping_ratio, m.class, m.order_share, m.record_share
+            );
+        }
+    }
+    // Periodic lines: each found within 0.05 Hz on the sprung channels and classed as such.
+    let sprung = role(Role::Sprung);
+    for f in lines {
+        assert!(
+            sprung.invariant_modes.iter().any(|m| {
+                m.class == ModeClass::PeriodicDisturbance && (m.frequency_hz - f).abs() <= 0.05
+            }),
+            "line at {f} Hz not found as a periodic disturbance"
+        );
+    }
+    // No structural mode classed as a disturbance: every disturbance is one of the true lines.
+    for r in &res.roles {
+        for m in r
+            .invariant_modes
+            .iter()
+            .filter(|m| m.class == ModeClass::PeriodicDisturbance)
+        {
+            assert!(
+                lines.iter().any(|f| (m.frequency_hz - f).abs() <= 0.1),
+                "{} Hz on {} classed as a disturbance but is no line",
+                m.frequency_hz,
+                r.role
+            );
+        }
+    }
+    // Body modes (heavily damped, close together) within 10 % on the sprung channels.
+    let sprung_body: Vec<f64> = sprung
+        .invariant_modes
+        .iter()
+        .filter(|m| m.class == ModeClass::Structural && m.frequency_hz < 3.0)
+        .map(|m| m.frequency_hz)
+        .collect();
+    assert!(!sprung_body.is_empty(), "no body mode found");
+    for f in &sprung_body {
+        assert!(
+            near(*f, &body, 0.10),
+            "body mode {f} Hz not within 10 % of {body:?}"
+        );
+    }
+    // Wheel-hop modes within 5 % on the unsprung channels.
+    let unsprung = role(Role::Unsprung);
+    let hops: Vec<f64> = unsprung
+        .invariant_modes
+        .iter()
+        .filter(|m| m.class == ModeClass::Structural && m.frequency_hz > 5.0)
+        .map(|m| m.frequency_hz)
+        .collect();
+    assert!(!hops.is_empty(), "no wheel-hop mode found");
+    for f in &hops {
+        assert!(
+            near(*f, &hop, 0.05),
+            "wheel-hop mode {f} Hz not within 5 % of {hop:?}"
+        );
+    }
+    // Every structural mode on either role is near a true mode (no spurious structural modes).
+    let all_true: Vec<f64> = sim.truth.modes.iter().map(|m| m.frequency_hz).collect();
+    for r in &res.roles {
+        for m in r
+            .invariant_modes
+            .iter()
+            .filter(|m| m.class == ModeClass::Structural)
+        {
+            assert!(
+                near(m.frequency_hz, &all_true, 0.10),
+                "structural mode {} Hz on {} is near no true mode",
+                m.frequency_hz,
+                r.role
+            );
+        }
+    }
+}
