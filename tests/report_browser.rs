@@ -1,0 +1,140 @@
+//! End-to-end: `vibmode demo` writes a report; headless Chromium loads it with no console
+//! errors, and every figure is present and non-empty (in the page and as SVG/PNG files).
+//!
+//! Skips (with a message) when no `chromium` binary is installed; `.ci/run` installs it.
+
+use std::path::Path;
+use std::process::Command;
+
+fn chromium() -> Option<String> {
+    ["chromium", "chromium-browser", "google-chrome"]
+        .iter()
+        .find(|b| {
+            Command::new(b)
+                .arg("--version")
+                .output()
+                .map(|o| o.status.success())
+                .unwrap_or(false)
+        })
+        .map(|s| s.to_string())
+}
+
+#[test]
+fn demo_report_renders_in_headless_chromium() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("report");
+    let status = Command::new(env!("CARGO_BIN_EXE_vibmode"))
+        .args(["demo", "--records", "3", "--quiet", "-o"])
+        .arg(&out)
+        .output()
+        .expect("run vibmode demo");
+    assert!(
+        status.status.success(),
+        "demo failed: {}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    // The figures on disk, as SVG and PNG.
+    let figs = out.join("figures");
+    let expected = [
+        "fig02_time_records",
+        "fig03_antialias",
+        "fig05_periodogram_welch",
+        "fig06_model_psd",
+        "fig08_stabilisation",
+        "fig09_frequency_damping",
+    ];
+    for name in expected {
+        for ext in ["svg", "png"] {
+            let p = figs.join(format!("{name}.{ext}"));
+            let len = std::fs::metadata(&p).map(|m| m.len()).unwrap_or(0);
+            assert!(
+                len > 2000,
+                "{} missing or nearly empty ({len} bytes)",
+                p.display()
+            );
+        }
+    }
+    let results: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join("results.json")).expect("results.json"),
+    )
+    .expect("results.json is JSON");
+    assert_eq!(results["records"].as_array().map(|a| a.len()), Some(3));
+    assert_eq!(results["channels"].as_array().map(|a| a.len()), Some(7));
+
+    let index = out.join("index.html");
+    let html = std::fs::read_to_string(&index).expect("index.html");
+    assert_eq!(
+        html.matches("<figure").count(),
+        expected.len(),
+        "figure count in the page"
+    );
+    assert!(!html.contains("<script"), "the report must be script-free");
+
+    let Some(browser) = chromium() else {
+        eprintln!("SKIP browser part: no chromium installed (apt-get install chromium)");
+        return;
+    };
+    let profile = dir.path().join("profile");
+    let run = Command::new(&browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--enable-logging=stderr",
+            "--v=0",
+            "--virtual-time-budget=5000",
+            "--dump-dom",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .arg(format!("file://{}", abs(&index)))
+        .output()
+        .expect("run chromium");
+    let dom = String::from_utf8_lossy(&run.stdout);
+    let log = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "chromium failed: {log}");
+    let console_errors: Vec<&str> = log
+        .lines()
+        .filter(|l| l.contains("CONSOLE") && (l.contains("ERROR") || l.contains("Uncaught")))
+        .collect();
+    assert!(
+        console_errors.is_empty(),
+        "console errors: {console_errors:?}"
+    );
+    // Every figure made it into the rendered DOM with drawn content.
+    let svgs: Vec<&str> = dom.split("<svg").skip(1).collect();
+    assert!(
+        svgs.len() >= expected.len(),
+        "rendered page has {} svg elements, expected {}",
+        svgs.len(),
+        expected.len()
+    );
+    for (i, s) in svgs.iter().enumerate() {
+        let body = s.split("</svg>").next().unwrap_or("");
+        let marks = body.matches("<polyline").count()
+            + body.matches("<path").count()
+            + body.matches("<circle").count()
+            + body.matches("<line").count()
+            + body.matches("<polygon").count()
+            + body.matches("<rect").count();
+        assert!(
+            marks > 10,
+            "figure {i} renders almost nothing ({marks} marks)"
+        );
+        assert!(body.contains("<text"), "figure {i} has no text");
+    }
+    assert!(
+        dom.contains("Invariant modes"),
+        "mode table missing from the rendered page"
+    );
+}
+
+fn abs(p: &Path) -> String {
+    std::fs::canonicalize(p)
+        .map(|p| p.display().to_string())
+        .unwrap_or_else(|_| p.display().to_string())
+}
