@@ -110,15 +110,19 @@ pub fn run(a: &AnalyzeArgs) -> Result<()> {
 pub fn vehicle_reference(path: &Path) -> Result<Vec<ReferenceMode>> {
     let params = vibmode_vehicle::VehicleParams::from_path(path)?;
     let car = vibmode_vehicle::FullCar::new(&params)?;
-    Ok(car
-        .modes()?
+    Ok(reference_modes(&car.modes()?))
+}
+
+/// Physical-model modes as the reference modes the clustering is matched to.
+fn reference_modes(modes: &[vibmode_vehicle::ModeInfo]) -> Vec<ReferenceMode> {
+    modes
         .iter()
         .map(|m| ReferenceMode {
             frequency_hz: m.frequency_hz,
             damping_ratio: m.damping_ratio,
             label: m.label.to_string(),
         })
-        .collect())
+        .collect()
 }
 
 /// Runs the analysis with a progress bar on a terminal.
@@ -599,16 +603,7 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
             recording: to_recording(r),
         })
         .collect();
-    let reference: Vec<ReferenceMode> = sim
-        .truth
-        .modes
-        .iter()
-        .map(|m| ReferenceMode {
-            frequency_hz: m.frequency_hz,
-            damping_ratio: m.damping_ratio,
-            label: m.label.to_string(),
-        })
-        .collect();
+    let reference = reference_modes(&sim.truth.modes);
     let results = run_analysis(&records, &cfg, &reference, a.quiet)?;
     let intro = "Demo: 8 simulated records of a 12 m city bus (vibmode's full-car simulator, examples/city_bus.toml) on an ISO 8608 class B road at 30 km/h, with engine/gear lines at 7, 11 and 12 Hz, sensor noise and bias, braking, acceleration and a turn, and tones at 150 Hz, 1.3 kHz and 6 kHz that alias without the anti-alias filter. The true modes are the full-car model's (red diamonds).";
     write_report(&a.output, &records, &results, Some(intro))?;
