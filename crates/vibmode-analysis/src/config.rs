@@ -145,6 +145,12 @@ pub struct AnalysisConfig {
     pub order_max: usize,
     /// Robust criterion factor (times the robust std of the initial residuals); 0 = quadratic.
     pub robust_factor: f64,
+    /// Iteration cap of each prediction-error fit of the sweep (default 20, MATLAB's
+    /// `MaxIterations`). A fit that reaches it is kept (`converged: false`).
+    pub max_iterations: usize,
+    /// Stopping tolerance of each fit: relative predicted improvement of the next Gauss-Newton
+    /// step below which the search stops (default 1e-4, MATLAB's `Tolerance` of 0.01 %).
+    pub tolerance: f64,
     /// Welch segment length in samples at the analysis rate (default 256).
     pub welch_nperseg: usize,
     /// Orders whose model PSD is drawn over the Welch estimate (the paper's Fig. 6-7: 10 and 20).
@@ -174,6 +180,8 @@ impl AnalysisConfig {
             order_min: 2,
             order_max: 30,
             robust_factor: 1.6,
+            max_iterations: 20,
+            tolerance: 1e-4,
             welch_nperseg: 128,
             psd_orders: vec![5, 10],
             channels: Vec::new(),
@@ -263,6 +271,16 @@ impl AnalysisConfig {
                 "order_min..order_max",
                 format!("{}..{}", self.order_min, self.order_max),
                 "must satisfy 1 <= order_min <= order_max",
+            );
+        }
+        if self.max_iterations == 0 {
+            return bad("max_iterations", "0".to_string(), "must be >= 1 (e.g. 20)");
+        }
+        if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
+            return bad(
+                "tolerance",
+                self.tolerance.to_string(),
+                "must be a small positive number (e.g. 1e-4)",
             );
         }
         if self.robust_factor < 0.0 || !self.robust_factor.is_finite() {

@@ -416,6 +416,8 @@ fn run_task(
         } else {
             Robust::Off
         },
+        max_iter: cfg.max_iterations,
+        tol: cfg.tolerance,
         ..ArmaParams::default()
     };
     let fits: Vec<Result<vibmode_ident::ArmaModel, vibmode_ident::IdentError>> = match cfg.model {

@@ -120,6 +120,10 @@ const EXACT_JACOBIAN_BUDGET: f64 = 2.0e7;
 /// Largest p + q searched from every starting candidate (multi-start).
 const MULTISTART_MAX_ORDER: usize = 16;
 
+/// Trial steps per iteration whose C leaves the unit circle and is reflected back (root finding);
+/// further such trials are halved instead.
+const MAX_REFLECTIONS: usize = 3;
+
 /// Iterations over which the stall rule measures progress.
 const STALL_WINDOW: usize = 5;
 
@@ -346,7 +350,21 @@ struct Search<'a> {
     cols: Vec<Vec<f64>>,
 }
 
-impl Search<'_> {
+impl<'a> Search<'a> {
+    fn new(ys: &'a [f64], p: usize, q: usize, rho: Option<f64>) -> Self {
+        let n = ys.len();
+        Search {
+            ys,
+            p,
+            q,
+            rho,
+            yf: vec![0.0; n],
+            ef: vec![0.0; n],
+            u: vec![0.0; n],
+            cols: Vec::new(),
+        }
+    }
+
     /// Gradient `sum w eps psi` and matrix `sum w psi psi^T` (raw sums; Huber weights applied
     /// exactly through a sparse correction of the unweighted Toeplitz-structured Gram), plus the
     /// unweighted Gram.
@@ -356,7 +374,7 @@ impl Search<'_> {
         c: &[f64],
         eps: &[f64],
     ) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-        let _ = a;
+        let _ = a; // the Jacobian of eps = (A/C) y does not depend on A
         let (p, q) = (self.p, self.q);
         let k = p + q;
         filter_inv_c(self.ys, c, &mut self.yf);
@@ -505,6 +523,14 @@ fn search(
         }
         _ => None,
     };
+    // Start from the candidate with the lowest value of the criterion itself (the robust scale
+    // above only fixes rho; with a warm start in a sweep this is usually the previous order).
+    if rho.is_some() {
+        for cand in cands.iter_mut() {
+            cand.score = mean_loss(&cand.eps[p..], rho);
+        }
+        cands.sort_by(|x, y| x.score.total_cmp(&y.score));
+    }
     if cands.is_empty() {
         // Unreachable in practice (Burg on finite data is finite); start from white noise.
         let mut a = vec![0.0; p + 1];
@@ -576,16 +602,7 @@ fn gauss_newton(
         ..
     } = start;
     let k = p + q;
-    let mut search = Search {
-        ys,
-        p,
-        q,
-        rho,
-        yf: vec![0.0; n],
-        ef: vec![0.0; n],
-        u: vec![0.0; n],
-        cols: Vec::new(),
-    };
+    let mut search = Search::new(ys, p, q, rho);
     let n_eff = n - p;
     let mut v = mean_loss(&eps[p..], rho);
     let mut mu = 1e-6;
@@ -604,7 +621,6 @@ fn gauss_newton(
         for j in 0..q {
             nc[j + 1] += s * d[p + j];
         }
-        stabilise(&mut nc);
         (na, nc)
     };
     while iterations < params.max_iter {
@@ -628,9 +644,21 @@ fn gauss_newton(
             d0
         };
         let mut accepted = None;
+        let mut reflected = 0usize;
         let mut s = 1.0;
         for hv in 0..=params.max_halvings {
-            let (na, nc) = apply(&a, &c, &dir, s);
+            let (na, mut nc) = apply(&a, &c, &dir, s);
+            // C must stay minimum phase: the first MAX_REFLECTIONS trials of an iteration that
+            // leave the unit circle are reflected back (roots z -> 1/conj z, the same |C| on the
+            // unit circle); later ones are just halved (root finding costs more than a trial).
+            if !is_min_phase(&nc) {
+                if reflected >= MAX_REFLECTIONS {
+                    s *= 0.5;
+                    continue;
+                }
+                reflected += 1;
+                stabilise(&mut nc);
+            }
             predict_errors(ys, &na, &nc, &mut trial_eps);
             let vt = mean_loss(&trial_eps[p..], rho);
             if vt.is_finite() && vt < v {
@@ -663,7 +691,15 @@ fn gauss_newton(
             }
             let mut s = if hdd > 0.0 { gd / hdd } else { 1.0 };
             for hv in 0..=params.max_halvings {
-                let (na, nc) = apply(&a, &c, &dg, s);
+                let (na, mut nc) = apply(&a, &c, &dg, s);
+                if !is_min_phase(&nc) {
+                    if reflected >= MAX_REFLECTIONS {
+                        s *= 0.5;
+                        continue;
+                    }
+                    reflected += 1;
+                    stabilise(&mut nc);
+                }
                 predict_errors(ys, &na, &nc, &mut trial_eps);
                 let vt = mean_loss(&trial_eps[p..], rho);
                 if vt.is_finite() && vt < v {
@@ -768,16 +804,7 @@ fn fit_impl(
     } = out;
     let k = p + q;
     let n_eff = n - p;
-    let mut search = Search {
-        ys: &ys,
-        p,
-        q,
-        rho,
-        yf: vec![0.0; n],
-        ef: vec![0.0; n],
-        u: vec![0.0; n],
-        cols: Vec::new(),
-    };
+    let mut search = Search::new(&ys, p, q, rho);
     // Final quantities.
     let (_, _, h_u) = search.normal_equations(&a, &c, &eps);
     let lambda_s = mean_loss(&eps[p..], None);

@@ -163,6 +163,18 @@ pub(crate) fn filter_inv_c_adjoint(v: &[f64], c: &[f64], out: &mut [f64]) {
 /// Solves the symmetric positive (semi)definite system `h x = b` (n x n row-major) by Cholesky,
 /// adding a relative ridge `ridge * mean(diag)` to the diagonal. Returns None if not positive definite.
 pub(crate) fn cholesky_solve(h: &[f64], b: &[f64], n: usize, ridge: f64) -> Option<Vec<f64>> {
+    let l = cholesky_factor(h, n, ridge)?;
+    let x = cholesky_apply(&l, b, n);
+    if x.iter().all(|v| v.is_finite()) {
+        Some(x)
+    } else {
+        None
+    }
+}
+
+/// Lower Cholesky factor (row-major, n x n) of `h + ridge * mean(diag h) * I`; None if `h` is not
+/// numerically positive definite.
+pub(crate) fn cholesky_factor(h: &[f64], n: usize, ridge: f64) -> Option<Vec<f64>> {
     if n == 0 {
         return Some(Vec::new());
     }
@@ -175,29 +187,29 @@ pub(crate) fn cholesky_solve(h: &[f64], b: &[f64], n: usize, ridge: f64) -> Opti
         l[i * n + i] += ridge * mean_diag;
     }
     for j in 0..n {
-        let mut d = l[j * n + j];
-        for k in 0..j {
-            d -= l[j * n + k] * l[j * n + k];
-        }
+        let (head, tail) = l.split_at_mut((j + 1) * n);
+        let row_j = &mut head[j * n..(j + 1) * n];
+        let d = row_j[j] - dot(&row_j[..j], &row_j[..j]);
         if !(d > 0.0 && d.is_finite()) {
             return None;
         }
         let d = d.sqrt();
-        l[j * n + j] = d;
+        row_j[j] = d;
+        let row_j = &head[j * n..j * n + j];
         for i in j + 1..n {
-            let mut s = l[i * n + j];
-            for k in 0..j {
-                s -= l[i * n + k] * l[j * n + k];
-            }
-            l[i * n + j] = s / d;
+            let row_i = &mut tail[(i - j - 1) * n..(i - j) * n];
+            let s = row_i[j] - dot(&row_i[..j], row_j);
+            row_i[j] = s / d;
         }
     }
+    Some(l)
+}
+
+/// Solves `L L^T x = b` with the factor of [`cholesky_factor`].
+pub(crate) fn cholesky_apply(l: &[f64], b: &[f64], n: usize) -> Vec<f64> {
     let mut x = b.to_vec();
     for i in 0..n {
-        let mut s = x[i];
-        for k in 0..i {
-            s -= l[i * n + k] * x[k];
-        }
+        let s = x[i] - dot(&l[i * n..i * n + i], &x[..i]);
         x[i] = s / l[i * n + i];
     }
     for i in (0..n).rev() {
@@ -207,23 +219,30 @@ pub(crate) fn cholesky_solve(h: &[f64], b: &[f64], n: usize, ridge: f64) -> Opti
         }
         x[i] = s / l[i * n + i];
     }
-    if x.iter().all(|v| v.is_finite()) {
-        Some(x)
+    x
+}
+
+/// Diagonal of the inverse of a symmetric positive definite matrix, from one Cholesky factor.
+pub(crate) fn spd_inverse_diag(h: &[f64], n: usize) -> Option<Vec<f64>> {
+    // diag(H^-1)_i = sum_j (L^-1)_{ji}^2: invert the lower factor column by column.
+    let l = cholesky_factor(h, n, 0.0)?;
+    let mut out = vec![0.0; n];
+    let mut col = vec![0.0; n];
+    for i in 0..n {
+        // Column i of L^-1 (zero above row i), by forward substitution.
+        col[..i].iter_mut().for_each(|v| *v = 0.0);
+        col[i] = 1.0 / l[i * n + i];
+        for r in i + 1..n {
+            let s = dot(&l[r * n + i..r * n + r], &col[i..r]);
+            col[r] = -s / l[r * n + r];
+        }
+        out[i] = col[i..].iter().map(|v| v * v).sum();
+    }
+    if out.iter().all(|v| v.is_finite()) {
+        Some(out)
     } else {
         None
     }
-}
-
-/// Inverse of a symmetric positive definite matrix (diagonal only), via Cholesky solves.
-pub(crate) fn spd_inverse_diag(h: &[f64], n: usize) -> Option<Vec<f64>> {
-    let mut out = Vec::with_capacity(n);
-    for i in 0..n {
-        let mut e = vec![0.0; n];
-        e[i] = 1.0;
-        let x = cholesky_solve(h, &e, n, 0.0)?;
-        out.push(x[i]);
-    }
-    Some(out)
 }
 
 /// Median of a slice (copied; NaN-free input assumed).
