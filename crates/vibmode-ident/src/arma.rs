@@ -12,6 +12,7 @@ use crate::linalg::{
     lagged_dot, lagged_gram, predict_errors, robust_std, spd_inverse_diag,
 };
 use crate::model::{information_criteria, ArmaModel, Estimator, StopReason};
+use crate::outliers::OutlierCleaning;
 use crate::roots::polynomial_roots;
 use crate::IdentError;
 
@@ -77,6 +78,10 @@ pub struct ArmaParams {
     pub max_halvings: usize,
     /// Subtract the mean of `y` before fitting. Default true.
     pub demean: bool,
+    /// Additive-outlier (spike) cleaning before a `Robust::Huber` fit (unused by `Robust::Off`).
+    /// Default `OutlierCleaning::RobustFilter` with default [`crate::CleanerParams`].
+    #[serde(default)]
+    pub outlier_cleaning: OutlierCleaning,
 }
 
 impl Default for ArmaParams {
@@ -87,6 +92,7 @@ impl Default for ArmaParams {
             tol: 1e-5,
             max_halvings: 10,
             demean: true,
+            outlier_cleaning: OutlierCleaning::default(),
         }
     }
 }
@@ -747,6 +753,8 @@ fn fit_impl(
             });
         }
     }
+    let (y, mean, outliers_replaced) = crate::outliers::prepare(y, mean, params)?;
+    let y: &[f64] = &y;
     let offset = if params.demean { mean } else { 0.0 };
     let centred: Vec<f64> = y.iter().map(|v| v - offset).collect();
     let scale = (centred.iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt();
@@ -820,6 +828,7 @@ fn fit_impl(
         n_samples: n,
         mean: offset,
         estimator: Estimator::PredictionError,
+        outliers_replaced,
     })
 }
 

@@ -46,6 +46,7 @@ mod arma;
 mod error;
 mod linalg;
 mod model;
+mod outliers;
 mod roots;
 pub mod sim;
 
@@ -59,4 +60,5 @@ pub use model::{
     information_criteria, modes_from_poles, ArmaModel, Estimator, Mode, ModeSet, Pole, StopReason,
 };
 pub use num_complex::Complex64;
+pub use outliers::{clean_additive_outliers, CleanedSignal, CleanerParams, OutlierCleaning};
 pub use roots::polynomial_roots;
