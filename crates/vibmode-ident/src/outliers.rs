@@ -6,10 +6,10 @@
 //! them through A, many more through 1/C), which the Huber criterion cannot bound. The cleaner runs
 //! a long AR predictor through the data, replaces a sample by its prediction from the already
 //! cleaned past when (i) its one-step residual exceeds `threshold` robust standard deviations and
-//! (ii) the replacement makes the following residuals smaller (an isolated spike: the data after it
-//! follow the undisturbed trajectory) rather than larger (a genuine innovation, e.g. a pothole's
-//! impulse response, which the data after it keep following). The AR model is refitted on the
-//! cleaned data and the pass repeated.
+//! (ii) the replacement makes the following residuals much smaller (an isolated spike: the data
+//! after it follow the undisturbed trajectory) rather than larger (a genuine innovation, e.g. a
+//! pothole's impulse response, which the data after it keep following). The AR model is refitted
+//! on the cleaned data and the pass repeated.
 
 use std::borrow::Cow;
 
@@ -108,21 +108,24 @@ pub struct CleanedSignal {
     pub passes: usize,
 }
 
-/// Robust AR filter-cleaner for additive outliers (isolated spikes) in `y`.
+/// Robust AR filter-cleaner for additive outliers (isolated spikes) in `y` (signal units).
 ///
-/// Each pass: fit AR(m) by Burg to the current cleaned signal (the raw signal in the first pass),
-/// minus the median of `y`; take the residual scale `s = MAD/0.6745` of its one-step residuals; then
-/// run through the raw signal: `r_t = y_t - yhat_t`, `yhat_t` predicted from the *cleaned* past.
-/// When `|r_t| > threshold * s`, compare the next `L = min(m, N - 1 - t)` residuals computed with
-/// `y_t` kept and with `y_t` replaced by `yhat_t`, each under the bounded loss
-/// `min(r^2, (threshold * s)^2)`; replace when the replaced variant has the smaller loss. The first m
-/// samples are checked by the same test run backwards in time (a stationary AR process has the same
-/// coefficients in reversed time). Passes stop early when the replaced set repeats.
+/// Each pass: fit AR(m) (m = `min(ar_order, N/10)`) by forward-backward least squares to the
+/// windows of the signal minus its median that contain no suspect sample (first pass: samples
+/// beyond 5 robust standard deviations of `y`; later passes: the samples the previous pass
+/// replaced); `s` = MAD/0.6745 of its one-step residuals. Then run a Kalman filter of that AR
+/// process through the raw signal: prediction `yhat_t` from the cleaned past, variance `v_t`
+/// (`s^2` when the m previous samples were observed, larger after a replaced one). When
+/// `(y_t - yhat_t)^2 > threshold^2 v_t`, filter the next `L = min(m, N - 1 - t)` samples once with
+/// `y_t` kept and once with it skipped, each costing `min(z^2, threshold^2)` per standardised
+/// residual z (samples beyond the threshold skipped); replace `y_t` by `yhat_t` when skipping costs
+/// less than half of keeping. The first m samples are checked by the same filter run backwards in
+/// time (a stationary AR process has the same coefficients in reversed time). Passes stop early
+/// when the replaced set repeats. Details and measured figures: docs/identification.md.
 ///
-/// The prediction is a Kalman filter of the AR(m) process: when the m samples before t were kept,
-/// a replaced sample becomes exactly `centre - sum_k ar[k] (y_{t-k} - centre)`; after a replaced
-/// sample the filter uses its estimate of the past (corrected by the samples observed since) and a
-/// correspondingly larger prediction variance in the test.
+/// When the m samples before t were kept, a replaced sample becomes exactly
+/// `centre - sum_k ar[k] (y_{t-k} - centre)`; after a replaced sample the filter uses its estimate
+/// of the past (corrected by the samples observed since).
 ///
 /// Errors: empty, non-finite or constant input; invalid params.
 pub fn clean_additive_outliers(
