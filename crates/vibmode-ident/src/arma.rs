@@ -140,7 +140,9 @@ pub fn max_arma_order(n: usize) -> usize {
 /// Starts from the best (by the residuals' robust scale, or mean square when `Robust::Off`) of a
 /// Hannan-Rissanen estimate and a Burg AR(p) model, then runs damped Gauss-Newton. A fit that hits
 /// `max_iter` is returned with `converged: false`. `q = 0` is allowed (robust AR by prediction
-/// error); `p = 0` is an error (no poles, no modes).
+/// error); `p = 0` is an error (no poles, no modes). With `Robust::Huber` and the default
+/// `outlier_cleaning`, additive spikes are first replaced by [`crate::clean_additive_outliers`]
+/// (count in `ArmaModel::outliers_replaced`).
 ///
 /// Errors: empty, non-finite or constant input; `p = 0`; `p + q > N/3`; invalid params.
 pub fn fit_arma(
