@@ -129,6 +129,7 @@ pub fn fit_ar(y: &[f64], p: usize, method: ArMethod) -> Result<ArmaModel, IdentE
         n_samples: n,
         mean,
         estimator,
+        outliers_replaced: 0,
     })
 }
 

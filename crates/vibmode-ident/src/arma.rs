@@ -12,6 +12,7 @@ use crate::linalg::{
     lagged_dot, lagged_gram, predict_errors, robust_std, spd_inverse_diag,
 };
 use crate::model::{information_criteria, ArmaModel, Estimator, StopReason};
+use crate::outliers::OutlierCleaning;
 use crate::roots::polynomial_roots;
 use crate::IdentError;
 
@@ -77,6 +78,10 @@ pub struct ArmaParams {
     pub max_halvings: usize,
     /// Subtract the mean of `y` before fitting. Default true.
     pub demean: bool,
+    /// Additive-outlier (spike) cleaning before a `Robust::Huber` fit (unused by `Robust::Off`).
+    /// Default `OutlierCleaning::RobustFilter` with default [`crate::CleanerParams`].
+    #[serde(default)]
+    pub outlier_cleaning: OutlierCleaning,
 }
 
 impl Default for ArmaParams {
@@ -87,6 +92,7 @@ impl Default for ArmaParams {
             tol: 1e-5,
             max_halvings: 10,
             demean: true,
+            outlier_cleaning: OutlierCleaning::default(),
         }
     }
 }
@@ -138,7 +144,9 @@ pub fn max_arma_order(n: usize) -> usize {
 /// Starts from the best (by the residuals' robust scale, or mean square when `Robust::Off`) of a
 /// Hannan-Rissanen estimate and a Burg AR(p) model, then runs damped Gauss-Newton. A fit that hits
 /// `max_iter` is returned with `converged: false`. `q = 0` is allowed (robust AR by prediction
-/// error); `p = 0` is an error (no poles, no modes).
+/// error); `p = 0` is an error (no poles, no modes). With `Robust::Huber` and the default
+/// `outlier_cleaning`, additive spikes are first replaced by [`crate::clean_additive_outliers`]
+/// (count in `ArmaModel::outliers_replaced`).
 ///
 /// Errors: empty, non-finite or constant input; `p = 0`; `p + q > N/3`; invalid params.
 pub fn fit_arma(
@@ -783,6 +791,8 @@ fn fit_impl(
             });
         }
     }
+    let (y, mean, outliers_replaced) = crate::outliers::prepare(y, mean, params)?;
+    let y: &[f64] = &y;
     let offset = if params.demean { mean } else { 0.0 };
     let centred: Vec<f64> = y.iter().map(|v| v - offset).collect();
     let scale = (centred.iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt();
@@ -847,6 +857,7 @@ fn fit_impl(
         n_samples: n,
         mean: offset,
         estimator: Estimator::PredictionError,
+        outliers_replaced,
     })
 }
 

@@ -6,6 +6,8 @@
 //! * AR(p) by Yule-Walker, Burg or forward-backward least squares ([`fit_ar`]);
 //! * ARMA(p, q) by quadratic or Huber-robustified prediction-error minimisation
 //!   ([`fit_arma`], [`fit_arma_warm`], [`sweep_arma`]), the method of MATLAB's `armax`/`pem`;
+//! * additive outliers (spikes in the signal) removed before robust fits by a robust AR
+//!   filter-cleaner ([`clean_additive_outliers`], [`OutlierCleaning`]);
 //! * model spectra in the units of a one-sided Welch density ([`ArmaModel::model_psd`]);
 //! * poles (balanced companion matrix, [`polynomial_roots`]) and modes: natural frequency in Hz
 //!   and damping ratio ([`ArmaModel::modes`]).
@@ -46,6 +48,7 @@ mod arma;
 mod error;
 mod linalg;
 mod model;
+mod outliers;
 mod roots;
 pub mod sim;
 
@@ -59,4 +62,5 @@ pub use model::{
     information_criteria, modes_from_poles, ArmaModel, Estimator, Mode, ModeSet, Pole, StopReason,
 };
 pub use num_complex::Complex64;
+pub use outliers::{clean_additive_outliers, CleanedSignal, CleanerParams, OutlierCleaning};
 pub use roots::polynomial_roots;

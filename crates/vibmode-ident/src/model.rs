@@ -84,6 +84,10 @@ pub struct ArmaModel {
     pub mean: f64,
     /// Estimator used.
     pub estimator: Estimator,
+    /// Samples replaced by the additive-outlier cleaner before fitting (robust prediction-error
+    /// fits with [`crate::OutlierCleaning::RobustFilter`]; 0 otherwise).
+    #[serde(default)]
+    pub outliers_replaced: usize,
 }
 
 /// One vibration mode from a stable complex pole pair.

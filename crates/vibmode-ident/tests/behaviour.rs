@@ -127,7 +127,7 @@ fn filter_ca(a: &[f64], c: &[f64], e: &[f64]) -> Vec<f64> {
 fn robust_fit_resists_innovation_spikes() {
     // 1 % of the innovations replaced by spikes of 15-30 innovation standard deviations (outliers
     // in the prediction errors, which the Huber criterion is designed for). Additive spikes in y
-    // are NOT covered (see docs/identification.md, Limits).
+    // are handled by the filter-cleaner: tests/outliers.rs.
     let fs = 200.0;
     let truth = [(3.0, 0.05), (9.0, 0.04)];
     let a = ar_from_modes(&truth, fs);
