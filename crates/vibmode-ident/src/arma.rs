@@ -178,10 +178,28 @@ pub fn sweep_arma(
     params: &ArmaParams,
 ) -> Vec<Result<ArmaModel, IdentError>> {
     let mut out: Vec<Result<ArmaModel, IdentError>> = Vec::with_capacity(orders.len());
+    // Additive outliers are cleaned once for the whole sweep (the same result at every order).
+    let cleaned = check_signal(y, 3)
+        .and_then(|mean| crate::outliers::prepare(y, mean, params))
+        .map(|(yc, _, k)| (yc.into_owned(), k));
+    let (yc, replaced) = match cleaned {
+        Ok(v) => v,
+        Err(e) => {
+            out.extend(orders.iter().map(|_| Err(e.clone())));
+            return out;
+        }
+    };
+    let inner = ArmaParams {
+        outlier_cleaning: OutlierCleaning::Off,
+        ..*params
+    };
     let mut prev: Option<ArmaModel> = None;
     for &o in orders {
         let init = prev.as_ref().filter(|m| m.p <= o && m.q <= o);
-        let r = fit_impl(y, o, o, init, params);
+        let r = fit_impl(&yc, o, o, init, &inner).map(|mut m| {
+            m.outliers_replaced = replaced;
+            m
+        });
         if let Ok(m) = &r {
             prev = Some(m.clone());
         }
