@@ -259,11 +259,27 @@ pub fn analyze(
         cutoff_hz: Some(cfg.cutoff_hz.min(first.recording.fs_hz / 2.0)),
         filter: true,
     };
+    // With a non-integer rate ratio the output rate is n_out / duration, which can fall a hair
+    // below analysis_fs_hz (e.g. 425.08 Hz -> 49.998 Hz); keep the cutoff below its Nyquist.
     let resampled: Vec<Recording> = records
         .par_iter()
-        .map(|r| r.recording.resample(&rp))
+        .map(|r| {
+            let planned = vibmode_signal::Resampler::new(r.recording.len(), r.recording.fs_hz, &rp)
+                .or_else(|_| {
+                    let loose = ResampleParams {
+                        cutoff_hz: None,
+                        ..rp.clone()
+                    };
+                    vibmode_signal::Resampler::new(r.recording.len(), r.recording.fs_hz, &loose)
+                })?;
+            let rp_r = ResampleParams {
+                cutoff_hz: rp.cutoff_hz.map(|c| c.min(planned.fs_out_hz() / 2.0)),
+                ..rp.clone()
+            };
+            r.recording.resample(&rp_r)
+        })
         .collect::<Result<_, _>>()?;
-    let fs = cfg.analysis_fs_hz;
+    let fs = resampled.first().map_or(cfg.analysis_fs_hz, |r| r.fs_hz);
     let n_ch = names.len();
     let tasks: Vec<(usize, usize)> = (0..records.len())
         .flat_map(|r| (0..n_ch).map(move |c| (r, c)))
