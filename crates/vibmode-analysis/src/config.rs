@@ -83,8 +83,15 @@ pub struct ChannelRole {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ClusterConfig {
-    /// Relative frequency neighbourhood of the density clustering (default 0.02 = 2 %).
+    /// Relative frequency neighbourhood of the density clustering for lightly damped poles
+    /// (default 0.02 = 2 %).
     pub freq_tol_rel: f64,
+    /// Growth of the frequency neighbourhood with damping: the relative radius is
+    /// `max(freq_tol_rel, freq_tol_per_damping * zeta)` (geometric-mean damping of the pair).
+    /// A mode of damping zeta has a half-power bandwidth `2 zeta f` and its poles scatter in
+    /// proportion; 0.5 = a quarter of that bandwidth (15 % at zeta = 0.3). 0 = fixed radius.
+    /// Default 0.5.
+    pub freq_tol_per_damping: f64,
     /// Neighbourhood in log10 damping (default 0.2 decades).
     pub log_damping_tol: f64,
     /// Share of records a mode must appear in to be invariant (default 0.5).
@@ -111,6 +118,7 @@ impl Default for ClusterConfig {
     fn default() -> Self {
         ClusterConfig {
             freq_tol_rel: 0.02,
+            freq_tol_per_damping: 0.5,
             log_damping_tol: 0.2,
             min_record_share: 0.5,
             min_order_share: 0.5,
@@ -158,6 +166,14 @@ pub struct AnalysisConfig {
     /// Roles of the channels; channels not listed are guessed from their names
     /// (containing "unsprung"/"wheel"/"axle" -> unsprung, "sprung"/"body"/"floor" -> sprung).
     pub channels: Vec<ChannelRole>,
+    /// Stops: a record whose activity (RMS acceleration in `activity_min_hz..cutoff_hz`, relative
+    /// to the median over the records; see [`crate::RecordSummary::activity_ratio`]) is below
+    /// this ratio is `stationary` (vehicle at rest: no road input) and left out of the mode
+    /// statistics. 0 disables. Default 0.4 (a record driven at typical intensity for less than
+    /// about 0.4^2 = 16 % of its length).
+    pub stop_rms_ratio: f64,
+    /// Lower edge of the activity band, Hz (default 0.5 Hz: above drift and gravity changes).
+    pub activity_min_hz: f64,
     /// Clustering settings.
     pub cluster: ClusterConfig,
 }
@@ -185,6 +201,8 @@ impl AnalysisConfig {
             welch_nperseg: 128,
             psd_orders: vec![5, 10],
             channels: Vec::new(),
+            stop_rms_ratio: 0.4,
+            activity_min_hz: 0.5,
             cluster: ClusterConfig::default(),
         };
         match p {
@@ -288,6 +306,26 @@ impl AnalysisConfig {
                 "robust_factor",
                 self.robust_factor.to_string(),
                 "must be >= 0 (0 = quadratic)",
+            );
+        }
+        if !(0.0..1.0).contains(&self.stop_rms_ratio) {
+            return bad(
+                "stop_rms_ratio",
+                self.stop_rms_ratio.to_string(),
+                "must be in [0, 1) (0 = no stop detection; default 0.4)",
+            );
+        }
+        if !(self.activity_min_hz.is_finite()
+            && self.activity_min_hz >= 0.0
+            && self.activity_min_hz < self.cutoff_hz)
+        {
+            return bad(
+                "activity_min_hz",
+                self.activity_min_hz.to_string(),
+                &format!(
+                    "must be in [0, cutoff_hz = {}) (default 0.5)",
+                    self.cutoff_hz
+                ),
             );
         }
         if self.welch_nperseg < 8 {

@@ -62,6 +62,18 @@ pub struct RecordSummary {
     pub n_samples: usize,
     /// Duration, s.
     pub duration_s: f64,
+    /// Activity per channel: RMS of the acceleration in `activity_min_hz..cutoff_hz`, from the
+    /// record's Welch PSD at the analysis rate (square root of its integral over the band), in
+    /// the channel's unit.
+    pub activity_rms: Vec<f64>,
+    /// Activity relative to the other records: per channel `activity_rms` divided by its median
+    /// over all records, then the median over channels (1 = a typical record).
+    pub activity_ratio: f64,
+    /// True when `activity_ratio < stop_rms_ratio`: the vehicle was (mostly) at rest, the record
+    /// is left out of the invariant-mode statistics (its poles are still in `poles`).
+    pub stationary: bool,
+    /// Why the record is left out of the mode statistics (None = used).
+    pub excluded_reason: Option<String>,
 }
 
 /// One pole pair of one fit.
@@ -162,6 +174,9 @@ pub struct AnalysisResults {
     pub roles: Vec<RoleAnalysis>,
     /// Physical model modes used for matching (empty without a vehicle model).
     pub reference_modes: Vec<ReferenceMode>,
+    /// Number of records marked `stationary` (stops), left out of the mode statistics; the
+    /// invariant modes' `record_share` and `order_share` are relative to the other records.
+    pub n_stationary: usize,
     /// Number of model fits run.
     pub n_fits: usize,
     /// Number of fits that did not converge.
@@ -185,6 +200,7 @@ struct TaskOut {
 fn cluster_params(cfg: &AnalysisConfig) -> ClusterParams {
     ClusterParams {
         freq_tol_rel: cfg.cluster.freq_tol_rel,
+        freq_tol_per_damping: cfg.cluster.freq_tol_per_damping,
         log_damping_tol: cfg.cluster.log_damping_tol,
         min_record_share: cfg.cluster.min_record_share,
         min_order_share: cfg.cluster.min_order_share,
@@ -243,11 +259,27 @@ pub fn analyze(
         cutoff_hz: Some(cfg.cutoff_hz.min(first.recording.fs_hz / 2.0)),
         filter: true,
     };
+    // With a non-integer rate ratio the output rate is n_out / duration, which can fall a hair
+    // below analysis_fs_hz (e.g. 425.08 Hz -> 49.998 Hz); keep the cutoff below its Nyquist.
     let resampled: Vec<Recording> = records
         .par_iter()
-        .map(|r| r.recording.resample(&rp))
+        .map(|r| {
+            let planned = vibmode_signal::Resampler::new(r.recording.len(), r.recording.fs_hz, &rp)
+                .or_else(|_| {
+                    let loose = ResampleParams {
+                        cutoff_hz: None,
+                        ..rp.clone()
+                    };
+                    vibmode_signal::Resampler::new(r.recording.len(), r.recording.fs_hz, &loose)
+                })?;
+            let rp_r = ResampleParams {
+                cutoff_hz: rp.cutoff_hz.map(|c| c.min(planned.fs_out_hz() / 2.0)),
+                ..rp.clone()
+            };
+            r.recording.resample(&rp_r)
+        })
         .collect::<Result<_, _>>()?;
-    let fs = cfg.analysis_fs_hz;
+    let fs = resampled.first().map_or(cfg.analysis_fs_hz, |r| r.fs_hz);
     let n_ch = names.len();
     let tasks: Vec<(usize, usize)> = (0..records.len())
         .flat_map(|r| (0..n_ch).map(move |c| (r, c)))
@@ -265,6 +297,46 @@ pub fn analyze(
             out
         })
         .collect::<Result<_, _>>()?;
+
+    // Stops: activity per record and channel, relative to the median over records.
+    let activity_rms: Vec<Vec<f64>> = (0..records.len())
+        .map(|r| {
+            (0..n_ch)
+                .map(|c| {
+                    outs.iter()
+                        .find(|o| o.record == r && o.channel == c)
+                        .map_or(f64::NAN, |o| {
+                            band_rms(&o.welch_freq, &o.welch, cfg.activity_min_hz, cfg.cutoff_hz)
+                        })
+                })
+                .collect()
+        })
+        .collect();
+    let activity_ratio = activity_ratios(&activity_rms, n_ch);
+    let mut stationary: Vec<bool> = activity_ratio
+        .iter()
+        .map(|&a| cfg.stop_rms_ratio > 0.0 && a < cfg.stop_rms_ratio)
+        .collect();
+    if stationary.iter().all(|&s| s) {
+        // cannot happen with a median reference and a ratio < 1; never drop everything
+        stationary.iter_mut().for_each(|s| *s = false);
+    }
+    // Records used for the modes, renumbered 0..n_active for the clustering.
+    let active: Vec<Option<usize>> = {
+        let mut k = 0;
+        stationary
+            .iter()
+            .map(|&s| {
+                if s {
+                    None
+                } else {
+                    k += 1;
+                    Some(k - 1)
+                }
+            })
+            .collect()
+    };
+    let n_active = active.iter().flatten().count();
 
     // Assemble per channel.
     let mut channels = Vec::with_capacity(n_ch);
@@ -286,13 +358,9 @@ pub fn analyze(
             .unwrap_or_default();
         let poles: Vec<PoleOut> = mine.iter().flat_map(|o| o.poles.iter().copied()).collect();
         let fits: Vec<FitSummary> = mine.iter().flat_map(|o| o.fits.iter().copied()).collect();
-        let obs = to_observations(&poles, name, cfg.role_of(name));
-        let invariant = vibmode_modal::find_invariant_modes(
-            &obs,
-            records.len(),
-            &orders,
-            &cluster_params(cfg),
-        )?;
+        let obs = to_observations(&poles, name, cfg.role_of(name), &active);
+        let invariant =
+            vibmode_modal::find_invariant_modes(&obs, n_active, &orders, &cluster_params(cfg))?;
         channels.push(ChannelAnalysis {
             name: name.clone(),
             unit: first.recording.channels[c].unit.clone(),
@@ -318,14 +386,10 @@ pub fn analyze(
         }
         let mut obs = Vec::new();
         for ch in &chans {
-            obs.extend(to_observations(&ch.poles, &ch.name, role));
+            obs.extend(to_observations(&ch.poles, &ch.name, role, &active));
         }
-        let invariant = vibmode_modal::find_invariant_modes(
-            &obs,
-            records.len(),
-            &orders,
-            &cluster_params(cfg),
-        )?;
+        let invariant =
+            vibmode_modal::find_invariant_modes(&obs, n_active, &orders, &cluster_params(cfg))?;
         let matches = if reference.is_empty() {
             Vec::new()
         } else {
@@ -348,32 +412,103 @@ pub fn analyze(
         config: cfg.clone(),
         records: records
             .iter()
-            .map(|r| RecordSummary {
+            .enumerate()
+            .map(|(i, r)| RecordSummary {
                 name: r.name.clone(),
                 fs_hz: r.recording.fs_hz,
                 n_samples: r.recording.len(),
                 duration_s: r.recording.duration_s(),
+                activity_rms: activity_rms[i].clone(),
+                activity_ratio: activity_ratio[i],
+                stationary: stationary[i],
+                excluded_reason: stationary[i].then(|| {
+                    format!(
+                        "stationary: activity {:.3} x the median record < stop_rms_ratio {}",
+                        activity_ratio[i], cfg.stop_rms_ratio
+                    )
+                }),
             })
             .collect(),
         channels,
         roles,
         reference_modes: reference.to_vec(),
+        n_stationary: stationary.iter().filter(|&&s| s).count(),
         n_fits,
         n_not_converged,
         elapsed_s: t0.elapsed().as_secs_f64(),
     })
 }
 
-fn to_observations(poles: &[PoleOut], channel: &str, role: Role) -> Vec<PoleObservation> {
+/// Poles of the records in use, with record indices renumbered by `active` (None = left out).
+fn to_observations(
+    poles: &[PoleOut],
+    channel: &str,
+    role: Role,
+    active: &[Option<usize>],
+) -> Vec<PoleObservation> {
     poles
         .iter()
-        .map(|p| PoleObservation {
-            frequency_hz: p.frequency_hz,
-            damping_ratio: p.damping_ratio,
-            order: p.order,
-            record: p.record,
-            channel: channel.to_string(),
-            role: Some(role.to_string()),
+        .filter_map(|p| {
+            let record = active.get(p.record).copied().flatten()?;
+            Some(PoleObservation {
+                frequency_hz: p.frequency_hz,
+                damping_ratio: p.damping_ratio,
+                order: p.order,
+                record,
+                channel: channel.to_string(),
+                role: Some(role.to_string()),
+            })
+        })
+        .collect()
+}
+
+/// RMS in `[f_lo, f_hi]` Hz from a one-sided PSD (unit^2/Hz) on a uniform grid: the square root
+/// of the sum of the bins in the band times the bin width. NaN for an empty grid.
+pub(crate) fn band_rms(freq_hz: &[f64], psd: &[f64], f_lo: f64, f_hi: f64) -> f64 {
+    if freq_hz.len() < 2 {
+        return f64::NAN;
+    }
+    let df = freq_hz[1] - freq_hz[0];
+    let power: f64 = freq_hz
+        .iter()
+        .zip(psd)
+        .filter(|(f, _)| **f >= f_lo && **f <= f_hi)
+        .map(|(_, p)| p * df)
+        .sum();
+    power.max(0.0).sqrt()
+}
+
+/// Per record: the median over channels of (activity / that channel's median over records).
+/// A channel whose median is zero or not finite gives no information and is skipped; a record
+/// with no informative channel gets 1 (never a stop).
+pub(crate) fn activity_ratios(rms: &[Vec<f64>], n_ch: usize) -> Vec<f64> {
+    let medians: Vec<f64> = (0..n_ch)
+        .map(|c| {
+            let v: Vec<f64> = rms
+                .iter()
+                .filter_map(|r| r.get(c).copied())
+                .filter(|x| x.is_finite())
+                .collect();
+            if v.is_empty() {
+                f64::NAN
+            } else {
+                vibmode_modal::stats::median(&v)
+            }
+        })
+        .collect();
+    rms.iter()
+        .map(|r| {
+            let ratios: Vec<f64> = r
+                .iter()
+                .zip(&medians)
+                .filter(|(x, m)| x.is_finite() && m.is_finite() && **m > 0.0)
+                .map(|(x, m)| x / m)
+                .collect();
+            if ratios.is_empty() {
+                1.0
+            } else {
+                vibmode_modal::stats::median(&ratios)
+            }
         })
         .collect()
 }
@@ -488,4 +623,32 @@ fn run_task(
         poles,
         fits: sums,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn band_rms_of_a_flat_psd() {
+        // 2 unit^2/Hz on 0, 0.5, ..., 25 Hz; band 1..3 Hz holds bins 1.0..3.0 = 5 bins x 0.5 Hz.
+        let f: Vec<f64> = (0..=50).map(|k| k as f64 * 0.5).collect();
+        let p = vec![2.0; f.len()];
+        assert!((band_rms(&f, &p, 1.0, 3.0) - (2.0f64 * 5.0 * 0.5).sqrt()).abs() < 1e-12);
+        assert!(band_rms(&[], &[], 1.0, 3.0).is_nan());
+    }
+
+    #[test]
+    fn activity_ratio_is_median_over_channels_of_relative_rms() {
+        // 3 records x 2 channels; channel medians 2.0 and 10.0.
+        let rms = vec![vec![2.0, 10.0], vec![4.0, 30.0], vec![0.2, 1.0]];
+        let a = activity_ratios(&rms, 2);
+        // record 0: (1, 1) -> 1; record 1: (2, 3) -> 2.5; record 2: (0.1, 0.1) -> 0.1
+        assert_eq!(a, vec![1.0, 2.5, 0.1]);
+        // A dead channel (all zero) is ignored, not a stop everywhere.
+        let rms = vec![vec![2.0, 0.0], vec![0.5, 0.0], vec![2.0, 0.0]];
+        assert_eq!(activity_ratios(&rms, 2), vec![1.0, 0.25, 1.0]);
+        let rms = vec![vec![0.0], vec![0.0]];
+        assert_eq!(activity_ratios(&rms, 1), vec![1.0, 1.0]);
+    }
 }

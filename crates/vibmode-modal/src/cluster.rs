@@ -86,6 +86,11 @@ pub fn analyse_poles(
 
     // Filter and map to the scaled plane.
     let lu = (1.0 + p.freq_tol_rel).ln();
+    let metric = Metric {
+        lu,
+        per_damping: p.freq_tol_per_damping,
+        min_rel: p.freq_tol_rel,
+    };
     let mut pts: Vec<Pt> = Vec::with_capacity(poles.len());
     let mut channel_ids: HashMap<&str, usize> = HashMap::new();
     for (i, pole) in poles.iter().enumerate() {
@@ -97,10 +102,18 @@ pub fn analyse_poles(
         let n_ch = channel_ids.len();
         let ch = *channel_ids.entry(pole.channel.as_str()).or_insert(n_ch);
         let u = f.ln() / lu;
-        let v = z.max(p.min_damping_ratio).log10() / p.log_damping_tol;
+        let zc = z.max(p.min_damping_ratio);
+        let v = zc.log10() / p.log_damping_tol;
+        // Largest frequency scale any neighbour can have: a neighbour's damping is at most
+        // 10^log_damping_tol times this one's (and at most max_damping_ratio).
+        let z_nb =
+            (zc * 10f64.powf(0.5 * p.log_damping_tol)).min((zc * p.max_damping_ratio).sqrt());
+        let reach_u = ((freq_scale(z_nb, p) / lu) * CELLS_PER_UNIT).ceil() as i64;
         pts.push(Pt {
             u,
             v,
+            zeta: zc,
+            reach_u: reach_u.max(REACH),
             cell: (
                 (u * CELLS_PER_UNIT).floor() as i64,
                 (v * CELLS_PER_UNIT).floor() as i64,
@@ -142,7 +155,11 @@ pub fn analyse_poles(
             start = k;
         }
     }
-    let grid = Grid { pts: &pts, cells };
+    let grid = Grid {
+        pts: &pts,
+        cells,
+        metric,
+    };
 
     // 1. Core poles (a cell holding at least core_threshold poles is all core).
     let mut core = vec![false; pts.len()];
@@ -170,7 +187,8 @@ pub fn analyse_poles(
             continue;
         };
         let c = pts[a].cell;
-        for dx in -REACH..=REACH {
+        let reach = pts[a..b].iter().map(|q| q.reach_u).max().unwrap_or(REACH);
+        for dx in -reach..=reach {
             for dy in -REACH..=REACH {
                 let d = (c.0 + dx, c.1 + dy);
                 if d <= c {
@@ -187,7 +205,7 @@ pub fn analyse_poles(
                 };
                 'pairs: for i in (a..b).filter(|&i| core[i]) {
                     for j in (da..db).filter(|&j| core[j]) {
-                        if dist2(&pts[i], &pts[j]) <= 1.0 {
+                        if metric.dist2(&pts[i], &pts[j]) <= 1.0 {
                             uf.union(i, j);
                             break 'pairs;
                         }
@@ -224,7 +242,7 @@ pub fn analyse_poles(
     // 4. Summarise each cluster.
     let mut clusters: Vec<(InvariantMode, Vec<usize>)> = members
         .into_values()
-        .map(|m| summarise(&pts, &m, poles, n_records, orders.len(), p))
+        .map(|m| summarise(&pts, &m, poles, n_records, orders.len(), p, &metric))
         .collect();
     clusters.sort_by(|a, b| {
         a.0.frequency_hz
@@ -291,15 +309,21 @@ fn summarise(
     n_records: usize,
     n_orders: usize,
     p: &ClusterParams,
+    metric: &Metric,
 ) -> (InvariantMode, Vec<usize>) {
     let cu = median(&members.iter().map(|&i| pts[i].u).collect::<Vec<_>>());
     let cv = median(&members.iter().map(|&i| pts[i].v).collect::<Vec<_>>());
+    // Frequency scale at the centre's damping (constant within the cluster).
+    let cs = metric.scale(
+        10f64.powf(cv * p.log_damping_tol),
+        10f64.powf(cv * p.log_damping_tol),
+    );
     // At most one pole per (record, channel, order): the nearest to the cluster centre.
     let mut best: HashMap<(usize, usize, usize), (f64, usize)> = HashMap::new();
     for &i in members {
         let pt = &pts[i];
         let pole = &poles[pt.idx];
-        let d2 = (pt.u - cu).powi(2) + (pt.v - cv).powi(2);
+        let d2 = ((pt.u - cu) * cs).powi(2) + (pt.v - cv).powi(2);
         let key = (pole.record, pt.ch, pole.order);
         match best.get(&key) {
             Some(&(bd, bidx)) if bd < d2 || (bd == d2 && bidx < pt.idx) => {}
@@ -369,16 +393,43 @@ fn summarise(
 
 /// Grid cells per unit of the scaled plane: side 1/sqrt(2), so a cell's diagonal is 1.
 const CELLS_PER_UNIT: f64 = std::f64::consts::SQRT_2;
-/// Neighbouring cells to search on each side (ceil(sqrt(2)) = 2).
+/// Neighbouring cells to search on each side in `v`, and at least in `u` (ceil(sqrt(2)) = 2).
 const REACH: i64 = 2;
 
-fn dist2(a: &Pt, b: &Pt) -> f64 {
-    (a.u - b.u) * (a.u - b.u) + (a.v - b.v) * (a.v - b.v)
+/// Relative frequency neighbourhood, as a log-frequency width, for a pair of poles whose
+/// geometric-mean damping ratio is `zeta`: `ln(1 + max(freq_tol_rel, freq_tol_per_damping * zeta))`.
+fn freq_scale(zeta: f64, p: &ClusterParams) -> f64 {
+    (1.0 + p.freq_tol_rel.max(p.freq_tol_per_damping * zeta)).ln()
+}
+
+/// The neighbour metric: `u` is in units of `ln(1 + freq_tol_rel)`; the frequency difference is
+/// rescaled by the damping-dependent width of the pair.
+#[derive(Clone, Copy)]
+struct Metric {
+    lu: f64,
+    per_damping: f64,
+    min_rel: f64,
+}
+
+impl Metric {
+    /// Factor (<= 1) applied to a `u` difference for poles of damping ratios `za`, `zb`.
+    fn scale(&self, za: f64, zb: f64) -> f64 {
+        let rel = self.min_rel.max(self.per_damping * (za * zb).sqrt());
+        self.lu / (1.0 + rel).ln()
+    }
+    fn dist2(&self, a: &Pt, b: &Pt) -> f64 {
+        let du = (a.u - b.u) * self.scale(a.zeta, b.zeta);
+        du * du + (a.v - b.v) * (a.v - b.v)
+    }
 }
 
 struct Pt {
     u: f64,
     v: f64,
+    /// Damping ratio, raised to `min_damping_ratio`.
+    zeta: f64,
+    /// Cells to search on each side in `u` (covers the widest neighbourhood of this pole).
+    reach_u: i64,
     cell: (i64, i64),
     idx: usize,
     ch: usize,
@@ -387,17 +438,18 @@ struct Pt {
 struct Grid<'a> {
     pts: &'a [Pt],
     cells: HashMap<(i64, i64), (usize, usize)>,
+    metric: Metric,
 }
 
 impl Grid<'_> {
     /// Calls `f(j, squared_distance)` for every neighbour j (distance <= 1), i itself included.
     fn for_each_neighbour(&self, i: usize, mut f: impl FnMut(usize, f64)) {
         let pi = &self.pts[i];
-        for dx in -REACH..=REACH {
+        for dx in -pi.reach_u..=pi.reach_u {
             for dy in -REACH..=REACH {
                 if let Some(&(a, b)) = self.cells.get(&(pi.cell.0 + dx, pi.cell.1 + dy)) {
                     for (j, pj) in self.pts[a..b].iter().enumerate() {
-                        let d2 = dist2(pi, pj);
+                        let d2 = self.metric.dist2(pi, pj);
                         if d2 <= 1.0 {
                             f(a + j, d2);
                         }
@@ -411,11 +463,11 @@ impl Grid<'_> {
     fn count_neighbours_upto(&self, i: usize, limit: usize) -> usize {
         let pi = &self.pts[i];
         let mut n = 0;
-        for dx in -REACH..=REACH {
+        for dx in -pi.reach_u..=pi.reach_u {
             for dy in -REACH..=REACH {
                 if let Some(&(a, b)) = self.cells.get(&(pi.cell.0 + dx, pi.cell.1 + dy)) {
                     for pj in &self.pts[a..b] {
-                        if dist2(pi, pj) <= 1.0 {
+                        if self.metric.dist2(pi, pj) <= 1.0 {
                             n += 1;
                             if n >= limit {
                                 return n;

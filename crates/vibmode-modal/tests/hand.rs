@@ -101,13 +101,22 @@ fn hand_clusters_shares_and_classes() {
     };
     let modes = find_invariant_modes(&hand_poles(), 2, &[4, 6], &p).unwrap();
     assert_eq!(modes[1].class, ModeClass::Structural);
-    // A tighter frequency tolerance (0.5 %) splits the 2 Hz pair (1 % apart) into noise.
+    // A tighter fixed frequency tolerance (0.5 %) splits the 2 Hz pair (1 % apart) into noise.
     let p = ClusterParams {
         freq_tol_rel: 0.005,
+        freq_tol_per_damping: 0.0,
         ..hand_params()
     };
     let modes = find_invariant_modes(&hand_poles(), 2, &[4, 6], &p).unwrap();
     assert!(modes.iter().all(|m| (m.frequency_hz - 2.01).abs() > 0.05));
+    // With the damping-dependent radius the pair (zeta 0.1: radius 0.5 * 0.1 = 5 %) stays one.
+    let p = ClusterParams {
+        freq_tol_rel: 0.005,
+        freq_tol_per_damping: 0.5,
+        ..hand_params()
+    };
+    let modes = find_invariant_modes(&hand_poles(), 2, &[4, 6], &p).unwrap();
+    assert!(modes.iter().any(|m| (m.frequency_hz - 2.01).abs() < 1e-12));
     // A line whose frequency spread is too large is not a disturbance.
     let p = ClusterParams {
         disturbance_freq_spread_max: 1e-4,
@@ -353,6 +362,14 @@ fn invalid_params_are_errors() {
             ..ClusterParams::default()
         },
         ClusterParams {
+            freq_tol_per_damping: -0.5,
+            ..ClusterParams::default()
+        },
+        ClusterParams {
+            freq_tol_per_damping: f64::NAN,
+            ..ClusterParams::default()
+        },
+        ClusterParams {
             freq_tol_rel: -0.01,
             ..ClusterParams::default()
         },
@@ -446,4 +463,92 @@ fn mode_class_parse_display_serde() {
     let m = mode(1.0, 0.2, ModeClass::Structural);
     let back: InvariantMode = serde_json::from_str(&serde_json::to_string(&m).unwrap()).unwrap();
     assert_eq!(back, m);
+}
+
+/// Two poles of equal damping zeta are neighbours when their frequency ratio is within
+/// 1 + max(freq_tol_rel, freq_tol_per_damping * zeta); with min_points = 2 a neighbouring pair
+/// is a cluster and a lone pole is noise.
+#[test]
+fn damping_dependent_radius_boundaries() {
+    let p = ClusterParams {
+        min_points: 2,
+        min_density_share: 0.0,
+        min_record_share: 0.0,
+        min_order_share: 0.0,
+        freq_tol_per_damping: 0.5,
+        ..ClusterParams::default()
+    };
+    let pair = |f2: f64, z: f64| {
+        let poles = vec![pole(1.0, z, 4, 0), pole(f2, z, 6, 0)];
+        find_invariant_modes(&poles, 1, &[4, 6], &p).unwrap().len()
+    };
+    // zeta 0.2: radius 0.5 * 0.2 = 10 %.
+    assert_eq!(pair(1.099, 0.2), 1);
+    assert_eq!(pair(1.101, 0.2), 0);
+    // zeta 0.3: radius 15 %.
+    assert_eq!(pair(1.149, 0.3), 1);
+    assert_eq!(pair(1.151, 0.3), 0);
+    // zeta 0.002 (a line): 0.5 * 0.002 = 0.1 % < freq_tol_rel, so the floor of 2 % holds.
+    assert_eq!(pair(1.0199, 0.002), 1);
+    assert_eq!(pair(1.0201, 0.002), 0);
+    // Different dampings: the radius uses the geometric mean, sqrt(0.16 * 0.25) = 0.2 -> 10 %,
+    // and the damping distance log10(0.25 / 0.16) / 0.2 = 0.969 must be added in quadrature:
+    // sqrt((ln(f2) / ln(1.1))^2 + 0.969^2) <= 1 needs ln(f2) <= 0.2467 * ln(1.1), f2 <= 1.0238.
+    let mixed = |f2: f64| {
+        let poles = vec![pole(1.0, 0.16, 4, 0), pole(f2, 0.25, 6, 0)];
+        find_invariant_modes(&poles, 1, &[4, 6], &p).unwrap().len()
+    };
+    assert_eq!(mixed(1.0230), 1);
+    assert_eq!(mixed(1.0246), 0);
+    // Off (0): the fixed 2 % radius for every damping.
+    let fixed = ClusterParams {
+        freq_tol_per_damping: 0.0,
+        ..p.clone()
+    };
+    assert_eq!(ClusterParams::default().freq_tol_per_damping, 0.0);
+    let poles = vec![pole(1.0, 0.3, 4, 0), pole(1.05, 0.3, 6, 0)];
+    assert!(find_invariant_modes(&poles, 1, &[4, 6], &fixed)
+        .unwrap()
+        .is_empty());
+}
+
+/// A heavily damped mode whose poles scatter by 10 % steps (1.0, 1.1, 1.21, 1.331 Hz, zeta 0.3)
+/// is one cluster with freq_tol_per_damping 0.5 (15 % at zeta 0.3) but only noise with the old fixed
+/// 2 %; two lines 3 % apart (zeta 0.002) stay two clusters either way.
+#[test]
+fn damped_mode_is_not_fragmented_lines_stay_apart() {
+    let orders = [4, 6, 8, 10];
+    let mut poles = Vec::new();
+    for (k, &o) in orders.iter().enumerate() {
+        poles.push(pole(1.1f64.powi(k as i32), 0.3, o, 0));
+        poles.push(pole(5.0, 0.002, o, 0));
+        poles.push(pole(5.15, 0.002, o, 0));
+    }
+    let p = ClusterParams {
+        min_points: 3,
+        min_density_share: 0.0,
+        freq_tol_per_damping: 0.5,
+        ..ClusterParams::default()
+    };
+    let modes = find_invariant_modes(&poles, 1, &orders, &p).unwrap();
+    assert_eq!(modes.len(), 3, "{modes:?}");
+    close(
+        modes[0].frequency_hz,
+        (1.0 + 1.1 + 1.21 + 1.331) / 4.0,
+        1e-12,
+    );
+    assert_eq!((modes[0].n_poles, modes[0].order_share), (4, 1.0));
+    assert_eq!(modes[0].class, ModeClass::Structural);
+    close(modes[1].frequency_hz, 5.0, 1e-12);
+    close(modes[2].frequency_hz, 5.15, 1e-12);
+    assert!(modes[1..]
+        .iter()
+        .all(|m| m.class == ModeClass::PeriodicDisturbance));
+    let fixed = ClusterParams {
+        freq_tol_per_damping: 0.0,
+        ..p
+    };
+    let modes = find_invariant_modes(&poles, 1, &orders, &fixed).unwrap();
+    assert_eq!(modes.len(), 2);
+    assert!(modes.iter().all(|m| m.frequency_hz > 4.0));
 }
