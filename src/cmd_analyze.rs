@@ -180,6 +180,20 @@ pub fn print_modes(r: &AnalysisResults, truth: Option<&[(String, f64, f64)]>) {
         r.config.order_min,
         r.config.order_max
     );
+    if r.n_stationary > 0 {
+        let stops: Vec<&str> = r
+            .records
+            .iter()
+            .filter(|rec| rec.stationary)
+            .map(|rec| rec.name.as_str())
+            .collect();
+        println!(
+            "{} of {} records were stops and are left out of the mode statistics: {}",
+            r.n_stationary,
+            r.records.len(),
+            stops.join(", ")
+        );
+    }
     for role in &r.roles {
         println!(
             "\nInvariant modes, {} channels ({}):",
@@ -307,7 +321,23 @@ pub fn write_report(
     )?;
     // Fig. 3-4: anti-aliasing.
     if first.fs_hz > cfg.analysis_fs_hz * 1.0001 {
-        let fig34 = antialias_figure(first, cfg.analysis_fs_hz, Some(cfg.cutoff_hz), 0.5)?;
+        // With a non-integer rate ratio the output rate can fall a hair below analysis_fs_hz
+        // (425.08 Hz -> 49.998 Hz): keep the cutoff at or below the output Nyquist, as the
+        // analysis itself does.
+        let planned = vibmode_signal::Resampler::new(
+            first.len(),
+            first.fs_hz,
+            &vibmode_signal::ResampleParams {
+                to_hz: cfg.analysis_fs_hz,
+                cutoff_hz: None,
+                filter: true,
+            },
+        )?;
+        let cutoff = cfg
+            .cutoff_hz
+            .min(planned.fs_out_hz() / 2.0)
+            .min(first.fs_hz / 2.0);
+        let fig34 = antialias_figure(first, cfg.analysis_fs_hz, Some(cutoff), 0.5)?;
         save_fig(&figdir, "fig03_antialias", &fig34)?;
         html.heading(2, "Anti-aliasing and resampling (Fig. 3-4)");
         html.figure(
@@ -544,6 +574,28 @@ fn summary_text(r: &AnalysisResults) -> String {
             if st.is_empty() { "none".into() } else { st.join(", ") },
             r.config.cluster.disturbance_damping_max,
             if di.is_empty() { "none".into() } else { di.join(", ") }
+        ));
+    }
+    if r.n_stationary > 0 {
+        let stops: Vec<String> = r
+            .records
+            .iter()
+            .filter(|rec| rec.stationary)
+            .map(|rec| {
+                format!(
+                    "{} (activity {:.2} of the median record)",
+                    rec.name, rec.activity_ratio
+                )
+            })
+            .collect();
+        s.push_str(&format!(
+            "{} of {} records were stops (acceleration RMS in {}-{} Hz below {} of the median record) and were left out of the mode statistics: {}. ",
+            r.n_stationary,
+            r.records.len(),
+            r.config.activity_min_hz,
+            r.config.cutoff_hz,
+            r.config.stop_rms_ratio,
+            stops.join(", ")
         ));
     }
     if r.config.preset == Preset::Paper {
