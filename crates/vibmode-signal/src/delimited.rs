@@ -18,6 +18,7 @@
 //! - header cells `name (unit)` or `name [unit]` give a name and a unit.
 
 use crate::error::{Result, SignalError};
+use crate::number::{parse_slow, scan_number, Scan};
 use serde::{Deserialize, Serialize};
 use std::io::BufRead;
 
@@ -88,7 +89,25 @@ pub struct Block {
     pub lines: Vec<usize>,
 }
 
+/// Drops values pushed for a row that was then not accepted (columns longer than `lines`).
+#[inline]
+fn truncate_rows(block: &mut Block) {
+    let n = block.lines.len();
+    for c in &mut block.columns {
+        c.truncate(n);
+    }
+}
+
 impl Block {
+    /// An empty block of `n_columns` columns with room for `rows` rows.
+    fn with_capacity(n_columns: usize, rows: usize) -> Block {
+        Block {
+            first_line: 0,
+            columns: (0..n_columns).map(|_| Vec::with_capacity(rows)).collect(),
+            lines: Vec::with_capacity(rows),
+        }
+    }
+
     /// Number of rows in the block.
     pub fn n_rows(&self) -> usize {
         self.lines.len()
@@ -451,8 +470,8 @@ impl<R: BufRead> DelimitedReader<R> {
             ctx.parse_row(&line, n, &mut block)?;
         }
         while block.lines.len() < max_rows {
-            // Fast path: parse the complete lines of the reader's buffer in place (for an
-            // in-memory slice that is the whole rest of the file).
+            // Parse the complete lines of the reader's buffer in place (for an in-memory slice
+            // that is the whole rest of the file).
             let avail = self.reader.fill_buf().map_err(|e| SignalError::Io {
                 action: "read",
                 path: ctx.path.to_string(),
@@ -461,20 +480,8 @@ impl<R: BufRead> DelimitedReader<R> {
             if avail.is_empty() {
                 break;
             }
-            let mut consumed = 0;
-            while block.lines.len() < max_rows {
-                let rest = &avail[consumed..];
-                let Some(i) = rest.iter().position(|&b| b == b'\n') else {
-                    break;
-                };
-                let mut line = &rest[..i];
-                if let [head @ .., b'\r'] = line {
-                    line = head;
-                }
-                self.line_no += 1;
-                consumed += i + 1;
-                ctx.parse_row(line, self.line_no, &mut block)?;
-            }
+            let consumed =
+                ctx.parse_lines(avail, &mut self.line_no, &mut block, max_rows, false)?;
             if consumed > 0 {
                 self.reader.consume(consumed);
             } else {
@@ -494,11 +501,7 @@ impl<R: BufRead> DelimitedReader<R> {
                 if self.buf.last() == Some(&b'\n') {
                     self.buf.pop();
                 }
-                if self.buf.last() == Some(&b'\r') {
-                    self.buf.pop();
-                }
-                self.line_no += 1;
-                ctx.parse_row(&self.buf, self.line_no, &mut block)?;
+                ctx.parse_lines(&self.buf, &mut self.line_no, &mut block, max_rows, true)?;
             }
         }
         if block.lines.is_empty() {
@@ -534,31 +537,7 @@ impl<'s> DelimitedReader<&'s [u8]> {
         }
         cuts.push(rest.len());
         cuts.dedup();
-        // Line number before each chunk.
-        let mut starts = Vec::with_capacity(cuts.len());
-        let mut line = self.line_no;
-        for w in cuts.windows(2) {
-            starts.push(line);
-            line += rest[w[0]..w[1]].iter().filter(|&&b| b == b'\n').count();
-        }
-        let nc = self.columns.len();
-        let mut first = Block {
-            first_line: 0,
-            columns: vec![Vec::new(); nc],
-            lines: Vec::new(),
-        };
-        if let Some((n, l)) = self.pending.take() {
-            let mut ctx = RowCtx {
-                path: &self.path,
-                sep: self.sep,
-                decimal_comma: self.decimal_comma,
-                columns: &self.columns,
-                reference_line: self.reference_line,
-                spans: &mut self.spans,
-                scratch: &mut self.scratch,
-            };
-            ctx.parse_row(&l, n, &mut first)?;
-        }
+        let chunks: Vec<&[u8]> = cuts.windows(2).map(|w| &rest[w[0]..w[1]]).collect();
         let (path, sep, dc, cols, refl) = (
             self.path.as_str(),
             self.sep,
@@ -566,12 +545,17 @@ impl<'s> DelimitedReader<&'s [u8]> {
             self.columns.as_slice(),
             self.reference_line,
         );
-        let results: Vec<Result<Block>> = std::thread::scope(|sc| {
-            let handles: Vec<_> = cuts
-                .windows(2)
-                .zip(&starts)
-                .map(|(w, &start_line)| {
-                    let chunk = &rest[w[0]..w[1]];
+        let pending = self.pending.take();
+        let line0 = self.line_no;
+        // Chunk 0 (after the pending row, if any) is numbered from the real line; the other
+        // chunks count their lines from 0 and are shifted once the earlier chunks' line counts
+        // are known. Each thread returns its block and the number of lines it went through.
+        let results: Vec<Result<(Block, usize)>> = std::thread::scope(|sc| {
+            let handles: Vec<_> = chunks
+                .iter()
+                .enumerate()
+                .map(|(k, &chunk)| {
+                    let pending = if k == 0 { pending.as_ref() } else { None };
                     sc.spawn(move || {
                         let mut spans = Vec::new();
                         let mut scratch = Vec::new();
@@ -584,21 +568,13 @@ impl<'s> DelimitedReader<&'s [u8]> {
                             spans: &mut spans,
                             scratch: &mut scratch,
                         };
-                        let mut b = Block {
-                            first_line: 0,
-                            columns: vec![Vec::new(); cols.len()],
-                            lines: Vec::new(),
-                        };
-                        let mut ln = start_line;
-                        for l in chunk.split(|&c| c == b'\n') {
-                            let l = match l {
-                                [head @ .., b'\r'] => head,
-                                _ => l,
-                            };
-                            ln += 1;
-                            ctx.parse_row(l, ln, &mut b)?;
+                        let mut b = Block::with_capacity(cols.len(), estimate_rows(chunk) + 1);
+                        if let Some((n, l)) = pending {
+                            ctx.parse_row(l, *n, &mut b)?;
                         }
-                        Ok(b)
+                        let mut ln = if k == 0 { line0 } else { 0 };
+                        ctx.parse_lines(chunk, &mut ln, &mut b, usize::MAX, true)?;
+                        Ok((b, if k == 0 { ln - line0 } else { ln }))
                     })
                 })
                 .collect();
@@ -615,27 +591,106 @@ impl<'s> DelimitedReader<&'s [u8]> {
                 })
                 .collect()
         });
-        self.reader = &rest[rest.len()..];
-        self.line_no = line;
-        for r in results {
-            let b = r?;
-            if first.lines.is_empty() && !b.lines.is_empty() {
-                first.first_line = b.first_line;
-            }
-            for (d, c) in first.columns.iter_mut().zip(b.columns) {
-                if d.is_empty() {
-                    *d = c;
-                } else {
-                    d.extend_from_slice(&c);
+        let mut offset = line0;
+        let mut blocks = Vec::with_capacity(results.len());
+        for (k, r) in results.into_iter().enumerate() {
+            match r {
+                Ok((mut b, n_lines)) => {
+                    if k > 0 {
+                        b.first_line += offset;
+                        for l in &mut b.lines {
+                            *l += offset;
+                        }
+                    }
+                    offset += n_lines;
+                    blocks.push(b);
+                }
+                Err(e) if k == 0 => return Err(e),
+                Err(e) => {
+                    // Parse the chunk again from its real first line, for the exact line number
+                    // in the message (all earlier chunks were read, so `offset` is known).
+                    let mut spans = Vec::new();
+                    let mut scratch = Vec::new();
+                    let mut ctx = RowCtx {
+                        path,
+                        sep,
+                        decimal_comma: dc,
+                        columns: cols,
+                        reference_line: refl,
+                        spans: &mut spans,
+                        scratch: &mut scratch,
+                    };
+                    let mut b = Block::with_capacity(cols.len(), 0);
+                    let mut ln = offset;
+                    ctx.parse_lines(chunks[k], &mut ln, &mut b, usize::MAX, true)?;
+                    return Err(e);
                 }
             }
-            first.lines.extend_from_slice(&b.lines);
         }
-        if first.lines.is_empty() {
+        self.reader = &rest[rest.len()..];
+        self.line_no = offset;
+        let total: usize = blocks.iter().map(Block::n_rows).sum();
+        let mut blocks = blocks.into_iter();
+        let Some(mut all) = blocks.next() else {
+            return Ok(None);
+        };
+        // Growing the first block's vectors in place (realloc of large blocks moves pages, not
+        // bytes), then one copy of the other chunks.
+        for c in &mut all.columns {
+            c.reserve_exact(total - c.len());
+        }
+        all.lines.reserve_exact(total - all.lines.len());
+        for b in blocks {
+            if all.lines.is_empty() {
+                all.first_line = b.first_line;
+            }
+            for (d, c) in all.columns.iter_mut().zip(&b.columns) {
+                d.extend_from_slice(c);
+            }
+            all.lines.extend_from_slice(&b.lines);
+        }
+        if all.lines.is_empty() {
             Ok(None)
         } else {
-            Ok(Some(first))
+            Ok(Some(all))
         }
+    }
+}
+
+/// Rough number of lines in `chunk` (from the newline density of its first 64 KiB), to reserve
+/// the column vectors once instead of growing them by doubling.
+fn estimate_rows(chunk: &[u8]) -> usize {
+    let head = &chunk[..chunk.len().min(1 << 16)];
+    let n = head.iter().filter(|&&b| b == b'\n').count().max(1);
+    let per_line = head.len() / n;
+    let est = chunk.len() / per_line.max(1);
+    est + est / 32 + 16
+}
+
+/// Outcome of [`RowCtx::fast_row`].
+enum FastRow {
+    /// A row of numbers, pushed onto the block's columns (but not yet onto `lines`); the line
+    /// ends at this index (its `\n`, or the end of the slice).
+    Row(usize),
+    /// A line with nothing but spaces, ending at this index.
+    Blank(usize),
+    /// Anything else (quotes, words, wrong cell count, ...): nothing was pushed, the caller
+    /// parses the line with [`RowCtx::parse_row`].
+    Fallback,
+}
+
+/// If a line ends at `s[i]` (`\n`, `\r\n`, a final `\r` or the end of `s`), the index of its
+/// end (the `\n`, or `s.len()`).
+#[inline(always)]
+fn line_end(s: &[u8], i: usize) -> Option<usize> {
+    match s.get(i) {
+        None => Some(s.len()),
+        Some(b'\n') => Some(i),
+        Some(b'\r') => match s.get(i + 1) {
+            None | Some(b'\n') => Some(i + 1),
+            _ => None,
+        },
+        _ => None,
     }
 }
 
@@ -652,6 +707,138 @@ struct RowCtx<'a> {
 }
 
 impl RowCtx<'_> {
+    /// Parses the lines of `buf` into `block` until it holds `max_rows` rows; blank lines are
+    /// skipped. `line_no` is the number of the line before the first line of `buf` and is
+    /// advanced per line. With `complete` false, a last line without `\n` is left alone (the
+    /// rest of it may not be in `buf` yet). Returns the number of bytes consumed.
+    fn parse_lines(
+        &mut self,
+        buf: &[u8],
+        line_no: &mut usize,
+        block: &mut Block,
+        max_rows: usize,
+        complete: bool,
+    ) -> Result<usize> {
+        let mut pos = 0;
+        while pos < buf.len() && block.lines.len() < max_rows {
+            let rest = &buf[pos..];
+            let end = match self.fast_row(rest, block) {
+                FastRow::Row(end) => {
+                    if !complete && end == rest.len() {
+                        truncate_rows(block);
+                        break;
+                    }
+                    *line_no += 1;
+                    if block.lines.is_empty() {
+                        block.first_line = *line_no;
+                    }
+                    block.lines.push(*line_no);
+                    end
+                }
+                FastRow::Blank(end) => {
+                    if !complete && end == rest.len() {
+                        break;
+                    }
+                    *line_no += 1;
+                    end
+                }
+                FastRow::Fallback => {
+                    let end = match rest.iter().position(|&b| b == b'\n') {
+                        Some(i) => i,
+                        None if complete => rest.len(),
+                        None => break,
+                    };
+                    let line = match &rest[..end] {
+                        [head @ .., b'\r'] => head,
+                        l => l,
+                    };
+                    *line_no += 1;
+                    self.parse_row(line, *line_no, block)?;
+                    end
+                }
+            };
+            pos += end + 1;
+        }
+        Ok(pos.min(buf.len()))
+    }
+
+    /// Parses the line at the start of `s` if it is plain: numbers separated by the separator,
+    /// padded with spaces (and tabs unless they separate), trailing empty cells, ended by
+    /// `\n`, `\r\n` or the end of `s`. Gives exactly what [`RowCtx::parse_row`] gives on such a
+    /// line; everything else is [`FastRow::Fallback`] (with nothing pushed).
+    #[inline]
+    fn fast_row(&mut self, s: &[u8], block: &mut Block) -> FastRow {
+        let ws = self.sep == Separator::Whitespace;
+        let sep = match self.sep {
+            Separator::Comma => b',',
+            Separator::Semicolon => b';',
+            Separator::Tab | Separator::Whitespace => b'\t',
+        };
+        // Padding that trimming removes and that does not separate cells.
+        let tab_pads = self.sep != Separator::Tab;
+        let is_pad = |b: u8| b == b' ' || (tab_pads && b == b'\t');
+        let skip_pad = |mut i: usize| {
+            while let Some(&b) = s.get(i) {
+                if !is_pad(b) {
+                    break;
+                }
+                i += 1;
+            }
+            i
+        };
+        let dc = self.decimal_comma;
+        let nc = self.columns.len();
+        let mut i = skip_pad(0);
+        if let Some(end) = line_end(s, i) {
+            return FastRow::Blank(end);
+        }
+        for c in 0..nc {
+            if c > 0 {
+                if ws {
+                    // skip_pad after the previous number must have moved (checked below).
+                } else if s.get(i) == Some(&sep) {
+                    i = skip_pad(i + 1);
+                } else {
+                    truncate_rows(block);
+                    return FastRow::Fallback;
+                }
+            }
+            let (scan, j) = scan_number(s, i, dc);
+            let v = match scan {
+                Scan::Fast(v) => v,
+                Scan::Slow => match parse_slow(&s[i..j], dc, self.scratch) {
+                    Some(v) => v,
+                    None => {
+                        truncate_rows(block);
+                        return FastRow::Fallback;
+                    }
+                },
+                Scan::Invalid => {
+                    truncate_rows(block);
+                    return FastRow::Fallback;
+                }
+            };
+            i = skip_pad(j);
+            if ws && i == j && c + 1 < nc {
+                // Two cells must be separated by spaces or tabs.
+                truncate_rows(block);
+                return FastRow::Fallback;
+            }
+            block.columns[c].push(v);
+        }
+        loop {
+            if let Some(end) = line_end(s, i) {
+                return FastRow::Row(end);
+            }
+            if !ws && s.get(i) == Some(&sep) {
+                i = skip_pad(i + 1);
+            } else {
+                truncate_rows(block);
+                return FastRow::Fallback;
+            }
+        }
+    }
+
     /// Parses one line into `block` (blank lines are skipped).
     fn parse_row(&mut self, line: &[u8], line_no: usize, block: &mut Block) -> Result<()> {
         let nc = self.columns.len();
