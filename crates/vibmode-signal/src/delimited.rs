@@ -501,7 +501,11 @@ impl<R: BufRead> DelimitedReader<R> {
                 if self.buf.last() == Some(&b'\n') {
                     self.buf.pop();
                 }
-                ctx.parse_lines(&self.buf, &mut self.line_no, &mut block, max_rows, true)?;
+                if self.buf.is_empty() {
+                    self.line_no += 1; // a blank line (parse_lines sees no line in "")
+                } else {
+                    ctx.parse_lines(&self.buf, &mut self.line_no, &mut block, max_rows, true)?;
+                }
             }
         }
         if block.lines.is_empty() {
@@ -940,5 +944,312 @@ mod tests {
         assert_eq!(b2.columns, vec![vec![5.0], vec![6.0]]);
         assert_eq!(b2.first_line, 5);
         assert!(r.next_block(2).unwrap().is_none());
+    }
+
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn random_number(rng: &mut ChaCha8Rng, decimal_comma: bool) -> String {
+        let mut t = String::new();
+        match rng.gen_range(0..5) {
+            0 | 1 => t.push('-'),
+            2 if rng.gen_bool(0.2) => t.push('+'),
+            _ => {}
+        }
+        let long = rng.gen_bool(0.1);
+        let int_digits = rng.gen_range(0..if long { 22 } else { 4 });
+        let frac_digits = rng.gen_range(0..if long { 22 } else { 10 });
+        for _ in 0..int_digits {
+            t.push(char::from(b'0' + rng.gen_range(0..10u8)));
+        }
+        if frac_digits > 0 || int_digits == 0 || rng.gen_bool(0.2) {
+            t.push(if decimal_comma && rng.gen_bool(0.5) {
+                ','
+            } else {
+                '.'
+            });
+        }
+        for _ in 0..frac_digits {
+            t.push(char::from(b'0' + rng.gen_range(0..10u8)));
+        }
+        if int_digits + frac_digits == 0 {
+            t.push('5');
+        }
+        if rng.gen_bool(0.15) {
+            t.push_str(["e", "E", "e-", "e+"][rng.gen_range(0..4)]);
+            t.push_str(&rng.gen_range(0..400).to_string());
+        }
+        t
+    }
+
+    fn random_cell(rng: &mut ChaCha8Rng, decimal_comma: bool) -> String {
+        match rng.gen_range(0..40) {
+            0 => String::new(),
+            1 => "abc".into(),
+            2 => [
+                "inf", "-inf", "NaN", "nan", "1e", "1.2.3", "--1", "+", ".", "1,2,3",
+            ][rng.gen_range(0..10)]
+            .into(),
+            3 => format!("\"{}\"", random_number(rng, decimal_comma)),
+            4 => random_number(rng, decimal_comma) + "x",
+            5 => "\u{b5}1".into(),
+            _ => random_number(rng, decimal_comma),
+        }
+    }
+
+    fn random_pad(rng: &mut ChaCha8Rng) -> &'static str {
+        match rng.gen_range(0..40) {
+            0 => "\x0c",
+            1 => " ",
+            2 => "  ",
+            3 => "\t",
+            4 => " \t",
+            _ => "",
+        }
+    }
+
+    /// A random line: mostly `nc` numbers, sometimes blank, ragged, padded, quoted or wrong.
+    fn random_line(rng: &mut ChaCha8Rng, sep: Separator, nc: usize, dc: bool) -> String {
+        if rng.gen_bool(0.03) {
+            return random_pad(rng).to_string();
+        }
+        let sep_text = |rng: &mut ChaCha8Rng| -> String {
+            match sep {
+                Separator::Comma => ",".into(),
+                Separator::Semicolon => ";".into(),
+                Separator::Tab => "\t".into(),
+                Separator::Whitespace => [" ", "  ", "\t", " \t "][rng.gen_range(0..4)].into(),
+            }
+        };
+        let n = match rng.gen_range(0..30) {
+            0 => nc.saturating_sub(1),
+            1 => nc + 1,
+            _ => nc,
+        };
+        let mut line = String::new();
+        for c in 0..n {
+            if c > 0 {
+                line.push_str(&sep_text(rng));
+            }
+            line.push_str(random_pad(rng));
+            line.push_str(&random_cell(rng, dc));
+            line.push_str(random_pad(rng));
+        }
+        for _ in 0..[0, 0, 0, 1, 2][rng.gen_range(0..5)] {
+            line.push_str(&sep_text(rng));
+            line.push_str(random_pad(rng));
+        }
+        if rng.gen_bool(0.1) {
+            line.push('\r');
+        }
+        line
+    }
+
+    fn ctx_parts(nc: usize) -> Vec<ColumnInfo> {
+        (0..nc)
+            .map(|i| ColumnInfo {
+                name: ["a", "b", "c", "d"][i % 4].to_string(),
+                unit: String::new(),
+                time_scale_s: None,
+            })
+            .collect()
+    }
+
+    /// A block with its values as bits (NaN == NaN), to compare blocks exactly.
+    fn block_bits(b: &Block) -> (usize, Vec<usize>, Vec<Vec<u64>>) {
+        let bits = b
+            .columns
+            .iter()
+            .map(|c| c.iter().map(|v| v.to_bits()).collect())
+            .collect();
+        (b.first_line, b.lines.clone(), bits)
+    }
+
+    /// Every line the fast row parser accepts gives exactly what the general parser gives; the
+    /// lines it refuses go to the general parser (same values, same errors).
+    #[test]
+    fn fast_rows_equal_general_rows() {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let mut n_fast = 0;
+        let mut n_lines = 0;
+        for sep in [
+            Separator::Comma,
+            Separator::Semicolon,
+            Separator::Tab,
+            Separator::Whitespace,
+        ] {
+            let dc = sep != Separator::Comma;
+            for nc in 1..=4 {
+                let columns = ctx_parts(nc);
+                let (mut spans, mut scratch) = (Vec::new(), Vec::new());
+                let mut ctx = RowCtx {
+                    path: "t.csv",
+                    sep,
+                    decimal_comma: dc,
+                    columns: &columns,
+                    reference_line: 1,
+                    spans: &mut spans,
+                    scratch: &mut scratch,
+                };
+                for _ in 0..5000 {
+                    let line = random_line(&mut rng, sep, nc, dc);
+                    let bytes = line.as_bytes();
+                    n_lines += 1;
+                    // Fast path (with fallback), as the readers use it: the line with its
+                    // newline, and (if not empty) without it, as the last line of a file.
+                    let with_nl = format!("{line}\n");
+                    let mut fast = Block::with_capacity(nc, 1);
+                    let mut ln = 6;
+                    let got =
+                        ctx.parse_lines(with_nl.as_bytes(), &mut ln, &mut fast, usize::MAX, true);
+                    assert_eq!(ln, 7);
+                    if !line.is_empty() {
+                        let mut last = Block::with_capacity(nc, 1);
+                        let mut ln = 6;
+                        let got_last = ctx.parse_lines(bytes, &mut ln, &mut last, usize::MAX, true);
+                        assert_eq!(ln, 7);
+                        match (&got, &got_last) {
+                            (Ok(_), Ok(_)) => {
+                                assert_eq!(block_bits(&fast), block_bits(&last), "{line:?}")
+                            }
+                            (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string()),
+                            _ => panic!("{line:?}: {got:?} with newline, {got_last:?} without"),
+                        }
+                    }
+                    // General path alone, on the line without its final '\r'.
+                    let mut general = Block::with_capacity(nc, 1);
+                    let plain = bytes.strip_suffix(b"\r").unwrap_or(bytes);
+                    let want = ctx.parse_row(plain, 7, &mut general);
+                    match (&got, &want) {
+                        (Ok(_), Ok(())) => assert_eq!(
+                            block_bits(&fast),
+                            block_bits(&general),
+                            "{line:?} ({sep:?})"
+                        ),
+                        (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string()),
+                        _ => panic!("{line:?} ({sep:?}): fast {got:?}, general {want:?}"),
+                    }
+                    let mut probe = Block::with_capacity(nc, 1);
+                    if let FastRow::Row(_) = ctx.fast_row(bytes, &mut probe) {
+                        n_fast += 1;
+                    }
+                }
+            }
+        }
+        // Most random lines are plain numbers: the fast path must really be taken.
+        assert!(
+            n_fast * 2 > n_lines,
+            "fast path on {n_fast} of {n_lines} lines"
+        );
+    }
+
+    /// The streaming reader with a tiny buffer (lines cut across buffer refills), the parallel
+    /// reader and the general parser line by line give the same block; with a bad line, the
+    /// same error (same line number).
+    #[test]
+    fn streaming_parallel_and_general_agree() {
+        let mut rng = ChaCha8Rng::seed_from_u64(8);
+        for (sep, head) in [
+            (Separator::Semicolon, "a;b;c"),
+            (Separator::Comma, "a,b,c"),
+            (Separator::Whitespace, "a b c"),
+        ] {
+            let dc = sep != Separator::Comma;
+            let s = match sep {
+                Separator::Comma => ",",
+                Separator::Semicolon => ";",
+                _ => "  ",
+            };
+            let mut text = format!("{head}\n");
+            let mut n = 0;
+            while text.len() < (1 << 20) + 5000 {
+                match rng.gen_range(0..50) {
+                    0 => text.push('\n'),
+                    1 => text.push_str("  \r\n"),
+                    _ => {
+                        let cells: Vec<String> =
+                            (0..3).map(|_| random_number(&mut rng, dc)).collect();
+                        text.push_str(&cells.join(s));
+                        text.push_str(if rng.gen_bool(0.2) { "\r\n" } else { "\n" });
+                        n += 1;
+                    }
+                }
+            }
+            text.push_str(&["1", "2", "3"].join(s)); // last line without newline
+            n += 1;
+            let bad_at = text.len() * 3 / 4;
+            let cut = bad_at + text[bad_at..].find('\n').unwrap_or(0) + 1;
+            let bad = format!("{}1{s}x2{s}3\n{}", &text[..cut], &text[cut..]);
+            for (t, ok) in [(&text, true), (&bad, false)] {
+                let reference: std::result::Result<Block, String> = (|| {
+                    let columns = ctx_parts(3);
+                    let (mut spans, mut scratch) = (Vec::new(), Vec::new());
+                    let mut ctx = RowCtx {
+                        path: "t.csv",
+                        sep,
+                        decimal_comma: dc,
+                        columns: &columns,
+                        reference_line: 1,
+                        spans: &mut spans,
+                        scratch: &mut scratch,
+                    };
+                    let mut b = Block::with_capacity(3, 0);
+                    for (i, l) in t.split('\n').enumerate().skip(1) {
+                        let l = l.strip_suffix('\r').unwrap_or(l);
+                        ctx.parse_row(l.as_bytes(), i + 1, &mut b)
+                            .map_err(|e| e.to_string())?;
+                    }
+                    Ok(b)
+                })();
+                let small = std::io::BufReader::with_capacity(16, t.as_bytes());
+                let streamed: std::result::Result<Block, String> = (|| {
+                    let mut r = DelimitedReader::new(small, "t.csv").map_err(|e| e.to_string())?;
+                    let mut all = Block::with_capacity(3, 0);
+                    while let Some(b) = r.next_block(1000).map_err(|e| e.to_string())? {
+                        assert!(b.n_rows() <= 1000);
+                        for (d, c) in all.columns.iter_mut().zip(b.columns) {
+                            d.extend(c);
+                        }
+                        if all.lines.is_empty() {
+                            all.first_line = b.first_line;
+                        }
+                        all.lines.extend(b.lines);
+                    }
+                    Ok(all)
+                })();
+                let parallel: std::result::Result<Block, String> = (|| {
+                    let mut r =
+                        DelimitedReader::new(t.as_bytes(), "t.csv").map_err(|e| e.to_string())?;
+                    assert_eq!(r.separator(), sep);
+                    Ok(r.read_all_parallel(3)
+                        .map_err(|e| e.to_string())?
+                        .unwrap_or(Block::with_capacity(3, 0)))
+                })();
+                let bits =
+                    |r: &std::result::Result<Block, String>| r.clone().map(|b| block_bits(&b));
+                let summary = |r: &std::result::Result<Block, String>| match r {
+                    Ok(b) => format!("{} rows from line {}", b.n_rows(), b.first_line),
+                    Err(e) => e.clone(),
+                };
+                for (name, got) in [("streamed", &streamed), ("parallel", &parallel)] {
+                    assert!(
+                        bits(got) == bits(&reference),
+                        "{sep:?} {name}: {} but line by line {}",
+                        summary(got),
+                        summary(&reference)
+                    );
+                }
+                if ok {
+                    assert_eq!(reference.as_ref().map(Block::n_rows), Ok(n));
+                } else {
+                    let e = reference.err().unwrap_or_default();
+                    let line = t[..cut].matches('\n').count() + 1;
+                    assert!(
+                        e.contains(&format!("line {line}, column 2")) && e.contains("'x2'"),
+                        "{e}"
+                    );
+                }
+            }
+        }
     }
 }
