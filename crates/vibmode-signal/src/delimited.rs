@@ -16,6 +16,15 @@
 //! - empty cells at the end of a row are ignored (a trailing separator on every row);
 //! - cells may be surrounded by spaces and double quotes;
 //! - header cells `name (unit)` or `name [unit]` give a name and a unit.
+//!
+//! Speed: each line is first tried by a one-pass row parser for plain numeric rows (numbers,
+//! separators, spaces, trailing separators, CRLF); its numbers come from a scanner that reads
+//! eight digits at a time and converts mantissas below 2^53 with powers of ten up to 10^22 by
+//! one exact IEEE operation, i.e. bit for bit what `str::parse::<f64>` gives (longer numbers go
+//! to `str::parse::<f64>`). Any other line (quotes, words, NaN, ragged rows, odd whitespace) is
+//! parsed by the general splitter below, which also produces every error message.
+//! [`DelimitedReader::read_all_parallel`] runs the same line parser on newline-aligned chunks
+//! in several threads.
 
 use crate::error::{Result, SignalError};
 use crate::number::{parse_slow, scan_number, Scan};
