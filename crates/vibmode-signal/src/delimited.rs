@@ -806,15 +806,14 @@ impl RowCtx<'_> {
             return FastRow::Blank(end);
         }
         for c in 0..nc {
-            if c > 0 {
-                if ws {
-                    // skip_pad after the previous number must have moved (checked below).
-                } else if s.get(i) == Some(&sep) {
-                    i = skip_pad(i + 1);
-                } else {
+            // Between cells: the separator and padding (with whitespace separators the padding
+            // after the previous number is the separator, checked below).
+            if c > 0 && !ws {
+                if s.get(i) != Some(&sep) {
                     truncate_rows(block);
                     return FastRow::Fallback;
                 }
+                i = skip_pad(i + 1);
             }
             let (scan, j) = scan_number(s, i, dc);
             let v = match scan {
