@@ -16,8 +16,18 @@
 //! - empty cells at the end of a row are ignored (a trailing separator on every row);
 //! - cells may be surrounded by spaces and double quotes;
 //! - header cells `name (unit)` or `name [unit]` give a name and a unit.
+//!
+//! Speed: each line is first tried by a one-pass row parser for plain numeric rows (numbers,
+//! separators, spaces, trailing separators, CRLF); its numbers come from a scanner that reads
+//! eight digits at a time and converts mantissas below 2^53 with powers of ten up to 10^22 by
+//! one exact IEEE operation, i.e. bit for bit what `str::parse::<f64>` gives (longer numbers go
+//! to `str::parse::<f64>`). Any other line (quotes, words, NaN, ragged rows, odd whitespace) is
+//! parsed by the general splitter below, which also produces every error message.
+//! [`DelimitedReader::read_all_parallel`] runs the same line parser on newline-aligned chunks
+//! in several threads.
 
 use crate::error::{Result, SignalError};
+use crate::number::{parse_slow, scan_number, Scan};
 use serde::{Deserialize, Serialize};
 use std::io::BufRead;
 
@@ -88,7 +98,25 @@ pub struct Block {
     pub lines: Vec<usize>,
 }
 
+/// Drops values pushed for a row that was then not accepted (columns longer than `lines`).
+#[inline]
+fn truncate_rows(block: &mut Block) {
+    let n = block.lines.len();
+    for c in &mut block.columns {
+        c.truncate(n);
+    }
+}
+
 impl Block {
+    /// An empty block of `n_columns` columns with room for `rows` rows.
+    fn with_capacity(n_columns: usize, rows: usize) -> Block {
+        Block {
+            first_line: 0,
+            columns: (0..n_columns).map(|_| Vec::with_capacity(rows)).collect(),
+            lines: Vec::with_capacity(rows),
+        }
+    }
+
     /// Number of rows in the block.
     pub fn n_rows(&self) -> usize {
         self.lines.len()
@@ -451,8 +479,8 @@ impl<R: BufRead> DelimitedReader<R> {
             ctx.parse_row(&line, n, &mut block)?;
         }
         while block.lines.len() < max_rows {
-            // Fast path: parse the complete lines of the reader's buffer in place (for an
-            // in-memory slice that is the whole rest of the file).
+            // Parse the complete lines of the reader's buffer in place (for an in-memory slice
+            // that is the whole rest of the file).
             let avail = self.reader.fill_buf().map_err(|e| SignalError::Io {
                 action: "read",
                 path: ctx.path.to_string(),
@@ -461,20 +489,8 @@ impl<R: BufRead> DelimitedReader<R> {
             if avail.is_empty() {
                 break;
             }
-            let mut consumed = 0;
-            while block.lines.len() < max_rows {
-                let rest = &avail[consumed..];
-                let Some(i) = rest.iter().position(|&b| b == b'\n') else {
-                    break;
-                };
-                let mut line = &rest[..i];
-                if let [head @ .., b'\r'] = line {
-                    line = head;
-                }
-                self.line_no += 1;
-                consumed += i + 1;
-                ctx.parse_row(line, self.line_no, &mut block)?;
-            }
+            let consumed =
+                ctx.parse_lines(avail, &mut self.line_no, &mut block, max_rows, false)?;
             if consumed > 0 {
                 self.reader.consume(consumed);
             } else {
@@ -494,11 +510,11 @@ impl<R: BufRead> DelimitedReader<R> {
                 if self.buf.last() == Some(&b'\n') {
                     self.buf.pop();
                 }
-                if self.buf.last() == Some(&b'\r') {
-                    self.buf.pop();
+                if self.buf.is_empty() {
+                    self.line_no += 1; // a blank line (parse_lines sees no line in "")
+                } else {
+                    ctx.parse_lines(&self.buf, &mut self.line_no, &mut block, max_rows, true)?;
                 }
-                self.line_no += 1;
-                ctx.parse_row(&self.buf, self.line_no, &mut block)?;
             }
         }
         if block.lines.is_empty() {
@@ -534,31 +550,7 @@ impl<'s> DelimitedReader<&'s [u8]> {
         }
         cuts.push(rest.len());
         cuts.dedup();
-        // Line number before each chunk.
-        let mut starts = Vec::with_capacity(cuts.len());
-        let mut line = self.line_no;
-        for w in cuts.windows(2) {
-            starts.push(line);
-            line += rest[w[0]..w[1]].iter().filter(|&&b| b == b'\n').count();
-        }
-        let nc = self.columns.len();
-        let mut first = Block {
-            first_line: 0,
-            columns: vec![Vec::new(); nc],
-            lines: Vec::new(),
-        };
-        if let Some((n, l)) = self.pending.take() {
-            let mut ctx = RowCtx {
-                path: &self.path,
-                sep: self.sep,
-                decimal_comma: self.decimal_comma,
-                columns: &self.columns,
-                reference_line: self.reference_line,
-                spans: &mut self.spans,
-                scratch: &mut self.scratch,
-            };
-            ctx.parse_row(&l, n, &mut first)?;
-        }
+        let chunks: Vec<&[u8]> = cuts.windows(2).map(|w| &rest[w[0]..w[1]]).collect();
         let (path, sep, dc, cols, refl) = (
             self.path.as_str(),
             self.sep,
@@ -566,12 +558,17 @@ impl<'s> DelimitedReader<&'s [u8]> {
             self.columns.as_slice(),
             self.reference_line,
         );
-        let results: Vec<Result<Block>> = std::thread::scope(|sc| {
-            let handles: Vec<_> = cuts
-                .windows(2)
-                .zip(&starts)
-                .map(|(w, &start_line)| {
-                    let chunk = &rest[w[0]..w[1]];
+        let pending = self.pending.take();
+        let line0 = self.line_no;
+        // Chunk 0 (after the pending row, if any) is numbered from the real line; the other
+        // chunks count their lines from 0 and are shifted once the earlier chunks' line counts
+        // are known. Each thread returns its block and the number of lines it went through.
+        let results: Vec<Result<(Block, usize)>> = std::thread::scope(|sc| {
+            let handles: Vec<_> = chunks
+                .iter()
+                .enumerate()
+                .map(|(k, &chunk)| {
+                    let pending = if k == 0 { pending.as_ref() } else { None };
                     sc.spawn(move || {
                         let mut spans = Vec::new();
                         let mut scratch = Vec::new();
@@ -584,21 +581,13 @@ impl<'s> DelimitedReader<&'s [u8]> {
                             spans: &mut spans,
                             scratch: &mut scratch,
                         };
-                        let mut b = Block {
-                            first_line: 0,
-                            columns: vec![Vec::new(); cols.len()],
-                            lines: Vec::new(),
-                        };
-                        let mut ln = start_line;
-                        for l in chunk.split(|&c| c == b'\n') {
-                            let l = match l {
-                                [head @ .., b'\r'] => head,
-                                _ => l,
-                            };
-                            ln += 1;
-                            ctx.parse_row(l, ln, &mut b)?;
+                        let mut b = Block::with_capacity(cols.len(), estimate_rows(chunk) + 1);
+                        if let Some((n, l)) = pending {
+                            ctx.parse_row(l, *n, &mut b)?;
                         }
-                        Ok(b)
+                        let mut ln = if k == 0 { line0 } else { 0 };
+                        ctx.parse_lines(chunk, &mut ln, &mut b, usize::MAX, true)?;
+                        Ok((b, if k == 0 { ln - line0 } else { ln }))
                     })
                 })
                 .collect();
@@ -615,27 +604,106 @@ impl<'s> DelimitedReader<&'s [u8]> {
                 })
                 .collect()
         });
-        self.reader = &rest[rest.len()..];
-        self.line_no = line;
-        for r in results {
-            let b = r?;
-            if first.lines.is_empty() && !b.lines.is_empty() {
-                first.first_line = b.first_line;
-            }
-            for (d, c) in first.columns.iter_mut().zip(b.columns) {
-                if d.is_empty() {
-                    *d = c;
-                } else {
-                    d.extend_from_slice(&c);
+        let mut offset = line0;
+        let mut blocks = Vec::with_capacity(results.len());
+        for (k, r) in results.into_iter().enumerate() {
+            match r {
+                Ok((mut b, n_lines)) => {
+                    if k > 0 {
+                        b.first_line += offset;
+                        for l in &mut b.lines {
+                            *l += offset;
+                        }
+                    }
+                    offset += n_lines;
+                    blocks.push(b);
+                }
+                Err(e) if k == 0 => return Err(e),
+                Err(e) => {
+                    // Parse the chunk again from its real first line, for the exact line number
+                    // in the message (all earlier chunks were read, so `offset` is known).
+                    let mut spans = Vec::new();
+                    let mut scratch = Vec::new();
+                    let mut ctx = RowCtx {
+                        path,
+                        sep,
+                        decimal_comma: dc,
+                        columns: cols,
+                        reference_line: refl,
+                        spans: &mut spans,
+                        scratch: &mut scratch,
+                    };
+                    let mut b = Block::with_capacity(cols.len(), 0);
+                    let mut ln = offset;
+                    ctx.parse_lines(chunks[k], &mut ln, &mut b, usize::MAX, true)?;
+                    return Err(e);
                 }
             }
-            first.lines.extend_from_slice(&b.lines);
         }
-        if first.lines.is_empty() {
+        self.reader = &rest[rest.len()..];
+        self.line_no = offset;
+        let total: usize = blocks.iter().map(Block::n_rows).sum();
+        let mut blocks = blocks.into_iter();
+        let Some(mut all) = blocks.next() else {
+            return Ok(None);
+        };
+        // Growing the first block's vectors in place (realloc of large blocks moves pages, not
+        // bytes), then one copy of the other chunks.
+        for c in &mut all.columns {
+            c.reserve_exact(total - c.len());
+        }
+        all.lines.reserve_exact(total - all.lines.len());
+        for b in blocks {
+            if all.lines.is_empty() {
+                all.first_line = b.first_line;
+            }
+            for (d, c) in all.columns.iter_mut().zip(&b.columns) {
+                d.extend_from_slice(c);
+            }
+            all.lines.extend_from_slice(&b.lines);
+        }
+        if all.lines.is_empty() {
             Ok(None)
         } else {
-            Ok(Some(first))
+            Ok(Some(all))
         }
+    }
+}
+
+/// Rough number of lines in `chunk` (from the newline density of its first 64 KiB), to reserve
+/// the column vectors once instead of growing them by doubling.
+fn estimate_rows(chunk: &[u8]) -> usize {
+    let head = &chunk[..chunk.len().min(1 << 16)];
+    let n = head.iter().filter(|&&b| b == b'\n').count().max(1);
+    let per_line = head.len() / n;
+    let est = chunk.len() / per_line.max(1);
+    est + est / 32 + 16
+}
+
+/// Outcome of [`RowCtx::fast_row`].
+enum FastRow {
+    /// A row of numbers, pushed onto the block's columns (but not yet onto `lines`); the line
+    /// ends at this index (its `\n`, or the end of the slice).
+    Row(usize),
+    /// A line with nothing but spaces, ending at this index.
+    Blank(usize),
+    /// Anything else (quotes, words, wrong cell count, ...): nothing was pushed, the caller
+    /// parses the line with [`RowCtx::parse_row`].
+    Fallback,
+}
+
+/// If a line ends at `s[i]` (`\n`, `\r\n`, a final `\r` or the end of `s`), the index of its
+/// end (the `\n`, or `s.len()`).
+#[inline(always)]
+fn line_end(s: &[u8], i: usize) -> Option<usize> {
+    match s.get(i) {
+        None => Some(s.len()),
+        Some(b'\n') => Some(i),
+        Some(b'\r') => match s.get(i + 1) {
+            None | Some(b'\n') => Some(i + 1),
+            _ => None,
+        },
+        _ => None,
     }
 }
 
@@ -652,6 +720,137 @@ struct RowCtx<'a> {
 }
 
 impl RowCtx<'_> {
+    /// Parses the lines of `buf` into `block` until it holds `max_rows` rows; blank lines are
+    /// skipped. `line_no` is the number of the line before the first line of `buf` and is
+    /// advanced per line. With `complete` false, a last line without `\n` is left alone (the
+    /// rest of it may not be in `buf` yet). Returns the number of bytes consumed.
+    fn parse_lines(
+        &mut self,
+        buf: &[u8],
+        line_no: &mut usize,
+        block: &mut Block,
+        max_rows: usize,
+        complete: bool,
+    ) -> Result<usize> {
+        let mut pos = 0;
+        while pos < buf.len() && block.lines.len() < max_rows {
+            let rest = &buf[pos..];
+            let end = match self.fast_row(rest, block) {
+                FastRow::Row(end) => {
+                    if !complete && end == rest.len() {
+                        truncate_rows(block);
+                        break;
+                    }
+                    *line_no += 1;
+                    if block.lines.is_empty() {
+                        block.first_line = *line_no;
+                    }
+                    block.lines.push(*line_no);
+                    end
+                }
+                FastRow::Blank(end) => {
+                    if !complete && end == rest.len() {
+                        break;
+                    }
+                    *line_no += 1;
+                    end
+                }
+                FastRow::Fallback => {
+                    let end = match rest.iter().position(|&b| b == b'\n') {
+                        Some(i) => i,
+                        None if complete => rest.len(),
+                        None => break,
+                    };
+                    let line = match &rest[..end] {
+                        [head @ .., b'\r'] => head,
+                        l => l,
+                    };
+                    *line_no += 1;
+                    self.parse_row(line, *line_no, block)?;
+                    end
+                }
+            };
+            pos += end + 1;
+        }
+        Ok(pos.min(buf.len()))
+    }
+
+    /// Parses the line at the start of `s` if it is plain: numbers separated by the separator,
+    /// padded with spaces (and tabs unless they separate), trailing empty cells, ended by
+    /// `\n`, `\r\n` or the end of `s`. Gives exactly what [`RowCtx::parse_row`] gives on such a
+    /// line; everything else is [`FastRow::Fallback`] (with nothing pushed).
+    #[inline]
+    fn fast_row(&mut self, s: &[u8], block: &mut Block) -> FastRow {
+        let ws = self.sep == Separator::Whitespace;
+        let sep = match self.sep {
+            Separator::Comma => b',',
+            Separator::Semicolon => b';',
+            Separator::Tab | Separator::Whitespace => b'\t',
+        };
+        // Padding that trimming removes and that does not separate cells.
+        let tab_pads = self.sep != Separator::Tab;
+        let is_pad = |b: u8| b == b' ' || (tab_pads && b == b'\t');
+        let skip_pad = |mut i: usize| {
+            while let Some(&b) = s.get(i) {
+                if !is_pad(b) {
+                    break;
+                }
+                i += 1;
+            }
+            i
+        };
+        let dc = self.decimal_comma;
+        let nc = self.columns.len();
+        let mut i = skip_pad(0);
+        if let Some(end) = line_end(s, i) {
+            return FastRow::Blank(end);
+        }
+        for c in 0..nc {
+            // Between cells: the separator and padding (with whitespace separators the padding
+            // after the previous number is the separator, checked below).
+            if c > 0 && !ws {
+                if s.get(i) != Some(&sep) {
+                    truncate_rows(block);
+                    return FastRow::Fallback;
+                }
+                i = skip_pad(i + 1);
+            }
+            let (scan, j) = scan_number(s, i, dc);
+            let v = match scan {
+                Scan::Fast(v) => v,
+                Scan::Slow => match parse_slow(&s[i..j], dc, self.scratch) {
+                    Some(v) => v,
+                    None => {
+                        truncate_rows(block);
+                        return FastRow::Fallback;
+                    }
+                },
+                Scan::Invalid => {
+                    truncate_rows(block);
+                    return FastRow::Fallback;
+                }
+            };
+            i = skip_pad(j);
+            if ws && i == j && c + 1 < nc {
+                // Two cells must be separated by spaces or tabs.
+                truncate_rows(block);
+                return FastRow::Fallback;
+            }
+            block.columns[c].push(v);
+        }
+        loop {
+            if let Some(end) = line_end(s, i) {
+                return FastRow::Row(end);
+            }
+            if !ws && s.get(i) == Some(&sep) {
+                i = skip_pad(i + 1);
+            } else {
+                truncate_rows(block);
+                return FastRow::Fallback;
+            }
+        }
+    }
+
     /// Parses one line into `block` (blank lines are skipped).
     fn parse_row(&mut self, line: &[u8], line_no: usize, block: &mut Block) -> Result<()> {
         let nc = self.columns.len();
@@ -753,5 +952,312 @@ mod tests {
         assert_eq!(b2.columns, vec![vec![5.0], vec![6.0]]);
         assert_eq!(b2.first_line, 5);
         assert!(r.next_block(2).unwrap().is_none());
+    }
+
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn random_number(rng: &mut ChaCha8Rng, decimal_comma: bool) -> String {
+        let mut t = String::new();
+        match rng.gen_range(0..5) {
+            0 | 1 => t.push('-'),
+            2 if rng.gen_bool(0.2) => t.push('+'),
+            _ => {}
+        }
+        let long = rng.gen_bool(0.1);
+        let int_digits = rng.gen_range(0..if long { 22 } else { 4 });
+        let frac_digits = rng.gen_range(0..if long { 22 } else { 10 });
+        for _ in 0..int_digits {
+            t.push(char::from(b'0' + rng.gen_range(0..10u8)));
+        }
+        if frac_digits > 0 || int_digits == 0 || rng.gen_bool(0.2) {
+            t.push(if decimal_comma && rng.gen_bool(0.5) {
+                ','
+            } else {
+                '.'
+            });
+        }
+        for _ in 0..frac_digits {
+            t.push(char::from(b'0' + rng.gen_range(0..10u8)));
+        }
+        if int_digits + frac_digits == 0 {
+            t.push('5');
+        }
+        if rng.gen_bool(0.15) {
+            t.push_str(["e", "E", "e-", "e+"][rng.gen_range(0..4)]);
+            t.push_str(&rng.gen_range(0..400).to_string());
+        }
+        t
+    }
+
+    fn random_cell(rng: &mut ChaCha8Rng, decimal_comma: bool) -> String {
+        match rng.gen_range(0..40) {
+            0 => String::new(),
+            1 => "abc".into(),
+            2 => [
+                "inf", "-inf", "NaN", "nan", "1e", "1.2.3", "--1", "+", ".", "1,2,3",
+            ][rng.gen_range(0..10)]
+            .into(),
+            3 => format!("\"{}\"", random_number(rng, decimal_comma)),
+            4 => random_number(rng, decimal_comma) + "x",
+            5 => "\u{b5}1".into(),
+            _ => random_number(rng, decimal_comma),
+        }
+    }
+
+    fn random_pad(rng: &mut ChaCha8Rng) -> &'static str {
+        match rng.gen_range(0..40) {
+            0 => "\x0c",
+            1 => " ",
+            2 => "  ",
+            3 => "\t",
+            4 => " \t",
+            _ => "",
+        }
+    }
+
+    /// A random line: mostly `nc` numbers, sometimes blank, ragged, padded, quoted or wrong.
+    fn random_line(rng: &mut ChaCha8Rng, sep: Separator, nc: usize, dc: bool) -> String {
+        if rng.gen_bool(0.03) {
+            return random_pad(rng).to_string();
+        }
+        let sep_text = |rng: &mut ChaCha8Rng| -> String {
+            match sep {
+                Separator::Comma => ",".into(),
+                Separator::Semicolon => ";".into(),
+                Separator::Tab => "\t".into(),
+                Separator::Whitespace => [" ", "  ", "\t", " \t "][rng.gen_range(0..4)].into(),
+            }
+        };
+        let n = match rng.gen_range(0..30) {
+            0 => nc.saturating_sub(1),
+            1 => nc + 1,
+            _ => nc,
+        };
+        let mut line = String::new();
+        for c in 0..n {
+            if c > 0 {
+                line.push_str(&sep_text(rng));
+            }
+            line.push_str(random_pad(rng));
+            line.push_str(&random_cell(rng, dc));
+            line.push_str(random_pad(rng));
+        }
+        for _ in 0..[0, 0, 0, 1, 2][rng.gen_range(0..5)] {
+            line.push_str(&sep_text(rng));
+            line.push_str(random_pad(rng));
+        }
+        if rng.gen_bool(0.1) {
+            line.push('\r');
+        }
+        line
+    }
+
+    fn ctx_parts(nc: usize) -> Vec<ColumnInfo> {
+        (0..nc)
+            .map(|i| ColumnInfo {
+                name: ["a", "b", "c", "d"][i % 4].to_string(),
+                unit: String::new(),
+                time_scale_s: None,
+            })
+            .collect()
+    }
+
+    /// A block with its values as bits (NaN == NaN), to compare blocks exactly.
+    fn block_bits(b: &Block) -> (usize, Vec<usize>, Vec<Vec<u64>>) {
+        let bits = b
+            .columns
+            .iter()
+            .map(|c| c.iter().map(|v| v.to_bits()).collect())
+            .collect();
+        (b.first_line, b.lines.clone(), bits)
+    }
+
+    /// Every line the fast row parser accepts gives exactly what the general parser gives; the
+    /// lines it refuses go to the general parser (same values, same errors).
+    #[test]
+    fn fast_rows_equal_general_rows() {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let mut n_fast = 0;
+        let mut n_lines = 0;
+        for sep in [
+            Separator::Comma,
+            Separator::Semicolon,
+            Separator::Tab,
+            Separator::Whitespace,
+        ] {
+            let dc = sep != Separator::Comma;
+            for nc in 1..=4 {
+                let columns = ctx_parts(nc);
+                let (mut spans, mut scratch) = (Vec::new(), Vec::new());
+                let mut ctx = RowCtx {
+                    path: "t.csv",
+                    sep,
+                    decimal_comma: dc,
+                    columns: &columns,
+                    reference_line: 1,
+                    spans: &mut spans,
+                    scratch: &mut scratch,
+                };
+                for _ in 0..5000 {
+                    let line = random_line(&mut rng, sep, nc, dc);
+                    let bytes = line.as_bytes();
+                    n_lines += 1;
+                    // Fast path (with fallback), as the readers use it: the line with its
+                    // newline, and (if not empty) without it, as the last line of a file.
+                    let with_nl = format!("{line}\n");
+                    let mut fast = Block::with_capacity(nc, 1);
+                    let mut ln = 6;
+                    let got =
+                        ctx.parse_lines(with_nl.as_bytes(), &mut ln, &mut fast, usize::MAX, true);
+                    assert_eq!(ln, 7);
+                    if !line.is_empty() {
+                        let mut last = Block::with_capacity(nc, 1);
+                        let mut ln = 6;
+                        let got_last = ctx.parse_lines(bytes, &mut ln, &mut last, usize::MAX, true);
+                        assert_eq!(ln, 7);
+                        match (&got, &got_last) {
+                            (Ok(_), Ok(_)) => {
+                                assert_eq!(block_bits(&fast), block_bits(&last), "{line:?}")
+                            }
+                            (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string()),
+                            _ => panic!("{line:?}: {got:?} with newline, {got_last:?} without"),
+                        }
+                    }
+                    // General path alone, on the line without its final '\r'.
+                    let mut general = Block::with_capacity(nc, 1);
+                    let plain = bytes.strip_suffix(b"\r").unwrap_or(bytes);
+                    let want = ctx.parse_row(plain, 7, &mut general);
+                    match (&got, &want) {
+                        (Ok(_), Ok(())) => assert_eq!(
+                            block_bits(&fast),
+                            block_bits(&general),
+                            "{line:?} ({sep:?})"
+                        ),
+                        (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string()),
+                        _ => panic!("{line:?} ({sep:?}): fast {got:?}, general {want:?}"),
+                    }
+                    let mut probe = Block::with_capacity(nc, 1);
+                    if let FastRow::Row(_) = ctx.fast_row(bytes, &mut probe) {
+                        n_fast += 1;
+                    }
+                }
+            }
+        }
+        // Most random lines are plain numbers: the fast path must really be taken.
+        assert!(
+            n_fast * 2 > n_lines,
+            "fast path on {n_fast} of {n_lines} lines"
+        );
+    }
+
+    /// The streaming reader with a tiny buffer (lines cut across buffer refills), the parallel
+    /// reader and the general parser line by line give the same block; with a bad line, the
+    /// same error (same line number).
+    #[test]
+    fn streaming_parallel_and_general_agree() {
+        let mut rng = ChaCha8Rng::seed_from_u64(8);
+        for (sep, head) in [
+            (Separator::Semicolon, "a;b;c"),
+            (Separator::Comma, "a,b,c"),
+            (Separator::Whitespace, "a b c"),
+        ] {
+            let dc = sep != Separator::Comma;
+            let s = match sep {
+                Separator::Comma => ",",
+                Separator::Semicolon => ";",
+                _ => "  ",
+            };
+            let mut text = format!("{head}\n");
+            let mut n = 0;
+            while text.len() < (1 << 20) + 5000 {
+                match rng.gen_range(0..50) {
+                    0 => text.push('\n'),
+                    1 => text.push_str("  \r\n"),
+                    _ => {
+                        let cells: Vec<String> =
+                            (0..3).map(|_| random_number(&mut rng, dc)).collect();
+                        text.push_str(&cells.join(s));
+                        text.push_str(if rng.gen_bool(0.2) { "\r\n" } else { "\n" });
+                        n += 1;
+                    }
+                }
+            }
+            text.push_str(&["1", "2", "3"].join(s)); // last line without newline
+            n += 1;
+            let bad_at = text.len() * 3 / 4;
+            let cut = bad_at + text[bad_at..].find('\n').unwrap_or(0) + 1;
+            let bad = format!("{}1{s}x2{s}3\n{}", &text[..cut], &text[cut..]);
+            for (t, ok) in [(&text, true), (&bad, false)] {
+                let reference: std::result::Result<Block, String> = (|| {
+                    let columns = ctx_parts(3);
+                    let (mut spans, mut scratch) = (Vec::new(), Vec::new());
+                    let mut ctx = RowCtx {
+                        path: "t.csv",
+                        sep,
+                        decimal_comma: dc,
+                        columns: &columns,
+                        reference_line: 1,
+                        spans: &mut spans,
+                        scratch: &mut scratch,
+                    };
+                    let mut b = Block::with_capacity(3, 0);
+                    for (i, l) in t.split('\n').enumerate().skip(1) {
+                        let l = l.strip_suffix('\r').unwrap_or(l);
+                        ctx.parse_row(l.as_bytes(), i + 1, &mut b)
+                            .map_err(|e| e.to_string())?;
+                    }
+                    Ok(b)
+                })();
+                let small = std::io::BufReader::with_capacity(16, t.as_bytes());
+                let streamed: std::result::Result<Block, String> = (|| {
+                    let mut r = DelimitedReader::new(small, "t.csv").map_err(|e| e.to_string())?;
+                    let mut all = Block::with_capacity(3, 0);
+                    while let Some(b) = r.next_block(1000).map_err(|e| e.to_string())? {
+                        assert!(b.n_rows() <= 1000);
+                        for (d, c) in all.columns.iter_mut().zip(b.columns) {
+                            d.extend(c);
+                        }
+                        if all.lines.is_empty() {
+                            all.first_line = b.first_line;
+                        }
+                        all.lines.extend(b.lines);
+                    }
+                    Ok(all)
+                })();
+                let parallel: std::result::Result<Block, String> = (|| {
+                    let mut r =
+                        DelimitedReader::new(t.as_bytes(), "t.csv").map_err(|e| e.to_string())?;
+                    assert_eq!(r.separator(), sep);
+                    Ok(r.read_all_parallel(3)
+                        .map_err(|e| e.to_string())?
+                        .unwrap_or(Block::with_capacity(3, 0)))
+                })();
+                let bits =
+                    |r: &std::result::Result<Block, String>| r.clone().map(|b| block_bits(&b));
+                let summary = |r: &std::result::Result<Block, String>| match r {
+                    Ok(b) => format!("{} rows from line {}", b.n_rows(), b.first_line),
+                    Err(e) => e.clone(),
+                };
+                for (name, got) in [("streamed", &streamed), ("parallel", &parallel)] {
+                    assert!(
+                        bits(got) == bits(&reference),
+                        "{sep:?} {name}: {} but line by line {}",
+                        summary(got),
+                        summary(&reference)
+                    );
+                }
+                if ok {
+                    assert_eq!(reference.as_ref().map(Block::n_rows), Ok(n));
+                } else {
+                    let e = reference.err().unwrap_or_default();
+                    let line = t[..cut].matches('\n').count() + 1;
+                    assert!(
+                        e.contains(&format!("line {line}, column 2")) && e.contains("'x2'"),
+                        "{e}"
+                    );
+                }
+            }
+        }
     }
 }

@@ -42,6 +42,7 @@
 
 pub mod delimited;
 pub mod error;
+mod number;
 pub mod read;
 pub mod recording;
 pub mod resample;
