@@ -66,6 +66,18 @@ fn main() {
             .collect();
         y = all.iter().skip(ch).step_by(nch).copied().collect();
     }
+    // DITHER=eps: add white noise of variance eps x mean square (relative floor).
+    if let Some(eps) = std::env::var("DITHER")
+        .ok()
+        .and_then(|s| s.parse::<f64>().ok())
+    {
+        let m = y.iter().sum::<f64>() / y.len() as f64;
+        let ms = y.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / y.len() as f64;
+        let w = simulate_arma(&[1.0], &[1.0], 1.0, y.len(), 7).unwrap();
+        for (v, wi) in y.iter_mut().zip(&w) {
+            *v += (eps * ms).sqrt() * wi;
+        }
+    }
     let mut params = ArmaParams::default();
     if !robust {
         params.robust = Robust::Off;

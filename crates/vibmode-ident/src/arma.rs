@@ -15,6 +15,9 @@ use crate::model::{information_criteria, ArmaModel, Estimator, StopReason};
 use crate::outliers::OutlierCleaning;
 use crate::roots::polynomial_roots;
 use crate::IdentError;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
 
 /// Robustification of the prediction-error criterion.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -82,7 +85,52 @@ pub struct ArmaParams {
     /// Default `OutlierCleaning::RobustFilter` with default [`crate::CleanerParams`].
     #[serde(default)]
     pub outlier_cleaning: OutlierCleaning,
+    /// Numerical noise floor for signals with an empty band (dimensionless, >= 0; 0 = off).
+    /// Default 1e-8 (-80 dB).
+    ///
+    /// After an ideal low-pass (the paper's 25 Hz cutoff at 200 Hz) the band above the cutoff is
+    /// empty to rounding error, the signal is almost perfectly predictable there, and the
+    /// prediction-error criterion has no minimum: C's zeros run to the unit circle, the loss falls
+    /// to 1e-20 of the signal's, fits hit the iteration cap and their poles are meaningless. When
+    /// the signal has such a band (more than 1 % of its periodogram bins below 1e-20 of the
+    /// largest: only rounding error is left there), white noise of variance `noise_floor x` its
+    /// mean square, from a fixed-seed generator (the same bytes every run), is added to the signal
+    /// the search works on. That bounds the prediction gain at 1/noise_floor and gives the
+    /// criterion a well-defined minimum. Signals without an empty band are fitted as they are.
+    /// The reported `noise_variance` and `loss` are those of the signal the search saw.
+    #[serde(default = "default_noise_floor")]
+    pub noise_floor: f64,
 }
+
+fn default_noise_floor() -> f64 {
+    1e-8
+}
+
+/// Whether `y` has a numerically empty band: more than 1 % of its periodogram bins below 1e-20 of
+/// the largest bin (what an ideal DFT low-pass leaves above its cutoff).
+fn has_empty_band(y: &[f64]) -> bool {
+    let n = y.len();
+    if n < 16 {
+        return false;
+    }
+    let mut planner = realfft::RealFftPlanner::<f64>::new();
+    let fft = planner.plan_fft_forward(n);
+    let mut input = y.to_vec();
+    let mut spec = fft.make_output_vec();
+    if fft.process(&mut input, &mut spec).is_err() {
+        return false;
+    }
+    let power: Vec<f64> = spec.iter().map(|z| z.norm_sqr()).collect();
+    let max = power.iter().cloned().fold(0.0, f64::max);
+    if !(max > 0.0 && max.is_finite()) {
+        return false;
+    }
+    let empty = power.iter().filter(|&&p| p < 1e-20 * max).count();
+    empty * 100 > power.len()
+}
+
+/// Seed of the noise-floor generator.
+const FLOOR_SEED: u64 = 0x7669_626d_6f64_65;
 
 impl Default for ArmaParams {
     fn default() -> Self {
@@ -93,6 +141,7 @@ impl Default for ArmaParams {
             max_halvings: 10,
             demean: true,
             outlier_cleaning: OutlierCleaning::default(),
+            noise_floor: default_noise_floor(),
         }
     }
 }
@@ -104,6 +153,13 @@ impl ArmaParams {
                 name: "tol",
                 value: self.tol.to_string(),
                 fix: "use a small positive number such as 1e-5",
+            });
+        }
+        if !(self.noise_floor.is_finite() && (0.0..0.1).contains(&self.noise_floor)) {
+            return Err(IdentError::InvalidParam {
+                name: "noise_floor",
+                value: self.noise_floor.to_string(),
+                fix: "use a small relative variance in [0, 0.1) such as 1e-8, or 0 for none",
             });
         }
         if let Robust::Huber { factor } = self.robust {
@@ -818,8 +874,24 @@ fn fit_impl(
         return Err(IdentError::Constant { value: y[0] });
     }
     let ys: Vec<f64> = centred.iter().map(|v| v / scale).collect();
-
-    let out = search(&ys, p, q, init.map(|m| (&m.a[..], &m.c[..])), params);
+    // The search works on the signal plus the numerical noise floor (ys has unit mean square).
+    let floored: Option<Vec<f64>> = (params.noise_floor > 0.0 && has_empty_band(&ys)).then(|| {
+        let sd = params.noise_floor.sqrt();
+        let mut rng = ChaCha8Rng::seed_from_u64(FLOOR_SEED);
+        ys.iter()
+            .map(|&v| {
+                let w: f64 = StandardNormal.sample(&mut rng);
+                v + sd * w
+            })
+            .collect()
+    });
+    let out = search(
+        floored.as_deref().unwrap_or(&ys),
+        p,
+        q,
+        init.map(|m| (&m.a[..], &m.c[..])),
+        params,
+    );
     let SearchOut {
         a,
         c,
@@ -830,6 +902,7 @@ fn fit_impl(
         stop,
         converged,
     } = out;
+    let ys = floored.unwrap_or(ys);
     let k = p + q;
     let n_eff = n - p;
     let mut search = Search::new(&ys, p, q, rho);
