@@ -130,7 +130,7 @@ fn has_empty_band(y: &[f64]) -> bool {
 }
 
 /// Seed of the noise-floor generator.
-const FLOOR_SEED: u64 = 0x7669_626d_6f64_65;
+const FLOOR_SEED: u64 = 0x0076_6962_6d6f_6465;
 
 impl Default for ArmaParams {
     fn default() -> Self {
