@@ -105,6 +105,11 @@ pub struct ClusterConfig {
     pub max_damping_ratio: f64,
     /// Lowest frequency considered, Hz (default 0.3).
     pub freq_min_hz: f64,
+    /// Highest frequency considered, Hz. Default (None): the cutoff, or 0.8 x the cutoff when the
+    /// analysis rate leaves an empty band above it (cutoff below 0.95 x the analysis Nyquist, as
+    /// in the paper's 25 Hz at 200 Hz): every model then spends lightly damped poles of its own on
+    /// the ideal filter's edge, 20-25 Hz, which are no vehicle modes.
+    pub freq_max_hz: Option<f64>,
     /// Largest relative frequency spread (std / mean) of a periodic disturbance (default 0.02:
     /// engine lines drift slowly with engine speed).
     pub disturbance_freq_spread_max: f64,
@@ -125,6 +130,7 @@ impl Default for ClusterConfig {
             disturbance_damping_max: 0.005,
             max_damping_ratio: 0.6,
             freq_min_hz: 0.3,
+            freq_max_hz: None,
             disturbance_freq_spread_max: 0.02,
             pole_zero_tol: 1.0,
         }
@@ -262,6 +268,15 @@ impl AnalysisConfig {
                 self.record_length_s.to_string(),
                 "must be positive",
             );
+        }
+        if let Some(f) = self.cluster.freq_max_hz {
+            if !(f.is_finite() && f > self.cluster.freq_min_hz) {
+                return bad(
+                    "cluster.freq_max_hz",
+                    f.to_string(),
+                    "must be above cluster.freq_min_hz (or left out for the default)",
+                );
+            }
         }
         if !(self.analysis_fs_hz.is_finite() && self.analysis_fs_hz > 0.0) {
             return bad(

@@ -197,7 +197,19 @@ struct TaskOut {
     fits: Vec<FitSummary>,
 }
 
-fn cluster_params(cfg: &AnalysisConfig) -> ClusterParams {
+/// Highest pole frequency clustered, Hz (see `ClusterConfig::freq_max_hz`), at analysis rate `fs`.
+fn freq_max_hz(cfg: &AnalysisConfig, fs: f64) -> f64 {
+    let cutoff = cfg.cutoff_hz.min(fs / 2.0);
+    cfg.cluster
+        .freq_max_hz
+        .unwrap_or(if cutoff < 0.95 * fs / 2.0 {
+            0.8 * cutoff
+        } else {
+            cutoff
+        })
+}
+
+fn cluster_params(cfg: &AnalysisConfig, fs: f64) -> ClusterParams {
     ClusterParams {
         freq_tol_rel: cfg.cluster.freq_tol_rel,
         freq_tol_per_damping: cfg.cluster.freq_tol_per_damping,
@@ -207,7 +219,7 @@ fn cluster_params(cfg: &AnalysisConfig) -> ClusterParams {
         disturbance_damping_max: cfg.cluster.disturbance_damping_max,
         max_damping_ratio: cfg.cluster.max_damping_ratio,
         freq_min_hz: cfg.cluster.freq_min_hz,
-        freq_max_hz: cfg.cutoff_hz,
+        freq_max_hz: freq_max_hz(cfg, fs),
         disturbance_freq_spread_max: cfg.cluster.disturbance_freq_spread_max,
         ..ClusterParams::default()
     }
@@ -360,7 +372,7 @@ pub fn analyze(
         let fits: Vec<FitSummary> = mine.iter().flat_map(|o| o.fits.iter().copied()).collect();
         let obs = to_observations(&poles, name, cfg.role_of(name), &active);
         let invariant =
-            vibmode_modal::find_invariant_modes(&obs, n_active, &orders, &cluster_params(cfg))?;
+            vibmode_modal::find_invariant_modes(&obs, n_active, &orders, &cluster_params(cfg, fs))?;
         channels.push(ChannelAnalysis {
             name: name.clone(),
             unit: first.recording.channels[c].unit.clone(),
@@ -389,7 +401,7 @@ pub fn analyze(
             obs.extend(to_observations(&ch.poles, &ch.name, role, &active));
         }
         let invariant =
-            vibmode_modal::find_invariant_modes(&obs, n_active, &orders, &cluster_params(cfg))?;
+            vibmode_modal::find_invariant_modes(&obs, n_active, &orders, &cluster_params(cfg, fs))?;
         let matches = if reference.is_empty() {
             Vec::new()
         } else {
