@@ -213,3 +213,16 @@ fn fullcar_and_simulate() {
     assert_eq!(a, b, "same seed, same bytes");
     assert!(d.path().join("a/truth.json").exists());
 }
+
+#[test]
+fn a_cause_already_in_the_message_is_not_repeated() {
+    let o = vibmode(&["simulate", "no_such_bus.toml", "--output", "x"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("no_such_bus.toml"), "{err}");
+    assert_eq!(
+        err.matches("os error 2").count(),
+        1,
+        "repeated cause: {err}"
+    );
+}
