@@ -177,13 +177,14 @@ impl ArmaParams {
 
 /// Largest N p (p + q) for which the AR columns of the Jacobian are filtered exactly
 /// (O(N p (p + q)) per iteration); beyond it delayed copies of y/C are used.
-const EXACT_JACOBIAN_BUDGET: f64 = 2.0e7;
+const EXACT_JACOBIAN_BUDGET: f64 = 1.0e8;
 
 /// Largest p + q searched from every starting candidate (multi-start).
 const MULTISTART_MAX_ORDER: usize = 16;
 
 /// Trial steps per iteration whose C leaves the unit circle and is reflected back (root finding);
-/// further such trials are halved instead.
+/// further such trials are halved instead (the line search is repeated reflecting every trial
+/// only when that finds no lower loss).
 const MAX_REFLECTIONS: usize = 3;
 
 /// Iterations over which the stall rule measures progress.
@@ -726,28 +727,37 @@ fn gauss_newton(
             d0
         };
         let mut accepted = None;
-        let mut reflected = 0usize;
-        let mut s = 1.0;
-        for hv in 0..=params.max_halvings {
-            let (na, mut nc) = apply(&a, &c, &dir, s);
-            // C must stay minimum phase: the first MAX_REFLECTIONS trials of an iteration that
-            // leave the unit circle are reflected back (roots z -> 1/conj z, the same |C| on the
-            // unit circle); later ones are just halved (root finding costs more than a trial).
-            if !is_min_phase(&nc) {
-                if reflected >= MAX_REFLECTIONS {
-                    s *= 0.5;
-                    continue;
+        let mut pred_gradient = f64::INFINITY;
+        // C must stay minimum phase: the first MAX_REFLECTIONS trials of an iteration that leave
+        // the unit circle are reflected back (roots z -> 1/conj z, the same |C| on the unit
+        // circle); later ones are just halved (root finding costs more than a trial). Only if that
+        // finds no lower loss is the line search repeated reflecting every trial.
+        for cap in [MAX_REFLECTIONS, usize::MAX] {
+            let mut reflected = 0usize;
+            let mut capped = false;
+            let mut s = 1.0;
+            for hv in 0..=params.max_halvings {
+                let (na, mut nc) = apply(&a, &c, &dir, s);
+                if !is_min_phase(&nc) {
+                    if reflected >= cap {
+                        capped = true;
+                        s *= 0.5;
+                        continue;
+                    }
+                    reflected += 1;
+                    stabilise(&mut nc);
                 }
-                reflected += 1;
-                stabilise(&mut nc);
+                predict_errors(ys, &na, &nc, &mut trial_eps);
+                let vt = mean_loss(&trial_eps[p..], rho);
+                if vt.is_finite() && vt < v {
+                    accepted = Some((na, nc, vt, hv));
+                    break;
+                }
+                s *= 0.5;
             }
-            predict_errors(ys, &na, &nc, &mut trial_eps);
-            let vt = mean_loss(&trial_eps[p..], rho);
-            if vt.is_finite() && vt < v {
-                accepted = Some((na, nc, vt, hv));
+            if accepted.is_some() || !capped {
                 break;
             }
-            s *= 0.5;
         }
         if accepted.is_none() {
             // Gradient fallback: Jacobi-scaled steepest descent with the exact line minimiser of
@@ -771,15 +781,15 @@ fn gauss_newton(
                 }
                 hdd += dg[i] * row;
             }
+            // First-order predicted decrease along the scaled gradient (not inflated by an
+            // ill-conditioned H, unlike the Newton decrement).
+            if hdd > 0.0 {
+                pred_gradient = gd * gd / hdd / n_eff as f64;
+            }
             let mut s = if hdd > 0.0 { gd / hdd } else { 1.0 };
             for hv in 0..=params.max_halvings {
                 let (na, mut nc) = apply(&a, &c, &dg, s);
                 if !is_min_phase(&nc) {
-                    if reflected >= MAX_REFLECTIONS {
-                        s *= 0.5;
-                        continue;
-                    }
-                    reflected += 1;
                     stabilise(&mut nc);
                 }
                 predict_errors(ys, &na, &nc, &mut trial_eps);
@@ -812,8 +822,19 @@ fn gauss_newton(
                 };
             }
             None => {
+                // No step lowers V. Converged when either model predicts only a negligible gain
+                // (the numerical floor of the criterion), or when C has a zero on the unit circle
+                // (within 1e-6): the minimum then lies on the boundary of the minimum-phase set,
+                // where every descent direction leaves it (a constrained optimum).
                 stop = StopReason::NoImprovement;
-                converged = pred <= 100.0 * params.tol * v;
+                let on_boundary = || {
+                    polynomial_roots(&c)
+                        .map(|r| r.iter().any(|z| z.norm() > 1.0 - 1e-6))
+                        .unwrap_or(false)
+                };
+                converged = pred <= 100.0 * params.tol * v
+                    || pred_gradient <= params.tol * v
+                    || on_boundary();
                 break;
             }
         }

@@ -255,23 +255,19 @@ fn hard_setting_empty_band_sweep_stays_sound() {
                 "{label} ARMA({o}) loss {}",
                 m.loss
             );
+            // Every fit ends by its own stopping rule, within the default 100 iterations.
             assert!(
-                // Sound = finite and never exploding; at this conditioning the search may also end
-                // on the numerical floor (NoImprovement) or the iteration cap.
-                m.converged
-                    || m.stop_reason == vibmode_ident::StopReason::MaxIterations
-                    || m.stop_reason == vibmode_ident::StopReason::NoImprovement,
-                "{label} ARMA({o}) {:?}",
-                m.stop_reason
+                m.converged && m.stop_reason != vibmode_ident::StopReason::MaxIterations,
+                "{label} ARMA({o}) {:?} after {} iterations",
+                m.stop_reason,
+                m.iterations
             );
             assert!(m.a.iter().chain(&m.c).all(|v| v.is_finite()));
             if label == "quadratic" {
-                // The warm start keeps the quadratic loss (nearly) non-increasing with the order:
-                // within 10 % of the best lower order. Not exactly: the conditional predictor
-                // restarts at t = p, and with C's zeros near the unit circle (the empty band) the
-                // restart transient costs up to ~6 % (measured ARMA(30) -> ARMA(40)).
-                assert!(m.loss <= prev_loss * 1.10, "ARMA({o}) loss went up");
-                prev_loss = prev_loss.min(m.loss);
+                // The warm start makes the quadratic loss decrease with the order (within 0.1 %:
+                // the criterion's sum starts at t = p, so its range shrinks with p).
+                assert!(m.loss <= prev_loss * 1.001, "ARMA({o}) loss went up");
+                prev_loss = m.loss;
             }
             println!(
                 "   modes < 25 Hz: {:?}",
