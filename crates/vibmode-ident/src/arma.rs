@@ -183,8 +183,7 @@ const EXACT_JACOBIAN_BUDGET: f64 = 1.0e8;
 const MULTISTART_MAX_ORDER: usize = 16;
 
 /// Trial steps per iteration whose C leaves the unit circle and is reflected back (root finding);
-/// further such trials are halved instead (the line search is repeated reflecting every trial
-/// only when that finds no lower loss).
+/// further such trials are halved instead.
 const MAX_REFLECTIONS: usize = 3;
 
 /// Iterations over which the stall rule measures progress.
@@ -730,34 +729,26 @@ fn gauss_newton(
         let mut pred_gradient = f64::INFINITY;
         // C must stay minimum phase: the first MAX_REFLECTIONS trials of an iteration that leave
         // the unit circle are reflected back (roots z -> 1/conj z, the same |C| on the unit
-        // circle); later ones are just halved (root finding costs more than a trial). Only if that
-        // finds no lower loss is the line search repeated reflecting every trial.
-        for cap in [MAX_REFLECTIONS, usize::MAX] {
-            let mut reflected = 0usize;
-            let mut capped = false;
-            let mut s = 1.0;
-            for hv in 0..=params.max_halvings {
-                let (na, mut nc) = apply(&a, &c, &dir, s);
-                if !is_min_phase(&nc) {
-                    if reflected >= cap {
-                        capped = true;
-                        s *= 0.5;
-                        continue;
-                    }
-                    reflected += 1;
-                    stabilise(&mut nc);
+        // circle); later ones are just halved (root finding costs more than a trial).
+        let mut reflected = 0usize;
+        let mut s = 1.0;
+        for hv in 0..=params.max_halvings {
+            let (na, mut nc) = apply(&a, &c, &dir, s);
+            if !is_min_phase(&nc) {
+                if reflected >= MAX_REFLECTIONS {
+                    s *= 0.5;
+                    continue;
                 }
-                predict_errors(ys, &na, &nc, &mut trial_eps);
-                let vt = mean_loss(&trial_eps[p..], rho);
-                if vt.is_finite() && vt < v {
-                    accepted = Some((na, nc, vt, hv));
-                    break;
-                }
-                s *= 0.5;
+                reflected += 1;
+                stabilise(&mut nc);
             }
-            if accepted.is_some() || !capped {
+            predict_errors(ys, &na, &nc, &mut trial_eps);
+            let vt = mean_loss(&trial_eps[p..], rho);
+            if vt.is_finite() && vt < v {
+                accepted = Some((na, nc, vt, hv));
                 break;
             }
+            s *= 0.5;
         }
         if accepted.is_none() {
             // Gradient fallback: Jacobi-scaled steepest descent with the exact line minimiser of
@@ -790,6 +781,11 @@ fn gauss_newton(
             for hv in 0..=params.max_halvings {
                 let (na, mut nc) = apply(&a, &c, &dg, s);
                 if !is_min_phase(&nc) {
+                    if reflected >= MAX_REFLECTIONS {
+                        s *= 0.5;
+                        continue;
+                    }
+                    reflected += 1;
                     stabilise(&mut nc);
                 }
                 predict_errors(ys, &na, &nc, &mut trial_eps);
