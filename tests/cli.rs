@@ -226,3 +226,27 @@ fn a_cause_already_in_the_message_is_not_repeated() {
         "repeated cause: {err}"
     );
 }
+
+#[test]
+fn unknown_channel_suggests_the_one_it_prefixes() {
+    let d = tempfile::tempdir().unwrap();
+    let f = d.path().join("phone.csv");
+    let mut text = String::from("Time (s),X-Axis (m/s2),Z-Axis (m/s2)\n");
+    for i in 0..400 {
+        let t = i as f64 / 100.0;
+        text.push_str(&format!("{t},{},{}\n", (t * 7.0).sin(), (t * 3.0).cos()));
+    }
+    std::fs::write(&f, text).unwrap();
+    let p = f.to_str().unwrap();
+    fails_with(
+        &["psd", p, "--channel", "z"],
+        &["no channel named 'z'", "did you mean 'Z-Axis'?"],
+    );
+    // Ambiguous or no prefix: the list only.
+    let o = vibmode(&["psd", p, "--channel", "Q"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("X-Axis") && !err.contains("did you mean"),
+        "{err}"
+    );
+}

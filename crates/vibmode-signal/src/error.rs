@@ -127,12 +127,15 @@ pub enum SignalError {
         path: String,
     },
     /// A channel name not present in the recording.
-    #[error("no channel named '{name}'; available: {available}")]
+    #[error("no channel named '{name}'; available: {available}{hint}")]
     UnknownChannel {
         /// The requested name.
         name: String,
         /// Comma-separated list of the available names.
         available: String,
+        /// `"; did you mean 'X'?"` when exactly one name starts with the requested one (ignoring
+        /// case), else empty.
+        hint: String,
     },
     /// A channel index out of range.
     #[error(

@@ -147,6 +147,21 @@ impl Recording {
         self.channels.iter().map(|c| c.name.as_str()).collect()
     }
 
+    /// `"; did you mean 'X'?"` when exactly one channel name starts with `name` (ignoring case).
+    fn prefix_hint(&self, name: &str) -> String {
+        let lower = name.to_lowercase();
+        let hits: Vec<&str> = self
+            .channels
+            .iter()
+            .map(|c| c.name.as_str())
+            .filter(|c| !lower.is_empty() && c.to_lowercase().starts_with(&lower))
+            .collect();
+        match hits.as_slice() {
+            [one] => format!("; did you mean '{one}'?"),
+            _ => String::new(),
+        }
+    }
+
     /// Finds a channel by name (exact match first, then unambiguous case-insensitive match).
     pub fn channel(&self, name: &str) -> Option<&Channel> {
         self.position(name).map(|i| &self.channels[i])
@@ -203,6 +218,7 @@ impl Recording {
                         .ok_or_else(|| SignalError::UnknownChannel {
                             name: n.clone(),
                             available: self.names().join(", "),
+                            hint: self.prefix_hint(n),
                         })?
                 }
             };
