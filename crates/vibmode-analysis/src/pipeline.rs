@@ -128,7 +128,7 @@ pub struct ChannelAnalysis {
     pub role: Role,
     /// Welch frequencies, Hz.
     pub welch_freq_hz: Vec<f64>,
-    /// Welch PSD averaged over the records, (unit)^2/Hz.
+    /// Welch PSD averaged over the records used for the modes (stops left out), (unit)^2/Hz.
     pub welch_psd: Vec<f64>,
     /// Periodogram frequencies of the first record, Hz.
     pub periodogram_freq_hz: Vec<f64>,
@@ -358,10 +358,12 @@ pub fn analyze(
             .first()
             .map(|o| o.welch_freq.clone())
             .unwrap_or_default();
+        // Averaged over the records used for the modes (stops left out).
+        let used: Vec<&&TaskOut> = mine.iter().filter(|o| !stationary[o.record]).collect();
         let mut welch_mean = vec![0.0; welch_freq.len()];
-        for o in &mine {
+        for o in &used {
             for (m, v) in welch_mean.iter_mut().zip(&o.welch) {
-                *m += v / mine.len() as f64;
+                *m += v / used.len() as f64;
             }
         }
         let first_out = mine.iter().find(|o| o.record == 0);
