@@ -630,7 +630,7 @@ pub struct DemoArgs {
 
 /// Runs `vibmode demo`: simulate the shipped city bus and analyse it.
 pub fn run_demo(a: &DemoArgs) -> Result<()> {
-    use crate::cmd_vehicle::{to_recording, write_simulation, RecordFormat};
+    use crate::cmd_vehicle::{write_simulation, RecordFormat};
     if a.records == 0 {
         bail!("--records 0: give at least one record");
     }
@@ -652,7 +652,7 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
         .enumerate()
         .map(|(i, r)| RecordInput {
             name: format!("record {:02} ({:.1} km/h)", i + 1, r.mean_speed_kmh),
-            recording: to_recording(r),
+            recording: r.to_recording(),
         })
         .collect();
     let reference = reference_modes(&sim.truth.modes);

@@ -5,7 +5,6 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
-use vibmode_signal::{Channel, Recording};
 use vibmode_vehicle::{FullCar, ModeInfo, RoadClass, SimParams, Simulation, VehicleParams};
 
 /// Arguments of `vibmode fullcar`.
@@ -135,24 +134,6 @@ pub fn sim_params(
     Ok(p)
 }
 
-/// Converts a simulated record to a [`Recording`] in m/s^2.
-pub fn to_recording(r: &vibmode_vehicle::SimRecord) -> Recording {
-    Recording {
-        fs_hz: r.fs_hz,
-        channels: r
-            .channel_names
-            .iter()
-            .zip(&r.samples)
-            .map(|(n, s)| Channel {
-                name: n.clone(),
-                unit: "m/s^2".into(),
-                samples: s.clone(),
-            })
-            .collect(),
-        time_axis: None,
-    }
-}
-
 /// Writes the records and truth.json of a simulation into `dir`.
 pub fn write_simulation(
     dir: &Path,
@@ -169,7 +150,7 @@ pub fn write_simulation(
     let mut paths = Vec::new();
     for (i, r) in sim.records.iter().enumerate() {
         let path = dir.join(format!("record_{:02}.{ext}", i + 1));
-        vibmode_signal::write_path(&path, &to_recording(r))
+        vibmode_signal::write_path(&path, &r.to_recording())
             .with_context(|| format!("writing {}", path.display()))?;
         paths.push(path);
     }

@@ -4,7 +4,6 @@
 
 use vibmode_analysis::{analyze, AnalysisConfig, RecordInput, Role};
 use vibmode_modal::{ModeClass, ReferenceMode};
-use vibmode_signal::{Channel, Recording};
 use vibmode_vehicle::{simulate, ModeLabel, SimParams, VehicleParams};
 
 #[test]
@@ -17,20 +16,7 @@ fn demo_data_gives_the_true_modes_and_lines() {
         .enumerate()
         .map(|(i, r)| RecordInput {
             name: format!("record {i}"),
-            recording: Recording {
-                fs_hz: r.fs_hz,
-                channels: r
-                    .channel_names
-                    .iter()
-                    .zip(&r.samples)
-                    .map(|(n, s)| Channel {
-                        name: n.clone(),
-                        unit: "m/s^2".into(),
-                        samples: s.clone(),
-                    })
-                    .collect(),
-                time_axis: None,
-            },
+            recording: r.to_recording(),
         })
         .collect();
     let reference: Vec<ReferenceMode> = sim

@@ -390,6 +390,27 @@ pub struct SimRecord {
     pub samples: Vec<Vec<f64>>,
 }
 
+impl SimRecord {
+    /// The record as a [`vibmode_signal::Recording`] (channels named after the sensors, unit
+    /// m/s^2, no time column), ready for the analysis or for writing.
+    pub fn to_recording(&self) -> vibmode_signal::Recording {
+        vibmode_signal::Recording {
+            fs_hz: self.fs_hz,
+            channels: self
+                .channel_names
+                .iter()
+                .zip(&self.samples)
+                .map(|(name, samples)| vibmode_signal::Channel {
+                    name: name.clone(),
+                    unit: "m/s^2".into(),
+                    samples: samples.clone(),
+                })
+                .collect(),
+            time_axis: None,
+        }
+    }
+}
+
 /// Ground truth of a simulation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Truth {

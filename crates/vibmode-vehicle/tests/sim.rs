@@ -495,3 +495,29 @@ fn sim_params_deserialise_with_defaults_and_reject_unknown_keys() {
         serde_json::from_str(&serde_json::to_string(&SimParams::in_service()).unwrap()).unwrap();
     assert_eq!(back, SimParams::in_service());
 }
+
+#[test]
+fn a_simulated_record_becomes_a_recording_sample_for_sample() {
+    let sp = SimParams {
+        fs_hz: 200.0,
+        duration_s: 2.0,
+        records: 1,
+        ..SimParams::default()
+    };
+    let sim = simulate(&VehicleParams::city_bus(), &sp).unwrap();
+    let rec = &sim.records[0];
+    let r = rec.to_recording();
+    assert_eq!(r.fs_hz, 200.0);
+    assert_eq!(
+        r.names(),
+        rec.channel_names
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>()
+    );
+    for (ch, s) in r.channels.iter().zip(&rec.samples) {
+        assert_eq!(ch.unit, "m/s^2");
+        assert_eq!(&ch.samples, s);
+        assert_eq!(ch.samples.len(), 400);
+    }
+}
