@@ -101,6 +101,7 @@ pub struct ChannelFit {
     bic: f64,
     fpe: f64,
     std_errors: Vec<f64>,
+    outliers_replaced: usize,
     modes: Vec<ModeOut>,
     real_poles: Vec<f64>,
     unstable_poles: Vec<[f64; 2]>,
@@ -178,6 +179,7 @@ pub fn channel_fit(
         bic: m.bic,
         fpe: m.fpe,
         std_errors: m.std_errors.clone(),
+        outliers_replaced: m.outliers_replaced,
         modes: ms
             .modes
             .iter()

@@ -112,6 +112,8 @@ fn fit_finds_the_tone_and_resample_writes_a_readable_file() {
             .any(|m| (m["frequency_hz"].as_f64().unwrap() - 12.0).abs() < 0.05),
         "{modes:?}"
     );
+    // A clean tone in noise: the spike cleaner replaces nothing.
+    assert_eq!(v["channels"][0]["outliers_replaced"].as_u64(), Some(0));
     let out = d.path().join("r.csv");
     let o = vibmode(&[
         "resample",
