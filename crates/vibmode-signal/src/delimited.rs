@@ -562,33 +562,40 @@ impl<'s> DelimitedReader<&'s [u8]> {
         let line0 = self.line_no;
         // Chunk 0 (after the pending row, if any) is numbered from the real line; the other
         // chunks count their lines from 0 and are shifted once the earlier chunks' line counts
-        // are known. Each thread returns its block and the number of lines it went through.
+        // are known. `parse_chunk` parses one chunk whose first line is `first_line` (after the
+        // pending row, if any) and returns its block and the number of lines it went through.
+        let parse_chunk = |chunk: &[u8],
+                           first_line: usize,
+                           pending: Option<&(usize, Vec<u8>)>|
+         -> Result<(Block, usize)> {
+            let mut spans = Vec::new();
+            let mut scratch = Vec::new();
+            let mut ctx = RowCtx {
+                path,
+                sep,
+                decimal_comma: dc,
+                columns: cols,
+                reference_line: refl,
+                spans: &mut spans,
+                scratch: &mut scratch,
+            };
+            let mut b = Block::with_capacity(cols.len(), estimate_rows(chunk) + 1);
+            if let Some((n, l)) = pending {
+                ctx.parse_row(l, *n, &mut b)?;
+            }
+            let mut ln = first_line;
+            ctx.parse_lines(chunk, &mut ln, &mut b, usize::MAX, true)?;
+            Ok((b, ln - first_line))
+        };
+        let parse_chunk = &parse_chunk;
         let results: Vec<Result<(Block, usize)>> = std::thread::scope(|sc| {
             let handles: Vec<_> = chunks
                 .iter()
                 .enumerate()
                 .map(|(k, &chunk)| {
                     let pending = if k == 0 { pending.as_ref() } else { None };
-                    sc.spawn(move || {
-                        let mut spans = Vec::new();
-                        let mut scratch = Vec::new();
-                        let mut ctx = RowCtx {
-                            path,
-                            sep,
-                            decimal_comma: dc,
-                            columns: cols,
-                            reference_line: refl,
-                            spans: &mut spans,
-                            scratch: &mut scratch,
-                        };
-                        let mut b = Block::with_capacity(cols.len(), estimate_rows(chunk) + 1);
-                        if let Some((n, l)) = pending {
-                            ctx.parse_row(l, *n, &mut b)?;
-                        }
-                        let mut ln = if k == 0 { line0 } else { 0 };
-                        ctx.parse_lines(chunk, &mut ln, &mut b, usize::MAX, true)?;
-                        Ok((b, if k == 0 { ln - line0 } else { ln }))
-                    })
+                    let first_line = if k == 0 { line0 } else { 0 };
+                    sc.spawn(move || parse_chunk(chunk, first_line, pending))
                 })
                 .collect();
             handles
@@ -622,20 +629,7 @@ impl<'s> DelimitedReader<&'s [u8]> {
                 Err(e) => {
                     // Parse the chunk again from its real first line, for the exact line number
                     // in the message (all earlier chunks were read, so `offset` is known).
-                    let mut spans = Vec::new();
-                    let mut scratch = Vec::new();
-                    let mut ctx = RowCtx {
-                        path,
-                        sep,
-                        decimal_comma: dc,
-                        columns: cols,
-                        reference_line: refl,
-                        spans: &mut spans,
-                        scratch: &mut scratch,
-                    };
-                    let mut b = Block::with_capacity(cols.len(), 0);
-                    let mut ln = offset;
-                    ctx.parse_lines(chunks[k], &mut ln, &mut b, usize::MAX, true)?;
+                    parse_chunk(chunks[k], offset, None)?;
                     return Err(e);
                 }
             }
