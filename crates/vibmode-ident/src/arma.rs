@@ -725,31 +725,34 @@ fn gauss_newton(
         } else {
             d0
         };
-        let mut accepted = None;
-        let mut pred_gradient = f64::INFINITY;
-        // C must stay minimum phase: the first MAX_REFLECTIONS trials of an iteration that leave
-        // the unit circle are reflected back (roots z -> 1/conj z, the same |C| on the unit
-        // circle); later ones are just halved (root finding costs more than a trial).
+        // Trials theta + s d for s = s0, s0/2, ... (`max_halvings` halvings); the first with a
+        // lower finite V is returned with its halving count. C must stay minimum phase: the
+        // first MAX_REFLECTIONS trials of an iteration that leave the unit circle are reflected
+        // back (roots z -> 1/conj z, the same |C| on the unit circle); later ones are just halved
+        // (root finding costs more than a trial).
         let mut reflected = 0usize;
-        let mut s = 1.0;
-        for hv in 0..=params.max_halvings {
-            let (na, mut nc) = apply(&a, &c, &dir, s);
-            if !is_min_phase(&nc) {
-                if reflected >= MAX_REFLECTIONS {
-                    s *= 0.5;
-                    continue;
+        let mut line_search = |d: &[f64], s0: f64, trial: &mut [f64]| {
+            let mut s = s0;
+            for hv in 0..=params.max_halvings {
+                let (na, mut nc) = apply(&a, &c, d, s);
+                s *= 0.5;
+                if !is_min_phase(&nc) {
+                    if reflected >= MAX_REFLECTIONS {
+                        continue;
+                    }
+                    reflected += 1;
+                    stabilise(&mut nc);
                 }
-                reflected += 1;
-                stabilise(&mut nc);
+                predict_errors(ys, &na, &nc, trial);
+                let vt = mean_loss(&trial[p..], rho);
+                if vt.is_finite() && vt < v {
+                    return Some((na, nc, vt, hv));
+                }
             }
-            predict_errors(ys, &na, &nc, &mut trial_eps);
-            let vt = mean_loss(&trial_eps[p..], rho);
-            if vt.is_finite() && vt < v {
-                accepted = Some((na, nc, vt, hv));
-                break;
-            }
-            s *= 0.5;
-        }
+            None
+        };
+        let mut pred_gradient = f64::INFINITY;
+        let mut accepted = line_search(&dir, 1.0, &mut trial_eps);
         if accepted.is_none() {
             // Gradient fallback: Jacobi-scaled steepest descent with the exact line minimiser of
             // the quadratic model as first step.
@@ -777,25 +780,9 @@ fn gauss_newton(
             if hdd > 0.0 {
                 pred_gradient = gd * gd / hdd / n_eff as f64;
             }
-            let mut s = if hdd > 0.0 { gd / hdd } else { 1.0 };
-            for hv in 0..=params.max_halvings {
-                let (na, mut nc) = apply(&a, &c, &dg, s);
-                if !is_min_phase(&nc) {
-                    if reflected >= MAX_REFLECTIONS {
-                        s *= 0.5;
-                        continue;
-                    }
-                    reflected += 1;
-                    stabilise(&mut nc);
-                }
-                predict_errors(ys, &na, &nc, &mut trial_eps);
-                let vt = mean_loss(&trial_eps[p..], rho);
-                if vt.is_finite() && vt < v {
-                    accepted = Some((na, nc, vt, hv + params.max_halvings + 1));
-                    break;
-                }
-                s *= 0.5;
-            }
+            let s0 = if hdd > 0.0 { gd / hdd } else { 1.0 };
+            accepted = line_search(&dg, s0, &mut trial_eps)
+                .map(|(na, nc, vt, hv)| (na, nc, vt, hv + params.max_halvings + 1));
         }
         match accepted {
             Some((na, nc, vt, hv)) => {

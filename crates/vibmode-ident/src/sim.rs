@@ -98,25 +98,49 @@ pub fn simulate_arma(
             sd * z
         })
         .collect();
-    let mut y = vec![0.0; total];
-    let p = a.len() - 1;
-    let q = c.len() - 1;
-    for t in 0..total {
+    let mut y = filter_arma(a, c, &e);
+    Ok(y.split_off(burn))
+}
+
+/// `y = (C/A) e`: `a[0] y_t = sum_k c_k e_{t-k} - sum_{k>=1} a_k y_{t-k}`, zero initial state (no
+/// burn-in: discard a warm-up if stationarity matters). `a[0]` must be nonzero (it divides);
+/// empty `a` or `c` give zeros.
+pub fn filter_arma(a: &[f64], c: &[f64], e: &[f64]) -> Vec<f64> {
+    let mut y = vec![0.0; e.len()];
+    let Some(&a0) = a.first() else {
+        return y;
+    };
+    for t in 0..e.len() {
         let mut v = 0.0;
-        for k in 0..=q.min(t) {
+        for k in 0..c.len().min(t + 1) {
             v += c[k] * e[t - k];
         }
-        for k in 1..=p.min(t) {
+        for k in 1..a.len().min(t + 1) {
             v -= a[k] * y[t - k];
         }
-        y[t] = v / a[0];
+        y[t] = v / a0;
     }
-    Ok(y.split_off(burn))
+    y
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn filter_arma_by_hand() {
+        // (1 - 0.5 q^-1) y = (1 + 0.5 q^-1) e, e = [1, 0, 0]: y0 = 1, y1 = 0.5 + 0.5 = 1,
+        // y2 = 0.5; with a0 = 2 every term is halved recursively: y0 = 0.5, y1 = (0.5 + 0.25)/2.
+        assert_eq!(
+            filter_arma(&[1.0, -0.5], &[1.0, 0.5], &[1.0, 0.0, 0.0]),
+            vec![1.0, 1.0, 0.5]
+        );
+        assert_eq!(
+            filter_arma(&[2.0, -0.5], &[1.0, 0.5], &[1.0, 0.0]),
+            vec![0.5, 0.375]
+        );
+        assert_eq!(filter_arma(&[], &[1.0], &[1.0, 2.0]), vec![0.0, 0.0]);
+    }
 
     #[test]
     fn ar_from_one_mode_by_hand() {

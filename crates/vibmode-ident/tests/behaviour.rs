@@ -3,7 +3,7 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use vibmode_ident::sim::{ar_from_modes, poly_mul, simulate_arma};
+use vibmode_ident::sim::{ar_from_modes, filter_arma, poly_mul, simulate_arma};
 use vibmode_ident::{
     fit_ar, fit_arma, fit_arma_warm, modes_from_poles, polynomial_roots, prediction_error_variance,
     sweep_arma, ArMethod, ArmaModel, ArmaParams, Complex64, IdentError, Mode, Robust,
@@ -107,22 +107,6 @@ fn arma_errors_shrink_like_one_over_sqrt_n() {
     assert!(err_20[1].sqrt() < 0.02);
 }
 
-/// `y = (C/A) e` with zero initial state (no burn-in; the caller discards a warm-up).
-fn filter_ca(a: &[f64], c: &[f64], e: &[f64]) -> Vec<f64> {
-    let mut y = vec![0.0; e.len()];
-    for t in 0..e.len() {
-        let mut v = 0.0;
-        for k in 0..c.len().min(t + 1) {
-            v += c[k] * e[t - k];
-        }
-        for k in 1..a.len().min(t + 1) {
-            v -= a[k] * y[t - k];
-        }
-        y[t] = v;
-    }
-    y
-}
-
 #[test]
 fn robust_fit_resists_innovation_spikes() {
     // 1 % of the innovations replaced by spikes of 15-30 innovation standard deviations (outliers
@@ -143,8 +127,8 @@ fn robust_fit_resists_innovation_spikes() {
         let sign = if rng.gen_bool(0.5) { 1.0 } else { -1.0 };
         e_spiky[i] = sign * rng.gen_range(15.0..30.0);
     }
-    let clean = filter_ca(&a, &c, &e)[2000..].to_vec();
-    let spiky = filter_ca(&a, &c, &e_spiky)[2000..].to_vec();
+    let clean = filter_arma(&a, &c, &e)[2000..].to_vec();
+    let spiky = filter_arma(&a, &c, &e_spiky)[2000..].to_vec();
     let robust = ArmaParams::default();
     let m_clean = fit_arma(&clean, 4, 2, &robust).unwrap();
     let m_rob = fit_arma(&spiky, 4, 2, &robust).unwrap();

@@ -3,7 +3,7 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use vibmode_ident::sim::{ar_from_modes, simulate_arma};
+use vibmode_ident::sim::{ar_from_modes, filter_arma, simulate_arma};
 use vibmode_ident::{
     clean_additive_outliers, fit_arma, ArmaModel, ArmaParams, CleanerParams, IdentError, Mode,
     OutlierCleaning, Robust,
@@ -182,22 +182,6 @@ fn cleaner_finds_the_spikes_and_restores_the_signal() {
     }
 }
 
-/// `y = (C/A) e` with zero initial state.
-fn filter_ca(a: &[f64], c: &[f64], e: &[f64]) -> Vec<f64> {
-    let mut y = vec![0.0; e.len()];
-    for t in 0..e.len() {
-        let mut v = 0.0;
-        for k in 0..c.len().min(t + 1) {
-            v += c[k] * e[t - k];
-        }
-        for k in 1..a.len().min(t + 1) {
-            v -= a[k] * y[t - k];
-        }
-        y[t] = v;
-    }
-    y
-}
-
 #[test]
 fn clean_data_is_left_alone() {
     // Guard: without spikes the cleaner replaces (almost) nothing and the default fit's modes do
@@ -213,7 +197,7 @@ fn clean_data_is_left_alone() {
             let e: Vec<f64> = (0..case.n + burn)
                 .map(|_| rng.sample::<f64, _>(rand_distr::StandardNormal))
                 .collect();
-            let gaussian = filter_ca(&a, &case.c, &e)[burn..].to_vec();
+            let gaussian = filter_arma(&a, &case.c, &e)[burn..].to_vec();
             // Pothole impulses in the innovations, 0.1 % of them at 4-8 std(y) of the Gaussian
             // record (hundreds to thousands of innovation standard deviations), and 3 single ones
             // at 20 std(y) whose responses stand far out of the record (beyond the pre-screen).
@@ -224,12 +208,12 @@ fn clean_data_is_left_alone() {
                 let sign = if rng.gen_bool(0.5) { 1.0 } else { -1.0 };
                 e_io[i] = sign * rng.gen_range(4.0..8.0) * sd;
             }
-            let potholes = filter_ca(&a, &case.c, &e_io)[burn..].to_vec();
+            let potholes = filter_arma(&a, &case.c, &e_io)[burn..].to_vec();
             let mut e_big = e.clone();
             for j in 1..=3 {
                 e_big[burn + j * case.n / 4] = 20.0 * sd;
             }
-            let big = filter_ca(&a, &case.c, &e_big)[burn..].to_vec();
+            let big = filter_arma(&a, &case.c, &e_big)[burn..].to_vec();
             for (name, y) in [
                 ("gaussian", &gaussian),
                 ("potholes", &potholes),
@@ -300,7 +284,7 @@ fn single_spike_in_ar2_is_replaced_by_exactly_its_prediction() {
         *v = rng.sample::<f64, _>(rand_distr::StandardNormal);
     }
     e[1000] = 15.0 * std_of(&y);
-    let io = filter_ca(&a_true, &[1.0], &e);
+    let io = filter_arma(&a_true, &[1.0], &e);
     let cl = clean_additive_outliers(&io, &params).unwrap();
     assert!(cl.replaced.is_empty(), "{:?}", cl.replaced);
 }
