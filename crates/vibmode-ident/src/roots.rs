@@ -9,9 +9,13 @@ use crate::IdentError;
 /// first, as `numpy.roots`). For `A = [1, a1, ..., ap]` these are the model poles.
 ///
 /// Method: companion matrix, Parlett-Reinsch balancing (nalgebra's
-/// `linalg::balancing::balance_parlett_reinsch`), real Schur decomposition, then at most three
-/// guarded Newton polishing steps per root on the original polynomial (a step is kept only if it
-/// lowers |p(z)| and is small against the distance to the nearest other root). Trailing zero
+/// `linalg::balancing::balance_parlett_reinsch`), real Schur decomposition, then at most four
+/// guarded Newton polishing steps per root on the original polynomial, its value evaluated in
+/// double-double arithmetic (a step is kept only if it lowers |p(z)| and is small against the
+/// distance to the nearest other root). The eigenvalues alone carry errors of about eps x the
+/// roots' condition number, 1e-6 relative for lightly damped modes near 1 Hz at 200 Hz in an
+/// order-60 polynomial (as `numpy.roots`); polished, such roots are exact to about 1e-14 relative
+/// when the coefficients are exact. Trailing zero
 /// coefficients give exact roots at zero. Roots come in exact conjugate pairs; order is unspecified.
 ///
 /// Errors: empty input or zero leading coefficient, non-finite coefficients, or (very unlikely)
@@ -51,15 +55,17 @@ pub fn polynomial_roots(coeffs: &[f64]) -> Result<Vec<Complex64>, IdentError> {
             .ok_or(IdentError::RootsNotConverged { degree: n })?;
         let eig = schur.complex_eigenvalues();
         let raw: Vec<Complex64> = eig.iter().map(|z| Complex64::new(z.re, z.im)).collect();
+        // Polish on the caller's coefficients (dividing by the leading one would round them).
+        let original = &coeffs[..end];
         for i in 0..raw.len() {
-            roots.push(polish(&c, raw[i], &raw, i));
+            roots.push(polish(original, raw[i], &raw, i));
         }
     }
     roots.extend(std::iter::repeat(Complex64::new(0.0, 0.0)).take(zeros_at_origin));
     Ok(roots)
 }
 
-/// Value and derivative of the monic polynomial `c` (highest power first) at z (Horner).
+/// Value and derivative of the polynomial `c` (highest power first) at z (Horner, f64).
 fn horner(c: &[f64], z: Complex64) -> (Complex64, Complex64) {
     let mut p = Complex64::new(c[0], 0.0);
     let mut dp = Complex64::new(0.0, 0.0);
@@ -70,7 +76,75 @@ fn horner(c: &[f64], z: Complex64) -> (Complex64, Complex64) {
     (p, dp)
 }
 
+/// A double-double number `hi + lo` (|lo| <= ulp(hi) / 2), about 106 bits of mantissa.
+#[derive(Clone, Copy)]
+struct Dd {
+    hi: f64,
+    lo: f64,
+}
+
+/// Error-free sum: `a + b = s + e` exactly (Knuth's TwoSum).
+#[inline]
+fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    let bb = s - a;
+    (s, (a - (s - bb)) + (b - bb))
+}
+
+impl Dd {
+    #[inline]
+    fn renorm(hi: f64, lo: f64) -> Dd {
+        let s = hi + lo;
+        Dd {
+            hi: s,
+            lo: lo - (s - hi),
+        }
+    }
+    #[inline]
+    fn mul_f64(self, x: f64) -> Dd {
+        // Error-free product of the high parts through a fused multiply-add.
+        let p = self.hi * x;
+        let e = self.hi.mul_add(x, -p);
+        Dd::renorm(p, e + self.lo * x)
+    }
+    #[inline]
+    fn add(self, o: Dd) -> Dd {
+        let (s, e) = two_sum(self.hi, o.hi);
+        Dd::renorm(s, e + self.lo + o.lo)
+    }
+    #[inline]
+    fn neg(self) -> Dd {
+        Dd {
+            hi: -self.hi,
+            lo: -self.lo,
+        }
+    }
+}
+
+/// `c(z)` for real `c` (highest power first) and a double-precision z, evaluated in double-double
+/// arithmetic and rounded once. Near a cluster of roots the terms of the plain Horner sum cancel
+/// to many digits, and its rounding error (about eps x sum |c_k| |z|^k) can exceed the value
+/// itself; here that error is about eps^2 x the same sum, so Newton steps can reach the root to
+/// full double precision where plain Horner stalls (compensated Horner, Graillat, Langlois and
+/// Louvet 2005, in complex form).
+fn horner_dd(c: &[f64], z: Complex64) -> Complex64 {
+    let mut re = Dd { hi: c[0], lo: 0.0 };
+    let mut im = Dd { hi: 0.0, lo: 0.0 };
+    for &ck in &c[1..] {
+        let nre = re.mul_f64(z.re).add(im.mul_f64(z.im).neg());
+        let nim = re.mul_f64(z.im).add(im.mul_f64(z.re));
+        re = nre.add(Dd { hi: ck, lo: 0.0 });
+        im = nim;
+    }
+    Complex64::new(re.hi + re.lo, im.hi + im.lo)
+}
+
+/// Newton polishing of the eigenvalue `all[idx]` on the original polynomial `c`: the value comes
+/// from [`horner_dd`], the derivative from plain Horner. A step is kept only if it lowers |c(z)|
+/// and is small against the distance to the nearest other eigenvalue (so it cannot jump to a
+/// neighbouring root); at most `POLISH_STEPS` steps.
 fn polish(c: &[f64], z0: Complex64, all: &[Complex64], idx: usize) -> Complex64 {
+    const POLISH_STEPS: usize = 4;
     let min_dist = all
         .iter()
         .enumerate()
@@ -78,13 +152,13 @@ fn polish(c: &[f64], z0: Complex64, all: &[Complex64], idx: usize) -> Complex64 
         .map(|(_, w)| (w - z0).norm())
         .fold(f64::INFINITY, f64::min);
     let mut z = z0;
-    let (mut pz, _) = horner(c, z);
-    for _ in 0..3 {
-        let (p, dp) = horner(c, z);
-        if dp.norm() == 0.0 || p.norm() == 0.0 {
+    let mut pz = horner_dd(c, z);
+    for _ in 0..POLISH_STEPS {
+        let (_, dp) = horner(c, z);
+        if dp.norm() == 0.0 || pz.norm() == 0.0 {
             break;
         }
-        let step = p / dp;
+        let step = pz / dp;
         if step.norm().is_nan() || step.norm() >= 0.1 * min_dist {
             break;
         }
@@ -92,7 +166,10 @@ fn polish(c: &[f64], z0: Complex64, all: &[Complex64], idx: usize) -> Complex64 
         if z.im == 0.0 {
             zn.im = 0.0;
         }
-        let (pn, _) = horner(c, zn);
+        if zn == z {
+            break;
+        }
+        let pn = horner_dd(c, zn);
         if pn.norm() < pz.norm() {
             z = zn;
             pz = pn;

@@ -378,6 +378,83 @@ fn yule_walker_spectrum_integrates_to_sample_variance_on_random_inputs() {
 }
 
 #[test]
+fn order_60_roots_recover_designed_modes_from_exact_coefficients() {
+    // An order-60 A(z) whose double coefficients are *exactly* the designed polynomial, so the
+    // designed poles are its exact roots (rounding designed poles' coefficients to double would
+    // move roots crowded near z = 1 by ~1e-3, see tests/reference.rs). Three lightly damped modes
+    // between 0.5 and 2 Hz at fs = 200 Hz, each a factor z^2 - (B/S) z + C/S with S = 2^13, times
+    // (z^27 - 2^-5)(z^27 + 2^-7): 54 more poles spread round the disc.
+    let fs = 200.0;
+    let ts = 1.0 / fs;
+    let s: i128 = 8192;
+    let factors: [(i128, i128); 3] = [(16369, 8179), (16360, 8177), (16331, 8171)];
+    // Exact integer product, scaled by S^3 * 2^12 = 2^51.
+    let mut q: Vec<i128> = vec![1];
+    for &(b, c) in &factors {
+        let f = [s, -b, c];
+        let mut next = vec![0i128; q.len() + 2];
+        for (i, &qi) in q.iter().enumerate() {
+            for (j, &fj) in f.iter().enumerate() {
+                next[i + j] += qi * fj;
+            }
+        }
+        q = next;
+    }
+    let mut r = vec![0i128; 55];
+    r[0] = 1 << 12;
+    r[27] = (1 << 5) - (1 << 7);
+    r[54] = -1;
+    let mut p_int = vec![0i128; q.len() + r.len() - 1];
+    for (i, &qi) in q.iter().enumerate() {
+        for (j, &rj) in r.iter().enumerate() {
+            p_int[i + j] += qi * rj;
+        }
+    }
+    assert_eq!(p_int.len(), 61);
+    assert_eq!(p_int[0], 1i128 << 51);
+    let a: Vec<f64> = p_int
+        .iter()
+        .map(|&v| {
+            // Every coefficient is exactly representable: the conversion loses nothing.
+            assert_eq!((v as f64) as i128, v, "coefficient {v} not exact in f64");
+            v as f64 / 2f64.powi(51)
+        })
+        .collect();
+    // The designed modes in closed form: r = sqrt(C/S), theta = atan2(sqrt(4CS - B^2), B)
+    // (4CS - B^2 is an exact integer), f = |ln z| / (2 pi Ts), zeta = -ln r / |ln z|.
+    let truth: Vec<(f64, f64)> = factors
+        .iter()
+        .map(|&(b, c)| {
+            let ln_r = 0.5 * ((c - s) as f64 / s as f64).ln_1p();
+            let theta = (((4 * c * s - b * b) as f64).sqrt()).atan2(b as f64);
+            let mag = ln_r.hypot(theta);
+            (mag / (2.0 * std::f64::consts::PI * ts), -ln_r / mag)
+        })
+        .collect();
+    // By hand: the three modes are near 0.50, 1.06 and 1.99 Hz, lightly damped.
+    for ((f, z), (f0, z0)) in truth.iter().zip([(0.4976, 0.0508), (1.0556, 0.0276), (1.9910, 0.0205)]) {
+        assert!((f - f0).abs() < 1e-4 && (z - z0).abs() < 1e-4, "{f} {z}");
+    }
+    let poles = polynomial_roots(&a).unwrap();
+    assert_eq!(poles.len(), 60);
+    let modes = modes_from_poles(&poles, fs);
+    // 13 pairs from each degree-27 factor plus the three designed modes; one real root each.
+    assert_eq!(modes.modes.len(), 29);
+    assert_eq!(modes.real_poles.len(), 2);
+    assert!(modes.unstable_poles.is_empty());
+    let mut worst = 0.0f64;
+    for &(f, z) in &truth {
+        let m = nearest(&modes.modes, f).unwrap();
+        let ef = (m.frequency_hz / f - 1.0).abs();
+        let ez = (m.damping_ratio / z - 1.0).abs();
+        worst = worst.max(ef);
+        assert!(ef < 1e-6, "{f} Hz recovered as {} Hz ({ef:e})", m.frequency_hz);
+        assert!(ez < 1e-5, "{f} Hz damping {z} recovered as {} ({ez:e})", m.damping_ratio);
+    }
+    println!("designed 0.5-2 Hz modes from exact order-60 coefficients: worst relative error {worst:e}");
+}
+
+#[test]
 fn roots_have_tiny_backward_error_on_random_polynomials() {
     // Identity: each computed root r satisfies |p(r)| <= 1e-12 * sum |c_k| |r|^k (relative
     // backward error), and the roots' sum and product match -c1/c0 and (-1)^n cn/c0.
