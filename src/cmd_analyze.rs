@@ -599,7 +599,7 @@ fn summary_text(r: &AnalysisResults) -> String {
         ));
     }
     if r.config.preset == Preset::Paper {
-        s.push_str("These are the paper's settings. At 200 Hz with a 25 Hz cutoff the band 25-100 Hz is empty: three quarters of the poles of every model are spent on it, the prediction-error criterion has no minimum without the -80 dB numerical noise floor vibmode adds to such signals, the ideal filter's edge draws lightly damped poles of its own (poles above 0.8 x the cutoff are not clustered), and every fit has four times the samples. On the simulated bus this costs about 20 times the default preset's time, places the wheel hop 10-20 % high with a wide spread and adds a spurious cluster near 17 Hz; the default preset analyses at 50 Hz (twice the cutoff, the same information) instead. ");
+        s.push_str("These are the paper's settings. At 200 Hz with a 25 Hz cutoff the band 25-100 Hz is empty: three quarters of the poles of every model are spent on it, the prediction-error criterion has no minimum without the -30 dB numerical noise floor vibmode adds to such signals, the ideal filter's edge draws lightly damped poles of its own (poles above 0.8 x the cutoff are not clustered), and every fit has four times the samples. On the simulated bus this costs about 14 times the default preset's time, spreads the wheel hop over 1.5 Hz and merges the 11 and 12 Hz engine lines into one cluster taken for a structural mode; the default preset analyses at 50 Hz (twice the cutoff, the same information) instead. ");
     }
     let _ = Role::Sprung;
     s
