@@ -691,7 +691,7 @@ fn search(
     // candidate and fell into a worse minimum) is repeated from the warm start: in a sweep the
     // loss then never rises with the order.
     if let Some(w) = warm_left {
-        if best.as_ref().is_none_or(|b| b.v > w.score) {
+        if best.as_ref().map_or(true, |b| b.v > w.score) {
             run(w, &mut best);
         }
     }
