@@ -236,15 +236,30 @@ pub fn run(a: &FitArgs) -> Result<()> {
     }
     match &a.json {
         Some(dest) => write_json(dest, &out)?,
-        None => print_table(&out, a.mark_damping_max),
+        None => print!(
+            "{}",
+            table_text(&out, a.mark_damping_max, empty_band_above(a, rec.fs_hz))
+        ),
     }
     Ok(())
 }
 
-fn print_table(o: &FitOutput, zmax: f64) {
+/// The ideal filter's cutoff (Hz) when resampling left an empty band above it (cutoff below 0.95 x
+/// the new Nyquist frequency, as the paper's 25 Hz at 200 Hz). Modes above it describe vibmode's
+/// numerical noise floor in that band, not the vehicle.
+fn empty_band_above(a: &FitArgs, fs_hz: f64) -> Option<f64> {
+    a.input.resample_to_hz?;
+    a.input.cutoff_hz.filter(|c| *c < 0.95 * fs_hz / 2.0)
+}
+
+/// The terminal table: per channel a header line and the modes, lightly damped ones (damping
+/// ratio below `zmax`) marked `*`; modes above `band_max_hz` (the cutoff of an empty band) are
+/// labelled as such instead, with one line saying what they are.
+fn table_text(o: &FitOutput, zmax: f64, band_max_hz: Option<f64>) -> String {
+    let mut s = String::new();
     for c in &o.channels {
-        println!(
-            "{}: {}({}{}) by {}, {} iterations{}, noise variance {:.6e}, loss {:.6e}, AIC {:.2}",
+        s.push_str(&format!(
+            "{}: {}({}{}) by {}, {} iterations{}, noise variance {:.6e}, loss {:.6e}, AIC {:.2}\n",
             c.name,
             if c.model == ModelKind::Ar {
                 "AR"
@@ -263,20 +278,35 @@ fn print_table(o: &FitOutput, zmax: f64) {
             c.noise_variance,
             c.loss,
             c.aic
-        );
-        println!("  {:>12} {:>14}  ", "freq_hz", "damping_ratio");
+        ));
+        s.push_str(&format!("  {:>12} {:>14}  \n", "freq_hz", "damping_ratio"));
+        let mut above = 0;
         for m in &c.modes {
-            println!(
-                "  {:>12.4} {:>14.5}  {}",
-                m.frequency_hz,
-                m.damping_ratio,
-                if m.damping_ratio < zmax { "*" } else { "" }
-            );
+            let tag = match band_max_hz {
+                Some(cut) if m.frequency_hz > cut => {
+                    above += 1;
+                    format!("(above the {cut} Hz cutoff)")
+                }
+                _ if m.damping_ratio < zmax => "*".to_string(),
+                _ => String::new(),
+            };
+            s.push_str(&format!(
+                "  {:>12.4} {:>14.5}  {}\n",
+                m.frequency_hz, m.damping_ratio, tag
+            ));
+        }
+        if let (Some(cut), true) = (band_max_hz, above > 0) {
+            s.push_str(&format!(
+                "  {above} mode(s) above the {cut} Hz cutoff lie in the band the ideal filter emptied: \
+                 they describe the numerical noise floor added there (docs/identification.md), not \
+                 the vehicle\n"
+            ));
         }
         if !c.unstable_poles.is_empty() {
-            println!("  {} unstable pole(s)", c.unstable_poles.len());
+            s.push_str(&format!("  {} unstable pole(s)\n", c.unstable_poles.len()));
         }
     }
+    s
 }
 
 fn fit_figure(
@@ -299,6 +329,7 @@ fn fit_figure(
             .modes
             .iter()
             .filter(|md| md.damping_ratio < a.mark_damping_max)
+            .filter(|md| empty_band_above(a, rec.fs_hz).map_or(true, |cut| md.frequency_hz <= cut))
             .map(|md| md.frequency_hz)
             .collect();
         let line = |label: &str, x: Vec<f64>, y: Vec<f64>, width: u32, alpha: f64| Series {
@@ -369,4 +400,69 @@ fn fit_figure(
         width_px: 1000,
         height_px: (500 * n.max(1)) as u32,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn mode(f: f64, z: f64) -> ModeOut {
+        ModeOut {
+            frequency_hz: f,
+            damping_ratio: z,
+            damped_frequency_hz: f * (1.0 - z * z).sqrt(),
+            pole_re: 0.0,
+            pole_im: 0.0,
+        }
+    }
+
+    #[test]
+    fn table_labels_modes_above_an_empty_band_cutoff() {
+        let out = FitOutput {
+            source: "x.csv".into(),
+            fs_hz: 200.0,
+            n_samples: 1000,
+            robust: "off".into(),
+            channels: vec![ChannelFit {
+                name: "z".into(),
+                unit: String::new(),
+                model: ModelKind::Arma,
+                method: "pem".into(),
+                p: 2,
+                q: 2,
+                a: vec![1.0; 3],
+                c: vec![1.0; 3],
+                noise_variance: 1.0,
+                loss: 1.0,
+                iterations: 3,
+                converged: true,
+                aic: 0.0,
+                bic: 0.0,
+                fpe: 1.0,
+                std_errors: vec![],
+                outliers_replaced: 0,
+                modes: vec![mode(1.2, 0.1), mode(96.0, 0.01)],
+                real_poles: vec![],
+                unstable_poles: vec![],
+            }],
+        };
+        let with = table_text(&out, 0.3, Some(25.0));
+        let lines: Vec<&str> = with.lines().collect();
+        assert!(
+            lines[2].contains("1.2000") && lines[2].ends_with('*'),
+            "{with}"
+        );
+        assert!(
+            lines[3].contains("96.0000") && lines[3].ends_with("(above the 25 Hz cutoff)"),
+            "{with}"
+        );
+        assert!(
+            lines[4].contains("1 mode(s) above the 25 Hz cutoff"),
+            "{with}"
+        );
+        // Without an empty band the 96 Hz mode is an ordinary lightly damped one.
+        let without = table_text(&out, 0.3, None);
+        assert!(without.lines().nth(3).is_some_and(|l| l.ends_with('*')));
+        assert!(!without.contains("cutoff"));
+    }
 }
