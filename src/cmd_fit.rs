@@ -102,6 +102,7 @@ pub struct ChannelFit {
     fpe: f64,
     std_errors: Vec<f64>,
     outliers_replaced: usize,
+    noise_floor_variance: f64,
     modes: Vec<ModeOut>,
     real_poles: Vec<f64>,
     unstable_poles: Vec<[f64; 2]>,
@@ -180,6 +181,7 @@ pub fn channel_fit(
         fpe: m.fpe,
         std_errors: m.std_errors.clone(),
         outliers_replaced: m.outliers_replaced,
+        noise_floor_variance: m.noise_floor_variance,
         modes: ms
             .modes
             .iter()
@@ -279,6 +281,12 @@ fn table_text(o: &FitOutput, zmax: f64, band_max_hz: Option<f64>) -> String {
             c.loss,
             c.aic
         ));
+        if c.noise_floor_variance > 0.0 {
+            s.push_str(&format!(
+                "  (the signal has an empty band: a white noise floor of variance {:.3e} was added before fitting, and is included in the noise variance and loss)\n",
+                c.noise_floor_variance
+            ));
+        }
         s.push_str(&format!("  {:>12} {:>14}  \n", "freq_hz", "damping_ratio"));
         let mut above = 0;
         for m in &c.modes {
@@ -441,6 +449,7 @@ mod tests {
                 fpe: 1.0,
                 std_errors: vec![],
                 outliers_replaced: 0,
+                noise_floor_variance: 0.0,
                 modes: vec![mode(1.2, 0.1), mode(96.0, 0.01)],
                 real_poles: vec![],
                 unstable_poles: vec![],

@@ -130,6 +130,7 @@ pub fn fit_ar(y: &[f64], p: usize, method: ArMethod) -> Result<ArmaModel, IdentE
         mean,
         estimator,
         outliers_replaced: 0,
+        noise_floor_variance: 0.0,
     })
 }
 

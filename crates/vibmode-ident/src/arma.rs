@@ -947,6 +947,7 @@ fn fit_impl(
         stop,
         converged,
     } = out;
+    let floor_added = floored.is_some();
     let ys = floored.unwrap_or(ys);
     let k = p + q;
     let n_eff = n - p;
@@ -994,6 +995,11 @@ fn fit_impl(
         mean: offset,
         estimator: Estimator::PredictionError,
         outliers_replaced,
+        noise_floor_variance: if floor_added {
+            params.noise_floor * s2
+        } else {
+            0.0
+        },
     })
 }
 

@@ -88,6 +88,11 @@ pub struct ArmaModel {
     /// fits with [`crate::OutlierCleaning::RobustFilter`]; 0 otherwise).
     #[serde(default)]
     pub outliers_replaced: usize,
+    /// Variance of the white noise floor added to a signal with an empty band before the search
+    /// (signal units squared; `ArmaParams::noise_floor` x the signal's variance), 0 when none was
+    /// added. When it is not 0, `noise_variance` and `loss` are those of the signal plus the floor.
+    #[serde(default)]
+    pub noise_floor_variance: f64,
 }
 
 /// One vibration mode from a stable complex pole pair.

@@ -288,6 +288,13 @@ fn hard_setting_lightly_damped_modes_found_at_every_order() {
                     .iter()
                     .map(|d| d + floor_density)
                     .collect();
+                // The floor that was added is reported, in signal units.
+                assert!(
+                    (fit.noise_floor_variance / (1e-3 * var) - 1.0).abs() < 1e-9,
+                    "{} vs {}",
+                    fit.noise_floor_variance,
+                    1e-3 * var
+                );
                 let est = fit.model_psd(&freqs, 200.0);
                 let (worst_db, worst_hz) = est
                     .iter()
@@ -731,4 +738,5 @@ fn noise_floor_leaves_broadband_data_alone() {
     assert_eq!(m0.a, m1.a);
     assert_eq!(m0.c, m1.c);
     assert_eq!(m0.noise_variance, m1.noise_variance);
+    assert_eq!(m1.noise_floor_variance, 0.0);
 }
