@@ -325,6 +325,7 @@ fn fit_figure(
 ) -> Result<Figure> {
     let wp = a.spectral.welch_params()?;
     let pp = a.spectral.periodogram_params()?;
+    let band_max_hz = empty_band_above(a, rec.fs_hz);
     let mut panels = Vec::new();
     for ((ch, m), f) in rec.channels.iter().zip(models).zip(fits) {
         let per = vibmode_spectra::periodogram(&ch.samples, rec.fs_hz, &pp)?;
@@ -337,7 +338,7 @@ fn fit_figure(
             .modes
             .iter()
             .filter(|md| md.damping_ratio < a.mark_damping_max)
-            .filter(|md| empty_band_above(a, rec.fs_hz).map_or(true, |cut| md.frequency_hz <= cut))
+            .filter(|md| band_max_hz.map_or(true, |cut| md.frequency_hz <= cut))
             .map(|md| md.frequency_hz)
             .collect();
         let line = |label: &str, x: Vec<f64>, y: Vec<f64>, width: u32, alpha: f64| Series {

@@ -308,11 +308,7 @@ fn stabilise(c: &mut [f64]) {
     }
     for r in [1.0 - 1e-9, 1.0 - 1e-8, 1.0 - 1e-7, 1.0 - 1e-6] {
         let mut shrunk = c.to_vec();
-        let mut rk = 1.0;
-        for ck in shrunk.iter_mut().skip(1) {
-            rk *= r;
-            *ck *= rk;
-        }
+        shrink_roots(&mut shrunk, r);
         if is_min_phase(&shrunk) {
             c.copy_from_slice(&shrunk);
             return;
@@ -338,12 +334,17 @@ fn stabilise(c: &mut [f64]) {
     // Fallback (roots on the unit circle or failed root finding): shrink all roots.
     let mut guard = 0;
     while !is_min_phase(c) && guard < 200 {
-        let mut r = 1.0;
-        for ck in c.iter_mut().skip(1) {
-            r *= 0.999;
-            *ck *= r;
-        }
+        shrink_roots(c, 0.999);
         guard += 1;
+    }
+}
+
+/// Moves every root of C radially by the factor `r` (`c_k -> c_k r^k`).
+fn shrink_roots(c: &mut [f64], r: f64) {
+    let mut rk = 1.0;
+    for ck in c.iter_mut().skip(1) {
+        rk *= r;
+        *ck *= rk;
     }
 }
 

@@ -57,7 +57,7 @@ fn mixed_whitespace_numbers(line: &[u8]) -> bool {
     let mut scratch = Vec::new();
     spans
         .iter()
-        .all(|&(a, b)| parse_num(&line[a..b], true, &mut scratch).is_some())
+        .all(|&(a, b)| parse_slow(&line[a..b], true, &mut scratch).is_some())
 }
 
 impl Separator {
@@ -227,17 +227,6 @@ fn split_spans(line: &[u8], sep: Separator, spans: &mut Vec<(usize, usize)>) {
     }
 }
 
-fn parse_num(cell: &[u8], decimal_comma: bool, scratch: &mut Vec<u8>) -> Option<f64> {
-    let bytes: &[u8] = if decimal_comma && cell.contains(&b',') {
-        scratch.clear();
-        scratch.extend(cell.iter().map(|&b| if b == b',' { b'.' } else { b }));
-        scratch
-    } else {
-        cell
-    };
-    std::str::from_utf8(bytes).ok()?.parse::<f64>().ok()
-}
-
 /// Splits `X-Axis (m/s2)` into (`X-Axis`, `m/s2`) and `Z [m/s^2]` into (`Z`, `m/s^2`).
 pub fn split_name_unit(header: &str) -> (String, String) {
     let h = header.trim();
@@ -351,7 +340,7 @@ impl<R: BufRead> DelimitedReader<R> {
         let mut scratch = Vec::new();
         let is_header = spans
             .iter()
-            .any(|&(a, b)| parse_num(&first.1[a..b], allow_comma, &mut scratch).is_none());
+            .any(|&(a, b)| parse_slow(&first.1[a..b], allow_comma, &mut scratch).is_none());
         if is_header {
             r.has_header = true;
             r.reference_line = first.0;
@@ -867,7 +856,7 @@ impl RowCtx<'_> {
             let cell = &line[a..b];
             let parsed = match text.and_then(|t| t.get(a..b)) {
                 Some(t) if !self.decimal_comma => t.parse::<f64>().ok(),
-                _ => parse_num(cell, self.decimal_comma, self.scratch),
+                _ => parse_slow(cell, self.decimal_comma, self.scratch),
             };
             match parsed {
                 Some(v) => block.columns[c].push(v),
