@@ -188,9 +188,11 @@ fn duplicates_within_a_fit_do_not_inflate_support() {
     assert!(a[0].order_share <= 1.0);
 }
 
-/// ~100k poles (8 records x 7 channels x 59 orders x ~30 poles) cluster well under a second.
+/// ~100k poles (8 records x 7 channels x 59 orders x ~30 poles): the paper-size workload still
+/// finds exactly the six invariant modes. Its speed is measured by `bench/` (BENCHMARKS.md), never
+/// asserted here: a wall-clock bound fails on a loaded machine.
 #[test]
-fn performance_100k_poles() {
+fn paper_size_pole_cloud_100k_poles() {
     let orders: Vec<usize> = (2..=60).collect();
     let (mut modes_in, lines) = brief_modes();
     modes_in.extend(lines);
@@ -200,16 +202,6 @@ fn performance_100k_poles() {
     let chans = ["FL", "FR", "RL", "RR", "sFR", "sRL", "sRR"];
     let poles = cloud(41, 8, &orders, &chans, &modes_in, 25);
     assert!(poles.len() > 90_000, "{}", poles.len());
-    let t0 = std::time::Instant::now();
     let a = analyse_poles(&poles, 8, &orders, &ClusterParams::default()).unwrap();
-    let dt = t0.elapsed().as_secs_f64();
-    eprintln!(
-        "{} poles clustered in {:.3} s, {} clusters, core threshold {}",
-        poles.len(),
-        dt,
-        a.modes.len(),
-        a.core_threshold
-    );
-    assert!(dt < 1.0, "took {dt} s");
     assert_eq!(a.modes.iter().filter(|m| m.is_invariant()).count(), 6);
 }

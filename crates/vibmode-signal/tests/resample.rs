@@ -381,9 +381,9 @@ fn error_paths() {
 }
 
 #[test]
-fn speed_seven_channels_paper_size() {
-    // 7 x 204 800 samples, 20 kHz -> 200 Hz with the ideal filter at 25 Hz. Timing is printed;
-    // the assertion is loose (test profile, shared machine); see the report for release timings.
+fn seven_channels_paper_size_resample_each_channel() {
+    // 7 x 204 800 samples, 20 kHz -> 200 Hz with the ideal filter at 25 Hz. Its speed is measured
+    // by bench/ (BENCHMARKS.md), never asserted in a test.
     let n = 204_800;
     let chans: Vec<Channel> = (0..7)
         .map(|c| Channel {
@@ -394,10 +394,9 @@ fn speed_seven_channels_paper_size() {
         .collect();
     let rec = Recording::new(20_000.0, chans).unwrap();
     let p = params(200.0, Some(25.0), true);
-    let t0 = std::time::Instant::now();
     let out = rec.resample(&p).unwrap();
-    let dt = t0.elapsed();
-    eprintln!("7 x 204800 resample: {:.1} ms", dt.as_secs_f64() * 1e3);
     assert_eq!(out.len(), 2048);
-    assert!(dt.as_secs_f64() < 2.0);
+    // Channels are resampled independently: channel 3 alone gives the same samples.
+    let alone = resample(&rec.channels[3].samples, 20_000.0, &p).unwrap();
+    assert_eq!(out.channels[3].samples, alone);
 }
