@@ -6,37 +6,98 @@
 //! orders and records are then pooled per channel and per role (sprung / unsprung) and clustered
 //! into invariant modes (`vibmode-modal`), optionally matched to a physical model's modes.
 //!
-//! Results are plain serialisable structs ([`AnalysisResults`]); figures and reports are drawn
-//! elsewhere (the `vibmode` binary), so this crate never depends on plotting.
+//! The analysis is a composition of named stages, each a public module: [`source`] (records),
+//! pre-processing (`vibmode_signal::preprocess`), [`identify`] (the [`Identifier`] trait and the
+//! order sweep), [`store`] (the pole store), [`stops`], clustering (`vibmode-modal`) and model
+//! matching, composed by [`analyze`] in [`pipeline`]. Results are plain versioned serialisable
+//! structs ([`AnalysisResults`], [`SCHEMA_VERSION`]); figures and reports are drawn by
+//! `vibmode-report`, so this crate never depends on plotting.
 //!
 //! ```
 //! use vibmode_analysis::{AnalysisConfig, Preset};
 //! let cfg = AnalysisConfig::preset(Preset::Paper);
-//! assert_eq!(cfg.analysis_fs_hz, 200.0);
+//! assert_eq!(cfg.preprocess.analysis_fs_hz, 200.0);
 //! assert_eq!(cfg.orders().len(), 59); // p = 2..=60
-//! let mine = AnalysisConfig::from_toml_str("order_max = 12\n").unwrap();
-//! assert_eq!(mine.order_max, 12);
+//! let mine = AnalysisConfig::from_toml_str("[sweep]\norder_max = 12\n").unwrap();
+//! assert_eq!(mine.sweep.order_max, 12);
 //! assert!(AnalysisConfig::from_toml_str("no_such_key = 1\n").is_err());
 //! ```
 
 mod config;
-mod pipeline;
+pub mod identify;
+pub mod pipeline;
+pub mod results;
+pub mod source;
+pub mod stops;
+pub mod store;
 
-pub use config::{AnalysisConfig, ChannelRole, ClusterConfig, Preset, Role, SweepModel};
-pub use pipeline::{
-    analyze, cut_records, AnalysisResults, ChannelAnalysis, FitSummary, ModelPsd, PoleOut,
-    RecordInput, RecordSummary, RoleAnalysis,
+pub use config::{AnalysisConfig, ChannelRole, Preset, ReportParams};
+pub use identify::{Identifier, PoleOut, SignalFits, SweepIdentifier};
+pub use pipeline::{analyze, analyze_with, check_records, cluster_params_for, preprocess_records};
+pub use results::{
+    AnalysisResults, ChannelAnalysis, RecordSummary, RoleAnalysis, Timing, SCHEMA_VERSION,
+};
+pub use source::{cut_records, CutRecords, RecordInput, RecordSource};
+pub use store::PoleStore;
+pub use vibmode_core::{
+    ClusterParams, Corner, FitSummary, ModelCoefficients, Placement, PoleFilterParams,
+    PreprocessParams, Robust, Role, SpectrumParams, StopParams, SweepModel, SweepParams,
 };
 
-/// Errors of the analysis; each message is one line naming the value and the fix.
+/// Errors of the analysis; each message is one line naming the value and the fix, never a
+/// command-line flag.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum AnalysisError {
-    /// A setting is invalid.
+    /// A setting of the config is invalid or cannot be parsed.
+    #[error("analysis config: {message}")]
+    Config {
+        /// The key at fault, when known.
+        key: Option<&'static str>,
+        /// What is wrong and how to fix it.
+        message: String,
+    },
+    /// A config file cannot be read or parsed.
+    #[error("config {path}: {message}")]
+    ConfigFile {
+        /// The file.
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A stage's parameter is out of range.
     #[error("analysis config: {0}")]
-    Config(String),
-    /// The records do not fit together (rates, channels, lengths).
-    #[error("{0}")]
-    Records(String),
+    Param(#[from] vibmode_core::ParamError),
+    /// No records were given.
+    #[error("no records to analyse; give at least one record")]
+    NoRecords,
+    /// Records with different channels.
+    #[error("record '{record}' has channels [{channels}] but '{first}' has [{first_channels}]; give records with the same channels or select the same channels in each")]
+    ChannelsDiffer {
+        /// The record at fault.
+        record: String,
+        /// Its channels.
+        channels: String,
+        /// The first record.
+        first: String,
+        /// The first record's channels.
+        first_channels: String,
+    },
+    /// Records at different sampling rates.
+    #[error("record '{record}' is sampled at {fs_hz} Hz but '{first}' at {first_fs_hz} Hz; resample them to one rate first")]
+    RatesDiffer {
+        /// The record at fault.
+        record: String,
+        /// Its rate, Hz.
+        fs_hz: f64,
+        /// The first record.
+        first: String,
+        /// The first record's rate, Hz.
+        first_fs_hz: f64,
+    },
+    /// A recording breaks its invariants.
+    #[error(transparent)]
+    Recording(#[from] vibmode_core::RecordingError),
     /// Reading or resampling failed.
     #[error(transparent)]
     Signal(#[from] vibmode_signal::SignalError),

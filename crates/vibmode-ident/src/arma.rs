@@ -1,8 +1,5 @@
 //! ARMA(p, q) by (robust) prediction-error minimisation. See docs/identification.md.
 
-use std::fmt;
-use std::str::FromStr;
-
 use num_complex::Complex64;
 use serde::{Deserialize, Serialize};
 
@@ -19,52 +16,8 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-/// Robustification of the prediction-error criterion.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum Robust {
-    /// Purely quadratic criterion `l(e) = e^2`.
-    Off,
-    /// Huber criterion: `l(e) = e^2` for `|e| <= rho`, `2 rho |e| - rho^2` beyond, with
-    /// `rho = factor * MAD/0.6745` of the initial residuals (dimensionless factor), fixed during the
-    /// search.
-    Huber {
-        /// Threshold in robust standard deviations (dimensionless, > 0).
-        factor: f64,
-    },
-}
-
-impl Default for Robust {
-    /// `Huber { factor: 1.6 }` (as in MATLAB's pem).
-    fn default() -> Self {
-        Robust::Huber { factor: 1.6 }
-    }
-}
-
-impl FromStr for Robust {
-    type Err = IdentError;
-    /// Accepts `off` (also `none`, `quadratic`), `huber` (factor 1.6) or a positive number (the
-    /// Huber factor).
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let t = s.trim().to_ascii_lowercase();
-        match t.as_str() {
-            "off" | "none" | "quadratic" => Ok(Robust::Off),
-            "huber" | "on" => Ok(Robust::default()),
-            _ => match t.parse::<f64>() {
-                Ok(f) if f.is_finite() && f > 0.0 => Ok(Robust::Huber { factor: f }),
-                _ => Err(IdentError::ParseRobust(s.to_string())),
-            },
-        }
-    }
-}
-
-impl fmt::Display for Robust {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Robust::Off => f.write_str("off"),
-            Robust::Huber { factor } => write!(f, "{factor}"),
-        }
-    }
-}
+pub use vibmode_core::Robust;
+use vibmode_core::BandLimit;
 
 /// Settings of the prediction-error search.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -106,6 +59,13 @@ pub struct ArmaParams {
     /// The reported `noise_variance` and `loss` are those of the signal the search saw.
     #[serde(default = "default_noise_floor")]
     pub noise_floor: f64,
+    /// The band the signal carries, as the pre-processing reported it
+    /// ([`vibmode_core::BandLimit`]: whether an ideal low-pass left an empty band). Its
+    /// `empty_band` decides whether the noise floor is added. `None` (default) for a signal of
+    /// unknown provenance: the band is then judged from the signal itself (more than 1 % of its
+    /// periodogram bins below 1e-20 of the largest, which is what an ideal DFT low-pass leaves).
+    #[serde(default)]
+    pub band: Option<BandLimit>,
 }
 
 fn default_noise_floor() -> f64 {
@@ -148,6 +108,7 @@ impl Default for ArmaParams {
             demean: true,
             outlier_cleaning: OutlierCleaning::default(),
             noise_floor: default_noise_floor(),
+            band: None,
         }
     }
 }
@@ -173,7 +134,7 @@ impl ArmaParams {
                 return Err(IdentError::InvalidParam {
                     name: "Huber factor",
                     value: factor.to_string(),
-                    fix: "use a positive factor such as 1.6, or Robust::Off",
+                    fix: "use a positive factor such as 1.6, or off",
                 });
             }
         }
@@ -921,7 +882,8 @@ fn fit_impl(
     }
     let ys: Vec<f64> = centred.iter().map(|v| v / scale).collect();
     // The search works on the signal plus the numerical noise floor (ys has unit mean square).
-    let floored: Option<Vec<f64>> = (params.noise_floor > 0.0 && has_empty_band(&ys)).then(|| {
+    let floored: Option<Vec<f64>> = (params.noise_floor > 0.0
+        && params.band.map_or_else(|| has_empty_band(&ys), |b| b.empty_band)).then(|| {
         let sd = params.noise_floor.sqrt();
         let mut rng = ChaCha8Rng::seed_from_u64(FLOOR_SEED);
         ys.iter()
@@ -1034,7 +996,7 @@ mod tests {
         assert_eq!(Robust::default(), Robust::Huber { factor: 1.6 });
         assert_eq!(Robust::default().to_string(), "1.6");
         let e = "-1".parse::<Robust>().unwrap_err().to_string();
-        assert!(e.contains("'-1'") && e.contains("off"));
+        assert!(e.contains("-1") && e.contains("off"), "{e}");
     }
 
     #[test]

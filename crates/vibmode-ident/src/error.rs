@@ -83,9 +83,6 @@ pub enum IdentError {
     /// An unknown AR method name was given.
     #[error("unknown AR method '{0}'; valid values: yule-walker (or yw), burg, ls")]
     ParseArMethod(String),
-    /// An invalid robustification setting was given.
-    #[error("invalid robust setting '{0}'; use 'off' or a positive Huber factor such as 1.6")]
-    ParseRobust(String),
     /// A warm-start model has orders that do not fit the requested ones.
     #[error("warm-start model has orders (p={init_p}, q={init_q}) larger than the requested (p={p}, q={q}); pass a lower-order model or none")]
     InitMismatch {

@@ -49,6 +49,7 @@ mod error;
 mod linalg;
 mod model;
 mod outliers;
+mod poles;
 mod roots;
 pub mod sim;
 
@@ -59,8 +60,9 @@ pub use arma::{
 };
 pub use error::IdentError;
 pub use model::{
-    information_criteria, modes_from_poles, ArmaModel, Estimator, Mode, ModeSet, Pole, StopReason,
+    arma_psd, information_criteria, modes_from_poles, ArmaModel, Estimator, Mode, ModeSet, Pole, StopReason,
 };
 pub use num_complex::Complex64;
 pub use outliers::{clean_additive_outliers, CleanedSignal, CleanerParams, OutlierCleaning};
+pub use poles::{cancelled_by_zero, filter_mode_set, filter_modes, FilteredMode, PoleRejection};
 pub use roots::polynomial_roots;

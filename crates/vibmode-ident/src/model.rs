@@ -196,17 +196,24 @@ impl ArmaModel {
     /// frequency in `freq_hz` (Hz), in signal units squared per Hz, directly comparable with a
     /// one-sided Welch density (e.g. `scipy.signal.welch(..., scaling="density")`).
     pub fn model_psd(&self, freq_hz: &[f64], fs_hz: f64) -> Vec<f64> {
-        let ts = 1.0 / fs_hz;
-        freq_hz
-            .iter()
-            .map(|&f| {
-                let w = 2.0 * std::f64::consts::PI * f * ts;
-                let num = eval_on_circle(&self.c, w).norm_sqr();
-                let den = eval_on_circle(&self.a, w).norm_sqr();
-                2.0 * self.noise_variance * ts * num / den
-            })
-            .collect()
+        arma_psd(&self.a, &self.c, self.noise_variance, freq_hz, fs_hz)
     }
+}
+
+/// One-sided PSD `2 lambda Ts |C(e^{iwTs}) / A(e^{iwTs})|^2` of the ARMA model with
+/// coefficients `a = [1, a1, ...]`, `c = [1, c1, ...]` and innovation variance `lambda`
+/// (signal units squared) at each frequency in `freq_hz` (Hz), sampled at `fs_hz`.
+pub fn arma_psd(a: &[f64], c: &[f64], noise_variance: f64, freq_hz: &[f64], fs_hz: f64) -> Vec<f64> {
+    let ts = 1.0 / fs_hz;
+    freq_hz
+        .iter()
+        .map(|&f| {
+            let w = 2.0 * std::f64::consts::PI * f * ts;
+            let num = eval_on_circle(c, w).norm_sqr();
+            let den = eval_on_circle(a, w).norm_sqr();
+            2.0 * noise_variance * ts * num / den
+        })
+        .collect()
 }
 
 /// Sorts discrete-time poles into a [`ModeSet`] at sampling frequency `fs_hz` (Hz).

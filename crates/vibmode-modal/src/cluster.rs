@@ -96,7 +96,7 @@ pub fn analyse_poles(
     for (i, pole) in poles.iter().enumerate() {
         let f = pole.frequency_hz;
         let z = pole.damping_ratio;
-        if !(f >= p.freq_min_hz && f <= p.freq_max_hz && z >= 0.0 && z <= p.max_damping_ratio) {
+        if !(f >= p.freq_min_hz && f <= p.freq_max_hz.unwrap_or(f64::INFINITY) && z >= 0.0 && z <= p.max_damping_ratio) {
             continue;
         }
         let n_ch = channel_ids.len();
@@ -355,7 +355,7 @@ fn summarise(
     let mut channels: Vec<String> = kept.iter().map(|&i| poles[i].channel.clone()).collect();
     channels.sort();
     channels.dedup();
-    let mut roles: Vec<String> = kept.iter().filter_map(|&i| poles[i].role.clone()).collect();
+    let mut roles: Vec<vibmode_core::Role> = kept.iter().filter_map(|&i| poles[i].role).collect();
     roles.sort();
     roles.dedup();
     let record_share = n_supporting as f64 / n_records as f64;

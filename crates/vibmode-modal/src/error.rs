@@ -4,6 +4,9 @@
 /// value and how to fix it.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ModalError {
+    /// A clustering parameter out of its range (see [`vibmode_core::ClusterParams::validate`]).
+    #[error(transparent)]
+    Param(#[from] vibmode_core::ParamError),
     /// A pole has a NaN or infinite frequency (Hz).
     #[error("pole {index} has a non-finite frequency_hz ({value}); drop or fix that pole before clustering")]
     NonFiniteFrequency {

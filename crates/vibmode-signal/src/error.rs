@@ -3,7 +3,12 @@
 
 /// Everything that can go wrong while reading, selecting, writing or resampling a recording.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum SignalError {
+    /// A recording that breaks its invariants (NaN or infinite sample, bad rate, unequal channel
+    /// lengths) or a channel that cannot be found.
+    #[error(transparent)]
+    Recording(#[from] vibmode_core::RecordingError),
     /// The file could not be opened, read or written.
     #[error("cannot {action} {path}: {message}; check the path and permissions")]
     Io {
@@ -54,34 +59,14 @@ pub enum SignalError {
         /// The offending text (truncated to 40 characters).
         text: String,
     },
-    /// A NaN or infinite sample.
-    #[error("channel '{channel}' sample {index} is {value}; clean the data first (remove or interpolate the bad samples)")]
-    NonFinite {
-        /// Channel name.
-        channel: String,
-        /// 0-based sample index.
-        index: usize,
-        /// The value (NaN, inf or -inf).
-        value: f64,
-    },
     /// No time column and no `fs_hz` given.
-    #[error("no time column in {path}; give the sampling rate with --fs HZ")]
+    #[error("no time column in {path}; give its sampling rate (fs_hz)")]
     NoSampleRate {
         /// The file.
         path: String,
     },
-    /// A sampling rate that is not a positive finite number.
-    #[error(
-        "sampling rate {fs_hz} Hz ({what}) must be a positive finite number; give e.g. --fs 500"
-    )]
-    InvalidSampleRate {
-        /// Where the rate came from.
-        what: String,
-        /// The value.
-        fs_hz: f64,
-    },
     /// The rate given by the user and the one found in the file disagree by more than 1 %.
-    #[error("{path}: the sampling rate from {source_name} is {file_fs_hz} Hz but --fs gives {given_fs_hz} Hz (more than 1% apart); drop --fs or fix the file")]
+    #[error("{path}: the sampling rate from {source_name} is {file_fs_hz} Hz but {given_fs_hz} Hz was given (more than 1% apart); give no rate or fix the file")]
     SampleRateMismatch {
         /// The file.
         path: String,
@@ -93,7 +78,7 @@ pub enum SignalError {
         given_fs_hz: f64,
     },
     /// The time column is not uniform enough.
-    #[error("time column '{column}' of {path} is not uniform: jitter {jitter_rel:.3e} of the mean step exceeds {max_jitter_rel:.3e}; pass --resample-nonuniform to interpolate onto a uniform grid at {mean_fs_hz:.6} Hz")]
+    #[error("time column '{column}' of {path} is not uniform: jitter {jitter_rel:.3e} of the mean step exceeds {max_jitter_rel:.3e}; enable resampling of non-uniform time (resample_nonuniform) to interpolate onto a uniform grid at {mean_fs_hz:.6} Hz")]
     NonUniformTime {
         /// The file.
         path: String,
@@ -125,44 +110,6 @@ pub enum SignalError {
     NoChannels {
         /// The file.
         path: String,
-    },
-    /// A channel name not present in the recording.
-    #[error("no channel named '{name}'; available: {available}{hint}")]
-    UnknownChannel {
-        /// The requested name.
-        name: String,
-        /// Comma-separated list of the available names.
-        available: String,
-        /// `"; did you mean 'X'?"` when exactly one name starts with the requested one (ignoring
-        /// case), else empty.
-        hint: String,
-    },
-    /// A channel index out of range.
-    #[error(
-        "channel index {index} is out of range: there are {count} channels (0-based: {available})"
-    )]
-    ChannelIndex {
-        /// The requested 0-based index.
-        index: usize,
-        /// Number of channels.
-        count: usize,
-        /// "0=x, 1=y, 2=z".
-        available: String,
-    },
-    /// An empty channel selector string.
-    #[error("empty channel selector; give a channel name or a 0-based index, e.g. --channel 0")]
-    EmptySelector,
-    /// Channels of different lengths in one recording.
-    #[error("channel '{channel}' has {found} samples but '{first}' has {expected}; all channels must have the same length")]
-    LengthMismatch {
-        /// Offending channel.
-        channel: String,
-        /// Its length.
-        found: usize,
-        /// The first channel's name.
-        first: String,
-        /// The first channel's length.
-        expected: usize,
     },
     /// A missing or malformed JSON sidecar of a raw binary file.
     #[error("sidecar {path}: {reason}")]

@@ -8,7 +8,7 @@
 //!   f32/f64 with a JSON sidecar into a [`Recording`]. The conventions are documented in
 //!   `docs/formats.md`. [`DelimitedReader`] streams text files as blocks of rows.
 //! - [`write_path`] writes CSV (with a `time_s` column), 32-bit float WAV or raw + sidecar.
-//! - [`resample()`], [`Resampler`] and [`Recording::resample`] implement the ideal DFT low-pass
+//! - [`resample()`], [`Resampler`] and [`ResampleRecording::resample`] implement the ideal DFT low-pass
 //!   followed by decimation (integer ratios) or Fourier resampling (other ratios, equal to
 //!   `scipy.signal.resample`); see the [`resample`](mod@resample) module.
 //!
@@ -16,7 +16,7 @@
 //! No function panics on input data.
 //!
 //! ```
-//! use vibmode_signal::{read_delimited, ReadOptions, ResampleParams};
+//! use vibmode_signal::{read_delimited, ReadOptions, ResampleParams, ResampleRecording};
 //! // A semicolon file with decimal commas, a time column in ms and a trailing separator.
 //! let mut text = String::from("Time (ms);Z-Axis [m/s^2];\n");
 //! for i in 0..1000 {
@@ -38,13 +38,12 @@
 //! assert!((low.channels[0].samples[7] - expected).abs() < 1e-9);
 //! ```
 
-#![warn(missing_docs)]
 
 pub mod delimited;
 pub mod error;
 mod number;
 pub mod read;
-pub mod recording;
+mod preprocess;
 pub mod resample;
 pub mod write;
 
@@ -54,6 +53,8 @@ pub use read::{
     read_delimited, read_delimited_bytes, read_path, sidecar_candidates, Format, ReadOptions,
     Sidecar,
 };
-pub use recording::{Channel, ChannelSelector, Recording, TimeAxis};
+pub use preprocess::{preprocess, Preprocessed};
+pub use resample::ResampleRecording;
+pub use vibmode_core::{Channel, ChannelSelector, Recording, RecordingError, RecordingView, TimeAxis};
 pub use resample::{resample, ResampleMethod, ResampleParams, Resampler};
 pub use write::write_path;

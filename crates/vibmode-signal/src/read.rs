@@ -2,7 +2,7 @@
 
 use crate::delimited::{Block, ColumnInfo, DelimitedReader};
 use crate::error::{io_err, Result, SignalError};
-use crate::recording::{check_finite, check_fs, Channel, Recording, TimeAxis};
+use vibmode_core::{check_finite, check_fs, Channel, Recording, RecordingError, TimeAxis};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::io::BufRead;
@@ -118,7 +118,7 @@ impl Default for ReadOptions {
 /// All samples are checked to be finite; channel order is file order (time column removed).
 pub fn read_path(path: &Path, opts: &ReadOptions) -> Result<Recording> {
     if let Some(fs) = opts.fs_hz {
-        check_fs(fs, "--fs")?;
+        check_fs(fs, "the given fs_hz")?;
     }
     if !(opts.max_jitter_rel.is_finite() && opts.max_jitter_rel >= 0.0) {
         return Err(SignalError::InvalidParam {
@@ -227,11 +227,7 @@ fn finish_delimited(
             let scale = c.time_scale_s.unwrap_or(1.0);
             time = Some(d.into_iter().map(|v| v * scale).collect());
         } else {
-            channels.push(Channel {
-                name: c.name.clone(),
-                unit: c.unit.clone(),
-                samples: d,
-            });
+            channels.push(Channel::new(c.name.clone(), c.unit.clone(), d));
         }
     }
     if channels.is_empty() {
@@ -245,11 +241,12 @@ fn finish_delimited(
             let name = cols[ti].name.clone();
             let n = t.len();
             if let Some(k) = t.iter().position(|v| !v.is_finite()) {
-                return Err(SignalError::NonFinite {
+                return Err(RecordingError::NonFinite {
                     channel: name,
                     index: k,
                     value: t[k],
-                });
+                }
+                .into());
             }
             if n < 2 {
                 return Err(SignalError::TooShort {
@@ -411,6 +408,7 @@ fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Recording> {
     )?;
     let channels: Vec<Channel> = (0..nch)
         .map(|c| Channel {
+            placement: Default::default(),
             name: format!("ch{c}"),
             unit: String::new(),
             samples: interleaved
@@ -528,6 +526,7 @@ fn read_raw(path: &Path, opts: &ReadOptions) -> Result<Recording> {
         .iter()
         .enumerate()
         .map(|(i, name)| Channel {
+            placement: Default::default(),
             name: name.clone(),
             unit: side
                 .units

@@ -38,7 +38,7 @@
 //! above it is refused (it would alias on decimation and has no effect on the Fourier path).
 
 use crate::error::{Result, SignalError};
-use crate::recording::{check_fs, Channel, Recording, TimeAxis};
+use vibmode_core::{check_fs, Channel, Recording, RecordingError, TimeAxis};
 use num_complex::Complex;
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 use serde::{Deserialize, Serialize};
@@ -323,11 +323,12 @@ impl Resampler {
             });
         }
         if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-            return Err(SignalError::NonFinite {
+            return Err(RecordingError::NonFinite {
                 channel: "input".into(),
                 index: i,
                 value: x[i],
-            });
+            }
+            .into());
         }
         match self.kind {
             Kind::Pick => {
@@ -451,27 +452,38 @@ pub fn resample(x: &[f64], fs_hz: f64, p: &ResampleParams) -> Result<Vec<f64>> {
     Ok(out)
 }
 
-impl Recording {
+/// Resampling of a whole [`Recording`] (an extension trait: the recording type lives in
+/// `vibmode-core`, which does no numerics).
+pub trait ResampleRecording {
     /// Resamples every channel (one planned [`Resampler`] shared by all channels). The new
     /// `fs_hz` is [`Resampler::fs_out_hz`]; a time axis keeps its start time and column name,
     /// with `fs_hz` the new rate and `jitter_rel` 0.
-    pub fn resample(&self, p: &ResampleParams) -> Result<Recording> {
+    fn resample(&self, p: &ResampleParams) -> Result<Recording>;
+}
+
+impl ResampleRecording for Recording {
+    /// Resamples every channel (one planned [`Resampler`] shared by all channels). The new
+    /// `fs_hz` is [`Resampler::fs_out_hz`]; a time axis keeps its start time and column name,
+    /// with `fs_hz` the new rate and `jitter_rel` 0.
+    fn resample(&self, p: &ResampleParams) -> Result<Recording> {
         let mut r = Resampler::new(self.len(), self.fs_hz, p)?;
         let mut channels = Vec::with_capacity(self.channels.len());
         for c in &self.channels {
             let mut out = vec![0.0; r.n_out()];
             r.process(&c.samples, &mut out).map_err(|e| match e {
-                SignalError::NonFinite { index, value, .. } => SignalError::NonFinite {
-                    channel: c.name.clone(),
-                    index,
-                    value,
-                },
+                SignalError::Recording(RecordingError::NonFinite { index, value, .. }) => {
+                    RecordingError::NonFinite {
+                        channel: c.name.clone(),
+                        index,
+                        value,
+                    }
+                    .into()
+                }
                 other => other,
             })?;
             channels.push(Channel {
-                name: c.name.clone(),
-                unit: c.unit.clone(),
                 samples: out,
+                ..Channel::new(c.name.clone(), c.unit.clone(), Vec::new()).with_placement(c.placement)
             });
         }
         Ok(Recording {

@@ -2,7 +2,7 @@
 
 use crate::error::{io_err, Result, SignalError};
 use crate::read::{Format, Sidecar};
-use crate::recording::{check_fs, Recording};
+use vibmode_core::{check_fs, Recording};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 

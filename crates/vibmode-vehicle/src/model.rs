@@ -112,6 +112,8 @@ pub struct ModeInfo {
 #[derive(Debug, Clone)]
 pub(crate) struct SensorRow {
     pub name: String,
+    /// Role, corner and direction (vertical) of the sensor.
+    pub placement: vibmode_core::Placement,
     /// Sensor displacement = row . q.
     pub row: DVector<f64>,
 }
@@ -219,6 +221,11 @@ impl FullCar {
                 }
                 SensorRow {
                     name: s.name.clone(),
+                    placement: vibmode_core::Placement {
+                        role: s.kind.role(),
+                        corner: s.corner,
+                        direction: Some(vibmode_core::Direction::Z),
+                    },
                     row,
                 }
             })
@@ -268,6 +275,11 @@ impl FullCar {
     /// Sensor (channel) names in output order.
     pub fn sensor_names(&self) -> Vec<String> {
         self.sensors.iter().map(|s| s.name.clone()).collect()
+    }
+
+    /// Sensor placements (role, corner, direction) in output order.
+    pub fn sensor_placements(&self) -> Vec<vibmode_core::Placement> {
+        self.sensors.iter().map(|s| s.placement).collect()
     }
 
     /// Mass matrix (diagonal), kg and kg m^2.

@@ -5,64 +5,16 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
 
-/// One wheel station. Coordinates: x forward from the centre of gravity, y to the left.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum Corner {
-    /// Front left.
-    FL,
-    /// Front right.
-    FR,
-    /// Rear left.
-    RL,
-    /// Rear right.
-    RR,
-}
+/// One wheel station (FL, FR, RL, RR; coordinates: x forward from the centre of gravity, y to
+/// the left). Defined once in `vibmode-core`.
+pub use vibmode_core::Corner;
 
-impl Corner {
-    /// All corners in model order (FL, FR, RL, RR): the order of road inputs and wheel DOFs.
-    pub const ALL: [Corner; 4] = [Corner::FL, Corner::FR, Corner::RL, Corner::RR];
-
-    /// Index 0..4 in model order.
-    pub fn index(self) -> usize {
+impl SensorKind {
+    /// The channel role of a sensor of this kind.
+    pub fn role(self) -> vibmode_core::Role {
         match self {
-            Corner::FL => 0,
-            Corner::FR => 1,
-            Corner::RL => 2,
-            Corner::RR => 3,
-        }
-    }
-
-    /// True for FL and FR.
-    pub fn is_front(self) -> bool {
-        matches!(self, Corner::FL | Corner::FR)
-    }
-}
-
-impl fmt::Display for Corner {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let s = match self {
-            Corner::FL => "FL",
-            Corner::FR => "FR",
-            Corner::RL => "RL",
-            Corner::RR => "RR",
-        };
-        f.write_str(s)
-    }
-}
-
-impl FromStr for Corner {
-    type Err = VehicleError;
-    fn from_str(s: &str) -> Result<Self> {
-        match s.trim().to_ascii_uppercase().as_str() {
-            "FL" => Ok(Corner::FL),
-            "FR" => Ok(Corner::FR),
-            "RL" => Ok(Corner::RL),
-            "RR" => Ok(Corner::RR),
-            _ => Err(VehicleError::UnknownName {
-                what: "corner",
-                value: s.to_string(),
-                valid: "FL, FR, RL, RR",
-            }),
+            SensorKind::Sprung => vibmode_core::Role::Sprung,
+            SensorKind::Unsprung => vibmode_core::Role::Unsprung,
         }
     }
 }

@@ -11,6 +11,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
+use vibmode_core::{Channel, Recording};
 use std::f64::consts::PI;
 
 /// A periodic engine / driveline line: a vertical force on the body.
@@ -378,37 +379,13 @@ impl SimParams {
 /// One record: successive segment of the drive.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SimRecord {
-    /// Sampling rate, Hz.
-    pub fs_hz: f64,
+    /// The accelerations: one channel per sensor (named after it, unit m/s^2, with the sensor's
+    /// role, corner and direction), at the simulation rate.
+    pub recording: Recording,
     /// Time of the first sample from the start of record 0, s.
     pub start_time_s: f64,
     /// Mean speed during the record, km/h.
     pub mean_speed_kmh: f64,
-    /// Channel names (sensor names).
-    pub channel_names: Vec<String>,
-    /// Vertical acceleration per channel, m/s^2 (`samples[channel][sample]`).
-    pub samples: Vec<Vec<f64>>,
-}
-
-impl SimRecord {
-    /// The record as a [`vibmode_signal::Recording`] (channels named after the sensors, unit
-    /// m/s^2, no time column), ready for the analysis or for writing.
-    pub fn to_recording(&self) -> vibmode_signal::Recording {
-        vibmode_signal::Recording {
-            fs_hz: self.fs_hz,
-            channels: self
-                .channel_names
-                .iter()
-                .zip(&self.samples)
-                .map(|(name, samples)| vibmode_signal::Channel {
-                    name: name.clone(),
-                    unit: "m/s^2".into(),
-                    samples: samples.clone(),
-                })
-                .collect(),
-            time_axis: None,
-        }
-    }
 }
 
 /// Ground truth of a simulation.
@@ -757,6 +734,7 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
     let d = Discrete::new(&car, fs)?;
     let p = car.sensors.len();
     let names = car.sensor_names();
+    let placements = car.sensor_placements();
     let mut samples: Vec<Vec<f64>> = vec![vec![0.0; n_rec * sim.records]; p];
     // State index k of `run` corresponds to array index k + 1.
     d.run(
@@ -833,12 +811,21 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
         let a = r * n_rec;
         let i0 = n_warm + a + 1;
         let mean_v = speed[i0..i0 + n_rec].iter().sum::<f64>() / n_rec as f64;
+        let channels = samples
+            .iter_mut()
+            .zip(names.iter().zip(&placements))
+            .map(|(s, (name, placement))| {
+                Channel::new(name.clone(), "m/s^2", s.split_off(a)).with_placement(*placement)
+            })
+            .collect();
         records.push(SimRecord {
-            fs_hz: fs,
+            recording: Recording {
+                fs_hz: fs,
+                channels,
+                time_axis: None,
+            },
             start_time_s: a as f64 * dt,
             mean_speed_kmh: mean_v * 3.6,
-            channel_names: names.clone(),
-            samples: samples.iter_mut().map(|s| s.split_off(a)).collect(),
         });
     }
     records.reverse();

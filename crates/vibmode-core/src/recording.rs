@@ -1,12 +1,13 @@
 //! The in-memory recording: channels of equally long sample vectors at one sampling rate.
 
-use crate::error::{Result, SignalError};
+use crate::error::RecordingError;
+use crate::placement::Placement;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
 
 /// One measured signal.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
 pub struct Channel {
     /// Channel name, e.g. `FL` or `Z-Axis` (without the unit).
     pub name: String,
@@ -14,6 +15,27 @@ pub struct Channel {
     pub unit: String,
     /// The samples, in `unit`, equally spaced at the recording's `fs_hz`.
     pub samples: Vec<f64>,
+    /// Where the sensor sits on the vehicle (role, corner, direction); all unknown by default.
+    #[serde(default)]
+    pub placement: Placement,
+}
+
+impl Channel {
+    /// A channel with an unknown placement.
+    pub fn new(name: impl Into<String>, unit: impl Into<String>, samples: Vec<f64>) -> Channel {
+        Channel {
+            name: name.into(),
+            unit: unit.into(),
+            samples,
+            placement: Placement::default(),
+        }
+    }
+
+    /// The same channel with a placement.
+    pub fn with_placement(mut self, placement: Placement) -> Channel {
+        self.placement = placement;
+        self
+    }
 }
 
 /// Where the sampling rate of a delimited file came from, when it had a time column.
@@ -57,11 +79,11 @@ pub enum ChannelSelector {
 }
 
 impl FromStr for ChannelSelector {
-    type Err = SignalError;
-    fn from_str(s: &str) -> Result<Self> {
+    type Err = RecordingError;
+    fn from_str(s: &str) -> Result<Self, RecordingError> {
         let t = s.trim();
         if t.is_empty() {
-            return Err(SignalError::EmptySelector);
+            return Err(RecordingError::EmptySelector);
         }
         if t.bytes().all(|b| b.is_ascii_digit()) {
             if let Ok(i) = t.parse::<usize>() {
@@ -81,11 +103,12 @@ impl fmt::Display for ChannelSelector {
     }
 }
 
-pub(crate) fn check_fs(fs_hz: f64, what: &str) -> Result<()> {
+/// Checks that a sampling rate is positive and finite; `what` names where it came from.
+pub fn check_fs(fs_hz: f64, what: &str) -> Result<(), RecordingError> {
     if fs_hz.is_finite() && fs_hz > 0.0 {
         Ok(())
     } else {
-        Err(SignalError::InvalidSampleRate {
+        Err(RecordingError::InvalidSampleRate {
             what: what.to_string(),
             fs_hz,
         })
@@ -95,12 +118,12 @@ pub(crate) fn check_fs(fs_hz: f64, what: &str) -> Result<()> {
 impl Recording {
     /// Builds a recording, checking the invariants: `fs_hz` positive and finite, equal channel
     /// lengths, finite samples. `time_axis` is `None`.
-    pub fn new(fs_hz: f64, channels: Vec<Channel>) -> Result<Recording> {
+    pub fn new(fs_hz: f64, channels: Vec<Channel>) -> Result<Recording, RecordingError> {
         check_fs(fs_hz, "fs_hz")?;
         if let Some(first) = channels.first() {
             for c in &channels {
                 if c.samples.len() != first.samples.len() {
-                    return Err(SignalError::LengthMismatch {
+                    return Err(RecordingError::LengthMismatch {
                         channel: c.name.clone(),
                         found: c.samples.len(),
                         first: first.name.clone(),
@@ -190,7 +213,7 @@ impl Recording {
     /// An empty selection returns a copy of all channels.
     ///
     /// Errors: unknown name (lists the available names), index out of range.
-    pub fn select(&self, sel: &[ChannelSelector]) -> Result<Recording> {
+    pub fn select(&self, sel: &[ChannelSelector]) -> Result<Recording, RecordingError> {
         if sel.is_empty() {
             return Ok(self.clone());
         }
@@ -199,7 +222,7 @@ impl Recording {
             let i = match s {
                 ChannelSelector::Index(i) => {
                     if *i >= self.channels.len() {
-                        return Err(SignalError::ChannelIndex {
+                        return Err(RecordingError::ChannelIndex {
                             index: *i,
                             count: self.channels.len(),
                             available: self
@@ -215,7 +238,7 @@ impl Recording {
                 }
                 ChannelSelector::Name(n) => {
                     self.position(n)
-                        .ok_or_else(|| SignalError::UnknownChannel {
+                        .ok_or_else(|| RecordingError::UnknownChannel {
                             name: n.clone(),
                             available: self.names().join(", "),
                             hint: self.prefix_hint(n),
@@ -235,12 +258,12 @@ impl Recording {
     /// samples of a record). The time axis start moves accordingly.
     ///
     /// Errors: `start >= end` or `end > len()`.
-    pub fn slice(&self, start: usize, end: usize) -> Result<Recording> {
+    pub fn slice(&self, start: usize, end: usize) -> Result<Recording, RecordingError> {
         if start >= end || end > self.len() {
-            return Err(SignalError::InvalidParam {
-                name: "sample range",
-                value: format!("{start}..{end}"),
-                fix: format!("need start < end <= {} (the number of samples)", self.len()),
+            return Err(RecordingError::InvalidRange {
+                start,
+                end,
+                len: self.len(),
             });
         }
         Ok(Recording {
@@ -252,6 +275,7 @@ impl Recording {
                     name: c.name.clone(),
                     unit: c.unit.clone(),
                     samples: c.samples[start..end].to_vec(),
+                    placement: c.placement,
                 })
                 .collect(),
             time_axis: self.time_axis.as_ref().map(|t| TimeAxis {
@@ -262,10 +286,11 @@ impl Recording {
     }
 }
 
-pub(crate) fn check_finite(channels: &[Channel]) -> Result<()> {
+/// Checks that every sample of every channel is finite (the first bad one is named).
+pub fn check_finite(channels: &[Channel]) -> Result<(), RecordingError> {
     for c in channels {
         if let Some(i) = c.samples.iter().position(|v| !v.is_finite()) {
-            return Err(SignalError::NonFinite {
+            return Err(RecordingError::NonFinite {
                 channel: c.name.clone(),
                 index: i,
                 value: c.samples[i],
@@ -273,4 +298,89 @@ pub(crate) fn check_finite(channels: &[Channel]) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// A borrowed view of a recording: a sample range of every channel, without copying.
+///
+/// Record sources hand these to the analysis so that cutting a long recording into records costs
+/// no copy of the samples.
+#[derive(Clone, Copy, Debug)]
+pub struct RecordingView<'a> {
+    /// The recording viewed.
+    pub recording: &'a Recording,
+    /// First sample of the view.
+    pub start: usize,
+    /// One past the last sample of the view.
+    pub end: usize,
+}
+
+impl<'a> RecordingView<'a> {
+    /// Sampling rate, Hz.
+    pub fn fs_hz(&self) -> f64 {
+        self.recording.fs_hz
+    }
+
+    /// Number of samples per channel in the view.
+    pub fn len(&self) -> usize {
+        self.end - self.start
+    }
+
+    /// True if the view holds no samples.
+    pub fn is_empty(&self) -> bool {
+        self.end == self.start
+    }
+
+    /// Duration of the view in seconds.
+    pub fn duration_s(&self) -> f64 {
+        self.len() as f64 / self.recording.fs_hz
+    }
+
+    /// The samples of channel `i` in the view (`None` for an index out of range).
+    pub fn samples(&self, i: usize) -> Option<&'a [f64]> {
+        self.recording
+            .channels
+            .get(i)
+            .map(|c| &c.samples[self.start..self.end])
+    }
+
+    /// An owned copy of the view (the time axis start moved to the view's first sample).
+    pub fn to_recording(&self) -> Recording {
+        Recording {
+            fs_hz: self.recording.fs_hz,
+            channels: self
+                .recording
+                .channels
+                .iter()
+                .map(|c| Channel {
+                    samples: c.samples[self.start..self.end].to_vec(),
+                    ..Channel::new(c.name.clone(), c.unit.clone(), Vec::new())
+                        .with_placement(c.placement)
+                })
+                .collect(),
+            time_axis: self.recording.time_axis.as_ref().map(|t| TimeAxis {
+                start_s: t.start_s + self.start as f64 / self.recording.fs_hz,
+                ..t.clone()
+            }),
+        }
+    }
+}
+
+impl Recording {
+    /// A borrowed view of samples `start..end` of every channel.
+    ///
+    /// Errors: `start >= end` or `end > len()`.
+    pub fn view(&self, start: usize, end: usize) -> Result<RecordingView<'_>, RecordingError> {
+        if start >= end || end > self.len() {
+            return Err(RecordingError::InvalidRange {
+                start,
+                end,
+                len: self.len(),
+            });
+        }
+        Ok(RecordingView {
+            recording: self,
+            start,
+            end,
+        })
+    }
 }

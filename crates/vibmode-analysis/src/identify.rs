@@ -1,0 +1,126 @@
+//! Stage 3, identification: models fitted to each (record, channel) signal and their poles.
+//! Today the ARMA/AR order sweep per channel ([`SweepIdentifier`]); a multichannel method is a
+//! second implementation of [`Identifier`].
+
+use serde::{Deserialize, Serialize};
+use vibmode_core::{
+    BandLimit, FitSummary, ModelCoefficients, PoleFilterParams, SweepModel, SweepParams,
+};
+use vibmode_ident::{ArMethod, ArmaModel, ArmaParams, IdentError};
+
+/// One pole pair of one fit that passed the pole filters.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PoleOut {
+    /// Record index.
+    pub record: usize,
+    /// Model order p.
+    pub order: usize,
+    /// Natural frequency, Hz.
+    pub frequency_hz: f64,
+    /// Damping ratio.
+    pub damping_ratio: f64,
+}
+
+/// What identification found in one signal.
+#[derive(Clone, Debug, Default)]
+pub struct SignalFits {
+    /// Poles of every fit that passed the pole filters.
+    pub poles: Vec<PoleOut>,
+    /// Every fit's summary (failed fits keep their reason).
+    pub fits: Vec<FitSummary>,
+    /// Coefficients of the fits at the requested orders.
+    pub models: Vec<ModelCoefficients>,
+}
+
+/// An identification method for one signal of one record.
+pub trait Identifier: Sync {
+    /// Fits the signal `y` of record `record`, which carries the band `band`; keeps the
+    /// coefficients of the fits whose order is in `keep_orders`.
+    fn identify(&self, y: &[f64], band: &BandLimit, record: usize, keep_orders: &[usize]) -> SignalFits;
+}
+
+/// The paper's method: an order sweep of ARMA(p,p) (or AR(p)) models, warm-started order to
+/// order, each fit's modes through the shared pole filters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SweepIdentifier {
+    /// The sweep's settings.
+    pub sweep: SweepParams,
+    /// The pole filters.
+    pub poles: PoleFilterParams,
+}
+
+impl SweepIdentifier {
+    /// The prediction-error settings of each fit of the sweep.
+    pub fn arma_params(&self, band: &BandLimit) -> ArmaParams {
+        ArmaParams {
+            robust: self.sweep.robust,
+            max_iter: self.sweep.max_iterations,
+            tol: self.sweep.tolerance,
+            band: Some(*band),
+            ..ArmaParams::default()
+        }
+    }
+
+    fn fits(&self, y: &[f64], band: &BandLimit) -> Vec<Result<ArmaModel, IdentError>> {
+        let orders = self.sweep.orders();
+        match self.sweep.model {
+            SweepModel::Arma => vibmode_ident::sweep_arma(y, &orders, &self.arma_params(band)),
+            SweepModel::Ar => orders
+                .iter()
+                .map(|&p| vibmode_ident::fit_ar(y, p, ArMethod::Burg))
+                .collect(),
+        }
+    }
+}
+
+impl Identifier for SweepIdentifier {
+    fn identify(&self, y: &[f64], band: &BandLimit, record: usize, keep_orders: &[usize]) -> SignalFits {
+        let mut out = SignalFits::default();
+        for (order, fit) in self.sweep.orders().into_iter().zip(self.fits(y, band)) {
+            match fit {
+                Ok(m) => {
+                    let set = m.modes(band.fs_hz);
+                    let modes = vibmode_ident::filter_mode_set(&m, &set, band, &self.poles);
+                    out.poles.extend(modes.iter().filter(|f| f.rejected.is_none()).map(|f| {
+                        PoleOut {
+                            record,
+                            order,
+                            frequency_hz: f.mode.frequency_hz,
+                            damping_ratio: f.mode.damping_ratio,
+                        }
+                    }));
+                    if keep_orders.contains(&order) {
+                        out.models.push(ModelCoefficients {
+                            order,
+                            fs_hz: band.fs_hz,
+                            a: m.a.clone(),
+                            c: m.c.clone(),
+                            noise_variance: m.noise_variance,
+                        });
+                    }
+                    out.fits.push(FitSummary {
+                        record,
+                        order,
+                        loss: m.loss,
+                        noise_variance: m.noise_variance,
+                        converged: m.converged,
+                        n_unstable: set.unstable_poles.len(),
+                        failed: false,
+                        error: None,
+                    });
+                }
+                Err(e) => out.fits.push(FitSummary {
+                    record,
+                    order,
+                    loss: f64::NAN,
+                    noise_variance: f64::NAN,
+                    converged: false,
+                    n_unstable: 0,
+                    failed: true,
+                    error: Some(e.to_string()),
+                }),
+            }
+        }
+        out
+    }
+}

@@ -1,0 +1,119 @@
+//! The results of an analysis: plain versioned structs, serialised as `results.json`. Nothing
+//! in here exists only for the report (spectra of single records and model spectra on a grid
+//! are computed by the report from the records and the kept model coefficients).
+
+use serde::{Deserialize, Serialize};
+use vibmode_core::{
+    BandLimit, FitSummary, InvariantMode, ModeMatch, ModelCoefficients, Placement, ReferenceMode,
+    Role,
+};
+
+use crate::config::AnalysisConfig;
+use crate::identify::PoleOut;
+
+/// Version of the layout of [`AnalysisResults`] (`schema_version` in `results.json`). 2: stage
+/// sections in `config`, per-record bands, fit errors kept, model coefficients instead of model
+/// spectra, timing apart.
+pub const SCHEMA_VERSION: u32 = 2;
+
+/// Facts about one analysed record.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RecordSummary {
+    /// Display name.
+    pub name: String,
+    /// Original sampling rate, Hz.
+    pub fs_hz: f64,
+    /// Original number of samples.
+    pub n_samples: usize,
+    /// Duration, s.
+    pub duration_s: f64,
+    /// The band of the record after pre-processing: the analysis rate actually reached (with a
+    /// non-integer rate ratio it can differ from `analysis_fs_hz` by a hair), the cutoff applied
+    /// and whether an empty band lies above it. This record's poles were computed at this rate.
+    pub band: BandLimit,
+    /// Activity per channel: RMS of the acceleration in `activity_min_hz..cutoff_hz`, from the
+    /// record's Welch PSD at the analysis rate (square root of its integral over the band), in
+    /// the channel's unit.
+    pub activity_rms: Vec<f64>,
+    /// Activity relative to the other records: per channel `activity_rms` divided by its median
+    /// over all records, then the median over channels (1 = a typical record).
+    pub activity_ratio: f64,
+    /// True when `activity_ratio < stop_rms_ratio`: the vehicle was (mostly) at rest, the record
+    /// is left out of the invariant-mode statistics (its poles are still in `poles`).
+    pub stationary: bool,
+    /// Why the record is left out of the mode statistics (None = used).
+    pub excluded_reason: Option<String>,
+}
+
+/// Everything found for one channel.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ChannelAnalysis {
+    /// Channel name.
+    pub name: String,
+    /// Unit of the samples.
+    pub unit: String,
+    /// Role on the vehicle.
+    pub role: Role,
+    /// Role, corner and direction.
+    pub placement: Placement,
+    /// Welch frequencies, Hz.
+    pub welch_freq_hz: Vec<f64>,
+    /// Welch PSD averaged over the records used for the modes (stops left out), (unit)^2/Hz.
+    pub welch_psd: Vec<f64>,
+    /// Every pole pair of every fit that passed the pole filters.
+    pub poles: Vec<PoleOut>,
+    /// Every fit's summary.
+    pub fits: Vec<FitSummary>,
+    /// Coefficients of the first record's models at the report's `model_psd_orders`.
+    pub first_record_models: Vec<ModelCoefficients>,
+    /// Invariant modes of this channel alone.
+    pub invariant_modes: Vec<InvariantMode>,
+}
+
+/// Modes pooled over all channels of one role.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RoleAnalysis {
+    /// The role.
+    pub role: Role,
+    /// Channels pooled.
+    pub channels: Vec<String>,
+    /// Invariant modes of the pool.
+    pub invariant_modes: Vec<InvariantMode>,
+    /// Reference (physical model) modes matched to the invariant structural modes.
+    pub matches: Vec<ModeMatch>,
+}
+
+/// How long the analysis took (kept apart from the results: it differs run to run).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct Timing {
+    /// Wall-clock time of the analysis, s.
+    pub elapsed_s: f64,
+}
+
+/// The whole analysis.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct AnalysisResults {
+    /// Layout version ([`SCHEMA_VERSION`]).
+    pub schema_version: u32,
+    /// Settings used.
+    pub config: AnalysisConfig,
+    /// Records analysed.
+    pub records: Vec<RecordSummary>,
+    /// Per channel results.
+    pub channels: Vec<ChannelAnalysis>,
+    /// Per role results.
+    pub roles: Vec<RoleAnalysis>,
+    /// Physical model modes used for matching (empty without a vehicle model).
+    pub reference_modes: Vec<ReferenceMode>,
+    /// Number of records marked `stationary` (stops), left out of the mode statistics; the
+    /// invariant modes' `record_share` and `order_share` are relative to the other records.
+    pub n_stationary: usize,
+    /// Number of model fits run.
+    pub n_fits: usize,
+    /// Number of fits that did not converge (failed fits included).
+    pub n_not_converged: usize,
+    /// Number of fits that failed outright (their `error` says why).
+    pub n_failed: usize,
+    /// Wall-clock time.
+    pub timing: Timing,
+}

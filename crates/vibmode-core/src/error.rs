@@ -1,0 +1,119 @@
+//! Errors of the core types. Messages name the offending value and the fix, never a
+//! command-line flag: the front end (CLI, Python) adds its own hints.
+
+/// A recording that breaks its invariants, or a channel that cannot be found.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum RecordingError {
+    /// A NaN or infinite sample.
+    #[error("channel '{channel}' sample {index} is {value}; clean the data first (remove or interpolate the bad samples)")]
+    NonFinite {
+        /// Channel name.
+        channel: String,
+        /// 0-based sample index.
+        index: usize,
+        /// The value (NaN, inf or -inf).
+        value: f64,
+    },
+    /// A sampling rate that is not a positive finite number.
+    #[error("sampling rate {fs_hz} Hz ({what}) must be a positive finite number")]
+    InvalidSampleRate {
+        /// Where the rate came from.
+        what: String,
+        /// The value.
+        fs_hz: f64,
+    },
+    /// A channel name not present in the recording.
+    #[error("no channel named '{name}'; available: {available}{hint}")]
+    UnknownChannel {
+        /// The requested name.
+        name: String,
+        /// Comma-separated list of the available names.
+        available: String,
+        /// `"; did you mean 'X'?"` when exactly one name starts with the requested one (ignoring
+        /// case), else empty.
+        hint: String,
+    },
+    /// A channel index out of range.
+    #[error(
+        "channel index {index} is out of range: there are {count} channels (0-based: {available})"
+    )]
+    ChannelIndex {
+        /// The requested 0-based index.
+        index: usize,
+        /// Number of channels.
+        count: usize,
+        /// "0=x, 1=y, 2=z".
+        available: String,
+    },
+    /// An empty channel selector string.
+    #[error("empty channel selector; give a channel name or a 0-based index")]
+    EmptySelector,
+    /// Channels of different lengths in one recording.
+    #[error("channel '{channel}' has {found} samples but '{first}' has {expected}; all channels must have the same length")]
+    LengthMismatch {
+        /// Offending channel.
+        channel: String,
+        /// Its length.
+        found: usize,
+        /// The first channel's name.
+        first: String,
+        /// The first channel's length.
+        expected: usize,
+    },
+    /// A sample range outside the recording.
+    #[error("sample range {start}..{end} is invalid: need start < end <= {len} (the number of samples)")]
+    InvalidRange {
+        /// First sample asked for.
+        start: usize,
+        /// One past the last sample asked for.
+        end: usize,
+        /// Number of samples in the recording.
+        len: usize,
+    },
+}
+
+/// A parameter outside its valid range, or a name that is not one of the valid ones.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ParamError {
+    /// A value out of range.
+    #[error("{name} = {value} {requirement}; use e.g. {name} = {suggestion}")]
+    OutOfRange {
+        /// Parameter name as in the params struct (and the TOML key).
+        name: &'static str,
+        /// The offending value, formatted.
+        value: String,
+        /// The rule it breaks, e.g. "must be > 0".
+        requirement: &'static str,
+        /// A valid value (usually the default).
+        suggestion: String,
+    },
+    /// A name that is not one of the valid ones (a preset, a model, a corner...).
+    #[error("unknown {what} '{value}'; valid: {valid}")]
+    UnknownName {
+        /// What was being named.
+        what: &'static str,
+        /// The text given.
+        value: String,
+        /// The valid names.
+        valid: &'static str,
+    },
+}
+
+impl ParamError {
+    /// Shorthand for [`ParamError::OutOfRange`].
+    pub fn out_of_range(
+        name: &'static str,
+        value: impl ToString,
+        requirement: &'static str,
+        suggestion: impl ToString,
+    ) -> ParamError {
+        ParamError::OutOfRange {
+            name,
+            value: value.to_string(),
+            requirement,
+            suggestion: suggestion.to_string(),
+        }
+    }
+}

@@ -1,0 +1,215 @@
+//! Poles, invariant modes and model fits: what identification and clustering exchange.
+
+use std::fmt;
+use std::str::FromStr;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::ParamError;
+use crate::placement::Role;
+
+/// One complex pole pair of one fitted model, as a mode: natural frequency and damping ratio,
+/// tagged with where it came from.
+///
+/// This crate does not depend on the identification crates; convert their poles into this type.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PoleObservation {
+    /// Undamped natural frequency, Hz (`|ln z| / (2 pi T_s)`).
+    pub frequency_hz: f64,
+    /// Damping ratio (dimensionless, `-Re(s)/|s|`), 0 < zeta < 1 for a stable resonant pole.
+    pub damping_ratio: f64,
+    /// Model order p of the fit that produced the pole.
+    pub order: usize,
+    /// Record (segment) index, 0-based, must be `< n_records`.
+    pub record: usize,
+    /// Channel (sensor) name, e.g. "FR_sprung".
+    pub channel: String,
+    /// Optional role of the channel (sprung / unsprung / other).
+    pub role: Option<Role>,
+    /// Mode shape at the sensors, one complex amplitude `[re, im]` per channel, when the
+    /// identification method gives one (multichannel methods); `None` for single-channel fits.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<Vec<[f64; 2]>>,
+}
+
+impl PoleObservation {
+    /// Convenience constructor without a role. Frequency in Hz, damping ratio dimensionless.
+    pub fn new(
+        frequency_hz: f64,
+        damping_ratio: f64,
+        order: usize,
+        record: usize,
+        channel: impl Into<String>,
+    ) -> Self {
+        PoleObservation {
+            frequency_hz,
+            damping_ratio,
+            order,
+            record,
+            channel: channel.into(),
+            role: None,
+            shape: None,
+        }
+    }
+}
+
+/// Class of a pole cluster.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ModeClass {
+    /// Invariant mode of the structure (suspension): supported by enough records and orders and
+    /// not a periodic disturbance.
+    Structural,
+    /// Invariant, very lightly damped and frequency-stable cluster: an engine/gear line, not a mode
+    /// of the suspension. Filter it out before further identification.
+    PeriodicDisturbance,
+    /// Dense cluster that fails the support tests (too few records or orders): not invariant.
+    Spurious,
+}
+
+impl ModeClass {
+    const VALID: &'static str = "structural, periodic-disturbance, spurious";
+}
+
+impl fmt::Display for ModeClass {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            ModeClass::Structural => "structural",
+            ModeClass::PeriodicDisturbance => "periodic-disturbance",
+            ModeClass::Spurious => "spurious",
+        })
+    }
+}
+
+impl FromStr for ModeClass {
+    type Err = ParamError;
+    /// Case-insensitive; accepts `_` or `-` as separator and the short form `disturbance`.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().replace('_', "-").as_str() {
+            "structural" => Ok(ModeClass::Structural),
+            "periodic-disturbance" | "disturbance" | "periodic" => {
+                Ok(ModeClass::PeriodicDisturbance)
+            }
+            "spurious" => Ok(ModeClass::Spurious),
+            _ => Err(ParamError::UnknownName {
+                what: "mode class",
+                value: s.to_string(),
+                valid: Self::VALID,
+            }),
+        }
+    }
+}
+
+/// One cluster of poles (an invariant mode, a periodic disturbance, or a spurious cluster).
+///
+/// Statistics are computed over the cluster's poles after keeping at most one pole per
+/// (record, channel, order) fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct InvariantMode {
+    /// Mean natural frequency of the cluster's poles, Hz.
+    pub frequency_hz: f64,
+    /// Sample standard deviation (n-1) of the poles' frequencies, Hz (0 for a single pole).
+    pub frequency_std_hz: f64,
+    /// Median damping ratio of the cluster's poles (dimensionless).
+    pub damping_ratio: f64,
+    /// 25th and 75th percentiles of the damping ratio (linear interpolation, numpy default).
+    pub damping_iqr: (f64, f64),
+    /// Share (0..1) of the `n_records x orders.len()` (record, order) fits in which the cluster has
+    /// at least one pole (in any channel) = mean over records of the share of orders.
+    pub order_share: f64,
+    /// Share (0..1) of the `n_records` records that contain the cluster, a record counting when the
+    /// cluster has poles in at least `max(1, ceil(record_min_order_share * orders.len()))` of its
+    /// orders.
+    pub record_share: f64,
+    /// Number of poles in the cluster (at most one per (record, channel, order)).
+    pub n_poles: usize,
+    /// Distinct channels contributing poles, sorted.
+    pub channels: Vec<String>,
+    /// Distinct roles of the contributing poles (those that have one), sorted.
+    pub roles: Vec<Role>,
+    /// Lowest model order contributing a pole.
+    pub min_order: usize,
+    /// Classification.
+    pub class: ModeClass,
+}
+
+impl InvariantMode {
+    /// True for `Structural` and `PeriodicDisturbance` (the cluster passed the support tests).
+    pub fn is_invariant(&self) -> bool {
+        self.class != ModeClass::Spurious
+    }
+}
+
+/// A mode of a physical reference model (e.g. the full-car model eigenvalues).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReferenceMode {
+    /// Natural frequency, Hz.
+    pub frequency_hz: f64,
+    /// Damping ratio (dimensionless).
+    pub damping_ratio: f64,
+    /// Label, e.g. "body heave" or "wheel hop FL".
+    pub label: String,
+}
+
+/// Result of matching one reference mode to the invariant modes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModeMatch {
+    /// The reference mode.
+    pub reference: ReferenceMode,
+    /// Index (into the `modes` slice) of the matched structural mode; `None` when no structural mode
+    /// lies within `max_freq_diff_rel`.
+    pub invariant: Option<usize>,
+    /// Signed relative frequency difference `(f_invariant - f_reference) / f_reference` to the
+    /// nearest structural mode (reported even when unmatched); NaN (null in JSON) when there is no
+    /// structural mode at all.
+    #[serde(deserialize_with = "nan_if_null")]
+    pub freq_diff_rel: f64,
+    /// Signed damping-ratio difference `zeta_invariant - zeta_reference` to the same nearest mode;
+    /// NaN (null in JSON) when there is no structural mode at all.
+    #[serde(deserialize_with = "nan_if_null")]
+    pub damping_diff: f64,
+}
+
+fn nan_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
+/// Summary of one model fit of a sweep (one record, channel and order).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FitSummary {
+    /// Record index.
+    pub record: usize,
+    /// Model order p.
+    pub order: usize,
+    /// Criterion value at the optimum (signal units squared); NaN when the fit failed.
+    #[serde(deserialize_with = "nan_if_null")]
+    pub loss: f64,
+    /// Innovation variance estimate (signal units squared); NaN when the fit failed.
+    #[serde(deserialize_with = "nan_if_null")]
+    pub noise_variance: f64,
+    /// Whether the search ended by its own stopping rule (not at the iteration cap).
+    pub converged: bool,
+    /// Number of poles outside the unit circle.
+    pub n_unstable: usize,
+    /// Whether the fit failed outright (then `error` says why).
+    pub failed: bool,
+    /// Why the fit failed (the identification error's message); `None` when it did not.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+}
+
+/// The coefficients of one fitted ARMA / AR model, enough to evaluate its spectrum and poles
+/// again: `A(z) = 1 + a1 z^-1 + ...`, `C(z) = 1 + c1 z^-1 + ...`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModelCoefficients {
+    /// Model order p.
+    pub order: usize,
+    /// Sampling rate the model was fitted at, Hz.
+    pub fs_hz: f64,
+    /// `[1, a1, ..., ap]`.
+    pub a: Vec<f64>,
+    /// `[1, c1, ..., cq]` (`[1]` for an AR model).
+    pub c: Vec<f64>,
+    /// Innovation variance (signal units squared).
+    pub noise_variance: f64,
+}

@@ -1,0 +1,681 @@
+//! One parameter struct per analysis stage, each with its defaults defined once and a
+//! `validate` that names the offending key. The library, the TOML config, the CLI and the Python
+//! package all read these structs.
+
+use std::fmt;
+use std::str::FromStr;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::ParamError;
+
+fn bad(
+    name: &'static str,
+    value: impl ToString,
+    requirement: &'static str,
+    suggestion: impl ToString,
+) -> ParamError {
+    ParamError::out_of_range(name, value, requirement, suggestion)
+}
+
+fn positive(name: &'static str, v: f64, default: f64) -> Result<(), ParamError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(bad(name, v, "must be finite and > 0", default))
+    }
+}
+
+fn share(name: &'static str, v: f64, default: f64) -> Result<(), ParamError> {
+    if (0.0..=1.0).contains(&v) {
+        Ok(())
+    } else {
+        Err(bad(name, v, "must be in [0, 1]", default))
+    }
+}
+
+/// A cutoff below this share of the Nyquist frequency leaves an *empty band* above it: an ideal
+/// DFT low-pass at the paper's 25 Hz followed by resampling to 200 Hz empties 25-100 Hz to
+/// rounding error. The one definition used by the resampler, the identification (which adds a
+/// numerical noise floor to such signals) and the pole filters (which leave out the filter-edge
+/// poles). 0.95: a cutoff within 5 % of Nyquist leaves too few empty bins to matter.
+pub const EMPTY_BAND_MAX_CUTOFF_SHARE: f64 = 0.95;
+
+/// Share of the cutoff above which poles are left out when an empty band lies above it: every
+/// model spends lightly damped poles of its own on the ideal filter's edge (20-25 Hz for the
+/// paper's 25 Hz cutoff), which are no vehicle modes.
+pub const EDGE_SHARE: f64 = 0.8;
+
+/// The band a pre-processed signal carries: what the anti-alias filter kept and whether an
+/// empty band lies above it. Produced by the resampler, carried as data to every later stage.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BandLimit {
+    /// Sampling rate of the signal, Hz.
+    pub fs_hz: f64,
+    /// Cutoff of the ideal low-pass applied, Hz (the Nyquist frequency when none was applied).
+    pub cutoff_hz: f64,
+    /// True when the band from the cutoff to Nyquist is empty (cutoff below
+    /// [`EMPTY_BAND_MAX_CUTOFF_SHARE`] x Nyquist and an ideal low-pass was applied).
+    pub empty_band: bool,
+}
+
+impl BandLimit {
+    /// A signal that was not low-passed: valid up to Nyquist, no empty band.
+    pub fn full(fs_hz: f64) -> BandLimit {
+        BandLimit {
+            fs_hz,
+            cutoff_hz: fs_hz / 2.0,
+            empty_band: false,
+        }
+    }
+
+    /// The band left by an ideal low-pass at `cutoff_hz` on a signal sampled at `fs_hz`
+    /// (the cutoff is clamped to Nyquist).
+    pub fn ideal_lowpass(fs_hz: f64, cutoff_hz: f64) -> BandLimit {
+        let nyquist = fs_hz / 2.0;
+        let cutoff_hz = cutoff_hz.min(nyquist);
+        BandLimit {
+            fs_hz,
+            cutoff_hz,
+            empty_band: cutoff_hz < EMPTY_BAND_MAX_CUTOFF_SHARE * nyquist,
+        }
+    }
+
+    /// Highest frequency at which poles describe the signal, Hz: the cutoff, or [`EDGE_SHARE`] x
+    /// the cutoff when an empty band lies above it.
+    pub fn valid_max_hz(&self) -> f64 {
+        if self.empty_band {
+            EDGE_SHARE * self.cutoff_hz
+        } else {
+            self.cutoff_hz
+        }
+    }
+}
+
+/// Pre-processing stage: the paper's ideal DFT anti-alias filter and resampling.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PreprocessParams {
+    /// Cutoff of the ideal DFT anti-alias filter, Hz (default 25 Hz, as in the paper).
+    pub cutoff_hz: f64,
+    /// Sampling rate of the analysis after resampling, Hz (default 50 Hz: twice the cutoff, so no
+    /// empty band; the paper uses 200 Hz).
+    pub analysis_fs_hz: f64,
+}
+
+impl Default for PreprocessParams {
+    fn default() -> Self {
+        PreprocessParams {
+            cutoff_hz: 25.0,
+            analysis_fs_hz: 50.0,
+        }
+    }
+}
+
+impl PreprocessParams {
+    /// Checks ranges.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        let d = PreprocessParams::default();
+        positive("analysis_fs_hz", self.analysis_fs_hz, d.analysis_fs_hz)?;
+        positive("cutoff_hz", self.cutoff_hz, d.cutoff_hz)?;
+        if self.cutoff_hz > self.analysis_fs_hz / 2.0 + 1e-9 {
+            return Err(bad(
+                "cutoff_hz",
+                self.cutoff_hz,
+                "must be at most the Nyquist frequency of analysis_fs_hz",
+                self.analysis_fs_hz / 2.0,
+            ));
+        }
+        Ok(())
+    }
+
+    /// The band the analysis signals will carry.
+    pub fn band_limit(&self) -> BandLimit {
+        BandLimit::ideal_lowpass(self.analysis_fs_hz, self.cutoff_hz)
+    }
+}
+
+/// Model structure fitted in an order sweep.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum SweepModel {
+    /// ARMA(p, p) by robust prediction-error minimisation (the paper's choice).
+    #[default]
+    Arma,
+    /// AR(p) by Burg's method (fast; a useful cross-check).
+    Ar,
+}
+
+impl FromStr for SweepModel {
+    type Err = ParamError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "arma" => Ok(SweepModel::Arma),
+            "ar" => Ok(SweepModel::Ar),
+            _ => Err(ParamError::UnknownName {
+                what: "model",
+                value: s.to_string(),
+                valid: "arma, ar",
+            }),
+        }
+    }
+}
+
+impl fmt::Display for SweepModel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            SweepModel::Arma => "arma",
+            SweepModel::Ar => "ar",
+        })
+    }
+}
+
+/// Robustification of the prediction-error criterion: one type, one spelling. In TOML and JSON
+/// it is a number (the Huber factor) or `"off"`; on the command line `1.6` or `off`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Robust {
+    /// Purely quadratic criterion `l(e) = e^2`.
+    Off,
+    /// Huber criterion: `l(e) = e^2` for `|e| <= rho`, `2 rho |e| - rho^2` beyond, with
+    /// `rho = factor * MAD/0.6745` of the initial residuals (dimensionless factor), fixed during the
+    /// search.
+    Huber {
+        /// Threshold in robust standard deviations (dimensionless, > 0).
+        factor: f64,
+    },
+}
+
+/// The default Huber factor, 1.6 (MATLAB's pem).
+pub const DEFAULT_HUBER_FACTOR: f64 = 1.6;
+
+impl Default for Robust {
+    /// `Huber { factor: 1.6 }` (as in MATLAB's pem).
+    fn default() -> Self {
+        Robust::Huber {
+            factor: DEFAULT_HUBER_FACTOR,
+        }
+    }
+}
+
+impl FromStr for Robust {
+    type Err = ParamError;
+    /// Accepts `off` (also `none`, `quadratic`, `0`), `huber` (factor 1.6) or a positive number
+    /// (the Huber factor).
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let t = s.trim().to_ascii_lowercase();
+        match t.as_str() {
+            "off" | "none" | "quadratic" => Ok(Robust::Off),
+            "huber" | "on" => Ok(Robust::default()),
+            _ => match t.parse::<f64>() {
+                Ok(f) if f == 0.0 => Ok(Robust::Off),
+                Ok(f) if f.is_finite() && f > 0.0 => Ok(Robust::Huber { factor: f }),
+                _ => Err(bad(
+                    "robust",
+                    s,
+                    "must be a positive Huber factor or off",
+                    DEFAULT_HUBER_FACTOR,
+                )),
+            },
+        }
+    }
+}
+
+impl fmt::Display for Robust {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Robust::Off => f.write_str("off"),
+            Robust::Huber { factor } => write!(f, "{factor}"),
+        }
+    }
+}
+
+impl Robust {
+    /// Checks that a Huber factor is positive and finite.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        match *self {
+            Robust::Huber { factor } if !(factor.is_finite() && factor > 0.0) => Err(bad(
+                "robust",
+                factor,
+                "must be a positive Huber factor or off",
+                DEFAULT_HUBER_FACTOR,
+            )),
+            _ => Ok(()),
+        }
+    }
+}
+
+impl Serialize for Robust {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            Robust::Off => s.serialize_str("off"),
+            Robust::Huber { factor } => s.serialize_f64(*factor),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Robust {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Repr {
+            Num(f64),
+            Int(i64),
+            Text(String),
+        }
+        match Repr::deserialize(d)? {
+            Repr::Num(f) => f.to_string().parse(),
+            Repr::Int(i) => i.to_string().parse(),
+            Repr::Text(t) => t.parse(),
+        }
+        .map_err(serde::de::Error::custom)
+    }
+}
+
+/// Identification stage: the order sweep fitted to every record and channel.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SweepParams {
+    /// Model structure (default ARMA(p,p)).
+    pub model: SweepModel,
+    /// Lowest model order (default 2).
+    pub order_min: usize,
+    /// Highest model order (default 30; the paper's 60 at 200 Hz has the same pole density per
+    /// Hz as 15 at 50 Hz).
+    pub order_max: usize,
+    /// Criterion (default Huber with factor 1.6).
+    pub robust: Robust,
+    /// Iteration cap of each prediction-error fit of the sweep (default 20, MATLAB's
+    /// `MaxIterations`). A fit that reaches it is kept (`converged: false`).
+    pub max_iterations: usize,
+    /// Stopping tolerance of each fit: relative predicted improvement of the next Gauss-Newton
+    /// step below which the search stops (default 1e-4, MATLAB's `Tolerance` of 0.01 %).
+    pub tolerance: f64,
+}
+
+impl Default for SweepParams {
+    fn default() -> Self {
+        SweepParams {
+            model: SweepModel::Arma,
+            order_min: 2,
+            order_max: 30,
+            robust: Robust::default(),
+            max_iterations: 20,
+            tolerance: 1e-4,
+        }
+    }
+}
+
+impl SweepParams {
+    /// The model orders of the sweep, `order_min..=order_max`.
+    pub fn orders(&self) -> Vec<usize> {
+        (self.order_min..=self.order_max).collect()
+    }
+
+    /// Checks ranges.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        let d = SweepParams::default();
+        if self.order_min < 1 {
+            return Err(bad("order_min", self.order_min, "must be >= 1", d.order_min));
+        }
+        if self.order_max < self.order_min {
+            return Err(bad(
+                "order_max",
+                self.order_max,
+                "must be >= order_min",
+                self.order_min.max(d.order_max),
+            ));
+        }
+        if self.max_iterations == 0 {
+            return Err(bad(
+                "max_iterations",
+                0,
+                "must be >= 1",
+                d.max_iterations,
+            ));
+        }
+        positive("tolerance", self.tolerance, d.tolerance)?;
+        self.robust.validate()
+    }
+}
+
+/// Pole filters applied to every fit before its modes are used (by `fit`, `sweep` and the
+/// analysis alike).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PoleFilterParams {
+    /// Pole-zero cancellation: a pole `z_p` of an ARMA fit is dropped when a zero `z_c` of C lies
+    /// within `pole_zero_tol * (1 - |z_p|)` of it (the pole's own bandwidth in the z-plane): such
+    /// a pair shapes the spectrum locally (a notch next to a peak) but is no mode. 0 disables
+    /// (default 1.0).
+    pub pole_zero_tol: f64,
+    /// Drop the poles above [`BandLimit::valid_max_hz`] when an empty band lies above the
+    /// cutoff (the ideal filter's edge poles). Default true.
+    pub drop_band_edge: bool,
+}
+
+impl Default for PoleFilterParams {
+    fn default() -> Self {
+        PoleFilterParams {
+            pole_zero_tol: 1.0,
+            drop_band_edge: true,
+        }
+    }
+}
+
+impl PoleFilterParams {
+    /// Checks ranges.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        if !(self.pole_zero_tol.is_finite() && self.pole_zero_tol >= 0.0) {
+            return Err(bad(
+                "pole_zero_tol",
+                self.pole_zero_tol,
+                "must be finite and >= 0 (0 = off)",
+                1.0,
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Stop detection: records in which the vehicle stood still carry no road input and are left
+/// out of the mode statistics.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StopParams {
+    /// A record whose activity (RMS acceleration in `activity_min_hz..cutoff_hz` relative to the
+    /// median record) is below this ratio is a stop. 0 disables. Default 0.4 (a record driven at
+    /// typical intensity for less than about 0.4^2 = 16 % of its length).
+    pub stop_rms_ratio: f64,
+    /// Lower edge of the activity band, Hz (default 0.5 Hz: above drift and gravity changes).
+    pub activity_min_hz: f64,
+}
+
+impl Default for StopParams {
+    fn default() -> Self {
+        StopParams {
+            stop_rms_ratio: 0.4,
+            activity_min_hz: 0.5,
+        }
+    }
+}
+
+impl StopParams {
+    /// Checks ranges; the activity band must lie below `cutoff_hz`.
+    pub fn validate(&self, cutoff_hz: f64) -> Result<(), ParamError> {
+        if !(0.0..1.0).contains(&self.stop_rms_ratio) {
+            return Err(bad(
+                "stop_rms_ratio",
+                self.stop_rms_ratio,
+                "must be in [0, 1) (0 = no stop detection)",
+                0.4,
+            ));
+        }
+        if !(self.activity_min_hz.is_finite()
+            && self.activity_min_hz >= 0.0
+            && self.activity_min_hz < cutoff_hz)
+        {
+            return Err(bad(
+                "activity_min_hz",
+                self.activity_min_hz,
+                "must be >= 0 and below cutoff_hz",
+                0.5,
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Spectra of each record (scipy.signal's vocabulary).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SpectrumParams {
+    /// Welch segment length in samples at the analysis rate (default 128: 2.56 s at 50 Hz,
+    /// 0.39 Hz resolution).
+    pub nperseg: usize,
+}
+
+impl Default for SpectrumParams {
+    fn default() -> Self {
+        SpectrumParams { nperseg: 128 }
+    }
+}
+
+impl SpectrumParams {
+    /// Checks ranges.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        if self.nperseg < 8 {
+            return Err(bad("nperseg", self.nperseg, "must be at least 8", 128));
+        }
+        Ok(())
+    }
+}
+
+/// Parameters of the clustering stage (`vibmode_modal::find_invariant_modes`); the one definition
+/// of every clustering setting and its default, read by the library, the TOML config (`[cluster]`),
+/// the CLI and Python alike. See `docs/modal.md` for the reasoning behind each default.
+///
+/// Poles are placed in the plane `u = ln(f) / ln(1 + freq_tol_rel)`,
+/// `v = log10(zeta) / log_damping_tol`; two poles are neighbours when their distance in that plane
+/// is at most 1, the `u` difference being shrunk for damped poles so that, at equal damping zeta,
+/// they are neighbours when their frequency ratio is within
+/// `1 + max(freq_tol_rel, freq_tol_per_damping * zeta)`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ClusterParams {
+    /// Relative frequency neighbourhood radius (dimensionless). Default 0.02 (2 %).
+    pub freq_tol_rel: f64,
+    /// Growth of the frequency neighbourhood with damping (dimensionless, >= 0): the relative
+    /// frequency radius for two poles of damping ratios `zeta_a`, `zeta_b` is
+    /// `max(freq_tol_rel, freq_tol_per_damping * sqrt(zeta_a * zeta_b))`. A mode of damping ratio
+    /// zeta has a half-power bandwidth of `2 zeta f`, and its identified poles scatter in frequency
+    /// roughly in proportion to it; 0.5 makes the radius a quarter of that bandwidth (7.5 % at
+    /// zeta = 0.15, 15 % at zeta = 0.3), so heavily damped modes are not fragmented, while lightly
+    /// damped lines keep the `freq_tol_rel` radius. Larger neighbourhoods also gather more
+    /// background poles, so use it with a strict `min_order_share`. Default 0.5 (0 = fixed
+    /// radius).
+    pub freq_tol_per_damping: f64,
+    /// Damping neighbourhood radius in decades of the damping ratio (log10 units). Default 0.2
+    /// (a factor 1.58).
+    pub log_damping_tol: f64,
+    /// Absolute minimum number of poles (the pole itself included) in a neighbourhood for the pole
+    /// to be a core pole. Default 5.
+    pub min_points: usize,
+    /// Relative core threshold: a neighbourhood must also hold at least
+    /// `min_density_share * n_fits` poles, where `n_fits = n_records * orders.len() * n_channels`.
+    /// The core threshold is `max(min_points, ceil(min_density_share * n_fits))`. Default 0.03.
+    pub min_density_share: f64,
+    /// Minimum share (0..1) of the records in which a cluster must appear to be invariant (ignored
+    /// when `n_records == 1`). Default 0.5.
+    pub min_record_share: f64,
+    /// A record counts as containing a cluster (for `record_share`) only when the cluster has poles
+    /// in at least `max(1, ceil(record_min_order_share * orders.len()))` of that record's model
+    /// orders (any channel), so that a few stray poles do not make a record "support" a mode.
+    /// Default 0.1.
+    pub record_min_order_share: f64,
+    /// Minimum `order_share` (0..1) of the (record, order) fits in which a cluster must appear to be
+    /// invariant. Default 0.5 (a vehicle mode shows at most orders of a sweep, a spurious pole at
+    /// a few).
+    pub min_order_share: f64,
+    /// A cluster is a periodic disturbance when its median damping ratio is below this value
+    /// (dimensionless) and its frequency spread is below `disturbance_freq_spread_max`.
+    /// Default 5e-3.
+    pub disturbance_damping_max: f64,
+    /// Maximum relative frequency spread (`frequency_std_hz / frequency_hz`) of a periodic
+    /// disturbance (dimensionless). Default 0.02 (engine lines drift slowly with engine speed).
+    pub disturbance_freq_spread_max: f64,
+    /// Poles below this natural frequency (Hz) are ignored. Default 0.3 Hz (below it lie drift and
+    /// the slow manoeuvres, not suspension modes).
+    pub freq_min_hz: f64,
+    /// Poles above this natural frequency (Hz) are ignored. Default `None`: the band the
+    /// pre-processing left valid ([`crate::BandLimit::valid_max_hz`]: the cutoff, or
+    /// `EDGE_SHARE` x the cutoff when an empty band lies above it), or no limit when the caller
+    /// gives none.
+    pub freq_max_hz: Option<f64>,
+    /// Poles with a damping ratio above this value are ignored (overdamped-like, not resonant).
+    /// Default 0.6.
+    pub max_damping_ratio: f64,
+    /// Damping ratios in `[0, min_damping_ratio)` are raised to this floor for the log10 coordinate
+    /// (statistics use the true values); negative damping ratios (unstable poles) are ignored.
+    /// Default 1e-6.
+    pub min_damping_ratio: f64,
+}
+
+impl Default for ClusterParams {
+    fn default() -> Self {
+        ClusterParams {
+            freq_tol_rel: 0.02,
+            freq_tol_per_damping: 0.5,
+            log_damping_tol: 0.2,
+            min_points: 5,
+            min_density_share: 0.03,
+            min_record_share: 0.5,
+            record_min_order_share: 0.1,
+            min_order_share: 0.5,
+            disturbance_damping_max: 5e-3,
+            disturbance_freq_spread_max: 0.02,
+            freq_min_hz: 0.3,
+            freq_max_hz: None,
+            max_damping_ratio: 0.6,
+            min_damping_ratio: 1e-6,
+        }
+    }
+}
+
+impl ClusterParams {
+    /// Check every field; returns the first invalid one.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        let d = ClusterParams::default();
+        positive("freq_tol_rel", self.freq_tol_rel, d.freq_tol_rel)?;
+        if !(self.freq_tol_per_damping.is_finite() && self.freq_tol_per_damping >= 0.0) {
+            return Err(bad(
+                "freq_tol_per_damping",
+                self.freq_tol_per_damping,
+                "must be finite and >= 0",
+                d.freq_tol_per_damping,
+            ));
+        }
+        positive("log_damping_tol", self.log_damping_tol, d.log_damping_tol)?;
+        if self.min_points == 0 {
+            return Err(bad("min_points", 0, "must be >= 1", d.min_points));
+        }
+        share(
+            "min_density_share",
+            self.min_density_share,
+            d.min_density_share,
+        )?;
+        share(
+            "min_record_share",
+            self.min_record_share,
+            d.min_record_share,
+        )?;
+        share(
+            "record_min_order_share",
+            self.record_min_order_share,
+            d.record_min_order_share,
+        )?;
+        share("min_order_share", self.min_order_share, d.min_order_share)?;
+        positive(
+            "disturbance_damping_max",
+            self.disturbance_damping_max,
+            d.disturbance_damping_max,
+        )?;
+        positive(
+            "disturbance_freq_spread_max",
+            self.disturbance_freq_spread_max,
+            d.disturbance_freq_spread_max,
+        )?;
+        positive("freq_min_hz", self.freq_min_hz, d.freq_min_hz)?;
+        if let Some(f) = self.freq_max_hz {
+            if f.is_nan() || f <= self.freq_min_hz {
+                return Err(bad(
+                    "freq_max_hz",
+                    f,
+                    "must be > freq_min_hz (or left out for the valid band)",
+                    2.0 * self.freq_min_hz.max(1.0),
+                ));
+            }
+        }
+        positive(
+            "max_damping_ratio",
+            self.max_damping_ratio,
+            d.max_damping_ratio,
+        )?;
+        positive(
+            "min_damping_ratio",
+            self.min_damping_ratio,
+            d.min_damping_ratio,
+        )?;
+        if self.min_damping_ratio >= self.max_damping_ratio {
+            return Err(bad(
+                "min_damping_ratio",
+                self.min_damping_ratio,
+                "must be < max_damping_ratio",
+                d.min_damping_ratio,
+            ));
+        }
+        Ok(())
+    }
+}
+
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn robust_has_one_spelling_in_toml_and_text() {
+        #[derive(Deserialize, Serialize)]
+        struct T {
+            robust: Robust,
+        }
+        let t: T = toml::from_str("robust = 1.6").unwrap();
+        assert_eq!(t.robust, Robust::Huber { factor: 1.6 });
+        let t: T = toml::from_str("robust = \"off\"").unwrap();
+        assert_eq!(t.robust, Robust::Off);
+        let t: T = toml::from_str("robust = 0").unwrap();
+        assert_eq!(t.robust, Robust::Off);
+        assert!(toml::from_str::<T>("robust = -1").is_err());
+        assert_eq!("2".parse::<Robust>(), Ok(Robust::Huber { factor: 2.0 }));
+        let back = toml::to_string(&T { robust: Robust::Off }).unwrap();
+        assert_eq!(back.trim(), "robust = \"off\"");
+    }
+
+    #[test]
+    fn empty_band_rule() {
+        // The paper: 25 Hz at 200 Hz leaves 25-100 Hz empty; poles above 20 Hz are edge poles.
+        let b = BandLimit::ideal_lowpass(200.0, 25.0);
+        assert!(b.empty_band);
+        assert_eq!(b.valid_max_hz(), 20.0);
+        // vibmode's default: 25 Hz at 50 Hz is Nyquist, nothing empty.
+        let b = BandLimit::ideal_lowpass(50.0, 25.0);
+        assert!(!b.empty_band);
+        assert_eq!(b.valid_max_hz(), 25.0);
+        // 0.95 x Nyquist is the boundary.
+        assert!(!BandLimit::ideal_lowpass(100.0, 47.5).empty_band);
+        assert!(BandLimit::ideal_lowpass(100.0, 47.4).empty_band);
+    }
+
+    #[test]
+    fn defaults_validate_and_bad_values_name_the_key() {
+        ClusterParams::default().validate().unwrap();
+        SweepParams::default().validate().unwrap();
+        PreprocessParams::default().validate().unwrap();
+        let e = SweepParams {
+            order_max: 1,
+            order_min: 3,
+            ..SweepParams::default()
+        }
+        .validate()
+        .unwrap_err()
+        .to_string();
+        assert!(e.starts_with("order_max = 1"), "{e}");
+        let e = PreprocessParams {
+            cutoff_hz: 30.0,
+            ..PreprocessParams::default()
+        }
+        .validate()
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("cutoff_hz = 30") && e.contains("25"), "{e}");
+    }
+}
