@@ -9,6 +9,7 @@ use serde_json::{json, Map, Value};
 use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
+use vibmode_signal::ResampleRecording;
 
 const ARMA_ORDERS: [usize; 3] = [4, 10, 20];
 
@@ -175,6 +176,7 @@ fn run(dir: &Path, quick: bool) -> Result<Value> {
                 name: format!("ch{i}"),
                 unit: "m/s^2".into(),
                 samples: s.clone(),
+                placement: Default::default(),
             })
             .collect(),
         time_axis: None,

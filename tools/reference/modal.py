@@ -28,6 +28,7 @@ CHANNELS = ["FR", "RL"]
 
 PARAMS = dict(
     freq_tol_rel=0.02,
+    freq_tol_per_damping=0.0,  # fixed radius: this script checks the k = 0 case
     log_damping_tol=0.2,
     min_points=5,
     min_density_share=0.03,

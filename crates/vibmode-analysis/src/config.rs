@@ -30,11 +30,13 @@ impl std::str::FromStr for Preset {
         match s.to_ascii_lowercase().as_str() {
             "vibmode" | "default" => Ok(Preset::Vibmode),
             "paper" => Ok(Preset::Paper),
-            _ => Err(AnalysisError::Param(vibmode_core::ParamError::UnknownName {
-                what: "preset",
-                value: s.to_string(),
-                valid: "vibmode, paper",
-            })),
+            _ => Err(AnalysisError::Param(
+                vibmode_core::ParamError::UnknownName {
+                    what: "preset",
+                    value: s.to_string(),
+                    valid: "vibmode, paper",
+                },
+            )),
         }
     }
 }
@@ -202,11 +204,12 @@ impl AnalysisConfig {
             None => Preset::Vibmode,
         };
         // Merge the file over the preset's defaults.
-        let mut base =
-            toml::Value::try_from(AnalysisConfig::preset(preset)).map_err(|e| AnalysisError::Config {
+        let mut base = toml::Value::try_from(AnalysisConfig::preset(preset)).map_err(|e| {
+            AnalysisError::Config {
                 key: None,
                 message: e.to_string(),
-            })?;
+            }
+        })?;
         merge(&mut base, value);
         let cfg: AnalysisConfig =
             base.try_into()
@@ -320,7 +323,8 @@ mod tests {
 
     #[test]
     fn sections_override_the_preset_and_unknown_keys_fail() {
-        let c = AnalysisConfig::from_toml_str("preset = \"paper\"\n[sweep]\norder_max = 40\n").unwrap();
+        let c =
+            AnalysisConfig::from_toml_str("preset = \"paper\"\n[sweep]\norder_max = 40\n").unwrap();
         assert_eq!(c.preprocess.analysis_fs_hz, 200.0);
         assert_eq!(c.sweep.order_max, 40);
         let e = AnalysisConfig::from_toml_str("[sweep]\nordermax = 40\n").unwrap_err();

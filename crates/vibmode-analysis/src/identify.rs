@@ -36,7 +36,13 @@ pub struct SignalFits {
 pub trait Identifier: Sync {
     /// Fits the signal `y` of record `record`, which carries the band `band`; keeps the
     /// coefficients of the fits whose order is in `keep_orders`.
-    fn identify(&self, y: &[f64], band: &BandLimit, record: usize, keep_orders: &[usize]) -> SignalFits;
+    fn identify(
+        &self,
+        y: &[f64],
+        band: &BandLimit,
+        record: usize,
+        keep_orders: &[usize],
+    ) -> SignalFits;
 }
 
 /// The paper's method: an order sweep of ARMA(p,p) (or AR(p)) models, warm-started order to
@@ -74,21 +80,31 @@ impl SweepIdentifier {
 }
 
 impl Identifier for SweepIdentifier {
-    fn identify(&self, y: &[f64], band: &BandLimit, record: usize, keep_orders: &[usize]) -> SignalFits {
+    fn identify(
+        &self,
+        y: &[f64],
+        band: &BandLimit,
+        record: usize,
+        keep_orders: &[usize],
+    ) -> SignalFits {
         let mut out = SignalFits::default();
         for (order, fit) in self.sweep.orders().into_iter().zip(self.fits(y, band)) {
             match fit {
                 Ok(m) => {
                     let set = m.modes(band.fs_hz);
                     let modes = vibmode_ident::filter_mode_set(&m, &set, band, &self.poles);
-                    out.poles.extend(modes.iter().filter(|f| f.rejected.is_none()).map(|f| {
-                        PoleOut {
-                            record,
-                            order,
-                            frequency_hz: f.mode.frequency_hz,
-                            damping_ratio: f.mode.damping_ratio,
-                        }
-                    }));
+                    out.poles
+                        .extend(
+                            modes
+                                .iter()
+                                .filter(|f| f.rejected.is_none())
+                                .map(|f| PoleOut {
+                                    record,
+                                    order,
+                                    frequency_hz: f.mode.frequency_hz,
+                                    damping_ratio: f.mode.damping_ratio,
+                                }),
+                        );
                     if keep_orders.contains(&order) {
                         out.models.push(ModelCoefficients {
                             order,

@@ -117,7 +117,10 @@ pub fn analyze_with(
     for (c, ch) in first.channels.iter().enumerate() {
         let placement = cfg.placement_of(ch);
         let mine: Vec<&SignalOut> = outs.iter().filter(|o| o.channel == c).collect();
-        let poles: Vec<_> = mine.iter().flat_map(|o| o.fits.poles.iter().copied()).collect();
+        let poles: Vec<_> = mine
+            .iter()
+            .flat_map(|o| o.fits.poles.iter().copied())
+            .collect();
         store.add(&ch.name, placement.role, &poles);
         let obs = store.observations(|n, _| n == ch.name, &active);
         let invariant = vibmode_modal::find_invariant_modes(&obs, n_active, &orders, &cluster)?;
@@ -130,7 +133,10 @@ pub fn analyze_with(
             welch_freq_hz,
             welch_psd,
             poles,
-            fits: mine.iter().flat_map(|o| o.fits.fits.iter().cloned()).collect(),
+            fits: mine
+                .iter()
+                .flat_map(|o| o.fits.fits.iter().cloned())
+                .collect(),
             first_record_models: mine
                 .iter()
                 .find(|o| o.record == 0)
@@ -139,7 +145,9 @@ pub fn analyze_with(
             invariant_modes: invariant,
         });
     }
-    let roles = role_modes(&channels, &store, &active, n_active, &orders, &cluster, reference)?;
+    let roles = role_modes(
+        &channels, &store, &active, n_active, &orders, &cluster, reference,
+    )?;
     let fits = channels.iter().flat_map(|c| c.fits.iter());
     let n_fits = fits.clone().count();
     let n_not_converged = fits.clone().filter(|f| !f.converged).count();
@@ -226,7 +234,12 @@ fn identify_all(
 }
 
 /// Activity per record and channel: band RMS of the Welch PSD.
-fn record_activity(outs: &[SignalOut], n_rec: usize, n_ch: usize, cfg: &AnalysisConfig) -> Vec<Vec<f64>> {
+fn record_activity(
+    outs: &[SignalOut],
+    n_rec: usize,
+    n_ch: usize,
+    cfg: &AnalysisConfig,
+) -> Vec<Vec<f64>> {
     (0..n_rec)
         .map(|r| {
             (0..n_ch)
@@ -263,7 +276,10 @@ fn renumber_active(stationary: &[bool]) -> Vec<Option<usize>> {
 
 /// The Welch PSD averaged over the records used for the modes (stops left out).
 fn mean_welch(mine: &[&SignalOut], stationary: &[bool]) -> (Vec<f64>, Vec<f64>) {
-    let freq = mine.first().map(|o| o.welch_freq.clone()).unwrap_or_default();
+    let freq = mine
+        .first()
+        .map(|o| o.welch_freq.clone())
+        .unwrap_or_default();
     let used: Vec<&&SignalOut> = mine.iter().filter(|o| !stationary[o.record]).collect();
     let mut mean = vec![0.0; freq.len()];
     for o in &used {

@@ -16,7 +16,7 @@ fn demo_data_gives_the_true_modes_and_lines() {
         .enumerate()
         .map(|(i, r)| RecordInput {
             name: format!("record {i}"),
-            recording: r.to_recording(),
+            recording: r.recording.clone(),
         })
         .collect();
     let reference: Vec<ReferenceMode> = sim

@@ -32,34 +32,36 @@ fn records_with_stops() -> (Vec<RecordInput>, Vec<f64>) {
     let mut out: Vec<RecordInput> = Vec::new();
     let mut state = 7u64;
     for (i, r) in sim.records.iter().enumerate() {
+        let fs_hz = r.recording.fs_hz;
         let rec = |samples: Vec<Vec<f64>>| Recording {
-            fs_hz: r.fs_hz,
+            fs_hz,
             channels: r
-                .channel_names
+                .recording
+                .channels
                 .iter()
                 .zip(samples)
-                .map(|(n, s)| Channel {
-                    name: n.clone(),
-                    unit: "m/s^2".into(),
+                .map(|(c, s)| Channel {
                     samples: s,
+                    ..c.clone()
                 })
                 .collect(),
             time_axis: None,
         };
         out.push(RecordInput {
             name: format!("drive {i}"),
-            recording: rec(r.samples.clone()),
+            recording: r.recording.clone(),
         });
         if i == 1 || i == 4 {
             // A stop after records 1 and 4: engine idling at 13.3 Hz (0.02 m/s^2) plus sensor
             // noise (0.01 m/s^2), nothing else.
             let stop: Vec<Vec<f64>> = r
-                .samples
+                .recording
+                .channels
                 .iter()
-                .map(|s| {
-                    (0..s.len())
+                .map(|c| {
+                    (0..c.samples.len())
                         .map(|k| {
-                            let t = k as f64 / r.fs_hz;
+                            let t = k as f64 / fs_hz;
                             0.02 * (2.0 * std::f64::consts::PI * 13.3 * t).sin()
                                 + 0.01 * noise(&mut state)
                         })
@@ -80,10 +82,8 @@ fn stop_records_are_excluded_and_modes_still_found() {
     let (records, body) = records_with_stops();
     assert_eq!(records.len(), 8);
     // Fewer orders than the default to keep the test short; stop detection does not depend on it.
-    let cfg = AnalysisConfig {
-        order_max: 16,
-        ..AnalysisConfig::default()
-    };
+    let mut cfg = AnalysisConfig::default();
+    cfg.sweep.order_max = 16;
     let res = analyze(&records, &cfg, &[], &|_, _| {}).expect("analysis");
     for r in &res.records {
         eprintln!(
@@ -145,10 +145,8 @@ fn stop_records_are_excluded_and_modes_still_found() {
     let tone_without_stops = tone_level(&res);
 
     // Without stop detection the stops dilute the shares: 6 of 8 records at most.
-    let off = AnalysisConfig {
-        stop_rms_ratio: 0.0,
-        ..cfg
-    };
+    let mut off = cfg;
+    off.stops.stop_rms_ratio = 0.0;
     let res = analyze(&records, &off, &[], &|_, _| {}).expect("analysis");
     assert_eq!(res.n_stationary, 0);
     let ratio = tone_level(&res) / tone_without_stops;

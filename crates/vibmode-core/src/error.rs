@@ -62,7 +62,9 @@ pub enum RecordingError {
         expected: usize,
     },
     /// A sample range outside the recording.
-    #[error("sample range {start}..{end} is invalid: need start < end <= {len} (the number of samples)")]
+    #[error(
+        "sample range {start}..{end} is invalid: need start < end <= {len} (the number of samples)"
+    )]
     InvalidRange {
         /// First sample asked for.
         start: usize,

@@ -255,17 +255,24 @@ impl Serialize for Robust {
 
 impl<'de> Deserialize<'de> for Robust {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        /// vibmode 0.1 wrote `{"Huber": {"factor": 1.6}}`; still read.
+        #[derive(Deserialize)]
+        enum Tagged {
+            Huber { factor: f64 },
+        }
         #[derive(Deserialize)]
         #[serde(untagged)]
         enum Repr {
             Num(f64),
             Int(i64),
             Text(String),
+            Tagged(Tagged),
         }
         match Repr::deserialize(d)? {
             Repr::Num(f) => f.to_string().parse(),
             Repr::Int(i) => i.to_string().parse(),
             Repr::Text(t) => t.parse(),
+            Repr::Tagged(Tagged::Huber { factor }) => factor.to_string().parse(),
         }
         .map_err(serde::de::Error::custom)
     }
@@ -315,7 +322,12 @@ impl SweepParams {
     pub fn validate(&self) -> Result<(), ParamError> {
         let d = SweepParams::default();
         if self.order_min < 1 {
-            return Err(bad("order_min", self.order_min, "must be >= 1", d.order_min));
+            return Err(bad(
+                "order_min",
+                self.order_min,
+                "must be >= 1",
+                d.order_min,
+            ));
         }
         if self.order_max < self.order_min {
             return Err(bad(
@@ -326,12 +338,7 @@ impl SweepParams {
             ));
         }
         if self.max_iterations == 0 {
-            return Err(bad(
-                "max_iterations",
-                0,
-                "must be >= 1",
-                d.max_iterations,
-            ));
+            return Err(bad("max_iterations", 0, "must be >= 1", d.max_iterations));
         }
         positive("tolerance", self.tolerance, d.tolerance)?;
         self.robust.validate()
@@ -617,7 +624,6 @@ impl ClusterParams {
     }
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -636,7 +642,10 @@ mod tests {
         assert_eq!(t.robust, Robust::Off);
         assert!(toml::from_str::<T>("robust = -1").is_err());
         assert_eq!("2".parse::<Robust>(), Ok(Robust::Huber { factor: 2.0 }));
-        let back = toml::to_string(&T { robust: Robust::Off }).unwrap();
+        let back = toml::to_string(&T {
+            robust: Robust::Off,
+        })
+        .unwrap();
         assert_eq!(back.trim(), "robust = \"off\"");
     }
 

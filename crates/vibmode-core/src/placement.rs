@@ -242,7 +242,10 @@ mod tests {
         assert_eq!(p.corner, Some(Corner::RR));
         assert_eq!(p.direction, Some(Direction::Z));
         let p = Placement::guess_from_name("Z-Axis");
-        assert_eq!((p.role, p.corner, p.direction), (Role::Other, None, Some(Direction::Z)));
+        assert_eq!(
+            (p.role, p.corner, p.direction),
+            (Role::Other, None, Some(Direction::Z))
+        );
         // "FLOOR" is not the corner FL.
         assert_eq!(Corner::guess_from_name("floor_front"), None);
     }

@@ -16,8 +16,8 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-pub use vibmode_core::Robust;
 use vibmode_core::BandLimit;
+pub use vibmode_core::Robust;
 
 /// Settings of the prediction-error search.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -883,7 +883,10 @@ fn fit_impl(
     let ys: Vec<f64> = centred.iter().map(|v| v / scale).collect();
     // The search works on the signal plus the numerical noise floor (ys has unit mean square).
     let floored: Option<Vec<f64>> = (params.noise_floor > 0.0
-        && params.band.map_or_else(|| has_empty_band(&ys), |b| b.empty_band)).then(|| {
+        && params
+            .band
+            .map_or_else(|| has_empty_band(&ys), |b| b.empty_band))
+    .then(|| {
         let sd = params.noise_floor.sqrt();
         let mut rng = ChaCha8Rng::seed_from_u64(FLOOR_SEED);
         ys.iter()

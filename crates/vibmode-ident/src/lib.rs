@@ -60,7 +60,8 @@ pub use arma::{
 };
 pub use error::IdentError;
 pub use model::{
-    arma_psd, information_criteria, modes_from_poles, ArmaModel, Estimator, Mode, ModeSet, Pole, StopReason,
+    arma_psd, information_criteria, modes_from_poles, ArmaModel, Estimator, Mode, ModeSet, Pole,
+    StopReason,
 };
 pub use num_complex::Complex64;
 pub use outliers::{clean_additive_outliers, CleanedSignal, CleanerParams, OutlierCleaning};

@@ -203,7 +203,13 @@ impl ArmaModel {
 /// One-sided PSD `2 lambda Ts |C(e^{iwTs}) / A(e^{iwTs})|^2` of the ARMA model with
 /// coefficients `a = [1, a1, ...]`, `c = [1, c1, ...]` and innovation variance `lambda`
 /// (signal units squared) at each frequency in `freq_hz` (Hz), sampled at `fs_hz`.
-pub fn arma_psd(a: &[f64], c: &[f64], noise_variance: f64, freq_hz: &[f64], fs_hz: f64) -> Vec<f64> {
+pub fn arma_psd(
+    a: &[f64],
+    c: &[f64],
+    noise_variance: f64,
+    freq_hz: &[f64],
+    fs_hz: f64,
+) -> Vec<f64> {
     let ts = 1.0 / fs_hz;
     freq_hz
         .iter()

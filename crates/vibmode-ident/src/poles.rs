@@ -49,7 +49,11 @@ pub fn cancelled_by_zero(re: f64, im: f64, zeros: &[Complex64], tol: f64) -> boo
 /// The modes of `model` (fitted at `band.fs_hz`) with the filters' verdicts, ascending in
 /// frequency. The band-edge rule acts only when `band.empty_band` and
 /// `params.drop_band_edge`; the cancellation rule only when `params.pole_zero_tol > 0`.
-pub fn filter_modes(model: &ArmaModel, band: &BandLimit, params: &PoleFilterParams) -> Vec<FilteredMode> {
+pub fn filter_modes(
+    model: &ArmaModel,
+    band: &BandLimit,
+    params: &PoleFilterParams,
+) -> Vec<FilteredMode> {
     filter_mode_set(model, &model.modes(band.fs_hz), band, params)
 }
 
@@ -69,7 +73,8 @@ pub fn filter_mode_set(
     set.modes
         .iter()
         .map(|&mode| {
-            let rejected = if params.drop_band_edge && band.empty_band && mode.frequency_hz > f_max {
+            let rejected = if params.drop_band_edge && band.empty_band && mode.frequency_hz > f_max
+            {
                 Some(PoleRejection::BandEdge)
             } else if cancelled_by_zero(mode.pole_re, mode.pole_im, &zeros, params.pole_zero_tol) {
                 Some(PoleRejection::PoleZeroCancellation)

@@ -96,7 +96,11 @@ pub fn analyse_poles(
     for (i, pole) in poles.iter().enumerate() {
         let f = pole.frequency_hz;
         let z = pole.damping_ratio;
-        if !(f >= p.freq_min_hz && f <= p.freq_max_hz.unwrap_or(f64::INFINITY) && z >= 0.0 && z <= p.max_damping_ratio) {
+        if !(f >= p.freq_min_hz
+            && f <= p.freq_max_hz.unwrap_or(f64::INFINITY)
+            && z >= 0.0
+            && z <= p.max_damping_ratio)
+        {
             continue;
         }
         let n_ch = channel_ids.len();

@@ -29,7 +29,6 @@ fn positive(name: &'static str, v: f64, default: f64) -> Result<(), ModalError> 
     }
 }
 
-
 /// Parameters of [`crate::stabilisation`] (classic stabilisation diagram criteria).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]

@@ -6,7 +6,7 @@ mod common;
 
 use std::collections::{BTreeSet, HashMap};
 
-use common::{cloud, line, structural, TrueMode};
+use common::{cloud, line, script_params, structural, TrueMode};
 use vibmode_modal::{analyse_poles, ClusterParams, ModeClass, PoleObservation};
 
 /// Brute-force neighbour test, straight from the definition in docs/modal.md.
@@ -31,7 +31,10 @@ fn brute_force(
     let used: Vec<usize> = (0..poles.len())
         .filter(|&i| {
             let (f, z) = (poles[i].frequency_hz, poles[i].damping_ratio);
-            f >= p.freq_min_hz && f <= p.freq_max_hz && z >= 0.0 && z <= p.max_damping_ratio
+            f >= p.freq_min_hz
+                && f <= p.freq_max_hz.unwrap_or(f64::INFINITY)
+                && z >= 0.0
+                && z <= p.max_damping_ratio
         })
         .collect();
     let n_ch = used
@@ -115,7 +118,7 @@ fn grid_search_equals_brute_force_with_damping_dependent_radius() {
         for per_damping in [0.0, 0.5, 2.0] {
             let p = ClusterParams {
                 freq_tol_per_damping: per_damping,
-                ..ClusterParams::default()
+                ..script_params()
             };
             let a = analyse_poles(&poles, 4, &orders, &p).unwrap();
             let bf = brute_force(&poles, 4, orders.len(), &p);
@@ -157,7 +160,7 @@ fn heavily_damped_mode_with_proportional_scatter_is_one_mode() {
         let p = ClusterParams {
             freq_tol_per_damping: 0.5,
             min_order_share: 0.5,
-            ..ClusterParams::default()
+            ..script_params()
         };
         let found = analyse_poles(&poles, 8, &orders, &p).unwrap().modes;
         let structural: Vec<_> = found

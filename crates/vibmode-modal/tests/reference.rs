@@ -73,12 +73,28 @@ fn matches_scipy_reference() {
 
 #[test]
 fn params_default_matches_reference_script() {
-    // The script spells out every parameter; they are the crate defaults.
+    // The script spells out every parameter: vibmode-modal 0.1's defaults (script_params).
     let text = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../tools/reference/data/modal.json"
     ))
     .unwrap();
     let case: Case = serde_json::from_str(&text).unwrap();
-    assert_eq!(case.params, ClusterParams::default());
+    assert_eq!(case.params, script_params());
+}
+
+/// The clustering settings of the reference script `tools/reference/modal.py` (and of these
+/// tests): vibmode-modal 0.1's defaults, spelled out. The analysis defaults
+/// (`ClusterParams::default()`) differ in five fields: a damping-scaled radius (0.5), a stricter
+/// order share (0.5), 0.3 Hz lowest frequency, no fixed highest frequency and a 2 % line spread.
+#[allow(dead_code)]
+fn script_params() -> ClusterParams {
+    ClusterParams {
+        freq_tol_per_damping: 0.0,
+        min_order_share: 0.25,
+        disturbance_freq_spread_max: 0.01,
+        freq_min_hz: 0.1,
+        freq_max_hz: Some(30.0),
+        ..ClusterParams::default()
+    }
 }

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{brief_modes, cloud, line, structural};
+use common::{brief_modes, cloud, line, script_params, structural};
 use vibmode_modal::{analyse_poles, find_invariant_modes, ClusterParams, InvariantMode, ModeClass};
 
 fn nearest(modes: &[InvariantMode], f: f64) -> &InvariantMode {
@@ -25,7 +25,7 @@ fn brief_cloud_recovers_modes_and_lines() {
     all.extend(lines.iter().copied());
     for seed in [1u64, 2, 3] {
         let poles = cloud(seed, 8, &orders, &["FR", "RL", "RR"], &all, 3);
-        let a = analyse_poles(&poles, 8, &orders, &ClusterParams::default()).unwrap();
+        let a = analyse_poles(&poles, 8, &orders, &script_params()).unwrap();
         let modes = &a.modes;
         for m in modes {
             eprintln!(
@@ -108,7 +108,7 @@ fn mode_in_too_few_records_is_not_invariant() {
         q.record = 5;
         q
     }));
-    let modes = find_invariant_modes(&poles, 8, &orders, &ClusterParams::default()).unwrap();
+    let modes = find_invariant_modes(&poles, 8, &orders, &script_params()).unwrap();
     let m = nearest(&modes, 4.0);
     assert!((m.frequency_hz - 4.0).abs() < 0.1, "{m:?}");
     assert_eq!(m.record_share, 1.0 / 8.0);
@@ -129,14 +129,14 @@ fn mode_in_too_few_records_is_not_invariant() {
                 }),
         );
     }
-    let modes = find_invariant_modes(&poles, 8, &orders, &ClusterParams::default()).unwrap();
+    let modes = find_invariant_modes(&poles, 8, &orders, &script_params()).unwrap();
     let m = nearest(&modes, 4.0);
     assert_eq!((m.record_share, m.class), (0.25, ModeClass::Spurious));
     // 2 of 8 records -> order_share ~ 0.25 * 0.93; lower both support thresholds.
     let p = ClusterParams {
         min_record_share: 0.25,
         min_order_share: 0.2,
-        ..ClusterParams::default()
+        ..script_params()
     };
     let modes = find_invariant_modes(&poles, 8, &orders, &p).unwrap();
     let m = nearest(&modes, 4.0);
@@ -149,7 +149,7 @@ fn line_next_to_structural_mode_kept_apart() {
     let orders: Vec<usize> = (2..=60).collect();
     let modes_in = [structural(8.0, 0.2), line(7.9)];
     let poles = cloud(21, 8, &orders, &["FR", "RL"], &modes_in, 3);
-    let modes = find_invariant_modes(&poles, 8, &orders, &ClusterParams::default()).unwrap();
+    let modes = find_invariant_modes(&poles, 8, &orders, &script_params()).unwrap();
     let inv: Vec<_> = modes.iter().filter(|m| m.is_invariant()).collect();
     assert_eq!(inv.len(), 2, "{inv:?}");
     assert_eq!(inv[0].class, ModeClass::PeriodicDisturbance);
@@ -173,7 +173,7 @@ fn duplicates_within_a_fit_do_not_inflate_support() {
         q2.frequency_hz *= 0.994;
         doubled.push(q2);
     }
-    let p = ClusterParams::default();
+    let p = script_params();
     let a = find_invariant_modes(&poles, 4, &orders, &p).unwrap();
     let b = find_invariant_modes(&doubled, 4, &orders, &p).unwrap();
     assert_eq!(a.len(), 1);
@@ -202,6 +202,6 @@ fn paper_size_pole_cloud_100k_poles() {
     let chans = ["FL", "FR", "RL", "RR", "sFR", "sRL", "sRR"];
     let poles = cloud(41, 8, &orders, &chans, &modes_in, 25);
     assert!(poles.len() > 90_000, "{}", poles.len());
-    let a = analyse_poles(&poles, 8, &orders, &ClusterParams::default()).unwrap();
+    let a = analyse_poles(&poles, 8, &orders, &script_params()).unwrap();
     assert_eq!(a.modes.iter().filter(|m| m.is_invariant()).count(), 6);
 }

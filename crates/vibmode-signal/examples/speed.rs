@@ -7,6 +7,7 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use vibmode_signal::ResampleRecording;
 use vibmode_signal::{read_path, write_path, Channel, ReadOptions, Recording, ResampleParams};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -28,6 +29,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             name: format!("ch{c}"),
             unit: "m/s^2".into(),
             samples: (0..204_800).map(|_| r.gen_range(-30.0..30.0)).collect(),
+            placement: Default::default(),
         })
         .collect();
     let rec = Recording::new(20_000.0, chans)?;

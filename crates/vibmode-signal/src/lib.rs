@@ -38,23 +38,24 @@
 //! assert!((low.channels[0].samples[7] - expected).abs() < 1e-9);
 //! ```
 
-
 pub mod delimited;
 pub mod error;
 mod number;
-pub mod read;
 mod preprocess;
+pub mod read;
 pub mod resample;
 pub mod write;
 
 pub use delimited::{Block, ColumnInfo, DelimitedReader, Separator};
 pub use error::SignalError;
+pub use preprocess::{preprocess, Preprocessed};
 pub use read::{
     read_delimited, read_delimited_bytes, read_path, sidecar_candidates, Format, ReadOptions,
     Sidecar,
 };
-pub use preprocess::{preprocess, Preprocessed};
 pub use resample::ResampleRecording;
-pub use vibmode_core::{Channel, ChannelSelector, Recording, RecordingError, RecordingView, TimeAxis};
 pub use resample::{resample, ResampleMethod, ResampleParams, Resampler};
+pub use vibmode_core::{
+    Channel, ChannelSelector, Recording, RecordingError, RecordingView, TimeAxis,
+};
 pub use write::write_path;

@@ -38,9 +38,9 @@ pub fn preprocess(rec: &Recording, p: &PreprocessParams) -> Result<Preprocessed>
         };
         Resampler::new(rec.len(), rec.fs_hz, &loose)
     })?;
-    let cutoff_hz = wanted
-        .cutoff_hz
-        .map_or(planned.fs_out_hz() / 2.0, |c| c.min(planned.fs_out_hz() / 2.0));
+    let cutoff_hz = wanted.cutoff_hz.map_or(planned.fs_out_hz() / 2.0, |c| {
+        c.min(planned.fs_out_hz() / 2.0)
+    });
     let params = ResampleParams {
         cutoff_hz: Some(cutoff_hz),
         ..wanted

@@ -2,12 +2,12 @@
 
 use crate::delimited::{Block, ColumnInfo, DelimitedReader};
 use crate::error::{io_err, Result, SignalError};
-use vibmode_core::{check_finite, check_fs, Channel, Recording, RecordingError, TimeAxis};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::io::BufRead;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
+use vibmode_core::{check_finite, check_fs, Channel, Recording, RecordingError, TimeAxis};
 
 /// File format. Detected from the extension when not given (see [`Format::from_path`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -252,7 +252,7 @@ fn finish_delimited(
                 return Err(SignalError::TooShort {
                     what: format!("time column '{name}' of {path}"),
                     n,
-                    fix: "need at least 2 rows to derive the sampling rate; or drop the time column and give --fs HZ".into(),
+                    fix: "need at least 2 rows to derive the sampling rate; or drop the time column and give the sampling rate (fs_hz)".into(),
                 });
             }
             for k in 1..n {
@@ -362,7 +362,9 @@ fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Recording> {
         return Err(SignalError::InvalidParam {
             name: "scale",
             value: opts.scale.to_string(),
-            fix: "the WAV scale must be a finite non-zero number, e.g. --scale 19.62".into(),
+            fix:
+                "the WAV scale must be a finite non-zero number, e.g. 19.62 (m/s^2 per full scale)"
+                    .into(),
         });
     }
     let interleaved: Vec<f64> = match spec.sample_format {

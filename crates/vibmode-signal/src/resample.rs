@@ -38,11 +38,11 @@
 //! above it is refused (it would alias on decimation and has no effect on the Fourier path).
 
 use crate::error::{Result, SignalError};
-use vibmode_core::{check_fs, Channel, Recording, RecordingError, TimeAxis};
 use num_complex::Complex;
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
+use vibmode_core::{check_fs, Channel, Recording, RecordingError, TimeAxis};
 
 /// Parameters of [`resample`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -156,7 +156,7 @@ impl Resampler {
             return Err(invalid(
                 "to_hz",
                 p.to_hz,
-                "the target rate must be a positive finite number of Hz, e.g. --to 200".into(),
+                "the target rate must be a positive finite number of Hz, e.g. 200".into(),
             ));
         }
         let ratio = fs_hz / p.to_hz;
@@ -209,7 +209,7 @@ impl Resampler {
                             "cutoff_hz",
                             c,
                             format!(
-                                "the cutoff must be > 0 and <= the output Nyquist frequency {nyq_out} Hz; use e.g. --cutoff {}",
+                                "the cutoff must be > 0 and <= the output Nyquist frequency {nyq_out} Hz; use e.g. a cutoff of {} Hz",
                                 nyq_out / 2.0
                             ),
                         ));
@@ -483,7 +483,8 @@ impl ResampleRecording for Recording {
             })?;
             channels.push(Channel {
                 samples: out,
-                ..Channel::new(c.name.clone(), c.unit.clone(), Vec::new()).with_placement(c.placement)
+                ..Channel::new(c.name.clone(), c.unit.clone(), Vec::new())
+                    .with_placement(c.placement)
             });
         }
         Ok(Recording {

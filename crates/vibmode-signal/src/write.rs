@@ -2,9 +2,9 @@
 
 use crate::error::{io_err, Result, SignalError};
 use crate::read::{Format, Sidecar};
-use vibmode_core::{check_fs, Recording};
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use vibmode_core::{check_fs, Recording};
 
 /// Writes `rec` to `path`, choosing the format by extension (case-insensitive):
 /// - `.csv`, `.txt`, `.tsv`, `.dat`: comma-separated text (tab for `.tsv`), header

@@ -3,9 +3,10 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::{Path, PathBuf};
+use vibmode_signal::ResampleRecording;
 use vibmode_signal::{
     read_delimited, read_path, write_path, Channel, ChannelSelector, DelimitedReader, Format,
-    ReadOptions, Recording, SignalError,
+    ReadOptions, Recording,
 };
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
@@ -22,7 +23,7 @@ fn opts_fs(fs: f64) -> ReadOptions {
 }
 
 /// Error message, checked to be one line.
-fn err_of<T: std::fmt::Debug>(r: Result<T, SignalError>) -> String {
+fn err_of<T: std::fmt::Debug, E: std::fmt::Display + std::fmt::Debug>(r: Result<T, E>) -> String {
     let s = r.unwrap_err().to_string();
     assert!(!s.contains('\n'), "not one line: {s}");
     s
@@ -35,6 +36,7 @@ fn random_recording(seed: u64, n: usize, nch: usize, fs: f64) -> Recording {
             name: ["FL", "FR", "RL", "RR", "S_FR", "S_RL", "S_RR"][c % 7].to_string(),
             unit: "m/s^2".into(),
             samples: (0..n).map(|_| r.gen_range(-30.0..30.0)).collect(),
+            placement: Default::default(),
         })
         .collect();
     Recording::new(fs, chans).unwrap()
@@ -102,10 +104,7 @@ fn tab_whitespace_headerless_and_comments() {
         "w.txt",
         &ReadOptions::default(),
     ));
-    assert_eq!(
-        e,
-        "no time column in w.txt; give the sampling rate with --fs HZ"
-    );
+    assert_eq!(e, "no time column in w.txt; give its sampling rate (fs_hz)");
     let rec = read_delimited(ws.as_bytes(), "w.txt", &opts_fs(50.0)).unwrap();
     assert_eq!(rec.fs_hz, 50.0);
     assert_eq!(rec.names(), vec!["ch0", "ch1", "ch2"]);
@@ -148,7 +147,10 @@ fn nonuniform_time_refused_then_interpolated() {
     ));
     // mean dt 0.1; max |dt - 0.1| = 0.03 -> jitter 0.3.
     assert!(
-        e.contains("3.000e-1") && e.contains("--resample-nonuniform") && e.contains("10.0000"),
+        e.contains("3.000e-1")
+            && e.contains("resample_nonuniform")
+            && e.contains("10.0000")
+            && !e.contains("--"),
         "{e}"
     );
     let o = ReadOptions {
@@ -270,11 +272,13 @@ fn channel_selection() {
                 name: "a".into(),
                 unit: String::new(),
                 samples: vec![1.0; 3],
+                placement: Default::default(),
             },
             Channel {
                 name: "b".into(),
                 unit: String::new(),
                 samples: vec![1.0; 2],
+                placement: Default::default(),
             },
         ],
     ));
@@ -532,7 +536,10 @@ fn real_bratislava_transit_files() {
     for (f, n) in expected {
         let p = dir.join(f);
         let e = err_of(read_path(&p, &ReadOptions::default()));
-        assert!(e.contains("--fs HZ"), "{e}");
+        assert!(
+            e.contains("sampling rate (fs_hz)") && !e.contains("--"),
+            "{e}"
+        );
         let rec = read_path(&p, &opts_fs(500.0)).unwrap();
         assert_eq!(rec.names(), vec!["x", "y", "z"], "{f}");
         assert_eq!(rec.len(), n, "{f}");

@@ -7,7 +7,7 @@
 #[non_exhaustive]
 pub enum SpectraError {
     /// The sampling rate is zero, negative, NaN or infinite.
-    #[error("sampling rate fs_hz = {fs_hz} must be positive and finite; check the recording's sample rate (e.g. --fs 100)")]
+    #[error("sampling rate fs_hz = {fs_hz} must be positive and finite; check the recording's sampling rate")]
     InvalidSampleRate {
         /// The rejected sampling rate, Hz.
         fs_hz: f64,
@@ -29,10 +29,10 @@ pub enum SpectraError {
         value: f64,
     },
     /// `nperseg` is zero.
-    #[error("nperseg must be at least 1 (got 0); use --nperseg 256")]
+    #[error("nperseg must be at least 1 (got 0); use nperseg = 256")]
     ZeroNperseg,
     /// `noverlap >= nperseg` (after clamping `nperseg` to the record length, as scipy does).
-    #[error("noverlap ({noverlap}) must be smaller than nperseg ({nperseg}); use --noverlap {suggested}")]
+    #[error("noverlap ({noverlap}) must be smaller than nperseg ({nperseg}); use noverlap = {suggested}")]
     NoverlapTooLarge {
         /// The requested overlap, samples.
         noverlap: usize,
@@ -42,7 +42,7 @@ pub enum SpectraError {
         suggested: usize,
     },
     /// `nfft < nperseg`.
-    #[error("nfft ({nfft}) must be at least nperseg ({nperseg}); use --nfft {nperseg} or larger")]
+    #[error("nfft ({nfft}) must be at least nperseg ({nperseg}); use nfft = {nperseg} or larger")]
     NfftTooSmall {
         /// The requested FFT length, samples.
         nfft: usize,
@@ -50,7 +50,7 @@ pub enum SpectraError {
         nperseg: usize,
     },
     /// `nfft` is zero.
-    #[error("nfft must be at least 1 (got 0); omit --nfft to use the default")]
+    #[error("nfft must be at least 1 (got 0); leave nfft unset for the default (nperseg)")]
     ZeroNfft,
     /// `x` and `y` of a cross-spectrum have different lengths.
     #[error("x has {len_x} samples but y has {len_y}; csd and coherence need records of equal length, trim the longer one to {min}", min = .len_x.min(.len_y))]
@@ -61,7 +61,7 @@ pub enum SpectraError {
         len_y: usize,
     },
     /// The record is shorter than one segment and [`crate::ShortRecord::Error`] was asked for.
-    #[error("record has {n_samples} samples, shorter than one segment (nperseg = {nperseg}); use --nperseg <= {n_samples}")]
+    #[error("record has {n_samples} samples, shorter than one segment (nperseg = {nperseg}); use nperseg <= {n_samples}")]
     ShortRecord {
         /// Samples in the record.
         n_samples: usize,

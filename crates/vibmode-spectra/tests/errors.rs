@@ -77,7 +77,7 @@ fn noverlap_not_smaller_than_nperseg() {
     let e = welch(&x, 10.0, &p).unwrap_err();
     assert_eq!(
         one_line(&e),
-        "noverlap (256) must be smaller than nperseg (256); use --noverlap 128"
+        "noverlap (256) must be smaller than nperseg (256); use noverlap = 128"
     );
     let p = WelchParams {
         noverlap: Some(300),
@@ -110,7 +110,7 @@ fn nfft_smaller_than_nperseg_or_zero() {
             nperseg: 256
         }
     );
-    assert!(one_line(&e).contains("--nfft 256"));
+    assert!(one_line(&e).contains("nfft = 256"));
     let p = WelchParams {
         nfft: Some(0),
         ..Default::default()
@@ -164,7 +164,7 @@ fn short_record_error_and_clamp() {
     let e = welch(&sig(300), 10.0, &p).unwrap_err();
     assert_eq!(
         one_line(&e),
-        "record has 300 samples, shorter than one segment (nperseg = 512); use --nperseg <= 300"
+        "record has 300 samples, shorter than one segment (nperseg = 512); use nperseg <= 300"
     );
     let s = welch(
         &sig(300),

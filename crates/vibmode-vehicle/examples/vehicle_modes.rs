@@ -45,9 +45,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let s = simulate(&bus, &sim)?;
         let el = t.elapsed().as_secs_f64();
         let rms: Vec<f64> = s.records[0]
-            .samples
+            .recording
+            .channels
             .iter()
-            .map(|c| (c.iter().map(|v| v * v).sum::<f64>() / c.len() as f64).sqrt())
+            .map(|c| (c.samples.iter().map(|v| v * v).sum::<f64>() / c.samples.len() as f64).sqrt())
             .collect();
         println!(
             "{label}: {el:.3} s (warm-up {:.1} s); record-0 RMS m/s^2 {:.3?}",

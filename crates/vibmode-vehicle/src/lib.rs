@@ -23,8 +23,10 @@
 //! let sim = SimParams { fs_hz: 500.0, duration_s: 2.0, records: 2, warmup_s: Some(1.0), ..SimParams::default() };
 //! let out = simulate(&bus, &sim)?;
 //! assert_eq!(out.records.len(), 2);
-//! assert_eq!(out.records[0].channel_names[4], "FR_sprung");
-//! assert_eq!(out.records[0].samples[4].len(), 1000);
+//! let rec = &out.records[0].recording; // a vibmode_core::Recording, ready for the analysis
+//! assert_eq!(rec.channels[4].name, "FR_sprung");
+//! assert_eq!(rec.channels[4].placement.role, vibmode_core::Role::Sprung);
+//! assert_eq!(rec.len(), 1000);
 //! # Ok::<(), vibmode_vehicle::VehicleError>(())
 //! ```
 

@@ -11,8 +11,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
-use vibmode_core::{Channel, Recording};
 use std::f64::consts::PI;
+use vibmode_core::{Channel, Recording};
 
 /// A periodic engine / driveline line: a vertical force on the body.
 /// In serialised form `drift_hz` (0), `drift_period_s` (30), `x_m` and `y_m` (0) may be omitted.

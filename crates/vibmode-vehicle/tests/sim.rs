@@ -75,7 +75,7 @@ fn band_power_matches_analytic_psd() {
             let segs: Vec<&[f64]> = sim
                 .records
                 .iter()
-                .map(|r| r.samples[c].as_slice())
+                .map(|r| r.recording.channels[c].samples.as_slice())
                 .collect();
             let (f, p) = avg_periodogram(&segs, sp.fs_hz);
             for (lo, hi) in [(0.5, 2.0), (2.0, 6.0), (6.0, 12.0), (12.0, 24.0)] {
@@ -115,11 +115,11 @@ fn spectral_peaks_at_body_and_wheel_hop_modes() {
         .map(|m| m.frequency_hz)
         .collect();
     assert_eq!((body.len(), hop.len()), (3, 4));
-    for (c, name) in sim.records[0].channel_names.iter().enumerate() {
+    for (c, name) in sim.records[0].recording.names().into_iter().enumerate() {
         let segs: Vec<&[f64]> = sim
             .records
             .iter()
-            .map(|r| r.samples[c].as_slice())
+            .map(|r| r.recording.channels[c].samples.as_slice())
             .collect();
         let (f, p) = avg_periodogram(&segs, 500.0);
         // smooth over 9 bins (0.9 Hz... 0.1 Hz bins at 10.24 s)
@@ -181,13 +181,13 @@ fn same_seed_same_output_and_records_are_successive() {
         },
     )
     .unwrap();
-    assert_ne!(a.records[0].samples, c.records[0].samples);
+    assert_ne!(a.records[0].recording, c.records[0].recording);
     let starts: Vec<f64> = a.records.iter().map(|r| r.start_time_s).collect();
     assert_eq!(starts, vec![0.0, 2.0, 4.0]);
     assert!(a
         .records
         .iter()
-        .all(|r| r.samples.len() == 7 && r.samples.iter().all(|s| s.len() == 800)));
+        .all(|r| r.recording.n_channels() == 7 && r.recording.len() == 800));
     // serialisable
     let j = serde_json::to_string(&a.truth).unwrap();
     assert!(j.contains("\"disturbance_lines_hz\":[7.0,11.0,12.0]"));
@@ -230,8 +230,8 @@ fn disturbances_show_up_where_expected() {
     .unwrap();
     assert_eq!(sim.truth.sensor_bias_m_s2.len(), 7);
     for c in 0..7 {
-        let x = &sim.records[0].samples[c];
-        let q = &quiet_sim.records[0].samples[c];
+        let x = &sim.records[0].recording.channels[c].samples;
+        let q = &quiet_sim.records[0].recording.channels[c].samples;
         // same seed stream for the road: the difference is only the disturbances
         let d: Vec<f64> = x.iter().zip(q).map(|(a, b)| a - b).collect();
         let mean = d.iter().sum::<f64>() / d.len() as f64;
@@ -467,7 +467,10 @@ fn braking_pitches_the_body_nose_down() {
     // Onset of the pulse (t = 1.0..1.5 s): acceleration difference due to the pitch moment.
     let diff = |c: usize| {
         (200..300)
-            .map(|k| a.records[0].samples[c][k] - b.records[0].samples[c][k])
+            .map(|k| {
+                a.records[0].recording.channels[c].samples[k]
+                    - b.records[0].recording.channels[c].samples[k]
+            })
             .sum::<f64>()
     };
     assert!(
@@ -497,27 +500,42 @@ fn sim_params_deserialise_with_defaults_and_reject_unknown_keys() {
 }
 
 #[test]
-fn a_simulated_record_becomes_a_recording_sample_for_sample() {
+fn a_simulated_record_carries_its_sensors_names_units_and_placements() {
     let sp = SimParams {
         fs_hz: 200.0,
         duration_s: 2.0,
         records: 1,
         ..SimParams::default()
     };
-    let sim = simulate(&VehicleParams::city_bus(), &sp).unwrap();
-    let rec = &sim.records[0];
-    let r = rec.to_recording();
+    let bus = VehicleParams::city_bus();
+    let sim = simulate(&bus, &sp).unwrap();
+    let r = &sim.records[0].recording;
     assert_eq!(r.fs_hz, 200.0);
+    let car = FullCar::new(&bus).unwrap();
     assert_eq!(
         r.names(),
-        rec.channel_names
+        car.sensor_names()
             .iter()
             .map(String::as_str)
             .collect::<Vec<_>>()
     );
-    for (ch, s) in r.channels.iter().zip(&rec.samples) {
+    for ch in &r.channels {
         assert_eq!(ch.unit, "m/s^2");
-        assert_eq!(&ch.samples, s);
         assert_eq!(ch.samples.len(), 400);
+        // The shipped bus names its sensors "FL_unsprung", "FR_sprung", ...: the placement the
+        // simulator attaches must agree with the name.
+        let role = if ch.name.contains("unsprung") {
+            vibmode_core::Role::Unsprung
+        } else {
+            vibmode_core::Role::Sprung
+        };
+        assert_eq!(ch.placement.role, role, "{}", ch.name);
+        assert_eq!(
+            ch.placement.corner.map(|c| c.to_string()),
+            Some(ch.name[..2].to_string()),
+            "{}",
+            ch.name
+        );
+        assert_eq!(ch.placement.direction, Some(vibmode_core::Direction::Z));
     }
 }

@@ -4,6 +4,7 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
+use vibmode_modal::ClusterParams;
 use vibmode_modal::PoleObservation;
 
 /// A true mode of the synthetic cloud.
@@ -104,4 +105,20 @@ pub fn cloud(
         }
     }
     out
+}
+
+/// The clustering settings of the reference script `tools/reference/modal.py` (and of these
+/// tests): vibmode-modal 0.1's defaults, spelled out. The analysis defaults
+/// (`ClusterParams::default()`) differ in five fields: a damping-scaled radius (0.5), a stricter
+/// order share (0.5), 0.3 Hz lowest frequency, no fixed highest frequency and a 2 % line spread.
+#[allow(dead_code)]
+pub fn script_params() -> ClusterParams {
+    ClusterParams {
+        freq_tol_per_damping: 0.0,
+        min_order_share: 0.25,
+        disturbance_freq_spread_max: 0.01,
+        freq_min_hz: 0.1,
+        freq_max_hz: Some(30.0),
+        ..ClusterParams::default()
+    }
 }
