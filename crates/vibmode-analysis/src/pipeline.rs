@@ -109,45 +109,24 @@ pub fn analyze_with(
     let stationary = detect_stops(&activity_ratio, &cfg.stops);
     let active = renumber_active(&stationary);
     let n_active = active.iter().flatten().count();
-    let first = &records[0].recording;
-    let mut store = PoleStore::new();
-    let mut channels = Vec::with_capacity(n_ch);
-    let orders = cfg.orders();
     let cluster = cluster_params_for(&cfg.cluster, &pre[0].band);
-    for (c, ch) in first.channels.iter().enumerate() {
-        let placement = cfg.placement_of(ch);
-        let mine: Vec<&SignalOut> = outs.iter().filter(|o| o.channel == c).collect();
-        let poles: Vec<_> = mine
-            .iter()
-            .flat_map(|o| o.fits.poles.iter().copied())
-            .collect();
-        store.add(&ch.name, placement.role, &poles);
-        let obs = store.observations(|n, _| n == ch.name, &active);
-        let invariant = vibmode_modal::find_invariant_modes(&obs, n_active, &orders, &cluster)?;
-        let (welch_freq_hz, welch_psd) = mean_welch(&mine, &stationary);
-        channels.push(ChannelAnalysis {
-            name: ch.name.clone(),
-            unit: ch.unit.clone(),
-            role: placement.role,
-            placement,
-            welch_freq_hz,
-            welch_psd,
-            poles,
-            fits: mine
-                .iter()
-                .flat_map(|o| o.fits.fits.iter().cloned())
-                .collect(),
-            first_record_models: mine
-                .iter()
-                .find(|o| o.record == 0)
-                .map(|o| o.fits.models.clone())
-                .unwrap_or_default(),
-            invariant_modes: invariant,
-        });
-    }
-    let roles = role_modes(
-        &channels, &store, &active, n_active, &orders, &cluster, reference,
+    let orders = cfg.orders();
+    let support = Support {
+        active: &active,
+        n_active,
+        orders: &orders,
+        cluster: &cluster,
+    };
+    let mut store = PoleStore::new();
+    let channels = channel_modes(
+        &records[0].recording,
+        &outs,
+        &stationary,
+        cfg,
+        &support,
+        &mut store,
     )?;
+    let roles = role_modes(&channels, &store, &support, reference)?;
     let fits = channels.iter().flat_map(|c| c.fits.iter());
     let n_fits = fits.clone().count();
     let n_not_converged = fits.clone().filter(|f| !f.converged).count();
@@ -290,15 +269,79 @@ fn mean_welch(mine: &[&SignalOut], stationary: &[bool]) -> (Vec<f64>, Vec<f64>) 
     (freq, mean)
 }
 
-/// Stage 5 and 6 per role: the poles of all channels of a role clustered together, and the
+/// What the clustering needs besides the poles: the records in use and the orders fitted.
+struct Support<'a> {
+    active: &'a [Option<usize>],
+    n_active: usize,
+    orders: &'a [usize],
+    cluster: &'a ClusterParams,
+}
+
+impl Support<'_> {
+    fn cluster(
+        &self,
+        store: &PoleStore,
+        which: impl Fn(&str, Role) -> bool,
+    ) -> Result<Vec<InvariantMode>, AnalysisError> {
+        let obs = store.observations(which, self.active);
+        Ok(vibmode_modal::find_invariant_modes(
+            &obs,
+            self.n_active,
+            self.orders,
+            self.cluster,
+        )?)
+    }
+}
+
+/// Stages 4 and 6 per channel: each channel's poles stored and clustered alone.
+fn channel_modes(
+    first: &vibmode_core::Recording,
+    outs: &[SignalOut],
+    stationary: &[bool],
+    cfg: &AnalysisConfig,
+    support: &Support<'_>,
+    store: &mut PoleStore,
+) -> Result<Vec<ChannelAnalysis>, AnalysisError> {
+    let mut channels = Vec::with_capacity(first.n_channels());
+    for (c, ch) in first.channels.iter().enumerate() {
+        let placement = cfg.placement_of(ch);
+        let mine: Vec<&SignalOut> = outs.iter().filter(|o| o.channel == c).collect();
+        let poles: Vec<_> = mine
+            .iter()
+            .flat_map(|o| o.fits.poles.iter().copied())
+            .collect();
+        store.add(&ch.name, placement.role, &poles);
+        let invariant_modes = support.cluster(store, |n, _| n == ch.name)?;
+        let (welch_freq_hz, welch_psd) = mean_welch(&mine, stationary);
+        channels.push(ChannelAnalysis {
+            name: ch.name.clone(),
+            unit: ch.unit.clone(),
+            role: placement.role,
+            placement,
+            welch_freq_hz,
+            welch_psd,
+            poles,
+            fits: mine
+                .iter()
+                .flat_map(|o| o.fits.fits.iter().cloned())
+                .collect(),
+            first_record_models: mine
+                .iter()
+                .find(|o| o.record == 0)
+                .map(|o| o.fits.models.clone())
+                .unwrap_or_default(),
+            invariant_modes,
+        });
+    }
+    Ok(channels)
+}
+
+/// Stages 6 and 7 per role: the poles of all channels of a role clustered together, and the
 /// structural modes matched to the physical model's.
 fn role_modes(
     channels: &[ChannelAnalysis],
     store: &PoleStore,
-    active: &[Option<usize>],
-    n_active: usize,
-    orders: &[usize],
-    cluster: &ClusterParams,
+    support: &Support<'_>,
     reference: &[ReferenceMode],
 ) -> Result<Vec<RoleAnalysis>, AnalysisError> {
     let mut roles = Vec::new();
@@ -311,13 +354,11 @@ fn role_modes(
         if names.is_empty() {
             continue;
         }
-        let obs = store.observations(|_, r| r == role, active);
-        let invariant: Vec<InvariantMode> =
-            vibmode_modal::find_invariant_modes(&obs, n_active, orders, cluster)?;
+        let invariant = support.cluster(store, |_, r| r == role)?;
         let matches = if reference.is_empty() {
             Vec::new()
         } else {
-            vibmode_modal::match_reference(&invariant, reference, 0.25)
+            vibmode_modal::match_reference(&invariant, reference, MATCH_MAX_FREQ_DIFF_REL)
         };
         roles.push(RoleAnalysis {
             role,
@@ -328,3 +369,7 @@ fn role_modes(
     }
     Ok(roles)
 }
+
+/// A physical-model mode is matched to the nearest structural mode within this relative
+/// frequency difference (25 %: body modes of a bus sit 15-25 % apart, wheel hop near 10 Hz).
+pub const MATCH_MAX_FREQ_DIFF_REL: f64 = 0.25;

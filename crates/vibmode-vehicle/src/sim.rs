@@ -639,6 +639,143 @@ impl FullCar {
     }
 }
 
+/// Default warm-up: five times the slowest mode's decay time `1 / (zeta omega)`, within 2-30 s.
+fn default_warmup_s(modes: &[ModeInfo]) -> f64 {
+    let tmax = modes
+        .iter()
+        .map(|m| 1.0 / (m.damping_ratio * 2.0 * PI * m.frequency_hz).max(1e-9))
+        .fold(0.0, f64::max);
+    (5.0 * tmax).clamp(2.0, 30.0)
+}
+
+/// Speed (m/s) at each of `nk` samples, integrating the manoeuvres' longitudinal acceleration
+/// `ax(t)` by the trapezoidal rule from `v0`; `time(k)` is the time of sample k.
+fn speed_profile(
+    v0: f64,
+    nk: usize,
+    dt: f64,
+    time: impl Fn(usize) -> f64,
+    ax: impl Fn(f64) -> f64,
+) -> Result<Vec<f64>> {
+    let mut speed = vec![v0; nk];
+    for k in 1..nk {
+        let t0 = time(k - 1);
+        let t1 = time(k);
+        speed[k] = speed[k - 1] + 0.5 * (ax(t0) + ax(t1)) * dt;
+        if speed[k] < 0.5 {
+            return Err(invalid(
+                "manoeuvres",
+                format!("speed {:.2} m/s at t = {:.2} s", speed[k], t1),
+                "brakes the vehicle below 0.5 m/s; reduce the braking longitudinal_accel_m_s2 or raise speed_kmh",
+            ));
+        }
+    }
+    Ok(speed)
+}
+
+/// Adds each channel's bias, the high-frequency tones and white sensor noise (in this order of
+/// draws from `rng`, which keeps a seed's output bit-identical); returns the biases drawn.
+fn add_sensor_effects(
+    samples: &mut [Vec<f64>],
+    dist: &Disturbances,
+    dt: f64,
+    rng: &mut ChaCha8Rng,
+) -> Vec<f64> {
+    let bias: Vec<f64> = (0..samples.len())
+        .map(|_| {
+            if dist.sensor_bias_max_m_s2 > 0.0 {
+                rng.gen_range(-1.0..1.0) * dist.sensor_bias_max_m_s2
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    for (c, s) in samples.iter_mut().enumerate() {
+        let phases: Vec<f64> = dist
+            .hf_tones
+            .iter()
+            .map(|_| rng.gen_range(0.0..2.0 * PI))
+            .collect();
+        for (j, v) in s.iter_mut().enumerate() {
+            let t = j as f64 * dt;
+            let mut add = bias[c];
+            for (tone, ph) in dist.hf_tones.iter().zip(&phases) {
+                add += tone.amplitude_m_s2 * (2.0 * PI * tone.frequency_hz * t + ph).sin();
+            }
+            if dist.sensor_noise_std_m_s2 > 0.0 {
+                let g: f64 = rng.sample(StandardNormal);
+                add += g * dist.sensor_noise_std_m_s2;
+            }
+            *v += add;
+        }
+    }
+    bias
+}
+
+/// Cuts the drive into records of `n_rec` samples, from the end (`split_off`) so the drive is
+/// never held twice; each channel named after its sensor, with its placement.
+fn split_records(
+    mut samples: Vec<Vec<f64>>,
+    car: &FullCar,
+    speed: &[f64],
+    n_warm: usize,
+    n_rec: usize,
+    fs: f64,
+) -> Vec<SimRecord> {
+    let names = car.sensor_names();
+    let placements = car.sensor_placements();
+    let n_records = samples.first().map_or(0, |s| s.len() / n_rec.max(1));
+    let mut records = Vec::with_capacity(n_records);
+    for r in (0..n_records).rev() {
+        let a = r * n_rec;
+        let i0 = n_warm + a + 1;
+        let mean_v = speed[i0..i0 + n_rec].iter().sum::<f64>() / n_rec as f64;
+        let channels = samples
+            .iter_mut()
+            .zip(names.iter().zip(&placements))
+            .map(|(s, (name, placement))| {
+                Channel::new(name.clone(), "m/s^2", s.split_off(a)).with_placement(*placement)
+            })
+            .collect();
+        records.push(SimRecord {
+            recording: Recording {
+                fs_hz: fs,
+                channels,
+                time_axis: None,
+            },
+            start_time_s: a as f64 * (1.0 / fs),
+            mean_speed_kmh: mean_v * 3.6,
+        });
+    }
+    records.reverse();
+    records
+}
+
+/// Per corner (FL, FR, RL, RR): the road track it runs on (0 left, 1 right) and its distance
+/// ahead of the rear axle, m.
+fn wheel_tracks(wheelbase_m: f64) -> [(usize, f64); 4] {
+    Corner::ALL.map(|c| {
+        (
+            if c.is_left() { 0 } else { 1 },
+            if c.is_front() { wheelbase_m } else { 0.0 },
+        )
+    })
+}
+
+/// Adds the engine/gear lines' generalised forces at time `t` (s) to `f` (heave N, pitch and
+/// roll N m); each line's phase drifts sinusoidally (`drift_hz` over `drift_period_s`).
+fn add_line_forces(f: &mut [f64], lines: &[(EngineLine, f64)], t: f64) {
+    for (l, ph0) in lines {
+        let phase = ph0
+            + 2.0 * PI * l.frequency_hz * t
+            + l.drift_hz * l.drift_period_s * (1.0 - (2.0 * PI * t / l.drift_period_s).cos());
+        let force = l.force_n * phase.sin();
+        f[DOF_HEAVE] += force;
+        f[DOF_PITCH] += force * l.x_m;
+        f[DOF_ROLL] += force * l.y_m;
+    }
+}
+
 /// Simulate the measurement campaign: one continuous drive over an ISO 8608 road, cut into
 /// `records` successive records, with the optional manoeuvres and disturbances.
 ///
@@ -649,16 +786,7 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
     let modes = car.modes()?;
     let fs = sim.fs_hz;
     let dt = 1.0 / fs;
-    let warmup_s = match sim.warmup_s {
-        Some(w) => w,
-        None => {
-            let tmax = modes
-                .iter()
-                .map(|m| 1.0 / (m.damping_ratio * 2.0 * PI * m.frequency_hz).max(1e-9))
-                .fold(0.0, f64::max);
-            (5.0 * tmax).clamp(2.0, 30.0)
-        }
-    };
+    let warmup_s = sim.warmup_s.unwrap_or_else(|| default_warmup_s(&modes));
     let n_warm = (warmup_s * fs).round() as usize;
     let n_rec = (sim.duration_s * fs).round() as usize;
     let n_total = n_warm + n_rec * sim.records;
@@ -680,19 +808,7 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
             .sum::<f64>()
     };
     let nk = n_total + 2;
-    let mut speed = vec![v0; nk];
-    for k in 1..nk {
-        let t0 = time(k - 1);
-        let t1 = time(k);
-        speed[k] = speed[k - 1] + 0.5 * (ax(t0) + ax(t1)) * dt;
-        if speed[k] < 0.5 {
-            return Err(invalid(
-                "manoeuvres",
-                format!("speed {:.2} m/s at t = {:.2} s", speed[k], t1),
-                "brakes the vehicle below 0.5 m/s; reduce the braking longitudinal_accel_m_s2 or raise speed_kmh",
-            ));
-        }
-    }
+    let speed = speed_profile(v0, nk, dt, time, ax)?;
     let wb = vehicle.geometry.wheelbase_m;
     let vmax = speed.iter().copied().fold(0.0, f64::max);
     let dx = vmax * dt;
@@ -707,19 +823,7 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
     let mut rng2 = ChaCha8Rng::seed_from_u64(sim.seed);
     rng2.set_stream(2);
     // Road heights for every index: front axle at pos + wb, rear at pos.
-    let corners: Vec<(usize, f64)> = Corner::ALL
-        .iter()
-        .map(|c| {
-            (
-                if matches!(c, Corner::FL | Corner::RL) {
-                    0
-                } else {
-                    1
-                },
-                if c.is_front() { wb } else { 0.0 },
-            )
-        })
-        .collect();
+    let corners = wheel_tracks(wb);
     let road_at = |k: usize| -> [f64; 4] {
         std::array::from_fn(|i| road.height_m(corners[i].0, pos[k] + corners[i].1))
     };
@@ -733,8 +837,6 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
         .collect();
     let d = Discrete::new(&car, fs)?;
     let p = car.sensors.len();
-    let names = car.sensor_names();
-    let placements = car.sensor_placements();
     let mut samples: Vec<Vec<f64>> = vec![vec![0.0; n_rec * sim.records]; p];
     // State index k of `run` corresponds to array index k + 1.
     d.run(
@@ -746,17 +848,7 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
             u[..4].copy_from_slice(&r);
             let t = time(idx);
             let f = &mut u[4..4 + n];
-            for (l, ph0) in &lines {
-                let phase = ph0
-                    + 2.0 * PI * l.frequency_hz * t
-                    + l.drift_hz
-                        * l.drift_period_s
-                        * (1.0 - (2.0 * PI * t / l.drift_period_s).cos());
-                let force = l.force_n * phase.sin();
-                f[DOF_HEAVE] += force;
-                f[DOF_PITCH] += force * l.x_m;
-                f[DOF_ROLL] += force * l.y_m;
-            }
+            add_line_forces(f, &lines, t);
             if !sim.manoeuvres.is_empty() {
                 f[DOF_PITCH] += body_m * ax(t) * h_cg;
                 f[DOF_ROLL] += body_m * ay(t) * h_cg;
@@ -775,60 +867,9 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
             }
         },
     );
-    // Sensor effects.
     let dist = &sim.disturbances;
-    let bias: Vec<f64> = (0..p)
-        .map(|_| {
-            if dist.sensor_bias_max_m_s2 > 0.0 {
-                rng2.gen_range(-1.0..1.0) * dist.sensor_bias_max_m_s2
-            } else {
-                0.0
-            }
-        })
-        .collect();
-    for (c, s) in samples.iter_mut().enumerate() {
-        let phases: Vec<f64> = dist
-            .hf_tones
-            .iter()
-            .map(|_| rng2.gen_range(0.0..2.0 * PI))
-            .collect();
-        for (j, v) in s.iter_mut().enumerate() {
-            let t = j as f64 * dt;
-            let mut add = bias[c];
-            for (tone, ph) in dist.hf_tones.iter().zip(&phases) {
-                add += tone.amplitude_m_s2 * (2.0 * PI * tone.frequency_hz * t + ph).sin();
-            }
-            if dist.sensor_noise_std_m_s2 > 0.0 {
-                let g: f64 = rng2.sample(StandardNormal);
-                add += g * dist.sensor_noise_std_m_s2;
-            }
-            *v += add;
-        }
-    }
-    // Split into records from the end (split_off) so the full drive is never held twice.
-    let mut records = Vec::with_capacity(sim.records);
-    for r in (0..sim.records).rev() {
-        let a = r * n_rec;
-        let i0 = n_warm + a + 1;
-        let mean_v = speed[i0..i0 + n_rec].iter().sum::<f64>() / n_rec as f64;
-        let channels = samples
-            .iter_mut()
-            .zip(names.iter().zip(&placements))
-            .map(|(s, (name, placement))| {
-                Channel::new(name.clone(), "m/s^2", s.split_off(a)).with_placement(*placement)
-            })
-            .collect();
-        records.push(SimRecord {
-            recording: Recording {
-                fs_hz: fs,
-                channels,
-                time_axis: None,
-            },
-            start_time_s: a as f64 * dt,
-            mean_speed_kmh: mean_v * 3.6,
-        });
-    }
-    records.reverse();
+    let bias = add_sensor_effects(&mut samples, dist, dt, &mut rng2);
+    let records = split_records(samples, &car, &speed, n_warm, n_rec, fs);
     Ok(Simulation {
         records,
         truth: Truth {
