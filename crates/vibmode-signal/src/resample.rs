@@ -145,83 +145,88 @@ fn fft_err(e: realfft::FftError) -> SignalError {
     }
 }
 
-impl Resampler {
-    /// Plans a resampler for records of `n_in` samples at `fs_hz`.
-    ///
-    /// Errors: `fs_hz` or `to_hz` not positive and finite; `cutoff_hz` not positive or above the
-    /// output Nyquist frequency `min(fs_in, fs_out) / 2`; fewer than 2 output samples.
-    pub fn new(n_in: usize, fs_hz: f64, p: &ResampleParams) -> Result<Resampler> {
-        check_fs(fs_hz, "input fs_hz")?;
-        if !(p.to_hz.is_finite() && p.to_hz > 0.0) {
-            return Err(invalid(
-                "to_hz",
-                p.to_hz,
-                "the target rate must be a positive finite number of Hz, e.g. 200".into(),
-            ));
-        }
-        let ratio = fs_hz / p.to_hz;
-        let d = ratio.round();
-        let integer = d >= 1.0 && (ratio - d).abs() <= 1e-9 * ratio;
-        let (kind, factor, n_out, fs_out) = if integer {
-            let dd = d as usize;
-            let n_out = n_in.div_ceil(dd);
-            let kind = match (p.filter, n_in % dd == 0) {
-                (false, _) => Kind::Pick,
-                (true, true) => Kind::Fold,
-                (true, false) => Kind::Full,
-            };
-            (kind, dd, n_out, fs_hz / d)
-        } else if p.filter {
-            let num = (n_in as f64 * p.to_hz / fs_hz).round_ties_even();
-            let fs_out = fs_hz * num / n_in as f64;
-            let fs_out = if (fs_out - p.to_hz).abs() <= 1e-9 * p.to_hz {
-                p.to_hz
-            } else {
-                fs_out
-            };
-            (Kind::Fourier, 0, num as usize, fs_out)
-        } else {
-            let n_out = if n_in == 0 {
-                0
-            } else {
-                ((n_in - 1) as f64 * p.to_hz / fs_hz * (1.0 + 1e-12)).floor() as usize + 1
-            };
-            (Kind::Linear, 0, n_out, p.to_hz)
+/// How a record of `n_in` samples at `fs_hz` is resampled to `p.to_hz`: the method, the
+/// decimation factor (integer ratios), the number of output samples and the output rate.
+fn plan_kind(n_in: usize, fs_hz: f64, p: &ResampleParams) -> (Kind, usize, usize, f64) {
+    let ratio = fs_hz / p.to_hz;
+    let d = ratio.round();
+    let integer = d >= 1.0 && (ratio - d).abs() <= 1e-9 * ratio;
+    if integer {
+        let dd = d as usize;
+        let n_out = n_in.div_ceil(dd);
+        let kind = match (p.filter, n_in % dd == 0) {
+            (false, _) => Kind::Pick,
+            (true, true) => Kind::Fold,
+            (true, false) => Kind::Full,
         };
-        if n_out < 2 {
-            return Err(SignalError::TooShort {
-                what: format!("resampling from {fs_hz} Hz to {} Hz", p.to_hz),
-                n: n_in,
-                fix: format!(
-                    "that gives {n_out} output samples; need at least 2 (a record of at least {:.0} samples)",
-                    (2.0 * fs_hz / p.to_hz).ceil()
-                ),
-            });
-        }
-        let nyq_out = 0.5 * fs_hz.min(fs_out);
-        let mut cutoff = None;
-        let mut kc = n_in / 2;
-        if p.filter {
-            let c = match p.cutoff_hz {
-                Some(c) => {
-                    if !(c.is_finite() && c > 0.0) || c > nyq_out * (1.0 + 1e-9) {
-                        return Err(invalid(
-                            "cutoff_hz",
-                            c,
-                            format!(
-                                "the cutoff must be > 0 and <= the output Nyquist frequency {nyq_out} Hz; use e.g. a cutoff of {} Hz",
-                                nyq_out / 2.0
-                            ),
-                        ));
-                    }
-                    c
+        (kind, dd, n_out, fs_hz / d)
+    } else if p.filter {
+        let num = (n_in as f64 * p.to_hz / fs_hz).round_ties_even();
+        let fs_out = fs_hz * num / n_in as f64;
+        let fs_out = if (fs_out - p.to_hz).abs() <= 1e-9 * p.to_hz {
+            p.to_hz
+        } else {
+            fs_out
+        };
+        (Kind::Fourier, 0, num as usize, fs_out)
+    } else {
+        let n_out = if n_in == 0 {
+            0
+        } else {
+            ((n_in - 1) as f64 * p.to_hz / fs_hz * (1.0 + 1e-12)).floor() as usize + 1
+        };
+        (Kind::Linear, 0, n_out, p.to_hz)
+    }
+}
+
+/// The cutoff (Hz) and the highest kept DFT bin of the ideal low-pass (every bin up to Nyquist
+/// without a filter).
+fn cutoff_bin(
+    n_in: usize,
+    fs_hz: f64,
+    fs_out: f64,
+    p: &ResampleParams,
+) -> Result<(Option<f64>, usize)> {
+    let nyq_out = 0.5 * fs_hz.min(fs_out);
+    let mut cutoff = None;
+    let mut kc = n_in / 2;
+    if p.filter {
+        let c = match p.cutoff_hz {
+            Some(c) => {
+                if !(c.is_finite() && c > 0.0) || c > nyq_out * (1.0 + 1e-9) {
+                    return Err(invalid(
+                        "cutoff_hz",
+                        c,
+                        format!(
+                            "the cutoff must be > 0 and <= the output Nyquist frequency {nyq_out} Hz; use e.g. a cutoff of {} Hz",
+                            nyq_out / 2.0
+                        ),
+                    ));
                 }
-                None => nyq_out,
-            };
-            let r = c * n_in as f64 / fs_hz;
-            kc = ((r + 1e-9 * r.max(1.0)).floor() as usize).min(n_in / 2);
-            cutoff = Some(c);
-        }
+                c
+            }
+            None => nyq_out,
+        };
+        let r = c * n_in as f64 / fs_hz;
+        kc = ((r + 1e-9 * r.max(1.0)).floor() as usize).min(n_in / 2);
+        cutoff = Some(c);
+    }
+    Ok((cutoff, kc))
+}
+
+/// The FFT plans and buffers of one resampler.
+struct Ffts {
+    fwd: Option<Arc<dyn RealToComplex<f64>>>,
+    inv: Option<Arc<dyn ComplexToReal<f64>>>,
+    buf_in: Vec<f64>,
+    spec_in: Vec<Complex<f64>>,
+    spec_out: Vec<Complex<f64>>,
+    buf_out: Vec<f64>,
+    scratch_len: usize,
+}
+
+impl Ffts {
+    fn plan(kind: Kind, n_in: usize, n_out: usize) -> Ffts {
         let mut planner = RealFftPlanner::<f64>::new();
         let (fwd, inv) = match kind {
             Kind::Pick | Kind::Linear => (None, None),
@@ -250,6 +255,45 @@ impl Resampler {
             Some(f) => (f.make_input_vec(), f.make_output_vec()),
             None => (Vec::new(), Vec::new()),
         };
+        Ffts {
+            fwd,
+            inv,
+            buf_in,
+            spec_in,
+            spec_out,
+            buf_out,
+            scratch_len,
+        }
+    }
+}
+
+impl Resampler {
+    /// Plans a resampler for records of `n_in` samples at `fs_hz`.
+    ///
+    /// Errors: `fs_hz` or `to_hz` not positive and finite; `cutoff_hz` not positive or above the
+    /// output Nyquist frequency `min(fs_in, fs_out) / 2`; fewer than 2 output samples.
+    pub fn new(n_in: usize, fs_hz: f64, p: &ResampleParams) -> Result<Resampler> {
+        check_fs(fs_hz, "input fs_hz")?;
+        if !(p.to_hz.is_finite() && p.to_hz > 0.0) {
+            return Err(invalid(
+                "to_hz",
+                p.to_hz,
+                "the target rate must be a positive finite number of Hz, e.g. 200".into(),
+            ));
+        }
+        let (kind, factor, n_out, fs_out) = plan_kind(n_in, fs_hz, p);
+        if n_out < 2 {
+            return Err(SignalError::TooShort {
+                what: format!("resampling from {fs_hz} Hz to {} Hz", p.to_hz),
+                n: n_in,
+                fix: format!(
+                    "that gives {n_out} output samples; need at least 2 (a record of at least {:.0} samples)",
+                    (2.0 * fs_hz / p.to_hz).ceil()
+                ),
+            });
+        }
+        let (cutoff, kc) = cutoff_bin(n_in, fs_hz, fs_out, p)?;
+        let ffts = Ffts::plan(kind, n_in, n_out);
         Ok(Resampler {
             n_in,
             n_out,
@@ -259,13 +303,13 @@ impl Resampler {
             kc,
             kind,
             factor,
-            fwd,
-            inv,
-            buf_in,
-            spec_in,
-            spec_out,
-            buf_out,
-            scratch: vec![Complex::new(0.0, 0.0); scratch_len],
+            fwd: ffts.fwd,
+            inv: ffts.inv,
+            buf_in: ffts.buf_in,
+            spec_in: ffts.spec_in,
+            spec_out: ffts.spec_out,
+            buf_out: ffts.buf_out,
+            scratch: vec![Complex::new(0.0, 0.0); ffts.scratch_len],
         })
     }
 
