@@ -78,7 +78,7 @@ pub enum SignalError {
         given_fs_hz: f64,
     },
     /// The time column is not uniform enough.
-    #[error("time column '{column}' of {path} is not uniform: jitter {jitter_rel:.3e} of the mean step exceeds {max_jitter_rel:.3e}; enable resampling of non-uniform time (resample_nonuniform) to interpolate onto a uniform grid at {mean_fs_hz:.6} Hz")]
+    #[error("time column '{column}' of {path} is not uniform: jitter {jitter_rel:.3e} of the mean step exceeds {max_jitter_rel:.3e}; allow a non-uniform time column (allow_nonuniform) to interpolate onto a uniform grid at {mean_fs_hz:.6} Hz")]
     NonUniformTime {
         /// The file.
         path: String,

@@ -148,7 +148,7 @@ fn nonuniform_time_refused_then_interpolated() {
     // mean dt 0.1; max |dt - 0.1| = 0.03 -> jitter 0.3.
     assert!(
         e.contains("3.000e-1")
-            && e.contains("resample_nonuniform")
+            && e.contains("allow_nonuniform")
             && e.contains("10.0000")
             && !e.contains("--"),
         "{e}"
