@@ -27,7 +27,7 @@ pub mod recording;
 pub use error::{ParamError, RecordingError};
 pub use modes::{
     FitSummary, InvariantMode, ModeClass, ModeMatch, ModelCoefficients, PoleObservation,
-    ReferenceMode,
+    ReferenceMode, SupportFailure,
 };
 pub use params::{
     BandLimit, ClusterParams, PoleFilterParams, PreprocessParams, Robust, SpectrumParams,

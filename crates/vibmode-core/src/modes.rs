@@ -213,3 +213,67 @@ pub struct ModelCoefficients {
     /// Innovation variance (signal units squared).
     pub noise_variance: f64,
 }
+
+/// A support test of the clustering that a cluster failed (why it is `Spurious`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "test", rename_all = "snake_case")]
+pub enum SupportFailure {
+    /// Found in too few records.
+    RecordShare {
+        /// Share of the records that contain the cluster.
+        share: f64,
+        /// The required share (`min_record_share`).
+        min: f64,
+    },
+    /// Found at too few model orders.
+    OrderShare {
+        /// Share of the (record, order) fits that contain the cluster.
+        share: f64,
+        /// The required share (`min_order_share`).
+        min: f64,
+    },
+}
+
+impl fmt::Display for SupportFailure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SupportFailure::RecordShare { share, min } => write!(
+                f,
+                "in {:.0} % of records, below min_record_share {}",
+                100.0 * share,
+                min
+            ),
+            SupportFailure::OrderShare { share, min } => write!(
+                f,
+                "in {:.0} % of orders, below min_order_share {}",
+                100.0 * share,
+                min
+            ),
+        }
+    }
+}
+
+impl InvariantMode {
+    /// The support tests this cluster fails under `params` with `n_records` records (empty for
+    /// an invariant mode): the same rule the clustering classifies by.
+    pub fn support_failures(
+        &self,
+        params: &crate::ClusterParams,
+        n_records: usize,
+    ) -> Vec<SupportFailure> {
+        let mut out = Vec::new();
+        if n_records > 1 && self.record_share < params.min_record_share {
+            out.push(SupportFailure::RecordShare {
+                share: self.record_share,
+                min: params.min_record_share,
+            });
+        }
+        if self.order_share < params.min_order_share {
+            out.push(SupportFailure::OrderShare {
+                share: self.order_share,
+                min: params.min_order_share,
+            });
+        }
+        out
+    }
+}
