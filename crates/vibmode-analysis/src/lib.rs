@@ -95,6 +95,24 @@ pub enum AnalysisError {
         /// The first record's rate, Hz.
         first_fs_hz: f64,
     },
+    /// A record too short for the analysis at the analysis rate.
+    #[error("record '{record}' has {n_samples} samples at the analysis rate {fs_hz} Hz ({duration_s:.3} s); the lowest model order p = {order_min} needs at least {needed} samples ({needed_s:.3} s): give a longer record")]
+    RecordTooShort {
+        /// The record.
+        record: String,
+        /// Its samples after pre-processing.
+        n_samples: usize,
+        /// The analysis rate reached, Hz.
+        fs_hz: f64,
+        /// Its duration, s.
+        duration_s: f64,
+        /// The lowest order of the sweep.
+        order_min: usize,
+        /// Samples needed.
+        needed: usize,
+        /// Duration needed, s.
+        needed_s: f64,
+    },
     /// A recording breaks its invariants.
     #[error(transparent)]
     Recording(#[from] vibmode_core::RecordingError),

@@ -54,6 +54,39 @@ pub fn check_records(records: &[RecordInput]) -> Result<(), AnalysisError> {
     Ok(())
 }
 
+/// Samples per model parameter a fit needs at least: ARMA(p, q) is fitted only when
+/// `p + q <= N / 3` (`vibmode_ident::max_arma_order`).
+const SAMPLES_PER_PARAMETER: usize = 3;
+
+/// Checks that every pre-processed record is long enough for the lowest order of the sweep
+/// (and for a Welch segment of 8 samples).
+pub fn check_lengths(
+    records: &[RecordInput],
+    pre: &[Preprocessed],
+    cfg: &AnalysisConfig,
+) -> Result<(), AnalysisError> {
+    let params = match cfg.sweep.model {
+        vibmode_core::SweepModel::Arma => 2 * cfg.sweep.order_min,
+        vibmode_core::SweepModel::Ar => cfg.sweep.order_min,
+    };
+    let needed = (SAMPLES_PER_PARAMETER * params).max(8);
+    for (r, p) in records.iter().zip(pre) {
+        let n = p.recording.len();
+        if n < needed {
+            return Err(AnalysisError::RecordTooShort {
+                record: r.name.clone(),
+                n_samples: n,
+                fs_hz: p.band.fs_hz,
+                duration_s: n as f64 / p.band.fs_hz,
+                order_min: cfg.sweep.order_min,
+                needed,
+                needed_s: needed as f64 / p.band.fs_hz,
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Stage 2 over every record, in parallel.
 pub fn preprocess_records(
     records: &[RecordInput],
@@ -102,6 +135,7 @@ pub fn analyze_with(
     cfg.validate()?;
     check_records(records)?;
     let pre = preprocess_records(records, cfg)?;
+    check_lengths(records, &pre, cfg)?;
     let outs = identify_all(&pre, cfg, identifier, progress)?;
     let n_ch = pre.first().map_or(0, |p| p.recording.n_channels());
     let activity_rms = record_activity(&outs, records.len(), n_ch, cfg);
