@@ -246,6 +246,16 @@ mod tests {
             (p.role, p.corner, p.direction),
             (Role::Other, None, Some(Direction::Z))
         );
+        for (name, role, corner) in [
+            ("unsprung_fl", Role::Unsprung, Corner::FL),
+            ("FL_unsprung", Role::Unsprung, Corner::FL),
+            ("wheel_FL", Role::Unsprung, Corner::FL),
+            ("sprung_rr", Role::Sprung, Corner::RR),
+            ("Body-RL", Role::Sprung, Corner::RL),
+        ] {
+            let p = Placement::guess_from_name(name);
+            assert_eq!((p.role, p.corner), (role, Some(corner)), "{name}");
+        }
         // "FLOOR" is not the corner FL.
         assert_eq!(Corner::guess_from_name("floor_front"), None);
     }
