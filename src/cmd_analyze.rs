@@ -174,11 +174,11 @@ pub fn print_modes(r: &AnalysisResults, truth: Option<&[(String, f64, f64)]>) {
         r.channels.len(),
         r.n_fits,
         r.n_not_converged,
-        r.elapsed_s,
-        r.config.analysis_fs_hz,
-        r.config.cutoff_hz,
-        r.config.order_min,
-        r.config.order_max
+        r.timing.elapsed_s,
+        r.config.preprocess.analysis_fs_hz,
+        r.config.preprocess.cutoff_hz,
+        r.config.sweep.order_min,
+        r.config.sweep.order_max
     );
     if r.n_stationary > 0 {
         let stops: Vec<&str> = r
@@ -320,7 +320,7 @@ pub fn write_report(
         "Acceleration of the first record, up to four channels.",
     )?;
     // Fig. 3-4: anti-aliasing.
-    if first.fs_hz > cfg.analysis_fs_hz * 1.0001 {
+    if first.fs_hz > cfg.preprocess.analysis_fs_hz * 1.0001 {
         // With a non-integer rate ratio the output rate can fall a hair below analysis_fs_hz
         // (425.08 Hz -> 49.998 Hz): keep the cutoff at or below the output Nyquist, as the
         // analysis itself does.
@@ -328,32 +328,34 @@ pub fn write_report(
             first.len(),
             first.fs_hz,
             &vibmode_signal::ResampleParams {
-                to_hz: cfg.analysis_fs_hz,
+                to_hz: cfg.preprocess.analysis_fs_hz,
                 cutoff_hz: None,
                 filter: true,
             },
         )?;
         let cutoff = cfg
+            .preprocess
             .cutoff_hz
             .min(planned.fs_out_hz() / 2.0)
             .min(first.fs_hz / 2.0);
-        let fig34 = antialias_figure(first, cfg.analysis_fs_hz, Some(cutoff), 0.5)?;
+        let fig34 = antialias_figure(first, cfg.preprocess.analysis_fs_hz, Some(cutoff), 0.5)?;
         save_fig(&figdir, "fig03_antialias", &fig34)?;
         html.heading(2, "Anti-aliasing and resampling (Fig. 3-4)");
         html.figure(
             &fig34,
             &format!(
                 "First channel: raw at {} Hz, resampled to {} Hz without filter (aliased), and with the ideal DFT low-pass at {} Hz.",
-                first.fs_hz, cfg.analysis_fs_hz, cfg.cutoff_hz
+                first.fs_hz, cfg.preprocess.analysis_fs_hz, cfg.preprocess.cutoff_hz
             ),
         )?;
     }
     // Fig. 5: periodogram vs Welch.
-    let fmax = cfg.analysis_fs_hz / 2.0;
+    let spectra = vibmode_analysis::first_record_spectra(records, r)?;
+    let fmax = cfg.preprocess.analysis_fs_hz / 2.0;
     let mut p5 = Vec::new();
     let mut p67 = Vec::new();
     let mut p8 = Vec::new();
-    for ch in &r.channels {
+    for (ch, sp) in r.channels.iter().zip(&spectra) {
         let u = unit_of(&ch.unit);
         p5.push(Panel {
             title: format!("{} ({})", ch.name, ch.role),
@@ -366,22 +368,22 @@ pub fn write_report(
             series: vec![
                 {
                     let (x, y) =
-                        figures::positive_freq(&ch.periodogram_freq_hz, &ch.periodogram_psd);
+                        figures::positive_freq(&sp.periodogram_freq_hz, &sp.periodogram_psd);
                     line("periodogram", x, y, 1, 0.4)
                 },
                 {
-                    let (x, y) = figures::positive_freq(&ch.welch_freq_hz, &ch.welch_psd_first);
+                    let (x, y) = figures::positive_freq(&sp.welch_freq_hz, &sp.welch_psd);
                     line("Welch", x, y, 2, 1.0)
                 },
             ],
             legend: true,
         });
-        let (wx, wy) = figures::positive_freq(&ch.welch_freq_hz, &ch.welch_psd_first);
+        let (wx, wy) = figures::positive_freq(&sp.welch_freq_hz, &sp.welch_psd);
         let mut s67 = vec![line("Welch", wx, wy, 2, 0.7)];
-        for m in &ch.model_psd_first {
+        for m in &sp.models {
             s67.push(line(
                 &format!("ARMA({},{})", m.order, m.order),
-                ch.model_freq_hz.clone(),
+                sp.model_freq_hz.clone(),
                 m.psd.clone(),
                 2,
                 1.0,
@@ -425,7 +427,7 @@ pub fn write_report(
         &fig67,
         &format!(
             "ARMA model PSD of the first record at orders {:?}, over the Welch estimate.",
-            cfg.psd_orders
+            cfg.report.model_psd_orders
         ),
     )?;
     let fig8 = figures::grid(p8, 2, 600, 380);
@@ -542,18 +544,18 @@ fn summary_text(r: &AnalysisResults) -> String {
         "{} record(s) of {} channel(s) were analysed at {} Hz after an ideal DFT low-pass at {} Hz; {} {} models (orders {} to {}) were fitted to each record and channel, {} fits in all ({} did not converge) in {:.1} s. ",
         r.records.len(),
         r.channels.len(),
-        r.config.analysis_fs_hz,
-        r.config.cutoff_hz,
-        match r.config.model {
+        r.config.preprocess.analysis_fs_hz,
+        r.config.preprocess.cutoff_hz,
+        match r.config.sweep.model {
             vibmode_analysis::SweepModel::Arma => "ARMA(p,p)",
             vibmode_analysis::SweepModel::Ar => "AR(p)",
         },
-        if r.config.robust_factor > 0.0 { "robust" } else { "quadratic-criterion" },
-        r.config.order_min,
-        r.config.order_max,
+        if r.config.sweep.robust != vibmode_analysis::Robust::Off { "robust" } else { "quadratic-criterion" },
+        r.config.sweep.order_min,
+        r.config.sweep.order_max,
         r.n_fits,
         r.n_not_converged,
-        r.elapsed_s
+        r.timing.elapsed_s
     );
     for role in &r.roles {
         let st: Vec<String> = role
@@ -592,9 +594,9 @@ fn summary_text(r: &AnalysisResults) -> String {
             "{} of {} records were stops (acceleration RMS in {}-{} Hz below {} of the median record) and were left out of the mode statistics: {}. ",
             r.n_stationary,
             r.records.len(),
-            r.config.activity_min_hz,
-            r.config.cutoff_hz,
-            r.config.stop_rms_ratio,
+            r.config.stops.activity_min_hz,
+            r.config.preprocess.cutoff_hz,
+            r.config.stops.stop_rms_ratio,
             stops.join(", ")
         ));
     }
@@ -652,7 +654,7 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
         .enumerate()
         .map(|(i, r)| RecordInput {
             name: format!("record {:02} ({:.1} km/h)", i + 1, r.mean_speed_kmh),
-            recording: r.to_recording(),
+            recording: r.recording.clone(),
         })
         .collect();
     let reference = reference_modes(&sim.truth.modes);

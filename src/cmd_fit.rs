@@ -7,7 +7,8 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 use std::path::PathBuf;
-use vibmode_ident::{ArMethod, ArmaModel, ArmaParams, Robust};
+use vibmode_core::{BandLimit, ClusterParams, PoleFilterParams};
+use vibmode_ident::{ArMethod, ArmaModel, ArmaParams, PoleRejection, Robust};
 use vibmode_report::{Figure, Panel, Scale, Series, SeriesStyle};
 
 /// Model structure.
@@ -50,19 +51,20 @@ pub struct FitArgs {
     /// Estimation method (default: burg for AR, pem for ARMA).
     #[arg(long, value_enum)]
     pub method: Option<FitMethod>,
-    /// Robust criterion for PEM: a factor (default 1.6, times the robust std of the initial
-    /// residuals) or `off` for the purely quadratic criterion.
-    #[arg(long, default_value = "1.6")]
-    pub robust: String,
+    /// Robust criterion for PEM: a Huber factor (default 1.6, times the robust std of the
+    /// initial residuals) or `off` for the purely quadratic criterion.
+    #[arg(long)]
+    pub robust: Option<String>,
     /// Write JSON results to this path (`-` for standard output).
     #[arg(long)]
     pub json: Option<String>,
     /// Plot periodogram, Welch and the model PSD with the modes (.svg or .png), paper Fig. 6-7.
     #[arg(long)]
     pub plot: Option<PathBuf>,
-    /// Modes with damping ratio below this are marked in the plot and the table.
-    #[arg(long = "mark-damping-max", default_value_t = 0.3)]
-    pub mark_damping_max: f64,
+    /// Modes that pass the pole filters with a damping ratio below this are marked `*` in the
+    /// table and drawn in the plot (default 0.6, the clustering's `max_damping_ratio`).
+    #[arg(long = "mark-damping-max")]
+    pub mark_damping_max: Option<f64>,
     #[command(flatten)]
     pub spectral: SpectralArgs,
 }
@@ -80,6 +82,8 @@ pub struct ModeOut {
     pub pole_re: f64,
     /// Imaginary part of the discrete-time pole.
     pub pole_im: f64,
+    /// Why the pole filters leave this pole pair out (`null`: a mode).
+    pub filtered_out: Option<PoleRejection>,
 }
 
 /// One channel's fitted model in the JSON output.
@@ -117,8 +121,8 @@ struct FitOutput {
     channels: Vec<ChannelFit>,
 }
 
-fn parse_robust(s: &str) -> Result<Robust> {
-    Ok(s.parse::<Robust>()?)
+fn parse_robust(s: Option<&str>) -> Result<Robust> {
+    Ok(s.map_or(Ok(Robust::default()), str::parse::<Robust>)?)
 }
 
 /// Fits one channel. Shared with other commands.
@@ -160,9 +164,10 @@ pub fn channel_fit(
     kind: ModelKind,
     method: String,
     m: &ArmaModel,
-    fs_hz: f64,
+    band: &BandLimit,
 ) -> ChannelFit {
-    let ms = m.modes(fs_hz);
+    let ms = m.modes(band.fs_hz);
+    let filtered = vibmode_ident::filter_mode_set(m, &ms, band, &PoleFilterParams::default());
     ChannelFit {
         name: name.to_string(),
         unit: unit.to_string(),
@@ -182,15 +187,15 @@ pub fn channel_fit(
         std_errors: m.std_errors.clone(),
         outliers_replaced: m.outliers_replaced,
         noise_floor_variance: m.noise_floor_variance,
-        modes: ms
-            .modes
+        modes: filtered
             .iter()
-            .map(|md| ModeOut {
-                frequency_hz: md.frequency_hz,
-                damping_ratio: md.damping_ratio,
-                damped_frequency_hz: md.damped_frequency_hz,
-                pole_re: md.pole_re,
-                pole_im: md.pole_im,
+            .map(|f| ModeOut {
+                frequency_hz: f.mode.frequency_hz,
+                damping_ratio: f.mode.damping_ratio,
+                damped_frequency_hz: f.mode.damped_frequency_hz,
+                pole_re: f.mode.pole_re,
+                pole_im: f.mode.pole_im,
+                filtered_out: f.rejected,
             })
             .collect(),
         real_poles: ms.real_poles.clone(),
@@ -200,12 +205,14 @@ pub fn channel_fit(
 
 /// Runs `vibmode fit`.
 pub fn run(a: &FitArgs) -> Result<()> {
-    let rec = a.input.load()?;
-    let robust = parse_robust(&a.robust)?;
+    let (rec, band) = a.input.load_with_band()?;
+    let robust = parse_robust(a.robust.as_deref())?;
     let params = ArmaParams {
         robust,
+        band,
         ..ArmaParams::default()
     };
+    let filter_band = band.unwrap_or_else(|| BandLimit::full(rec.fs_hz));
     let q = match a.model {
         ModelKind::Ar => 0,
         ModelKind::Arma => a.ma_order.unwrap_or(a.order),
@@ -219,7 +226,12 @@ pub fn run(a: &FitArgs) -> Result<()> {
         let (m, method) = fit_channel(&ch.samples, a.model, a.method, a.order, q, &params)
             .with_context(|| format!("channel '{}'", ch.name))?;
         channels.push(channel_fit(
-            &ch.name, &ch.unit, a.model, method, &m, rec.fs_hz,
+            &ch.name,
+            &ch.unit,
+            a.model,
+            method,
+            &m,
+            &filter_band,
         ));
         models.push(m);
     }
@@ -227,7 +239,7 @@ pub fn run(a: &FitArgs) -> Result<()> {
         source: a.input.input.display().to_string(),
         fs_hz: rec.fs_hz,
         n_samples: rec.len(),
-        robust: a.robust.clone(),
+        robust: robust.to_string(),
         channels,
     };
     if let Some(path) = &a.plot {
@@ -238,26 +250,22 @@ pub fn run(a: &FitArgs) -> Result<()> {
     }
     match &a.json {
         Some(dest) => write_json(dest, &out)?,
-        None => print!(
-            "{}",
-            table_text(&out, a.mark_damping_max, empty_band_above(a, rec.fs_hz))
-        ),
+        None => print!("{}", table_text(&out, mark_damping_max(a))),
     }
     Ok(())
 }
 
-/// The ideal filter's cutoff (Hz) when resampling left an empty band above it (cutoff below 0.95 x
-/// the new Nyquist frequency, as the paper's 25 Hz at 200 Hz). Modes above it describe vibmode's
-/// numerical noise floor in that band, not the vehicle.
-fn empty_band_above(a: &FitArgs, fs_hz: f64) -> Option<f64> {
-    a.input.resample_to_hz?;
-    a.input.cutoff_hz.filter(|c| *c < 0.95 * fs_hz / 2.0)
+/// The damping ratio below which modes are marked: the option, else the clustering's
+/// `max_damping_ratio` (one definition).
+fn mark_damping_max(a: &FitArgs) -> f64 {
+    a.mark_damping_max
+        .unwrap_or_else(|| ClusterParams::default().max_damping_ratio)
 }
 
-/// The terminal table: per channel a header line and the modes, lightly damped ones (damping
-/// ratio below `zmax`) marked `*`; modes above `band_max_hz` (the cutoff of an empty band) are
-/// labelled as such instead, with one line saying what they are.
-fn table_text(o: &FitOutput, zmax: f64, band_max_hz: Option<f64>) -> String {
+/// The terminal table: per channel a header line and the modes. Modes that pass the shared pole
+/// filters with a damping ratio below `zmax` are marked `*`; pole pairs the filters leave out
+/// say why; a legend explains the marks.
+fn table_text(o: &FitOutput, zmax: f64) -> String {
     let mut s = String::new();
     for c in &o.channels {
         s.push_str(&format!(
@@ -288,24 +296,27 @@ fn table_text(o: &FitOutput, zmax: f64, band_max_hz: Option<f64>) -> String {
             ));
         }
         s.push_str(&format!("  {:>12} {:>14}  \n", "freq_hz", "damping_ratio"));
-        let mut above = 0;
+        let mut edge = 0;
         for m in &c.modes {
-            let tag = match band_max_hz {
-                Some(cut) if m.frequency_hz > cut => {
-                    above += 1;
-                    format!("(above the {cut} Hz cutoff)")
+            let tag = match m.filtered_out {
+                Some(PoleRejection::BandEdge) => {
+                    edge += 1;
+                    "(above the valid band: empty band)".to_string()
                 }
-                _ if m.damping_ratio < zmax => "*".to_string(),
-                _ => String::new(),
+                Some(PoleRejection::PoleZeroCancellation) => {
+                    "(cancelled by a zero of C: a notch, no mode)".to_string()
+                }
+                None if m.damping_ratio < zmax => "*".to_string(),
+                None => String::new(),
             };
             s.push_str(&format!(
                 "  {:>12.4} {:>14.5}  {}\n",
                 m.frequency_hz, m.damping_ratio, tag
             ));
         }
-        if let (Some(cut), true) = (band_max_hz, above > 0) {
+        if edge > 0 {
             s.push_str(&format!(
-                "  {above} mode(s) above the {cut} Hz cutoff lie in the band the ideal filter emptied: \
+                "  {edge} pole pair(s) above the valid band lie in the band the ideal filter emptied (or on its edge): \
                  they describe the numerical noise floor added there (docs/identification.md), not \
                  the vehicle\n"
             ));
@@ -314,6 +325,9 @@ fn table_text(o: &FitOutput, zmax: f64, band_max_hz: Option<f64>) -> String {
             s.push_str(&format!("  {} unstable pole(s)\n", c.unstable_poles.len()));
         }
     }
+    s.push_str(&format!(
+        "* mode: a stable pole pair that passes the pole filters, damping ratio below {zmax} (the modes the analysis clusters)\n"
+    ));
     s
 }
 
@@ -325,7 +339,7 @@ fn fit_figure(
 ) -> Result<Figure> {
     let wp = a.spectral.welch_params()?;
     let pp = a.spectral.periodogram_params()?;
-    let band_max_hz = empty_band_above(a, rec.fs_hz);
+    let zmax = mark_damping_max(a);
     let mut panels = Vec::new();
     for ((ch, m), f) in rec.channels.iter().zip(models).zip(fits) {
         let per = vibmode_spectra::periodogram(&ch.samples, rec.fs_hz, &pp)?;
@@ -337,8 +351,7 @@ fn fit_figure(
         let marks: Vec<f64> = f
             .modes
             .iter()
-            .filter(|md| md.damping_ratio < a.mark_damping_max)
-            .filter(|md| band_max_hz.map_or(true, |cut| md.frequency_hz <= cut))
+            .filter(|md| md.filtered_out.is_none() && md.damping_ratio < zmax)
             .map(|md| md.frequency_hz)
             .collect();
         let line = |label: &str, x: Vec<f64>, y: Vec<f64>, width: u32, alpha: f64| Series {
@@ -390,7 +403,7 @@ fn fit_figure(
                 },
                 line("model", grid, mpsd, 2, 1.0),
                 Series {
-                    label: Some(format!("modes, damping < {}", a.mark_damping_max)),
+                    label: Some(format!("modes, damping < {zmax}")),
                     x: marks,
                     y: vec![],
                     style: SeriesStyle::VLines { dotted: true },
@@ -415,18 +428,19 @@ fn fit_figure(
 mod tests {
     use super::*;
 
-    fn mode(f: f64, z: f64) -> ModeOut {
+    fn mode(f: f64, z: f64, filtered_out: Option<PoleRejection>) -> ModeOut {
         ModeOut {
             frequency_hz: f,
             damping_ratio: z,
             damped_frequency_hz: f * (1.0 - z * z).sqrt(),
             pole_re: 0.0,
             pole_im: 0.0,
+            filtered_out,
         }
     }
 
     #[test]
-    fn table_labels_modes_above_an_empty_band_cutoff() {
+    fn table_marks_modes_and_says_why_pole_pairs_are_left_out() {
         let out = FitOutput {
             source: "x.csv".into(),
             fs_hz: 200.0,
@@ -451,28 +465,41 @@ mod tests {
                 std_errors: vec![],
                 outliers_replaced: 0,
                 noise_floor_variance: 0.0,
-                modes: vec![mode(1.2, 0.1), mode(96.0, 0.01)],
+                modes: vec![
+                    mode(0.92, 0.34, None),
+                    mode(10.58, 0.01, Some(PoleRejection::PoleZeroCancellation)),
+                    mode(96.0, 0.01, Some(PoleRejection::BandEdge)),
+                    mode(30.0, 0.8, None),
+                ],
                 real_poles: vec![],
                 unstable_poles: vec![],
             }],
         };
-        let with = table_text(&out, 0.3, Some(25.0));
-        let lines: Vec<&str> = with.lines().collect();
+        let t = table_text(&out, 0.6);
+        let lines: Vec<&str> = t.lines().collect();
         assert!(
-            lines[2].contains("1.2000") && lines[2].ends_with('*'),
-            "{with}"
+            lines[2].contains("0.9200") && lines[2].ends_with('*'),
+            "{t}"
         );
         assert!(
-            lines[3].contains("96.0000") && lines[3].ends_with("(above the 25 Hz cutoff)"),
-            "{with}"
+            lines[3].contains("10.5800") && lines[3].contains("zero of C"),
+            "{t}"
         );
         assert!(
-            lines[4].contains("1 mode(s) above the 25 Hz cutoff"),
-            "{with}"
+            lines[4].contains("96.0000") && lines[4].contains("valid band"),
+            "{t}"
         );
-        // Without an empty band the 96 Hz mode is an ordinary lightly damped one.
-        let without = table_text(&out, 0.3, None);
-        assert!(without.lines().nth(3).is_some_and(|l| l.ends_with('*')));
-        assert!(!without.contains("cutoff"));
+        assert!(
+            lines[5].contains("30.0000") && !lines[5].ends_with('*'),
+            "{t}"
+        );
+        assert!(
+            lines[6].contains("1 pole pair(s) above the valid band"),
+            "{t}"
+        );
+        assert!(
+            t.lines().last().is_some_and(|l| l.starts_with("* mode:")),
+            "{t}"
+        );
     }
 }

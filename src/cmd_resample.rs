@@ -6,6 +6,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::PathBuf;
 use vibmode_report::{Figure, Panel, Scale, Series, SeriesStyle};
+use vibmode_signal::ResampleRecording;
 use vibmode_signal::{Recording, ResampleParams};
 use vibmode_spectra::{Detrend, PeriodogramParams, Scaling, Window};
 

@@ -8,25 +8,33 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde::Serialize;
 use std::path::PathBuf;
-use vibmode_ident::{ArMethod, ArmaParams, Robust};
+use vibmode_core::{BandLimit, PoleFilterParams, SweepParams};
+use vibmode_ident::{ArMethod, ArmaParams, PoleRejection, Robust};
 
 /// Arguments of `vibmode sweep`.
 #[derive(Args, Debug)]
 pub struct SweepArgs {
     #[command(flatten)]
     pub input: InputArgs,
-    /// Model orders: `2:60` (inclusive range), `2:60:2` (with step) or a list `4,8,16`.
-    #[arg(long, default_value = "2:60")]
-    pub orders: String,
+    /// Model orders: `2:60` (inclusive range), `2:60:2` (with step) or a list `4,8,16`
+    /// (default: the analysis sweep's, 2:30).
+    #[arg(long)]
+    pub orders: Option<String>,
     /// Model structure: arma (ARMA(p,p)) or ar.
     #[arg(long, value_enum, default_value_t = ModelKind::Arma)]
     pub model: ModelKind,
     /// Estimation method (default: burg for AR, pem for ARMA).
     #[arg(long, value_enum)]
     pub method: Option<FitMethod>,
-    /// Robust criterion factor for PEM, or `off`.
-    #[arg(long, default_value = "1.6")]
-    pub robust: String,
+    /// Robust criterion: a Huber factor (default 1.6, the analysis sweep's) or `off`.
+    #[arg(long)]
+    pub robust: Option<String>,
+    /// Iteration cap of each fit (default 20, the analysis sweep's).
+    #[arg(long)]
+    pub max_iterations: Option<usize>,
+    /// Stopping tolerance of each fit (default 1e-4, the analysis sweep's).
+    #[arg(long)]
+    pub tolerance: Option<f64>,
     /// Write JSON results to this path (`-` for standard output).
     #[arg(long)]
     pub json: Option<String>,
@@ -77,6 +85,19 @@ pub struct SweepMode {
     pub damping_ratio: f64,
 }
 
+/// A pole pair the pole filters left out, and why.
+#[derive(Serialize, Clone, Copy, Debug)]
+pub struct FilteredMode {
+    /// Model order p.
+    pub order: usize,
+    /// Natural frequency, Hz.
+    pub frequency_hz: f64,
+    /// Damping ratio.
+    pub damping_ratio: f64,
+    /// Why it is no mode.
+    pub reason: PoleRejection,
+}
+
 #[derive(Serialize)]
 struct SweepChannel {
     name: String,
@@ -86,6 +107,7 @@ struct SweepChannel {
     converged: Vec<bool>,
     errors: Vec<Option<String>>,
     modes: Vec<SweepMode>,
+    filtered_out: Vec<FilteredMode>,
     welch_freq_hz: Vec<f64>,
     welch_psd: Vec<f64>,
 }
@@ -101,13 +123,33 @@ struct SweepOutput {
 
 /// Runs `vibmode sweep`.
 pub fn run(a: &SweepArgs) -> Result<()> {
-    let rec = a.input.load()?;
-    let orders = parse_orders(&a.orders)?;
-    let robust: Robust = a.robust.parse()?;
-    let params = ArmaParams {
+    let (rec, band) = a.input.load_with_band()?;
+    // The analysis sweep's settings are the defaults: one definition (vibmode_core::SweepParams).
+    let defaults = SweepParams::default();
+    let orders = match &a.orders {
+        Some(o) => parse_orders(o)?,
+        None => defaults.orders(),
+    };
+    let robust: Robust = match &a.robust {
+        Some(r) => r.parse()?,
+        None => defaults.robust,
+    };
+    let sweep = SweepParams {
         robust,
+        max_iterations: a.max_iterations.unwrap_or(defaults.max_iterations),
+        tolerance: a.tolerance.unwrap_or(defaults.tolerance),
+        ..defaults
+    };
+    sweep.validate()?;
+    let params = ArmaParams {
+        robust: sweep.robust,
+        max_iter: sweep.max_iterations,
+        tol: sweep.tolerance,
+        band,
         ..ArmaParams::default()
     };
+    let filter_band = band.unwrap_or_else(|| BandLimit::full(rec.fs_hz));
+    let filters = PoleFilterParams::default();
     let ar_method = match (a.model, a.method) {
         (ModelKind::Ar, None | Some(FitMethod::Burg)) => ArMethod::Burg,
         (ModelKind::Ar, Some(FitMethod::YuleWalker)) => ArMethod::YuleWalker,
@@ -145,6 +187,7 @@ pub fn run(a: &SweepArgs) -> Result<()> {
             converged: vec![],
             errors: vec![],
             modes: vec![],
+            filtered_out: vec![],
             welch_freq_hz: vec![],
             welch_psd: vec![],
         };
@@ -154,12 +197,22 @@ pub fn run(a: &SweepArgs) -> Result<()> {
                     out.loss.push(m.loss);
                     out.converged.push(m.converged);
                     out.errors.push(None);
-                    for md in m.modes(rec.fs_hz).modes {
-                        out.modes.push(SweepMode {
-                            order: p,
-                            frequency_hz: md.frequency_hz,
-                            damping_ratio: md.damping_ratio,
-                        });
+                    for f in vibmode_ident::filter_modes(&m, &filter_band, &filters) {
+                        let (frequency_hz, damping_ratio) =
+                            (f.mode.frequency_hz, f.mode.damping_ratio);
+                        match f.rejected {
+                            None => out.modes.push(SweepMode {
+                                order: p,
+                                frequency_hz,
+                                damping_ratio,
+                            }),
+                            Some(reason) => out.filtered_out.push(FilteredMode {
+                                order: p,
+                                frequency_hz,
+                                damping_ratio,
+                                reason,
+                            }),
+                        }
                     }
                 }
                 Err(e) => {
@@ -224,10 +277,11 @@ pub fn run(a: &SweepArgs) -> Result<()> {
             for c in &out.channels {
                 let nc = c.converged.iter().filter(|x| !**x).count();
                 println!(
-                    "{}: {} orders, {} pole pairs, {} fits not converged, {} failed",
+                    "{}: {} orders, {} pole pairs ({} more left out by the pole filters: cancelled by a zero of C or above the valid band), {} fits not converged, {} failed",
                     c.name,
                     c.orders.len(),
                     c.modes.len(),
+                    c.filtered_out.len(),
                     nc,
                     c.errors.iter().filter(|e| e.is_some()).count()
                 );

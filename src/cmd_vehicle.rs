@@ -150,7 +150,7 @@ pub fn write_simulation(
     let mut paths = Vec::new();
     for (i, r) in sim.records.iter().enumerate() {
         let path = dir.join(format!("record_{:02}.{ext}", i + 1));
-        vibmode_signal::write_path(&path, &r.to_recording())
+        vibmode_signal::write_path(&path, &r.recording)
             .with_context(|| format!("writing {}", path.display()))?;
         paths.push(path);
     }

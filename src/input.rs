@@ -3,7 +3,7 @@
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
-use vibmode_signal::{ChannelSelector, ReadOptions, Recording, ResampleParams};
+use vibmode_signal::{ChannelSelector, ReadOptions, Recording, ResampleParams, ResampleRecording};
 
 /// Options every analysis command shares for reading its input.
 #[derive(Args, Debug, Clone)]
@@ -53,6 +53,18 @@ impl InputArgs {
                 Ok(rec)
             }
         }
+    }
+
+    /// Reads, selects and optionally resamples, with the band the signal then carries: `Some`
+    /// after resampling (the ideal low-pass's cutoff and whether an empty band lies above it),
+    /// `None` for a file used as it is (the identification then judges the band itself).
+    pub fn load_with_band(&self) -> Result<(Recording, Option<vibmode_core::BandLimit>)> {
+        let rec = self.load()?;
+        let band = self.resample_to_hz.map(|_| {
+            let nyquist = rec.fs_hz / 2.0;
+            vibmode_core::BandLimit::ideal_lowpass(rec.fs_hz, self.cutoff_hz.unwrap_or(nyquist))
+        });
+        Ok((rec, band))
     }
 
     /// Reads the file and selects channels, without resampling.

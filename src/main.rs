@@ -11,6 +11,7 @@ mod cmd_resample;
 mod cmd_sweep;
 mod cmd_vehicle;
 mod figures;
+mod hints;
 mod input;
 mod output;
 
@@ -72,6 +73,9 @@ fn main() -> ExitCode {
                     msg.push_str(": ");
                 }
                 msg.push_str(&text);
+            }
+            if let Some(h) = hints::hint(&e) {
+                msg.push_str(&format!(" ({h})"));
             }
             eprintln!("vibmode: error: {}", msg.replace('\n', " "));
             ExitCode::from(2)

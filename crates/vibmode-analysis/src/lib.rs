@@ -24,6 +24,7 @@
 //! ```
 
 mod config;
+pub mod first_record;
 pub mod identify;
 pub mod pipeline;
 pub mod results;
@@ -32,6 +33,7 @@ pub mod stops;
 pub mod store;
 
 pub use config::{AnalysisConfig, ChannelRole, Preset, ReportParams};
+pub use first_record::{first_record_spectra, FirstRecordSpectra, ModelPsd};
 pub use identify::{Identifier, PoleOut, SignalFits, SweepIdentifier};
 pub use pipeline::{analyze, analyze_with, check_records, cluster_params_for, preprocess_records};
 pub use results::{

@@ -1,0 +1,50 @@
+//! Command-line hints for library errors. The libraries name values (`fs_hz`), never flags; the
+//! binary knows its flags and adds one short hint to the one-line message.
+
+use vibmode_analysis::AnalysisError;
+use vibmode_core::RecordingError;
+use vibmode_signal::SignalError;
+
+/// The flag that fixes `e`, if the error is one a flag fixes.
+pub fn hint(e: &anyhow::Error) -> Option<&'static str> {
+    for cause in e.chain() {
+        if let Some(s) = cause.downcast_ref::<SignalError>() {
+            return signal_hint(s);
+        }
+        if let Some(a) = cause.downcast_ref::<AnalysisError>() {
+            return match a {
+                AnalysisError::Signal(s) => signal_hint(s),
+                AnalysisError::Recording(r) => recording_hint(r),
+                AnalysisError::ChannelsDiffer { .. } => {
+                    Some("select the same channels with --channel")
+                }
+                _ => None,
+            };
+        }
+        if let Some(r) = cause.downcast_ref::<RecordingError>() {
+            return recording_hint(r);
+        }
+    }
+    None
+}
+
+fn signal_hint(e: &SignalError) -> Option<&'static str> {
+    match e {
+        SignalError::NoSampleRate { .. } => Some("give it with --fs HZ"),
+        SignalError::SampleRateMismatch { .. } => Some("drop --fs to use the file's rate"),
+        SignalError::NonUniformTime { .. } => Some("pass --resample-nonuniform"),
+        SignalError::Recording(r) => recording_hint(r),
+        _ => None,
+    }
+}
+
+fn recording_hint(e: &RecordingError) -> Option<&'static str> {
+    match e {
+        RecordingError::UnknownChannel { .. } | RecordingError::ChannelIndex { .. } => {
+            Some("choose channels with --channel NAME|INDEX")
+        }
+        RecordingError::EmptySelector => Some("e.g. --channel 0"),
+        RecordingError::InvalidSampleRate { .. } => Some("give a positive rate, e.g. --fs 500"),
+        _ => None,
+    }
+}
