@@ -16,7 +16,7 @@ pub fn hint(e: &anyhow::Error) -> Option<&'static str> {
                 AnalysisError::Signal(s) => signal_hint(s),
                 AnalysisError::Recording(r) => recording_hint(r),
                 AnalysisError::ChannelsDiffer { .. } => {
-                    Some("select the same channels with --channel")
+                    Some("--channel NAME for each channel to keep")
                 }
                 _ => None,
             };
@@ -30,9 +30,9 @@ pub fn hint(e: &anyhow::Error) -> Option<&'static str> {
 
 fn signal_hint(e: &SignalError) -> Option<&'static str> {
     match e {
-        SignalError::NoSampleRate { .. } => Some("give it with --fs HZ"),
+        SignalError::NoSampleRate { .. } => Some("--fs HZ"),
         SignalError::SampleRateMismatch { .. } => Some("drop --fs to use the file's rate"),
-        SignalError::NonUniformTime { .. } => Some("pass --resample-nonuniform"),
+        SignalError::NonUniformTime { .. } => Some("--resample-nonuniform"),
         SignalError::Recording(r) => recording_hint(r),
         _ => None,
     }
@@ -41,10 +41,10 @@ fn signal_hint(e: &SignalError) -> Option<&'static str> {
 fn recording_hint(e: &RecordingError) -> Option<&'static str> {
     match e {
         RecordingError::UnknownChannel { .. } | RecordingError::ChannelIndex { .. } => {
-            Some("choose channels with --channel NAME|INDEX")
+            Some("--channel NAME|INDEX")
         }
         RecordingError::EmptySelector => Some("e.g. --channel 0"),
-        RecordingError::InvalidSampleRate { .. } => Some("give a positive rate, e.g. --fs 500"),
+        RecordingError::InvalidSampleRate { .. } => Some("e.g. --fs 500"),
         _ => None,
     }
 }

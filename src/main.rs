@@ -75,7 +75,7 @@ fn main() -> ExitCode {
                 msg.push_str(&text);
             }
             if let Some(h) = hints::hint(&e) {
-                msg.push_str(&format!(" ({h})"));
+                msg.push_str(&format!(" (on the command line: {h})"));
             }
             eprintln!("vibmode: error: {}", msg.replace('\n', " "));
             ExitCode::from(2)
