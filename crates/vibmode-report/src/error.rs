@@ -106,6 +106,10 @@ pub enum ReportError {
         /// The path given.
         path: PathBuf,
     },
+    /// The data a report is drawn from could not be prepared (e.g. a record that cannot be
+    /// resampled for a figure).
+    #[error("{0}")]
+    Analysis(String),
     /// Writing a file failed.
     #[error(
         "could not write '{path}': {message}; check that the directory exists and is writable"

@@ -21,6 +21,21 @@ pub fn escape_html(text: &str) -> String {
     out
 }
 
+/// Whether a table cell holds a number (right-aligned) rather than text (left-aligned): a
+/// number, optionally signed, with a unit or percent sign after it, or a range `a-b` of numbers.
+pub fn is_numeric_cell(cell: &str) -> bool {
+    let t = cell.trim();
+    let t = t.strip_suffix('%').map_or(t, str::trim_end);
+    let first = t.split(' ').next().unwrap_or("");
+    let parts: Vec<&str> = if first.len() > 1 && first[1..].contains('-') && !first.contains('e') {
+        let (a, b) = first.split_at(first[1..].find('-').map_or(0, |i| i + 1));
+        vec![a, &b[1..]]
+    } else {
+        vec![first]
+    };
+    !first.is_empty() && parts.iter().all(|p| p.parse::<f64>().is_ok())
+}
+
 const CSS: &str = "body{font-family:\"DejaVu Sans\",Verdana,Arial,sans-serif;max-width:1100px;\
 margin:2em auto;padding:0 1em;color:#222;line-height:1.45}\
 h1,h2,h3,h4,h5,h6{color:#113;margin-top:1.4em}\
@@ -28,7 +43,8 @@ figure{margin:1.5em 0;text-align:center}\
 figure svg{max-width:100%;height:auto;border:1px solid #ddd}\
 figcaption{font-size:0.92em;color:#444;margin-top:0.4em}\
 table{border-collapse:collapse;margin:1em 0;font-size:0.95em}\
-th,td{border:1px solid #bbb;padding:0.25em 0.6em;text-align:right}\
+th,td{border:1px solid #bbb;padding:0.25em 0.6em;text-align:left}\
+td.num{text-align:right;font-variant-numeric:tabular-nums}\
 th{background:#eef}tr:nth-child(even) td{background:#f7f7f7}\
 pre{background:#f4f4f4;border:1px solid #ddd;padding:0.6em;overflow-x:auto}";
 
@@ -94,7 +110,11 @@ impl HtmlReport {
         for row in rows {
             t.push_str("<tr>");
             for cell in row {
-                let _ = write!(t, "<td>{}</td>", escape_html(cell));
+                if is_numeric_cell(cell) {
+                    let _ = write!(t, "<td class=\"num\">{}</td>", escape_html(cell));
+                } else {
+                    let _ = write!(t, "<td>{}</td>", escape_html(cell));
+                }
             }
             for _ in row.len()..headers.len() {
                 t.push_str("<td></td>");
@@ -133,5 +153,35 @@ impl HtmlReport {
             path: path.to_path_buf(),
             message: e.to_string(),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::is_numeric_cell;
+
+    #[test]
+    fn numeric_cells_are_recognised() {
+        for c in [
+            "1.181",
+            "-0.5",
+            "85 %",
+            "0.1578-0.2010",
+            "+1.2 %",
+            "1e-4",
+            "12",
+        ] {
+            assert!(is_numeric_cell(c), "{c}");
+        }
+        for c in [
+            "structural mode",
+            "FR_sprung",
+            "-",
+            "",
+            "record 01 (30.0 km/h)",
+            "used",
+        ] {
+            assert!(!is_numeric_cell(c), "{c}");
+        }
     }
 }

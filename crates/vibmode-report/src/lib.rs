@@ -59,20 +59,25 @@
 
 #![warn(missing_docs)]
 
+pub mod analysis;
 pub mod axes;
 mod error;
 mod font;
 mod html;
 mod model;
+pub mod panels;
 mod render;
+pub mod signal_figures;
 
+pub use analysis::{modes_csv, modes_table_text, write_analysis_report, ReportFiles, TruthRow};
 pub use error::ReportError;
 pub use font::{ensure_font, DEJAVU_SANS_TTF, FONT_FAMILY};
-pub use html::{escape_html, HtmlReport};
+pub use html::{escape_html, is_numeric_cell, HtmlReport};
 pub use model::{Figure, Marker, Panel, Rgb, Scale, Series, SeriesStyle, PALETTE};
 pub use render::{
     MAX_POINTS_PER_SERIES, MAX_SIDE_PX, MIN_CELL_HEIGHT_PX, MIN_CELL_WIDTH_PX, MIN_SIDE_PX,
 };
+pub use signal_figures::antialias_figure;
 
 /// Re-export of plotters, so callers of [`Figure::draw_on`] use the same version.
 pub use plotters;

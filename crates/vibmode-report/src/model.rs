@@ -363,6 +363,11 @@ impl Panel {
         self.series.push(series);
         self
     }
+    /// No legend.
+    pub fn without_legend(mut self) -> Self {
+        self.legend = false;
+        self
+    }
 }
 
 /// A figure: a grid of panels, filled row by row, with an optional overall title.

@@ -1,10 +1,46 @@
-//! Building the paper's figures from results (the numerics know nothing of plotting).
+//! Panels of the paper's figures built from results (the numerics know nothing of plotting):
+//! stabilisation diagrams, frequency-damping plots, grids.
 
+use crate::model::{Figure, Marker, Panel, Rgb, Scale, Series, SeriesStyle};
 use std::path::{Path, PathBuf};
-use vibmode_report::{Figure, Marker, Panel, Rgb, Scale, Series, SeriesStyle};
 
 /// Red used for physical-model modes.
 pub const RED: Rgb = Rgb(200, 30, 30);
+
+/// Green used to mark the invariant structural modes.
+pub const GREEN: Rgb = Rgb(20, 140, 60);
+
+/// Orange used to mark periodic disturbances (engine/gear lines).
+pub const ORANGE: Rgb = Rgb(230, 120, 0);
+
+/// Share of the order range added above the highest order of a stabilisation diagram, so that
+/// the legend (upper right) covers no pole.
+pub const LEGEND_HEADROOM: f64 = 0.3;
+
+/// Vertical dashed lines at the invariant structural modes and periodic disturbances, for a
+/// stabilisation diagram or a frequency-damping plot.
+pub fn mode_marks(structural_hz: &[f64], disturbances_hz: &[f64]) -> Vec<Series> {
+    let mut out = Vec::new();
+    if !structural_hz.is_empty() {
+        out.push(
+            Series::vlines(structural_hz.to_vec())
+                .with_label("invariant structural modes")
+                .with_color(GREEN)
+                .with_style(SeriesStyle::VLines { dotted: false })
+                .with_alpha(0.9),
+        );
+    }
+    if !disturbances_hz.is_empty() {
+        out.push(
+            Series::vlines(disturbances_hz.to_vec())
+                .with_label("periodic disturbances")
+                .with_color(ORANGE)
+                .with_style(SeriesStyle::VLines { dotted: true })
+                .with_alpha(0.9),
+        );
+    }
+    out
+}
 
 /// `dir/name.svg` -> `dir/name{suffix}.svg`.
 pub fn sibling(path: &Path, suffix: &str) -> PathBuf {
@@ -68,7 +104,11 @@ pub fn stabilisation_panel(
         x_scale: Scale::Linear,
         y_scale: Scale::Linear,
         x_range: Some((0.0, fmax_hz)),
-        y_range: Some((omin - 1.0, omax + 1.0)),
+        // Headroom above the highest order: the legend sits there, not on the poles.
+        y_range: Some((
+            omin - 1.0,
+            omax + 1.0 + LEGEND_HEADROOM * (omax - omin + 2.0),
+        )),
         series: vec![
             Series {
                 label: Some("Welch PSD (log, scaled)".into()),
@@ -141,7 +181,8 @@ pub fn damping_panel(
         x_scale: Scale::Linear,
         y_scale: Scale::Log,
         x_range: Some((0.0, fmax_hz)),
-        y_range: Some((1e-4, 1.0)),
+        // Damping ratios lie below 1; the decade above holds the legend.
+        y_range: Some((1e-4, 10.0)),
         series,
         legend: true,
     }

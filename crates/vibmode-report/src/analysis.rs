@@ -1,0 +1,706 @@
+//! The report of an analysis (`vibmode analyze`, `vibmode demo`): functions from results to
+//! figures, tables, text and files. The binary only calls [`write_analysis_report`] and prints
+//! [`modes_table_text`].
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use vibmode_analysis::{
+    first_record_spectra, AnalysisResults, FirstRecordSpectra, RecordInput, RoleAnalysis,
+};
+use vibmode_core::{InvariantMode, ModeClass, Recording, Robust, SweepModel};
+
+use crate::error::ReportError;
+use crate::html::HtmlReport;
+use crate::model::{Figure, Panel, Scale, Series, SeriesStyle};
+use crate::panels::{damping_panel, grid, mode_marks, positive_freq, stabilisation_panel};
+
+/// A true mode of a simulation, printed beside the identified ones: label, frequency (Hz),
+/// damping ratio.
+pub type TruthRow = (String, f64, f64);
+
+/// Files written by [`write_analysis_report`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReportFiles {
+    /// `DIR/index.html`.
+    pub html: PathBuf,
+    /// `DIR/results.json`.
+    pub results_json: PathBuf,
+    /// `DIR/modes.csv`.
+    pub modes_csv: PathBuf,
+    /// `DIR/figures/*.svg|png`.
+    pub figures: Vec<PathBuf>,
+}
+
+/// The axis label of a quantity in `unit`; an unknown unit is said so, never faked.
+fn unit_label(unit: &str) -> String {
+    if unit.is_empty() {
+        "input units".into()
+    } else {
+        unit.to_string()
+    }
+}
+
+/// `PSD [(m/s^2)^2/Hz]`, or `PSD [(input units)^2/Hz]` for an unknown unit.
+fn psd_label(unit: &str) -> String {
+    format!("PSD [({})^2/Hz]", unit_label(unit))
+}
+
+fn class_name(c: &ModeClass) -> &'static str {
+    match c {
+        ModeClass::Structural => "structural mode",
+        ModeClass::PeriodicDisturbance => "periodic disturbance",
+        ModeClass::Spurious => "spurious",
+    }
+}
+
+fn shown(modes: &[InvariantMode]) -> impl Iterator<Item = &InvariantMode> {
+    modes.iter().filter(|m| m.class != ModeClass::Spurious)
+}
+
+fn freqs_of(modes: &[InvariantMode], class: ModeClass) -> Vec<f64> {
+    modes
+        .iter()
+        .filter(|m| m.class == class)
+        .map(|m| m.frequency_hz)
+        .collect()
+}
+
+/// The first line of the terminal summary: counts, rate, cutoff, orders and run time.
+pub fn run_summary_line(r: &AnalysisResults) -> String {
+    format!(
+        "{} records, {} channels, {} fits ({} not converged, {} failed) in {:.1} s; analysis at {} Hz, cutoff {} Hz, orders {}..{}",
+        r.records.len(),
+        r.channels.len(),
+        r.n_fits,
+        r.n_not_converged,
+        r.n_failed,
+        r.timing.elapsed_s,
+        r.config.preprocess.analysis_fs_hz,
+        r.config.preprocess.cutoff_hz,
+        r.config.sweep.order_min,
+        r.config.sweep.order_max
+    )
+}
+
+/// What the support tests rejected, for a pool without any invariant mode: the densest
+/// candidates (most poles) with the tests each failed.
+fn candidates_text(r: &AnalysisResults, modes: &[InvariantMode], indent: &str) -> String {
+    let n_active = r.records.len() - r.n_stationary;
+    let mut cands: Vec<&InvariantMode> = modes
+        .iter()
+        .filter(|m| m.class == ModeClass::Spurious)
+        .collect();
+    cands.sort_by(|a, b| b.n_poles.cmp(&a.n_poles));
+    if cands.is_empty() {
+        return format!(
+            "{indent}no cluster of poles at all: every pole was isolated or outside the band\n"
+        );
+    }
+    let mut s = format!("{indent}no cluster passed the support tests; the best candidates:\n");
+    for m in cands.iter().take(3) {
+        let why: Vec<String> = m
+            .support_failures(&r.config.cluster, n_active)
+            .iter()
+            .map(|f| f.to_string())
+            .collect();
+        let _ = writeln!(
+            s,
+            "{indent}  {:.2} Hz, damping {:.2}: {}",
+            m.frequency_hz,
+            m.damping_ratio,
+            why.join("; ")
+        );
+    }
+    s
+}
+
+/// The invariant-mode table per role, as printed by the command line; with `truth`, the true
+/// modes beside it. A pool without invariant modes says so and lists the best candidates with
+/// the support test each failed.
+pub fn modes_table_text(r: &AnalysisResults, truth: Option<&[TruthRow]>) -> String {
+    let mut s = run_summary_line(r);
+    s.push('\n');
+    if r.n_stationary > 0 {
+        let stops: Vec<&str> = r
+            .records
+            .iter()
+            .filter(|rec| rec.stationary)
+            .map(|rec| rec.name.as_str())
+            .collect();
+        let _ = writeln!(
+            s,
+            "{} of {} records were stops and are left out of the mode statistics: {}",
+            r.n_stationary,
+            r.records.len(),
+            stops.join(", ")
+        );
+    }
+    for role in &r.roles {
+        let _ = writeln!(
+            s,
+            "\nInvariant modes, {} channels ({}):",
+            role.role,
+            role.channels.join(", ")
+        );
+        let _ = writeln!(
+            s,
+            "  {:>9} {:>8} {:>9} {:>7} {:>7}  class",
+            "freq_hz", "std_hz", "damping", "orders", "records"
+        );
+        let mut any = false;
+        for m in shown(&role.invariant_modes) {
+            any = true;
+            let _ = writeln!(
+                s,
+                "  {:>9.3} {:>8.3} {:>9.4} {:>6.0}% {:>6.0}%  {}",
+                m.frequency_hz,
+                m.frequency_std_hz,
+                m.damping_ratio,
+                100.0 * m.order_share,
+                100.0 * m.record_share,
+                class_name(&m.class)
+            );
+        }
+        if !any {
+            s.push_str(&candidates_text(r, &role.invariant_modes, "  "));
+        }
+    }
+    if let Some(t) = truth {
+        s.push_str("\nTrue values (simulation):\n");
+        let _ = writeln!(s, "  {:>9} {:>9}  what", "freq_hz", "damping");
+        for (label, f, z) in t {
+            let _ = writeln!(s, "  {f:>9.3} {z:>9.4}  {label}");
+        }
+    }
+    s
+}
+
+/// The invariant modes of every role pool and every channel as CSV (one row per mode, spurious
+/// clusters left out): `pool,channels,frequency_hz,frequency_std_hz,damping_ratio,
+/// damping_iqr_lo,damping_iqr_hi,order_share,record_share,n_poles,class`.
+pub fn modes_csv(r: &AnalysisResults) -> String {
+    let mut s = String::from(
+        "pool,channels,frequency_hz,frequency_std_hz,damping_ratio,damping_iqr_lo,damping_iqr_hi,order_share,record_share,n_poles,class\n",
+    );
+    let mut row = |pool: String, channels: String, m: &InvariantMode| {
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{},{}",
+            csv_cell(&pool),
+            csv_cell(&channels),
+            m.frequency_hz,
+            m.frequency_std_hz,
+            m.damping_ratio,
+            m.damping_iqr.0,
+            m.damping_iqr.1,
+            m.order_share,
+            m.record_share,
+            m.n_poles,
+            m.class
+        );
+    };
+    for role in &r.roles {
+        for m in shown(&role.invariant_modes) {
+            row(format!("role:{}", role.role), role.channels.join(" "), m);
+        }
+    }
+    for ch in &r.channels {
+        for m in shown(&ch.invariant_modes) {
+            row(format!("channel:{}", ch.name), ch.name.clone(), m);
+        }
+    }
+    s
+}
+
+fn csv_cell(text: &str) -> String {
+    if text.contains([',', '"', '\n']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
+    }
+}
+
+fn mode_row(m: &InvariantMode) -> Vec<String> {
+    vec![
+        format!("{:.3}", m.frequency_hz),
+        format!("{:.3}", m.frequency_std_hz),
+        format!("{:.4}", m.damping_ratio),
+        format!("{:.4}-{:.4}", m.damping_iqr.0, m.damping_iqr.1),
+        format!("{:.0} %", 100.0 * m.order_share),
+        format!("{:.0} %", 100.0 * m.record_share),
+        m.n_poles.to_string(),
+        class_name(&m.class).to_string(),
+    ]
+}
+
+/// The summary paragraph: what was analysed, how, and what was found per role.
+pub fn summary_text(r: &AnalysisResults) -> String {
+    let cfg = &r.config;
+    let mut s = format!(
+        "{} record(s) of {} channel(s) were analysed at {} Hz after an ideal DFT low-pass at {} Hz; {} {} models (orders {} to {}) were fitted to each record and channel, {} fits in all ({} did not converge, {} failed) in {:.1} s. ",
+        r.records.len(),
+        r.channels.len(),
+        cfg.preprocess.analysis_fs_hz,
+        cfg.preprocess.cutoff_hz,
+        match cfg.sweep.model {
+            SweepModel::Arma => "ARMA(p,p)",
+            SweepModel::Ar => "AR(p)",
+        },
+        if cfg.sweep.robust == Robust::Off { "quadratic-criterion" } else { "robust" },
+        cfg.sweep.order_min,
+        cfg.sweep.order_max,
+        r.n_fits,
+        r.n_not_converged,
+        r.n_failed,
+        r.timing.elapsed_s
+    );
+    for role in &r.roles {
+        s.push_str(&role_sentence(role, cfg.cluster.disturbance_damping_max));
+    }
+    if r.n_stationary > 0 {
+        let stops: Vec<String> = r
+            .records
+            .iter()
+            .filter(|rec| rec.stationary)
+            .map(|rec| {
+                format!(
+                    "{} (activity {:.2} of the median record)",
+                    rec.name, rec.activity_ratio
+                )
+            })
+            .collect();
+        let _ = write!(
+            s,
+            "{} of {} records were stops (acceleration RMS in {}-{} Hz below {} of the median record) and were left out of the mode statistics: {}. ",
+            r.n_stationary,
+            r.records.len(),
+            cfg.stops.activity_min_hz,
+            cfg.preprocess.cutoff_hz,
+            cfg.stops.stop_rms_ratio,
+            stops.join(", ")
+        );
+    }
+    if cfg.preset == vibmode_analysis::Preset::Paper {
+        s.push_str("These are the paper's settings. At 200 Hz with a 25 Hz cutoff the band 25-100 Hz is empty: three quarters of the poles of every model are spent on it, the prediction-error criterion has no minimum without the -30 dB numerical noise floor vibmode adds to such signals, the ideal filter's edge draws lightly damped poles of its own (poles above 0.8 x the cutoff are left out by the pole filters), and every fit has four times the samples. On the simulated bus this costs about 14 times the default preset's time, spreads the wheel hop over 1.5 Hz and merges the 11 and 12 Hz engine lines into one cluster taken for a structural mode; the default preset analyses at 50 Hz (twice the cutoff, the same information) instead. ");
+    }
+    s
+}
+
+fn role_sentence(role: &RoleAnalysis, disturbance_damping_max: f64) -> String {
+    let st: Vec<String> = role
+        .invariant_modes
+        .iter()
+        .filter(|m| m.class == ModeClass::Structural)
+        .map(|m| format!("{:.2} Hz (damping {:.3})", m.frequency_hz, m.damping_ratio))
+        .collect();
+    let di: Vec<String> = freqs_of(&role.invariant_modes, ModeClass::PeriodicDisturbance)
+        .iter()
+        .map(|f| format!("{f:.2} Hz"))
+        .collect();
+    let structural = if st.is_empty() {
+        format!(
+            "On the {} channels no invariant structural mode was found (see the table for the candidates the support tests rejected)",
+            role.role
+        )
+    } else {
+        format!(
+            "On the {} channels the invariant structural modes are {}",
+            role.role,
+            st.join(", ")
+        )
+    };
+    let lines = if di.is_empty() {
+        "no periodic disturbance (line with damping below {}) was found"
+            .replace("{}", &disturbance_damping_max.to_string())
+    } else {
+        format!(
+            "periodic disturbances (lines with damping below {disturbance_damping_max}) lie at {}",
+            di.join(", ")
+        )
+    };
+    format!("{structural}; {lines}. ")
+}
+
+/// Builds figures, numbers them once (heading and caption agree) and saves each as SVG and PNG.
+struct FigureWriter<'a> {
+    dir: &'a Path,
+    html: HtmlReport,
+    files: Vec<PathBuf>,
+}
+
+impl FigureWriter<'_> {
+    fn add(
+        &mut self,
+        file: &str,
+        title: &str,
+        fig: &Figure,
+        caption: &str,
+    ) -> Result<(), ReportError> {
+        for ext in ["svg", "png"] {
+            let path = self.dir.join(format!("{file}.{ext}"));
+            fig.save(&path)?;
+            self.files.push(path);
+        }
+        let n = self.html.figure_count() + 1;
+        self.html.heading(2, &format!("Figure {n}: {title}"));
+        self.html.figure(fig, caption)
+    }
+}
+
+fn line(label: &str, x: Vec<f64>, y: Vec<f64>, width: u32, alpha: f64) -> Series {
+    Series::line(x, y)
+        .with_label(label)
+        .with_style(SeriesStyle::Line {
+            width,
+            dashed: false,
+        })
+        .with_alpha(alpha)
+}
+
+/// Most samples drawn per channel in the time-record figure.
+const TIME_FIGURE_MAX_POINTS: usize = 20_000;
+
+fn time_records_figure(name: &str, rec: &Recording) -> Figure {
+    let panels = rec
+        .channels
+        .iter()
+        .map(|ch| {
+            let n = ch.samples.len();
+            let step = (n / TIME_FIGURE_MAX_POINTS).max(1);
+            let x: Vec<f64> = (0..n).step_by(step).map(|i| i as f64 / rec.fs_hz).collect();
+            let y: Vec<f64> = ch.samples.iter().step_by(step).copied().collect();
+            Panel::new(
+                &format!("{name}: {}", ch.name),
+                "Time [s]",
+                &format!("Acceleration [{}]", unit_label(&ch.unit)),
+            )
+            .with_series(line(&ch.name, x, y, 1, 1.0))
+            .without_legend()
+        })
+        .collect();
+    grid(panels, 2, 600, 260)
+}
+
+fn spectra_figures(
+    r: &AnalysisResults,
+    spectra: &[FirstRecordSpectra],
+    fmax: f64,
+) -> (Figure, Figure) {
+    let mut p5 = Vec::new();
+    let mut p67 = Vec::new();
+    for (ch, sp) in r.channels.iter().zip(spectra) {
+        let (px, py) = positive_freq(&sp.periodogram_freq_hz, &sp.periodogram_psd);
+        let (wx, wy) = positive_freq(&sp.welch_freq_hz, &sp.welch_psd);
+        p5.push(
+            Panel::new(
+                &format!("{} ({})", ch.name, ch.role),
+                "Frequency [Hz]",
+                &psd_label(&ch.unit),
+            )
+            .with_scales(Scale::Linear, Scale::Log)
+            .with_x_range(0.0, fmax)
+            .with_series(line("periodogram", px, py, 1, 0.4))
+            .with_series(line("Welch", wx.clone(), wy.clone(), 2, 1.0)),
+        );
+        let mut panel = Panel::new(
+            &format!("{}: model PSD over Welch", ch.name),
+            "Frequency [Hz]",
+            &psd_label(&ch.unit),
+        )
+        .with_scales(Scale::Linear, Scale::Log)
+        .with_x_range(0.0, fmax)
+        .with_series(line("Welch", wx, wy, 2, 0.7));
+        for m in &sp.models {
+            panel = panel.with_series(line(
+                &format!("ARMA({},{})", m.order, m.order),
+                sp.model_freq_hz.clone(),
+                m.psd.clone(),
+                2,
+                1.0,
+            ));
+        }
+        p67.push(panel);
+    }
+    (grid(p5, 2, 600, 340), grid(p67, 2, 600, 340))
+}
+
+fn stabilisation_figure(r: &AnalysisResults, fmax: f64) -> Figure {
+    let panels = r
+        .channels
+        .iter()
+        .map(|ch| {
+            let pts: Vec<(usize, f64, f64)> = ch
+                .poles
+                .iter()
+                .map(|p| (p.order, p.frequency_hz, p.damping_ratio))
+                .collect();
+            let mut panel = stabilisation_panel(
+                &format!("{}: all records", ch.name),
+                &pts,
+                &ch.welch_freq_hz,
+                &ch.welch_psd,
+                fmax,
+            );
+            panel.series.extend(mode_marks(
+                &freqs_of(&ch.invariant_modes, ModeClass::Structural),
+                &freqs_of(&ch.invariant_modes, ModeClass::PeriodicDisturbance),
+            ));
+            panel
+        })
+        .collect();
+    grid(panels, 2, 600, 400)
+}
+
+fn damping_figure(r: &AnalysisResults, fmax: f64) -> Figure {
+    let refs: Vec<(f64, f64, String)> = r
+        .reference_modes
+        .iter()
+        .map(|m| (m.frequency_hz, m.damping_ratio, m.label.clone()))
+        .collect();
+    let panels = r
+        .roles
+        .iter()
+        .map(|role| {
+            let pts: Vec<(usize, f64, f64)> = r
+                .channels
+                .iter()
+                .filter(|c| c.role == role.role)
+                .flat_map(|c| {
+                    c.poles
+                        .iter()
+                        .map(|p| (p.order, p.frequency_hz, p.damping_ratio))
+                })
+                .collect();
+            let mut panel = damping_panel(
+                &format!("{} channels: frequency vs damping", role.role),
+                &pts,
+                &refs,
+                fmax,
+            );
+            panel.series.extend(mode_marks(
+                &freqs_of(&role.invariant_modes, ModeClass::Structural),
+                &freqs_of(&role.invariant_modes, ModeClass::PeriodicDisturbance),
+            ));
+            panel
+        })
+        .collect();
+    grid(panels, 1, 1000, 450)
+}
+
+fn inputs_table(html: &mut HtmlReport, r: &AnalysisResults) {
+    html.heading(2, "Inputs");
+    let units: Vec<String> = r
+        .channels
+        .iter()
+        .map(|c| format!("{} [{}]", c.name, unit_label(&c.unit)))
+        .collect();
+    html.paragraph(&format!("Channels: {}.", units.join(", ")));
+    let rows: Vec<Vec<String>> = r
+        .records
+        .iter()
+        .map(|rec| {
+            vec![
+                rec.name.clone(),
+                format!("{}", rec.fs_hz),
+                rec.n_samples.to_string(),
+                format!("{:.2}", rec.duration_s),
+                format!("{:.3}", rec.band.fs_hz),
+                format!("{:.2}", rec.activity_ratio),
+                rec.excluded_reason.clone().unwrap_or_else(|| "used".into()),
+            ]
+        })
+        .collect();
+    html.table(
+        &[
+            "record",
+            "rate [Hz]",
+            "samples",
+            "duration [s]",
+            "analysis rate [Hz]",
+            "activity",
+            "status",
+        ],
+        &rows,
+    );
+}
+
+fn modes_tables(html: &mut HtmlReport, r: &AnalysisResults) {
+    html.heading(2, "Invariant modes");
+    let headers = [
+        "frequency [Hz]",
+        "std [Hz]",
+        "damping ratio (median)",
+        "damping IQR",
+        "orders",
+        "records",
+        "poles",
+        "class",
+    ];
+    for role in &r.roles {
+        html.heading(
+            3,
+            &format!("{} channels: {}", role.role, role.channels.join(", ")),
+        );
+        let rows: Vec<Vec<String>> = shown(&role.invariant_modes).map(mode_row).collect();
+        if rows.is_empty() {
+            html.paragraph(&candidates_text(r, &role.invariant_modes, ""));
+        } else {
+            html.table(&headers, &rows);
+        }
+        if !role.matches.is_empty() {
+            html.paragraph("Physical model modes matched to the invariant structural modes:");
+            let rows: Vec<Vec<String>> = role
+                .matches
+                .iter()
+                .map(|m| {
+                    let inv = m.invariant.and_then(|i| role.invariant_modes.get(i));
+                    let or_dash = |v: Option<String>| v.unwrap_or_else(|| "-".into());
+                    vec![
+                        m.reference.label.clone(),
+                        format!("{:.3}", m.reference.frequency_hz),
+                        format!("{:.3}", m.reference.damping_ratio),
+                        or_dash(inv.map(|i| format!("{:.3}", i.frequency_hz))),
+                        or_dash(inv.map(|i| format!("{:.3}", i.damping_ratio))),
+                        or_dash(inv.map(|_| format!("{:+.1} %", 100.0 * m.freq_diff_rel))),
+                        or_dash(inv.map(|_| format!("{:+.3}", m.damping_diff))),
+                    ]
+                })
+                .collect();
+            html.table(
+                &[
+                    "model mode",
+                    "model f [Hz]",
+                    "model damping",
+                    "identified f [Hz]",
+                    "identified damping",
+                    "f difference",
+                    "damping difference",
+                ],
+                &rows,
+            );
+        }
+    }
+}
+
+fn write_text(path: &Path, text: &str) -> Result<(), ReportError> {
+    std::fs::write(path, text).map_err(|e| ReportError::Write {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })
+}
+
+/// Writes `DIR/index.html`, `DIR/results.json`, `DIR/modes.csv` and `DIR/figures/*.svg|png` for
+/// the analysis `r` of `records`; `intro` is a first paragraph (e.g. what was simulated).
+pub fn write_analysis_report(
+    dir: &Path,
+    records: &[RecordInput],
+    r: &AnalysisResults,
+    intro: Option<&str>,
+) -> Result<ReportFiles, ReportError> {
+    let figdir = dir.join("figures");
+    std::fs::create_dir_all(&figdir).map_err(|e| ReportError::Write {
+        path: figdir.clone(),
+        message: e.to_string(),
+    })?;
+    let results_json = dir.join("results.json");
+    let json = serde_json::to_string_pretty(r).map_err(|e| ReportError::Write {
+        path: results_json.clone(),
+        message: e.to_string(),
+    })?;
+    write_text(&results_json, &(json + "\n"))?;
+    let modes_csv_path = dir.join("modes.csv");
+    write_text(&modes_csv_path, &modes_csv(r))?;
+    let first = records
+        .first()
+        .ok_or_else(|| ReportError::Analysis("no records".into()))?;
+    let spectra =
+        first_record_spectra(records, r).map_err(|e| ReportError::Analysis(e.to_string()))?;
+    let cfg = &r.config;
+    let fmax = cfg.preprocess.analysis_fs_hz / 2.0;
+    let mut html = HtmlReport::new("vibmode: vibration modes from in-service accelerations");
+    if let Some(t) = intro {
+        html.paragraph(t);
+    }
+    html.paragraph(&summary_text(r));
+    inputs_table(&mut html, r);
+    let mut w = FigureWriter {
+        dir: &figdir,
+        html,
+        files: Vec::new(),
+    };
+    let fig = time_records_figure(&first.name, &first.recording);
+    w.add(
+        "time_records",
+        "time records",
+        &fig,
+        "Acceleration of the first record, every channel.",
+    )?;
+    if first.recording.fs_hz > cfg.preprocess.analysis_fs_hz * 1.0001 {
+        let band = r.records.first().map(|x| x.band);
+        let cutoff = band.map_or(cfg.preprocess.cutoff_hz, |b| b.cutoff_hz);
+        let fig = crate::signal_figures::antialias_figure(
+            &first.recording,
+            cfg.preprocess.analysis_fs_hz,
+            Some(cutoff),
+            0.5,
+        )?;
+        w.add(
+            "antialias",
+            "anti-aliasing and resampling",
+            &fig,
+            &format!(
+                "First channel: raw at {} Hz, resampled to {} Hz without filter (aliased), and with the ideal DFT low-pass at {} Hz.",
+                first.recording.fs_hz, cfg.preprocess.analysis_fs_hz, cutoff
+            ),
+        )?;
+    }
+    let (fig5, fig67) = spectra_figures(r, &spectra, fmax);
+    w.add(
+        "periodogram_welch",
+        "periodogram and Welch spectra",
+        &fig5,
+        "First record of each channel: periodogram (boxcar) and Welch (Hann).",
+    )?;
+    w.add(
+        "model_psd",
+        "model spectra",
+        &fig67,
+        &format!(
+            "ARMA model PSD of the first record at orders {:?}, over its Welch estimate.",
+            cfg.report.model_psd_orders
+        ),
+    )?;
+    w.add(
+        "stabilisation",
+        "stabilisation diagrams",
+        &stabilisation_figure(r, fmax),
+        "Frequency of every complex pole pair that passed the pole filters against model order, all records; the Welch PSD (log) drawn behind; the channel's invariant structural modes (green) and periodic disturbances (orange, dotted) marked.",
+    )?;
+    let with_model = if r.reference_modes.is_empty() {
+        ""
+    } else {
+        "; red diamonds: the physical model's modes"
+    };
+    w.add(
+        "frequency_damping",
+        "frequency and damping",
+        &damping_figure(r, fmax),
+        &format!("Every pole pair of every order and record, pooled per role; the pool's invariant structural modes (green) and periodic disturbances (orange, dotted) marked{with_model}."),
+    )?;
+    let FigureWriter {
+        mut html, files, ..
+    } = w;
+    modes_tables(&mut html, r);
+    html.paragraph("The same modes, per role and per channel, are in modes.csv beside this page; every number of the analysis is in results.json.");
+    html.heading(2, "Settings");
+    html.preformatted(&toml::to_string(&r.config).unwrap_or_default());
+    let html_path = dir.join("index.html");
+    html.save(&html_path)?;
+    Ok(ReportFiles {
+        html: html_path,
+        results_json,
+        modes_csv: modes_csv_path,
+        figures: files,
+    })
+}
