@@ -1,10 +1,6 @@
 //! ARMA(p, q) by (robust) prediction-error minimisation. See docs/identification.md.
 
-use std::fmt;
-use std::str::FromStr;
-
 use num_complex::Complex64;
-use serde::{Deserialize, Serialize};
 
 use crate::ar::burg;
 use crate::linalg::{
@@ -13,173 +9,10 @@ use crate::linalg::{
 };
 use crate::model::{information_criteria, ArmaModel, Estimator, StopReason};
 use crate::outliers::OutlierCleaning;
+use crate::params::{ArmaParams, Robust};
+use crate::prepare::{self, Prepared};
 use crate::roots::polynomial_roots;
 use crate::IdentError;
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, StandardNormal};
-
-/// Robustification of the prediction-error criterion.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum Robust {
-    /// Purely quadratic criterion `l(e) = e^2`.
-    Off,
-    /// Huber criterion: `l(e) = e^2` for `|e| <= rho`, `2 rho |e| - rho^2` beyond, with
-    /// `rho = factor * MAD/0.6745` of the initial residuals (dimensionless factor), fixed during the
-    /// search.
-    Huber {
-        /// Threshold in robust standard deviations (dimensionless, > 0).
-        factor: f64,
-    },
-}
-
-impl Default for Robust {
-    /// `Huber { factor: 1.6 }` (as in MATLAB's pem).
-    fn default() -> Self {
-        Robust::Huber { factor: 1.6 }
-    }
-}
-
-impl FromStr for Robust {
-    type Err = IdentError;
-    /// Accepts `off` (also `none`, `quadratic`), `huber` (factor 1.6) or a positive number (the
-    /// Huber factor).
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let t = s.trim().to_ascii_lowercase();
-        match t.as_str() {
-            "off" | "none" | "quadratic" => Ok(Robust::Off),
-            "huber" | "on" => Ok(Robust::default()),
-            _ => match t.parse::<f64>() {
-                Ok(f) if f.is_finite() && f > 0.0 => Ok(Robust::Huber { factor: f }),
-                _ => Err(IdentError::ParseRobust(s.to_string())),
-            },
-        }
-    }
-}
-
-impl fmt::Display for Robust {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Robust::Off => f.write_str("off"),
-            Robust::Huber { factor } => write!(f, "{factor}"),
-        }
-    }
-}
-
-/// Settings of the prediction-error search.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct ArmaParams {
-    /// Criterion. Default `Robust::Huber { factor: 1.6 }`.
-    pub robust: Robust,
-    /// Maximum Gauss-Newton iterations. Default 100.
-    pub max_iter: usize,
-    /// Stopping tolerance (dimensionless): the search stops when the predicted relative
-    /// improvement of a Gauss-Newton step `(V - V_pred) / V` is below `tol`, or when the loss
-    /// dropped by less than `tol` (relative) over the last 5 iterations. Default 1e-5.
-    pub tol: f64,
-    /// Maximum step halvings per direction. Default 10.
-    pub max_halvings: usize,
-    /// Subtract the mean of `y` before fitting. Default true.
-    pub demean: bool,
-    /// Additive-outlier (spike) cleaning before a `Robust::Huber` fit (unused by `Robust::Off`).
-    /// Default `OutlierCleaning::RobustFilter` with default [`crate::CleanerParams`].
-    #[serde(default)]
-    pub outlier_cleaning: OutlierCleaning,
-    /// Numerical noise floor for signals with an empty band (dimensionless, >= 0; 0 = off).
-    /// Default 1e-3 (-30 dB of the signal's mean square).
-    ///
-    /// After an ideal low-pass (the paper's 25 Hz cutoff at 200 Hz) the band above the cutoff is
-    /// empty to rounding error, the signal is almost perfectly predictable there, and the
-    /// prediction-error criterion has no minimum: C's zeros run to the unit circle, the loss falls
-    /// to 1e-20 of the signal's, fits hit the iteration cap and their poles are meaningless. When
-    /// the signal has such a band (more than 1 % of its periodogram bins below 1e-20 of the
-    /// largest: only rounding error is left there), white noise of variance `noise_floor x` its
-    /// mean square, from a fixed-seed generator (the same bytes every run), is added to the signal
-    /// the search works on. That bounds the prediction gain at 1/noise_floor and gives the
-    /// criterion a well-defined minimum. A floor only just deep enough for a minimum (1e-8) leaves
-    /// C with zeros within ~1e-8 of the unit circle: the predictor's start-up transient then
-    /// never decays within the record, the loss depends on where its sum starts, warm starts are
-    /// useless and half the fits reach the iteration cap; at 1e-3 the fits are sound (see
-    /// docs/identification.md for the measurements). White noise added to an ARMA(p, q <= p)
-    /// process leaves its poles where they are. Signals without an empty band are fitted as they
-    /// are.
-    /// The reported `noise_variance` and `loss` are those of the signal the search saw.
-    #[serde(default = "default_noise_floor")]
-    pub noise_floor: f64,
-}
-
-fn default_noise_floor() -> f64 {
-    1e-3
-}
-
-/// Whether `y` has a numerically empty band: more than 1 % of its periodogram bins below 1e-20 of
-/// the largest bin (what an ideal DFT low-pass leaves above its cutoff).
-fn has_empty_band(y: &[f64]) -> bool {
-    let n = y.len();
-    if n < 16 {
-        return false;
-    }
-    let mut planner = realfft::RealFftPlanner::<f64>::new();
-    let fft = planner.plan_fft_forward(n);
-    let mut input = y.to_vec();
-    let mut spec = fft.make_output_vec();
-    if fft.process(&mut input, &mut spec).is_err() {
-        return false;
-    }
-    let power: Vec<f64> = spec.iter().map(|z| z.norm_sqr()).collect();
-    let max = power.iter().cloned().fold(0.0, f64::max);
-    if !(max > 0.0 && max.is_finite()) {
-        return false;
-    }
-    let empty = power.iter().filter(|&&p| p < 1e-20 * max).count();
-    empty * 100 > power.len()
-}
-
-/// Seed of the noise-floor generator.
-const FLOOR_SEED: u64 = 0x0076_6962_6d6f_6465;
-
-impl Default for ArmaParams {
-    fn default() -> Self {
-        ArmaParams {
-            robust: Robust::default(),
-            max_iter: 100,
-            tol: 1e-5,
-            max_halvings: 10,
-            demean: true,
-            outlier_cleaning: OutlierCleaning::default(),
-            noise_floor: default_noise_floor(),
-        }
-    }
-}
-
-impl ArmaParams {
-    fn validate(&self) -> Result<(), IdentError> {
-        if !(self.tol.is_finite() && self.tol > 0.0) {
-            return Err(IdentError::InvalidParam {
-                name: "tol",
-                value: self.tol.to_string(),
-                fix: "use a small positive number such as 1e-5",
-            });
-        }
-        if !(self.noise_floor.is_finite() && (0.0..0.1).contains(&self.noise_floor)) {
-            return Err(IdentError::InvalidParam {
-                name: "noise_floor",
-                value: self.noise_floor.to_string(),
-                fix: "use a small relative variance in [0, 0.1) such as 1e-3 (the default), or 0 for none",
-            });
-        }
-        if let Robust::Huber { factor } = self.robust {
-            if !(factor.is_finite() && factor > 0.0) {
-                return Err(IdentError::InvalidParam {
-                    name: "Huber factor",
-                    value: factor.to_string(),
-                    fix: "use a positive factor such as 1.6, or Robust::Off",
-                });
-            }
-        }
-        Ok(())
-    }
-}
 
 /// Largest N p (p + q) for which the AR columns of the Jacobian are filtered exactly
 /// (O(N p (p + q)) per iteration); beyond it delayed copies of y/C are used.
@@ -242,7 +75,7 @@ pub fn sweep_arma(
     let mut out: Vec<Result<ArmaModel, IdentError>> = Vec::with_capacity(orders.len());
     // Additive outliers are cleaned once for the whole sweep (the same result at every order).
     let cleaned = check_signal(y, 3)
-        .and_then(|mean| crate::outliers::prepare(y, mean, params))
+        .and_then(|mean| prepare::cleaned(y, mean, params))
         .map(|(yc, _, k)| (yc.into_owned(), k));
     let (yc, replaced) = match cleaned {
         Ok(v) => v,
@@ -886,13 +719,26 @@ fn fit_impl(
 ) -> Result<ArmaModel, IdentError> {
     params.validate()?;
     let mean = check_signal(y, 3)?;
+    check_orders(y.len(), p, q, init)?;
+    let prepared = prepare::for_search(y, mean, params)?;
+    let out = search(
+        &prepared.ys,
+        p,
+        q,
+        init.map(|m| (&m.a[..], &m.c[..])),
+        params,
+    );
+    Ok(finish_model(&prepared, p, q, out, params))
+}
+
+/// Checks the orders against the record length `n` and the warm start against the orders.
+fn check_orders(n: usize, p: usize, q: usize, init: Option<&ArmaModel>) -> Result<(), IdentError> {
     if p == 0 {
         return Err(IdentError::ZeroOrder {
             what: "ARMA AR order p",
             fix: "modes come from A(z); choose p >= 1 (e.g. p = q)",
         });
     }
-    let n = y.len();
     if p + q > max_arma_order(n) {
         return Err(IdentError::OrderTooHigh {
             what: "ARMA order p + q",
@@ -911,33 +757,37 @@ fn fit_impl(
             });
         }
     }
-    let (y, mean, outliers_replaced) = crate::outliers::prepare(y, mean, params)?;
-    let y: &[f64] = &y;
-    let offset = if params.demean { mean } else { 0.0 };
-    let centred: Vec<f64> = y.iter().map(|v| v - offset).collect();
-    let scale = (centred.iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt();
-    if !(scale > 0.0 && scale.is_finite()) {
-        return Err(IdentError::Constant { value: y[0] });
+    Ok(())
+}
+
+/// Asymptotic variance factor of the estimates: the innovation variance `lambda_s` for the
+/// quadratic criterion; for Huber's, `mean(clip(eps, rho)^2) / share_inside^2` (the sandwich
+/// estimator's scale), NaN when no residual lies inside the threshold.
+fn variance_factor(tail: &[f64], rho: Option<f64>, lambda_s: f64) -> f64 {
+    match rho {
+        None => lambda_s,
+        Some(r) => {
+            let n_eff = tail.len();
+            let num = tail.iter().map(|e| e.clamp(-r, r).powi(2)).sum::<f64>() / n_eff as f64;
+            let inside = tail.iter().filter(|e| e.abs() <= r).count() as f64 / n_eff as f64;
+            if inside > 0.0 {
+                num / (inside * inside)
+            } else {
+                f64::NAN
+            }
+        }
     }
-    let ys: Vec<f64> = centred.iter().map(|v| v / scale).collect();
-    // The search works on the signal plus the numerical noise floor (ys has unit mean square).
-    let floored: Option<Vec<f64>> = (params.noise_floor > 0.0 && has_empty_band(&ys)).then(|| {
-        let sd = params.noise_floor.sqrt();
-        let mut rng = ChaCha8Rng::seed_from_u64(FLOOR_SEED);
-        ys.iter()
-            .map(|&v| {
-                let w: f64 = StandardNormal.sample(&mut rng);
-                v + sd * w
-            })
-            .collect()
-    });
-    let out = search(
-        floored.as_deref().unwrap_or(&ys),
-        p,
-        q,
-        init.map(|m| (&m.a[..], &m.c[..])),
-        params,
-    );
+}
+
+/// The fitted model in signal units from the search's result on the prepared signal: standard
+/// errors, information criteria, and the scale mapped back.
+fn finish_model(
+    prepared: &Prepared,
+    p: usize,
+    q: usize,
+    out: SearchOut,
+    params: &ArmaParams,
+) -> ArmaModel {
     let SearchOut {
         a,
         c,
@@ -948,35 +798,22 @@ fn fit_impl(
         stop,
         converged,
     } = out;
-    let floor_added = floored.is_some();
-    let ys = floored.unwrap_or(ys);
+    let ys = &prepared.ys;
+    let n = ys.len();
     let k = p + q;
-    let n_eff = n - p;
-    let mut search = Search::new(&ys, p, q, rho);
-    // Final quantities.
+    let mut search = Search::new(ys, p, q, rho);
     let (_, _, h_u) = search.normal_equations(&a, &c, &eps);
     let lambda_s = mean_loss(&eps[p..], None);
-    let kappa = match rho {
-        None => lambda_s,
-        Some(r) => {
-            let tail = &eps[p..];
-            let num = tail.iter().map(|e| e.clamp(-r, r).powi(2)).sum::<f64>() / n_eff as f64;
-            let inside = tail.iter().filter(|e| e.abs() <= r).count() as f64 / n_eff as f64;
-            if inside > 0.0 {
-                num / (inside * inside)
-            } else {
-                f64::NAN
-            }
-        }
-    };
+    let kappa = variance_factor(&eps[p..], rho, lambda_s);
     let std_errors = match spd_inverse_diag(&h_u, k) {
         Some(d) => d.iter().map(|v| (kappa * v).sqrt()).collect(),
         None => vec![f64::NAN; k],
     };
+    let scale = prepared.scale;
     let s2 = scale * scale;
     let lambda = lambda_s * s2;
     let (aic, bic, fpe) = information_criteria(lambda, n, k);
-    Ok(ArmaModel {
+    ArmaModel {
         p,
         q,
         a,
@@ -993,15 +830,15 @@ fn fit_impl(
         reflection_coefficients: Vec::new(),
         robust_rho: rho.map(|r| r * scale),
         n_samples: n,
-        mean: offset,
+        mean: prepared.offset,
         estimator: Estimator::PredictionError,
-        outliers_replaced,
-        noise_floor_variance: if floor_added {
+        outliers_replaced: prepared.outliers_replaced,
+        noise_floor_variance: if prepared.floor_added {
             params.noise_floor * s2
         } else {
             0.0
         },
-    })
+    }
 }
 
 /// Mean squared one-step prediction error `(1/(N-p)) sum_{t=p}^{N-1} eps_t^2` of the model
@@ -1023,19 +860,6 @@ pub fn prediction_error_variance(y: &[f64], mean: f64, a: &[f64], c: &[f64]) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn robust_parse_display() {
-        assert_eq!("off".parse::<Robust>().unwrap(), Robust::Off);
-        assert_eq!(
-            "2.5".parse::<Robust>().unwrap(),
-            Robust::Huber { factor: 2.5 }
-        );
-        assert_eq!(Robust::default(), Robust::Huber { factor: 1.6 });
-        assert_eq!(Robust::default().to_string(), "1.6");
-        let e = "-1".parse::<Robust>().unwrap_err().to_string();
-        assert!(e.contains("'-1'") && e.contains("off"));
-    }
 
     #[test]
     fn huber_loss_by_hand() {

@@ -49,18 +49,18 @@ mod error;
 mod linalg;
 mod model;
 mod outliers;
+mod params;
+mod prepare;
 mod roots;
 pub mod sim;
 
 pub use ar::{fit_ar, max_ar_order, ArMethod};
-pub use arma::{
-    fit_arma, fit_arma_warm, max_arma_order, prediction_error_variance, sweep_arma, ArmaParams,
-    Robust,
-};
+pub use arma::{fit_arma, fit_arma_warm, max_arma_order, prediction_error_variance, sweep_arma};
 pub use error::IdentError;
 pub use model::{
     information_criteria, modes_from_poles, ArmaModel, Estimator, Mode, ModeSet, Pole, StopReason,
 };
 pub use num_complex::Complex64;
 pub use outliers::{clean_additive_outliers, CleanedSignal, CleanerParams, OutlierCleaning};
+pub use params::{ArmaParams, Robust};
 pub use roots::polynomial_roots;

@@ -11,12 +11,9 @@
 //! pothole's impulse response, which the data after it keep following). The AR model is refitted
 //! on the cleaned data and the pass repeated.
 
-use std::borrow::Cow;
-
 use serde::{Deserialize, Serialize};
 
 use crate::ar::burg;
-use crate::arma::{ArmaParams, Robust};
 use crate::linalg::{check_signal, cholesky_solve, median, predict_errors, robust_std};
 use crate::IdentError;
 
@@ -47,7 +44,7 @@ impl Default for CleanerParams {
 }
 
 impl CleanerParams {
-    fn validate(&self) -> Result<(), IdentError> {
+    pub(crate) fn validate(&self) -> Result<(), IdentError> {
         if self.ar_order == 0 {
             return Err(IdentError::InvalidParam {
                 name: "cleaner ar_order",
@@ -506,28 +503,6 @@ fn lookahead_loss(next: &[f64], mut kf: ArKalman<'_>, k: f64) -> f64 {
         }
     }
     loss
-}
-
-/// The signal a robust fit works on: cleaned when `params.robust` is Huber and cleaning is on
-/// (returns the signal, its mean and the number of replaced samples), else `y` and `mean` as given.
-pub(crate) fn prepare<'a>(
-    y: &'a [f64],
-    mean: f64,
-    params: &ArmaParams,
-) -> Result<(Cow<'a, [f64]>, f64, usize), IdentError> {
-    let OutlierCleaning::RobustFilter(cp) = params.outlier_cleaning else {
-        return Ok((Cow::Borrowed(y), mean, 0));
-    };
-    cp.validate()?;
-    if params.robust == Robust::Off {
-        return Ok((Cow::Borrowed(y), mean, 0));
-    }
-    let c = clean_additive_outliers(y, &cp)?;
-    if c.replaced.is_empty() {
-        return Ok((Cow::Borrowed(y), mean, 0));
-    }
-    let mean = c.y.iter().sum::<f64>() / c.y.len() as f64;
-    Ok((Cow::Owned(c.y), mean, c.replaced.len()))
 }
 
 #[cfg(test)]
