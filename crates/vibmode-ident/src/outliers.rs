@@ -13,8 +13,10 @@
 
 use serde::{Deserialize, Serialize};
 
+use nalgebra::DMatrix;
+
 use crate::ar::burg;
-use crate::linalg::{check_signal, cholesky_solve, median, predict_errors, robust_std};
+use crate::linalg::{check_signal, cholesky_solve_ridged, median, predict_errors, robust_std};
 use crate::IdentError;
 
 /// Settings of the robust AR filter-cleaner ([`clean_additive_outliers`]).
@@ -283,27 +285,19 @@ fn masked_fb_ls(x: &[f64], bad: &[bool], m: usize) -> Option<(Vec<f64>, f64)> {
     if windows.len() < (5 * m).max(n / 10) {
         return None;
     }
-    let mut g = vec![0.0; m * m];
+    let mut g = DMatrix::<f64>::zeros(m, m);
     let mut rhs = vec![0.0; m];
     for &t in &windows {
         for i in 1..=m {
             let (fi, bi) = (x[t - i], x[t - m + i]);
             rhs[i - 1] -= fi * x[t] + bi * x[t - m];
             for j in i..=m {
-                g[(i - 1) * m + j - 1] += fi * x[t - j] + bi * x[t - m + j];
+                g[(i - 1, j - 1)] += fi * x[t - j] + bi * x[t - m + j];
             }
         }
     }
-    for i in 0..m {
-        for j in 0..i {
-            g[i * m + j] = g[j * m + i];
-        }
-    }
-    let solve = |b: &[f64]| {
-        cholesky_solve(&g, b, m, 0.0)
-            .or_else(|| cholesky_solve(&g, b, m, 1e-12))
-            .or_else(|| cholesky_solve(&g, b, m, 1e-8))
-    };
+    g.fill_lower_triangle_with_upper_triangle();
+    let solve = |b: &[f64]| cholesky_solve_ridged(&g, b);
     let mut coef = solve(&rhs)?;
     let residuals = |coef: &[f64], t: usize| -> (f64, f64) {
         let mut f = x[t];
