@@ -45,6 +45,24 @@ impl PoleObservation {
             role: None,
         }
     }
+
+    /// Checks that frequency and damping ratio are finite; `index` (the pole's position in the
+    /// caller's slice) goes into the error. Shared by clustering and the stabilisation diagram.
+    pub(crate) fn check_finite(&self, index: usize) -> Result<(), ModalError> {
+        if !self.frequency_hz.is_finite() {
+            return Err(ModalError::NonFiniteFrequency {
+                index,
+                value: self.frequency_hz,
+            });
+        }
+        if !self.damping_ratio.is_finite() {
+            return Err(ModalError::NonFiniteDamping {
+                index,
+                value: self.damping_ratio,
+            });
+        }
+        Ok(())
+    }
 }
 
 /// Class of a pole cluster.
