@@ -522,9 +522,37 @@ fn search(
     init: Option<(&[f64], &[f64])>,
     params: &ArmaParams,
 ) -> SearchOut {
-    let n = ys.len();
     let robust = matches!(params.robust, Robust::Huber { .. });
-    // Starting candidates.
+    let mut cands = starting_candidates(ys, p, q, init, robust);
+    let rho = match (params.robust, cands.first()) {
+        (Robust::Huber { factor }, Some(best)) => huber_threshold(factor, &best.eps[p..]),
+        _ => None,
+    };
+    // Start from the candidate with the lowest value of the criterion itself (the robust scale
+    // above only fixes rho; with a warm start in a sweep this is usually the previous order).
+    if rho.is_some() {
+        for cand in cands.iter_mut() {
+            cand.score = mean_loss(&cand.eps[p..], rho);
+        }
+        cands.sort_by(|x, y| x.score.total_cmp(&y.score));
+    }
+    if cands.is_empty() {
+        // Unreachable in practice (Burg on finite data is finite); start from white noise.
+        cands.push(white_noise_candidate(ys, p, q));
+    }
+    multistart(ys, p, q, cands, rho, params)
+}
+
+/// The starting candidates, best (lowest score) first: Hannan-Rissanen, Burg AR(p) with C = 1,
+/// and the caller's warm start `init` zero-padded to the orders (marked `warm`). Candidates with
+/// non-finite coefficients or score are left out.
+fn starting_candidates(
+    ys: &[f64],
+    p: usize,
+    q: usize,
+    init: Option<(&[f64], &[f64])>,
+    robust: bool,
+) -> Vec<Candidate> {
     let mut cands: Vec<Candidate> = Vec::new();
     let (ha, hc) = hannan_rissanen(ys, p, q);
     cands.extend(make_candidate(ys, ha, hc, robust));
@@ -540,45 +568,50 @@ fn search(
         cands.extend(make_candidate(ys, a, c, robust).map(|cand| Candidate { warm: true, ..cand }));
     }
     cands.sort_by(|x, y| x.score.total_cmp(&y.score));
-    let rho = match (params.robust, cands.first()) {
-        (Robust::Huber { factor }, Some(best)) => {
-            let eps = &best.eps[p..];
-            let mut s = robust_std(eps);
-            if s.is_nan() || s <= 0.0 {
-                s = (mean_loss(eps, None)).sqrt();
-            }
-            if s > 0.0 {
-                Some(factor * s)
-            } else {
-                None
-            }
-        }
-        _ => None,
-    };
-    // Start from the candidate with the lowest value of the criterion itself (the robust scale
-    // above only fixes rho; with a warm start in a sweep this is usually the previous order).
-    if rho.is_some() {
-        for cand in cands.iter_mut() {
-            cand.score = mean_loss(&cand.eps[p..], rho);
-        }
-        cands.sort_by(|x, y| x.score.total_cmp(&y.score));
+    cands
+}
+
+/// Huber threshold `factor x` the robust scale (MAD/0.6745) of the residuals `eps`, falling back
+/// to their root mean square when the robust scale is zero or NaN; None when both are zero.
+fn huber_threshold(factor: f64, eps: &[f64]) -> Option<f64> {
+    let mut s = robust_std(eps);
+    if s.is_nan() || s <= 0.0 {
+        s = (mean_loss(eps, None)).sqrt();
     }
-    if cands.is_empty() {
-        // Unreachable in practice (Burg on finite data is finite); start from white noise.
-        let mut a = vec![0.0; p + 1];
-        a[0] = 1.0;
-        let mut c = vec![0.0; q + 1];
-        c[0] = 1.0;
-        let mut eps = vec![0.0; n];
-        predict_errors(ys, &a, &c, &mut eps);
-        cands.push(Candidate {
-            a,
-            c,
-            eps,
-            score: 0.0,
-            warm: false,
-        });
+    if s > 0.0 {
+        Some(factor * s)
+    } else {
+        None
     }
+}
+
+/// The white-noise model A = 1, C = 1 as a candidate.
+fn white_noise_candidate(ys: &[f64], p: usize, q: usize) -> Candidate {
+    let mut a = vec![0.0; p + 1];
+    a[0] = 1.0;
+    let mut c = vec![0.0; q + 1];
+    c[0] = 1.0;
+    let mut eps = vec![0.0; ys.len()];
+    predict_errors(ys, &a, &c, &mut eps);
+    Candidate {
+        a,
+        c,
+        eps,
+        score: 0.0,
+        warm: false,
+    }
+}
+
+/// Gauss-Newton from the candidates (sorted, best first, non-empty), keeping the lowest end
+/// point; the iterations of all runs are added up.
+fn multistart(
+    ys: &[f64],
+    p: usize,
+    q: usize,
+    cands: Vec<Candidate>,
+    rho: Option<f64>,
+    params: &ArmaParams,
+) -> SearchOut {
     // Small models: search from every candidate and keep the best end point (guards against
     // neighbouring local minima); larger models: from the best-scored candidate only.
     let starts = if p + q <= MULTISTART_MAX_ORDER {
@@ -659,6 +692,33 @@ impl LineSearch<'_> {
         (na, nc)
     }
 
+    /// Line search from `point` = (A, C, loss) along the damped Newton direction `dir`; when no
+    /// trial lowers the loss, along the Jacobi-scaled gradient of the normal equations
+    /// `(h, -g)` (its halvings counted after the `max_halvings + 1` Newton trials). Returns the
+    /// accepted trial, if any, and the gradient model's predicted decrease (infinite when the
+    /// gradient was not tried or has no positive curvature).
+    fn descend(
+        &self,
+        point: (&[f64], &[f64], f64),
+        dir: &[f64],
+        (h, neg_g): (&DMatrix<f64>, &[f64]),
+        trial: &mut [f64],
+    ) -> (Option<Trial>, f64) {
+        let mut reflected = 0usize;
+        let accepted = self.run(point, dir, 1.0, trial, &mut reflected);
+        if accepted.is_some() {
+            return (accepted, f64::INFINITY);
+        }
+        let (dg, s0, pred_gradient) = scaled_gradient_step(h, neg_g, self.ys.len() - self.p);
+        let accepted = self
+            .run(point, &dg, s0, trial, &mut reflected)
+            .map(|t| Trial {
+                halvings: t.halvings + self.max_halvings + 1,
+                ..t
+            });
+        (accepted, pred_gradient)
+    }
+
     /// Trials `theta + s d` for s = s0, s0/2, ... (`max_halvings` halvings) from `(a, c)` with loss
     /// `v`; the first with a lower finite loss is returned with its halving count, its residuals
     /// in `trial`. C must stay minimum phase: the first [`MAX_REFLECTIONS`] trials of an iteration
@@ -697,6 +757,14 @@ impl LineSearch<'_> {
         }
         None
     }
+}
+
+/// Gauss-Newton step `d0` (with a negligible ridge) and the Newton decrement, the predicted
+/// decrease of V per sample `d0 . (-g) / n_eff`. None when the normal matrix cannot be factored.
+fn newton_decrement(h: &DMatrix<f64>, neg_g: &[f64], n_eff: usize) -> Option<(Vec<f64>, f64)> {
+    let d0 = solve_scaled(h, neg_g, NEWTON_DECREMENT_RIDGE)?;
+    let pred = d0.iter().zip(neg_g).map(|(x, y)| x * y).sum::<f64>() / n_eff as f64;
+    Some((d0, pred))
 }
 
 /// Gradient fallback: the Jacobi-scaled steepest-descent direction `D^-1 (-g)` (D = diag h), the
@@ -792,12 +860,10 @@ fn gauss_newton(
     while iterations < params.max_iter {
         let (g, h, _) = search.normal_equations(&c, &eps);
         let neg_g: Vec<f64> = g.iter().map(|v| -v).collect();
-        // Newton decrement (predicted decrease of V) with a negligible ridge.
-        let Some(d0) = solve_scaled(&h, &neg_g, NEWTON_DECREMENT_RIDGE) else {
+        let Some((d0, pred)) = newton_decrement(&h, &neg_g, n_eff) else {
             stop = StopReason::NoImprovement;
             break;
         };
-        let pred = d0.iter().zip(&neg_g).map(|(x, y)| x * y).sum::<f64>() / n_eff as f64;
         if pred.is_nan() || pred <= params.tol * v {
             stop = StopReason::Converged;
             converged = true;
@@ -809,19 +875,8 @@ fn gauss_newton(
         } else {
             d0
         };
-        let mut reflected = 0usize;
-        let mut pred_gradient = f64::INFINITY;
-        let mut accepted = line.run((&a, &c, v), &dir, 1.0, &mut trial_eps, &mut reflected);
-        if accepted.is_none() {
-            let (dg, s0, pg) = scaled_gradient_step(&h, &neg_g, n_eff);
-            pred_gradient = pg;
-            accepted = line
-                .run((&a, &c, v), &dg, s0, &mut trial_eps, &mut reflected)
-                .map(|t| Trial {
-                    halvings: t.halvings + params.max_halvings + 1,
-                    ..t
-                });
-        }
+        let (accepted, pred_gradient) =
+            line.descend((&a, &c, v), &dir, (&h, &neg_g), &mut trial_eps);
         let Some(t) = accepted else {
             // No step lowers V.
             stop = StopReason::NoImprovement;

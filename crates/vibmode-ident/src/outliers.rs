@@ -155,15 +155,7 @@ pub fn clean_additive_outliers(
     let mut flags = vec![false; n];
     let mut resid = vec![0.0; n];
     for pass in 0..params.passes {
-        let (a, s) = match masked_fb_ls(&x, &bad, m) {
-            Some(fit) => fit,
-            None => {
-                let (a, _, _) = burg(&x, m);
-                predict_errors(&x, &a, &[1.0], &mut resid);
-                let s = robust_std(&resid[m..]);
-                (a, s)
-            }
-        };
+        let (a, s) = fit_predictor(&x, &bad, m, &mut resid);
         out.ar = a;
         out.residual_scale = s;
         out.passes = pass + 1;
@@ -173,40 +165,7 @@ pub fn clean_additive_outliers(
             flags.iter_mut().for_each(|f| *f = false);
             break;
         }
-        // Forward pass from t = m; the first m samples keep their previous cleaned values as the
-        // initial state of the predictor.
-        let mut nx = raw.clone();
-        nx[..m].copy_from_slice(&x[..m]);
-        let mut nflags = vec![false; n];
-        filter_forward(
-            &raw,
-            &mut nx,
-            &mut nflags,
-            &out.ar,
-            s,
-            params.threshold,
-            m..n,
-        );
-        // Backward pass over the first m samples (time reversed, the rest already cleaned).
-        let rraw: Vec<f64> = raw.iter().rev().copied().collect();
-        let mut rx: Vec<f64> = nx.iter().rev().copied().collect();
-        let mut rflags = vec![false; n];
-        for (t, v) in rx.iter_mut().enumerate().skip(n - m) {
-            *v = rraw[t];
-        }
-        filter_forward(
-            &rraw,
-            &mut rx,
-            &mut rflags,
-            &out.ar,
-            s,
-            params.threshold,
-            n - m..n,
-        );
-        for t in 0..m {
-            nx[t] = rx[n - 1 - t];
-            nflags[t] = rflags[n - 1 - t];
-        }
+        let (nx, nflags) = clean_pass(&raw, &x[..m], &out.ar, s, params.threshold);
         let same = nflags == flags;
         x = nx;
         flags = nflags;
@@ -224,6 +183,53 @@ pub fn clean_additive_outliers(
         }
     }
     Ok(out)
+}
+
+/// AR(m) predictor of one pass (m = `a.len() - 1`): the masked forward-backward least-squares fit
+/// of `x` on the windows free of `bad` samples, or, when too few windows are usable, Burg's fit
+/// of the whole of `x` with the robust scale of its residuals (computed in `resid`). Returns the
+/// A coefficients and the innovation scale.
+fn fit_predictor(x: &[f64], bad: &[bool], m: usize, resid: &mut [f64]) -> (Vec<f64>, f64) {
+    match masked_fb_ls(x, bad, m) {
+        Some(fit) => fit,
+        None => {
+            let (a, _, _) = burg(x, m);
+            predict_errors(x, &a, &[1.0], resid);
+            let s = robust_std(&resid[m..]);
+            (a, s)
+        }
+    }
+}
+
+/// One filter-cleaner pass over the centred raw signal `raw` with the AR predictor `a` (order m)
+/// and innovation scale `s`: forward from t = m, the first m samples keeping their previous
+/// cleaned values `head` as the initial state; then backward (time reversed, the rest already
+/// cleaned) over the first m samples. Returns the cleaned signal and the replaced samples' flags.
+fn clean_pass(
+    raw: &[f64],
+    head: &[f64],
+    a: &[f64],
+    s: f64,
+    threshold: f64,
+) -> (Vec<f64>, Vec<bool>) {
+    let n = raw.len();
+    let m = head.len();
+    let mut nx = raw.to_vec();
+    nx[..m].copy_from_slice(head);
+    let mut nflags = vec![false; n];
+    filter_forward(raw, &mut nx, &mut nflags, a, s, threshold, m..n);
+    let rraw: Vec<f64> = raw.iter().rev().copied().collect();
+    let mut rx: Vec<f64> = nx.iter().rev().copied().collect();
+    let mut rflags = vec![false; n];
+    for (t, v) in rx.iter_mut().enumerate().skip(n - m) {
+        *v = rraw[t];
+    }
+    filter_forward(&rraw, &mut rx, &mut rflags, a, s, threshold, n - m..n);
+    for t in 0..m {
+        nx[t] = rx[n - 1 - t];
+        nflags[t] = rflags[n - 1 - t];
+    }
+    (nx, nflags)
 }
 
 /// Marginal threshold (robust standard deviations of the signal) of the pre-screen that protects the
