@@ -278,12 +278,17 @@ fn make_candidate(ys: &[f64], a: Vec<f64>, mut c: Vec<f64>, robust: bool) -> Opt
     })
 }
 
+/// The long AR model of the Hannan-Rissanen estimate has order p + 4 q (at most N / 3, at least
+/// p + q): long enough for its residuals to approximate the innovations of an ARMA(p, q) whose
+/// MA zeros are not close to the unit circle.
+const HR_LONG_AR_PER_MA: usize = 4;
+
 /// Hannan-Rissanen initial estimate on the scaled signal.
 fn hannan_rissanen(ys: &[f64], p: usize, q: usize) -> (Vec<f64>, Vec<f64>) {
     let n = ys.len();
     let k = p + q;
     let (ehat, t0) = if q > 0 {
-        let m = (p + 4 * q).min(n / 3).max(k);
+        let m = (p + HR_LONG_AR_PER_MA * q).min(n / 3).max(k);
         let (a_long, _, _) = burg(ys, m);
         let mut e = vec![0.0; n];
         predict_errors(ys, &a_long, &[1.0], &mut e);

@@ -43,6 +43,8 @@
 //! No function panics on input data; bad input gives an [`IdentError`] whose message names the
 //! offending value and the fix.
 
+#![warn(missing_docs)]
+
 mod ar;
 mod arma;
 mod error;

@@ -305,11 +305,16 @@ pub(crate) fn median(v: &[f64]) -> f64 {
     }
 }
 
-/// Robust standard deviation MAD / 0.6745 (median absolute deviation from the median).
+/// Ratio of the median absolute deviation to the standard deviation of a Gaussian sample
+/// (`Phi^-1(3/4)`, rounded as in the literature and in MATLAB's pem): MAD / 0.6745 estimates the
+/// standard deviation robustly.
+pub(crate) const MAD_PER_STD: f64 = 0.6745;
+
+/// Robust standard deviation MAD / [`MAD_PER_STD`] (median absolute deviation from the median).
 pub(crate) fn robust_std(v: &[f64]) -> f64 {
     let med = median(v);
     let dev: Vec<f64> = v.iter().map(|x| (x - med).abs()).collect();
-    median(&dev) / 0.6745
+    median(&dev) / MAD_PER_STD
 }
 
 /// Whether the monic polynomial `1 + c1 z^-1 + ...` has all roots strictly inside the unit circle

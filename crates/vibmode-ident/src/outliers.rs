@@ -135,7 +135,7 @@ pub fn clean_additive_outliers(
     check_signal(y, 3)?;
     let n = y.len();
     let centre = median(y);
-    let m = params.ar_order.min(n / 10);
+    let m = params.ar_order.min(n / SAMPLES_PER_AR_ORDER);
     let mut out = CleanedSignal {
         y: y.to_vec(),
         replaced: Vec::new(),
@@ -160,7 +160,7 @@ pub fn clean_additive_outliers(
         out.residual_scale = s;
         out.passes = pass + 1;
         // No usable scale (e.g. a perfectly predictable signal): nothing can be called an outlier.
-        if !(s.is_finite() && s > 1e-12 * rms) {
+        if !(s.is_finite() && s > MIN_RELATIVE_SCALE * rms) {
             x.copy_from_slice(&raw);
             flags.iter_mut().for_each(|f| *f = false);
             break;
@@ -232,6 +232,23 @@ fn clean_pass(
     (nx, nflags)
 }
 
+/// The cleaner's AR order is at most N / 10 (and nothing is cleaned below 10 samples): an AR
+/// predictor needs several samples per coefficient to be estimated at all. The same ratio sets the
+/// least number of usable windows of the masked fit.
+const SAMPLES_PER_AR_ORDER: usize = 10;
+
+/// The masked least-squares fit needs at least 5 usable windows per coefficient (else Burg on the
+/// whole signal is used).
+const MIN_WINDOWS_PER_ORDER: usize = 5;
+
+/// Refinement steps of the masked least-squares fit with the exact residual gradient (undo the
+/// precision lost to the normal equations).
+const MASKED_LS_REFINEMENTS: usize = 2;
+
+/// A residual scale below 1e-12 of the signal's RMS is rounding error (a perfectly predictable
+/// signal): nothing is then called an outlier.
+const MIN_RELATIVE_SCALE: f64 = 1e-12;
+
 /// Marginal threshold (robust standard deviations of the signal) of the pre-screen that protects the
 /// first pass's AR fit.
 const PRESCREEN: f64 = 5.0;
@@ -288,7 +305,7 @@ fn masked_fb_ls(x: &[f64], bad: &[bool], m: usize) -> Option<(Vec<f64>, f64)> {
             windows.push(t);
         }
     }
-    if windows.len() < (5 * m).max(n / 10) {
+    if windows.len() < (MIN_WINDOWS_PER_ORDER * m).max(n / SAMPLES_PER_AR_ORDER) {
         return None;
     }
     let mut g = DMatrix::<f64>::zeros(m, m);
@@ -314,7 +331,7 @@ fn masked_fb_ls(x: &[f64], bad: &[bool], m: usize) -> Option<(Vec<f64>, f64)> {
         }
         (f, b)
     };
-    for _ in 0..2 {
+    for _ in 0..MASKED_LS_REFINEMENTS {
         let mut grad = vec![0.0; m];
         for &t in &windows {
             let (f, b) = residuals(&coef, t);

@@ -28,7 +28,9 @@ pub enum Robust {
 impl Default for Robust {
     /// `Huber { factor: 1.6 }` (as in MATLAB's pem).
     fn default() -> Self {
-        Robust::Huber { factor: 1.6 }
+        Robust::Huber {
+            factor: DEFAULT_HUBER_FACTOR,
+        }
     }
 }
 
@@ -100,8 +102,19 @@ pub struct ArmaParams {
     pub noise_floor: f64,
 }
 
+/// Default Huber threshold in robust standard deviations: MATLAB pem's 1.6 (about 95 %
+/// efficiency at Gaussian innovations while bounding the influence of large residuals).
+const DEFAULT_HUBER_FACTOR: f64 = 1.6;
+
+/// Default [`ArmaParams::noise_floor`] (relative variance): -30 dB, see the field's documentation.
+const DEFAULT_NOISE_FLOOR: f64 = 1e-3;
+
+/// Largest accepted [`ArmaParams::noise_floor`] (exclusive): -10 dB; more noise than that would
+/// visibly bias the fit rather than only bound the prediction gain.
+const MAX_NOISE_FLOOR: f64 = 0.1;
+
 fn default_noise_floor() -> f64 {
-    1e-3
+    DEFAULT_NOISE_FLOOR
 }
 
 impl Default for ArmaParams {
@@ -127,7 +140,7 @@ impl ArmaParams {
                 fix: "use a small positive number such as 1e-5",
             });
         }
-        if !(self.noise_floor.is_finite() && (0.0..0.1).contains(&self.noise_floor)) {
+        if !(self.noise_floor.is_finite() && (0.0..MAX_NOISE_FLOOR).contains(&self.noise_floor)) {
             return Err(IdentError::InvalidParam {
                 name: "noise_floor",
                 value: self.noise_floor.to_string(),

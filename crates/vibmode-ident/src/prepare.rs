@@ -34,11 +34,25 @@ pub(crate) fn cleaned<'a>(
     Ok((Cow::Owned(c.y), mean, c.replaced.len()))
 }
 
-/// Whether `y` has a numerically empty band: more than 1 % of its periodogram bins below 1e-20 of
-/// the largest bin (what an ideal DFT low-pass leaves above its cutoff).
+/// Shortest signal checked for an empty band: a shorter periodogram has too few bins for a 1 %
+/// share to mean anything.
+const EMPTY_BAND_MIN_LEN: usize = 16;
+
+/// A periodogram bin is "empty" below this fraction of the largest bin: about the square of
+/// double-precision rounding (1e-16) relative to the signal, times a margin of 1e12, so only what
+/// an ideal DFT low-pass leaves above its cutoff falls below it, never a genuinely weak band.
+const EMPTY_BIN_LEVEL: f64 = 1e-20;
+
+/// A signal has an empty band when more than this percentage of its periodogram bins are empty
+/// (1 %: a band wide enough to make the predictor's gain unbounded there).
+const EMPTY_BAND_PERCENT: usize = 1;
+
+/// Whether `y` has a numerically empty band: more than [`EMPTY_BAND_PERCENT`] % of its periodogram
+/// bins below [`EMPTY_BIN_LEVEL`] of the largest bin (what an ideal DFT low-pass leaves above its
+/// cutoff).
 fn has_empty_band(y: &[f64]) -> bool {
     let n = y.len();
-    if n < 16 {
+    if n < EMPTY_BAND_MIN_LEN {
         return false;
     }
     let mut planner = realfft::RealFftPlanner::<f64>::new();
@@ -53,8 +67,8 @@ fn has_empty_band(y: &[f64]) -> bool {
     if !(max > 0.0 && max.is_finite()) {
         return false;
     }
-    let empty = power.iter().filter(|&&p| p < 1e-20 * max).count();
-    empty * 100 > power.len()
+    let empty = power.iter().filter(|&&p| p < EMPTY_BIN_LEVEL * max).count();
+    empty * 100 > EMPTY_BAND_PERCENT * power.len()
 }
 
 /// Seed of the noise-floor generator.

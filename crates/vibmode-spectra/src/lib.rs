@@ -43,6 +43,8 @@
 //! # Ok::<(), vibmode_spectra::SpectraError>(())
 //! ```
 
+#![warn(missing_docs)]
+
 mod error;
 mod params;
 mod welch;

@@ -69,6 +69,9 @@ pub struct Coherence {
     pub notes: Vec<String>,
 }
 
+/// Segment length when [`WelchParams::nperseg`] is `None`: scipy.signal.welch's default.
+const DEFAULT_NPERSEG: usize = 256;
+
 /// Checks that the sampling rate is positive and finite.
 pub(crate) fn check_fs(fs_hz: f64) -> Result<(), SpectraError> {
     if fs_hz.is_finite() && fs_hz > 0.0 {
@@ -202,7 +205,7 @@ impl WelchPlan {
         if n_samples == 0 {
             return Err(SpectraError::EmptyInput { name: "x" });
         }
-        let requested = p.nperseg.unwrap_or(256);
+        let requested = p.nperseg.unwrap_or(DEFAULT_NPERSEG);
         if requested == 0 {
             return Err(SpectraError::ZeroNperseg);
         }
