@@ -186,10 +186,9 @@ fn scaled_points(
 
 /// Sorts the points by grid cell (side 1/sqrt(2): any two poles in one cell are neighbours) and
 /// returns each cell's range of points, by cell and in order.
-#[allow(clippy::type_complexity)]
-fn sort_into_cells(pts: &mut [Pt]) -> (HashMap<(i64, i64), (usize, usize)>, Vec<(usize, usize)>) {
+fn sort_into_cells(pts: &mut [Pt]) -> (Cells, Vec<(usize, usize)>) {
     pts.sort_by(|a, b| a.cell.cmp(&b.cell).then(a.idx.cmp(&b.idx)));
-    let mut cells: HashMap<(i64, i64), (usize, usize)> = HashMap::new();
+    let mut cells: Cells = HashMap::new();
     let mut cell_list: Vec<(usize, usize)> = Vec::new();
     let mut start = 0;
     for k in 1..=pts.len() {
@@ -486,21 +485,31 @@ impl Metric {
     }
 }
 
+/// A pole in the scaled plane: `u` = ln f / ln(1 + freq_tol_rel), `v` = log10 zeta / log_damping_tol.
 struct Pt {
+    /// Log frequency in units of the relative frequency radius.
     u: f64,
+    /// Log10 damping ratio in units of the damping radius.
     v: f64,
     /// Damping ratio, raised to `min_damping_ratio`.
     zeta: f64,
     /// Cells to search on each side in `u` (covers the widest neighbourhood of this pole).
     reach_u: i64,
+    /// Grid cell of (u, v).
     cell: (i64, i64),
+    /// Index of the pole in the input slice.
     idx: usize,
+    /// Channel id (index among the distinct channels of the used poles).
     ch: usize,
 }
 
+/// Range of points (`start..end` into the sorted points) of each occupied grid cell.
+type Cells = HashMap<(i64, i64), (usize, usize)>;
+
+/// The points sorted by cell, with each cell's range, for neighbour queries.
 struct Grid<'a> {
     pts: &'a [Pt],
-    cells: HashMap<(i64, i64), (usize, usize)>,
+    cells: Cells,
     metric: Metric,
 }
 
@@ -544,6 +553,7 @@ impl Grid<'_> {
     }
 }
 
+/// Disjoint sets over point indices (union by size, path compression).
 struct UnionFind {
     parent: Vec<usize>,
     size: Vec<usize>,
