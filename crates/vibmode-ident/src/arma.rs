@@ -475,6 +475,7 @@ impl<'a> Search<'a> {
         let (p, q) = (self.p, self.q);
         let k = p + q;
         let mut psi = vec![0.0; k];
+        let mut fpsi = vec![0.0; k];
         for (t, &et) in eps.iter().enumerate().skip(p) {
             let e = et.abs();
             if e <= r {
@@ -494,13 +495,17 @@ impl<'a> Search<'a> {
                 psi[p + j - 1] = if t >= j { -self.ef[t - j] } else { 0.0 };
             }
             let f = w - 1.0;
-            for i in 0..k {
-                let fi = f * psi[i];
-                if fi == 0.0 {
-                    continue;
-                }
-                for j in 0..k {
-                    h[(i, j)] += fi * psi[j];
+            for (fi, &p_i) in fpsi.iter_mut().zip(&psi) {
+                *fi = f * p_i;
+            }
+            // Column by column (contiguous in nalgebra's storage); each entry gets the same single
+            // update, and rows with f psi_i = 0 are left untouched.
+            for (j, &psi_j) in psi.iter().enumerate() {
+                let mut column = h.column_mut(j);
+                for (hij, &fi) in column.as_mut_slice().iter_mut().zip(&fpsi) {
+                    if fi != 0.0 {
+                        *hij += fi * psi_j;
+                    }
                 }
             }
         }
