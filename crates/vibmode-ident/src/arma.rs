@@ -671,7 +671,7 @@ fn multistart(
     })
 }
 
-/// A trial point accepted by [`line_search`]: the new model, its loss, and the halvings it took.
+/// A trial point accepted by [`LineSearch::run`]: the new model, its loss, and the halvings it took.
 struct Trial {
     a: Vec<f64>,
     c: Vec<f64>,

@@ -196,7 +196,7 @@ impl ClusterParams {
     }
 }
 
-/// Parameters of [`crate::stabilisation`] (classic stabilisation diagram criteria).
+/// Parameters of [`crate::stabilisation()`] (classic stabilisation diagram criteria).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct StabilisationParams {

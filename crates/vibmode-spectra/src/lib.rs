@@ -121,7 +121,7 @@ pub fn welch(x: &[f64], fs_hz: f64, p: &WelchParams) -> Result<Spectrum, Spectra
 }
 
 /// Cross-spectral density `Pxy` (conj(X) Y, one-sided) of `x` and `y` sampled at `fs_hz`
-/// (Hz), as `scipy.signal.csd`. Errors as [`welch`], plus `x` and `y` of different lengths.
+/// (Hz), as `scipy.signal.csd`. Errors as [`welch()`], plus `x` and `y` of different lengths.
 pub fn csd(
     x: &[f64],
     y: &[f64],

@@ -224,7 +224,7 @@ impl FromStr for ShortRecord {
     }
 }
 
-/// Parameters of [`crate::welch`], [`crate::csd`], [`crate::coherence`] and
+/// Parameters of [`crate::welch()`], [`crate::csd`], [`crate::coherence`] and
 /// [`crate::WelchPlan`], with scipy.signal.welch's meaning and defaults.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct WelchParams {
