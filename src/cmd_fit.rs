@@ -394,11 +394,11 @@ fn fit_figure(
             y_range: None,
             series: vec![
                 {
-                    let (x, y) = crate::figures::positive_freq(&per.freq_hz, &per.psd);
+                    let (x, y) = vibmode_report::panels::positive_freq(&per.freq_hz, &per.psd);
                     line("periodogram", x, y, 1, 0.4)
                 },
                 {
-                    let (x, y) = crate::figures::positive_freq(&wel.freq_hz, &wel.psd);
+                    let (x, y) = vibmode_report::panels::positive_freq(&wel.freq_hz, &wel.psd);
                     line("Welch", x, y, 2, 1.0)
                 },
                 line("model", grid, mpsd, 2, 1.0),

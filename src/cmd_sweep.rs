@@ -1,7 +1,6 @@
 //! `vibmode sweep`: fit every model order and collect every mode (stabilisation diagram).
 
 use crate::cmd_fit::{FitMethod, ModelKind};
-use crate::figures;
 use crate::input::InputArgs;
 use crate::output::{ensure_parent, write_json};
 use anyhow::{bail, Context, Result};
@@ -10,6 +9,7 @@ use serde::Serialize;
 use std::path::PathBuf;
 use vibmode_core::{BandLimit, PoleFilterParams, SweepParams};
 use vibmode_ident::{ArMethod, ArmaParams, PoleRejection, Robust};
+use vibmode_report::panels as figures;
 
 /// Arguments of `vibmode sweep`.
 #[derive(Args, Debug)]

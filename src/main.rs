@@ -10,7 +10,6 @@ mod cmd_psd;
 mod cmd_resample;
 mod cmd_sweep;
 mod cmd_vehicle;
-mod figures;
 mod hints;
 mod input;
 mod output;

@@ -5,7 +5,11 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
-use crate::linalg::{check_signal, cholesky_solve, dot, lagged_dot, lagged_gram, spd_inverse_diag};
+use nalgebra::DMatrix;
+
+use crate::linalg::{
+    check_signal, cholesky_solve_ridged, dot, lagged_dot, lagged_gram, spd_inverse_diag, Lags,
+};
 use crate::model::{information_criteria, ArmaModel, Estimator, StopReason};
 use crate::IdentError;
 
@@ -99,13 +103,8 @@ pub fn fit_ar(y: &[f64], p: usize, method: ArMethod) -> Result<ArmaModel, IdentE
         }
     };
     // Asymptotic standard errors from the autocovariance matrix.
-    let mut rm = vec![0.0; p * p];
-    for i in 0..p {
-        for j in 0..p {
-            rm[i * p + j] = r[i.abs_diff(j)];
-        }
-    }
-    let std_errors = match spd_inverse_diag(&rm, p) {
+    let rm = DMatrix::from_fn(p, p, |i, j| r[i.abs_diff(j)]);
+    let std_errors = match spd_inverse_diag(&rm) {
         Some(d) => d.iter().map(|v| (lambda * v / n as f64).sqrt()).collect(),
         None => vec![f64::NAN; p],
     };
@@ -205,26 +204,37 @@ pub(crate) fn burg(x: &[f64], p: usize) -> (Vec<f64>, Vec<f64>, f64) {
     (a, refl, lambda)
 }
 
+/// Refinement steps of [`fb_least_squares`] (corrected semi-normal equations): each gains about
+/// as many digits as the normal equations lose to the squared condition number; three reach full
+/// precision for the orders used here.
+const FB_LS_REFINEMENTS: usize = 3;
+
 /// Forward-backward least squares on demeaned `x`: (A coefficients, noise variance).
 pub(crate) fn fb_least_squares(x: &[f64], p: usize) -> (Vec<f64>, f64) {
     let n = x.len();
     let xr: Vec<f64> = x.iter().rev().copied().collect();
-    let mut g = vec![0.0; p * p];
-    let mut gb = vec![0.0; p * p];
-    lagged_gram(x, p, x, p, p, &mut g, p, 0, 0, 1.0);
-    lagged_gram(&xr, p, &xr, p, p, &mut gb, p, 0, 0, 1.0);
+    let mut g = DMatrix::<f64>::zeros(p, p);
+    let mut gb = DMatrix::<f64>::zeros(p, p);
+    lagged_gram(
+        Lags::new(x, p),
+        Lags::new(x, p),
+        p,
+        g.view_mut((0, 0), (p, p)),
+        1.0,
+    );
+    lagged_gram(
+        Lags::new(&xr, p),
+        Lags::new(&xr, p),
+        p,
+        gb.view_mut((0, 0), (p, p)),
+        1.0,
+    );
     let mut rhs = vec![0.0; p];
     for i in 1..=p {
         rhs[i - 1] = -(lagged_dot(x, i, x, 0, p) + lagged_dot(&xr, i, &xr, 0, p));
     }
-    for (gi, bi) in g.iter_mut().zip(&gb) {
-        *gi += bi;
-    }
-    let solve = |b: &[f64]| {
-        cholesky_solve(&g, b, p, 0.0)
-            .or_else(|| cholesky_solve(&g, b, p, 1e-12))
-            .or_else(|| cholesky_solve(&g, b, p, 1e-8))
-    };
+    g += &gb;
+    let solve = |b: &[f64]| cholesky_solve_ridged(&g, b);
     let mut a = vec![1.0];
     a.extend(solve(&rhs).unwrap_or_else(|| vec![0.0; p]));
     // The normal equations square the condition number: refine with the exact gradient
@@ -232,7 +242,7 @@ pub(crate) fn fb_least_squares(x: &[f64], p: usize) -> (Vec<f64>, f64) {
     let mut fe = vec![0.0; n];
     let mut be = vec![0.0; n];
     let mut ss = 0.0;
-    for step in 0..4 {
+    for step in 0..=FB_LS_REFINEMENTS {
         ss = 0.0;
         for t in p..n {
             let (mut f, mut b) = (0.0, 0.0);
@@ -244,7 +254,7 @@ pub(crate) fn fb_least_squares(x: &[f64], p: usize) -> (Vec<f64>, f64) {
             be[t] = b;
             ss += f * f + b * b;
         }
-        if step == 3 {
+        if step == FB_LS_REFINEMENTS {
             break;
         }
         let grad: Vec<f64> = (1..=p)

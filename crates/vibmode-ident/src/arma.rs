@@ -1,146 +1,21 @@
 //! ARMA(p, q) by (robust) prediction-error minimisation. See docs/identification.md.
 
 use num_complex::Complex64;
-use serde::{Deserialize, Serialize};
 
 use crate::ar::burg;
+use nalgebra::DMatrix;
+
 use crate::linalg::{
     check_signal, cholesky_solve, dot, filter_inv_c, filter_inv_c_adjoint, is_min_phase,
-    lagged_dot, lagged_gram, predict_errors, robust_std, spd_inverse_diag,
+    lagged_dot, lagged_gram, mirror_upper_block, predict_errors, robust_std, spd_inverse_diag,
+    Lags,
 };
 use crate::model::{information_criteria, ArmaModel, Estimator, StopReason};
 use crate::outliers::OutlierCleaning;
+use crate::params::{ArmaParams, Robust};
+use crate::prepare::{self, Prepared};
 use crate::roots::polynomial_roots;
 use crate::IdentError;
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, StandardNormal};
-
-use vibmode_core::BandLimit;
-pub use vibmode_core::Robust;
-
-/// Settings of the prediction-error search.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct ArmaParams {
-    /// Criterion. Default `Robust::Huber { factor: 1.6 }`.
-    pub robust: Robust,
-    /// Maximum Gauss-Newton iterations. Default 100.
-    pub max_iter: usize,
-    /// Stopping tolerance (dimensionless): the search stops when the predicted relative
-    /// improvement of a Gauss-Newton step `(V - V_pred) / V` is below `tol`, or when the loss
-    /// dropped by less than `tol` (relative) over the last 5 iterations. Default 1e-5.
-    pub tol: f64,
-    /// Maximum step halvings per direction. Default 10.
-    pub max_halvings: usize,
-    /// Subtract the mean of `y` before fitting. Default true.
-    pub demean: bool,
-    /// Additive-outlier (spike) cleaning before a `Robust::Huber` fit (unused by `Robust::Off`).
-    /// Default `OutlierCleaning::RobustFilter` with default [`crate::CleanerParams`].
-    #[serde(default)]
-    pub outlier_cleaning: OutlierCleaning,
-    /// Numerical noise floor for signals with an empty band (dimensionless, >= 0; 0 = off).
-    /// Default 1e-3 (-30 dB of the signal's mean square).
-    ///
-    /// After an ideal low-pass (the paper's 25 Hz cutoff at 200 Hz) the band above the cutoff is
-    /// empty to rounding error, the signal is almost perfectly predictable there, and the
-    /// prediction-error criterion has no minimum: C's zeros run to the unit circle, the loss falls
-    /// to 1e-20 of the signal's, fits hit the iteration cap and their poles are meaningless. When
-    /// the signal has such a band (more than 1 % of its periodogram bins below 1e-20 of the
-    /// largest: only rounding error is left there), white noise of variance `noise_floor x` its
-    /// mean square, from a fixed-seed generator (the same bytes every run), is added to the signal
-    /// the search works on. That bounds the prediction gain at 1/noise_floor and gives the
-    /// criterion a well-defined minimum. A floor only just deep enough for a minimum (1e-8) leaves
-    /// C with zeros within ~1e-8 of the unit circle: the predictor's start-up transient then
-    /// never decays within the record, the loss depends on where its sum starts, warm starts are
-    /// useless and half the fits reach the iteration cap; at 1e-3 the fits are sound (see
-    /// docs/identification.md for the measurements). White noise added to an ARMA(p, q <= p)
-    /// process leaves its poles where they are. Signals without an empty band are fitted as they
-    /// are.
-    /// The reported `noise_variance` and `loss` are those of the signal the search saw.
-    #[serde(default = "default_noise_floor")]
-    pub noise_floor: f64,
-    /// The band the signal carries, as the pre-processing reported it
-    /// ([`vibmode_core::BandLimit`]: whether an ideal low-pass left an empty band). Its
-    /// `empty_band` decides whether the noise floor is added. `None` (default) for a signal of
-    /// unknown provenance: the band is then judged from the signal itself (more than 1 % of its
-    /// periodogram bins below 1e-20 of the largest, which is what an ideal DFT low-pass leaves).
-    #[serde(default)]
-    pub band: Option<BandLimit>,
-}
-
-fn default_noise_floor() -> f64 {
-    1e-3
-}
-
-/// Whether `y` has a numerically empty band: more than 1 % of its periodogram bins below 1e-20 of
-/// the largest bin (what an ideal DFT low-pass leaves above its cutoff).
-fn has_empty_band(y: &[f64]) -> bool {
-    let n = y.len();
-    if n < 16 {
-        return false;
-    }
-    let mut planner = realfft::RealFftPlanner::<f64>::new();
-    let fft = planner.plan_fft_forward(n);
-    let mut input = y.to_vec();
-    let mut spec = fft.make_output_vec();
-    if fft.process(&mut input, &mut spec).is_err() {
-        return false;
-    }
-    let power: Vec<f64> = spec.iter().map(|z| z.norm_sqr()).collect();
-    let max = power.iter().cloned().fold(0.0, f64::max);
-    if !(max > 0.0 && max.is_finite()) {
-        return false;
-    }
-    let empty = power.iter().filter(|&&p| p < 1e-20 * max).count();
-    empty * 100 > power.len()
-}
-
-/// Seed of the noise-floor generator.
-const FLOOR_SEED: u64 = 0x0076_6962_6d6f_6465;
-
-impl Default for ArmaParams {
-    fn default() -> Self {
-        ArmaParams {
-            robust: Robust::default(),
-            max_iter: 100,
-            tol: 1e-5,
-            max_halvings: 10,
-            demean: true,
-            outlier_cleaning: OutlierCleaning::default(),
-            noise_floor: default_noise_floor(),
-            band: None,
-        }
-    }
-}
-
-impl ArmaParams {
-    fn validate(&self) -> Result<(), IdentError> {
-        if !(self.tol.is_finite() && self.tol > 0.0) {
-            return Err(IdentError::InvalidParam {
-                name: "tol",
-                value: self.tol.to_string(),
-                fix: "use a small positive number such as 1e-5",
-            });
-        }
-        if !(self.noise_floor.is_finite() && (0.0..0.1).contains(&self.noise_floor)) {
-            return Err(IdentError::InvalidParam {
-                name: "noise_floor",
-                value: self.noise_floor.to_string(),
-                fix: "use a small relative variance in [0, 0.1) such as 1e-3 (the default), or 0 for none",
-            });
-        }
-        if let Robust::Huber { factor } = self.robust {
-            if !(factor.is_finite() && factor > 0.0) {
-                return Err(IdentError::InvalidParam {
-                    name: "Huber factor",
-                    value: factor.to_string(),
-                    fix: "use a positive factor such as 1.6, or off",
-                });
-            }
-        }
-        Ok(())
-    }
-}
 
 /// Largest N p (p + q) for which the AR columns of the Jacobian are filtered exactly
 /// (O(N p (p + q)) per iteration); beyond it delayed copies of y/C are used.
@@ -155,6 +30,66 @@ const MAX_REFLECTIONS: usize = 3;
 
 /// Iterations over which the stall rule measures progress.
 const STALL_WINDOW: usize = 5;
+
+/// Initial Levenberg-Marquardt ridge of the Gauss-Newton search (relative to the unit diagonal of
+/// the Jacobi-scaled normal matrix): small, so that a well-conditioned first step is almost a
+/// pure Gauss-Newton step.
+const MU_INITIAL: f64 = 1e-6;
+
+/// Smallest ridge: at or below it the plain Gauss-Newton direction is used (the ridge would only
+/// change the last digits of the step).
+const MU_MIN: f64 = 1e-12;
+
+/// Largest ridge: the step is then a short Jacobi-scaled gradient step; a larger ridge would only
+/// shorten it further, which the step halvings do anyway.
+const MU_MAX: f64 = 1e6;
+
+/// Factor applied to the ridge after a full (unhalved) step.
+const MU_DECREASE: f64 = 0.1;
+
+/// Factor applied to the ridge after a step that needed halving.
+const MU_INCREASE: f64 = 10.0;
+
+/// Ridge of the solve for the Newton decrement (the predicted decrease that decides
+/// convergence): just enough to factor a numerically singular normal matrix, without changing the
+/// prediction.
+const NEWTON_DECREMENT_RIDGE: f64 = 1e-12;
+
+/// Ridge of the Hannan-Rissanen regression: its regressors (y and long-AR residuals) can be
+/// nearly collinear for overfitted orders; 1e-10 keeps the solve stable without visibly biasing
+/// a starting point that the search refines anyway.
+const HANNAN_RISSANEN_RIDGE: f64 = 1e-10;
+
+/// Attempts of [`solve_scaled`], each with the ridge multiplied by [`RIDGE_GROWTH`]: from
+/// [`MIN_RIDGE`], 8 attempts reach 1e2 (a matrix dominated by its ridge, which always factors).
+const RIDGE_ESCALATIONS: usize = 8;
+
+/// Growth of the ridge between attempts of [`solve_scaled`].
+const RIDGE_GROWTH: f64 = 100.0;
+
+/// First non-zero ridge of [`solve_scaled`] when the requested one is zero (rounding level).
+const MIN_RIDGE: f64 = 1e-12;
+
+/// A search without a lower point has converged when the Newton decrement is within this
+/// multiple of `tol x V`: a predicted gain that small is at the criterion's numerical floor, where
+/// rounding in the loss hides any real decrease.
+const NO_STEP_TOL_FACTOR: f64 = 100.0;
+
+/// C has a zero "on" the unit circle when its modulus exceeds 1 - 1e-6: the radial shrink of
+/// [`stabilise`] moves roots by at most this much, so such a zero is at the boundary of the
+/// minimum-phase set.
+const BOUNDARY_MARGIN: f64 = 1e-6;
+
+/// Radial shrink factors tried in turn by [`stabilise`] for roots on or just outside the unit
+/// circle (1 - 1e-9 .. 1 - 1e-6): the smallest move that makes C minimum phase, so that a
+/// converged C whose zeros sit within rounding of the circle is changed as little as possible.
+const SHRINK_FACTORS: [f64; 4] = [1.0 - 1e-9, 1.0 - 1e-8, 1.0 - 1e-7, 1.0 - 1e-6];
+
+/// Shrink factor of the last-resort loop of [`stabilise`] (roots on the unit circle or failed root
+/// finding), and the most times it is applied (0.999^200 ~ 0.82: far inside the circle).
+const FALLBACK_SHRINK: f64 = 0.999;
+/// See [`FALLBACK_SHRINK`].
+const FALLBACK_SHRINK_STEPS: usize = 200;
 
 /// Largest `p + q` allowed for `n` samples: `n / 3`.
 pub fn max_arma_order(n: usize) -> usize {
@@ -203,7 +138,7 @@ pub fn sweep_arma(
     let mut out: Vec<Result<ArmaModel, IdentError>> = Vec::with_capacity(orders.len());
     // Additive outliers are cleaned once for the whole sweep (the same result at every order).
     let cleaned = check_signal(y, 3)
-        .and_then(|mean| crate::outliers::prepare(y, mean, params))
+        .and_then(|mean| prepare::cleaned(y, mean, params))
         .map(|(yc, _, k)| (yc.into_owned(), k));
     let (yc, replaced) = match cleaned {
         Ok(v) => v,
@@ -267,7 +202,7 @@ fn stabilise(c: &mut [f64]) {
     if c.len() <= 1 || is_min_phase(c) {
         return;
     }
-    for r in [1.0 - 1e-9, 1.0 - 1e-8, 1.0 - 1e-7, 1.0 - 1e-6] {
+    for r in SHRINK_FACTORS {
         let mut shrunk = c.to_vec();
         shrink_roots(&mut shrunk, r);
         if is_min_phase(&shrunk) {
@@ -294,8 +229,8 @@ fn stabilise(c: &mut [f64]) {
     }
     // Fallback (roots on the unit circle or failed root finding): shrink all roots.
     let mut guard = 0;
-    while !is_min_phase(c) && guard < 200 {
-        shrink_roots(c, 0.999);
+    while !is_min_phase(c) && guard < FALLBACK_SHRINK_STEPS {
+        shrink_roots(c, FALLBACK_SHRINK);
         guard += 1;
     }
 }
@@ -343,12 +278,17 @@ fn make_candidate(ys: &[f64], a: Vec<f64>, mut c: Vec<f64>, robust: bool) -> Opt
     })
 }
 
+/// The long AR model of the Hannan-Rissanen estimate has order p + 4 q (at most N / 3, at least
+/// p + q): long enough for its residuals to approximate the innovations of an ARMA(p, q) whose
+/// MA zeros are not close to the unit circle.
+const HR_LONG_AR_PER_MA: usize = 4;
+
 /// Hannan-Rissanen initial estimate on the scaled signal.
 fn hannan_rissanen(ys: &[f64], p: usize, q: usize) -> (Vec<f64>, Vec<f64>) {
     let n = ys.len();
     let k = p + q;
     let (ehat, t0) = if q > 0 {
-        let m = (p + 4 * q).min(n / 3).max(k);
+        let m = (p + HR_LONG_AR_PER_MA * q).min(n / 3).max(k);
         let (a_long, _, _) = burg(ys, m);
         let mut e = vec![0.0; n];
         predict_errors(ys, &a_long, &[1.0], &mut e);
@@ -356,16 +296,13 @@ fn hannan_rissanen(ys: &[f64], p: usize, q: usize) -> (Vec<f64>, Vec<f64>) {
     } else {
         (Vec::new(), p)
     };
-    let mut g = vec![0.0; k * k];
-    lagged_gram(ys, p, ys, p, t0, &mut g, k, 0, 0, 1.0);
+    let mut g = DMatrix::<f64>::zeros(k, k);
+    let (y_lags, e_lags) = (Lags::new(ys, p), Lags::new(&ehat, q));
+    lagged_gram(y_lags, y_lags, t0, g.view_mut((0, 0), (p, p)), 1.0);
     if q > 0 {
-        lagged_gram(ys, p, &ehat, q, t0, &mut g, k, 0, p, -1.0);
-        lagged_gram(&ehat, q, &ehat, q, t0, &mut g, k, p, p, 1.0);
-        for i in 0..p {
-            for j in p..k {
-                g[j * k + i] = g[i * k + j];
-            }
-        }
+        lagged_gram(y_lags, e_lags, t0, g.view_mut((0, p), (p, q)), -1.0);
+        lagged_gram(e_lags, e_lags, t0, g.view_mut((p, p), (q, q)), 1.0);
+        mirror_upper_block(&mut g, p);
     }
     let mut rhs = vec![0.0; k];
     for i in 1..=p {
@@ -374,7 +311,7 @@ fn hannan_rissanen(ys: &[f64], p: usize, q: usize) -> (Vec<f64>, Vec<f64>) {
     for j in 1..=q {
         rhs[p + j - 1] = lagged_dot(&ehat, j, ys, 0, t0);
     }
-    let theta = solve_scaled(&g, &rhs, k, 1e-10).unwrap_or_else(|| vec![0.0; k]);
+    let theta = solve_scaled(&g, &rhs, HANNAN_RISSANEN_RIDGE).unwrap_or_else(|| vec![0.0; k]);
     let mut a = vec![1.0];
     a.extend_from_slice(&theta[..p]);
     let mut c = vec![1.0];
@@ -384,10 +321,11 @@ fn hannan_rissanen(ys: &[f64], p: usize, q: usize) -> (Vec<f64>, Vec<f64>) {
 
 /// Solves `h x = b` after Jacobi scaling, with relative ridge `mu` (added to the unit diagonal),
 /// escalating the ridge if the factorisation fails.
-fn solve_scaled(h: &[f64], b: &[f64], k: usize, mu: f64) -> Option<Vec<f64>> {
+fn solve_scaled(h: &DMatrix<f64>, b: &[f64], mu: f64) -> Option<Vec<f64>> {
+    let k = h.nrows();
     let d: Vec<f64> = (0..k)
         .map(|i| {
-            let v = h[i * k + i];
+            let v = h[(i, i)];
             if v > 0.0 && v.is_finite() {
                 v.sqrt()
             } else {
@@ -395,19 +333,18 @@ fn solve_scaled(h: &[f64], b: &[f64], k: usize, mu: f64) -> Option<Vec<f64>> {
             }
         })
         .collect();
-    let mut hs = vec![0.0; k * k];
-    for i in 0..k {
-        for j in 0..k {
-            hs[i * k + j] = h[i * k + j] / (d[i] * d[j]);
-        }
-    }
+    let hs = DMatrix::from_fn(k, k, |i, j| h[(i, j)] / (d[i] * d[j]));
     let bs: Vec<f64> = (0..k).map(|i| b[i] / d[i]).collect();
     let mut ridge = mu;
-    for _ in 0..8 {
-        if let Some(x) = cholesky_solve(&hs, &bs, k, ridge) {
+    for _ in 0..RIDGE_ESCALATIONS {
+        if let Some(x) = cholesky_solve(&hs, &bs, ridge) {
             return Some(x.iter().zip(&d).map(|(v, di)| v / di).collect());
         }
-        ridge = if ridge > 0.0 { ridge * 100.0 } else { 1e-12 };
+        ridge = if ridge > 0.0 {
+            ridge * RIDGE_GROWTH
+        } else {
+            MIN_RIDGE
+        };
     }
     None
 }
@@ -441,106 +378,137 @@ impl<'a> Search<'a> {
 
     /// Gradient `sum w eps psi` and matrix `sum w psi psi^T` (raw sums; Huber weights applied
     /// exactly through a sparse correction of the unweighted Toeplitz-structured Gram), plus the
-    /// unweighted Gram.
+    /// unweighted Gram. The Jacobian of `eps = (A/C) y` does not depend on A, so only `c` is
+    /// needed besides the current residuals `eps`.
     fn normal_equations(
         &mut self,
-        a: &[f64],
         c: &[f64],
         eps: &[f64],
-    ) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-        let _ = a; // the Jacobian of eps = (A/C) y does not depend on A
+    ) -> (Vec<f64>, DMatrix<f64>, DMatrix<f64>) {
+        let h_unweighted = self.gram(c, eps);
+        let mut h = h_unweighted.clone();
+        let g = self.gradient(c, eps);
+        if let Some(r) = self.rho {
+            self.add_huber_correction(eps, r, &mut h);
+        }
+        (g, h, h_unweighted)
+    }
+
+    /// Unweighted Gram `sum psi psi^T` of the Jacobian rows `psi_t` (t >= p), after filtering
+    /// `y / C` and `eps / C` into the scratch buffers.
+    fn gram(&mut self, c: &[f64], eps: &[f64]) -> DMatrix<f64> {
         let (p, q) = (self.p, self.q);
         let k = p + q;
         filter_inv_c(self.ys, c, &mut self.yf);
         filter_inv_c(eps, c, &mut self.ef);
         let n = self.ys.len();
-        let mut h = vec![0.0; k * k];
+        let mut h = DMatrix::<f64>::zeros(k, k);
         // Exact a-columns (1/C)[y_{t-k} 1{t >= p}] when affordable; otherwise delayed copies of y/C
         // (ignores that A(q) y is only formed from t = p on: a transient-only approximation).
         let exact = (n as f64) * (p as f64) * (k as f64) <= EXACT_JACOBIAN_BUDGET;
         self.cols.clear();
         if exact {
-            let mut z = vec![0.0; n];
-            for i in 1..=p {
-                for (t, zt) in z.iter_mut().enumerate() {
-                    *zt = if t >= p { self.ys[t - i] } else { 0.0 };
-                }
-                let mut col = vec![0.0; n];
-                filter_inv_c(&z, c, &mut col);
-                self.cols.push(col);
-            }
-            for i in 0..p {
-                for j in i..p {
-                    let v = dot(&self.cols[i][p..], &self.cols[j][p..]);
-                    h[i * k + j] = v;
-                    h[j * k + i] = v;
-                }
-                for j in 1..=q {
-                    h[i * k + p + j - 1] = -dot(&self.cols[i][p..n], &self.ef[p - j..n - j]);
-                }
-            }
-        } else {
-            lagged_gram(&self.yf, p, &self.yf, p, p, &mut h, k, 0, 0, 1.0);
+            self.exact_ar_block(c, &mut h);
+        }
+        let (yf, ef) = (Lags::new(&self.yf, p), Lags::new(&self.ef, q));
+        if !exact {
+            lagged_gram(yf, yf, p, h.view_mut((0, 0), (p, p)), 1.0);
             if q > 0 {
-                lagged_gram(&self.yf, p, &self.ef, q, p, &mut h, k, 0, p, -1.0);
+                lagged_gram(yf, ef, p, h.view_mut((0, p), (p, q)), -1.0);
             }
         }
         if q > 0 {
-            lagged_gram(&self.ef, q, &self.ef, q, p, &mut h, k, p, p, 1.0);
-            for i in 0..p {
-                for j in p..k {
-                    h[j * k + i] = h[i * k + j];
-                }
+            lagged_gram(ef, ef, p, h.view_mut((p, p), (q, q)), 1.0);
+            mirror_upper_block(&mut h, p);
+        }
+        h
+    }
+
+    /// The exact AR columns of the Jacobian into `self.cols`, and the rows `0..p` of the Gram
+    /// (the AR block and the upper AR-MA block).
+    fn exact_ar_block(&mut self, c: &[f64], h: &mut DMatrix<f64>) {
+        let (p, q) = (self.p, self.q);
+        let n = self.ys.len();
+        let mut z = vec![0.0; n];
+        for i in 1..=p {
+            for (t, zt) in z.iter_mut().enumerate() {
+                *zt = if t >= p { self.ys[t - i] } else { 0.0 };
+            }
+            let mut col = vec![0.0; n];
+            filter_inv_c(&z, c, &mut col);
+            self.cols.push(col);
+        }
+        for i in 0..p {
+            for j in i..p {
+                let v = dot(&self.cols[i][p..], &self.cols[j][p..]);
+                h[(i, j)] = v;
+                h[(j, i)] = v;
+            }
+            for j in 1..=q {
+                h[(i, p + j - 1)] = -dot(&self.cols[i][p..n], &self.ef[p - j..n - j]);
             }
         }
-        let h_unweighted = h.clone();
-        // Exact gradient by the adjoint filter: with v_t = w_t eps_t (= clip(eps_t, rho)),
-        // sum_t v_t d(eps_t)/d(theta) = sum_t u_t d(w_t)/d(theta), u = adjoint(1/C) v.
+    }
+
+    /// Exact gradient by the adjoint filter: with v_t = w_t eps_t (= clip(eps_t, rho)),
+    /// sum_t v_t d(eps_t)/d(theta) = sum_t u_t d(w_t)/d(theta), u = adjoint(1/C) v.
+    fn gradient(&mut self, c: &[f64], eps: &[f64]) -> Vec<f64> {
+        let (p, q) = (self.p, self.q);
         let we: Vec<f64> = match self.rho {
             Some(r) => eps.iter().map(|&e| e.clamp(-r, r)).collect(),
             None => eps.to_vec(),
         };
         filter_inv_c_adjoint(&we, c, &mut self.u);
-        let mut g = vec![0.0; k];
+        let mut g = vec![0.0; p + q];
         for i in 1..=p {
             g[i - 1] = lagged_dot(self.ys, i, &self.u, 0, p);
         }
         for j in 1..=q {
             g[p + j - 1] = -lagged_dot(eps, j, &self.u, 0, p);
         }
-        if let Some(r) = self.rho {
-            let mut psi = vec![0.0; k];
-            for (t, &et) in eps.iter().enumerate().skip(p) {
-                let e = et.abs();
-                if e <= r {
-                    continue;
-                }
-                let w = r / e;
-                for i in 1..=p {
-                    psi[i - 1] = if !self.cols.is_empty() {
-                        self.cols[i - 1][t]
-                    } else if t >= i {
-                        self.yf[t - i]
-                    } else {
-                        0.0
-                    };
-                }
-                for j in 1..=q {
-                    psi[p + j - 1] = if t >= j { -self.ef[t - j] } else { 0.0 };
-                }
-                let f = w - 1.0;
-                for i in 0..k {
-                    let fi = f * psi[i];
-                    if fi == 0.0 {
-                        continue;
-                    }
-                    for j in 0..k {
-                        h[i * k + j] += fi * psi[j];
+        g
+    }
+
+    /// Huber weights `w_t = r / |eps_t|` beyond the threshold `r`: adds `(w_t - 1) psi_t psi_t^T`
+    /// to the unweighted Gram `h` for those samples only.
+    fn add_huber_correction(&self, eps: &[f64], r: f64, h: &mut DMatrix<f64>) {
+        let (p, q) = (self.p, self.q);
+        let k = p + q;
+        let mut psi = vec![0.0; k];
+        let mut fpsi = vec![0.0; k];
+        for (t, &et) in eps.iter().enumerate().skip(p) {
+            let e = et.abs();
+            if e <= r {
+                continue;
+            }
+            let w = r / e;
+            for i in 1..=p {
+                psi[i - 1] = if !self.cols.is_empty() {
+                    self.cols[i - 1][t]
+                } else if t >= i {
+                    self.yf[t - i]
+                } else {
+                    0.0
+                };
+            }
+            for j in 1..=q {
+                psi[p + j - 1] = if t >= j { -self.ef[t - j] } else { 0.0 };
+            }
+            let f = w - 1.0;
+            for (fi, &p_i) in fpsi.iter_mut().zip(&psi) {
+                *fi = f * p_i;
+            }
+            // Column by column (contiguous in nalgebra's storage); each entry gets the same single
+            // update, and rows with f psi_i = 0 are left untouched.
+            for (j, &psi_j) in psi.iter().enumerate() {
+                let mut column = h.column_mut(j);
+                for (hij, &fi) in column.as_mut_slice().iter_mut().zip(&fpsi) {
+                    if fi != 0.0 {
+                        *hij += fi * psi_j;
                     }
                 }
             }
         }
-        (g, h, h_unweighted)
     }
 }
 
@@ -564,9 +532,37 @@ fn search(
     init: Option<(&[f64], &[f64])>,
     params: &ArmaParams,
 ) -> SearchOut {
-    let n = ys.len();
     let robust = matches!(params.robust, Robust::Huber { .. });
-    // Starting candidates.
+    let mut cands = starting_candidates(ys, p, q, init, robust);
+    let rho = match (params.robust, cands.first()) {
+        (Robust::Huber { factor }, Some(best)) => huber_threshold(factor, &best.eps[p..]),
+        _ => None,
+    };
+    // Start from the candidate with the lowest value of the criterion itself (the robust scale
+    // above only fixes rho; with a warm start in a sweep this is usually the previous order).
+    if rho.is_some() {
+        for cand in cands.iter_mut() {
+            cand.score = mean_loss(&cand.eps[p..], rho);
+        }
+        cands.sort_by(|x, y| x.score.total_cmp(&y.score));
+    }
+    if cands.is_empty() {
+        // Unreachable in practice (Burg on finite data is finite); start from white noise.
+        cands.push(white_noise_candidate(ys, p, q));
+    }
+    multistart(ys, p, q, cands, rho, params)
+}
+
+/// The starting candidates, best (lowest score) first: Hannan-Rissanen, Burg AR(p) with C = 1,
+/// and the caller's warm start `init` zero-padded to the orders (marked `warm`). Candidates with
+/// non-finite coefficients or score are left out.
+fn starting_candidates(
+    ys: &[f64],
+    p: usize,
+    q: usize,
+    init: Option<(&[f64], &[f64])>,
+    robust: bool,
+) -> Vec<Candidate> {
     let mut cands: Vec<Candidate> = Vec::new();
     let (ha, hc) = hannan_rissanen(ys, p, q);
     cands.extend(make_candidate(ys, ha, hc, robust));
@@ -582,45 +578,50 @@ fn search(
         cands.extend(make_candidate(ys, a, c, robust).map(|cand| Candidate { warm: true, ..cand }));
     }
     cands.sort_by(|x, y| x.score.total_cmp(&y.score));
-    let rho = match (params.robust, cands.first()) {
-        (Robust::Huber { factor }, Some(best)) => {
-            let eps = &best.eps[p..];
-            let mut s = robust_std(eps);
-            if s.is_nan() || s <= 0.0 {
-                s = (mean_loss(eps, None)).sqrt();
-            }
-            if s > 0.0 {
-                Some(factor * s)
-            } else {
-                None
-            }
-        }
-        _ => None,
-    };
-    // Start from the candidate with the lowest value of the criterion itself (the robust scale
-    // above only fixes rho; with a warm start in a sweep this is usually the previous order).
-    if rho.is_some() {
-        for cand in cands.iter_mut() {
-            cand.score = mean_loss(&cand.eps[p..], rho);
-        }
-        cands.sort_by(|x, y| x.score.total_cmp(&y.score));
+    cands
+}
+
+/// Huber threshold `factor x` the robust scale (MAD/0.6745) of the residuals `eps`, falling back
+/// to their root mean square when the robust scale is zero or NaN; None when both are zero.
+fn huber_threshold(factor: f64, eps: &[f64]) -> Option<f64> {
+    let mut s = robust_std(eps);
+    if s.is_nan() || s <= 0.0 {
+        s = (mean_loss(eps, None)).sqrt();
     }
-    if cands.is_empty() {
-        // Unreachable in practice (Burg on finite data is finite); start from white noise.
-        let mut a = vec![0.0; p + 1];
-        a[0] = 1.0;
-        let mut c = vec![0.0; q + 1];
-        c[0] = 1.0;
-        let mut eps = vec![0.0; n];
-        predict_errors(ys, &a, &c, &mut eps);
-        cands.push(Candidate {
-            a,
-            c,
-            eps,
-            score: 0.0,
-            warm: false,
-        });
+    if s > 0.0 {
+        Some(factor * s)
+    } else {
+        None
     }
+}
+
+/// The white-noise model A = 1, C = 1 as a candidate.
+fn white_noise_candidate(ys: &[f64], p: usize, q: usize) -> Candidate {
+    let mut a = vec![0.0; p + 1];
+    a[0] = 1.0;
+    let mut c = vec![0.0; q + 1];
+    c[0] = 1.0;
+    let mut eps = vec![0.0; ys.len()];
+    predict_errors(ys, &a, &c, &mut eps);
+    Candidate {
+        a,
+        c,
+        eps,
+        score: 0.0,
+        warm: false,
+    }
+}
+
+/// Gauss-Newton from the candidates (sorted, best first, non-empty), keeping the lowest end
+/// point; the iterations of all runs are added up.
+fn multistart(
+    ys: &[f64],
+    p: usize,
+    q: usize,
+    cands: Vec<Candidate>,
+    rho: Option<f64>,
+    params: &ArmaParams,
+) -> SearchOut {
     // Small models: search from every candidate and keep the best end point (guards against
     // neighbouring local minima); larger models: from the best-scored candidate only.
     let starts = if p + q <= MULTISTART_MAX_ORDER {
@@ -670,6 +671,169 @@ fn search(
     })
 }
 
+/// A trial point accepted by [`LineSearch::run`]: the new model, its loss, and the halvings it took.
+struct Trial {
+    a: Vec<f64>,
+    c: Vec<f64>,
+    v: f64,
+    halvings: usize,
+}
+
+/// What a line search needs besides the current point and the direction.
+struct LineSearch<'a> {
+    ys: &'a [f64],
+    p: usize,
+    q: usize,
+    rho: Option<f64>,
+    max_halvings: usize,
+}
+
+impl LineSearch<'_> {
+    /// `theta + s d` as (A, C) coefficients.
+    fn step(&self, a: &[f64], c: &[f64], d: &[f64], s: f64) -> (Vec<f64>, Vec<f64>) {
+        let mut na = a.to_vec();
+        let mut nc = c.to_vec();
+        for i in 0..self.p {
+            na[i + 1] += s * d[i];
+        }
+        for j in 0..self.q {
+            nc[j + 1] += s * d[self.p + j];
+        }
+        (na, nc)
+    }
+
+    /// Line search from `point` = (A, C, loss) along the damped Newton direction `dir`; when no
+    /// trial lowers the loss, along the Jacobi-scaled gradient of the normal equations
+    /// `(h, -g)` (its halvings counted after the `max_halvings + 1` Newton trials). Returns the
+    /// accepted trial, if any, and the gradient model's predicted decrease (infinite when the
+    /// gradient was not tried or has no positive curvature).
+    fn descend(
+        &self,
+        point: (&[f64], &[f64], f64),
+        dir: &[f64],
+        (h, neg_g): (&DMatrix<f64>, &[f64]),
+        trial: &mut [f64],
+    ) -> (Option<Trial>, f64) {
+        let mut reflected = 0usize;
+        let accepted = self.run(point, dir, 1.0, trial, &mut reflected);
+        if accepted.is_some() {
+            return (accepted, f64::INFINITY);
+        }
+        let (dg, s0, pred_gradient) = scaled_gradient_step(h, neg_g, self.ys.len() - self.p);
+        let accepted = self
+            .run(point, &dg, s0, trial, &mut reflected)
+            .map(|t| Trial {
+                halvings: t.halvings + self.max_halvings + 1,
+                ..t
+            });
+        (accepted, pred_gradient)
+    }
+
+    /// Trials `theta + s d` for s = s0, s0/2, ... (`max_halvings` halvings) from `(a, c)` with loss
+    /// `v`; the first with a lower finite loss is returned with its halving count, its residuals
+    /// in `trial`. C must stay minimum phase: the first [`MAX_REFLECTIONS`] trials of an iteration
+    /// (counted in `reflected`, shared by the line searches of one iteration) that leave the unit
+    /// circle are reflected back (roots z -> 1/conj z, the same |C| on the unit circle); later ones
+    /// are just halved (root finding costs more than a trial).
+    fn run(
+        &self,
+        (a, c, v): (&[f64], &[f64], f64),
+        d: &[f64],
+        s0: f64,
+        trial: &mut [f64],
+        reflected: &mut usize,
+    ) -> Option<Trial> {
+        let mut s = s0;
+        for hv in 0..=self.max_halvings {
+            let (na, mut nc) = self.step(a, c, d, s);
+            s *= 0.5;
+            if !is_min_phase(&nc) {
+                if *reflected >= MAX_REFLECTIONS {
+                    continue;
+                }
+                *reflected += 1;
+                stabilise(&mut nc);
+            }
+            predict_errors(self.ys, &na, &nc, trial);
+            let vt = mean_loss(&trial[self.p..], self.rho);
+            if vt.is_finite() && vt < v {
+                return Some(Trial {
+                    a: na,
+                    c: nc,
+                    v: vt,
+                    halvings: hv,
+                });
+            }
+        }
+        None
+    }
+}
+
+/// Gauss-Newton step `d0` (with a negligible ridge) and the Newton decrement, the predicted
+/// decrease of V per sample `d0 . (-g) / n_eff`. None when the normal matrix cannot be factored.
+fn newton_decrement(h: &DMatrix<f64>, neg_g: &[f64], n_eff: usize) -> Option<(Vec<f64>, f64)> {
+    let d0 = solve_scaled(h, neg_g, NEWTON_DECREMENT_RIDGE)?;
+    let pred = d0.iter().zip(neg_g).map(|(x, y)| x * y).sum::<f64>() / n_eff as f64;
+    Some((d0, pred))
+}
+
+/// Gradient fallback: the Jacobi-scaled steepest-descent direction `D^-1 (-g)` (D = diag h), the
+/// exact line minimiser of the quadratic model along it (1 when the curvature is not positive),
+/// and the first-order predicted decrease per sample along it (infinite when the curvature is not
+/// positive; unlike the Newton decrement, not inflated by an ill-conditioned H).
+fn scaled_gradient_step(h: &DMatrix<f64>, neg_g: &[f64], n_eff: usize) -> (Vec<f64>, f64, f64) {
+    let k = neg_g.len();
+    let dg: Vec<f64> = (0..k)
+        .map(|i| {
+            let hd = h[(i, i)];
+            if hd > 0.0 {
+                neg_g[i] / hd
+            } else {
+                neg_g[i]
+            }
+        })
+        .collect();
+    let gd: f64 = dg.iter().zip(neg_g).map(|(x, y)| x * y).sum();
+    let mut hdd = 0.0;
+    for i in 0..k {
+        let mut row = 0.0;
+        for j in 0..k {
+            row += h[(i, j)] * dg[j];
+        }
+        hdd += dg[i] * row;
+    }
+    let mut pred_gradient = f64::INFINITY;
+    if hdd > 0.0 {
+        pred_gradient = gd * gd / hdd / n_eff as f64;
+    }
+    let s0 = if hdd > 0.0 { gd / hdd } else { 1.0 };
+    (dg, s0, pred_gradient)
+}
+
+/// Whether a search that found no lower point has converged: either model predicts only a
+/// negligible gain (the numerical floor of the criterion: the Newton decrement `pred` within
+/// [`NO_STEP_TOL_FACTOR`] x tol, or the gradient model's `pred_gradient` within tol), or C has a
+/// zero on the unit circle (within [`BOUNDARY_MARGIN`]): the minimum then lies on the boundary
+/// of the minimum-phase set, where every descent direction leaves it (a constrained optimum).
+fn converged_without_step(pred: f64, pred_gradient: f64, v: f64, c: &[f64], tol: f64) -> bool {
+    let on_boundary = || {
+        polynomial_roots(c)
+            .map(|r| r.iter().any(|z| z.norm() > 1.0 - BOUNDARY_MARGIN))
+            .unwrap_or(false)
+    };
+    pred <= NO_STEP_TOL_FACTOR * tol * v || pred_gradient <= tol * v || on_boundary()
+}
+
+/// Levenberg-Marquardt ridge after an iteration whose accepted step took `halvings` halvings:
+/// decreased after a full step, increased otherwise, within [`MU_MIN`, `MU_MAX`].
+fn next_mu(mu: f64, halvings: usize) -> f64 {
+    if halvings == 0 {
+        (mu * MU_DECREASE).max(MU_MIN)
+    } else {
+        (mu * MU_INCREASE).min(MU_MAX)
+    }
+}
+
 /// Damped Gauss-Newton from one starting candidate (see docs/identification.md).
 fn gauss_newton(
     ys: &[f64],
@@ -686,144 +850,62 @@ fn gauss_newton(
         mut eps,
         ..
     } = start;
-    let k = p + q;
     let mut search = Search::new(ys, p, q, rho);
+    let line = LineSearch {
+        ys,
+        p,
+        q,
+        rho,
+        max_halvings: params.max_halvings,
+    };
     let n_eff = n - p;
     let mut v = mean_loss(&eps[p..], rho);
-    let mut mu = 1e-6;
+    let mut mu = MU_INITIAL;
     let mut iterations = 0;
     let mut stop = StopReason::MaxIterations;
     let mut converged = false;
     let mut trial_eps = vec![0.0; n];
     // Loss history for the stall rule.
     let mut history: Vec<f64> = vec![v];
-    let apply = |a: &[f64], c: &[f64], d: &[f64], s: f64| -> (Vec<f64>, Vec<f64>) {
-        let mut na = a.to_vec();
-        let mut nc = c.to_vec();
-        for i in 0..p {
-            na[i + 1] += s * d[i];
-        }
-        for j in 0..q {
-            nc[j + 1] += s * d[p + j];
-        }
-        (na, nc)
-    };
     while iterations < params.max_iter {
-        let (g, h, _) = search.normal_equations(&a, &c, &eps);
+        let (g, h, _) = search.normal_equations(&c, &eps);
         let neg_g: Vec<f64> = g.iter().map(|v| -v).collect();
-        // Newton decrement (predicted decrease of V) with a negligible ridge.
-        let Some(d0) = solve_scaled(&h, &neg_g, k, 1e-12) else {
+        let Some((d0, pred)) = newton_decrement(&h, &neg_g, n_eff) else {
             stop = StopReason::NoImprovement;
             break;
         };
-        let pred = d0.iter().zip(&neg_g).map(|(x, y)| x * y).sum::<f64>() / n_eff as f64;
         if pred.is_nan() || pred <= params.tol * v {
             stop = StopReason::Converged;
             converged = true;
             break;
         }
         iterations += 1;
-        let dir = if mu > 1e-12 {
-            solve_scaled(&h, &neg_g, k, mu).unwrap_or(d0)
+        let dir = if mu > MU_MIN {
+            solve_scaled(&h, &neg_g, mu).unwrap_or(d0)
         } else {
             d0
         };
-        // Trials theta + s d for s = s0, s0/2, ... (`max_halvings` halvings); the first with a
-        // lower finite V is returned with its halving count. C must stay minimum phase: the
-        // first MAX_REFLECTIONS trials of an iteration that leave the unit circle are reflected
-        // back (roots z -> 1/conj z, the same |C| on the unit circle); later ones are just halved
-        // (root finding costs more than a trial).
-        let mut reflected = 0usize;
-        let mut line_search = |d: &[f64], s0: f64, trial: &mut [f64]| {
-            let mut s = s0;
-            for hv in 0..=params.max_halvings {
-                let (na, mut nc) = apply(&a, &c, d, s);
-                s *= 0.5;
-                if !is_min_phase(&nc) {
-                    if reflected >= MAX_REFLECTIONS {
-                        continue;
-                    }
-                    reflected += 1;
-                    stabilise(&mut nc);
-                }
-                predict_errors(ys, &na, &nc, trial);
-                let vt = mean_loss(&trial[p..], rho);
-                if vt.is_finite() && vt < v {
-                    return Some((na, nc, vt, hv));
-                }
-            }
-            None
+        let (accepted, pred_gradient) =
+            line.descend((&a, &c, v), &dir, (&h, &neg_g), &mut trial_eps);
+        let Some(t) = accepted else {
+            // No step lowers V.
+            stop = StopReason::NoImprovement;
+            converged = converged_without_step(pred, pred_gradient, v, &c, params.tol);
+            break;
         };
-        let mut pred_gradient = f64::INFINITY;
-        let mut accepted = line_search(&dir, 1.0, &mut trial_eps);
-        if accepted.is_none() {
-            // Gradient fallback: Jacobi-scaled steepest descent with the exact line minimiser of
-            // the quadratic model as first step.
-            let dg: Vec<f64> = (0..k)
-                .map(|i| {
-                    let hd = h[i * k + i];
-                    if hd > 0.0 {
-                        neg_g[i] / hd
-                    } else {
-                        neg_g[i]
-                    }
-                })
-                .collect();
-            let gd: f64 = dg.iter().zip(&neg_g).map(|(x, y)| x * y).sum();
-            let mut hdd = 0.0;
-            for i in 0..k {
-                let mut row = 0.0;
-                for j in 0..k {
-                    row += h[i * k + j] * dg[j];
-                }
-                hdd += dg[i] * row;
-            }
-            // First-order predicted decrease along the scaled gradient (not inflated by an
-            // ill-conditioned H, unlike the Newton decrement).
-            if hdd > 0.0 {
-                pred_gradient = gd * gd / hdd / n_eff as f64;
-            }
-            let s0 = if hdd > 0.0 { gd / hdd } else { 1.0 };
-            accepted = line_search(&dg, s0, &mut trial_eps)
-                .map(|(na, nc, vt, hv)| (na, nc, vt, hv + params.max_halvings + 1));
+        a = t.a;
+        c = t.c;
+        v = t.v;
+        std::mem::swap(&mut eps, &mut trial_eps);
+        history.push(v);
+        if history.len() > STALL_WINDOW
+            && history[history.len() - 1 - STALL_WINDOW] - v < params.tol * v
+        {
+            stop = StopReason::Stalled;
+            converged = true;
+            break;
         }
-        match accepted {
-            Some((na, nc, vt, hv)) => {
-                a = na;
-                c = nc;
-                v = vt;
-                std::mem::swap(&mut eps, &mut trial_eps);
-                history.push(v);
-                if history.len() > STALL_WINDOW
-                    && history[history.len() - 1 - STALL_WINDOW] - v < params.tol * v
-                {
-                    stop = StopReason::Stalled;
-                    converged = true;
-                    break;
-                }
-                mu = if hv == 0 {
-                    (mu * 0.1).max(1e-12)
-                } else {
-                    (mu * 10.0).min(1e6)
-                };
-            }
-            None => {
-                // No step lowers V. Converged when either model predicts only a negligible gain
-                // (the numerical floor of the criterion), or when C has a zero on the unit circle
-                // (within 1e-6): the minimum then lies on the boundary of the minimum-phase set,
-                // where every descent direction leaves it (a constrained optimum).
-                stop = StopReason::NoImprovement;
-                let on_boundary = || {
-                    polynomial_roots(&c)
-                        .map(|r| r.iter().any(|z| z.norm() > 1.0 - 1e-6))
-                        .unwrap_or(false)
-                };
-                converged = pred <= 100.0 * params.tol * v
-                    || pred_gradient <= params.tol * v
-                    || on_boundary();
-                break;
-            }
-        }
+        mu = next_mu(mu, t.halvings);
     }
 
     SearchOut {
@@ -847,13 +929,26 @@ fn fit_impl(
 ) -> Result<ArmaModel, IdentError> {
     params.validate()?;
     let mean = check_signal(y, 3)?;
+    check_orders(y.len(), p, q, init)?;
+    let prepared = prepare::for_search(y, mean, params)?;
+    let out = search(
+        &prepared.ys,
+        p,
+        q,
+        init.map(|m| (&m.a[..], &m.c[..])),
+        params,
+    );
+    Ok(finish_model(&prepared, p, q, out, params))
+}
+
+/// Checks the orders against the record length `n` and the warm start against the orders.
+fn check_orders(n: usize, p: usize, q: usize, init: Option<&ArmaModel>) -> Result<(), IdentError> {
     if p == 0 {
         return Err(IdentError::ZeroOrder {
             what: "ARMA AR order p",
             fix: "modes come from A(z); choose p >= 1 (e.g. p = q)",
         });
     }
-    let n = y.len();
     if p + q > max_arma_order(n) {
         return Err(IdentError::OrderTooHigh {
             what: "ARMA order p + q",
@@ -872,37 +967,37 @@ fn fit_impl(
             });
         }
     }
-    let (y, mean, outliers_replaced) = crate::outliers::prepare(y, mean, params)?;
-    let y: &[f64] = &y;
-    let offset = if params.demean { mean } else { 0.0 };
-    let centred: Vec<f64> = y.iter().map(|v| v - offset).collect();
-    let scale = (centred.iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt();
-    if !(scale > 0.0 && scale.is_finite()) {
-        return Err(IdentError::Constant { value: y[0] });
+    Ok(())
+}
+
+/// Asymptotic variance factor of the estimates: the innovation variance `lambda_s` for the
+/// quadratic criterion; for Huber's, `mean(clip(eps, rho)^2) / share_inside^2` (the sandwich
+/// estimator's scale), NaN when no residual lies inside the threshold.
+fn variance_factor(tail: &[f64], rho: Option<f64>, lambda_s: f64) -> f64 {
+    match rho {
+        None => lambda_s,
+        Some(r) => {
+            let n_eff = tail.len();
+            let num = tail.iter().map(|e| e.clamp(-r, r).powi(2)).sum::<f64>() / n_eff as f64;
+            let inside = tail.iter().filter(|e| e.abs() <= r).count() as f64 / n_eff as f64;
+            if inside > 0.0 {
+                num / (inside * inside)
+            } else {
+                f64::NAN
+            }
+        }
     }
-    let ys: Vec<f64> = centred.iter().map(|v| v / scale).collect();
-    // The search works on the signal plus the numerical noise floor (ys has unit mean square).
-    let floored: Option<Vec<f64>> = (params.noise_floor > 0.0
-        && params
-            .band
-            .map_or_else(|| has_empty_band(&ys), |b| b.empty_band))
-    .then(|| {
-        let sd = params.noise_floor.sqrt();
-        let mut rng = ChaCha8Rng::seed_from_u64(FLOOR_SEED);
-        ys.iter()
-            .map(|&v| {
-                let w: f64 = StandardNormal.sample(&mut rng);
-                v + sd * w
-            })
-            .collect()
-    });
-    let out = search(
-        floored.as_deref().unwrap_or(&ys),
-        p,
-        q,
-        init.map(|m| (&m.a[..], &m.c[..])),
-        params,
-    );
+}
+
+/// The fitted model in signal units from the search's result on the prepared signal: standard
+/// errors, information criteria, and the scale mapped back.
+fn finish_model(
+    prepared: &Prepared,
+    p: usize,
+    q: usize,
+    out: SearchOut,
+    params: &ArmaParams,
+) -> ArmaModel {
     let SearchOut {
         a,
         c,
@@ -913,35 +1008,22 @@ fn fit_impl(
         stop,
         converged,
     } = out;
-    let floor_added = floored.is_some();
-    let ys = floored.unwrap_or(ys);
+    let ys = &prepared.ys;
+    let n = ys.len();
     let k = p + q;
-    let n_eff = n - p;
-    let mut search = Search::new(&ys, p, q, rho);
-    // Final quantities.
-    let (_, _, h_u) = search.normal_equations(&a, &c, &eps);
+    let mut search = Search::new(ys, p, q, rho);
+    let (_, _, h_u) = search.normal_equations(&c, &eps);
     let lambda_s = mean_loss(&eps[p..], None);
-    let kappa = match rho {
-        None => lambda_s,
-        Some(r) => {
-            let tail = &eps[p..];
-            let num = tail.iter().map(|e| e.clamp(-r, r).powi(2)).sum::<f64>() / n_eff as f64;
-            let inside = tail.iter().filter(|e| e.abs() <= r).count() as f64 / n_eff as f64;
-            if inside > 0.0 {
-                num / (inside * inside)
-            } else {
-                f64::NAN
-            }
-        }
-    };
-    let std_errors = match spd_inverse_diag(&h_u, k) {
+    let kappa = variance_factor(&eps[p..], rho, lambda_s);
+    let std_errors = match spd_inverse_diag(&h_u) {
         Some(d) => d.iter().map(|v| (kappa * v).sqrt()).collect(),
         None => vec![f64::NAN; k],
     };
+    let scale = prepared.scale;
     let s2 = scale * scale;
     let lambda = lambda_s * s2;
     let (aic, bic, fpe) = information_criteria(lambda, n, k);
-    Ok(ArmaModel {
+    ArmaModel {
         p,
         q,
         a,
@@ -958,15 +1040,15 @@ fn fit_impl(
         reflection_coefficients: Vec::new(),
         robust_rho: rho.map(|r| r * scale),
         n_samples: n,
-        mean: offset,
+        mean: prepared.offset,
         estimator: Estimator::PredictionError,
-        outliers_replaced,
-        noise_floor_variance: if floor_added {
+        outliers_replaced: prepared.outliers_replaced,
+        noise_floor_variance: if prepared.floor_added {
             params.noise_floor * s2
         } else {
             0.0
         },
-    })
+    }
 }
 
 /// Mean squared one-step prediction error `(1/(N-p)) sum_{t=p}^{N-1} eps_t^2` of the model
@@ -988,19 +1070,6 @@ pub fn prediction_error_variance(y: &[f64], mean: f64, a: &[f64], c: &[f64]) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn robust_parse_display() {
-        assert_eq!("off".parse::<Robust>().unwrap(), Robust::Off);
-        assert_eq!(
-            "2.5".parse::<Robust>().unwrap(),
-            Robust::Huber { factor: 2.5 }
-        );
-        assert_eq!(Robust::default(), Robust::Huber { factor: 1.6 });
-        assert_eq!(Robust::default().to_string(), "1.6");
-        let e = "-1".parse::<Robust>().unwrap_err().to_string();
-        assert!(e.contains("-1") && e.contains("off"), "{e}");
-    }
 
     #[test]
     fn huber_loss_by_hand() {

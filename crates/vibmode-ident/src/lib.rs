@@ -43,21 +43,22 @@
 //! No function panics on input data; bad input gives an [`IdentError`] whose message names the
 //! offending value and the fix.
 
+#![warn(missing_docs)]
+
 mod ar;
 mod arma;
 mod error;
 mod linalg;
 mod model;
 mod outliers;
+mod params;
 mod poles;
+mod prepare;
 mod roots;
 pub mod sim;
 
 pub use ar::{fit_ar, max_ar_order, ArMethod};
-pub use arma::{
-    fit_arma, fit_arma_warm, max_arma_order, prediction_error_variance, sweep_arma, ArmaParams,
-    Robust,
-};
+pub use arma::{fit_arma, fit_arma_warm, max_arma_order, prediction_error_variance, sweep_arma};
 pub use error::IdentError;
 pub use model::{
     arma_psd, information_criteria, modes_from_poles, ArmaModel, Estimator, Mode, ModeSet, Pole,
@@ -65,5 +66,6 @@ pub use model::{
 };
 pub use num_complex::Complex64;
 pub use outliers::{clean_additive_outliers, CleanedSignal, CleanerParams, OutlierCleaning};
+pub use params::{ArmaParams, Robust};
 pub use poles::{cancelled_by_zero, filter_mode_set, filter_modes, FilteredMode, PoleRejection};
 pub use roots::polynomial_roots;

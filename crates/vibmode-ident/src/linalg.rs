@@ -1,5 +1,7 @@
 //! Internal numeric helpers: input checks, lagged Gram matrices in O(N k), filtering, Cholesky.
 
+use nalgebra::{DMatrix, DMatrixViewMut};
+
 use crate::IdentError;
 
 /// Checks a signal: non-empty, finite, not constant. Returns its mean.
@@ -50,63 +52,80 @@ pub(crate) fn lagged_dot(x: &[f64], i: usize, z: &[f64], j: usize, t0: usize) ->
     dot(&x[start - i..n - i], &z[start - j..n - j])
 }
 
+/// A signal and how many of its delays (lags 1..=`count`) form one side of a Gram block.
+#[derive(Clone, Copy)]
+pub(crate) struct Lags<'a> {
+    /// The signal.
+    pub(crate) x: &'a [f64],
+    /// Number of lags, starting at lag 1.
+    pub(crate) count: usize,
+}
+
+impl<'a> Lags<'a> {
+    /// Lags 1..=`count` of `x`.
+    pub(crate) fn new(x: &'a [f64], count: usize) -> Self {
+        Lags { x, count }
+    }
+
+    /// `x[k]`, zero outside the first `n` samples (and for negative `k`).
+    fn at(&self, k: isize, n: usize) -> f64 {
+        if k >= 0 && (k as usize) < n {
+            self.x[k as usize]
+        } else {
+            0.0
+        }
+    }
+}
+
 /// Exact Gram block `M[i-1][j-1] = sum_{t=t0}^{N-1} x[t-i] z[t-j]` for i = 1..=lx, j = 1..=lz
-/// (zero for negative indices), written row-major into `out` (lx * lz) with stride `stride`
-/// starting at `offset`, multiplied by `sign`.
+/// (`lx = x.count`, `lz = z.count`; zero for negative indices), multiplied by `sign` and written
+/// into `out` (an `lx` x `lz` view, usually a block of a larger matrix).
 ///
 /// Cost O(N (lx + lz)) for the first row and column plus O(lx lz) for the shift recursion
 /// `M(i+1, j+1) = M(i, j) - x[N-1-i] z[N-1-j] + x[t0-1-i] z[t0-1-j]`.
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn lagged_gram(
-    x: &[f64],
-    lx: usize,
-    z: &[f64],
-    lz: usize,
+    x: Lags<'_>,
+    z: Lags<'_>,
     t0: usize,
-    out: &mut [f64],
-    stride: usize,
-    row0: usize,
-    col0: usize,
+    mut out: DMatrixViewMut<'_, f64>,
     sign: f64,
 ) {
+    let (lx, lz) = (x.count, z.count);
     if lx == 0 || lz == 0 {
         return;
     }
-    let n = x.len().min(z.len());
-    let mut m = vec![0.0; lx * lz];
+    let n = x.x.len().min(z.x.len());
+    let mut m = DMatrix::<f64>::zeros(lx, lz);
     for j in 1..=lz {
-        m[j - 1] = lagged_dot(x, 1, z, j, t0);
+        m[(0, j - 1)] = lagged_dot(x.x, 1, z.x, j, t0);
     }
     for i in 2..=lx {
-        m[(i - 1) * lz] = lagged_dot(x, i, z, 1, t0);
+        m[(i - 1, 0)] = lagged_dot(x.x, i, z.x, 1, t0);
     }
-    let xv = |k: isize| -> f64 {
-        if k >= 0 && (k as usize) < n {
-            x[k as usize]
-        } else {
-            0.0
-        }
-    };
-    let zv = |k: isize| -> f64 {
-        if k >= 0 && (k as usize) < n {
-            z[k as usize]
-        } else {
-            0.0
-        }
-    };
     let (ni, t0i) = (n as isize, t0 as isize);
     for i in 1..lx {
         for j in 1..lz {
             // m(i+1, j+1) from m(i, j), with 1-based lags i, j.
             let (ii, jj) = (i as isize, j as isize);
-            let prev = m[(i - 1) * lz + (j - 1)];
-            let v = prev - xv(ni - 1 - ii) * zv(ni - 1 - jj) + xv(t0i - 1 - ii) * zv(t0i - 1 - jj);
-            m[i * lz + j] = v;
+            let prev = m[(i - 1, j - 1)];
+            m[(i, j)] = prev - x.at(ni - 1 - ii, n) * z.at(ni - 1 - jj, n)
+                + x.at(t0i - 1 - ii, n) * z.at(t0i - 1 - jj, n);
         }
     }
     for i in 0..lx {
         for j in 0..lz {
-            out[(row0 + i) * stride + col0 + j] = sign * m[i * lz + j];
+            out[(i, j)] = sign * m[(i, j)];
+        }
+    }
+}
+
+/// Copies the upper triangle of the off-diagonal block `rows 0..split`, `columns split..k` of the
+/// square matrix `h` into the lower one, so that `h` is symmetric across that block.
+pub(crate) fn mirror_upper_block(h: &mut DMatrix<f64>, split: usize) {
+    let k = h.nrows();
+    for i in 0..split {
+        for j in split..k {
+            h[(j, i)] = h[(i, j)];
         }
     }
 }
@@ -160,11 +179,12 @@ pub(crate) fn filter_inv_c_adjoint(v: &[f64], c: &[f64], out: &mut [f64]) {
     }
 }
 
-/// Solves the symmetric positive (semi)definite system `h x = b` (n x n row-major) by Cholesky,
-/// adding a relative ridge `ridge * mean(diag)` to the diagonal. Returns None if not positive definite.
-pub(crate) fn cholesky_solve(h: &[f64], b: &[f64], n: usize, ridge: f64) -> Option<Vec<f64>> {
-    let l = cholesky_factor(h, n, ridge)?;
-    let x = cholesky_apply(&l, b, n);
+/// Solves the symmetric positive (semi)definite system `h x = b` by Cholesky, adding a relative
+/// ridge `ridge * mean(diag)` to the diagonal. Reads only the lower triangle of `h`. Returns None
+/// if not positive definite.
+pub(crate) fn cholesky_solve(h: &DMatrix<f64>, b: &[f64], ridge: f64) -> Option<Vec<f64>> {
+    let r = cholesky_factor(h, ridge)?;
+    let x = cholesky_apply(&r, b);
     if x.iter().all(|v| v.is_finite()) {
         Some(x)
     } else {
@@ -172,69 +192,92 @@ pub(crate) fn cholesky_solve(h: &[f64], b: &[f64], n: usize, ridge: f64) -> Opti
     }
 }
 
-/// Lower Cholesky factor (row-major, n x n) of `h + ridge * mean(diag h) * I`; None if `h` is not
-/// numerically positive definite.
-pub(crate) fn cholesky_factor(h: &[f64], n: usize, ridge: f64) -> Option<Vec<f64>> {
+/// Relative ridges tried in turn by [`cholesky_solve_ridged`]: none first (the exact normal
+/// equations), then 1e-12 (a few units of rounding relative to the mean diagonal: rescues a matrix
+/// that is singular only to rounding), then 1e-8 (a genuinely rank-deficient Gram matrix, e.g. an
+/// AR order above what the data support; still far below any statistically meaningful ridge).
+const FALLBACK_RIDGES: [f64; 3] = [0.0, 1e-12, 1e-8];
+
+/// [`cholesky_solve`] with the first of [`FALLBACK_RIDGES`] that gives a finite solution.
+pub(crate) fn cholesky_solve_ridged(h: &DMatrix<f64>, b: &[f64]) -> Option<Vec<f64>> {
+    FALLBACK_RIDGES
+        .iter()
+        .find_map(|&ridge| cholesky_solve(h, b, ridge))
+}
+
+/// Rows `0..len` of column `j` of `m`: contiguous in nalgebra's column-major storage.
+fn column_head(m: &DMatrix<f64>, j: usize, len: usize) -> &[f64] {
+    &m.column(j).data.into_slice()[..len]
+}
+
+/// Cholesky factor of `h + ridge * mean(diag h) * I` (only the lower triangle of `h` is read),
+/// stored transposed: the upper triangle of the result is `R = L^T`, so that column `j` of `R`
+/// holds row `j` of the lower factor `L` contiguously (the strict lower triangle of the result
+/// is scratch). None if `h` is not numerically positive definite.
+pub(crate) fn cholesky_factor(h: &DMatrix<f64>, ridge: f64) -> Option<DMatrix<f64>> {
+    let n = h.nrows();
     if n == 0 {
-        return Some(Vec::new());
+        return Some(DMatrix::zeros(0, 0));
     }
-    let mean_diag = (0..n).map(|i| h[i * n + i]).sum::<f64>() / n as f64;
+    let mean_diag = (0..n).map(|i| h[(i, i)]).sum::<f64>() / n as f64;
     if !(mean_diag.is_finite() && mean_diag > 0.0) {
         return None;
     }
-    let mut l = h.to_vec();
+    // r[(j, i)] = h[(i, j)]: the lower triangle of h becomes the upper triangle of r.
+    let mut r = h.transpose();
     for i in 0..n {
-        l[i * n + i] += ridge * mean_diag;
+        r[(i, i)] += ridge * mean_diag;
     }
     for j in 0..n {
-        let (head, tail) = l.split_at_mut((j + 1) * n);
-        let row_j = &mut head[j * n..(j + 1) * n];
-        let d = row_j[j] - dot(&row_j[..j], &row_j[..j]);
+        let row_j = column_head(&r, j, j);
+        let d = r[(j, j)] - dot(row_j, row_j);
         if !(d > 0.0 && d.is_finite()) {
             return None;
         }
         let d = d.sqrt();
-        row_j[j] = d;
-        let row_j = &head[j * n..j * n + j];
+        r[(j, j)] = d;
         for i in j + 1..n {
-            let row_i = &mut tail[(i - j - 1) * n..(i - j) * n];
-            let s = row_i[j] - dot(&row_i[..j], row_j);
-            row_i[j] = s / d;
+            let s = r[(j, i)] - dot(column_head(&r, i, j), column_head(&r, j, j));
+            r[(j, i)] = s / d;
         }
     }
-    Some(l)
+    Some(r)
 }
 
-/// Solves `L L^T x = b` with the factor of [`cholesky_factor`].
-pub(crate) fn cholesky_apply(l: &[f64], b: &[f64], n: usize) -> Vec<f64> {
+/// Solves `L L^T x = b` with the (transposed) factor `r = L^T` of [`cholesky_factor`].
+pub(crate) fn cholesky_apply(r: &DMatrix<f64>, b: &[f64]) -> Vec<f64> {
+    let n = r.nrows();
     let mut x = b.to_vec();
     for i in 0..n {
-        let s = x[i] - dot(&l[i * n..i * n + i], &x[..i]);
-        x[i] = s / l[i * n + i];
+        let s = x[i] - dot(column_head(r, i, i), &x[..i]);
+        x[i] = s / r[(i, i)];
     }
     for i in (0..n).rev() {
         let mut s = x[i];
         for k in i + 1..n {
-            s -= l[k * n + i] * x[k];
+            s -= r[(i, k)] * x[k];
         }
-        x[i] = s / l[i * n + i];
+        x[i] = s / r[(i, i)];
     }
     x
 }
 
-/// Diagonal of the inverse of a symmetric positive definite matrix, from one Cholesky factor.
-pub(crate) fn spd_inverse_diag(h: &[f64], n: usize) -> Option<Vec<f64>> {
+/// Diagonal of the inverse of a symmetric positive definite matrix (lower triangle read), from
+/// one Cholesky factor.
+pub(crate) fn spd_inverse_diag(h: &DMatrix<f64>) -> Option<Vec<f64>> {
     // diag(H^-1)_i = sum_j (L^-1)_{ji}^2: invert the lower factor column by column.
-    let l = cholesky_factor(h, n, 0.0)?;
+    let n = h.nrows();
+    let r = cholesky_factor(h, 0.0)?;
     let mut out = vec![0.0; n];
     let mut col = vec![0.0; n];
     for i in 0..n {
-        // Column i of L^-1 (zero above row i), by forward substitution.
+        // Column i of L^-1 (zero above row i), by forward substitution; row `row` of L is
+        // column `row` of r.
         col[..i].iter_mut().for_each(|v| *v = 0.0);
-        col[i] = 1.0 / l[i * n + i];
-        for r in i + 1..n {
-            let s = dot(&l[r * n + i..r * n + r], &col[i..r]);
-            col[r] = -s / l[r * n + r];
+        col[i] = 1.0 / r[(i, i)];
+        for row in i + 1..n {
+            let s = dot(&column_head(&r, row, row)[i..], &col[i..row]);
+            col[row] = -s / r[(row, row)];
         }
         out[i] = col[i..].iter().map(|v| v * v).sum();
     }
@@ -262,11 +305,16 @@ pub(crate) fn median(v: &[f64]) -> f64 {
     }
 }
 
-/// Robust standard deviation MAD / 0.6745 (median absolute deviation from the median).
+/// Ratio of the median absolute deviation to the standard deviation of a Gaussian sample
+/// (`Phi^-1(3/4)`, rounded as in the literature and in MATLAB's pem): MAD / 0.6745 estimates the
+/// standard deviation robustly.
+pub(crate) const MAD_PER_STD: f64 = 0.6745;
+
+/// Robust standard deviation MAD / [`MAD_PER_STD`] (median absolute deviation from the median).
 pub(crate) fn robust_std(v: &[f64]) -> f64 {
     let med = median(v);
     let dev: Vec<f64> = v.iter().map(|x| (x - med).abs()).collect();
-    median(&dev) / 0.6745
+    median(&dev) / MAD_PER_STD
 }
 
 /// Whether the monic polynomial `1 + c1 z^-1 + ...` has all roots strictly inside the unit circle
@@ -300,8 +348,14 @@ mod tests {
         let z: Vec<f64> = (0..37).map(|t| ((t * 5 % 13) as f64 - 6.0) * 0.2).collect();
         for &t0 in &[0usize, 3, 9] {
             let (lx, lz) = (5, 4);
-            let mut out = vec![0.0; lx * lz];
-            lagged_gram(&x, lx, &z, lz, t0, &mut out, lz, 0, 0, 1.0);
+            let mut out = DMatrix::<f64>::zeros(lx, lz);
+            lagged_gram(
+                Lags::new(&x, lx),
+                Lags::new(&z, lz),
+                t0,
+                out.view_mut((0, 0), (lx, lz)),
+                1.0,
+            );
             for i in 1..=lx {
                 for j in 1..=lz {
                     let mut s = 0.0;
@@ -311,7 +365,7 @@ mod tests {
                         }
                     }
                     assert!(
-                        (out[(i - 1) * lz + j - 1] - s).abs() < 1e-12,
+                        (out[(i - 1, j - 1)] - s).abs() < 1e-12,
                         "t0={t0} i={i} j={j}"
                     );
                 }
@@ -322,9 +376,11 @@ mod tests {
     #[test]
     fn cholesky_solves_small_system() {
         // [[4, 2], [2, 3]] x = [2, 1] -> x = [0.5, 0]
-        let x = cholesky_solve(&[4.0, 2.0, 2.0, 3.0], &[2.0, 1.0], 2, 0.0).unwrap();
+        let h = DMatrix::from_row_slice(2, 2, &[4.0, 2.0, 2.0, 3.0]);
+        let x = cholesky_solve(&h, &[2.0, 1.0], 0.0).unwrap();
         assert!((x[0] - 0.5).abs() < 1e-14 && x[1].abs() < 1e-14);
-        assert!(cholesky_solve(&[1.0, 2.0, 2.0, 1.0], &[1.0, 1.0], 2, 0.0).is_none());
+        let h = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
+        assert!(cholesky_solve(&h, &[1.0, 1.0], 0.0).is_none());
     }
 
     #[test]

@@ -11,13 +11,12 @@
 //! pothole's impulse response, which the data after it keep following). The AR model is refitted
 //! on the cleaned data and the pass repeated.
 
-use std::borrow::Cow;
-
 use serde::{Deserialize, Serialize};
 
+use nalgebra::DMatrix;
+
 use crate::ar::burg;
-use crate::arma::{ArmaParams, Robust};
-use crate::linalg::{check_signal, cholesky_solve, median, predict_errors, robust_std};
+use crate::linalg::{check_signal, cholesky_solve_ridged, median, predict_errors, robust_std};
 use crate::IdentError;
 
 /// Settings of the robust AR filter-cleaner ([`clean_additive_outliers`]).
@@ -47,7 +46,7 @@ impl Default for CleanerParams {
 }
 
 impl CleanerParams {
-    fn validate(&self) -> Result<(), IdentError> {
+    pub(crate) fn validate(&self) -> Result<(), IdentError> {
         if self.ar_order == 0 {
             return Err(IdentError::InvalidParam {
                 name: "cleaner ar_order",
@@ -136,7 +135,7 @@ pub fn clean_additive_outliers(
     check_signal(y, 3)?;
     let n = y.len();
     let centre = median(y);
-    let m = params.ar_order.min(n / 10);
+    let m = params.ar_order.min(n / SAMPLES_PER_AR_ORDER);
     let mut out = CleanedSignal {
         y: y.to_vec(),
         replaced: Vec::new(),
@@ -156,58 +155,17 @@ pub fn clean_additive_outliers(
     let mut flags = vec![false; n];
     let mut resid = vec![0.0; n];
     for pass in 0..params.passes {
-        let (a, s) = match masked_fb_ls(&x, &bad, m) {
-            Some(fit) => fit,
-            None => {
-                let (a, _, _) = burg(&x, m);
-                predict_errors(&x, &a, &[1.0], &mut resid);
-                let s = robust_std(&resid[m..]);
-                (a, s)
-            }
-        };
+        let (a, s) = fit_predictor(&x, &bad, m, &mut resid);
         out.ar = a;
         out.residual_scale = s;
         out.passes = pass + 1;
         // No usable scale (e.g. a perfectly predictable signal): nothing can be called an outlier.
-        if !(s.is_finite() && s > 1e-12 * rms) {
+        if !(s.is_finite() && s > MIN_RELATIVE_SCALE * rms) {
             x.copy_from_slice(&raw);
             flags.iter_mut().for_each(|f| *f = false);
             break;
         }
-        // Forward pass from t = m; the first m samples keep their previous cleaned values as the
-        // initial state of the predictor.
-        let mut nx = raw.clone();
-        nx[..m].copy_from_slice(&x[..m]);
-        let mut nflags = vec![false; n];
-        filter_forward(
-            &raw,
-            &mut nx,
-            &mut nflags,
-            &out.ar,
-            s,
-            params.threshold,
-            m..n,
-        );
-        // Backward pass over the first m samples (time reversed, the rest already cleaned).
-        let rraw: Vec<f64> = raw.iter().rev().copied().collect();
-        let mut rx: Vec<f64> = nx.iter().rev().copied().collect();
-        let mut rflags = vec![false; n];
-        for (t, v) in rx.iter_mut().enumerate().skip(n - m) {
-            *v = rraw[t];
-        }
-        filter_forward(
-            &rraw,
-            &mut rx,
-            &mut rflags,
-            &out.ar,
-            s,
-            params.threshold,
-            n - m..n,
-        );
-        for t in 0..m {
-            nx[t] = rx[n - 1 - t];
-            nflags[t] = rflags[n - 1 - t];
-        }
+        let (nx, nflags) = clean_pass(&raw, &x[..m], &out.ar, s, params.threshold);
         let same = nflags == flags;
         x = nx;
         flags = nflags;
@@ -226,6 +184,70 @@ pub fn clean_additive_outliers(
     }
     Ok(out)
 }
+
+/// AR(m) predictor of one pass (m = `a.len() - 1`): the masked forward-backward least-squares fit
+/// of `x` on the windows free of `bad` samples, or, when too few windows are usable, Burg's fit
+/// of the whole of `x` with the robust scale of its residuals (computed in `resid`). Returns the
+/// A coefficients and the innovation scale.
+fn fit_predictor(x: &[f64], bad: &[bool], m: usize, resid: &mut [f64]) -> (Vec<f64>, f64) {
+    match masked_fb_ls(x, bad, m) {
+        Some(fit) => fit,
+        None => {
+            let (a, _, _) = burg(x, m);
+            predict_errors(x, &a, &[1.0], resid);
+            let s = robust_std(&resid[m..]);
+            (a, s)
+        }
+    }
+}
+
+/// One filter-cleaner pass over the centred raw signal `raw` with the AR predictor `a` (order m)
+/// and innovation scale `s`: forward from t = m, the first m samples keeping their previous
+/// cleaned values `head` as the initial state; then backward (time reversed, the rest already
+/// cleaned) over the first m samples. Returns the cleaned signal and the replaced samples' flags.
+fn clean_pass(
+    raw: &[f64],
+    head: &[f64],
+    a: &[f64],
+    s: f64,
+    threshold: f64,
+) -> (Vec<f64>, Vec<bool>) {
+    let n = raw.len();
+    let m = head.len();
+    let mut nx = raw.to_vec();
+    nx[..m].copy_from_slice(head);
+    let mut nflags = vec![false; n];
+    filter_forward(raw, &mut nx, &mut nflags, a, s, threshold, m..n);
+    let rraw: Vec<f64> = raw.iter().rev().copied().collect();
+    let mut rx: Vec<f64> = nx.iter().rev().copied().collect();
+    let mut rflags = vec![false; n];
+    for (t, v) in rx.iter_mut().enumerate().skip(n - m) {
+        *v = rraw[t];
+    }
+    filter_forward(&rraw, &mut rx, &mut rflags, a, s, threshold, n - m..n);
+    for t in 0..m {
+        nx[t] = rx[n - 1 - t];
+        nflags[t] = rflags[n - 1 - t];
+    }
+    (nx, nflags)
+}
+
+/// The cleaner's AR order is at most N / 10 (and nothing is cleaned below 10 samples): an AR
+/// predictor needs several samples per coefficient to be estimated at all. The same ratio sets the
+/// least number of usable windows of the masked fit.
+const SAMPLES_PER_AR_ORDER: usize = 10;
+
+/// The masked least-squares fit needs at least 5 usable windows per coefficient (else Burg on the
+/// whole signal is used).
+const MIN_WINDOWS_PER_ORDER: usize = 5;
+
+/// Refinement steps of the masked least-squares fit with the exact residual gradient (undo the
+/// precision lost to the normal equations).
+const MASKED_LS_REFINEMENTS: usize = 2;
+
+/// A residual scale below 1e-12 of the signal's RMS is rounding error (a perfectly predictable
+/// signal): nothing is then called an outlier.
+const MIN_RELATIVE_SCALE: f64 = 1e-12;
 
 /// Marginal threshold (robust standard deviations of the signal) of the pre-screen that protects the
 /// first pass's AR fit.
@@ -283,30 +305,22 @@ fn masked_fb_ls(x: &[f64], bad: &[bool], m: usize) -> Option<(Vec<f64>, f64)> {
             windows.push(t);
         }
     }
-    if windows.len() < (5 * m).max(n / 10) {
+    if windows.len() < (MIN_WINDOWS_PER_ORDER * m).max(n / SAMPLES_PER_AR_ORDER) {
         return None;
     }
-    let mut g = vec![0.0; m * m];
+    let mut g = DMatrix::<f64>::zeros(m, m);
     let mut rhs = vec![0.0; m];
     for &t in &windows {
         for i in 1..=m {
             let (fi, bi) = (x[t - i], x[t - m + i]);
             rhs[i - 1] -= fi * x[t] + bi * x[t - m];
             for j in i..=m {
-                g[(i - 1) * m + j - 1] += fi * x[t - j] + bi * x[t - m + j];
+                g[(i - 1, j - 1)] += fi * x[t - j] + bi * x[t - m + j];
             }
         }
     }
-    for i in 0..m {
-        for j in 0..i {
-            g[i * m + j] = g[j * m + i];
-        }
-    }
-    let solve = |b: &[f64]| {
-        cholesky_solve(&g, b, m, 0.0)
-            .or_else(|| cholesky_solve(&g, b, m, 1e-12))
-            .or_else(|| cholesky_solve(&g, b, m, 1e-8))
-    };
+    g.fill_lower_triangle_with_upper_triangle();
+    let solve = |b: &[f64]| cholesky_solve_ridged(&g, b);
     let mut coef = solve(&rhs)?;
     let residuals = |coef: &[f64], t: usize| -> (f64, f64) {
         let mut f = x[t];
@@ -317,7 +331,7 @@ fn masked_fb_ls(x: &[f64], bad: &[bool], m: usize) -> Option<(Vec<f64>, f64)> {
         }
         (f, b)
     };
-    for _ in 0..2 {
+    for _ in 0..MASKED_LS_REFINEMENTS {
         let mut grad = vec![0.0; m];
         for &t in &windows {
             let (f, b) = residuals(&coef, t);
@@ -506,28 +520,6 @@ fn lookahead_loss(next: &[f64], mut kf: ArKalman<'_>, k: f64) -> f64 {
         }
     }
     loss
-}
-
-/// The signal a robust fit works on: cleaned when `params.robust` is Huber and cleaning is on
-/// (returns the signal, its mean and the number of replaced samples), else `y` and `mean` as given.
-pub(crate) fn prepare<'a>(
-    y: &'a [f64],
-    mean: f64,
-    params: &ArmaParams,
-) -> Result<(Cow<'a, [f64]>, f64, usize), IdentError> {
-    let OutlierCleaning::RobustFilter(cp) = params.outlier_cleaning else {
-        return Ok((Cow::Borrowed(y), mean, 0));
-    };
-    cp.validate()?;
-    if params.robust == Robust::Off {
-        return Ok((Cow::Borrowed(y), mean, 0));
-    }
-    let c = clean_additive_outliers(y, &cp)?;
-    if c.replaced.is_empty() {
-        return Ok((Cow::Borrowed(y), mean, 0));
-    }
-    let mean = c.y.iter().sum::<f64>() / c.y.len() as f64;
-    Ok((Cow::Owned(c.y), mean, c.replaced.len()))
 }
 
 #[cfg(test)]

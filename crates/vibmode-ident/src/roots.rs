@@ -51,7 +51,7 @@ pub fn polynomial_roots(coeffs: &[f64]) -> Result<Vec<Complex64>, IdentError> {
             m[(i, i - 1)] = 1.0;
         }
         balance_parlett_reinsch(&mut m);
-        let schur = Schur::try_new(m, f64::EPSILON, 100 * n.max(10))
+        let schur = Schur::try_new(m, f64::EPSILON, SCHUR_ITERATIONS_PER_ROOT * n.max(10))
             .ok_or(IdentError::RootsNotConverged { degree: n })?;
         let eig = schur.complex_eigenvalues();
         let raw: Vec<Complex64> = eig.iter().map(|z| Complex64::new(z.re, z.im)).collect();
@@ -64,6 +64,14 @@ pub fn polynomial_roots(coeffs: &[f64]) -> Result<Vec<Complex64>, IdentError> {
     roots.extend(std::iter::repeat(Complex64::new(0.0, 0.0)).take(zeros_at_origin));
     Ok(roots)
 }
+
+/// Schur iterations allowed per eigenvalue (for at least 10 of them): the QR algorithm needs
+/// about 2 to 3 per eigenvalue; 100 only stops an iteration that does not converge.
+const SCHUR_ITERATIONS_PER_ROOT: usize = 100;
+
+/// A polishing step is kept only when shorter than this fraction of the distance to the nearest
+/// other eigenvalue, so it cannot jump to a neighbouring root.
+const MAX_STEP_PER_ROOT_GAP: f64 = 0.1;
 
 /// Value and derivative of the polynomial `c` (highest power first) at z (Horner, f64).
 fn horner(c: &[f64], z: Complex64) -> (Complex64, Complex64) {
@@ -159,7 +167,7 @@ fn polish(c: &[f64], z0: Complex64, all: &[Complex64], idx: usize) -> Complex64 
             break;
         }
         let step = pz / dp;
-        if step.norm().is_nan() || step.norm() >= 0.1 * min_dist {
+        if step.norm().is_nan() || step.norm() >= MAX_STEP_PER_ROOT_GAP * min_dist {
             break;
         }
         let mut zn = z - step;

@@ -8,6 +8,14 @@ use crate::linalg::is_min_phase;
 use crate::roots::polynomial_roots;
 use crate::IdentError;
 
+/// `ln(1e-12)` (rounded): the burn-in lets the slowest pole's transient decay by 1e-12, below
+/// double-precision rounding relative to the stationary signal.
+const BURN_IN_DECAY_LN: f64 = -27.6;
+
+/// Cap of the burn-in, samples: a pole within ~3e-5 of the unit circle would otherwise ask for
+/// more (and such a process is practically non-stationary anyway).
+const MAX_BURN_IN: usize = 1_000_000;
+
 /// A(z) coefficients (leading 1, length 2 * modes.len() + 1) whose poles are the discrete-time
 /// images `z = exp(s / fs_hz)` of the continuous poles `s = -zeta w0 +- i w0 sqrt(1 - zeta^2)`,
 /// `w0 = 2 pi frequency_hz`, for each `(frequency_hz, damping_ratio)` in `modes`
@@ -85,7 +93,7 @@ pub fn simulate_arma(
         return Err(IdentError::UnstableModel { modulus: rmax });
     }
     let burn = if rmax > 0.0 {
-        ((-27.6 / rmax.ln()).ceil() as usize).min(1_000_000)
+        ((BURN_IN_DECAY_LN / rmax.ln()).ceil() as usize).min(MAX_BURN_IN)
     } else {
         0
     } + 10 * (a.len() + c.len());

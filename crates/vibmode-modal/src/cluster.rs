@@ -56,17 +56,73 @@ pub fn analyse_poles(
     p: &ClusterParams,
 ) -> Result<ModalAnalysis, ModalError> {
     p.validate()?;
-    let mut labels = vec![None; poles.len()];
     if poles.is_empty() {
         return Ok(ModalAnalysis {
             modes: Vec::new(),
-            labels,
+            labels: Vec::new(),
             n_used: 0,
             n_ignored: 0,
             n_fits: 0,
             core_threshold: p.min_points,
         });
     }
+    let orders = checked_orders(poles, n_records, orders)?;
+    let metric = Metric::new(p);
+    let (mut pts, n_channels) = scaled_points(poles, p, &metric);
+    let n_used = pts.len();
+    let n_fits = n_records
+        .saturating_mul(orders.len())
+        .saturating_mul(n_channels);
+    let core_threshold = p
+        .min_points
+        .max((p.min_density_share * n_fits as f64).ceil() as usize);
+    let mut out = ModalAnalysis {
+        modes: Vec::new(),
+        labels: vec![None; poles.len()],
+        n_used,
+        n_ignored: poles.len() - n_used,
+        n_fits,
+        core_threshold,
+    };
+    if pts.is_empty() {
+        return Ok(out);
+    }
+    let (cells, cell_list) = sort_into_cells(&mut pts);
+    let grid = Grid {
+        pts: &pts,
+        cells,
+        metric,
+    };
+    // 1. Core poles; 2. connected core poles; 3. border poles to their nearest core neighbour.
+    let core = core_flags(&grid, &cell_list, core_threshold);
+    let mut uf = connect_cores(&grid, &cell_list, &core);
+    let members = cluster_members(&grid, &core, &mut uf);
+    // 4. Summarise each cluster.
+    let mut clusters: Vec<(InvariantMode, Vec<usize>)> = members
+        .into_values()
+        .map(|m| summarise(&pts, &m, poles, n_records, orders.len(), p, &metric))
+        .collect();
+    clusters.sort_by(|a, b| {
+        a.0.frequency_hz
+            .total_cmp(&b.0.frequency_hz)
+            .then(a.0.damping_ratio.total_cmp(&b.0.damping_ratio))
+    });
+    for (k, (mode, kept)) in clusters.into_iter().enumerate() {
+        for idx in kept {
+            out.labels[idx] = Some(k);
+        }
+        out.modes.push(mode);
+    }
+    Ok(out)
+}
+
+/// Checks `n_records` and the poles against the records and orders; returns the orders sorted
+/// and deduplicated.
+fn checked_orders(
+    poles: &[PoleObservation],
+    n_records: usize,
+    orders: &[usize],
+) -> Result<Vec<usize>, ModalError> {
     if n_records == 0 {
         return Err(ModalError::EmptySupport {
             what: "n_records",
@@ -83,14 +139,17 @@ pub fn analyse_poles(
         });
     }
     validate_poles(poles, n_records, &orders)?;
+    Ok(orders)
+}
 
-    // Filter and map to the scaled plane.
-    let lu = (1.0 + p.freq_tol_rel).ln();
-    let metric = Metric {
-        lu,
-        per_damping: p.freq_tol_per_damping,
-        min_rel: p.freq_tol_rel,
-    };
+/// The poles that pass the frequency/damping filters, mapped to the scaled plane, and the number
+/// of distinct channels among them.
+fn scaled_points(
+    poles: &[PoleObservation],
+    p: &ClusterParams,
+    metric: &Metric,
+) -> (Vec<Pt>, usize) {
+    let lu = metric.lu;
     let mut pts: Vec<Pt> = Vec::with_capacity(poles.len());
     let mut channel_ids: HashMap<&str, usize> = HashMap::new();
     for (i, pole) in poles.iter().enumerate() {
@@ -126,30 +185,14 @@ pub fn analyse_poles(
             ch,
         });
     }
-    let n_used = pts.len();
-    let n_fits = n_records
-        .saturating_mul(orders.len())
-        .saturating_mul(channel_ids.len());
-    let core_threshold = p
-        .min_points
-        .max((p.min_density_share * n_fits as f64).ceil() as usize);
-    let mut out = ModalAnalysis {
-        modes: Vec::new(),
-        labels: Vec::new(),
-        n_used,
-        n_ignored: poles.len() - n_used,
-        n_fits,
-        core_threshold,
-    };
-    if pts.is_empty() {
-        out.labels = labels;
-        return Ok(out);
-    }
+    (pts, channel_ids.len())
+}
 
-    // Grid of cells of side 1/sqrt(2) (any two poles in one cell are neighbours), poles sorted
-    // by cell.
+/// Sorts the points by grid cell (side 1/sqrt(2): any two poles in one cell are neighbours) and
+/// returns each cell's range of points, by cell and in order.
+fn sort_into_cells(pts: &mut [Pt]) -> (Cells, Vec<(usize, usize)>) {
     pts.sort_by(|a, b| a.cell.cmp(&b.cell).then(a.idx.cmp(&b.idx)));
-    let mut cells: HashMap<(i64, i64), (usize, usize)> = HashMap::new();
+    let mut cells: Cells = HashMap::new();
     let mut cell_list: Vec<(usize, usize)> = Vec::new();
     let mut start = 0;
     for k in 1..=pts.len() {
@@ -159,26 +202,28 @@ pub fn analyse_poles(
             start = k;
         }
     }
-    let grid = Grid {
-        pts: &pts,
-        cells,
-        metric,
-    };
+    (cells, cell_list)
+}
 
-    // 1. Core poles (a cell holding at least core_threshold poles is all core).
-    let mut core = vec![false; pts.len()];
-    for &(a, b) in &cell_list {
+/// Core poles: at least `core_threshold` neighbours (a cell holding that many poles is all core).
+fn core_flags(grid: &Grid<'_>, cell_list: &[(usize, usize)], core_threshold: usize) -> Vec<bool> {
+    let mut core = vec![false; grid.pts.len()];
+    for &(a, b) in cell_list {
         for (i, c) in core.iter_mut().enumerate().take(b).skip(a) {
             *c = b - a >= core_threshold
                 || grid.count_neighbours_upto(i, core_threshold) >= core_threshold;
         }
     }
+    core
+}
 
-    // 2. Connect core poles that are neighbours (union-find): all core poles of a cell together,
-    //    then one neighbouring core pair per pair of cells is enough.
+/// Connects core poles that are neighbours (union-find): all core poles of a cell together, then
+/// one neighbouring core pair per pair of cells is enough.
+fn connect_cores(grid: &Grid<'_>, cell_list: &[(usize, usize)], core: &[bool]) -> UnionFind {
+    let pts = grid.pts;
     let mut uf = UnionFind::new(pts.len());
     let mut first_core: HashMap<(i64, i64), usize> = HashMap::new();
-    for &(a, b) in &cell_list {
+    for &(a, b) in cell_list {
         if let Some(f) = (a..b).find(|&i| core[i]) {
             for i in (f + 1..b).filter(|&i| core[i]) {
                 uf.union(f, i);
@@ -186,7 +231,7 @@ pub fn analyse_poles(
             first_core.insert(pts[f].cell, f);
         }
     }
-    for &(a, b) in &cell_list {
+    for &(a, b) in cell_list {
         let Some(&fa) = first_core.get(&pts[a].cell) else {
             continue;
         };
@@ -209,7 +254,7 @@ pub fn analyse_poles(
                 };
                 'pairs: for i in (a..b).filter(|&i| core[i]) {
                     for j in (da..db).filter(|&j| core[j]) {
-                        if metric.dist2(&pts[i], &pts[j]) <= 1.0 {
+                        if grid.metric.dist2(&pts[i], &pts[j]) <= 1.0 {
                             uf.union(i, j);
                             break 'pairs;
                         }
@@ -218,10 +263,19 @@ pub fn analyse_poles(
             }
         }
     }
+    uf
+}
 
-    // 3. Border poles join the cluster of their nearest core neighbour.
-    let mut root_of: Vec<Option<usize>> = vec![None; pts.len()];
-    for i in 0..pts.len() {
+/// Members (point indices) of every cluster, keyed by its union-find root: core poles by their
+/// component, border poles by the component of their nearest core neighbour.
+fn cluster_members(
+    grid: &Grid<'_>,
+    core: &[bool],
+    uf: &mut UnionFind,
+) -> HashMap<usize, Vec<usize>> {
+    let n = grid.pts.len();
+    let mut root_of: Vec<Option<usize>> = vec![None; n];
+    for i in 0..n {
         if core[i] {
             root_of[i] = Some(uf.find(i));
         } else {
@@ -242,25 +296,7 @@ pub fn analyse_poles(
             members.entry(*r).or_default().push(i);
         }
     }
-
-    // 4. Summarise each cluster.
-    let mut clusters: Vec<(InvariantMode, Vec<usize>)> = members
-        .into_values()
-        .map(|m| summarise(&pts, &m, poles, n_records, orders.len(), p, &metric))
-        .collect();
-    clusters.sort_by(|a, b| {
-        a.0.frequency_hz
-            .total_cmp(&b.0.frequency_hz)
-            .then(a.0.damping_ratio.total_cmp(&b.0.damping_ratio))
-    });
-    for (k, (mode, kept)) in clusters.into_iter().enumerate() {
-        for idx in kept {
-            labels[idx] = Some(k);
-        }
-        out.modes.push(mode);
-    }
-    out.labels = labels;
-    Ok(out)
+    members
 }
 
 fn validate_poles(
@@ -269,18 +305,7 @@ fn validate_poles(
     orders: &[usize],
 ) -> Result<(), ModalError> {
     for (index, pole) in poles.iter().enumerate() {
-        if !pole.frequency_hz.is_finite() {
-            return Err(ModalError::NonFiniteFrequency {
-                index,
-                value: pole.frequency_hz,
-            });
-        }
-        if !pole.damping_ratio.is_finite() {
-            return Err(ModalError::NonFiniteDamping {
-                index,
-                value: pole.damping_ratio,
-            });
-        }
+        crate::types::check_finite(pole, index)?;
         if pole.record >= n_records {
             let needed = poles.iter().map(|q| q.record).max().unwrap_or(0) + 1;
             return Err(ModalError::RecordOutOfRange {
@@ -315,55 +340,14 @@ fn summarise(
     p: &ClusterParams,
     metric: &Metric,
 ) -> (InvariantMode, Vec<usize>) {
-    let cu = median(&members.iter().map(|&i| pts[i].u).collect::<Vec<_>>());
-    let cv = median(&members.iter().map(|&i| pts[i].v).collect::<Vec<_>>());
-    // Frequency scale at the centre's damping (constant within the cluster).
-    let cs = metric.scale(
-        10f64.powf(cv * p.log_damping_tol),
-        10f64.powf(cv * p.log_damping_tol),
-    );
-    // At most one pole per (record, channel, order): the nearest to the cluster centre.
-    let mut best: HashMap<(usize, usize, usize), (f64, usize)> = HashMap::new();
-    for &i in members {
-        let pt = &pts[i];
-        let pole = &poles[pt.idx];
-        let d2 = ((pt.u - cu) * cs).powi(2) + (pt.v - cv).powi(2);
-        let key = (pole.record, pt.ch, pole.order);
-        match best.get(&key) {
-            Some(&(bd, bidx)) if bd < d2 || (bd == d2 && bidx < pt.idx) => {}
-            _ => {
-                best.insert(key, (d2, pt.idx));
-            }
-        }
-    }
-    let mut kept: Vec<usize> = best.values().map(|&(_, idx)| idx).collect();
-    kept.sort_unstable();
-
+    let kept = nearest_per_fit(pts, members, poles, p, metric);
     let freqs: Vec<f64> = kept.iter().map(|&i| poles[i].frequency_hz).collect();
     let mut damps: Vec<f64> = kept.iter().map(|&i| poles[i].damping_ratio).collect();
     damps.sort_by(f64::total_cmp);
     let (f_mean, f_std) = mean_std(&freqs);
-    let rec_orders: HashSet<(usize, usize)> = kept
-        .iter()
-        .map(|&i| (poles[i].record, poles[i].order))
-        .collect();
-    let mut orders_per_record: HashMap<usize, usize> = HashMap::new();
-    for &(r, _) in &rec_orders {
-        *orders_per_record.entry(r).or_insert(0) += 1;
-    }
-    let min_orders = ((p.record_min_order_share * n_orders as f64).ceil() as usize).max(1);
-    let n_supporting = orders_per_record
-        .values()
-        .filter(|&&n| n >= min_orders)
-        .count();
-    let mut channels: Vec<String> = kept.iter().map(|&i| poles[i].channel.clone()).collect();
-    channels.sort();
-    channels.dedup();
-    let mut roles: Vec<vibmode_core::Role> = kept.iter().filter_map(|&i| poles[i].role).collect();
-    roles.sort();
-    roles.dedup();
-    let record_share = n_supporting as f64 / n_records as f64;
-    let order_share = rec_orders.len() as f64 / (n_records as f64 * n_orders as f64);
+    let (record_share, order_share) = support(&kept, poles, n_records, n_orders, p);
+    let channels = distinct(kept.iter().map(|&i| poles[i].channel.clone()));
+    let roles = distinct(kept.iter().filter_map(|&i| poles[i].role));
     let damping_ratio = percentile_sorted(&damps, 0.5);
     let supported =
         (n_records <= 1 || record_share >= p.min_record_share) && order_share >= p.min_order_share;
@@ -395,6 +379,76 @@ fn summarise(
     (mode, kept)
 }
 
+/// At most one pole per fit (record, channel, order) of the cluster `members`: the nearest to the
+/// cluster centre (median of u and v), ties to the lower input index. Returns the kept input
+/// indices, ascending.
+fn nearest_per_fit(
+    pts: &[Pt],
+    members: &[usize],
+    poles: &[PoleObservation],
+    p: &ClusterParams,
+    metric: &Metric,
+) -> Vec<usize> {
+    let cu = median(&members.iter().map(|&i| pts[i].u).collect::<Vec<_>>());
+    let cv = median(&members.iter().map(|&i| pts[i].v).collect::<Vec<_>>());
+    // Frequency scale at the centre's damping (constant within the cluster).
+    let cs = metric.scale(
+        10f64.powf(cv * p.log_damping_tol),
+        10f64.powf(cv * p.log_damping_tol),
+    );
+    let mut best: HashMap<(usize, usize, usize), (f64, usize)> = HashMap::new();
+    for &i in members {
+        let pt = &pts[i];
+        let pole = &poles[pt.idx];
+        let d2 = ((pt.u - cu) * cs).powi(2) + (pt.v - cv).powi(2);
+        let key = (pole.record, pt.ch, pole.order);
+        match best.get(&key) {
+            Some(&(bd, bidx)) if bd < d2 || (bd == d2 && bidx < pt.idx) => {}
+            _ => {
+                best.insert(key, (d2, pt.idx));
+            }
+        }
+    }
+    let mut kept: Vec<usize> = best.values().map(|&(_, idx)| idx).collect();
+    kept.sort_unstable();
+    kept
+}
+
+/// Support of a cluster (kept input indices): the share of records with at least
+/// `record_min_order_share` of the orders, and the share of (record, order) fits present.
+fn support(
+    kept: &[usize],
+    poles: &[PoleObservation],
+    n_records: usize,
+    n_orders: usize,
+    p: &ClusterParams,
+) -> (f64, f64) {
+    let rec_orders: HashSet<(usize, usize)> = kept
+        .iter()
+        .map(|&i| (poles[i].record, poles[i].order))
+        .collect();
+    let mut orders_per_record: HashMap<usize, usize> = HashMap::new();
+    for &(r, _) in &rec_orders {
+        *orders_per_record.entry(r).or_insert(0) += 1;
+    }
+    let min_orders = ((p.record_min_order_share * n_orders as f64).ceil() as usize).max(1);
+    let n_supporting = orders_per_record
+        .values()
+        .filter(|&&n| n >= min_orders)
+        .count();
+    let record_share = n_supporting as f64 / n_records as f64;
+    let order_share = rec_orders.len() as f64 / (n_records as f64 * n_orders as f64);
+    (record_share, order_share)
+}
+
+/// The distinct values, sorted.
+fn distinct<T: Ord>(values: impl Iterator<Item = T>) -> Vec<T> {
+    let mut v: Vec<T> = values.collect();
+    v.sort();
+    v.dedup();
+    v
+}
+
 /// Grid cells per unit of the scaled plane: side 1/sqrt(2), so a cell's diagonal is 1.
 const CELLS_PER_UNIT: f64 = std::f64::consts::SQRT_2;
 /// Neighbouring cells to search on each side in `v`, and at least in `u` (ceil(sqrt(2)) = 2).
@@ -416,6 +470,14 @@ struct Metric {
 }
 
 impl Metric {
+    fn new(p: &ClusterParams) -> Self {
+        Metric {
+            lu: (1.0 + p.freq_tol_rel).ln(),
+            per_damping: p.freq_tol_per_damping,
+            min_rel: p.freq_tol_rel,
+        }
+    }
+
     /// Factor (<= 1) applied to a `u` difference for poles of damping ratios `za`, `zb`.
     fn scale(&self, za: f64, zb: f64) -> f64 {
         let rel = self.min_rel.max(self.per_damping * (za * zb).sqrt());
@@ -427,21 +489,31 @@ impl Metric {
     }
 }
 
+/// A pole in the scaled plane: `u` = ln f / ln(1 + freq_tol_rel), `v` = log10 zeta / log_damping_tol.
 struct Pt {
+    /// Log frequency in units of the relative frequency radius.
     u: f64,
+    /// Log10 damping ratio in units of the damping radius.
     v: f64,
     /// Damping ratio, raised to `min_damping_ratio`.
     zeta: f64,
     /// Cells to search on each side in `u` (covers the widest neighbourhood of this pole).
     reach_u: i64,
+    /// Grid cell of (u, v).
     cell: (i64, i64),
+    /// Index of the pole in the input slice.
     idx: usize,
+    /// Channel id (index among the distinct channels of the used poles).
     ch: usize,
 }
 
+/// Range of points (`start..end` into the sorted points) of each occupied grid cell.
+type Cells = HashMap<(i64, i64), (usize, usize)>;
+
+/// The points sorted by cell, with each cell's range, for neighbour queries.
 struct Grid<'a> {
     pts: &'a [Pt],
-    cells: HashMap<(i64, i64), (usize, usize)>,
+    cells: Cells,
     metric: Metric,
 }
 
@@ -485,6 +557,7 @@ impl Grid<'_> {
     }
 }
 
+/// Disjoint sets over point indices (union by size, path compression).
 struct UnionFind {
     parent: Vec<usize>,
     size: Vec<usize>,

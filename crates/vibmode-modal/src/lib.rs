@@ -8,7 +8,7 @@
 //! cluster as [`ModeClass::Structural`], [`ModeClass::PeriodicDisturbance`] (engine/gear lines:
 //! damping ~1e-3, frequency extremely stable) or [`ModeClass::Spurious`] (not supported by enough
 //! records/orders). [`match_reference`] compares the structural modes with a physical model, and
-//! [`stabilisation`] gives the classic stabilisation-diagram status of every pole.
+//! [`stabilisation()`] gives the classic stabilisation-diagram status of every pole.
 //!
 //! The crate is independent of the other vibmode crates; it never panics on input data.
 //!

@@ -74,18 +74,7 @@ pub fn stabilisation(
 ) -> Result<Vec<Stability>, ModalError> {
     p.validate()?;
     for (index, pole) in poles.iter().enumerate() {
-        if !pole.frequency_hz.is_finite() {
-            return Err(ModalError::NonFiniteFrequency {
-                index,
-                value: pole.frequency_hz,
-            });
-        }
-        if !pole.damping_ratio.is_finite() {
-            return Err(ModalError::NonFiniteDamping {
-                index,
-                value: pole.damping_ratio,
-            });
-        }
+        crate::types::check_finite(pole, index)?;
     }
     let mut sweeps: HashMap<(usize, &str), BTreeMap<usize, Vec<usize>>> = HashMap::new();
     for (i, pole) in poles.iter().enumerate() {

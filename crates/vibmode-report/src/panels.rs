@@ -182,7 +182,7 @@ pub fn damping_panel(
         y_scale: Scale::Log,
         x_range: Some((0.0, fmax_hz)),
         // Damping ratios lie below 1; the decade above holds the legend.
-        y_range: Some((1e-4, 10.0)),
+        y_range: Some((1e-4, 30.0)),
         series,
         legend: true,
     }

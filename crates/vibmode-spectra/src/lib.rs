@@ -43,6 +43,8 @@
 //! # Ok::<(), vibmode_spectra::SpectraError>(())
 //! ```
 
+#![warn(missing_docs)]
+
 mod error;
 mod params;
 mod welch;
@@ -54,7 +56,15 @@ pub use params::{Average, Detrend, PeriodogramParams, Scaling, ShortRecord, Welc
 pub use welch::{Coherence, CrossSpectrum, Spectrum, WelchPlan};
 pub use window::window_values;
 
-use welch::{check_fs, check_samples};
+use welch::{check_fs, check_pair_samples, check_samples};
+
+/// Checks `fs_hz` and the pair `x`, `y` (non-empty, finite, one length) and plans Welch spectra
+/// of that length: the shared set-up of [`csd`] and [`coherence`].
+fn pair_plan(x: &[f64], y: &[f64], fs_hz: f64, p: &WelchParams) -> Result<WelchPlan, SpectraError> {
+    check_fs(fs_hz)?;
+    check_pair_samples(x, y)?;
+    WelchPlan::new(x.len(), fs_hz, p)
+}
 
 /// Periodogram of `x` sampled at `fs_hz` (Hz), as `scipy.signal.periodogram`: one segment
 /// of the whole record (window [`Window::Boxcar`] by default), no overlap.
@@ -111,23 +121,14 @@ pub fn welch(x: &[f64], fs_hz: f64, p: &WelchParams) -> Result<Spectrum, Spectra
 }
 
 /// Cross-spectral density `Pxy` (conj(X) Y, one-sided) of `x` and `y` sampled at `fs_hz`
-/// (Hz), as `scipy.signal.csd`. Errors as [`welch`], plus `x` and `y` of different lengths.
+/// (Hz), as `scipy.signal.csd`. Errors as [`welch()`], plus `x` and `y` of different lengths.
 pub fn csd(
     x: &[f64],
     y: &[f64],
     fs_hz: f64,
     p: &WelchParams,
 ) -> Result<CrossSpectrum, SpectraError> {
-    check_fs(fs_hz)?;
-    check_samples(x, "x")?;
-    check_samples(y, "y")?;
-    if x.len() != y.len() {
-        return Err(SpectraError::LengthMismatch {
-            len_x: x.len(),
-            len_y: y.len(),
-        });
-    }
-    WelchPlan::new(x.len(), fs_hz, p)?.csd(x, y)
+    pair_plan(x, y, fs_hz, p)?.csd(x, y)
 }
 
 /// Magnitude-squared coherence `|Pxy|^2 / (Pxx Pyy)` (dimensionless, in [0, 1]) of `x` and
@@ -140,14 +141,5 @@ pub fn coherence(
     fs_hz: f64,
     p: &WelchParams,
 ) -> Result<Coherence, SpectraError> {
-    check_fs(fs_hz)?;
-    check_samples(x, "x")?;
-    check_samples(y, "y")?;
-    if x.len() != y.len() {
-        return Err(SpectraError::LengthMismatch {
-            len_x: x.len(),
-            len_y: y.len(),
-        });
-    }
-    WelchPlan::new(x.len(), fs_hz, p)?.coherence(x, y)
+    pair_plan(x, y, fs_hz, p)?.coherence(x, y)
 }

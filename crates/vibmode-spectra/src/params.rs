@@ -5,6 +5,9 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
 
+/// Taper fraction of the window named plain `tukey`: scipy.signal.windows.tukey's default 0.5.
+const DEFAULT_TUKEY_ALPHA: f64 = 0.5;
+
 /// Taper applied to each segment. All windows are *periodic* (scipy
 /// `get_window(name, n)`, i.e. `fftbins=True`): the symmetric window of length n + 1
 /// with its last sample dropped.
@@ -71,7 +74,9 @@ impl FromStr for Window {
             "blackman" => Window::Blackman,
             "boxcar" | "rect" => Window::Boxcar,
             "flattop" => Window::Flattop,
-            "tukey" => Window::Tukey { alpha: 0.5 },
+            "tukey" => Window::Tukey {
+                alpha: DEFAULT_TUKEY_ALPHA,
+            },
             _ => {
                 let rest = t.strip_prefix("tukey:").ok_or_else(unknown)?;
                 let alpha: f64 = rest.trim().parse().map_err(|_| unknown())?;
@@ -219,7 +224,7 @@ impl FromStr for ShortRecord {
     }
 }
 
-/// Parameters of [`crate::welch`], [`crate::csd`], [`crate::coherence`] and
+/// Parameters of [`crate::welch()`], [`crate::csd`], [`crate::coherence`] and
 /// [`crate::WelchPlan`], with scipy.signal.welch's meaning and defaults.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct WelchParams {

@@ -69,6 +69,9 @@ pub struct Coherence {
     pub notes: Vec<String>,
 }
 
+/// Segment length when [`WelchParams::nperseg`] is `None`: scipy.signal.welch's default.
+const DEFAULT_NPERSEG: usize = 256;
+
 /// Checks that the sampling rate is positive and finite.
 pub(crate) fn check_fs(fs_hz: f64) -> Result<(), SpectraError> {
     if fs_hz.is_finite() && fs_hz > 0.0 {
@@ -91,6 +94,19 @@ pub(crate) fn check_samples(x: &[f64], name: &'static str) -> Result<(), Spectra
         }),
         None => Ok(()),
     }
+}
+
+/// Checks a pair of inputs: each non-empty and finite, and of one length.
+pub(crate) fn check_pair_samples(x: &[f64], y: &[f64]) -> Result<(), SpectraError> {
+    check_samples(x, "x")?;
+    check_samples(y, "y")?;
+    if x.len() != y.len() {
+        return Err(SpectraError::LengthMismatch {
+            len_x: x.len(),
+            len_y: y.len(),
+        });
+    }
+    Ok(())
 }
 
 /// scipy's bias of the median of `k` periodograms relative to their mean.
@@ -189,7 +205,7 @@ impl WelchPlan {
         if n_samples == 0 {
             return Err(SpectraError::EmptyInput { name: "x" });
         }
-        let requested = p.nperseg.unwrap_or(256);
+        let requested = p.nperseg.unwrap_or(DEFAULT_NPERSEG);
         if requested == 0 {
             return Err(SpectraError::ZeroNperseg);
         }
@@ -335,13 +351,7 @@ impl WelchPlan {
     pub fn welch(&mut self, x: &[f64]) -> Result<Spectrum, SpectraError> {
         self.check_input(x, "x")?;
         let k = self.n_segments;
-        let nfreq = self.freq_hz.len();
-        let median = self.average == Average::Median && k > 1;
-        if median {
-            self.store_re.resize(nfreq * k, 0.0);
-        } else {
-            self.acc_xx.fill(0.0);
-        }
+        let median = self.begin_average(false);
         for s in 0..k {
             self.transform_segment(x, s, false);
             if median {
@@ -381,14 +391,7 @@ impl WelchPlan {
     pub fn csd(&mut self, x: &[f64], y: &[f64]) -> Result<CrossSpectrum, SpectraError> {
         self.check_pair(x, y)?;
         let k = self.n_segments;
-        let nfreq = self.freq_hz.len();
-        let median = self.average == Average::Median && k > 1;
-        if median {
-            self.store_re.resize(nfreq * k, 0.0);
-            self.store_im.resize(nfreq * k, 0.0);
-        } else {
-            self.acc_xy.fill(Complex64::new(0.0, 0.0));
-        }
+        let median = self.begin_average(true);
         for s in 0..k {
             self.transform_segment(x, s, false);
             self.transform_segment(y, s, true);
@@ -491,16 +494,29 @@ impl WelchPlan {
     }
 
     fn check_pair(&self, x: &[f64], y: &[f64]) -> Result<(), SpectraError> {
-        check_samples(x, "x")?;
-        check_samples(y, "y")?;
-        if x.len() != y.len() {
-            return Err(SpectraError::LengthMismatch {
-                len_x: x.len(),
-                len_y: y.len(),
-            });
-        }
+        check_pair_samples(x, y)?;
         self.check_input(x, "x")?;
         self.check_input(y, "y")
+    }
+
+    /// Prepares the buffers of a [`WelchPlan::welch`] (`cross` false: `acc_xx`, `store_re`) or
+    /// [`WelchPlan::csd`] (`cross` true: `acc_xy`, `store_re`, `store_im`) average. Returns whether
+    /// the median is taken (per-segment values stored) rather than the mean (accumulated).
+    fn begin_average(&mut self, cross: bool) -> bool {
+        let k = self.n_segments;
+        let nfreq = self.freq_hz.len();
+        let median = self.average == Average::Median && k > 1;
+        if median {
+            self.store_re.resize(nfreq * k, 0.0);
+            if cross {
+                self.store_im.resize(nfreq * k, 0.0);
+            }
+        } else if cross {
+            self.acc_xy.fill(Complex64::new(0.0, 0.0));
+        } else {
+            self.acc_xx.fill(0.0);
+        }
+        median
     }
 
     /// Detrends, windows, zero-pads and transforms segment `s` of `x` into `spec_x`

@@ -3,9 +3,14 @@
 use crate::Window;
 use std::f64::consts::PI;
 
+/// Cosine-sum coefficients `a_k` of `w = sum_k (-1)^k a_k cos(2 pi k j / n)`, as scipy.signal.windows
+/// defines them. Hann.
 const HANN: [f64; 2] = [0.5, 0.5];
+/// Hamming (0.54, 0.46: the classic rounded values, as scipy).
 const HAMMING: [f64; 2] = [0.54, 0.46];
+/// Blackman (0.42, 0.5, 0.08: the classic rounded values, as scipy).
 const BLACKMAN: [f64; 3] = [0.42, 0.50, 0.08];
+/// Flat top (scipy's coefficients).
 const FLATTOP: [f64; 5] = [
     0.21557895,
     0.41663158,
