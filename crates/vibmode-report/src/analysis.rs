@@ -337,12 +337,12 @@ impl FigureWriter<'_> {
         fig: &Figure,
         caption: &str,
     ) -> Result<(), ReportError> {
+        let n = self.html.figure_count() + 1;
         for ext in ["svg", "png"] {
-            let path = self.dir.join(format!("{file}.{ext}"));
+            let path = self.dir.join(format!("fig{n:02}_{file}.{ext}"));
             fig.save(&path)?;
             self.files.push(path);
         }
-        let n = self.html.figure_count() + 1;
         self.html.heading(2, &format!("Figure {n}: {title}"));
         self.html.figure(fig, caption)
     }
