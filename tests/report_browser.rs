@@ -72,12 +72,21 @@ fn demo_report_renders_in_headless_chromium() {
     // One numbering: the heading "Figure n: ..." and the caption "Figure n." agree.
     for n in 1..=expected.len() {
         assert!(html.contains(&format!("<h2>Figure {n}: ")), "heading {n}");
-        assert!(html.contains(&format!("<figcaption>Figure {n}. ")), "caption {n}");
+        assert!(
+            html.contains(&format!("<figcaption>Figure {n}. ")),
+            "caption {n}"
+        );
     }
     // The intro states the records actually simulated; the inputs are listed; modes.csv exists.
     assert!(html.contains("Demo: 3 simulated record(s)"), "intro");
-    assert!(html.contains("<h2>Inputs</h2>") && html.contains("m/s^2"), "inputs table");
-    assert!(!html.contains("(unit)") && !html.contains(" at none"), "placeholders");
+    assert!(
+        html.contains("<h2>Inputs</h2>") && html.contains("m/s^2"),
+        "inputs table"
+    );
+    assert!(
+        !html.contains("(unit)") && !html.contains(" at none"),
+        "placeholders"
+    );
     let csv = std::fs::read_to_string(out.join("modes.csv")).expect("modes.csv");
     assert!(csv.starts_with("pool,channels,frequency_hz,"), "{csv}");
     assert!(csv.lines().count() > 2, "{csv}");

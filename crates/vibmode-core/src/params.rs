@@ -207,7 +207,7 @@ impl FromStr for Robust {
             "off" | "none" | "quadratic" => Ok(Robust::Off),
             "huber" | "on" => Ok(Robust::default()),
             _ => match t.parse::<f64>() {
-                Ok(f) if f == 0.0 => Ok(Robust::Off),
+                Ok(0.0) => Ok(Robust::Off),
                 Ok(f) if f.is_finite() && f > 0.0 => Ok(Robust::Huber { factor: f }),
                 _ => Err(bad(
                     "robust",

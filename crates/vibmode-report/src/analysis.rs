@@ -91,7 +91,7 @@ fn candidates_text(r: &AnalysisResults, modes: &[InvariantMode], indent: &str) -
         .iter()
         .filter(|m| m.class == ModeClass::Spurious)
         .collect();
-    cands.sort_by(|a, b| b.n_poles.cmp(&a.n_poles));
+    cands.sort_by_key(|m| std::cmp::Reverse(m.n_poles));
     if cands.is_empty() {
         return format!(
             "{indent}no cluster of poles at all: every pole was isolated or outside the band\n"
@@ -371,9 +371,9 @@ fn time_records_figure(name: &str, rec: &Recording) -> Figure {
             let x: Vec<f64> = (0..n).step_by(step).map(|i| i as f64 / rec.fs_hz).collect();
             let y: Vec<f64> = ch.samples.iter().step_by(step).copied().collect();
             Panel::new(
-                &format!("{name}: {}", ch.name),
+                format!("{name}: {}", ch.name),
                 "Time [s]",
-                &format!("Acceleration [{}]", unit_label(&ch.unit)),
+                format!("Acceleration [{}]", unit_label(&ch.unit)),
             )
             .with_series(line(&ch.name, x, y, 1, 1.0))
             .without_legend()
@@ -394,9 +394,9 @@ fn spectra_figures(
         let (wx, wy) = positive_freq(&sp.welch_freq_hz, &sp.welch_psd);
         p5.push(
             Panel::new(
-                &format!("{} ({})", ch.name, ch.role),
+                format!("{} ({})", ch.name, ch.role),
                 "Frequency [Hz]",
-                &psd_label(&ch.unit),
+                psd_label(&ch.unit),
             )
             .with_scales(Scale::Linear, Scale::Log)
             .with_x_range(0.0, fmax)
@@ -404,9 +404,9 @@ fn spectra_figures(
             .with_series(line("Welch", wx.clone(), wy.clone(), 2, 1.0)),
         );
         let mut panel = Panel::new(
-            &format!("{}: model PSD over Welch", ch.name),
+            format!("{}: model PSD over Welch", ch.name),
             "Frequency [Hz]",
-            &psd_label(&ch.unit),
+            psd_label(&ch.unit),
         )
         .with_scales(Scale::Linear, Scale::Log)
         .with_x_range(0.0, fmax)

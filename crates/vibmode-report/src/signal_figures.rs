@@ -83,7 +83,7 @@ pub fn antialias_figure(
     Ok(Figure {
         title: Some(format!("Anti-aliasing and resampling: {ch_name}")),
         panels: vec![
-            Panel::new("Time domain", "Time [s]", &format!("Acceleration [{u}]"))
+            Panel::new("Time domain", "Time [s]", format!("Acceleration [{u}]"))
                 .with_x_range(0.0, t_end)
                 .with_series(time_series(&first, &raw_label, 1))
                 .with_series(time_series(&plain, &plain_label, 2))
@@ -91,7 +91,7 @@ pub fn antialias_figure(
             Panel::new(
                 "Periodogram (Hann), 0 to the new Nyquist frequency",
                 "Frequency [Hz]",
-                &format!("PSD [({u})^2/Hz]"),
+                format!("PSD [({u})^2/Hz]"),
             )
             .with_scales(Scale::Linear, Scale::Log)
             .with_x_range(0.0, to_hz / 2.0)

@@ -118,8 +118,16 @@ fn table_rendering() {
     assert_eq!(html.matches("<th>").count(), 3);
     assert_eq!(html.matches("<tr>").count(), 3, "header row + 2 rows");
     // Text left-aligned (plain <td>), numbers right-aligned (class "num"); short rows padded.
-    assert_eq!(html.matches("<td>").count(), 3, "two text cells and one padding cell");
-    assert_eq!(html.matches("<td class=\"num\">").count(), 3, "three numbers");
+    assert_eq!(
+        html.matches("<td>").count(),
+        3,
+        "two text cells and one padding cell"
+    );
+    assert_eq!(
+        html.matches("<td class=\"num\">").count(),
+        3,
+        "three numbers"
+    );
     assert!(html.contains("<tr><td>wheel hop</td><td class=\"num\">9.00</td><td></td></tr>"));
     assert!(html.contains("td.num{text-align:right"));
     assert!(html.contains("<th>Frequency [Hz]</th>"));
