@@ -181,7 +181,7 @@ struct PsdOutput {
 }
 
 fn psd_unit(unit: &str, scaling: Scaling) -> String {
-    let u = if unit.is_empty() { "unit" } else { unit };
+    let u = if unit.is_empty() { "input units" } else { unit };
     match scaling {
         Scaling::Density => format!("({u})^2/Hz"),
         Scaling::Spectrum => format!("({u})^2"),
@@ -307,31 +307,26 @@ fn print_summary(o: &PsdOutput) {
         }
     );
     println!(
-        "{:<24} {:>14} {:>16} {:>12}",
-        "channel", "peak_hz", "peak_psd", "rms"
+        "{:<24} {:>14} {:>16} {:>12}  unit of peak / unit of rms",
+        "channel", "peak_hz", "peak", "rms"
     );
     for c in &o.channels {
-        let (mut ip, mut vp) = (0usize, f64::NEG_INFINITY);
-        for (i, &v) in c.psd.iter().enumerate().skip(1) {
-            if v > vp {
-                vp = v;
-                ip = i;
-            }
-        }
-        let df = if c.frequency_hz.len() > 1 {
-            c.frequency_hz[1] - c.frequency_hz[0]
+        let (fpk, vp) =
+            vibmode_spectra::peak(&c.frequency_hz, &c.psd).unwrap_or((f64::NAN, f64::NAN));
+        let scaling = if p.scaling == "density" {
+            Scaling::Density
         } else {
-            0.0
+            Scaling::Spectrum
         };
-        let rms = if p.scaling == "density" {
-            (c.psd.iter().sum::<f64>() * df).sqrt()
+        let rms = vibmode_spectra::rms(&c.frequency_hz, &c.psd, scaling);
+        let unit = if c.unit.is_empty() {
+            "input units"
         } else {
-            c.psd.iter().sum::<f64>().sqrt()
+            c.unit.as_str()
         };
-        let fpk = c.frequency_hz.get(ip).copied().unwrap_or(f64::NAN);
         println!(
-            "{:<24} {:>14.4} {:>16.6e} {:>12.5e}  {}",
-            c.name, fpk, vp, rms, c.psd_unit
+            "{:<24} {:>14.4} {:>16.6e} {:>12.5e}  {} / {}",
+            c.name, fpk, vp, rms, c.psd_unit, unit
         );
     }
 }

@@ -3,21 +3,7 @@
 
 use vibmode_core::StopParams;
 
-/// RMS in `[f_lo, f_hi]` Hz from a one-sided PSD (unit^2/Hz) on a uniform grid: the square root
-/// of the sum of the bins in the band times the bin width. NaN for an empty grid.
-pub fn band_rms(freq_hz: &[f64], psd: &[f64], f_lo: f64, f_hi: f64) -> f64 {
-    if freq_hz.len() < 2 {
-        return f64::NAN;
-    }
-    let df = freq_hz[1] - freq_hz[0];
-    let power: f64 = freq_hz
-        .iter()
-        .zip(psd)
-        .filter(|(f, _)| **f >= f_lo && **f <= f_hi)
-        .map(|(_, p)| p * df)
-        .sum();
-    power.max(0.0).sqrt()
-}
+pub use vibmode_spectra::band_rms;
 
 /// Per record: the median over channels of (activity / that channel's median over records).
 /// A channel whose median is zero or not finite gives no information and is skipped; a record

@@ -46,11 +46,13 @@
 #![warn(missing_docs)]
 
 mod error;
+mod integrate;
 mod params;
 mod welch;
 mod window;
 
 pub use error::SpectraError;
+pub use integrate::{band_rms, peak, rms};
 pub use num_complex::Complex64;
 pub use params::{Average, Detrend, PeriodogramParams, Scaling, ShortRecord, WelchParams, Window};
 pub use welch::{Coherence, CrossSpectrum, Spectrum, WelchPlan};

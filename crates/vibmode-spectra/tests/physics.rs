@@ -333,3 +333,38 @@ fn coherence_ignores_median_like_scipy() {
     let avg = mean.coherence.iter().sum::<f64>() / mean.coherence.len() as f64;
     assert!((avg - 0.5).abs() < 0.1, "{avg}");
 }
+
+/// Parseval through `rms`: the boxcar periodogram (density, mean removed) of any signal
+/// integrates to its variance, over many seeds, odd and even lengths and rates.
+#[test]
+fn rms_of_the_periodogram_is_the_standard_deviation() {
+    use rand::{Rng, SeedableRng};
+    for seed in 0..20u64 {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let n = 64 + (seed as usize * 37) % 500;
+        let fs = 10.0 + seed as f64 * 7.5;
+        let x: Vec<f64> = (0..n).map(|_| rng.gen_range(-3.0..3.0) + 1.5).collect();
+        let mean = x.iter().sum::<f64>() / n as f64;
+        let std = (x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64).sqrt();
+        let p = vibmode_spectra::periodogram(
+            &x,
+            fs,
+            &vibmode_spectra::PeriodogramParams {
+                window: vibmode_spectra::Window::Boxcar,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let r = vibmode_spectra::rms(&p.freq_hz, &p.psd, vibmode_spectra::Scaling::Density);
+        assert!(
+            (r / std - 1.0).abs() < 1e-12,
+            "seed {seed}, n {n}: {r} vs {std}"
+        );
+        // Every bin (the last one, fs/2, may round a hair above fs / 2).
+        let b = vibmode_spectra::band_rms(&p.freq_hz, &p.psd, 0.0, fs);
+        assert!(
+            (b / std - 1.0).abs() < 1e-12,
+            "seed {seed}: band {b} vs {std}"
+        );
+    }
+}
