@@ -102,7 +102,7 @@ pub fn run(a: &AnalyzeArgs) -> Result<()> {
     };
     let results = run_analysis(&records, &cfg, &reference, a.quiet)?;
     write_report(&a.output, &records, &results, None)?;
-    print_modes(&results, None);
+    print_modes(&results, None)?;
     eprintln!("report: {}", a.output.join("index.html").display());
     Ok(())
 }
@@ -160,8 +160,8 @@ pub fn run_analysis(
 }
 
 /// Prints the invariant-mode table per role; with `truth`, the true modes beside it.
-pub fn print_modes(r: &AnalysisResults, truth: Option<&[TruthRow]>) {
-    print!("{}", vibmode_report::modes_table_text(r, truth));
+pub fn print_modes(r: &AnalysisResults, truth: Option<&[TruthRow]>) -> Result<()> {
+    crate::output::print_stdout(&vibmode_report::modes_table_text(r, truth))
 }
 
 /// Writes `DIR/index.html`, `DIR/results.json`, `DIR/modes.csv` and `DIR/figures/*`.
@@ -260,7 +260,7 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
         truth.push(("engine/gear line".into(), *f, 0.0));
     }
     truth.sort_by(|x, y| x.1.total_cmp(&y.1));
-    print_modes(&results, Some(&truth));
+    print_modes(&results, Some(&truth))?;
     eprintln!("report: {}", a.output.join("index.html").display());
     Ok(())
 }

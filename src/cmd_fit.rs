@@ -250,7 +250,7 @@ pub fn run(a: &FitArgs) -> Result<()> {
     }
     match &a.json {
         Some(dest) => write_json(dest, &out)?,
-        None => print!("{}", table_text(&out, mark_damping_max(a))),
+        None => crate::output::print_stdout(&table_text(&out, mark_damping_max(a)))?,
     }
     Ok(())
 }

@@ -287,12 +287,14 @@ pub fn run(a: &PsdArgs) -> Result<()> {
     }
     match &a.json {
         Some(dest) => write_json(dest, &output)?,
-        None => print_summary(&output),
+        None => print_summary(&output)?,
     }
     Ok(())
 }
 
-fn print_summary(o: &PsdOutput) {
+fn print_summary(o: &PsdOutput) -> Result<()> {
+    use std::fmt::Write as _;
+    let mut text = String::new();
     let p = &o.parameters;
     eprintln!(
         "{}: fs = {} Hz, {} samples, window {}, nfft {}{}",
@@ -306,7 +308,8 @@ fn print_summary(o: &PsdOutput) {
             _ => String::new(),
         }
     );
-    println!(
+    let _ = writeln!(
+        text,
         "{:<24} {:>14} {:>16} {:>12}  unit of peak / unit of rms",
         "channel", "peak_hz", "peak", "rms"
     );
@@ -324,11 +327,13 @@ fn print_summary(o: &PsdOutput) {
         } else {
             c.unit.as_str()
         };
-        println!(
+        let _ = writeln!(
+            text,
             "{:<24} {:>14.4} {:>16.6e} {:>12.5e}  {} / {}",
             c.name, fpk, vp, rms, c.psd_unit, unit
         );
     }
+    crate::output::print_stdout(&text)
 }
 
 fn write_csv(path: &std::path::Path, o: &PsdOutput) -> Result<()> {

@@ -274,9 +274,10 @@ pub fn run(a: &SweepArgs) -> Result<()> {
     match &a.json {
         Some(dest) => write_json(dest, &out)?,
         None => {
+            let mut text = String::new();
             for c in &out.channels {
                 let nc = c.converged.iter().filter(|x| !**x).count();
-                println!(
+                text += &format!(
                     "{}: {} orders, {} pole pairs ({} more left out by the pole filters: cancelled by a zero of C or above the valid band), {} fits not converged, {} failed",
                     c.name,
                     c.orders.len(),
@@ -285,7 +286,9 @@ pub fn run(a: &SweepArgs) -> Result<()> {
                     nc,
                     c.errors.iter().filter(|e| e.is_some()).count()
                 );
+                text.push('\n');
             }
+            crate::output::print_stdout(&text)?;
         }
     }
     Ok(())

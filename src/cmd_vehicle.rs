@@ -35,17 +35,17 @@ pub fn run_fullcar(a: &FullcarArgs) -> Result<()> {
     match &a.json {
         Some(dest) => write_json(dest, &out)?,
         None => {
-            println!("Modes of {}:", out.source);
-            println!(
-                "  {:>10} {:>14} {:>12}  label",
-                "freq_hz", "damping_ratio", "damped_hz"
+            let mut text = format!(
+                "Modes of {}:\n  {:>10} {:>14} {:>12}  label\n",
+                out.source, "freq_hz", "damping_ratio", "damped_hz"
             );
             for m in &out.modes {
-                println!(
-                    "  {:>10.3} {:>14.4} {:>12.3}  {}",
+                text += &format!(
+                    "  {:>10.3} {:>14.4} {:>12.3}  {}\n",
                     m.frequency_hz, m.damping_ratio, m.damped_frequency_hz, m.label
                 );
             }
+            crate::output::print_stdout(&text)?;
         }
     }
     Ok(())

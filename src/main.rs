@@ -28,20 +28,28 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Power spectral density (Welch and/or periodogram) of one or more channels.
+    #[command(allow_negative_numbers = true)]
     Psd(cmd_psd::PsdArgs),
     /// Ideal DFT anti-alias filter and resampling to a new rate.
+    #[command(allow_negative_numbers = true)]
     Resample(cmd_resample::ResampleArgs),
     /// Fit an AR or ARMA model to each channel and report its modes.
+    #[command(allow_negative_numbers = true)]
     Fit(cmd_fit::FitArgs),
     /// Fit every model order and collect every mode (stabilisation diagram).
+    #[command(allow_negative_numbers = true)]
     Sweep(cmd_sweep::SweepArgs),
     /// The paper's whole analysis over many records, with an HTML report.
+    #[command(allow_negative_numbers = true)]
     Analyze(cmd_analyze::AnalyzeArgs),
     /// Simulate a city bus and run the whole analysis, writing a report.
+    #[command(allow_negative_numbers = true)]
     Demo(cmd_analyze::DemoArgs),
     /// Modes of a 7-DOF full-car model given by a TOML parameter file.
+    #[command(allow_negative_numbers = true)]
     Fullcar(cmd_vehicle::FullcarArgs),
     /// Simulate in-service acceleration records of a vehicle on an ISO 8608 road.
+    #[command(allow_negative_numbers = true)]
     Simulate(cmd_vehicle::SimulateArgs),
 }
 

@@ -5,13 +5,21 @@ use serde::Serialize;
 use std::io::Write;
 use std::path::Path;
 
+/// Writes `text` to standard output. A closed pipe (`vibmode ... | head`) is not an error: the
+/// reader has what it wanted, so the rest is dropped quietly.
+pub fn print_stdout(text: &str) -> Result<()> {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+        _ => Ok(()),
+    }
+}
+
 /// Writes `value` as pretty JSON to `dest`, where `-` means standard output.
 pub fn write_json<T: Serialize>(dest: &str, value: &T) -> Result<()> {
     let text = serde_json::to_string_pretty(value).context("serialising results to JSON")?;
     if dest == "-" {
-        let mut out = std::io::stdout().lock();
-        out.write_all(text.as_bytes())?;
-        out.write_all(b"\n")?;
+        print_stdout(&(text + "\n"))?;
     } else {
         std::fs::write(dest, text + "\n")
             .with_context(|| format!("cannot write JSON to {dest}"))?;

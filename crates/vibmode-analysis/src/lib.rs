@@ -46,6 +46,21 @@ pub use vibmode_core::{
     PreprocessParams, Robust, Role, SpectrumParams, StopParams, SweepModel, SweepParams,
 };
 
+/// A number for a message: at most 9 significant digits, no trailing zeros (100.00000000000001
+/// -> "100").
+fn short(x: f64) -> String {
+    if !x.is_finite() || x == 0.0 {
+        return x.to_string();
+    }
+    let digits = (8 - x.abs().log10().floor() as i32).clamp(0, 17) as usize;
+    let s = format!("{x:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
 /// Errors of the analysis; each message is one line naming the value and the fix, never a
 /// command-line flag.
 #[derive(Debug, thiserror::Error)]
@@ -86,7 +101,7 @@ pub enum AnalysisError {
         first_channels: String,
     },
     /// Records at different sampling rates.
-    #[error("record '{record}' is sampled at {fs_hz} Hz but '{first}' at {first_fs_hz} Hz; resample them to one rate first")]
+    #[error("record '{record}' is sampled at {} Hz but '{first}' at {} Hz; resample them to one rate first", short(*fs_hz), short(*first_fs_hz))]
     RatesDiffer {
         /// The record at fault.
         record: String,
@@ -98,7 +113,7 @@ pub enum AnalysisError {
         first_fs_hz: f64,
     },
     /// A record too short for the analysis at the analysis rate.
-    #[error("record '{record}' has {n_samples} samples at the analysis rate {fs_hz} Hz ({duration_s:.3} s); the lowest model order p = {order_min} needs at least {needed} samples ({needed_s:.3} s): give a longer record")]
+    #[error("record '{record}' has {n_samples} samples at the analysis rate {} Hz ({duration_s:.3} s); the lowest model order p = {order_min} needs at least {needed} samples ({needed_s:.3} s): give a longer record", short(*fs_hz))]
     RecordTooShort {
         /// The record.
         record: String,

@@ -1,0 +1,196 @@
+//! `vibmode analyze`, `vibmode sweep` and a closed output pipe, as a user meets them: exit codes,
+//! the files written, one-line errors.
+
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::process::{Command, Output, Stdio};
+
+fn vibmode(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_vibmode"))
+        .args(args)
+        .output()
+        .expect("run vibmode")
+}
+
+/// Exit code 2, one line on stderr holding every needle, no panic.
+fn fails_with(args: &[&str], needles: &[&str]) {
+    let o = vibmode(args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "args {args:?}: stderr {err}");
+    assert!(!err.contains("panicked"), "panic: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
+    for n in needles {
+        assert!(err.contains(n), "'{n}' not in: {err}");
+    }
+}
+
+/// A lightly damped 1.5 Hz resonance (zeta 0.05) driven by seeded white noise, sampled at
+/// `fs` Hz: an AR(2) filter, plus 5 % measurement noise. Columns `time_s` and `z` (m/s^2).
+fn write_resonance(path: &Path, seconds: f64, fs: f64, seed: u64) {
+    let n = (seconds * fs) as usize;
+    let (f0, zeta) = (1.5, 0.05);
+    let r = (-zeta * 2.0 * std::f64::consts::PI * f0 / fs).exp();
+    let th = 2.0 * std::f64::consts::PI * f0 * (1.0 - zeta * zeta).sqrt() / fs;
+    let (a1, a2) = (2.0 * r * th.cos(), -r * r);
+    let mut state = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    let mut noise = || {
+        // Sum of 4 uniforms: close enough to Gaussian for a driving noise.
+        (0..4)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            })
+            .sum::<f64>()
+    };
+    let (mut y1, mut y2) = (0.0, 0.0);
+    let mut s = String::from("time_s,z [m/s^2]\n");
+    for i in 0..n {
+        let y = a1 * y1 + a2 * y2 + noise();
+        y2 = y1;
+        y1 = y;
+        s.push_str(&format!("{},{}\n", i as f64 / fs, y + 0.05 * noise()));
+    }
+    std::fs::write(path, s).expect("write csv");
+}
+
+#[test]
+fn analyze_writes_the_report_and_finds_the_resonance() {
+    let d = tempfile::tempdir().unwrap();
+    let a = d.path().join("a.csv");
+    let b = d.path().join("b.csv");
+    write_resonance(&a, 60.0, 50.0, 1);
+    write_resonance(&b, 60.0, 50.0, 2);
+    let out = d.path().join("report");
+    let cfg = d.path().join("quick.toml");
+    std::fs::write(&cfg, "[sweep]\norder_max = 10\n").unwrap();
+    let o = vibmode(&[
+        "analyze",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--config",
+        cfg.to_str().unwrap(),
+        "-q",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in [
+        "index.html",
+        "results.json",
+        "modes.csv",
+        "figures/fig01_time_records.svg",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    // 2 x 60 s files -> 2 x 5 records of 10.24 s; the resonance is a structural mode.
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    assert_eq!(v["schema_version"], 2);
+    assert_eq!(v["records"].as_array().map(Vec::len), Some(10));
+    let csv = std::fs::read_to_string(out.join("modes.csv")).unwrap();
+    let found = csv.lines().skip(1).any(|l| {
+        let c: Vec<&str> = l.split(',').collect();
+        c[10] == "structural" && c[2].parse::<f64>().is_ok_and(|f| (f - 1.5).abs() < 0.1)
+    });
+    assert!(found, "no 1.5 Hz structural mode in\n{csv}\n{stdout}");
+}
+
+#[test]
+fn analyze_and_sweep_errors_are_one_line_with_exit_code_2() {
+    let d = tempfile::tempdir().unwrap();
+    let a = d.path().join("a.csv");
+    write_resonance(&a, 20.0, 50.0, 3);
+    let b = d.path().join("b.csv");
+    write_resonance(&b, 20.0, 100.0, 4);
+    let out = d.path().join("r");
+    let (a, b, out) = (
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        out.to_str().unwrap(),
+    );
+    fails_with(&["analyze", "/no/such.csv", "-o", out], &["/no/such.csv"]);
+    fails_with(
+        &["analyze", a, "--channel", "q", "-o", out],
+        &["'q'", "--channel"],
+    );
+    fails_with(
+        &["analyze", a, "--preset", "nope", "-o", out],
+        &["nope", "vibmode, paper"],
+    );
+    let cfg = d.path().join("bad.toml");
+    std::fs::write(&cfg, "[sweep]\nordermax = 3\n").unwrap();
+    fails_with(
+        &["analyze", a, "--config", cfg.to_str().unwrap(), "-o", out],
+        &["ordermax"],
+    );
+    fails_with(&["analyze", a, b, "-o", out], &["100 Hz", "50 Hz"]);
+    assert!(
+        !Path::new(out).join("index.html").exists(),
+        "nothing written on error"
+    );
+    fails_with(&["sweep", a, "--orders", "5:2"], &["--orders", "5:2"]);
+    fails_with(&["sweep", a, "--orders", "x"], &["--orders"]);
+    fails_with(&["sweep", a, "--robust", "-2"], &["robust", "-2"]);
+}
+
+#[test]
+fn sweep_json_lists_every_order_and_the_filtered_poles() {
+    let d = tempfile::tempdir().unwrap();
+    let a = d.path().join("a.csv");
+    write_resonance(&a, 20.0, 50.0, 5);
+    let o = vibmode(&[
+        "sweep",
+        a.to_str().unwrap(),
+        "--orders",
+        "2:8",
+        "--json",
+        "-",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let ch = &v["channels"][0];
+    assert_eq!(ch["orders"].as_array().map(Vec::len), Some(7));
+    assert!(ch["filtered_out"].is_array());
+    let near = ch["modes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|m| (m["frequency_hz"].as_f64().unwrap() - 1.5).abs() < 0.1)
+        .count();
+    assert!(near >= 5, "the 1.5 Hz resonance at most orders: {near}");
+}
+
+#[test]
+fn a_closed_pipe_ends_quietly() {
+    let d = tempfile::tempdir().unwrap();
+    let a = d.path().join("a.csv");
+    write_resonance(&a, 60.0, 50.0, 6);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_vibmode"))
+        .args([
+            "psd",
+            a.to_str().unwrap(),
+            "--method",
+            "periodogram",
+            "--json",
+            "-",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    let mut first = String::new();
+    {
+        let stdout = child.stdout.take().expect("stdout");
+        BufReader::new(stdout).read_line(&mut first).expect("read");
+    } // the reader closes the pipe, as `| head -1` does
+    let o = child.wait_with_output().expect("wait");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(first.trim(), "{");
+    assert!(o.status.success(), "exit {:?}: {err}", o.status);
+    assert!(!err.contains("error") && !err.contains("panicked"), "{err}");
+}
