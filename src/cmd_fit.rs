@@ -9,7 +9,7 @@ use serde::Serialize;
 use std::path::PathBuf;
 use vibmode_core::{BandLimit, ClusterParams, PoleFilterParams};
 use vibmode_ident::{ArMethod, ArmaModel, ArmaParams, PoleRejection, Robust};
-use vibmode_report::{Figure, Panel, Scale, Series, SeriesStyle};
+use vibmode_report::{Curve, Figure, ModelSpectrumPanel};
 
 /// Model structure.
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -340,89 +340,43 @@ fn fit_figure(
     let wp = a.spectral.welch_params()?;
     let pp = a.spectral.periodogram_params()?;
     let zmax = mark_damping_max(a);
+    let nyquist = rec.fs_hz / 2.0;
+    let grid: Vec<f64> = (1..=MODEL_GRID_POINTS)
+        .map(|i| i as f64 * nyquist / MODEL_GRID_POINTS as f64)
+        .collect();
     let mut panels = Vec::new();
     for ((ch, m), f) in rec.channels.iter().zip(models).zip(fits) {
         let per = vibmode_spectra::periodogram(&ch.samples, rec.fs_hz, &pp)?;
         let wel = vibmode_spectra::welch(&ch.samples, rec.fs_hz, &wp)?;
-        let grid: Vec<f64> = (1..=1000)
-            .map(|i| i as f64 * rec.fs_hz / 2.0 / 1000.0)
-            .collect();
-        let mpsd = m.model_psd(&grid, rec.fs_hz);
-        let marks: Vec<f64> = f
-            .modes
-            .iter()
-            .filter(|md| md.filtered_out.is_none() && md.damping_ratio < zmax)
-            .map(|md| md.frequency_hz)
-            .collect();
-        let line = |label: &str, x: Vec<f64>, y: Vec<f64>, width: u32, alpha: f64| Series {
-            label: Some(label.to_string()),
-            x,
-            y,
-            style: SeriesStyle::Line {
-                width,
-                dashed: false,
-            },
-            color: None,
-            alpha,
+        let structure = match f.model {
+            ModelKind::Ar => format!("AR({})", f.p),
+            ModelKind::Arma => format!("ARMA({},{})", f.p, f.q),
         };
-        let u = if ch.unit.is_empty() {
-            "unit".to_string()
+        let unit = if ch.unit.is_empty() {
+            "input units"
         } else {
-            ch.unit.clone()
+            ch.unit.as_str()
         };
-        panels.push(Panel {
-            title: format!(
-                "{}: {}({}{})",
-                ch.name,
-                if f.model == ModelKind::Ar {
-                    "AR"
-                } else {
-                    "ARMA"
-                },
-                f.p,
-                if f.model == ModelKind::Arma {
-                    format!(",{}", f.q)
-                } else {
-                    String::new()
-                }
-            ),
-            x_label: "Frequency [Hz]".into(),
-            y_label: format!("PSD [({u})^2/Hz]"),
-            x_scale: Scale::Linear,
-            y_scale: Scale::Log,
-            x_range: Some((0.0, rec.fs_hz / 2.0)),
-            y_range: None,
-            series: vec![
-                {
-                    let (x, y) = vibmode_report::panels::positive_freq(&per.freq_hz, &per.psd);
-                    line("periodogram", x, y, 1, 0.4)
-                },
-                {
-                    let (x, y) = vibmode_report::panels::positive_freq(&wel.freq_hz, &wel.psd);
-                    line("Welch", x, y, 2, 1.0)
-                },
-                line("model", grid, mpsd, 2, 1.0),
-                Series {
-                    label: Some(format!("modes, damping < {zmax}")),
-                    x: marks,
-                    y: vec![],
-                    style: SeriesStyle::VLines { dotted: true },
-                    color: None,
-                    alpha: 0.8,
-                },
-            ],
-            legend: true,
+        panels.push(ModelSpectrumPanel {
+            title: format!("{}: {structure}", ch.name),
+            psd_unit: format!("({unit})^2/Hz"),
+            periodogram: Curve::new("periodogram", per.freq_hz, per.psd),
+            welch: Curve::new("Welch", wel.freq_hz, wel.psd),
+            model: Curve::new("model", grid.clone(), m.model_psd(&grid, rec.fs_hz)),
+            marks_hz: f
+                .modes
+                .iter()
+                .filter(|md| md.filtered_out.is_none() && md.damping_ratio < zmax)
+                .map(|md| md.frequency_hz)
+                .collect(),
+            marks_label: format!("modes, damping < {zmax}"),
         });
     }
-    let n = panels.len();
-    Ok(Figure {
-        title: None,
-        panels,
-        columns: 1,
-        width_px: 1000,
-        height_px: (500 * n.max(1)) as u32,
-    })
+    Ok(vibmode_report::model_spectra_figure(&panels, nyquist))
 }
+
+/// Points of the model-PSD grid of `fit --plot`, 0 to Nyquist.
+const MODEL_GRID_POINTS: usize = 1000;
 
 #[cfg(test)]
 mod tests {

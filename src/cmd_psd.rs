@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 use std::path::PathBuf;
-use vibmode_report::{Figure, Panel, Scale, Series, SeriesStyle};
+use vibmode_report::{Curve, Figure, Scale};
 use vibmode_signal::Recording;
 use vibmode_spectra::{
     Average, Detrend, PeriodogramParams, Scaling, ShortRecord, Spectrum, WelchParams, Window,
@@ -359,52 +359,33 @@ fn write_csv(path: &std::path::Path, o: &PsdOutput) -> Result<()> {
 }
 
 fn psd_figure(o: &PsdOutput, xs: Scale, ys: Scale, fmax: Option<f64>) -> Figure {
-    let mut series = Vec::new();
     let several = o.channels.len() > 1;
-    // The DC bin of a detrended spectrum is ~0 and would stretch a log axis over 20 decades.
-    let skip_dc = |f: &[f64], p: &[f64]| -> (Vec<f64>, Vec<f64>) {
-        f.iter()
-            .zip(p)
-            .filter(|(f, _)| ys != Scale::Log || **f > 0.0)
-            .map(|(f, p)| (*f, *p))
-            .unzip()
-    };
-    for c in &o.channels {
-        if let Some(p) = &c.periodogram {
-            series.push(Series {
-                label: Some(if several {
-                    format!("{} periodogram", c.name)
-                } else {
-                    "periodogram".into()
-                }),
-                x: skip_dc(&p.frequency_hz, &p.psd).0,
-                y: skip_dc(&p.frequency_hz, &p.psd).1,
-                style: SeriesStyle::Line {
-                    width: 1,
-                    dashed: false,
-                },
-                color: None,
-                alpha: 0.45,
-            });
-        }
-        let label = match (c.method, several) {
-            (Method::Periodogram, false) => "periodogram".to_string(),
-            (_, false) => "Welch".to_string(),
-            (Method::Periodogram, true) => c.name.clone(),
-            (_, true) => format!("{} Welch", c.name),
-        };
-        series.push(Series {
-            label: Some(label),
-            x: skip_dc(&c.frequency_hz, &c.psd).0,
-            y: skip_dc(&c.frequency_hz, &c.psd).1,
-            style: SeriesStyle::Line {
-                width: 2,
-                dashed: false,
-            },
-            color: None,
-            alpha: 1.0,
-        });
-    }
+    let background: Vec<Curve> = o
+        .channels
+        .iter()
+        .filter_map(|c| {
+            let p = c.periodogram.as_ref()?;
+            let label = if several {
+                format!("{} periodogram", c.name)
+            } else {
+                "periodogram".into()
+            };
+            Some(Curve::new(label, p.frequency_hz.clone(), p.psd.clone()))
+        })
+        .collect();
+    let curves: Vec<Curve> = o
+        .channels
+        .iter()
+        .map(|c| {
+            let label = match (c.method, several) {
+                (Method::Periodogram, false) => "periodogram".to_string(),
+                (_, false) => "Welch".to_string(),
+                (Method::Periodogram, true) => c.name.clone(),
+                (_, true) => format!("{} Welch", c.name),
+            };
+            Curve::new(label, c.frequency_hz.clone(), c.psd.clone())
+        })
+        .collect();
     let unit = o
         .channels
         .first()
@@ -416,27 +397,16 @@ fn psd_figure(o: &PsdOutput, xs: Scale, ys: Scale, fmax: Option<f64>) -> Figure 
     } else {
         0.0
     };
-    Figure {
-        title: None,
-        panels: vec![Panel {
-            title: format!(
-                "Power spectral density: {}",
-                std::path::Path::new(&o.source)
-                    .file_name()
-                    .map(|s| s.to_string_lossy().to_string())
-                    .unwrap_or_else(|| o.source.clone())
-            ),
-            x_label: "Frequency [Hz]".into(),
-            y_label: format!("PSD [{unit}]"),
-            x_scale: xs,
-            y_scale: ys,
-            x_range: Some((xmin, fmax.unwrap_or(nyq).min(nyq))),
-            y_range: None,
-            series,
-            legend: true,
-        }],
-        columns: 1,
-        width_px: 1000,
-        height_px: 600,
-    }
+    let name = std::path::Path::new(&o.source)
+        .file_name()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_else(|| o.source.clone());
+    vibmode_report::psd_figure(
+        &format!("Power spectral density: {name}"),
+        &background,
+        &curves,
+        &unit,
+        (xs, ys),
+        (xmin, fmax.unwrap_or(nyq).min(nyq)),
+    )
 }

@@ -121,10 +121,9 @@ struct SweepOutput {
     channels: Vec<SweepChannel>,
 }
 
-/// Runs `vibmode sweep`.
-pub fn run(a: &SweepArgs) -> Result<()> {
-    let (rec, band) = a.input.load_with_band()?;
-    // The analysis sweep's settings are the defaults: one definition (vibmode_core::SweepParams).
+/// The orders and fit settings: the options given, else the analysis sweep's defaults (one
+/// definition, `vibmode_core::SweepParams`).
+fn sweep_settings(a: &SweepArgs, band: Option<BandLimit>) -> Result<(Vec<usize>, ArmaParams)> {
     let defaults = SweepParams::default();
     let orders = match &a.orders {
         Some(o) => parse_orders(o)?,
@@ -148,9 +147,48 @@ pub fn run(a: &SweepArgs) -> Result<()> {
         band,
         ..ArmaParams::default()
     };
-    let filter_band = band.unwrap_or_else(|| BandLimit::full(rec.fs_hz));
-    let filters = PoleFilterParams::default();
-    let ar_method = match (a.model, a.method) {
+    Ok((orders, params))
+}
+
+/// The stabilisation diagram at `path` and the frequency-damping plot beside it.
+fn write_plots(path: &std::path::Path, out: &SweepOutput) -> Result<()> {
+    ensure_parent(path)?;
+    let mut stab = Vec::new();
+    let mut damp = Vec::new();
+    for c in &out.channels {
+        let pts: Vec<(usize, f64, f64)> = c
+            .modes
+            .iter()
+            .map(|m| (m.order, m.frequency_hz, m.damping_ratio))
+            .collect();
+        stab.push(figures::stabilisation_panel(
+            &format!("{}: stabilisation diagram", c.name),
+            &pts,
+            &c.welch_freq_hz,
+            &c.welch_psd,
+            out.fs_hz / 2.0,
+        ));
+        damp.push(figures::damping_panel(
+            &format!("{}: frequency vs damping", c.name),
+            &pts,
+            &[],
+            out.fs_hz / 2.0,
+        ));
+    }
+    figures::grid(stab, 1, 1000, 520)
+        .save(path)
+        .with_context(|| format!("writing plot {}", path.display()))?;
+    let dpath = figures::sibling(path, "-damping");
+    figures::grid(damp, 1, 1000, 520)
+        .save(&dpath)
+        .with_context(|| format!("writing plot {}", dpath.display()))?;
+    eprintln!("wrote {} and {}", path.display(), dpath.display());
+    Ok(())
+}
+
+/// The AR estimator of `--model ar` (ARMA is fitted by PEM).
+fn ar_method(a: &SweepArgs) -> Result<ArMethod> {
+    Ok(match (a.model, a.method) {
         (ModelKind::Ar, None | Some(FitMethod::Burg)) => ArMethod::Burg,
         (ModelKind::Ar, Some(FitMethod::YuleWalker)) => ArMethod::YuleWalker,
         (ModelKind::Ar, Some(FitMethod::Ls)) => ArMethod::LeastSquares,
@@ -161,7 +199,56 @@ pub fn run(a: &SweepArgs) -> Result<()> {
         (ModelKind::Arma, Some(m)) => {
             bail!("--model arma is fitted by --method pem; {m:?} applies to --model ar")
         }
-    };
+    })
+}
+
+/// Every fit's loss, convergence or error, and its modes split by the pole filters.
+fn collect_fits(
+    out: &mut SweepChannel,
+    orders: &[usize],
+    fits: Vec<Result<vibmode_ident::ArmaModel, vibmode_ident::IdentError>>,
+    band: &BandLimit,
+    filters: &PoleFilterParams,
+) {
+    for (&p, f) in orders.iter().zip(fits) {
+        match f {
+            Ok(m) => {
+                out.loss.push(m.loss);
+                out.converged.push(m.converged);
+                out.errors.push(None);
+                for f in vibmode_ident::filter_modes(&m, band, filters) {
+                    let (frequency_hz, damping_ratio) = (f.mode.frequency_hz, f.mode.damping_ratio);
+                    match f.rejected {
+                        None => out.modes.push(SweepMode {
+                            order: p,
+                            frequency_hz,
+                            damping_ratio,
+                        }),
+                        Some(reason) => out.filtered_out.push(FilteredMode {
+                            order: p,
+                            frequency_hz,
+                            damping_ratio,
+                            reason,
+                        }),
+                    }
+                }
+            }
+            Err(e) => {
+                out.loss.push(f64::NAN);
+                out.converged.push(false);
+                out.errors.push(Some(e.to_string()));
+            }
+        }
+    }
+}
+
+/// Runs `vibmode sweep`.
+pub fn run(a: &SweepArgs) -> Result<()> {
+    let (rec, band) = a.input.load_with_band()?;
+    let (orders, params) = sweep_settings(a, band)?;
+    let filter_band = band.unwrap_or_else(|| BandLimit::full(rec.fs_hz));
+    let filters = PoleFilterParams::default();
+    let ar_method = ar_method(a)?;
     // Fail early, with the fit's own message, if the highest order cannot be fitted at all.
     let max_order = orders.iter().copied().max().unwrap_or(1);
     let mut channels = Vec::new();
@@ -191,37 +278,7 @@ pub fn run(a: &SweepArgs) -> Result<()> {
             welch_freq_hz: vec![],
             welch_psd: vec![],
         };
-        for (&p, f) in orders.iter().zip(fits) {
-            match f {
-                Ok(m) => {
-                    out.loss.push(m.loss);
-                    out.converged.push(m.converged);
-                    out.errors.push(None);
-                    for f in vibmode_ident::filter_modes(&m, &filter_band, &filters) {
-                        let (frequency_hz, damping_ratio) =
-                            (f.mode.frequency_hz, f.mode.damping_ratio);
-                        match f.rejected {
-                            None => out.modes.push(SweepMode {
-                                order: p,
-                                frequency_hz,
-                                damping_ratio,
-                            }),
-                            Some(reason) => out.filtered_out.push(FilteredMode {
-                                order: p,
-                                frequency_hz,
-                                damping_ratio,
-                                reason,
-                            }),
-                        }
-                    }
-                }
-                Err(e) => {
-                    out.loss.push(f64::NAN);
-                    out.converged.push(false);
-                    out.errors.push(Some(e.to_string()));
-                }
-            }
-        }
+        collect_fits(&mut out, &orders, fits, &filter_band, &filters);
         let wp = vibmode_spectra::WelchParams {
             nperseg: Some(256.min(ch.samples.len())),
             ..Default::default()
@@ -239,37 +296,7 @@ pub fn run(a: &SweepArgs) -> Result<()> {
         channels,
     };
     if let Some(path) = &a.plot {
-        ensure_parent(path)?;
-        let mut stab = Vec::new();
-        let mut damp = Vec::new();
-        for c in &out.channels {
-            let pts: Vec<(usize, f64, f64)> = c
-                .modes
-                .iter()
-                .map(|m| (m.order, m.frequency_hz, m.damping_ratio))
-                .collect();
-            stab.push(figures::stabilisation_panel(
-                &format!("{}: stabilisation diagram", c.name),
-                &pts,
-                &c.welch_freq_hz,
-                &c.welch_psd,
-                out.fs_hz / 2.0,
-            ));
-            damp.push(figures::damping_panel(
-                &format!("{}: frequency vs damping", c.name),
-                &pts,
-                &[],
-                out.fs_hz / 2.0,
-            ));
-        }
-        figures::grid(stab, 1, 1000, 520)
-            .save(path)
-            .with_context(|| format!("writing plot {}", path.display()))?;
-        let dpath = figures::sibling(path, "-damping");
-        figures::grid(damp, 1, 1000, 520)
-            .save(&dpath)
-            .with_context(|| format!("writing plot {}", dpath.display()))?;
-        eprintln!("wrote {} and {}", path.display(), dpath.display());
+        write_plots(path, &out)?;
     }
     match &a.json {
         Some(dest) => write_json(dest, &out)?,

@@ -590,45 +590,15 @@ fn write_text(path: &Path, text: &str) -> Result<(), ReportError> {
     })
 }
 
-/// Writes `DIR/index.html`, `DIR/results.json`, `DIR/modes.csv` and `DIR/figures/*.svg|png` for
-/// the analysis `r` of `records`; `intro` is a first paragraph (e.g. what was simulated).
-pub fn write_analysis_report(
-    dir: &Path,
-    records: &[RecordInput],
+/// The figures of the report, in the paper's order.
+fn add_figures(
+    w: &mut FigureWriter<'_>,
+    first: &RecordInput,
     r: &AnalysisResults,
-    intro: Option<&str>,
-) -> Result<ReportFiles, ReportError> {
-    let figdir = dir.join("figures");
-    std::fs::create_dir_all(&figdir).map_err(|e| ReportError::Write {
-        path: figdir.clone(),
-        message: e.to_string(),
-    })?;
-    let results_json = dir.join("results.json");
-    let json = serde_json::to_string_pretty(r).map_err(|e| ReportError::Write {
-        path: results_json.clone(),
-        message: e.to_string(),
-    })?;
-    write_text(&results_json, &(json + "\n"))?;
-    let modes_csv_path = dir.join("modes.csv");
-    write_text(&modes_csv_path, &modes_csv(r))?;
-    let first = records
-        .first()
-        .ok_or_else(|| ReportError::Analysis("no records".into()))?;
-    let spectra =
-        first_record_spectra(records, r).map_err(|e| ReportError::Analysis(e.to_string()))?;
+    spectra: &[FirstRecordSpectra],
+) -> Result<(), ReportError> {
     let cfg = &r.config;
     let fmax = cfg.preprocess.analysis_fs_hz / 2.0;
-    let mut html = HtmlReport::new("vibmode: vibration modes from in-service accelerations");
-    if let Some(t) = intro {
-        html.paragraph(t);
-    }
-    html.paragraph(&summary_text(r));
-    inputs_table(&mut html, r);
-    let mut w = FigureWriter {
-        dir: &figdir,
-        html,
-        files: Vec::new(),
-    };
     let fig = time_records_figure(&first.name, &first.recording);
     w.add(
         "time_records",
@@ -655,7 +625,7 @@ pub fn write_analysis_report(
             ),
         )?;
     }
-    let (fig5, fig67) = spectra_figures(r, &spectra, fmax);
+    let (fig5, fig67) = spectra_figures(r, spectra, fmax);
     w.add(
         "periodogram_welch",
         "periodogram and Welch spectra",
@@ -688,6 +658,47 @@ pub fn write_analysis_report(
         &damping_figure(r, fmax),
         &format!("Every pole pair of every order and record, pooled per role; the pool's invariant structural modes (green) and periodic disturbances (orange, dotted) marked{with_model}."),
     )?;
+    Ok(())
+}
+
+/// Writes `DIR/index.html`, `DIR/results.json`, `DIR/modes.csv` and `DIR/figures/*.svg|png` for
+/// the analysis `r` of `records`; `intro` is a first paragraph (e.g. what was simulated).
+pub fn write_analysis_report(
+    dir: &Path,
+    records: &[RecordInput],
+    r: &AnalysisResults,
+    intro: Option<&str>,
+) -> Result<ReportFiles, ReportError> {
+    let figdir = dir.join("figures");
+    std::fs::create_dir_all(&figdir).map_err(|e| ReportError::Write {
+        path: figdir.clone(),
+        message: e.to_string(),
+    })?;
+    let results_json = dir.join("results.json");
+    let json = serde_json::to_string_pretty(r).map_err(|e| ReportError::Write {
+        path: results_json.clone(),
+        message: e.to_string(),
+    })?;
+    write_text(&results_json, &(json + "\n"))?;
+    let modes_csv_path = dir.join("modes.csv");
+    write_text(&modes_csv_path, &modes_csv(r))?;
+    let first = records
+        .first()
+        .ok_or_else(|| ReportError::Analysis("no records".into()))?;
+    let spectra =
+        first_record_spectra(records, r).map_err(|e| ReportError::Analysis(e.to_string()))?;
+    let mut html = HtmlReport::new("vibmode: vibration modes from in-service accelerations");
+    if let Some(t) = intro {
+        html.paragraph(t);
+    }
+    html.paragraph(&summary_text(r));
+    inputs_table(&mut html, r);
+    let mut w = FigureWriter {
+        dir: &figdir,
+        html,
+        files: Vec::new(),
+    };
+    add_figures(&mut w, first, r, &spectra)?;
     let FigureWriter {
         mut html, files, ..
     } = w;

@@ -68,6 +68,7 @@ mod model;
 pub mod panels;
 mod render;
 pub mod signal_figures;
+pub mod spectrum_figures;
 
 pub use analysis::{modes_csv, modes_table_text, write_analysis_report, ReportFiles, TruthRow};
 pub use error::ReportError;
@@ -78,6 +79,7 @@ pub use render::{
     MAX_POINTS_PER_SERIES, MAX_SIDE_PX, MIN_CELL_HEIGHT_PX, MIN_CELL_WIDTH_PX, MIN_SIDE_PX,
 };
 pub use signal_figures::antialias_figure;
+pub use spectrum_figures::{model_spectra_figure, psd_figure, Curve, ModelSpectrumPanel};
 
 /// Re-export of plotters, so callers of [`Figure::draw_on`] use the same version.
 pub use plotters;
