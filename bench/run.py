@@ -49,6 +49,16 @@ def peers(data_dir, quick):
     res["welch_204800_nperseg256"] = {"scipy.signal.welch": median_time(lambda: ss.welch(x, fs=20000.0, nperseg=256), r)}
     res["welch_204800_nperseg4096"] = {"scipy.signal.welch": median_time(lambda: ss.welch(x, fs=20000.0, nperseg=4096), r)}
     raw = np.fromfile(os.path.join(data_dir, "raw7.f64"), dtype="<f8").reshape(-1, 7)
+    # Clustering: the independent scipy implementation of tools/reference/modal.py (cKDTree radius
+    # queries + connected components) on the same pole cloud and settings.
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "tools", "reference"))
+    import modal as modal_ref
+    cloud = json.load(open(os.path.join(data_dir, "poles.json")))
+    cl_params = {k: v for k, v in cloud["params"].items() if v is not None}
+    res["cluster_poles"] = {
+        "scipy reference (tools/reference/modal.py)": median_time(
+            lambda: modal_ref.cluster(cloud["poles"], cloud["n_records"], cloud["orders"], cl_params), 1 if quick else 3)
+    }
 
     def ideal_numpy():
         X = np.fft.rfft(raw, axis=0)
@@ -139,6 +149,9 @@ def main():
             ls = py[case].get("_lambda_statsmodels")
             if lr is not None and ls is not None:
                 print(f"\n{case}: lambda vibmode {lr:.6e}, statsmodels (evaluated by the same predictor) {ls:.6e}, ratio {lr / ls:.5f}")
+    cl = rust.get("cluster_poles", {})
+    if "_n_poles" in cl:
+        print(f"\ncluster_poles: {cl['_n_poles']} poles, {cl['_invariant_modes']} invariant modes (vibmode)")
     print("\nversions:", json.dumps(py.get("_versions", {})), json.dumps(extra))
     if args.out:
         json.dump({"vibmode": rust, "peers": py}, open(args.out, "w"), indent=1, default=float)

@@ -84,6 +84,60 @@ fn arma_signal(p: usize, n: usize, rng: &mut Rng) -> Vec<f64> {
     y[burn..].to_vec()
 }
 
+/// The paper-size pole cloud: 8 records x 7 channels x orders 2..=60, each fit with the four
+/// structural modes and two lines of the brief (jittered, present with probability 0.85) and
+/// 0..=50 spurious poles (uniform 0.5-20 Hz, log-uniform damping 1e-3..0.6): about 100 000 poles,
+/// clustered with the reference script's settings (fixed radius) by both implementations.
+fn write_pole_cloud(dir: &Path, rng: &mut Rng) -> Result<()> {
+    let modes = [
+        (1.1, 0.25, 0.015),
+        (1.5, 0.2, 0.015),
+        (9.5, 0.15, 0.015),
+        (11.0, 0.12, 0.015),
+        (7.0, 0.001, 0.0005),
+        (11.8, 0.001, 0.0005),
+    ];
+    let channels = ["FL", "FR", "RL", "RR", "sFR", "sRL", "sRR"];
+    let orders: Vec<usize> = (2..=60).collect();
+    let mut poles = Vec::new();
+    for record in 0..8usize {
+        for ch in channels {
+            for &order in &orders {
+                for &(f0, z0, fj) in &modes {
+                    if rng.uniform() < 0.85 {
+                        poles.push(json!({"frequency_hz": f0 * (1.0 + fj * rng.normal()),
+                            "damping_ratio": z0 * (0.35 * rng.normal()).exp(),
+                            "order": order, "record": record, "channel": ch}));
+                    }
+                }
+                for _ in 0..(rng.uniform() * 51.0) as usize {
+                    poles.push(json!({"frequency_hz": 0.5 + 19.5 * rng.uniform(),
+                        "damping_ratio": 10f64.powf(-3.0 + rng.uniform() * (0.6f64.log10() + 3.0)),
+                        "order": order, "record": record, "channel": ch}));
+                }
+            }
+        }
+    }
+    let params = script_cluster_params();
+    std::fs::write(
+        dir.join("poles.json"),
+        json!({"n_records": 8, "orders": orders, "params": params, "poles": poles}).to_string(),
+    )?;
+    Ok(())
+}
+
+/// The settings of tools/reference/modal.py (vibmode-modal 0.1's defaults, fixed radius).
+fn script_cluster_params() -> vibmode_core::ClusterParams {
+    vibmode_core::ClusterParams {
+        freq_tol_per_damping: 0.0,
+        min_order_share: 0.25,
+        disturbance_freq_spread_max: 0.01,
+        freq_min_hz: 0.1,
+        freq_max_hz: Some(30.0),
+        ..Default::default()
+    }
+}
+
 fn gen(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir)?;
     let mut rng = Rng(0x9E3779B97F4A7C15);
@@ -114,6 +168,7 @@ fn gen(dir: &Path) -> Result<()> {
             &arma_signal(p, 2048, &mut rng),
         )?;
     }
+    write_pole_cloud(dir, &mut rng)?;
     std::fs::write(
         dir.join("meta.json"),
         json!({"arma_orders": ARMA_ORDERS, "n": n, "fs_hz": 20000.0}).to_string(),
@@ -210,6 +265,21 @@ fn run(dir: &Path, quick: bool) -> Result<Value> {
     out.insert(
         "read_csv_7x204800".into(),
         json!({"vibmode_signal::read_path": t_csv}),
+    );
+    // Clustering the paper-size pole cloud.
+    let cloud: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("poles.json"))?)?;
+    let poles: Vec<vibmode_core::PoleObservation> = serde_json::from_value(cloud["poles"].clone())?;
+    let orders: Vec<usize> = serde_json::from_value(cloud["orders"].clone())?;
+    let params = script_cluster_params();
+    let mut n_modes = 0;
+    let t_cl = median_time(if quick { 2 } else { 7 }, || {
+        let a = vibmode_modal::analyse_poles(&poles, 8, &orders, &params)?;
+        n_modes = a.modes.iter().filter(|m| m.is_invariant()).count();
+        Ok(())
+    })?;
+    out.insert(
+        "cluster_poles".into(),
+        json!({"vibmode_modal::analyse_poles": t_cl, "_n_poles": poles.len(), "_invariant_modes": n_modes}),
     );
     // ARMA fits, quadratic criterion (as statsmodels), N = 2048.
     for p in ARMA_ORDERS {
