@@ -364,6 +364,126 @@ macro_rules! draw_markers {
     }};
 }
 
+/// Draws one prepared series on `chart` and registers its legend entry; true when it has one.
+fn draw_one_series<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<AxisCoord, AxisCoord>>,
+    s: &PreparedSeries,
+    (ylo, yhi): (f64, f64),
+) -> Result<bool, ReportError> {
+    let color = s.color;
+    let anno = match (&s.geometry, s.style) {
+        (Geometry::Lines(pieces), SeriesStyle::Line { width, dashed }) => {
+            let st = color.stroke_width(width);
+            let a = if dashed {
+                let dash = (4 * width).max(6) as i32;
+                chart.draw_series(
+                    pieces
+                        .iter()
+                        .map(move |p| DashedPathElement::new(p.clone(), dash, dash * 2 / 3, st)),
+                )
+            } else {
+                chart.draw_series(pieces.iter().map(move |p| PathElement::new(p.clone(), st)))
+            }
+            .map_err(ReportError::draw)?;
+            s.label.as_ref().map(|l| {
+                let gap = if dashed { 4 } else { 0 };
+                a.label(l.as_str()).legend(move |(x, y)| {
+                    EmptyElement::at((x, y))
+                        + PathElement::new(vec![(0, 0), (8, 0)], st)
+                        + PathElement::new(vec![(8 + gap, 0), (20, 0)], st)
+                });
+            })
+        }
+        (Geometry::Points(pts), SeriesStyle::Points { size, marker }) => {
+            let r = size as i32;
+            let d = r + r / 3;
+            let fill = color.filled();
+            let st = color.stroke_width(size.div_ceil(2).max(1));
+            let label = s.label.as_ref();
+            match marker {
+                Marker::Circle => {
+                    draw_markers!(chart, pts, label, Circle::new((0, 0), r, fill))
+                }
+                Marker::Cross => {
+                    draw_markers!(chart, pts, label, Cross::new((0, 0), r, st))
+                }
+                Marker::Diamond => draw_markers!(
+                    chart,
+                    pts,
+                    label,
+                    Polygon::new(vec![(0, -d), (d, 0), (0, d), (-d, 0)], fill)
+                ),
+                Marker::Square => {
+                    draw_markers!(chart, pts, label, Rectangle::new([(-r, -r), (r, r)], fill))
+                }
+                Marker::Triangle => draw_markers!(
+                    chart,
+                    pts,
+                    label,
+                    Polygon::new(vec![(0, -d), (d, d * 3 / 4), (-d, d * 3 / 4)], fill)
+                ),
+            }
+        }
+        (Geometry::VLines(xv), SeriesStyle::VLines { dotted }) => {
+            let st = color.stroke_width(1);
+            let a = if dotted {
+                chart.draw_series(
+                    xv.iter()
+                        .map(move |&x| DashedPathElement::new(vec![(x, ylo), (x, yhi)], 3, 3, st)),
+                )
+            } else {
+                chart.draw_series(
+                    xv.iter()
+                        .map(move |&x| PathElement::new(vec![(x, ylo), (x, yhi)], st)),
+                )
+            }
+            .map_err(ReportError::draw)?;
+            s.label.as_ref().map(|l| {
+                a.label(l.as_str()).legend(move |(x, y)| {
+                    let gap = if dotted { 3 } else { 0 };
+                    EmptyElement::at((x, y))
+                        + PathElement::new(vec![(0, 0), (8, 0)], st)
+                        + PathElement::new(vec![(8 + gap, 0), (12, 0)], st)
+                        + PathElement::new(vec![(12 + gap, 0), (20, 0)], st)
+                });
+            })
+        }
+        _ => None,
+    };
+    Ok(anno.is_some())
+}
+
+/// Pixel sizes of the y label area (tick labels and axis label) and of the x label area.
+fn label_areas(
+    panel: &Panel,
+    y_major: &[f64],
+    ys: Scale,
+    tick_px: f64,
+    label_px: f64,
+) -> (u32, u32) {
+    let y_label_chars = y_major
+        .iter()
+        .map(|&t| format_tick(from_axis(t, ys)).chars().count())
+        .max()
+        .unwrap_or(1);
+    let y_area: u32 = (y_label_chars as f64 * 0.62 * tick_px
+        + if panel.y_label.is_empty() {
+            0.0
+        } else {
+            label_px * 1.8
+        }
+        + 10.0) as u32;
+    let x_area: u32 = (tick_px * 1.6
+        + if panel.x_label.is_empty() {
+            0.0
+        } else {
+            label_px * 1.8
+        }
+        + 6.0) as u32;
+
+    (y_area, x_area)
+}
+
 fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     panel: &Panel,
@@ -379,26 +499,7 @@ fn draw_panel<DB: DrawingBackend>(
     let (x_major, x_minor) = ticks(prepared.x_axis, xs, max_x_ticks);
     let (y_major, y_minor) = ticks(prepared.y_axis, ys, max_y_ticks);
 
-    let y_label_chars = y_major
-        .iter()
-        .map(|&t| format_tick(from_axis(t, ys)).chars().count())
-        .max()
-        .unwrap_or(1);
-    let y_area = (y_label_chars as f64 * 0.62 * tick_px
-        + if panel.y_label.is_empty() {
-            0.0
-        } else {
-            label_px * 1.8
-        }
-        + 10.0) as u32;
-    let x_area = (tick_px * 1.6
-        + if panel.x_label.is_empty() {
-            0.0
-        } else {
-            label_px * 1.8
-        }
-        + 6.0) as u32;
-
+    let (y_area, x_area) = label_areas(panel, &y_major, ys, tick_px, label_px);
     let mut builder = ChartBuilder::on(area);
     builder
         .margin(6)
@@ -445,83 +546,7 @@ fn draw_panel<DB: DrawingBackend>(
     let (ylo, yhi) = prepared.y_axis;
     let mut any_label = false;
     for s in &prepared.series {
-        let color = s.color;
-        let anno = match (&s.geometry, s.style) {
-            (Geometry::Lines(pieces), SeriesStyle::Line { width, dashed }) => {
-                let st = color.stroke_width(width);
-                let a = if dashed {
-                    let dash = (4 * width).max(6) as i32;
-                    chart.draw_series(
-                        pieces.iter().map(move |p| {
-                            DashedPathElement::new(p.clone(), dash, dash * 2 / 3, st)
-                        }),
-                    )
-                } else {
-                    chart.draw_series(pieces.iter().map(move |p| PathElement::new(p.clone(), st)))
-                }
-                .map_err(ReportError::draw)?;
-                s.label.as_ref().map(|l| {
-                    let gap = if dashed { 4 } else { 0 };
-                    a.label(l.as_str()).legend(move |(x, y)| {
-                        EmptyElement::at((x, y))
-                            + PathElement::new(vec![(0, 0), (8, 0)], st)
-                            + PathElement::new(vec![(8 + gap, 0), (20, 0)], st)
-                    });
-                })
-            }
-            (Geometry::Points(pts), SeriesStyle::Points { size, marker }) => {
-                let r = size as i32;
-                let d = r + r / 3;
-                let fill = color.filled();
-                let st = color.stroke_width(size.div_ceil(2).max(1));
-                let label = s.label.as_ref();
-                match marker {
-                    Marker::Circle => {
-                        draw_markers!(chart, pts, label, Circle::new((0, 0), r, fill))
-                    }
-                    Marker::Cross => {
-                        draw_markers!(chart, pts, label, Cross::new((0, 0), r, st))
-                    }
-                    Marker::Diamond => draw_markers!(
-                        chart,
-                        pts,
-                        label,
-                        Polygon::new(vec![(0, -d), (d, 0), (0, d), (-d, 0)], fill)
-                    ),
-                    Marker::Square => {
-                        draw_markers!(chart, pts, label, Rectangle::new([(-r, -r), (r, r)], fill))
-                    }
-                    Marker::Triangle => draw_markers!(
-                        chart,
-                        pts,
-                        label,
-                        Polygon::new(vec![(0, -d), (d, d * 3 / 4), (-d, d * 3 / 4)], fill)
-                    ),
-                }
-            }
-            (Geometry::VLines(xv), SeriesStyle::VLines { dotted }) => {
-                let st = color.stroke_width(1);
-                let a =
-                    if dotted {
-                        chart.draw_series(xv.iter().map(move |&x| {
-                            DashedPathElement::new(vec![(x, ylo), (x, yhi)], 3, 3, st)
-                        }))
-                    } else {
-                        chart.draw_series(
-                            xv.iter()
-                                .map(move |&x| PathElement::new(vec![(x, ylo), (x, yhi)], st)),
-                        )
-                    }
-                    .map_err(ReportError::draw)?;
-                s.label.as_ref().map(|l| {
-                    a.label(l.as_str()).legend(move |(x, y)| {
-                        DashedPathElement::new(vec![(x, y), (x + 20, y)], 3, 3, st)
-                    });
-                })
-            }
-            _ => None,
-        };
-        any_label |= anno.is_some();
+        any_label |= draw_one_series(&mut chart, s, (ylo, yhi))?;
     }
 
     if !prepared.has_data {
