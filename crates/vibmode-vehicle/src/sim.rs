@@ -776,6 +776,36 @@ fn add_line_forces(f: &mut [f64], lines: &[(EngineLine, f64)], t: f64) {
     }
 }
 
+/// Position along the road (m) at each sample, integrating `speed` (m/s) by the trapezoidal rule
+/// from one road step `dx = max speed x dt`, and that step.
+fn positions(speed: &[f64], dt: f64) -> (Vec<f64>, f64) {
+    let vmax = speed.iter().copied().fold(0.0, f64::max);
+    let dx = vmax * dt;
+    let mut pos = vec![dx; speed.len()];
+    for k in 1..speed.len() {
+        pos[k] = pos[k - 1] + 0.5 * (speed[k - 1] + speed[k]) * dt;
+    }
+    (pos, dx)
+}
+
+/// What the identification should find, and what was drawn.
+fn make_truth(sim: &SimParams, modes: Vec<ModeInfo>, bias: Vec<f64>, warmup_s: f64) -> Truth {
+    let dist = &sim.disturbances;
+    Truth {
+        modes,
+        disturbance_lines_hz: dist.engine_lines.iter().map(|l| l.frequency_hz).collect(),
+        hf_tones_hz: dist.hf_tones.iter().map(|t| t.frequency_hz).collect(),
+        sensor_bias_m_s2: bias,
+        sensor_noise_std_m_s2: dist.sensor_noise_std_m_s2,
+        road_class: sim.road,
+        road_gd_n0_m3: sim.road.gd_n0_m3(),
+        road: sim.road_input(),
+        speed_kmh: sim.speed_kmh,
+        warmup_s,
+        seed: sim.seed,
+    }
+}
+
 /// Simulate the measurement campaign: one continuous drive over an ISO 8608 road, cut into
 /// `records` successive records, with the optional manoeuvres and disturbances.
 ///
@@ -810,12 +840,7 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
     let nk = n_total + 2;
     let speed = speed_profile(v0, nk, dt, time, ax)?;
     let wb = vehicle.geometry.wheelbase_m;
-    let vmax = speed.iter().copied().fold(0.0, f64::max);
-    let dx = vmax * dt;
-    let mut pos = vec![dx; nk];
-    for k in 1..nk {
-        pos[k] = pos[k - 1] + 0.5 * (speed[k - 1] + speed[k]) * dt;
-    }
+    let (pos, dx) = positions(&speed, dt);
     let length = pos[nk - 1] + wb + 4.0 * dx;
     let mut rng = ChaCha8Rng::seed_from_u64(sim.seed);
     rng.set_stream(1);
@@ -872,18 +897,6 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
     let records = split_records(samples, &car, &speed, n_warm, n_rec, fs);
     Ok(Simulation {
         records,
-        truth: Truth {
-            modes,
-            disturbance_lines_hz: dist.engine_lines.iter().map(|l| l.frequency_hz).collect(),
-            hf_tones_hz: dist.hf_tones.iter().map(|t| t.frequency_hz).collect(),
-            sensor_bias_m_s2: bias,
-            sensor_noise_std_m_s2: dist.sensor_noise_std_m_s2,
-            road_class: sim.road,
-            road_gd_n0_m3: sim.road.gd_n0_m3(),
-            road: sim.road_input(),
-            speed_kmh: sim.speed_kmh,
-            warmup_s,
-            seed: sim.seed,
-        },
+        truth: make_truth(sim, modes, bias, warmup_s),
     })
 }
