@@ -46,6 +46,49 @@ pub struct AnalyzeArgs {
     /// No progress bar.
     #[arg(long, short = 'q')]
     pub quiet: bool,
+    /// Role of a channel, `NAME=sprung|unsprung|other` (repeat for several); overrides the
+    /// config's `[[channels]]` and the guess from the name.
+    #[arg(long = "role", value_name = "NAME=ROLE")]
+    pub roles: Vec<String>,
+    /// Corner of a channel, `NAME=FL|FR|RL|RR` (repeat for several).
+    #[arg(long = "corner", value_name = "NAME=CORNER")]
+    pub corners: Vec<String>,
+}
+
+/// `NAME=VALUE` of `--role` / `--corner`.
+fn split_assignment<'a>(flag: &str, text: &'a str) -> Result<(&'a str, &'a str)> {
+    match text.rsplit_once('=') {
+        Some((name, value)) if !name.is_empty() && !value.is_empty() => Ok((name, value)),
+        _ => bail!("{flag} '{text}' must be NAME=VALUE, e.g. {flag} FL_wheel=unsprung"),
+    }
+}
+
+/// Adds the `--role` and `--corner` assignments to the config's channel table.
+fn apply_placements(cfg: &mut AnalysisConfig, roles: &[String], corners: &[String]) -> Result<()> {
+    use vibmode_analysis::{ChannelRole, Corner, Role};
+    fn entry<'c>(cfg: &'c mut AnalysisConfig, name: &str) -> &'c mut ChannelRole {
+        let i = match cfg.channels.iter().position(|c| c.name == name) {
+            Some(i) => i,
+            None => {
+                cfg.channels.push(ChannelRole {
+                    name: name.to_string(),
+                    role: Role::guess_from_name(name),
+                    corner: Corner::guess_from_name(name),
+                });
+                cfg.channels.len() - 1
+            }
+        };
+        &mut cfg.channels[i]
+    }
+    for r in roles {
+        let (name, value) = split_assignment("--role", r)?;
+        entry(cfg, name).role = value.parse::<Role>()?;
+    }
+    for c in corners {
+        let (name, value) = split_assignment("--corner", c)?;
+        entry(cfg, name).corner = Some(value.parse::<Corner>()?);
+    }
+    Ok(())
 }
 
 /// Reads the config: --config file (with its own preset key) or --preset, else defaults.
@@ -72,7 +115,8 @@ fn load_config(config: Option<&Path>, preset: Option<&str>) -> Result<AnalysisCo
 
 /// Runs `vibmode analyze`.
 pub fn run(a: &AnalyzeArgs) -> Result<()> {
-    let cfg = load_config(a.config.as_deref(), a.preset.as_deref())?;
+    let mut cfg = load_config(a.config.as_deref(), a.preset.as_deref())?;
+    apply_placements(&mut cfg, &a.roles, &a.corners)?;
     let opts = ReadOptions {
         fs_hz: a.fs_hz,
         scale: a.scale,

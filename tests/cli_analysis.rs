@@ -194,3 +194,48 @@ fn a_closed_pipe_ends_quietly() {
     assert!(o.status.success(), "exit {:?}: {err}", o.status);
     assert!(!err.contains("error") && !err.contains("panicked"), "{err}");
 }
+
+#[test]
+fn channels_without_a_role_are_analysed_alone_and_roles_can_be_given() {
+    let d = tempfile::tempdir().unwrap();
+    let a = d.path().join("a.csv");
+    write_resonance(&a, 30.0, 50.0, 7);
+    let cfg = d.path().join("quick.toml");
+    std::fs::write(&cfg, "[sweep]\norder_max = 8\n").unwrap();
+    let out = d.path().join("r");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "analyze",
+            a.to_str().unwrap(),
+            "--config",
+            cfg.to_str().unwrap(),
+            "-q",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = vibmode(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stdout).to_string()
+    };
+    let alone = run(&[]);
+    assert!(
+        alone.contains("channel z (no role: analysed alone, not pooled)"),
+        "{alone}"
+    );
+    let sprung = run(&["--role", "z=sprung", "--corner", "z=FR"]);
+    assert!(sprung.contains("sprung channels (z)"), "{sprung}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    assert_eq!(v["channels"][0]["placement"]["corner"], "FR");
+    let a = a.to_str().unwrap();
+    fails_with(
+        &["analyze", a, "--role", "z=up"],
+        &["'up'", "sprung, unsprung, other"],
+    );
+    fails_with(&["analyze", a, "--role", "z"], &["--role", "NAME=VALUE"]);
+    fails_with(
+        &["analyze", a, "--corner", "z=XX"],
+        &["'XX'", "FL, FR, RL, RR"],
+    );
+}

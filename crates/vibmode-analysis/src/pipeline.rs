@@ -371,7 +371,9 @@ fn channel_modes(
 }
 
 /// Stages 6 and 7 per role: the poles of all channels of a role clustered together, and the
-/// structural modes matched to the physical model's.
+/// structural modes matched to the physical model's. Channels without a role (`Role::Other`:
+/// x, y and z of one sensor, or sensors of unknown place) are not pooled: their modes differ,
+/// and each is analysed alone (`ChannelAnalysis::invariant_modes`).
 fn role_modes(
     channels: &[ChannelAnalysis],
     store: &PoleStore,
@@ -379,7 +381,7 @@ fn role_modes(
     reference: &[ReferenceMode],
 ) -> Result<Vec<RoleAnalysis>, AnalysisError> {
     let mut roles = Vec::new();
-    for role in Role::ALL {
+    for role in [Role::Sprung, Role::Unsprung] {
         let names: Vec<String> = channels
             .iter()
             .filter(|c| c.role == role)

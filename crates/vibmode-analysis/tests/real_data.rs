@@ -42,11 +42,16 @@ fn bus_body_mode_with_default_settings() {
     // driving records are not.
     assert!(stops.contains(&4) && stops.contains(&5), "{stops:?}");
     assert!(stops.len() <= 3, "{stops:?}");
+    // A channel without a role is analysed alone, never pooled.
+    assert!(
+        res.roles.is_empty(),
+        "no role pools for a channel without a role"
+    );
     let role = res
-        .roles
+        .channels
         .iter()
-        .find(|r| r.role == Role::Other)
-        .expect("channel z pooled as 'other'");
+        .find(|c| c.name == "z" && c.role == Role::Other)
+        .expect("channel z");
     for m in &role.invariant_modes {
         if m.is_invariant() {
             eprintln!(

@@ -5,9 +5,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use vibmode_analysis::{
-    first_record_spectra, AnalysisResults, FirstRecordSpectra, RecordInput, RoleAnalysis,
-};
+use vibmode_analysis::{first_record_spectra, AnalysisResults, FirstRecordSpectra, RecordInput};
 use vibmode_core::{InvariantMode, ModeClass, Recording, Robust, SweepModel};
 
 use crate::error::ReportError;
@@ -64,6 +62,46 @@ fn freqs_of(modes: &[InvariantMode], class: ModeClass) -> Vec<f64> {
         .filter(|m| m.class == class)
         .map(|m| m.frequency_hz)
         .collect()
+}
+
+/// A group of channels whose poles were clustered together: a role pool, or one channel without
+/// a role (analysed alone, never pooled).
+struct Pool<'a> {
+    /// "sprung channels (FR_sprung, ...)" or "channel z (no role: analysed alone)".
+    title: String,
+    /// "the sprung channels" or "channel z".
+    subject: String,
+    modes: &'a [InvariantMode],
+    matches: &'a [vibmode_core::ModeMatch],
+    channels: Vec<&'a vibmode_analysis::ChannelAnalysis>,
+}
+
+fn pools(r: &AnalysisResults) -> Vec<Pool<'_>> {
+    let mut out: Vec<Pool<'_>> = r
+        .roles
+        .iter()
+        .map(|role| Pool {
+            title: format!("{} channels ({})", role.role, role.channels.join(", ")),
+            subject: format!("the {} channels", role.role),
+            modes: &role.invariant_modes,
+            matches: &role.matches,
+            channels: r.channels.iter().filter(|c| c.role == role.role).collect(),
+        })
+        .collect();
+    for ch in r
+        .channels
+        .iter()
+        .filter(|c| c.role == vibmode_core::Role::Other)
+    {
+        out.push(Pool {
+            title: format!("channel {} (no role: analysed alone, not pooled)", ch.name),
+            subject: format!("channel {}", ch.name),
+            modes: &ch.invariant_modes,
+            matches: &[],
+            channels: vec![ch],
+        });
+    }
+    out
 }
 
 /// The first line of the terminal summary: counts, rate, cutoff, orders and run time.
@@ -136,20 +174,15 @@ pub fn modes_table_text(r: &AnalysisResults, truth: Option<&[TruthRow]>) -> Stri
             stops.join(", ")
         );
     }
-    for role in &r.roles {
-        let _ = writeln!(
-            s,
-            "\nInvariant modes, {} channels ({}):",
-            role.role,
-            role.channels.join(", ")
-        );
+    for pool in pools(r) {
+        let _ = writeln!(s, "\nInvariant modes, {}:", pool.title);
         let _ = writeln!(
             s,
             "  {:>9} {:>8} {:>9} {:>7} {:>7}  class",
             "freq_hz", "std_hz", "damping", "orders", "records"
         );
         let mut any = false;
-        for m in shown(&role.invariant_modes) {
+        for m in shown(pool.modes) {
             any = true;
             let _ = writeln!(
                 s,
@@ -163,7 +196,7 @@ pub fn modes_table_text(r: &AnalysisResults, truth: Option<&[TruthRow]>) -> Stri
             );
         }
         if !any {
-            s.push_str(&candidates_text(r, &role.invariant_modes, "  "));
+            s.push_str(&candidates_text(r, pool.modes, "  "));
         }
     }
     if let Some(t) = truth {
@@ -255,8 +288,8 @@ pub fn summary_text(r: &AnalysisResults) -> String {
         r.n_failed,
         r.timing.elapsed_s
     );
-    for role in &r.roles {
-        s.push_str(&role_sentence(role, cfg.cluster.disturbance_damping_max));
+    for pool in pools(r) {
+        s.push_str(&pool_sentence(&pool, cfg.cluster.disturbance_damping_max));
     }
     if r.n_stationary > 0 {
         let stops: Vec<String> = r
@@ -287,26 +320,26 @@ pub fn summary_text(r: &AnalysisResults) -> String {
     s
 }
 
-fn role_sentence(role: &RoleAnalysis, disturbance_damping_max: f64) -> String {
-    let st: Vec<String> = role
-        .invariant_modes
+fn pool_sentence(pool: &Pool<'_>, disturbance_damping_max: f64) -> String {
+    let st: Vec<String> = pool
+        .modes
         .iter()
         .filter(|m| m.class == ModeClass::Structural)
         .map(|m| format!("{:.2} Hz (damping {:.3})", m.frequency_hz, m.damping_ratio))
         .collect();
-    let di: Vec<String> = freqs_of(&role.invariant_modes, ModeClass::PeriodicDisturbance)
+    let di: Vec<String> = freqs_of(pool.modes, ModeClass::PeriodicDisturbance)
         .iter()
         .map(|f| format!("{f:.2} Hz"))
         .collect();
     let structural = if st.is_empty() {
         format!(
-            "On the {} channels no invariant structural mode was found (see the table for the candidates the support tests rejected)",
-            role.role
+            "On {} no invariant structural mode was found (see the table for the candidates the support tests rejected)",
+            pool.subject
         )
     } else {
         format!(
-            "On the {} channels the invariant structural modes are {}",
-            role.role,
+            "On {} the invariant structural modes are {}",
+            pool.subject,
             st.join(", ")
         )
     };
@@ -458,14 +491,12 @@ fn damping_figure(r: &AnalysisResults, fmax: f64) -> Figure {
         .iter()
         .map(|m| (m.frequency_hz, m.damping_ratio, m.label.clone()))
         .collect();
-    let panels = r
-        .roles
+    let panels = pools(r)
         .iter()
-        .map(|role| {
-            let pts: Vec<(usize, f64, f64)> = r
+        .map(|pool| {
+            let pts: Vec<(usize, f64, f64)> = pool
                 .channels
                 .iter()
-                .filter(|c| c.role == role.role)
                 .flat_map(|c| {
                     c.poles
                         .iter()
@@ -473,14 +504,14 @@ fn damping_figure(r: &AnalysisResults, fmax: f64) -> Figure {
                 })
                 .collect();
             let mut panel = damping_panel(
-                &format!("{} channels: frequency vs damping", role.role),
+                &format!("{}: frequency vs damping", pool.subject),
                 &pts,
                 &refs,
                 fmax,
             );
             panel.series.extend(mode_marks(
-                &freqs_of(&role.invariant_modes, ModeClass::Structural),
-                &freqs_of(&role.invariant_modes, ModeClass::PeriodicDisturbance),
+                &freqs_of(pool.modes, ModeClass::Structural),
+                &freqs_of(pool.modes, ModeClass::PeriodicDisturbance),
             ));
             panel
         })
@@ -537,24 +568,21 @@ fn modes_tables(html: &mut HtmlReport, r: &AnalysisResults) {
         "poles",
         "class",
     ];
-    for role in &r.roles {
-        html.heading(
-            3,
-            &format!("{} channels: {}", role.role, role.channels.join(", ")),
-        );
-        let rows: Vec<Vec<String>> = shown(&role.invariant_modes).map(mode_row).collect();
+    for pool in pools(r) {
+        html.heading(3, &pool.title);
+        let rows: Vec<Vec<String>> = shown(pool.modes).map(mode_row).collect();
         if rows.is_empty() {
-            html.paragraph(&candidates_text(r, &role.invariant_modes, ""));
+            html.paragraph(&candidates_text(r, pool.modes, ""));
         } else {
             html.table(&headers, &rows);
         }
-        if !role.matches.is_empty() {
+        if !pool.matches.is_empty() {
             html.paragraph("Physical model modes matched to the invariant structural modes:");
-            let rows: Vec<Vec<String>> = role
+            let rows: Vec<Vec<String>> = pool
                 .matches
                 .iter()
                 .map(|m| {
-                    let inv = m.invariant.and_then(|i| role.invariant_modes.get(i));
+                    let inv = m.invariant.and_then(|i| pool.modes.get(i));
                     let or_dash = |v: Option<String>| v.unwrap_or_else(|| "-".into());
                     vec![
                         m.reference.label.clone(),
