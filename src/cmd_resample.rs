@@ -36,6 +36,15 @@ pub fn run(a: &ResampleArgs) -> Result<()> {
     if a.input.resample_to_hz.is_some() {
         bail!("use --to HZ with `vibmode resample` (--resample-to is for the analysis commands)");
     }
+    // Refuse early to overwrite the input (it would be truncated while still being read).
+    if let (Ok(i), Ok(o)) = (a.input.input.canonicalize(), a.output.canonicalize()) {
+        if i == o {
+            bail!(
+                "the output {} is the input file; write to another file (-o OUT.csv)",
+                a.output.display()
+            );
+        }
+    }
     let raw = a.input.load_raw()?;
     let p = ResampleParams {
         to_hz: a.to_hz,

@@ -136,6 +136,18 @@ fn analyze_and_sweep_errors_are_one_line_with_exit_code_2() {
     fails_with(&["sweep", a, "--orders", "5:2"], &["--orders", "5:2"]);
     fails_with(&["sweep", a, "--orders", "x"], &["--orders"]);
     fails_with(&["sweep", a, "--robust", "-2"], &["robust", "-2"]);
+    // Resampling onto its own input is refused and leaves the input whole.
+    let before = std::fs::read(a).unwrap();
+    fails_with(
+        &["resample", a, "--to", "25", "-o", a],
+        &["is the input file"],
+    );
+    assert_eq!(std::fs::read(a).unwrap(), before);
+    // Used to panic (exit 101) in the ARMA search.
+    fails_with(
+        &["fit", a, "--order", "4", "--ma-order", "5"],
+        &["q = 5", "p = 4"],
+    );
 }
 
 #[test]

@@ -106,7 +106,7 @@ pub fn max_arma_order(n: usize) -> usize {
 /// `outlier_cleaning`, additive spikes are first replaced by [`crate::clean_additive_outliers`]
 /// (count in `ArmaModel::outliers_replaced`).
 ///
-/// Errors: empty, non-finite or constant input; `p = 0`; `p + q > N/3`; invalid params.
+/// Errors: empty, non-finite or constant input; `p = 0`; `q > p`; `p + q > N/3`; invalid params.
 pub fn fit_arma(
     y: &[f64],
     p: usize,
@@ -948,6 +948,9 @@ fn check_orders(n: usize, p: usize, q: usize, init: Option<&ArmaModel>) -> Resul
             what: "ARMA AR order p",
             fix: "modes come from A(z); choose p >= 1 (e.g. p = q)",
         });
+    }
+    if q > p {
+        return Err(IdentError::MaOrderAboveAr { p, q });
     }
     if p + q > max_arma_order(n) {
         return Err(IdentError::OrderTooHigh {

@@ -40,6 +40,15 @@ pub enum IdentError {
         /// Largest allowed order for this number of samples.
         max_order: usize,
     },
+    /// An MA order above the AR order: the prediction-error criterion sums from t = p, so the
+    /// fit needs q <= p.
+    #[error("MA order q = {q} is above the AR order p = {p}; vibmode fits ARMA(p, q) with q <= p: lower q or raise p (the paper's ARMA(p, p))")]
+    MaOrderAboveAr {
+        /// AR order.
+        p: usize,
+        /// MA order.
+        q: usize,
+    },
     /// An order of zero where it is meaningless.
     #[error("{what} must be at least 1 (got 0); {fix}")]
     ZeroOrder {

@@ -698,6 +698,10 @@ fn bad_inputs_give_one_line_errors() {
     assert!(s.contains("AR order p") && s.contains("got 0"), "{s}");
     // q = 0 is a valid (robust AR) fit.
     assert!(fit_arma(&y, 2, 0, &ArmaParams::default()).is_ok());
+    // q > p is refused with the values (it used to panic: the criterion sums from t = p).
+    let s = one_line(fit_arma(&y, 4, 5, &ArmaParams::default()).unwrap_err());
+    assert!(s.contains("q = 5") && s.contains("p = 4"), "{s}");
+    assert!(fit_arma(&y, 4, 4, &ArmaParams::default()).is_ok());
     // Invalid params and warm start.
     let p = ArmaParams {
         tol: -1.0,
