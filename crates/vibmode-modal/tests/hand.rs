@@ -1,5 +1,9 @@
 //! Small cases checkable by hand: clustering, matching, stabilisation, and the bad-input paths.
 
+mod common;
+
+use common::script_params;
+
 use vibmode_modal::{
     analyse_poles, find_invariant_modes, match_reference, stabilisation, ClusterParams,
     InvariantMode, ModalError, ModeClass, ModeMatch, PoleObservation, ReferenceMode,
@@ -551,20 +555,4 @@ fn damped_mode_is_not_fragmented_lines_stay_apart() {
     let modes = find_invariant_modes(&poles, 1, &orders, &fixed).unwrap();
     assert_eq!(modes.len(), 2);
     assert!(modes.iter().all(|m| m.frequency_hz > 4.0));
-}
-
-/// The clustering settings of the reference script `tools/reference/modal.py` (and of these
-/// tests): vibmode-modal 0.1's defaults, spelled out. The analysis defaults
-/// (`ClusterParams::default()`) differ in five fields: a damping-scaled radius (0.5), a stricter
-/// order share (0.5), 0.3 Hz lowest frequency, no fixed highest frequency and a 2 % line spread.
-#[allow(dead_code)]
-fn script_params() -> ClusterParams {
-    ClusterParams {
-        freq_tol_per_damping: 0.0,
-        min_order_share: 0.25,
-        disturbance_freq_spread_max: 0.01,
-        freq_min_hz: 0.1,
-        freq_max_hz: Some(30.0),
-        ..ClusterParams::default()
-    }
 }

@@ -1,6 +1,10 @@
 //! Comparison with the independent scipy implementation in tools/reference/modal.py
 //! (cKDTree radius queries + csgraph connected components; numpy statistics).
 
+mod common;
+
+use common::script_params;
+
 use serde::Deserialize;
 use vibmode_modal::{analyse_poles, ClusterParams, InvariantMode, PoleObservation};
 
@@ -81,20 +85,4 @@ fn params_default_matches_reference_script() {
     .unwrap();
     let case: Case = serde_json::from_str(&text).unwrap();
     assert_eq!(case.params, script_params());
-}
-
-/// The clustering settings of the reference script `tools/reference/modal.py` (and of these
-/// tests): vibmode-modal 0.1's defaults, spelled out. The analysis defaults
-/// (`ClusterParams::default()`) differ in five fields: a damping-scaled radius (0.5), a stricter
-/// order share (0.5), 0.3 Hz lowest frequency, no fixed highest frequency and a 2 % line spread.
-#[allow(dead_code)]
-fn script_params() -> ClusterParams {
-    ClusterParams {
-        freq_tol_per_damping: 0.0,
-        min_order_share: 0.25,
-        disturbance_freq_spread_max: 0.01,
-        freq_min_hz: 0.1,
-        freq_max_hz: Some(30.0),
-        ..ClusterParams::default()
-    }
 }
