@@ -9,7 +9,7 @@ use vibmode_vehicle::{simulate, ModeLabel, SimParams, VehicleParams};
 #[test]
 fn demo_data_gives_the_true_modes_and_lines() {
     let vehicle = VehicleParams::city_bus();
-    let sim = simulate(&vehicle, &SimParams::demo(8, 1)).expect("simulation");
+    let sim = simulate(&vehicle, &SimParams::demo_ideal(8, 1)).expect("simulation");
     let records: Vec<RecordInput> = sim
         .records
         .iter()

@@ -19,7 +19,7 @@ fn records_with_stops() -> (Vec<RecordInput>, Vec<f64>) {
     let vehicle = VehicleParams::city_bus();
     let params = SimParams {
         fs_hz: 500.0,
-        ..SimParams::demo(6, 3)
+        ..SimParams::demo_ideal(6, 3)
     };
     let sim = simulate(&vehicle, &params).expect("simulation");
     let body: Vec<f64> = sim

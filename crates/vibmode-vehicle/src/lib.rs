@@ -33,12 +33,14 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod lines;
 pub mod model;
 pub mod params;
 pub mod road;
 pub mod sim;
 
 pub use error::{Result, VehicleError};
+pub use lines::LineTruth;
 pub use model::{FullCar, ModeInfo, ModeLabel, SensorPsd};
 pub use params::{
     default_sensors, Axle, Bending, Body, Corner, Geometry, SensorKind, SensorSpec, VehicleParams,

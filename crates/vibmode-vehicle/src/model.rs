@@ -107,6 +107,28 @@ pub struct ModeInfo {
     pub shape_im: Vec<f64>,
     /// Fraction of the modal kinetic energy (M_ii |v_i|^2 / sum) per DOF.
     pub energy_fraction: Vec<f64>,
+    /// Names of the sensors, in the order of `sensor_shape_re` / `sensor_shape_im`.
+    #[serde(default)]
+    pub sensor_names: Vec<String>,
+    /// Real part of the mode shape seen by the sensors (their displacements; accelerations are
+    /// the same shape times -s^2), normalised so that the largest-modulus sensor is 1 + 0i.
+    /// This is what a multichannel identification of the sensor signals should find.
+    #[serde(default)]
+    pub sensor_shape_re: Vec<f64>,
+    /// Imaginary part of the sensor mode shape.
+    #[serde(default)]
+    pub sensor_shape_im: Vec<f64>,
+}
+
+impl ModeInfo {
+    /// The sensor mode shape as `[re, im]` pairs (empty when the sensors are unknown).
+    pub fn sensor_shape(&self) -> Vec<[f64; 2]> {
+        self.sensor_shape_re
+            .iter()
+            .zip(&self.sensor_shape_im)
+            .map(|(&re, &im)| [re, im])
+            .collect()
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -334,6 +356,7 @@ impl FullCar {
             let norm = v[imax];
             let shape: Vec<Complex64> = v.iter().map(|x| x / norm).collect();
             let label = label_mode(&energy, &shape);
+            let sensor_shape = self.sensor_shape(&shape);
             let w = s.norm();
             out.push(ModeInfo {
                 frequency_hz: w / (2.0 * std::f64::consts::PI),
@@ -344,10 +367,39 @@ impl FullCar {
                 shape_re: shape.iter().map(|x| x.re).collect(),
                 shape_im: shape.iter().map(|x| x.im).collect(),
                 energy_fraction: energy,
+                sensor_names: self.sensor_names(),
+                sensor_shape_re: sensor_shape.iter().map(|x| x.re).collect(),
+                sensor_shape_im: sensor_shape.iter().map(|x| x.im).collect(),
             });
         }
         out.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
         Ok(out)
+    }
+
+    /// The DOF shape seen by the sensors (row . shape per sensor), largest modulus 1 + 0i.
+    fn sensor_shape(&self, shape: &[Complex64]) -> Vec<Complex64> {
+        let raw: Vec<Complex64> = self
+            .sensors
+            .iter()
+            .map(|s| {
+                s.row
+                    .iter()
+                    .zip(shape)
+                    .map(|(r, v)| v * *r)
+                    .sum::<Complex64>()
+            })
+            .collect();
+        let big = raw.iter().copied().fold(Complex64::new(0.0, 0.0), |b, x| {
+            if x.norm() > b.norm() {
+                x
+            } else {
+                b
+            }
+        });
+        if big.norm() == 0.0 {
+            return raw;
+        }
+        raw.iter().map(|x| x / big).collect()
     }
 
     /// Null vector of s^2 M + s C + K (smallest right singular vector).

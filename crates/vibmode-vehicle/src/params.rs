@@ -201,6 +201,7 @@ pub struct VehicleParams {
 }
 
 const CITY_BUS_TOML: &str = include_str!("../../../examples/city_bus.toml");
+const CITY_BUS_FLEXIBLE_TOML: &str = include_str!("../../../examples/city_bus_flexible.toml");
 const PASSENGER_CAR_TOML: &str = include_str!("../../../examples/passenger_car.toml");
 
 impl Default for VehicleParams {
@@ -219,6 +220,17 @@ impl VehicleParams {
         // The shipped file is checked by the unit tests, so parsing cannot fail.
         Self::from_toml_str(CITY_BUS_TOML)
             .unwrap_or_else(|e| panic!("examples/city_bus.toml is invalid: {e}"))
+    }
+
+    /// The city bus with a flexible body shipped in `examples/city_bus_flexible.toml`
+    /// (compiled in): rigid-body modes at ~1.03, 1.17 and 1.33 Hz and a first bending mode at
+    /// ~9.0 Hz between the axle modes. The vehicle of `vibmode demo`.
+    ///
+    /// # Panics
+    /// Only if the compiled-in example file were invalid; the test suite parses it.
+    pub fn city_bus_flexible() -> Self {
+        Self::from_toml_str(CITY_BUS_FLEXIBLE_TOML)
+            .unwrap_or_else(|e| panic!("examples/city_bus_flexible.toml is invalid: {e}"))
     }
 
     /// The passenger car shipped in `examples/passenger_car.toml` (compiled in).

@@ -1,6 +1,7 @@
 //! Exact (first-order-hold) discretisation and the measurement-campaign simulator.
 
 use crate::error::{invalid, Result, VehicleError};
+use crate::lines::{LineBank, LineTruth, OrnsteinUhlenbeck};
 use crate::model::{FullCar, ModeInfo, DOF_HEAVE, DOF_PITCH, DOF_ROLL};
 use crate::params::{Corner, VehicleParams};
 use crate::road::{
@@ -15,7 +16,16 @@ use std::f64::consts::PI;
 use vibmode_core::{Channel, Recording};
 
 /// A periodic engine / driveline line: a vertical force on the body.
-/// In serialised form `drift_hz` (0), `drift_period_s` (30), `x_m` and `y_m` (0) may be omitted.
+/// In serialised form every field but `frequency_hz` and `force_n` may be omitted: `drift_hz` (0),
+/// `drift_period_s` (30), `x_m` and `y_m` (0), `wander_rel_std` (0), `wander_correlation_s` (2),
+/// `am_rel_std` (0), `am_correlation_s` (1), `speed_coupling` (0).
+///
+/// Instantaneous frequency: `frequency_hz * g_r * (1 + w(t)) * (v(t) / v0)^speed_coupling +
+/// drift_hz * sin(2 pi t / drift_period_s)`, where `g_r` is the record's engine-speed factor
+/// ([`Disturbances::engine_speed_record_rel_std`]), `w` a Gauss-Markov wander of relative
+/// standard deviation `wander_rel_std` and correlation time `wander_correlation_s`, and `v / v0`
+/// the speed ratio from the manoeuvres. Amplitude: `force_n * (1 + m(t))` with `m` a
+/// Gauss-Markov modulation of standard deviation `am_rel_std`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EngineLine {
@@ -35,10 +45,54 @@ pub struct EngineLine {
     /// Body y of the force (to the left of the centre of gravity), m.
     #[serde(default)]
     pub y_m: f64,
+    /// Relative standard deviation of the slow random frequency wander (0 = none; real engines
+    /// ~1e-3).
+    #[serde(default)]
+    pub wander_rel_std: f64,
+    /// Correlation time of the frequency wander, s.
+    #[serde(default = "default_wander_correlation")]
+    pub wander_correlation_s: f64,
+    /// Relative standard deviation of the random amplitude modulation (0 = none; ~0.1).
+    #[serde(default)]
+    pub am_rel_std: f64,
+    /// Correlation time of the amplitude modulation, s.
+    #[serde(default = "default_am_correlation")]
+    pub am_correlation_s: f64,
+    /// Exponent of the speed ratio in the frequency: 0 = independent of the vehicle speed,
+    /// 1 = proportional to it (a driveline order in a fixed gear).
+    #[serde(default)]
+    pub speed_coupling: f64,
+}
+
+impl EngineLine {
+    /// A constant line of `force_n` at `frequency_hz` applied at the centre of gravity.
+    pub fn constant(frequency_hz: f64, force_n: f64) -> Self {
+        EngineLine {
+            frequency_hz,
+            force_n,
+            drift_hz: 0.0,
+            drift_period_s: default_drift_period(),
+            x_m: 0.0,
+            y_m: 0.0,
+            wander_rel_std: 0.0,
+            wander_correlation_s: default_wander_correlation(),
+            am_rel_std: 0.0,
+            am_correlation_s: default_am_correlation(),
+            speed_coupling: 0.0,
+        }
+    }
 }
 
 fn default_drift_period() -> f64 {
     30.0
+}
+
+fn default_wander_correlation() -> f64 {
+    2.0
+}
+
+fn default_am_correlation() -> f64 {
+    1.0
 }
 
 /// A sinusoidal tone added to every channel (models pick-up above the anti-alias cutoff).
@@ -66,6 +120,16 @@ pub struct Disturbances {
     pub sensor_bias_max_m_s2: f64,
     /// High-frequency tones added to every channel (random phase per channel; default none).
     pub hf_tones: Vec<Tone>,
+    /// Relative standard deviation of the engine speed from record to record (default 0): each
+    /// record draws one log-normal factor that multiplies the frequency of every line.
+    pub engine_speed_record_rel_std: f64,
+    /// Sensor misalignment (default 0): each sensor is tilted by an angle drawn uniformly from
+    /// +-this value about the lateral axis and another about the longitudinal axis, deg. It then
+    /// measures `cos a cos b` of the vertical acceleration plus `sin a` of the longitudinal
+    /// acceleration (speed changes) and `sin b` of the lateral one (turns). Gravity is left out:
+    /// its constant component is part of the bias. The angles drawn are in
+    /// [`Truth::sensor_misalignment_deg`].
+    pub sensor_misalignment_max_deg: f64,
 }
 
 impl Disturbances {
@@ -74,12 +138,11 @@ impl Disturbances {
     /// 150 Hz, 1.3 kHz and 6 kHz (0.05, 0.1, 0.2 m/s^2).
     pub fn in_service() -> Self {
         let line = |f: f64, force: f64, drift: f64| EngineLine {
-            frequency_hz: f,
-            force_n: force,
             drift_hz: drift,
             drift_period_s: 20.0,
             x_m: -3.0,
             y_m: 0.3,
+            ..EngineLine::constant(f, force)
         };
         Disturbances {
             engine_lines: vec![
@@ -103,6 +166,8 @@ impl Disturbances {
                     amplitude_m_s2: 0.2,
                 },
             ],
+            engine_speed_record_rel_std: 0.0,
+            sensor_misalignment_max_deg: 0.0,
         }
     }
 }
@@ -137,7 +202,7 @@ impl Manoeuvre {
 /// Simulator settings. Defaults: road C, default coherence (exponential, 0.2 cycles/m),
 /// tyre enveloping 3 cycles/m,
 /// 40 km/h, 8 records of 10.24 s at 20 kHz, seed 0, no manoeuvres, no disturbances,
-/// automatic warm-up. Missing fields take these defaults when deserialised (e.g. from a TOML
+/// automatic warm-up, no speed wander. Missing fields take these defaults when deserialised (e.g. from a TOML
 /// or JSON config); unknown fields are errors.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -165,6 +230,12 @@ pub struct SimParams {
     /// Warm-up driven before record 0 and discarded, s. `None` (default): 5 times the slowest
     /// modal decay time 1/(zeta omega), clamped to 2..30 s.
     pub warmup_s: Option<f64>,
+    /// Relative standard deviation of a slow random speed variation on top of the manoeuvres
+    /// (default 0): the speed is `v(t) (1 + u(t))` with `u` a Gauss-Markov process of
+    /// correlation time `speed_wander_correlation_s`.
+    pub speed_wander_rel_std: f64,
+    /// Correlation time of the speed variation, s (default 5).
+    pub speed_wander_correlation_s: f64,
 }
 
 impl Default for SimParams {
@@ -181,15 +252,50 @@ impl Default for SimParams {
             manoeuvres: Vec::new(),
             disturbances: Disturbances::default(),
             warmup_s: None,
+            speed_wander_rel_std: 0.0,
+            speed_wander_correlation_s: 5.0,
         }
     }
 }
 
 impl SimParams {
-    /// The settings of `vibmode demo`: [`SimParams::in_service`] on an ISO 8608 class B road
-    /// at 30 km/h, `records` records of 10.24 s at 20 kHz, engine/gear lines of 3 kN each
-    /// (strong enough to stand out of the body response, as on the paper's bus).
+    /// The settings of `vibmode demo` (use them with
+    /// [`VehicleParams::city_bus_flexible`](crate::VehicleParams::city_bus_flexible)):
+    /// [`SimParams::in_service`] on an ISO 8608 class B road at 30 km/h, `records` records of
+    /// 10.24 s at 20 kHz, and what real buses add:
+    /// - engine/gear lines of 3 kN each (strong enough to stand out of the body response, as
+    ///   on the paper's bus) whose frequency wanders (relative std 1e-3, correlation time 2 s)
+    ///   and whose amplitude is modulated (10 %, 1 s); the engine speed differs from record to
+    ///   record (2 %), and the 7 Hz driveline line follows the vehicle speed (braking and
+    ///   acceleration sweep it);
+    /// - a speed that varies within each record (3 %, correlation time 5 s);
+    /// - sensors misaligned by up to 3 deg.
     pub fn demo(records: usize, seed: u64) -> Self {
+        let mut p = SimParams {
+            road: RoadClass::B,
+            speed_kmh: 30.0,
+            records,
+            seed,
+            speed_wander_rel_std: 0.03,
+            ..SimParams::in_service()
+        };
+        p.disturbances.engine_speed_record_rel_std = 0.02;
+        p.disturbances.sensor_misalignment_max_deg = 3.0;
+        for line in &mut p.disturbances.engine_lines {
+            line.force_n = 3000.0;
+            line.wander_rel_std = 1e-3;
+            line.am_rel_std = 0.1;
+            if line.frequency_hz < 8.0 {
+                line.speed_coupling = 1.0;
+            }
+        }
+        p
+    }
+
+    /// [`SimParams::demo`] as it was before vibmode 0.2: constant-amplitude lines at fixed
+    /// frequencies, a steady speed between the manoeuvres, aligned sensors (use it with
+    /// [`VehicleParams::city_bus`](crate::VehicleParams::city_bus)). The idealised case.
+    pub fn demo_ideal(records: usize, seed: u64) -> Self {
         let mut p = SimParams {
             road: RoadClass::B,
             speed_kmh: 30.0,
@@ -340,6 +446,32 @@ impl SimParams {
                     "must be positive (s)",
                 ));
             }
+            let rel = |key: &str, v: f64, max: f64| -> Result<()> {
+                if v.is_finite() && (0.0..=max).contains(&v) {
+                    Ok(())
+                } else {
+                    Err(invalid(
+                        format!("engine_lines[{i}].{key}"),
+                        v,
+                        format!("must be between 0 and {max}"),
+                    ))
+                }
+            };
+            rel("wander_rel_std", l.wander_rel_std, 0.2)?;
+            rel("am_rel_std", l.am_rel_std, 0.5)?;
+            rel("speed_coupling", l.speed_coupling, 2.0)?;
+            for (key, v) in [
+                ("wander_correlation_s", l.wander_correlation_s),
+                ("am_correlation_s", l.am_correlation_s),
+            ] {
+                if !(v.is_finite() && v > 0.0 && v <= 1e4) {
+                    return Err(invalid(
+                        format!("engine_lines[{i}].{key}"),
+                        v,
+                        "must be positive and at most 10000 (s)",
+                    ));
+                }
+            }
             if !(l.force_n.is_finite() && l.x_m.is_finite() && l.y_m.is_finite()) {
                 return Err(invalid(
                     format!("engine_lines[{i}].force_n"),
@@ -360,6 +492,43 @@ impl SimParams {
                 "sensor_bias_max_m_s2",
                 d.sensor_bias_max_m_s2,
                 "must be >= 0 (m/s^2)",
+            ));
+        }
+        if !(d.engine_speed_record_rel_std.is_finite()
+            && (0.0..=0.3).contains(&d.engine_speed_record_rel_std))
+        {
+            return Err(invalid(
+                "engine_speed_record_rel_std",
+                d.engine_speed_record_rel_std,
+                "must be between 0 and 0.3",
+            ));
+        }
+        if !(d.sensor_misalignment_max_deg.is_finite()
+            && (0.0..=45.0).contains(&d.sensor_misalignment_max_deg))
+        {
+            return Err(invalid(
+                "sensor_misalignment_max_deg",
+                d.sensor_misalignment_max_deg,
+                "must be between 0 and 45 (deg)",
+            ));
+        }
+        if !(self.speed_wander_rel_std.is_finite()
+            && (0.0..=0.3).contains(&self.speed_wander_rel_std))
+        {
+            return Err(invalid(
+                "speed_wander_rel_std",
+                self.speed_wander_rel_std,
+                "must be between 0 and 0.3",
+            ));
+        }
+        if !(self.speed_wander_correlation_s.is_finite()
+            && self.speed_wander_correlation_s > 0.0
+            && self.speed_wander_correlation_s <= 1e4)
+        {
+            return Err(invalid(
+                "speed_wander_correlation_s",
+                self.speed_wander_correlation_s,
+                "must be positive and at most 10000 (s)",
             ));
         }
         for (i, t) in d.hf_tones.iter().enumerate() {
@@ -395,6 +564,11 @@ pub struct Truth {
     pub modes: Vec<ModeInfo>,
     /// Nominal frequencies of the engine / gear lines, Hz.
     pub disturbance_lines_hz: Vec<f64>,
+    /// What each engine / gear line did in each record (its frequency moves with the engine
+    /// speed, the wander and the drift).
+    pub lines: Vec<LineTruth>,
+    /// Tilt of each sensor (about the lateral axis, about the longitudinal axis), deg.
+    pub sensor_misalignment_deg: Vec<[f64; 2]>,
     /// Frequencies of the added high-frequency tones, Hz.
     pub hf_tones_hz: Vec<f64>,
     /// Bias drawn for each channel, m/s^2.
@@ -763,17 +937,46 @@ fn wheel_tracks(wheelbase_m: f64) -> [(usize, f64); 4] {
 }
 
 /// Adds the engine/gear lines' generalised forces at time `t` (s) to `f` (heave N, pitch and
-/// roll N m); each line's phase drifts sinusoidally (`drift_hz` over `drift_period_s`).
-fn add_line_forces(f: &mut [f64], lines: &[(EngineLine, f64)], t: f64) {
-    for (l, ph0) in lines {
-        let phase = ph0
-            + 2.0 * PI * l.frequency_hz * t
-            + l.drift_hz * l.drift_period_s * (1.0 - (2.0 * PI * t / l.drift_period_s).cos());
-        let force = l.force_n * phase.sin();
+/// roll N m), stepping the lines' random processes.
+fn add_line_forces(f: &mut [f64], lines: &mut LineBank, t: f64, speed_ratio: f64) {
+    for (l, force) in lines.forces(t, speed_ratio) {
         f[DOF_HEAVE] += force;
         f[DOF_PITCH] += force * l.x_m;
         f[DOF_ROLL] += force * l.y_m;
     }
+}
+
+/// Multiplies the speed by `1 + u(t)`, `u` the speed wander (stream 4 of the seed), kept
+/// above half the speed.
+fn add_speed_wander(speed: &mut [f64], sim: &SimParams, dt: f64) {
+    let mut rng = ChaCha8Rng::seed_from_u64(sim.seed);
+    rng.set_stream(4);
+    if let Some(mut u) = OrnsteinUhlenbeck::new(
+        sim.speed_wander_rel_std,
+        sim.speed_wander_correlation_s,
+        dt,
+        &mut rng,
+    ) {
+        for v in speed.iter_mut() {
+            *v *= (1.0 + u.next(&mut rng)).max(0.5);
+        }
+    }
+}
+
+/// Each sensor's tilt angles (about the lateral axis, about the longitudinal axis), deg.
+fn misalignment_angles(n: usize, max_deg: f64, rng: &mut ChaCha8Rng) -> Vec<[f64; 2]> {
+    (0..n)
+        .map(|_| {
+            if max_deg > 0.0 {
+                [
+                    rng.gen_range(-1.0..1.0) * max_deg,
+                    rng.gen_range(-1.0..1.0) * max_deg,
+                ]
+            } else {
+                [0.0, 0.0]
+            }
+        })
+        .collect()
 }
 
 /// Position along the road (m) at each sample, integrating `speed` (m/s) by the trapezoidal rule
@@ -789,10 +992,19 @@ fn positions(speed: &[f64], dt: f64) -> (Vec<f64>, f64) {
 }
 
 /// What the identification should find, and what was drawn.
-fn make_truth(sim: &SimParams, modes: Vec<ModeInfo>, bias: Vec<f64>, warmup_s: f64) -> Truth {
+fn make_truth(
+    sim: &SimParams,
+    modes: Vec<ModeInfo>,
+    bias: Vec<f64>,
+    warmup_s: f64,
+    lines: Vec<LineTruth>,
+    misalignment: Vec<[f64; 2]>,
+) -> Truth {
     let dist = &sim.disturbances;
     Truth {
         modes,
+        lines,
+        sensor_misalignment_deg: misalignment,
         disturbance_lines_hz: dist.engine_lines.iter().map(|l| l.frequency_hz).collect(),
         hf_tones_hz: dist.hf_tones.iter().map(|t| t.frequency_hz).collect(),
         sensor_bias_m_s2: bias,
@@ -838,7 +1050,9 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
             .sum::<f64>()
     };
     let nk = n_total + 2;
-    let speed = speed_profile(v0, nk, dt, time, ax)?;
+    let speed_manoeuvres = speed_profile(v0, nk, dt, time, ax)?;
+    let mut speed = speed_manoeuvres.clone();
+    add_speed_wander(&mut speed, sim, dt);
     let wb = vehicle.geometry.wheelbase_m;
     let (pos, dx) = positions(&speed, dt);
     let length = pos[nk - 1] + wb + 4.0 * dx;
@@ -854,14 +1068,21 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
     };
     // Generalised forces.
     let n = car.n;
-    let lines: Vec<(EngineLine, f64)> = sim
-        .disturbances
-        .engine_lines
-        .iter()
-        .map(|l| (l.clone(), rng2.gen_range(0.0..2.0 * PI)))
-        .collect();
-    let d = Discrete::new(&car, fs)?;
+    let mut rng3 = ChaCha8Rng::seed_from_u64(sim.seed);
+    rng3.set_stream(3);
     let p = car.sensors.len();
+    let dist = &sim.disturbances;
+    let tilt = misalignment_angles(p, dist.sensor_misalignment_max_deg, &mut rng3);
+    let mut lines = LineBank::new(
+        &dist.engine_lines,
+        dist.engine_speed_record_rel_std,
+        sim.records,
+        sim.duration_s,
+        dt,
+        &mut rng2,
+        rng3,
+    );
+    let d = Discrete::new(&car, fs)?;
     let mut samples: Vec<Vec<f64>> = vec![vec![0.0; n_rec * sim.records]; p];
     // State index k of `run` corresponds to array index k + 1.
     d.run(
@@ -873,7 +1094,7 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
             u[..4].copy_from_slice(&r);
             let t = time(idx);
             let f = &mut u[4..4 + n];
-            add_line_forces(f, &lines, t);
+            add_line_forces(f, &mut lines, t, speed_manoeuvres[idx] / v0);
             if !sim.manoeuvres.is_empty() {
                 f[DOF_PITCH] += body_m * ax(t) * h_cg;
                 f[DOF_ROLL] += body_m * ay(t) * h_cg;
@@ -886,17 +1107,27 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
         |k, y| {
             if k >= n_warm {
                 let j = k - n_warm;
-                for (s, v) in samples.iter_mut().zip(y) {
-                    s[j] = *v;
+                if dist.sensor_misalignment_max_deg > 0.0 {
+                    // Longitudinal acceleration from the speed, lateral from the manoeuvres.
+                    let idx = k + 1;
+                    let a_x = (speed[idx + 1] - speed[idx - 1]) / (2.0 * dt);
+                    let a_y = ay(time(idx));
+                    for ((s, v), [a, b]) in samples.iter_mut().zip(y).zip(&tilt) {
+                        let (a, b) = (a.to_radians(), b.to_radians());
+                        s[j] = a.cos() * b.cos() * v + a.sin() * a_x + b.sin() * a_y;
+                    }
+                } else {
+                    for (s, v) in samples.iter_mut().zip(y) {
+                        s[j] = *v;
+                    }
                 }
             }
         },
     );
-    let dist = &sim.disturbances;
     let bias = add_sensor_effects(&mut samples, dist, dt, &mut rng2);
     let records = split_records(samples, &car, &speed, n_warm, n_rec, fs);
     Ok(Simulation {
         records,
-        truth: make_truth(sim, modes, bias, warmup_s),
+        truth: make_truth(sim, modes, bias, warmup_s, lines.truth(), tilt),
     })
 }

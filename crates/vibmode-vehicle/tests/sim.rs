@@ -199,12 +199,9 @@ fn disturbances_show_up_where_expected() {
     let fs = 1000.0;
     let dist = Disturbances {
         engine_lines: vec![EngineLine {
-            frequency_hz: 7.0,
-            force_n: 500.0,
-            drift_hz: 0.0,
             drift_period_s: 10.0,
             x_m: -3.0,
-            y_m: 0.0,
+            ..EngineLine::constant(7.0, 500.0)
         }],
         sensor_noise_std_m_s2: 0.05,
         sensor_bias_max_m_s2: 0.2,
@@ -212,6 +209,7 @@ fn disturbances_show_up_where_expected() {
             frequency_hz: 150.0,
             amplitude_m_s2: 0.3,
         }],
+        ..Disturbances::default()
     };
     let sp = SimParams {
         road: RoadClass::A,
