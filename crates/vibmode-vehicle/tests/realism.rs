@@ -1,3 +1,4 @@
+#![allow(clippy::needless_range_loop)]
 //! The simulator's in-service effects, each checked against what it must do physically, over
 //! several seeds: lines that move from record to record and follow the speed, wander and
 //! amplitude modulation, misaligned sensors, speed variation, bending shapes at the sensors.
