@@ -30,8 +30,8 @@ pub use modes::{
     ReferenceMode, SupportFailure,
 };
 pub use params::{
-    BandLimit, ClusterParams, PoleFilterParams, PreprocessParams, Robust, SpectrumParams,
-    StopParams, SweepModel, SweepParams, DEFAULT_HUBER_FACTOR, EDGE_SHARE,
+    BandLimit, ClusterParams, LineParams, PoleFilterParams, PreprocessParams, Robust,
+    SpectrumParams, StopParams, SweepModel, SweepParams, DEFAULT_HUBER_FACTOR, EDGE_SHARE,
     EMPTY_BAND_MAX_CUTOFF_SHARE,
 };
 pub use placement::{Corner, Direction, Placement, Role};

@@ -47,14 +47,17 @@
 
 mod error;
 mod integrate;
+mod lines;
 mod params;
 mod welch;
 mod window;
 
 pub use error::SpectraError;
 pub use integrate::{band_rms, peak, rms};
+pub use lines::{line_candidates, narrowband_kurtosis, LineCandidate};
 pub use num_complex::Complex64;
 pub use params::{Average, Detrend, PeriodogramParams, Scaling, ShortRecord, WelchParams, Window};
+pub use vibmode_core::LineParams;
 pub use welch::{Coherence, CrossSpectrum, Spectrum, WelchPlan};
 pub use window::window_values;
 
