@@ -5,8 +5,8 @@ use std::path::Path;
 
 use crate::AnalysisError;
 use vibmode_core::{
-    ClusterParams, Corner, PoleFilterParams, PreprocessParams, Role, SpectrumParams, StopParams,
-    SweepParams,
+    ClusterParams, Corner, LineParams, PoleFilterParams, PreprocessParams, Role, SpectrumParams,
+    StopParams, SweepParams,
 };
 
 /// Named sets of defaults.
@@ -101,6 +101,8 @@ pub struct AnalysisConfig {
     pub stops: StopParams,
     /// Clustering and classification.
     pub cluster: ClusterParams,
+    /// Periodic line detection and tracking.
+    pub lines: LineParams,
     /// What the report draws.
     pub report: ReportParams,
 }
@@ -170,6 +172,7 @@ impl AnalysisConfig {
             poles: PoleFilterParams::default(),
             stops: StopParams::default(),
             cluster: ClusterParams::default(),
+            lines: LineParams::default(),
             report: ReportParams::default(),
         };
         match p {
@@ -258,6 +261,7 @@ impl AnalysisConfig {
         self.poles.validate()?;
         self.stops.validate(self.preprocess.cutoff_hz)?;
         self.cluster.validate()?;
+        self.lines.validate()?;
         Ok(())
     }
 

@@ -26,6 +26,7 @@
 mod config;
 pub mod first_record;
 pub mod identify;
+pub mod lines;
 pub mod pipeline;
 pub mod results;
 pub mod source;
@@ -35,6 +36,7 @@ pub mod store;
 pub use config::{AnalysisConfig, ChannelRole, Preset, ReportParams};
 pub use first_record::{first_record_spectra, FirstRecordSpectra, ModelPsd};
 pub use identify::{Identifier, PoleOut, SignalFits, SweepIdentifier};
+pub use lines::LineTrack;
 pub use pipeline::{analyze, analyze_with, check_records, cluster_params_for, preprocess_records};
 pub use results::{
     AnalysisResults, ChannelAnalysis, RecordSummary, RoleAnalysis, Timing, SCHEMA_VERSION,

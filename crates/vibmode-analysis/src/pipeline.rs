@@ -12,6 +12,7 @@ use vibmode_spectra::{WelchParams, Window};
 
 use crate::config::AnalysisConfig;
 use crate::identify::{Identifier, SignalFits, SweepIdentifier};
+use crate::lines::LineStage;
 use crate::results::{
     AnalysisResults, ChannelAnalysis, RecordSummary, RoleAnalysis, Timing, SCHEMA_VERSION,
 };
@@ -151,6 +152,11 @@ pub fn analyze_with(
         orders: &orders,
         cluster: &cluster,
     };
+    let lines = LineStage {
+        pre: &pre,
+        used: stationary.iter().map(|s| !s).collect(),
+        params: &cfg.lines,
+    };
     let mut store = PoleStore::new();
     let channels = channel_modes(
         &records[0].recording,
@@ -158,9 +164,10 @@ pub fn analyze_with(
         &stationary,
         cfg,
         &support,
+        &lines,
         &mut store,
     )?;
-    let roles = role_modes(&channels, &store, &support, reference)?;
+    let roles = role_modes(&channels, &store, &support, &lines, reference)?;
     let fits = channels.iter().flat_map(|c| c.fits.iter());
     let n_fits = fits.clone().count();
     let n_not_converged = fits.clone().filter(|f| !f.converged).count();
@@ -334,6 +341,7 @@ fn channel_modes(
     stationary: &[bool],
     cfg: &AnalysisConfig,
     support: &Support<'_>,
+    lines: &LineStage<'_>,
     store: &mut PoleStore,
 ) -> Result<Vec<ChannelAnalysis>, AnalysisError> {
     let mut channels = Vec::with_capacity(first.n_channels());
@@ -345,7 +353,8 @@ fn channel_modes(
             .flat_map(|o| o.fits.poles.iter().copied())
             .collect();
         store.add(&ch.name, placement.role, &poles);
-        let invariant_modes = support.cluster(store, |n, _| n == ch.name)?;
+        let mut invariant_modes = support.cluster(store, |n, _| n == ch.name)?;
+        lines.classify(&mut invariant_modes, &[c]);
         let (welch_freq_hz, welch_psd) = mean_welch(&mine, stationary);
         channels.push(ChannelAnalysis {
             name: ch.name.clone(),
@@ -365,6 +374,7 @@ fn channel_modes(
                 .map(|o| o.fits.models.clone())
                 .unwrap_or_default(),
             invariant_modes,
+            lines: lines.tracks(&[c]),
         });
     }
     Ok(channels)
@@ -378,6 +388,7 @@ fn role_modes(
     channels: &[ChannelAnalysis],
     store: &PoleStore,
     support: &Support<'_>,
+    lines: &LineStage<'_>,
     reference: &[ReferenceMode],
 ) -> Result<Vec<RoleAnalysis>, AnalysisError> {
     let mut roles = Vec::new();
@@ -390,7 +401,14 @@ fn role_modes(
         if names.is_empty() {
             continue;
         }
-        let invariant = support.cluster(store, |_, r| r == role)?;
+        let idx: Vec<usize> = channels
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.role == role)
+            .map(|(i, _)| i)
+            .collect();
+        let mut invariant = support.cluster(store, |_, r| r == role)?;
+        lines.classify(&mut invariant, &idx);
         let matches = if reference.is_empty() {
             Vec::new()
         } else {
@@ -401,6 +419,7 @@ fn role_modes(
             channels: names,
             invariant_modes: invariant,
             matches,
+            lines: lines.tracks(&idx),
         });
     }
     Ok(roles)

@@ -10,11 +10,13 @@ use vibmode_core::{
 
 use crate::config::AnalysisConfig;
 use crate::identify::PoleOut;
+use crate::lines::LineTrack;
 
 /// Version of the layout of [`AnalysisResults`] (`schema_version` in `results.json`). 2: stage
 /// sections in `config`, per-record bands, fit errors kept, model coefficients instead of model
-/// spectra, timing apart.
-pub const SCHEMA_VERSION: u32 = 2;
+/// spectra, timing apart. 3: periodic line tracks (`lines`) per channel and pool, each mode's
+/// `line_kurtosis`, the `[lines]` config section.
+pub const SCHEMA_VERSION: u32 = 3;
 
 /// Facts about one analysed record.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -68,6 +70,9 @@ pub struct ChannelAnalysis {
     pub first_record_models: Vec<ModelCoefficients>,
     /// Invariant modes of this channel alone.
     pub invariant_modes: Vec<InvariantMode>,
+    /// Periodic lines of this channel, tracked over the records.
+    #[serde(default)]
+    pub lines: Vec<LineTrack>,
 }
 
 /// Modes pooled over all channels of one role.
@@ -79,6 +84,9 @@ pub struct RoleAnalysis {
     pub channels: Vec<String>,
     /// Invariant modes of the pool.
     pub invariant_modes: Vec<InvariantMode>,
+    /// Periodic lines of the pool's channels, tracked over the records.
+    #[serde(default)]
+    pub lines: Vec<LineTrack>,
     /// Reference (physical model) modes matched to the invariant structural modes.
     pub matches: Vec<ModeMatch>,
 }

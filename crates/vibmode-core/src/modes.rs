@@ -131,6 +131,11 @@ pub struct InvariantMode {
     pub min_order: usize,
     /// Classification.
     pub class: ModeClass,
+    /// Median kurtosis of the signal band-passed around the mode's frequency over the records
+    /// and channels of its pool (1.5 for a sine, 3 for a randomly excited mode), when the
+    /// analysis computed it (line detection on).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub line_kurtosis: Option<f64>,
 }
 
 impl InvariantMode {

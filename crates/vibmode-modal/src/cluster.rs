@@ -375,6 +375,7 @@ fn summarise(
         roles,
         min_order: kept.iter().map(|&i| poles[i].order).min().unwrap_or(0),
         class,
+        line_kurtosis: None,
     };
     (mode, kept)
 }

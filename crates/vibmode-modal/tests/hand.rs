@@ -162,6 +162,7 @@ fn mode(f: f64, z: f64, class: ModeClass) -> InvariantMode {
         roles: vec![],
         min_order: 4,
         class,
+        line_kurtosis: None,
     }
 }
 

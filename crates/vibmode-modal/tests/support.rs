@@ -53,6 +53,7 @@ fn hand_case_message() {
         roles: vec![],
         min_order: 4,
         class: ModeClass::Spurious,
+        line_kurtosis: None,
     };
     let f = m.support_failures(&ClusterParams::default(), 20);
     assert_eq!(
