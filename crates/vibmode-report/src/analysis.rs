@@ -74,6 +74,7 @@ struct Pool<'a> {
     modes: &'a [InvariantMode],
     matches: &'a [vibmode_core::ModeMatch],
     channels: Vec<&'a vibmode_analysis::ChannelAnalysis>,
+    lines: &'a [vibmode_analysis::LineTrack],
 }
 
 fn pools(r: &AnalysisResults) -> Vec<Pool<'_>> {
@@ -86,6 +87,7 @@ fn pools(r: &AnalysisResults) -> Vec<Pool<'_>> {
             modes: &role.invariant_modes,
             matches: &role.matches,
             channels: r.channels.iter().filter(|c| c.role == role.role).collect(),
+            lines: &role.lines,
         })
         .collect();
     for ch in r
@@ -99,6 +101,7 @@ fn pools(r: &AnalysisResults) -> Vec<Pool<'_>> {
             modes: &ch.invariant_modes,
             matches: &[],
             channels: vec![ch],
+            lines: &ch.lines,
         });
     }
     out
@@ -198,6 +201,7 @@ pub fn modes_table_text(r: &AnalysisResults, truth: Option<&[TruthRow]>) -> Stri
         if !any {
             s.push_str(&candidates_text(r, pool.modes, "  "));
         }
+        s.push_str(&lines_text(r, pool.lines, "  "));
     }
     if let Some(t) = truth {
         s.push_str("\nTrue values (simulation):\n");
@@ -205,6 +209,46 @@ pub fn modes_table_text(r: &AnalysisResults, truth: Option<&[TruthRow]>) -> Stri
         for (label, f, z) in t {
             let _ = writeln!(s, "  {f:>9.3} {z:>9.4}  {label}");
         }
+    }
+    s
+}
+
+/// The periodic lines of a pool, one per row with its frequency in each record (`-` where it was
+/// not found), or a sentence saying none was found.
+pub fn lines_text(r: &AnalysisResults, lines: &[vibmode_analysis::LineTrack], indent: &str) -> String {
+    let mut s = String::new();
+    if r.config.lines.max_kurtosis <= 0.0 {
+        return s;
+    }
+    if lines.is_empty() {
+        let _ = writeln!(
+            s,
+            "{indent}No periodic lines (no prominent peak with a narrow-band kurtosis below {} in {:.0} % of the records).",
+            r.config.lines.max_kurtosis,
+            100.0 * r.config.lines.min_record_share
+        );
+        return s;
+    }
+    let _ = writeln!(
+        s,
+        "{indent}Periodic lines (engine/gear orders: narrow-band kurtosis near 1.5), frequency per record, Hz:"
+    );
+    for t in lines {
+        let per: Vec<String> = t
+            .record_hz
+            .iter()
+            .map(|f| f.map_or("-".to_string(), |f| format!("{f:.2}")))
+            .collect();
+        let _ = writeln!(
+            s,
+            "{indent}  {:>7.2} Hz ({:.2}-{:.2}, {:.0} % of records, kurtosis {:.2}): {}",
+            t.frequency_hz,
+            t.frequency_range_hz.0,
+            t.frequency_range_hz.1,
+            100.0 * t.record_share,
+            t.kurtosis,
+            per.join(" ")
+        );
     }
     s
 }
