@@ -215,7 +215,11 @@ pub fn modes_table_text(r: &AnalysisResults, truth: Option<&[TruthRow]>) -> Stri
 
 /// The periodic lines of a pool, one per row with its frequency in each record (`-` where it was
 /// not found), or a sentence saying none was found.
-pub fn lines_text(r: &AnalysisResults, lines: &[vibmode_analysis::LineTrack], indent: &str) -> String {
+pub fn lines_text(
+    r: &AnalysisResults,
+    lines: &[vibmode_analysis::LineTrack],
+    indent: &str,
+) -> String {
     let mut s = String::new();
     if r.config.lines.max_kurtosis <= 0.0 {
         return s;
