@@ -4,9 +4,10 @@
 //!
 //! Rule (documented in docs/analysis.md): with line detection on (`max_kurtosis > 0`), each
 //! supported cluster gets the median narrow-band kurtosis of its frequency over the records used
-//! and the channels of its pool. Below `max_kurtosis` it is a periodic disturbance, whatever its
-//! damping; a cluster the damping rule calls periodic is a structural mode when that kurtosis is
-//! at least [`GAUSSIAN_KURTOSIS_MIN`] (clearly random).
+//! and the channels of its pool. It is a periodic disturbance, whatever its damping, when that
+//! kurtosis is below `max_kurtosis`, or below [`GAUSSIAN_KURTOSIS_MIN`] with a line track of the
+//! pool within half a band-width of its frequency. A cluster the damping rule calls periodic is a
+//! structural mode when that kurtosis is at least [`GAUSSIAN_KURTOSIS_MIN`] (clearly random).
 
 use serde::{Deserialize, Serialize};
 use vibmode_core::{InvariantMode, LineParams, ModeClass};
@@ -117,17 +118,25 @@ impl LineStage<'_> {
     }
 
     /// Sets each mode's `line_kurtosis` and, for supported clusters, its class by the rule of
-    /// this module.
-    pub fn classify(&self, modes: &mut [InvariantMode], channels: &[usize]) {
+    /// this module; `tracks` are the pool's line tracks.
+    pub fn classify(&self, modes: &mut [InvariantMode], channels: &[usize], tracks: &[LineTrack]) {
         if !self.enabled() {
             return;
         }
+        let hw = self.params.half_width_hz;
         for m in modes.iter_mut() {
             let k = self.kurtosis_at(m.frequency_hz, channels);
             m.line_kurtosis = k;
             let Some(k) = k else { continue };
+            // A tracked line at the cluster's frequency (the kurtosis at the cluster's mean
+            // frequency can miss the line's peak by a few bins).
+            let on_track = tracks.iter().any(|t| {
+                t.frequency_range_hz.0 - 0.5 * hw <= m.frequency_hz
+                    && m.frequency_hz <= t.frequency_range_hz.1 + 0.5 * hw
+            });
+            let periodic = k < self.params.max_kurtosis || (on_track && k < GAUSSIAN_KURTOSIS_MIN);
             match m.class {
-                ModeClass::Structural if k < self.params.max_kurtosis => {
+                ModeClass::Structural if periodic => {
                     m.class = ModeClass::PeriodicDisturbance;
                 }
                 ModeClass::PeriodicDisturbance if k >= GAUSSIAN_KURTOSIS_MIN => {

@@ -354,7 +354,8 @@ fn channel_modes(
             .collect();
         store.add(&ch.name, placement.role, &poles);
         let mut invariant_modes = support.cluster(store, |n, _| n == ch.name)?;
-        lines.classify(&mut invariant_modes, &[c]);
+        let tracks = lines.tracks(&[c]);
+        lines.classify(&mut invariant_modes, &[c], &tracks);
         let (welch_freq_hz, welch_psd) = mean_welch(&mine, stationary);
         channels.push(ChannelAnalysis {
             name: ch.name.clone(),
@@ -374,7 +375,7 @@ fn channel_modes(
                 .map(|o| o.fits.models.clone())
                 .unwrap_or_default(),
             invariant_modes,
-            lines: lines.tracks(&[c]),
+            lines: tracks,
         });
     }
     Ok(channels)
@@ -408,7 +409,8 @@ fn role_modes(
             .map(|(i, _)| i)
             .collect();
         let mut invariant = support.cluster(store, |_, r| r == role)?;
-        lines.classify(&mut invariant, &idx);
+        let tracks = lines.tracks(&idx);
+        lines.classify(&mut invariant, &idx, &tracks);
         let matches = if reference.is_empty() {
             Vec::new()
         } else {
@@ -419,7 +421,7 @@ fn role_modes(
             channels: names,
             invariant_modes: invariant,
             matches,
-            lines: lines.tracks(&idx),
+            lines: tracks,
         });
     }
     Ok(roles)

@@ -69,3 +69,50 @@ fn bus_body_mode_with_default_settings() {
     // A heavily damped body mode, as the stabilisation figures show (zeta 0.1-0.6).
     assert!((0.1..0.6).contains(&body[0].damping_ratio), "{:?}", body[0]);
 }
+
+const IDLING: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../../shared/data/real/bratislava_transit/L35_1915_Most_Kutiky_neutral.csv"
+);
+
+/// The same bus standing with its engine idling: no road input, only engine lines. The firing
+/// line near 10.8 Hz and its 1.5 order near 16.3 Hz are reported as periodic lines and every
+/// supported cluster is classed periodic (nothing else excites the bus).
+#[test]
+fn idling_bus_engine_lines_are_lines() {
+    let path = Path::new(IDLING);
+    if !path.exists() {
+        eprintln!("skipped: {IDLING} not found (shared real data absent)");
+        return;
+    }
+    let opts = ReadOptions {
+        fs_hz: Some(500.0),
+        ..ReadOptions::default()
+    };
+    let rec = read_path(path, &opts).expect("read the idling file");
+    let rec = rec
+        .select(&[ChannelSelector::Name("z".into())])
+        .expect("channel z");
+    let cfg = AnalysisConfig::default();
+    let records = cut_records("idling", &rec, cfg.record_length_s);
+    let res = analyze(&records, &cfg, &[], &|_, _| {}).expect("analysis");
+    let ch = &res.channels[0];
+    for f0 in [10.83, 16.27] {
+        assert!(
+            ch.lines
+                .iter()
+                .any(|t| (t.frequency_hz - f0).abs() < 0.1 && t.kurtosis < 2.0),
+            "no line at {f0} Hz: {:?}",
+            ch.lines
+        );
+    }
+    let supported: Vec<_> = ch
+        .invariant_modes
+        .iter()
+        .filter(|m| m.class != ModeClass::Spurious)
+        .collect();
+    assert!(!supported.is_empty());
+    for m in supported {
+        assert_eq!(m.class, ModeClass::PeriodicDisturbance, "{m:?}");
+    }
+}
