@@ -604,6 +604,46 @@ fn inputs_table(html: &mut HtmlReport, r: &AnalysisResults) {
     );
 }
 
+/// The pool's periodic lines: one row per track with its frequency in every record.
+fn lines_table(html: &mut HtmlReport, r: &AnalysisResults, lines: &[vibmode_analysis::LineTrack]) {
+    if r.config.lines.max_kurtosis <= 0.0 {
+        return;
+    }
+    if lines.is_empty() {
+        html.paragraph(lines_text(r, lines, "").trim());
+        return;
+    }
+    html.paragraph(
+        "Periodic lines (engine/gear orders), tracked over the records: a prominent peak whose narrow-band signal has the kurtosis of a sine (1.5) rather than of a randomly excited mode (3). Frequency in each record, Hz (- = not found there or a stop).",
+    );
+    let mut headers: Vec<String> = vec![
+        "frequency [Hz]".into(),
+        "range [Hz]".into(),
+        "records".into(),
+        "kurtosis".into(),
+    ];
+    headers.extend((1..=r.records.len()).map(|i| format!("r{i}")));
+    let rows: Vec<Vec<String>> = lines
+        .iter()
+        .map(|t| {
+            let mut row = vec![
+                format!("{:.2}", t.frequency_hz),
+                format!("{:.2}-{:.2}", t.frequency_range_hz.0, t.frequency_range_hz.1),
+                format!("{:.0} %", 100.0 * t.record_share),
+                format!("{:.2}", t.kurtosis),
+            ];
+            row.extend(
+                t.record_hz
+                    .iter()
+                    .map(|f| f.map_or("-".to_string(), |f| format!("{f:.2}"))),
+            );
+            row
+        })
+        .collect();
+    let h: Vec<&str> = headers.iter().map(String::as_str).collect();
+    html.table(&h, &rows);
+}
+
 fn modes_tables(html: &mut HtmlReport, r: &AnalysisResults) {
     html.heading(2, "Invariant modes");
     let headers = [
@@ -624,6 +664,7 @@ fn modes_tables(html: &mut HtmlReport, r: &AnalysisResults) {
         } else {
             html.table(&headers, &rows);
         }
+        lines_table(html, r, pool.lines);
         if !pool.matches.is_empty() {
             html.paragraph("Physical model modes matched to the invariant structural modes:");
             let rows: Vec<Vec<String>> = pool
