@@ -136,6 +136,13 @@ pub struct InvariantMode {
     /// analysis computed it (line detection on).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub line_kurtosis: Option<f64>,
+    /// Mean mode shape of the cluster's poles (one complex `[re, im]` per channel of the
+    /// identification, largest modulus 1 + 0i), when its poles carry shapes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<Vec<[f64; 2]>>,
+    /// Median and lowest MAC of the poles' shapes with the mean shape (the shape spread).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape_mac: Option<(f64, f64)>,
 }
 
 impl InvariantMode {

@@ -525,6 +525,15 @@ pub struct ClusterParams {
     /// (statistics use the true values); negative damping ratios (unstable poles) are ignored.
     /// Default 1e-6.
     pub min_damping_ratio: f64,
+    /// Mode-shape tolerance: when two poles both carry a shape (multichannel identification),
+    /// `((1 - MAC) / shape_tol)^2` is added to their squared distance, so poles whose shapes
+    /// have MAC below `1 - shape_tol` are never neighbours. Default 0.2; 0 ignores shapes.
+    #[serde(default = "default_shape_tol")]
+    pub shape_tol: f64,
+}
+
+fn default_shape_tol() -> f64 {
+    0.2
 }
 
 impl Default for ClusterParams {
@@ -544,6 +553,7 @@ impl Default for ClusterParams {
             freq_max_hz: None,
             max_damping_ratio: 0.6,
             min_damping_ratio: 1e-6,
+            shape_tol: default_shape_tol(),
         }
     }
 }
@@ -612,6 +622,14 @@ impl ClusterParams {
             self.min_damping_ratio,
             d.min_damping_ratio,
         )?;
+        if !(self.shape_tol.is_finite() && (0.0..=1.0).contains(&self.shape_tol)) {
+            return Err(bad(
+                "shape_tol",
+                self.shape_tol,
+                "must be in [0, 1] (0 = ignore mode shapes)",
+                d.shape_tol,
+            ));
+        }
         if self.min_damping_ratio >= self.max_damping_ratio {
             return Err(bad(
                 "min_damping_ratio",

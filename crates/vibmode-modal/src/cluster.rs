@@ -4,6 +4,7 @@ use std::collections::{HashMap, HashSet};
 
 use serde::{Deserialize, Serialize};
 
+use crate::shapes::{mac, mean_shape};
 use crate::stats::{mean_std, median, percentile_sorted};
 use crate::{ClusterParams, InvariantMode, ModalError, ModeClass, PoleObservation};
 
@@ -183,6 +184,7 @@ fn scaled_points(
             ),
             idx: i,
             ch,
+            shape: pole.shape.clone(),
         });
     }
     (pts, channel_ids.len())
@@ -205,12 +207,14 @@ fn sort_into_cells(pts: &mut [Pt]) -> (Cells, Vec<(usize, usize)>) {
     (cells, cell_list)
 }
 
-/// Core poles: at least `core_threshold` neighbours (a cell holding that many poles is all core).
+/// Core poles: at least `core_threshold` neighbours (a cell holding that many poles is all core,
+/// unless shapes can make cell-mates strangers).
 fn core_flags(grid: &Grid<'_>, cell_list: &[(usize, usize)], core_threshold: usize) -> Vec<bool> {
     let mut core = vec![false; grid.pts.len()];
+    let cells_are_cliques = !grid.metric.uses_shapes(grid.pts);
     for &(a, b) in cell_list {
         for (i, c) in core.iter_mut().enumerate().take(b).skip(a) {
-            *c = b - a >= core_threshold
+            *c = (cells_are_cliques && b - a >= core_threshold)
                 || grid.count_neighbours_upto(i, core_threshold) >= core_threshold;
         }
     }
@@ -223,10 +227,21 @@ fn connect_cores(grid: &Grid<'_>, cell_list: &[(usize, usize)], core: &[bool]) -
     let pts = grid.pts;
     let mut uf = UnionFind::new(pts.len());
     let mut first_core: HashMap<(i64, i64), usize> = HashMap::new();
+    let cells_are_cliques = !grid.metric.uses_shapes(pts);
     for &(a, b) in cell_list {
         if let Some(f) = (a..b).find(|&i| core[i]) {
-            for i in (f + 1..b).filter(|&i| core[i]) {
-                uf.union(f, i);
+            if cells_are_cliques {
+                for i in (f + 1..b).filter(|&i| core[i]) {
+                    uf.union(f, i);
+                }
+            } else {
+                for i in (f..b).filter(|&i| core[i]) {
+                    for j in (i + 1..b).filter(|&j| core[j]) {
+                        if grid.metric.dist2(&pts[i], &pts[j]) <= 1.0 {
+                            uf.union(i, j);
+                        }
+                    }
+                }
             }
             first_core.insert(pts[f].cell, f);
         }
@@ -246,7 +261,7 @@ fn connect_cores(grid: &Grid<'_>, cell_list: &[(usize, usize)], core: &[bool]) -
                 let Some(&fd) = first_core.get(&d) else {
                     continue;
                 };
-                if uf.find(fa) == uf.find(fd) {
+                if cells_are_cliques && uf.find(fa) == uf.find(fd) {
                     continue;
                 }
                 let Some(&(da, db)) = grid.cells.get(&d) else {
@@ -256,7 +271,9 @@ fn connect_cores(grid: &Grid<'_>, cell_list: &[(usize, usize)], core: &[bool]) -
                     for j in (da..db).filter(|&j| core[j]) {
                         if grid.metric.dist2(&pts[i], &pts[j]) <= 1.0 {
                             uf.union(i, j);
-                            break 'pairs;
+                            if cells_are_cliques {
+                                break 'pairs;
+                            }
                         }
                     }
                 }
@@ -360,6 +377,7 @@ fn summarise(
     } else {
         ModeClass::Structural
     };
+    let (shape, shape_mac) = shape_stats(&kept, poles);
     let mode = InvariantMode {
         frequency_hz: f_mean,
         frequency_std_hz: f_std,
@@ -376,8 +394,29 @@ fn summarise(
         min_order: kept.iter().map(|&i| poles[i].order).min().unwrap_or(0),
         class,
         line_kurtosis: None,
+        shape,
+        shape_mac,
     };
     (mode, kept)
+}
+
+/// Mean shape of the kept poles that carry one (all of one length), and the median and lowest
+/// MAC of their shapes with it.
+fn shape_stats(
+    kept: &[usize],
+    poles: &[PoleObservation],
+) -> (Option<Vec<[f64; 2]>>, Option<(f64, f64)>) {
+    let shapes: Vec<&[[f64; 2]]> = kept
+        .iter()
+        .filter_map(|&i| poles[i].shape.as_deref())
+        .collect();
+    let Some(mean) = mean_shape(&shapes) else {
+        return (None, None);
+    };
+    let mut macs: Vec<f64> = shapes.iter().map(|s| mac(s, &mean)).collect();
+    macs.sort_by(f64::total_cmp);
+    let lowest = macs.first().copied().unwrap_or(0.0);
+    (Some(mean), Some((median(&macs), lowest)))
 }
 
 /// At most one pole per fit (record, channel, order) of the cluster `members`: the nearest to the
@@ -468,6 +507,7 @@ struct Metric {
     lu: f64,
     per_damping: f64,
     min_rel: f64,
+    shape_tol: f64,
 }
 
 impl Metric {
@@ -476,7 +516,14 @@ impl Metric {
             lu: (1.0 + p.freq_tol_rel).ln(),
             per_damping: p.freq_tol_per_damping,
             min_rel: p.freq_tol_rel,
+            shape_tol: p.shape_tol,
         }
+    }
+
+    /// True when poles carry shapes that enter the distance: then two poles of one grid cell
+    /// need not be neighbours.
+    fn uses_shapes(&self, pts: &[Pt]) -> bool {
+        self.shape_tol > 0.0 && pts.iter().any(|p| p.shape.is_some())
     }
 
     /// Factor (<= 1) applied to a `u` difference for poles of damping ratios `za`, `zb`.
@@ -486,7 +533,14 @@ impl Metric {
     }
     fn dist2(&self, a: &Pt, b: &Pt) -> f64 {
         let du = (a.u - b.u) * self.scale(a.zeta, b.zeta);
-        du * du + (a.v - b.v) * (a.v - b.v)
+        let d2 = du * du + (a.v - b.v) * (a.v - b.v);
+        match (&a.shape, &b.shape) {
+            (Some(sa), Some(sb)) if self.shape_tol > 0.0 && d2 <= 1.0 => {
+                let ds = (1.0 - mac(sa, sb)) / self.shape_tol;
+                d2 + ds * ds
+            }
+            _ => d2,
+        }
     }
 }
 
@@ -506,6 +560,8 @@ struct Pt {
     idx: usize,
     /// Channel id (index among the distinct channels of the used poles).
     ch: usize,
+    /// Mode shape of the pole, when the identification gave one.
+    shape: Option<Vec<[f64; 2]>>,
 }
 
 /// Range of points (`start..end` into the sorted points) of each occupied grid cell.

@@ -44,6 +44,7 @@ mod cluster;
 mod error;
 mod matching;
 mod params;
+pub mod shapes;
 mod stabilisation;
 pub mod stats;
 mod types;

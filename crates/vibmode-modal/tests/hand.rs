@@ -163,6 +163,8 @@ fn mode(f: f64, z: f64, class: ModeClass) -> InvariantMode {
         min_order: 4,
         class,
         line_kurtosis: None,
+        shape: None,
+        shape_mac: None,
     }
 }
 

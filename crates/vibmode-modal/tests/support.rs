@@ -54,6 +54,8 @@ fn hand_case_message() {
         min_order: 4,
         class: ModeClass::Spurious,
         line_kurtosis: None,
+        shape: None,
+        shape_mac: None,
     };
     let f = m.support_failures(&ClusterParams::default(), 20);
     assert_eq!(

@@ -628,7 +628,10 @@ fn lines_table(html: &mut HtmlReport, r: &AnalysisResults, lines: &[vibmode_anal
         .map(|t| {
             let mut row = vec![
                 format!("{:.2}", t.frequency_hz),
-                format!("{:.2}-{:.2}", t.frequency_range_hz.0, t.frequency_range_hz.1),
+                format!(
+                    "{:.2}-{:.2}",
+                    t.frequency_range_hz.0, t.frequency_range_hz.1
+                ),
                 format!("{:.0} %", 100.0 * t.record_share),
                 format!("{:.2}", t.kurtosis),
             ];
