@@ -42,7 +42,7 @@ pub fn mpc(shape: &[[f64; 2]]) -> f64 {
         sxy += x * y;
     }
     let total = sxx + syy;
-    if !(total > 0.0) || !total.is_finite() {
+    if total.is_nan() || total <= 0.0 || total.is_infinite() {
         return 1.0;
     }
     let d = sxx - syy;

@@ -38,7 +38,7 @@ fn simulate(n: usize, seed: u64) -> Vec<Vec<f64>> {
         .collect();
     let burn = 2000;
     let mut x = vec![[0.0f64; 2]; MODES.len()];
-    let mut y = vec![Vec::with_capacity(n); 5];
+    let mut y: Vec<Vec<f64>> = (0..5).map(|_| Vec::with_capacity(n)).collect();
     for t in 0..n + burn {
         if t >= burn {
             for (ch, out) in y.iter_mut().enumerate() {
