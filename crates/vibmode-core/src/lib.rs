@@ -23,6 +23,7 @@ pub mod modes;
 pub mod params;
 pub mod placement;
 pub mod recording;
+pub mod ssi;
 
 pub use error::{ParamError, RecordingError};
 pub use modes::{
@@ -38,3 +39,4 @@ pub use placement::{Corner, Direction, Placement, Role};
 pub use recording::{
     check_finite, check_fs, Channel, ChannelSelector, Recording, RecordingView, TimeAxis,
 };
+pub use ssi::{SsiParams, StabilityParams};

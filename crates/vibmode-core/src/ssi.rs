@@ -1,0 +1,230 @@
+//! Parameters of covariance-driven stochastic subspace identification (SSI-cov) and of its
+//! stabilisation diagram. The numerics are in the `vibmode-ssi` crate; these structs are shared
+//! by the TOML config, the command line and the Python package.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::ParamError;
+
+/// SSI-cov: the block Toeplitz matrix and the model orders identified from it.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SsiParams {
+    /// Number of block rows `i` of the block Toeplitz matrix of output correlations (default 20).
+    /// The matrix holds the lags 1..=2i-1 and is `(i * l) x (i * l)` for `l` channels; the
+    /// highest identifiable order is `(i - 1) * l`, and each channel needs at least `2 i` samples.
+    pub block_rows: usize,
+    /// Lowest model order (state dimension) identified (default 2: one mode).
+    pub order_min: usize,
+    /// Highest model order identified (default 60).
+    pub order_max: usize,
+    /// Step between identified orders (default 2: one mode per step).
+    pub order_step: usize,
+}
+
+impl Default for SsiParams {
+    fn default() -> Self {
+        SsiParams {
+            block_rows: 20,
+            order_min: 2,
+            order_max: 60,
+            order_step: 2,
+        }
+    }
+}
+
+impl SsiParams {
+    /// The identified orders: `order_min, order_min + order_step, ...` up to `order_max`
+    /// (inclusive when reached). Empty only for parameters that fail [`SsiParams::validate`].
+    pub fn orders(&self) -> Vec<usize> {
+        if self.order_step == 0 || self.order_max < self.order_min {
+            return Vec::new();
+        }
+        (self.order_min..=self.order_max)
+            .step_by(self.order_step)
+            .collect()
+    }
+
+    /// Checks ranges: `block_rows >= 1`, `order_min >= 2`, `order_step >= 1`,
+    /// `order_max >= order_min`.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        let d = SsiParams::default();
+        if self.block_rows < 1 {
+            return Err(ParamError::out_of_range(
+                "block_rows",
+                self.block_rows,
+                "must be >= 1",
+                d.block_rows,
+            ));
+        }
+        if self.order_min < 2 {
+            return Err(ParamError::out_of_range(
+                "order_min",
+                self.order_min,
+                "must be >= 2 (one mode needs two states)",
+                d.order_min,
+            ));
+        }
+        if self.order_step < 1 {
+            return Err(ParamError::out_of_range(
+                "order_step",
+                self.order_step,
+                "must be >= 1",
+                d.order_step,
+            ));
+        }
+        if self.order_max < self.order_min {
+            return Err(ParamError::out_of_range(
+                "order_max",
+                self.order_max,
+                "must be >= order_min",
+                self.order_min.max(d.order_max),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Stabilisation criteria between the modes of consecutive identified orders (a stabilisation
+/// diagram): a mode is *stable* when a mode of the previous order lies within all three
+/// tolerances.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StabilityParams {
+    /// Largest relative frequency difference `|f - f_prev| / f_prev` (default 0.01).
+    pub freq_tol_rel: f64,
+    /// Largest relative damping difference `|z - z_prev| / z_prev` (default 0.05).
+    pub damping_tol_rel: f64,
+    /// Smallest modal assurance criterion between the two mode shapes (default 0.98).
+    pub mac_min: f64,
+}
+
+impl Default for StabilityParams {
+    fn default() -> Self {
+        StabilityParams {
+            freq_tol_rel: 0.01,
+            damping_tol_rel: 0.05,
+            mac_min: 0.98,
+        }
+    }
+}
+
+impl StabilityParams {
+    /// Checks ranges: both tolerances finite and >= 0, `mac_min` in [0, 1].
+    pub fn validate(&self) -> Result<(), ParamError> {
+        let d = StabilityParams::default();
+        for (name, v, default) in [
+            ("freq_tol_rel", self.freq_tol_rel, d.freq_tol_rel),
+            ("damping_tol_rel", self.damping_tol_rel, d.damping_tol_rel),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(ParamError::out_of_range(
+                    name,
+                    v,
+                    "must be finite and >= 0",
+                    default,
+                ));
+            }
+        }
+        if !(0.0..=1.0).contains(&self.mac_min) {
+            return Err(ParamError::out_of_range(
+                "mac_min",
+                self.mac_min,
+                "must be in [0, 1]",
+                d.mac_min,
+            ));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn orders_and_defaults() {
+        let p = SsiParams::default();
+        assert!(p.validate().is_ok());
+        let o = p.orders();
+        assert_eq!(o.first(), Some(&2));
+        assert_eq!(o.last(), Some(&60));
+        assert_eq!(o.len(), 30);
+        let p = SsiParams {
+            order_min: 3,
+            order_max: 10,
+            order_step: 3,
+            ..p
+        };
+        assert_eq!(p.orders(), vec![3, 6, 9]);
+        assert!(StabilityParams::default().validate().is_ok());
+    }
+
+    #[test]
+    fn validation_names_the_key() {
+        let cases = [
+            (
+                SsiParams {
+                    block_rows: 0,
+                    ..Default::default()
+                },
+                "block_rows = 0",
+            ),
+            (
+                SsiParams {
+                    order_min: 1,
+                    ..Default::default()
+                },
+                "order_min = 1",
+            ),
+            (
+                SsiParams {
+                    order_step: 0,
+                    ..Default::default()
+                },
+                "order_step = 0",
+            ),
+            (
+                SsiParams {
+                    order_min: 10,
+                    order_max: 4,
+                    ..Default::default()
+                },
+                "order_max = 4",
+            ),
+        ];
+        for (p, text) in cases {
+            let e = p.validate().unwrap_err().to_string();
+            assert!(e.contains(text), "{e}");
+        }
+        let s = StabilityParams {
+            mac_min: 1.5,
+            ..Default::default()
+        };
+        assert!(s
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("mac_min = 1.5"));
+        let s = StabilityParams {
+            freq_tol_rel: f64::NAN,
+            ..Default::default()
+        };
+        assert!(s
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("freq_tol_rel = NaN"));
+    }
+
+    #[test]
+    fn toml_round_trip_and_unknown_keys() {
+        let p: SsiParams = toml::from_str("block_rows = 30\norder_max = 40").unwrap();
+        assert_eq!(p.block_rows, 30);
+        assert_eq!(p.order_max, 40);
+        assert_eq!(p.order_min, 2);
+        assert!(toml::from_str::<SsiParams>("block_row = 30").is_err());
+        let s: StabilityParams = toml::from_str("mac_min = 0.9").unwrap();
+        assert_eq!(s.mac_min, 0.9);
+    }
+}

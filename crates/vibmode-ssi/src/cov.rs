@@ -1,0 +1,495 @@
+//! SSI-cov: output correlations, block Toeplitz matrix, its SVD, and poles at any order.
+
+use nalgebra::{DMatrix, SVD};
+use num_complex::Complex64;
+use serde::{Deserialize, Serialize};
+use vibmode_core::SsiParams;
+
+use crate::eig::complex_eigenpairs;
+use crate::error::SsiError;
+use crate::shape::mpc;
+
+/// One identified mode: one pole of a conjugate pair (`Im > 0`) of the identified state matrix.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SsiMode {
+    /// Natural frequency `|s| / 2 pi`, Hz, of the continuous pole `s = ln(lambda) fs_hz`.
+    pub frequency_hz: f64,
+    /// Damping ratio `-Re(s) / |s|` (dimensionless, in (0, 1)).
+    pub damping_ratio: f64,
+    /// Complex mode shape `C psi`, one `[re, im]` per channel, scaled so that the entry of
+    /// largest modulus is `[1, 0]`.
+    pub shape: Vec<[f64; 2]>,
+    /// Modal phase collinearity of the shape ([`crate::mpc`]).
+    pub mpc: f64,
+}
+
+/// The modes identified at one model order, by increasing frequency.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SsiOrder {
+    /// Model order (state dimension).
+    pub order: usize,
+    /// Modes kept at this order (see [`SsiCov::poles_at`] for which poles are dropped).
+    pub modes: Vec<SsiMode>,
+}
+
+/// The result of an SSI-cov order sweep.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SsiResult {
+    /// Sampling rate of the channels, Hz.
+    pub fs_hz: f64,
+    /// Block rows `i` of the Toeplitz matrix.
+    pub block_rows: usize,
+    /// One entry per identified order, in the order asked for.
+    pub orders: Vec<SsiOrder>,
+    /// Singular values of the block Toeplitz matrix, largest first (`i * l` of them).
+    pub singular_values: Vec<f64>,
+}
+
+/// A planned SSI-cov identification: the correlations, block Toeplitz matrix and its SVD are
+/// computed once by [`SsiCov::new`]; [`SsiCov::poles_at`] then identifies any order from them.
+///
+/// Definitions, for `l` channels `y_t` (each with its mean removed), `N` samples and
+/// `i = block_rows`:
+///
+/// * output correlations `R_k = 1/(N - k) sum_{t=0}^{N-1-k} y_{t+k} y_t^T` (`l x l`) for the lags
+///   `k = 1..=2i-1` (lag 0, which carries the measurement noise, is not used);
+/// * block Toeplitz matrix `T` (`il x il`) with block `(a, b) = R_{i+a-b}`
+///   (`[R_i ... R_1; R_{i+1} ... R_2; ...; R_{2i-1} ... R_i]`), of rank `n` for an `n`-state
+///   system: `T = O_i G_i` with the observability matrix `O_i = [C; CA; ...; CA^{i-1}]`;
+/// * its SVD `T = U S V^T`; at order `n`, `O = U_n S_n^{1/2}` (first `n` columns), `C` = the
+///   first `l` rows of `O`, and `A` the least-squares solution of `O_up A = O_down` (`O` without
+///   its last, resp. first, block row).
+#[derive(Clone, Debug)]
+pub struct SsiCov {
+    fs_hz: f64,
+    block_rows: usize,
+    n_channels: usize,
+    n_samples: usize,
+    u: DMatrix<f64>,
+    singular_values: Vec<f64>,
+    rank: usize,
+    rank_tolerance: f64,
+}
+
+/// Convergence tolerance of nalgebra's SVD: its own default (`5 eps`). With `eps` alone the
+/// iteration stops with inaccurate singular vectors when several singular values are zero
+/// (seen on the rank-2 Toeplitz matrix of one exact mode: the column space off by 5e-3).
+const SVD_EPS: f64 = 5.0 * f64::EPSILON;
+
+/// Checks the channels: at least one, each with >= 2 samples, equal lengths, finite samples.
+/// Returns the common length.
+fn check_channels(channels: &[&[f64]]) -> Result<usize, SsiError> {
+    let first = channels.first().ok_or(SsiError::NoChannels)?;
+    let n = first.len();
+    for (c, ch) in channels.iter().enumerate() {
+        if ch.len() < 2 {
+            return Err(SsiError::TooShort {
+                channel: c,
+                n_samples: ch.len(),
+            });
+        }
+        if ch.len() != n {
+            return Err(SsiError::LengthMismatch {
+                channel: c,
+                found: ch.len(),
+                expected: n,
+            });
+        }
+        if let Some((index, &value)) = ch.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(SsiError::NonFinite {
+                channel: c,
+                index,
+                value,
+            });
+        }
+    }
+    Ok(n)
+}
+
+/// `R_k` for `k = 1..=max_lag` of the demeaned channels, each `l x l`, entry `(a, b)` =
+/// `1/(N-k) sum_t y_a[t+k] y_b[t]`.
+fn correlations(channels: &[Vec<f64>], max_lag: usize) -> Vec<DMatrix<f64>> {
+    let l = channels.len();
+    let n = channels.first().map_or(0, Vec::len);
+    (1..=max_lag)
+        .map(|k| {
+            DMatrix::from_fn(l, l, |a, b| {
+                let ya = &channels[a][k..];
+                let yb = &channels[b][..n - k];
+                ya.iter().zip(yb).map(|(x, y)| x * y).sum::<f64>() / (n - k) as f64
+            })
+        })
+        .collect()
+}
+
+impl SsiCov {
+    /// Plans SSI-cov for `channels` (equal lengths, finite) sampled at `fs_hz`, with
+    /// `params.block_rows` block rows (the orders in `params` are used by [`SsiCov::sweep`]'s
+    /// callers such as [`crate::ssi_cov`], not here). Removes each channel's mean, computes the
+    /// correlations, the block Toeplitz matrix and its SVD.
+    pub fn new(channels: &[&[f64]], fs_hz: f64, params: &SsiParams) -> Result<SsiCov, SsiError> {
+        params.validate()?;
+        if !(fs_hz.is_finite() && fs_hz > 0.0) {
+            return Err(SsiError::InvalidSampleRate { fs_hz });
+        }
+        let n = check_channels(channels)?;
+        let i = params.block_rows;
+        let max_lag = 2 * i - 1;
+        if n < 2 * i {
+            return Err(SsiError::TooFewSamples {
+                n_samples: n,
+                block_rows: i,
+                max_lag,
+                min_samples: 2 * i,
+            });
+        }
+        let demeaned: Vec<Vec<f64>> = channels
+            .iter()
+            .map(|ch| {
+                let m = ch.iter().sum::<f64>() / n as f64;
+                ch.iter().map(|v| v - m).collect()
+            })
+            .collect();
+        let r = correlations(&demeaned, max_lag);
+        let mut cov = SsiCov::from_correlations(&r, fs_hz, i)?;
+        cov.n_samples = n;
+        Ok(cov)
+    }
+
+    /// From given correlations `r[k - 1] = R_k`, `k = 1..=2i-1`, each `l x l` (checked by the
+    /// callers).
+    pub(crate) fn from_correlations(
+        r: &[DMatrix<f64>],
+        fs_hz: f64,
+        block_rows: usize,
+    ) -> Result<SsiCov, SsiError> {
+        let i = block_rows;
+        let l = r.first().map_or(0, DMatrix::nrows);
+        let dim = i * l;
+        let t = DMatrix::from_fn(dim, dim, |row, col| {
+            let (a, ra) = (row / l, row % l);
+            let (b, cb) = (col / l, col % l);
+            r[i + a - b - 1][(ra, cb)]
+        });
+        let iterations = 60 * dim.max(1) + 100;
+        let svd =
+            SVD::try_new(t, true, false, SVD_EPS, iterations).ok_or(SsiError::NotConverged {
+                what: "SVD of the block Toeplitz matrix",
+                size: dim,
+                iterations,
+            })?;
+        let singular_values: Vec<f64> = svd.singular_values.iter().copied().collect();
+        let u = svd.u.ok_or(SsiError::NotConverged {
+            what: "SVD of the block Toeplitz matrix",
+            size: dim,
+            iterations,
+        })?;
+        let smax = singular_values.first().copied().unwrap_or(0.0);
+        let rank_tolerance = smax * dim as f64 * f64::EPSILON;
+        let rank = singular_values
+            .iter()
+            .filter(|&&s| s > rank_tolerance)
+            .count();
+        Ok(SsiCov {
+            fs_hz,
+            block_rows: i,
+            n_channels: l,
+            n_samples: 0,
+            u,
+            singular_values,
+            rank,
+            rank_tolerance,
+        })
+    }
+
+    /// Sampling rate, Hz.
+    pub fn fs_hz(&self) -> f64 {
+        self.fs_hz
+    }
+
+    /// Block rows `i` of the Toeplitz matrix.
+    pub fn block_rows(&self) -> usize {
+        self.block_rows
+    }
+
+    /// Number of channels `l`.
+    pub fn n_channels(&self) -> usize {
+        self.n_channels
+    }
+
+    /// Samples per channel.
+    pub fn n_samples(&self) -> usize {
+        self.n_samples
+    }
+
+    /// Singular values of the block Toeplitz matrix, largest first.
+    pub fn singular_values(&self) -> &[f64] {
+        &self.singular_values
+    }
+
+    /// Numerical rank of the block Toeplitz matrix: the singular values above
+    /// `s_max * (i l) * f64::EPSILON` (as numpy's `matrix_rank`).
+    pub fn rank(&self) -> usize {
+        self.rank
+    }
+
+    /// Highest order [`SsiCov::poles_at`] accepts: `min((i - 1) l, rank)`.
+    pub fn max_order(&self) -> usize {
+        ((self.block_rows - 1) * self.n_channels).min(self.rank)
+    }
+
+    /// The modes of the order-`order` model, by increasing frequency.
+    ///
+    /// Every eigenvalue `lambda` of `A` gives a continuous pole `s = ln(lambda) fs_hz`. Kept:
+    /// one pole of each complex conjugate pair (the one with `Im(lambda) > 0`) with a damping
+    /// ratio `-Re(s)/|s|` above 0. Dropped: real eigenvalues (no oscillation; a negative real
+    /// eigenvalue would map to the Nyquist frequency), and poles on or outside the unit circle
+    /// (damping <= 0: not a stable mode). The mode shape is `C psi` for the right eigenvector
+    /// `psi` of `A`, scaled so that its entry of largest modulus is `1 + 0i`.
+    ///
+    /// Errors: order 0 ([`SsiError::ZeroOrder`]), above `(i - 1) l`
+    /// ([`SsiError::OrderTooHigh`]) or above the Toeplitz matrix's rank
+    /// ([`SsiError::OrderAboveRank`]).
+    pub fn poles_at(&self, order: usize) -> Result<Vec<SsiMode>, SsiError> {
+        let (i, l) = (self.block_rows, self.n_channels);
+        if order == 0 {
+            return Err(SsiError::ZeroOrder);
+        }
+        let max_order = (i - 1) * l;
+        if order > max_order {
+            return Err(SsiError::OrderTooHigh {
+                order,
+                block_rows: i,
+                n_channels: l,
+                max_order,
+                needed_block_rows: order.div_ceil(l) + 1,
+            });
+        }
+        if order > self.rank {
+            return Err(SsiError::OrderAboveRank {
+                order,
+                rank: self.rank,
+                tolerance: self.rank_tolerance,
+            });
+        }
+        let dim = i * l;
+        let o = DMatrix::from_fn(dim, order, |r, c| {
+            self.u[(r, c)] * self.singular_values[c].sqrt()
+        });
+        let rows = dim - l;
+        let o_up = o.rows(0, rows).into_owned();
+        let o_down = o.rows(l, rows).into_owned();
+        let a = least_squares(o_up, &o_down)?;
+        let c = o.rows(0, l).into_owned();
+        let pairs = complex_eigenpairs(a)?;
+        let mut modes: Vec<SsiMode> = pairs
+            .into_iter()
+            .filter_map(|p| {
+                let s = p.lambda.ln() * self.fs_hz;
+                let abs = s.norm();
+                let damping_ratio = -s.re / abs;
+                if !(abs.is_finite() && abs > 0.0 && damping_ratio > 0.0) {
+                    return None;
+                }
+                let shape = normalised_shape(&c, &p.vector);
+                let mpc = mpc(&shape);
+                Some(SsiMode {
+                    frequency_hz: abs / (2.0 * std::f64::consts::PI),
+                    damping_ratio,
+                    shape,
+                    mpc,
+                })
+            })
+            .collect();
+        modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+        Ok(modes)
+    }
+
+    /// [`SsiCov::poles_at`] for every order of `orders`.
+    pub fn sweep(&self, orders: &[usize]) -> Result<SsiResult, SsiError> {
+        let orders = orders
+            .iter()
+            .map(|&order| {
+                Ok(SsiOrder {
+                    order,
+                    modes: self.poles_at(order)?,
+                })
+            })
+            .collect::<Result<Vec<_>, SsiError>>()?;
+        Ok(SsiResult {
+            fs_hz: self.fs_hz,
+            block_rows: self.block_rows,
+            orders,
+            singular_values: self.singular_values.clone(),
+        })
+    }
+}
+
+/// `C psi`, scaled so that its entry of largest modulus is `1 + 0i` (left as is when zero).
+fn normalised_shape(c: &DMatrix<f64>, psi: &[Complex64]) -> Vec<[f64; 2]> {
+    let phi: Vec<Complex64> = (0..c.nrows())
+        .map(|r| {
+            psi.iter()
+                .enumerate()
+                .map(|(m, v)| *v * c[(r, m)])
+                .sum::<Complex64>()
+        })
+        .collect();
+    let pivot = phi
+        .iter()
+        .copied()
+        .max_by(|a, b| a.norm().total_cmp(&b.norm()))
+        .unwrap_or(Complex64::new(0.0, 0.0));
+    phi.iter()
+        .map(|v| {
+            let w = if pivot.norm() > 0.0 { *v / pivot } else { *v };
+            [w.re, w.im]
+        })
+        .collect()
+}
+
+/// Least-squares solution `X` of `a X = b` (`a` tall, full column rank expected): QR, with an
+/// SVD-based minimum-norm solution when `R` has a zero pivot.
+fn least_squares(a: DMatrix<f64>, b: &DMatrix<f64>) -> Result<DMatrix<f64>, SsiError> {
+    let qr = a.clone().qr();
+    let r = qr.r();
+    let rmax = r.diagonal().amax();
+    let tiny = rmax * a.nrows().max(a.ncols()) as f64 * f64::EPSILON;
+    if rmax > 0.0 && r.diagonal().iter().all(|d| d.abs() > tiny) {
+        let qtb = qr.q().tr_mul(b);
+        if let Some(x) = r.solve_upper_triangular(&qtb) {
+            return Ok(x);
+        }
+    }
+    let size = a.nrows().max(a.ncols());
+    let iterations = 60 * size + 100;
+    let svd = SVD::try_new(a, true, true, SVD_EPS, iterations).ok_or(SsiError::NotConverged {
+        what: "SVD of the shifted observability matrix",
+        size,
+        iterations,
+    })?;
+    let eps = svd.singular_values.amax() * size as f64 * f64::EPSILON;
+    svd.solve(b, eps).map_err(|_| SsiError::NotConverged {
+        what: "SVD of the shifted observability matrix",
+        size,
+        iterations,
+    })
+}
+
+/// SSI-cov in one call: [`SsiCov::new`] and [`SsiCov::sweep`] over `params.orders()`.
+///
+/// ```
+/// use vibmode_core::SsiParams;
+/// use vibmode_ssi::ssi_cov;
+/// // Two channels of a 3 Hz mode with 5 % damping, free decay sampled at 50 Hz.
+/// let fs_hz = 50.0;
+/// let (f, z) = (3.0, 0.05);
+/// let w = 2.0 * std::f64::consts::PI * f;
+/// let y1: Vec<f64> = (0..4000)
+///     .map(|t| {
+///         let t = t as f64 / fs_hz;
+///         (-z * w * t).exp() * (w * (1.0 - z * z).sqrt() * t).cos()
+///     })
+///     .collect();
+/// let y2: Vec<f64> = y1.iter().map(|v| -0.5 * v).collect();
+/// let params = SsiParams { block_rows: 10, order_min: 2, order_max: 2, ..SsiParams::default() };
+/// let result = ssi_cov(&[&y1, &y2], fs_hz, &params).unwrap();
+/// let mode = &result.orders[0].modes[0];
+/// assert!((mode.frequency_hz - f).abs() < 1e-3);
+/// assert!((mode.damping_ratio - z).abs() < 1e-3);
+/// assert!((mode.shape[1][0] + 0.5).abs() < 1e-6); // channel 2 moves against channel 1
+/// ```
+pub fn ssi_cov(channels: &[&[f64]], fs_hz: f64, params: &SsiParams) -> Result<SsiResult, SsiError> {
+    SsiCov::new(channels, fs_hz, params)?.sweep(&params.orders())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    /// Exact correlations of one mode, `R_k = Re(a lambda^k)` with a complex amplitude `a`:
+    /// the Toeplitz matrix has rank 2 and order 2 must return the pole itself.
+    fn one_mode_correlations(f_hz: f64, zeta: f64, fs_hz: f64, i: usize) -> Vec<DMatrix<f64>> {
+        let w = 2.0 * PI * f_hz;
+        let s = Complex64::new(-zeta * w, w * (1.0 - zeta * zeta).sqrt());
+        let lambda = (s / fs_hz).exp();
+        let a = Complex64::new(0.7, -0.3);
+        (1..2 * i)
+            .map(|k| DMatrix::from_element(1, 1, (a * lambda.powu(k as u32)).re))
+            .collect()
+    }
+
+    #[test]
+    fn exact_correlations_give_the_pole_to_1e_8() {
+        for &(f, z, i) in &[
+            (2.0, 0.05, 5),
+            (7.3, 0.15, 10),
+            (0.8, 0.01, 20),
+            (20.0, 0.3, 3),
+        ] {
+            let r = one_mode_correlations(f, z, 50.0, i);
+            let cov = SsiCov::from_correlations(&r, 50.0, i).unwrap();
+            assert_eq!(
+                cov.rank(),
+                2,
+                "f {f} z {z} i {i}: {:?}",
+                cov.singular_values()
+            );
+            let modes = cov.poles_at(2).unwrap();
+            assert_eq!(modes.len(), 1);
+            let m = &modes[0];
+            assert!(
+                (m.frequency_hz - f).abs() < 1e-8 * f,
+                "f {f}: {}",
+                m.frequency_hz
+            );
+            assert!(
+                (m.damping_ratio - z).abs() < 1e-8,
+                "z {z}: {}",
+                m.damping_ratio
+            );
+            assert_eq!(m.shape, vec![[1.0, 0.0]]);
+            assert_eq!(m.mpc, 1.0);
+        }
+    }
+
+    #[test]
+    fn order_above_the_rank_of_exact_correlations_is_refused() {
+        let r = one_mode_correlations(2.0, 0.05, 50.0, 5);
+        let cov = SsiCov::from_correlations(&r, 50.0, 5).unwrap();
+        let e = cov.poles_at(4).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                SsiError::OrderAboveRank {
+                    order: 4,
+                    rank: 2,
+                    ..
+                }
+            ),
+            "{e:?}"
+        );
+        let m = e.to_string();
+        assert!(
+            m.contains("order 4") && m.contains("rank 2") && m.contains("<= 2"),
+            "{m}"
+        );
+    }
+
+    /// `R_1` and `R_5` only, i = 3: the Toeplitz matrix `[[0,0,R1],[0,0,0],[R5,0,0]]` has rank 2
+    /// but the observability matrix without its last block row has rank 1, so the QR pivot is
+    /// zero and the minimum-norm least-squares fallback is used: no panic, a finite answer.
+    #[test]
+    fn rank_deficient_shifted_observability_uses_the_fallback() {
+        let mut r = vec![DMatrix::from_element(1, 1, 0.0); 5];
+        r[0][(0, 0)] = 1.0;
+        r[4][(0, 0)] = 0.5;
+        let cov = SsiCov::from_correlations(&r, 50.0, 3).unwrap();
+        assert_eq!(cov.rank(), 2);
+        let modes = cov.poles_at(2).unwrap();
+        for m in modes {
+            assert!(m.frequency_hz.is_finite() && m.damping_ratio > 0.0);
+        }
+    }
+}

@@ -1,0 +1,100 @@
+//! Error type of the crate.
+
+use vibmode_core::ParamError;
+
+/// Everything that can go wrong in SSI-cov. Every message is one line naming the offending value
+/// and how to fix it.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SsiError {
+    /// No channel was given.
+    #[error("no channels given; pass at least one channel of samples")]
+    NoChannels,
+    /// A channel with fewer than two samples.
+    #[error("channel {channel} has {n_samples} samples; every channel needs at least 2")]
+    TooShort {
+        /// 0-based channel index.
+        channel: usize,
+        /// Its number of samples.
+        n_samples: usize,
+    },
+    /// Channels of different lengths.
+    #[error("channel {channel} has {found} samples but channel 0 has {expected}; all channels must have the same length")]
+    LengthMismatch {
+        /// 0-based index of the offending channel.
+        channel: usize,
+        /// Its length.
+        found: usize,
+        /// The length of channel 0.
+        expected: usize,
+    },
+    /// A NaN or infinite sample.
+    #[error("channel {channel} sample {index} is {value}; remove or interpolate non-finite samples first")]
+    NonFinite {
+        /// 0-based channel index.
+        channel: usize,
+        /// 0-based sample index.
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+    /// A sampling rate that is not a positive finite number.
+    #[error("sampling rate {fs_hz} Hz must be a positive finite number")]
+    InvalidSampleRate {
+        /// The value.
+        fs_hz: f64,
+    },
+    /// Too few samples for the lags of the block Toeplitz matrix.
+    #[error("{n_samples} samples per channel are too few for block_rows = {block_rows} (lags up to {max_lag}); pass at least {min_samples} samples or lower block_rows")]
+    TooFewSamples {
+        /// Samples per channel.
+        n_samples: usize,
+        /// Block rows asked for.
+        block_rows: usize,
+        /// Largest lag of the Toeplitz matrix, `2 * block_rows - 1`.
+        max_lag: usize,
+        /// Smallest number of samples accepted, `2 * block_rows`.
+        min_samples: usize,
+    },
+    /// A parameter out of range.
+    #[error(transparent)]
+    Param(#[from] ParamError),
+    /// A model order of zero.
+    #[error("model order 0 identifies nothing; ask for an order >= 1 (2 per mode)")]
+    ZeroOrder,
+    /// An order above what the shift invariance of the observability matrix can determine.
+    #[error("order {order} is too high for block_rows = {block_rows} with {n_channels} channels: the largest is (block_rows - 1) x channels = {max_order}; lower the order or raise block_rows to {needed_block_rows}")]
+    OrderTooHigh {
+        /// Order asked for.
+        order: usize,
+        /// Block rows of the Toeplitz matrix.
+        block_rows: usize,
+        /// Number of channels.
+        n_channels: usize,
+        /// Largest order for these block rows, `(block_rows - 1) * n_channels`.
+        max_order: usize,
+        /// Smallest number of block rows that allows the order.
+        needed_block_rows: usize,
+    },
+    /// An order above the numerical rank of the block Toeplitz matrix (noise-free or degenerate
+    /// data: fewer independent components than states asked for).
+    #[error("order {order} is above the numerical rank {rank} of the block Toeplitz matrix (singular values below {tolerance:e} are treated as zero); ask for an order <= {rank}")]
+    OrderAboveRank {
+        /// Order asked for.
+        order: usize,
+        /// Numerical rank of the Toeplitz matrix.
+        rank: usize,
+        /// Singular values at or below this are zero.
+        tolerance: f64,
+    },
+    /// An iterative decomposition (SVD or Schur) did not converge.
+    #[error("the {what} of a {size}x{size} matrix did not converge within {iterations} iterations; check the data for extreme magnitudes (scale the channels)")]
+    NotConverged {
+        /// Which decomposition ("SVD of the Toeplitz matrix", "Schur form of A").
+        what: &'static str,
+        /// Matrix size.
+        size: usize,
+        /// Iteration cap.
+        iterations: usize,
+    },
+}

@@ -1,0 +1,229 @@
+//! Every `SsiError` variant from bad input, with its message naming the offending value.
+//! (`NotConverged` is produced by a unit test of the eigen-decomposition in `src/eig.rs`: finite
+//! input data cannot reach it through the public functions.)
+
+use vibmode_ssi::{ssi_cov, SsiCov, SsiError, SsiParams};
+
+fn noise(n: usize, seed: u64) -> Vec<f64> {
+    // A small linear congruential generator: deterministic, no RNG crate needed.
+    let mut s = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    (0..n)
+        .map(|_| {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        })
+        .collect()
+}
+
+fn params(block_rows: usize) -> SsiParams {
+    SsiParams {
+        block_rows,
+        order_min: 2,
+        order_max: 4,
+        order_step: 2,
+    }
+}
+
+fn msg(r: Result<impl std::fmt::Debug, SsiError>) -> (SsiError, String) {
+    let e = r.expect_err("expected an error");
+    let m = e.to_string();
+    assert!(!m.contains('\n'), "one line: {m}");
+    assert!(!m.contains("--"), "no command-line flag: {m}");
+    (e, m)
+}
+
+#[test]
+fn no_channels() {
+    let (e, m) = msg(ssi_cov(&[], 50.0, &params(5)));
+    assert_eq!(e, SsiError::NoChannels);
+    assert!(m.contains("at least one channel"), "{m}");
+}
+
+#[test]
+fn too_short() {
+    let a = noise(1, 1);
+    let (e, m) = msg(ssi_cov(&[&a], 50.0, &params(5)));
+    assert!(
+        matches!(
+            e,
+            SsiError::TooShort {
+                channel: 0,
+                n_samples: 1
+            }
+        ),
+        "{e:?}"
+    );
+    assert!(m.contains("1 samples") && m.contains("at least 2"), "{m}");
+}
+
+#[test]
+fn length_mismatch() {
+    let (a, b) = (noise(100, 1), noise(99, 2));
+    let (e, m) = msg(ssi_cov(&[&a, &b], 50.0, &params(5)));
+    assert!(
+        matches!(
+            e,
+            SsiError::LengthMismatch {
+                channel: 1,
+                found: 99,
+                expected: 100
+            }
+        ),
+        "{e:?}"
+    );
+    assert!(m.contains("channel 1 has 99") && m.contains("100"), "{m}");
+}
+
+#[test]
+fn non_finite() {
+    let a = noise(100, 1);
+    let mut b = noise(100, 2);
+    b[37] = f64::NAN;
+    let (e, m) = msg(ssi_cov(&[&a, &b], 50.0, &params(5)));
+    assert!(
+        matches!(
+            e,
+            SsiError::NonFinite {
+                channel: 1,
+                index: 37,
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    assert!(m.contains("channel 1 sample 37 is NaN"), "{m}");
+    b[37] = f64::NEG_INFINITY;
+    let (_, m) = msg(ssi_cov(&[&a, &b], 50.0, &params(5)));
+    assert!(m.contains("is -inf"), "{m}");
+}
+
+#[test]
+fn invalid_sample_rate() {
+    let a = noise(100, 1);
+    for fs in [0.0, -50.0, f64::NAN, f64::INFINITY] {
+        let (e, m) = msg(ssi_cov(&[&a], fs, &params(5)));
+        assert!(matches!(e, SsiError::InvalidSampleRate { .. }), "{e:?}");
+        assert!(m.contains(&format!("{fs} Hz")), "{m}");
+    }
+}
+
+#[test]
+fn too_few_samples_for_the_block_rows() {
+    let a = noise(39, 1);
+    let (e, m) = msg(ssi_cov(&[&a], 50.0, &params(20)));
+    assert_eq!(
+        e,
+        SsiError::TooFewSamples {
+            n_samples: 39,
+            block_rows: 20,
+            max_lag: 39,
+            min_samples: 40
+        }
+    );
+    assert!(
+        m.contains("39 samples") && m.contains("block_rows = 20") && m.contains("at least 40"),
+        "{m}"
+    );
+    // Exactly 2 i samples is accepted.
+    let a = noise(40, 1);
+    assert!(SsiCov::new(&[&a], 50.0, &params(20)).is_ok());
+}
+
+#[test]
+fn invalid_params() {
+    let a = noise(100, 1);
+    let p = SsiParams {
+        order_min: 1,
+        ..params(5)
+    };
+    let (e, m) = msg(ssi_cov(&[&a], 50.0, &p));
+    assert!(matches!(e, SsiError::Param(_)), "{e:?}");
+    assert!(
+        m.contains("order_min = 1") && m.contains("order_min = 2"),
+        "{m}"
+    );
+    let p = SsiParams {
+        block_rows: 0,
+        ..params(5)
+    };
+    let (_, m) = msg(ssi_cov(&[&a], 50.0, &p));
+    assert!(m.contains("block_rows = 0"), "{m}");
+}
+
+#[test]
+fn zero_order() {
+    let a = noise(200, 1);
+    let cov = SsiCov::new(&[&a], 50.0, &params(5)).unwrap();
+    let (e, m) = msg(cov.poles_at(0));
+    assert_eq!(e, SsiError::ZeroOrder);
+    assert!(m.contains("order 0") && m.contains(">= 1"), "{m}");
+}
+
+#[test]
+fn order_too_high_for_the_block_rows() {
+    let (a, b) = (noise(500, 1), noise(500, 2));
+    let cov = SsiCov::new(&[&a, &b], 50.0, &params(5)).unwrap();
+    assert_eq!(cov.max_order(), 8);
+    assert!(cov.poles_at(8).is_ok());
+    let (e, m) = msg(cov.poles_at(10));
+    assert_eq!(
+        e,
+        SsiError::OrderTooHigh {
+            order: 10,
+            block_rows: 5,
+            n_channels: 2,
+            max_order: 8,
+            needed_block_rows: 6
+        }
+    );
+    assert!(
+        m.contains("order 10") && m.contains("= 8") && m.contains("block_rows to 6"),
+        "{m}"
+    );
+    // Through ssi_cov: the sweep stops at the first order it cannot identify.
+    let p = SsiParams {
+        order_max: 12,
+        ..params(5)
+    };
+    let (e, _) = msg(ssi_cov(&[&a, &b], 50.0, &p));
+    assert!(
+        matches!(e, SsiError::OrderTooHigh { order: 10, .. }),
+        "{e:?}"
+    );
+    // One block row leaves no shift: every order is too high.
+    let (e, _) = msg(ssi_cov(&[&a, &b], 50.0, &params(1)));
+    assert!(
+        matches!(
+            e,
+            SsiError::OrderTooHigh {
+                order: 2,
+                max_order: 0,
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+}
+
+#[test]
+fn order_above_the_rank() {
+    // A constant channel is zero once its mean is removed: rank 0.
+    let a = vec![3.5; 200];
+    let (e, m) = msg(ssi_cov(&[&a], 50.0, &params(5)));
+    assert!(
+        matches!(
+            e,
+            SsiError::OrderAboveRank {
+                order: 2,
+                rank: 0,
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    assert!(m.contains("order 2") && m.contains("rank 0"), "{m}");
+}

@@ -1,0 +1,171 @@
+//! Identity over many seeds: a simulated linear system with known modes and mode shapes,
+//! identified by SSI-cov at an order of twice the number of modes.
+//!
+//! The simulator is written here: three modes (1.2 Hz / 0.05, 4.5 Hz / 0.02, 9.0 Hz / 0.1) in
+//! real modal form, each the exact discretisation `exp(A_c / fs)` of its continuous block
+//! `[[sigma, -omega_d], [omega_d, sigma]]` (poles `s = sigma +- i omega_d`), driven by seeded
+//! white noise; five channels `y = C x + v`, where `C` puts the real mode shape of each mode on
+//! the first state of its block and `v` is white measurement noise of 10 % of each channel's
+//! standard deviation.
+
+use std::f64::consts::PI;
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
+use vibmode_ssi::{mac, ssi_cov, stabilisation, SsiParams, Stability, StabilityParams};
+
+const FS: f64 = 50.0;
+const MODES: [(f64, f64); 3] = [(1.2, 0.05), (4.5, 0.02), (9.0, 0.1)];
+const SHAPES: [[f64; 5]; 3] = [
+    [1.0, 0.8, 0.5, 0.2, -0.1],
+    [0.3, -0.6, 1.0, 0.2, -0.8],
+    [-0.5, 1.0, 0.1, -0.9, 0.4],
+];
+
+fn simulate(n: usize, seed: u64) -> Vec<Vec<f64>> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let blocks: Vec<[f64; 5]> = MODES
+        .iter()
+        .map(|&(f, z)| {
+            let w = 2.0 * PI * f;
+            let (sigma, wd) = (-z * w, w * (1.0 - z * z).sqrt());
+            let r = (sigma / FS).exp();
+            let (c, s) = ((wd / FS).cos(), (wd / FS).sin());
+            // Input standard deviation sqrt(1 - r^2): every mode has unit stationary variance.
+            [r * c, -r * s, r * s, r * c, (1.0 - r * r).sqrt()]
+        })
+        .collect();
+    let burn = 2000;
+    let mut x = vec![[0.0f64; 2]; MODES.len()];
+    let mut y: Vec<Vec<f64>> = (0..5).map(|_| Vec::with_capacity(n)).collect();
+    for t in 0..n + burn {
+        if t >= burn {
+            for (ch, out) in y.iter_mut().enumerate() {
+                out.push(
+                    (0..MODES.len())
+                        .map(|m| SHAPES[m][ch] * x[m][0])
+                        .sum::<f64>(),
+                );
+            }
+        }
+        for (m, b) in blocks.iter().enumerate() {
+            let w0: f64 = b[4] * Distribution::<f64>::sample(&StandardNormal, &mut rng);
+            let w1: f64 = b[4] * Distribution::<f64>::sample(&StandardNormal, &mut rng);
+            let [x0, x1] = x[m];
+            x[m] = [b[0] * x0 + b[1] * x1 + w0, b[2] * x0 + b[3] * x1 + w1];
+        }
+    }
+    for ch in y.iter_mut() {
+        let sd = (ch.iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt();
+        for v in ch.iter_mut() {
+            let e: f64 = StandardNormal.sample(&mut rng);
+            *v += 0.1 * sd * e;
+        }
+    }
+    y
+}
+
+fn real_shape(s: &[f64]) -> Vec<[f64; 2]> {
+    s.iter().map(|&v| [v, 0.0]).collect()
+}
+
+/// Every seed 0..12, every mode: frequency within 1 %, damping within 0.02 absolute, MAC > 0.99
+/// at order 6 (block rows 20, 40 000 samples at 50 Hz). Measured (printed summary, recall
+/// 36/36): worst relative frequency errors 0.71 % (1.2 Hz), 0.23 % (4.5 Hz), 0.84 % (9 Hz);
+/// worst damping errors 0.0049, 0.0029, 0.0077; worst MAC 0.99993. The errors scatter around
+/// zero (no bias) with a standard deviation of about 0.35 % for 1.2 and 9 Hz. With the 9 Hz mode
+/// at damping 0.2 and 20 000 samples its frequency scatters by 1-1.5 % (pyOMA2 1.4.3's SSI-cov
+/// scatters alike on the same system), beyond a 1 % bound, hence 0.1 and 40 000 samples.
+#[test]
+fn three_modes_recovered_over_seeds() {
+    let n = 40_000;
+    let seeds: Vec<u64> = (0..12).collect();
+    let params = SsiParams {
+        block_rows: 20,
+        order_min: 6,
+        order_max: 6,
+        ..SsiParams::default()
+    };
+    let mut recovered = 0;
+    let mut failures = Vec::new();
+    // Per mode: worst relative frequency error, worst absolute damping error, worst MAC.
+    let mut worst = [(0.0f64, 0.0f64, 1.0f64); 3];
+    for &seed in &seeds {
+        let y = simulate(n, seed);
+        let ch: Vec<&[f64]> = y.iter().map(Vec::as_slice).collect();
+        let r = ssi_cov(&ch, FS, &params).unwrap();
+        let modes = &r.orders[0].modes;
+        for (m, &(f, z)) in MODES.iter().enumerate() {
+            let best = modes.iter().min_by(|a, b| {
+                (a.frequency_hz - f)
+                    .abs()
+                    .total_cmp(&(b.frequency_hz - f).abs())
+            });
+            let Some(best) = best else {
+                failures.push(format!("seed {seed} mode {f} Hz: no mode identified"));
+                continue;
+            };
+            let ef = (best.frequency_hz - f).abs() / f;
+            let ez = (best.damping_ratio - z).abs();
+            let mc = mac(&best.shape, &real_shape(&SHAPES[m]));
+            worst[m] = (worst[m].0.max(ef), worst[m].1.max(ez), worst[m].2.min(mc));
+            if ef <= 0.01 && ez <= 0.02 && mc > 0.99 {
+                recovered += 1;
+            } else {
+                failures.push(format!(
+                    "seed {seed} mode {f} Hz: {:.4} Hz, damping {:.4} (true {z}), MAC {mc:.5}",
+                    best.frequency_hz, best.damping_ratio
+                ));
+            }
+        }
+    }
+    let total = seeds.len() * MODES.len();
+    eprintln!("recall {recovered}/{total}");
+    for (m, w) in worst.iter().enumerate() {
+        eprintln!(
+            "{} Hz: worst relative frequency error {:.2e}, damping error {:.2e}, MAC {:.6}",
+            MODES[m].0, w.0, w.1, w.2
+        );
+    }
+    assert_eq!(
+        recovered, total,
+        "recall {recovered}/{total} over seeds {seeds:?}: {failures:?}"
+    );
+}
+
+/// The lightly damped true modes (1.2 Hz / 0.05, 4.5 Hz / 0.02) are stable through the orders
+/// 6..=30 of one simulated record: from order 8 on, each has a mode labelled `Stable` at (at
+/// least) 80 % of the orders. (The 9 Hz / 0.1 mode is left out: from order to order its damping
+/// estimate moves by more than the 5 % relative tolerance, 0.09-0.12 on seed 100, so it is
+/// mostly labelled `Frequency`.)
+#[test]
+fn true_modes_stabilise() {
+    let y = simulate(40_000, 100);
+    let ch: Vec<&[f64]> = y.iter().map(Vec::as_slice).collect();
+    let params = SsiParams {
+        block_rows: 20,
+        order_min: 6,
+        order_max: 30,
+        order_step: 2,
+    };
+    let r = ssi_cov(&ch, FS, &params).unwrap();
+    let labels = stabilisation(&r, &StabilityParams::default());
+    for &(f, _) in MODES.iter().filter(|(_, z)| *z <= 0.05) {
+        let stable = r.orders[1..]
+            .iter()
+            .zip(&labels[1..])
+            .filter(|(o, l)| {
+                o.modes
+                    .iter()
+                    .zip(l.iter())
+                    .any(|(m, &s)| s == Stability::Stable && (m.frequency_hz - f).abs() < 0.01 * f)
+            })
+            .count();
+        let total = r.orders.len() - 1;
+        assert!(
+            stable * 5 >= total * 4,
+            "{f} Hz stable at {stable} of {total} orders"
+        );
+    }
+}
