@@ -160,14 +160,7 @@ pub fn vehicle_reference(path: &Path) -> Result<Vec<ReferenceMode>> {
 
 /// Physical-model modes as the reference modes the clustering is matched to.
 fn reference_modes(modes: &[vibmode_vehicle::ModeInfo]) -> Vec<ReferenceMode> {
-    modes
-        .iter()
-        .map(|m| ReferenceMode {
-            frequency_hz: m.frequency_hz,
-            damping_ratio: m.damping_ratio,
-            label: m.label.to_string(),
-        })
-        .collect()
+    modes.iter().map(|m| m.to_reference()).collect()
 }
 
 /// Runs the analysis with a progress bar on a terminal.

@@ -5,8 +5,8 @@ use std::path::Path;
 
 use crate::AnalysisError;
 use vibmode_core::{
-    ClusterParams, Corner, LineParams, PoleFilterParams, PreprocessParams, Role, SpectrumParams,
-    StopParams, SweepParams,
+    ClusterParams, Corner, IdentMethod, LineParams, PoleFilterParams, PreprocessParams, Role,
+    SpectrumParams, SsiParams, StopParams, SweepParams,
 };
 
 /// Named sets of defaults.
@@ -89,6 +89,9 @@ pub struct AnalysisConfig {
     /// one guessed from the name (containing "unsprung"/"wheel"/"axle" -> unsprung,
     /// "sprung"/"body"/"floor" -> sprung, corner FL/FR/RL/RR as a token).
     pub channels: Vec<ChannelRole>,
+    /// Identification method: `"arma"` (per channel), `"ssi-cov"` (all channels at once, with
+    /// mode shapes) or `"both"`.
+    pub method: IdentMethod,
     /// Pre-processing: ideal anti-alias filter and resampling.
     pub preprocess: PreprocessParams,
     /// Spectra of every record.
@@ -97,6 +100,8 @@ pub struct AnalysisConfig {
     pub sweep: SweepParams,
     /// Pole filters applied to every fit.
     pub poles: PoleFilterParams,
+    /// Multichannel identification (SSI-cov).
+    pub ssi: SsiParams,
     /// Stop detection.
     pub stops: StopParams,
     /// Clustering and classification.
@@ -173,6 +178,8 @@ impl AnalysisConfig {
             stops: StopParams::default(),
             cluster: ClusterParams::default(),
             lines: LineParams::default(),
+            method: IdentMethod::default(),
+            ssi: SsiParams::default(),
             report: ReportParams::default(),
         };
         match p {
@@ -190,6 +197,7 @@ impl AnalysisConfig {
                 report: ReportParams {
                     model_psd_orders: vec![10, 20],
                 },
+                method: IdentMethod::Arma,
                 ..base
             },
         }
@@ -262,6 +270,7 @@ impl AnalysisConfig {
         self.stops.validate(self.preprocess.cutoff_hz)?;
         self.cluster.validate()?;
         self.lines.validate()?;
+        self.ssi.validate()?;
         Ok(())
     }
 

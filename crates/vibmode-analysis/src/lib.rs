@@ -27,6 +27,7 @@ mod config;
 pub mod first_record;
 pub mod identify;
 pub mod lines;
+pub mod multichannel;
 pub mod pipeline;
 pub mod results;
 pub mod source;
@@ -37,6 +38,7 @@ pub use config::{AnalysisConfig, ChannelRole, Preset, ReportParams};
 pub use first_record::{first_record_spectra, FirstRecordSpectra, ModelPsd};
 pub use identify::{Identifier, PoleOut, SignalFits, SweepIdentifier};
 pub use lines::LineTrack;
+pub use multichannel::{ShapedPole, SsiAnalysis, MATCH_MAC_MIN};
 pub use pipeline::{analyze, analyze_with, check_records, cluster_params_for, preprocess_records};
 pub use results::{
     AnalysisResults, ChannelAnalysis, RecordSummary, RoleAnalysis, Timing, SCHEMA_VERSION,

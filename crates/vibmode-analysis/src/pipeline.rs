@@ -13,6 +13,7 @@ use vibmode_spectra::{WelchParams, Window};
 use crate::config::AnalysisConfig;
 use crate::identify::{Identifier, SignalFits, SweepIdentifier};
 use crate::lines::LineStage;
+use crate::multichannel::SsiStage;
 use crate::results::{
     AnalysisResults, ChannelAnalysis, RecordSummary, RoleAnalysis, Timing, SCHEMA_VERSION,
 };
@@ -168,6 +169,19 @@ pub fn analyze_with(
         &mut store,
     )?;
     let roles = role_modes(&channels, &store, &support, &lines, reference)?;
+    let ssi = if cfg.method.runs_ssi() {
+        let stage = SsiStage {
+            pre: &pre,
+            active: &active,
+            n_active,
+            params: &cfg.ssi,
+            cluster: &cluster,
+            drop_band_edge: cfg.poles.drop_band_edge,
+        };
+        Some(stage.run(&lines, reference)?)
+    } else {
+        None
+    };
     let fits = channels.iter().flat_map(|c| c.fits.iter());
     let n_fits = fits.clone().count();
     let n_not_converged = fits.clone().filter(|f| !f.converged).count();
@@ -201,6 +215,7 @@ pub fn analyze_with(
         roles,
         reference_modes: reference.to_vec(),
         n_stationary: stationary.iter().filter(|&&s| s).count(),
+        ssi,
         n_fits,
         n_not_converged,
         n_failed,
@@ -240,7 +255,11 @@ fn identify_all(
             } else {
                 &[]
             };
-            let fits = identifier.identify(y, &p.band, r, keep);
+            let fits = if cfg.method.runs_arma() {
+                identifier.identify(y, &p.band, r, keep)
+            } else {
+                SignalFits::default()
+            };
             progress(done.fetch_add(1, Ordering::SeqCst) + 1, total);
             Ok(SignalOut {
                 record: r,

@@ -11,11 +11,13 @@ use vibmode_core::{
 use crate::config::AnalysisConfig;
 use crate::identify::PoleOut;
 use crate::lines::LineTrack;
+use crate::multichannel::SsiAnalysis;
 
 /// Version of the layout of [`AnalysisResults`] (`schema_version` in `results.json`). 2: stage
 /// sections in `config`, per-record bands, fit errors kept, model coefficients instead of model
 /// spectra, timing apart. 3: periodic line tracks (`lines`) per channel and pool, each mode's
-/// `line_kurtosis`, the `[lines]` config section.
+/// `line_kurtosis`, the `[lines]` config section, `method`, `[ssi]` and the multichannel
+/// results `ssi` (poles with shapes, clusters with mean shapes, matches with MAC).
 pub const SCHEMA_VERSION: u32 = 3;
 
 /// Facts about one analysed record.
@@ -111,6 +113,9 @@ pub struct AnalysisResults {
     pub channels: Vec<ChannelAnalysis>,
     /// Per role results.
     pub roles: Vec<RoleAnalysis>,
+    /// Multichannel (SSI-cov) results, when that method ran.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ssi: Option<SsiAnalysis>,
     /// Physical model modes used for matching (empty without a vehicle model).
     pub reference_modes: Vec<ReferenceMode>,
     /// Number of records marked `stationary` (stops), left out of the mode statistics; the

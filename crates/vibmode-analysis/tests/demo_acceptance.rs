@@ -19,16 +19,7 @@ fn demo_data_gives_the_true_modes_and_lines() {
             recording: r.recording.clone(),
         })
         .collect();
-    let reference: Vec<ReferenceMode> = sim
-        .truth
-        .modes
-        .iter()
-        .map(|m| ReferenceMode {
-            frequency_hz: m.frequency_hz,
-            damping_ratio: m.damping_ratio,
-            label: m.label.to_string(),
-        })
-        .collect();
+    let reference: Vec<ReferenceMode> = sim.truth.modes.iter().map(|m| m.to_reference()).collect();
     let cfg = AnalysisConfig::default();
     let res = analyze(&records, &cfg, &reference, &|_, _| {}).expect("analysis");
     let role = |r: Role| {

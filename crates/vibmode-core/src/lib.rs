@@ -31,7 +31,7 @@ pub use modes::{
     ReferenceMode, SupportFailure,
 };
 pub use params::{
-    BandLimit, ClusterParams, LineParams, PoleFilterParams, PreprocessParams, Robust,
+    BandLimit, ClusterParams, IdentMethod, LineParams, PoleFilterParams, PreprocessParams, Robust,
     SpectrumParams, StopParams, SweepModel, SweepParams, DEFAULT_HUBER_FACTOR, EDGE_SHARE,
     EMPTY_BAND_MAX_CUTOFF_SHARE,
 };

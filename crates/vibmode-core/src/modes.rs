@@ -161,6 +161,41 @@ pub struct ReferenceMode {
     pub damping_ratio: f64,
     /// Label, e.g. "body heave" or "wheel hop FL".
     pub label: String,
+    /// Mode shape at the sensors (one complex `[re, im]` per entry of `shape_channels`), when
+    /// the model knows its sensors.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<Vec<[f64; 2]>>,
+    /// Channel names of the entries of `shape`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub shape_channels: Vec<String>,
+}
+
+impl ReferenceMode {
+    /// A reference mode without a shape.
+    pub fn new(frequency_hz: f64, damping_ratio: f64, label: impl Into<String>) -> Self {
+        ReferenceMode {
+            frequency_hz,
+            damping_ratio,
+            label: label.into(),
+            shape: None,
+            shape_channels: Vec::new(),
+        }
+    }
+
+    /// The shape reordered to `channels` (by name); `None` when the mode has no shape or a
+    /// channel is not among `shape_channels`.
+    pub fn shape_for(&self, channels: &[String]) -> Option<Vec<[f64; 2]>> {
+        let shape = self.shape.as_ref()?;
+        channels
+            .iter()
+            .map(|c| {
+                self.shape_channels
+                    .iter()
+                    .position(|n| n == c)
+                    .and_then(|i| shape.get(i).copied())
+            })
+            .collect()
+    }
 }
 
 /// Result of matching one reference mode to the invariant modes.
@@ -180,6 +215,9 @@ pub struct ModeMatch {
     /// NaN (null in JSON) when there is no structural mode at all.
     #[serde(deserialize_with = "nan_if_null")]
     pub damping_diff: f64,
+    /// MAC between the matched mode's shape and the reference shape, when both have one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mac: Option<f64>,
 }
 
 fn nan_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {

@@ -405,10 +405,7 @@ type ShapeStats = (Option<Vec<[f64; 2]>>, Option<(f64, f64)>);
 
 /// Mean shape of the kept poles that carry one (all of one length), and the median and lowest
 /// MAC of their shapes with it.
-fn shape_stats(
-    kept: &[usize],
-    poles: &[PoleObservation],
-) -> ShapeStats {
+fn shape_stats(kept: &[usize], poles: &[PoleObservation]) -> ShapeStats {
     let shapes: Vec<&[[f64; 2]]> = kept
         .iter()
         .filter_map(|&i| poles[i].shape.as_deref())

@@ -38,14 +38,162 @@ pub fn match_reference(
                     invariant: (d <= max_freq_diff_rel).then_some(k),
                     freq_diff_rel: (modes[k].frequency_hz - r.frequency_hz) / r.frequency_hz,
                     damping_diff: modes[k].damping_ratio - r.damping_ratio,
+                    mac: None,
                 },
                 None => ModeMatch {
                     reference: r.clone(),
                     invariant: None,
                     freq_diff_rel: f64::NAN,
                     damping_diff: f64::NAN,
+                    mac: None,
                 },
             }
         })
         .collect()
+}
+
+/// Matching by frequency **and** shape, one to one: every (reference, structural mode) pair
+/// whose relative frequency difference is at most `max_freq_diff_rel` and whose shapes have
+/// MAC at least `mac_min` is a candidate (the reference's shape is taken at `channels`, the
+/// channels of the identified shapes, by name); candidates are accepted by decreasing MAC (then
+/// increasing frequency difference), each reference and each identified mode at most once.
+/// References or modes without a shape fall back to frequency only, after the shape matches,
+/// and only onto modes still free. The output has one entry per reference mode, in input order,
+/// with the MAC of the match. Never panics.
+pub fn match_reference_shapes(
+    modes: &[InvariantMode],
+    reference: &[ReferenceMode],
+    channels: &[String],
+    max_freq_diff_rel: f64,
+    mac_min: f64,
+) -> Vec<ModeMatch> {
+    let ok = |r: &ReferenceMode, m: &InvariantMode| {
+        m.class == ModeClass::Structural
+            && m.frequency_hz.is_finite()
+            && r.frequency_hz.is_finite()
+            && r.frequency_hz > 0.0
+            && ((m.frequency_hz - r.frequency_hz).abs() / r.frequency_hz) <= max_freq_diff_rel
+    };
+    let ref_shapes: Vec<Option<Vec<[f64; 2]>>> =
+        reference.iter().map(|r| r.shape_for(channels)).collect();
+    let mut pairs: Vec<(usize, usize, f64, f64)> = Vec::new();
+    for (i, r) in reference.iter().enumerate() {
+        let Some(rs) = &ref_shapes[i] else { continue };
+        for (k, m) in modes.iter().enumerate() {
+            let Some(ms) = &m.shape else { continue };
+            if !ok(r, m) {
+                continue;
+            }
+            let mac = crate::shapes::mac(rs, ms);
+            if mac >= mac_min {
+                let d = (m.frequency_hz - r.frequency_hz).abs() / r.frequency_hz;
+                pairs.push((i, k, mac, d));
+            }
+        }
+    }
+    pairs.sort_by(|a, b| b.2.total_cmp(&a.2).then(a.3.total_cmp(&b.3)));
+    let mut of_ref: Vec<Option<(usize, Option<f64>)>> = vec![None; reference.len()];
+    let mut taken = vec![false; modes.len()];
+    for (i, k, mac, _) in pairs {
+        if of_ref[i].is_none() && !taken[k] {
+            of_ref[i] = Some((k, Some(mac)));
+            taken[k] = true;
+        }
+    }
+    // Frequency only, for what has no shape.
+    for (i, r) in reference.iter().enumerate() {
+        if of_ref[i].is_some() {
+            continue;
+        }
+        let free_nearest = modes
+            .iter()
+            .enumerate()
+            .filter(|(k, m)| {
+                !taken[*k] && ok(r, m) && (ref_shapes[i].is_none() || m.shape.is_none())
+            })
+            .min_by(|a, b| {
+                let da = (a.1.frequency_hz - r.frequency_hz).abs();
+                let db = (b.1.frequency_hz - r.frequency_hz).abs();
+                da.total_cmp(&db)
+            });
+        if let Some((k, _)) = free_nearest {
+            of_ref[i] = Some((k, None));
+            taken[k] = true;
+        }
+    }
+    let nearest = match_reference(modes, reference, f64::INFINITY);
+    reference
+        .iter()
+        .zip(nearest)
+        .zip(of_ref)
+        .map(|((r, near), m)| match m {
+            Some((k, mac)) => ModeMatch {
+                reference: r.clone(),
+                invariant: Some(k),
+                freq_diff_rel: (modes[k].frequency_hz - r.frequency_hz) / r.frequency_hz,
+                damping_diff: modes[k].damping_ratio - r.damping_ratio,
+                mac,
+            },
+            None => ModeMatch {
+                invariant: None,
+                ..near
+            },
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn mode(f: f64, shape: Vec<[f64; 2]>) -> InvariantMode {
+        InvariantMode {
+            frequency_hz: f,
+            frequency_std_hz: 0.0,
+            damping_ratio: 0.2,
+            damping_iqr: (0.2, 0.2),
+            order_share: 1.0,
+            record_share: 1.0,
+            n_poles: 10,
+            channels: vec!["ssi".into()],
+            roles: vec![],
+            min_order: 2,
+            class: ModeClass::Structural,
+            line_kurtosis: None,
+            shape: Some(shape),
+            shape_mac: None,
+        }
+    }
+
+    #[test]
+    fn shapes_decide_between_modes_close_in_frequency_one_to_one() {
+        let chans: Vec<String> = ["a", "b"].iter().map(|s| s.to_string()).collect();
+        // identified: 1.05 Hz in phase, 1.10 Hz out of phase
+        let modes = vec![
+            mode(1.05, vec![[1.0, 0.0], [1.0, 0.0]]),
+            mode(1.10, vec![[1.0, 0.0], [-1.0, 0.0]]),
+        ];
+        // model: pitch 1.03 out of phase, heave 1.17 in phase (channels given in reverse order)
+        let r = |f: f64, label: &str, s: Vec<[f64; 2]>| ReferenceMode {
+            shape: Some(s),
+            shape_channels: vec!["b".into(), "a".into()],
+            ..ReferenceMode::new(f, 0.2, label)
+        };
+        let reference = vec![
+            r(1.03, "pitch", vec![[-1.0, 0.0], [1.0, 0.0]]),
+            r(1.17, "heave", vec![[1.0, 0.0], [1.0, 0.0]]),
+            r(1.08, "no shape twin", vec![[0.0, 0.0], [0.0, 0.0]]),
+        ];
+        let m = match_reference_shapes(&modes, &reference, &chans, 0.25, 0.5);
+        assert_eq!(
+            m[0].invariant,
+            Some(1),
+            "pitch goes to the out-of-phase mode"
+        );
+        assert_eq!(m[1].invariant, Some(0), "heave to the in-phase one");
+        assert!((m[0].mac.unwrap() - 1.0).abs() < 1e-12);
+        // both identified modes are taken: the third reference stays unmatched
+        assert_eq!(m[2].invariant, None);
+        assert!(m[2].freq_diff_rel.is_finite());
+    }
 }

@@ -169,11 +169,7 @@ fn mode(f: f64, z: f64, class: ModeClass) -> InvariantMode {
 }
 
 fn reference(f: f64, z: f64, label: &str) -> ReferenceMode {
-    ReferenceMode {
-        frequency_hz: f,
-        damping_ratio: z,
-        label: label.into(),
-    }
+    ReferenceMode::new(f, z, label)
 }
 
 #[test]

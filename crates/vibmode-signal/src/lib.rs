@@ -51,7 +51,7 @@ pub use error::SignalError;
 pub use preprocess::{preprocess, Preprocessed};
 pub use read::{
     read_delimited, read_delimited_bytes, read_path, sidecar_candidates, Format, ReadOptions,
-    Sidecar,
+    Sidecar, WavSidecar,
 };
 pub use resample::ResampleRecording;
 pub use resample::{resample, ResampleMethod, ResampleParams, Resampler};

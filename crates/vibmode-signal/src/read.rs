@@ -408,11 +408,12 @@ fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Recording> {
         spec.sample_rate as f64,
         opts.fs_hz,
     )?;
+    let (names, units) = wav_names(path, nch)?;
     let channels: Vec<Channel> = (0..nch)
         .map(|c| Channel {
             placement: Default::default(),
-            name: format!("ch{c}"),
-            unit: String::new(),
+            name: names[c].clone(),
+            unit: units[c].clone(),
             samples: interleaved
                 .iter()
                 .skip(c)
@@ -428,6 +429,58 @@ fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Recording> {
         channels,
         time_axis: None,
     })
+}
+
+/// The optional JSON sidecar of a WAV file (`<path>.json`): channel names and units, which WAV
+/// cannot hold. vibmode writes one beside every WAV it writes; other keys are ignored.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct WavSidecar {
+    /// Channel names, in the WAV's channel order.
+    pub channels: Vec<String>,
+    /// Units per channel (optional; same length as `channels`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub units: Option<Vec<String>>,
+}
+
+/// Channel names and units of a WAV: from `<path>.json` when it exists, else `ch0`, `ch1`, ...
+fn wav_names(path: &Path, nch: usize) -> Result<(Vec<String>, Vec<String>)> {
+    let mut full = path.as_os_str().to_owned();
+    full.push(".json");
+    let side = PathBuf::from(full);
+    if !side.is_file() {
+        return Ok((
+            (0..nch).map(|c| format!("ch{c}")).collect(),
+            vec![String::new(); nch],
+        ));
+    }
+    let sp = side.display().to_string();
+    let text = std::fs::read_to_string(&side).map_err(|e| io_err("read", &side, &e))?;
+    let bad = |reason: String| SignalError::Sidecar {
+        path: sp.clone(),
+        reason,
+    };
+    let w: WavSidecar = serde_json::from_str(&text).map_err(|e| {
+        bad(format!(
+            "{e}; expected {{\"channels\": [\"FL\", ...]}} (or delete it to name the channels ch0, ch1, ...)"
+        ))
+    })?;
+    if w.channels.len() != nch {
+        return Err(bad(format!(
+            "names {} channels but the WAV has {nch}; fix the channel list or delete the file",
+            w.channels.len()
+        )));
+    }
+    let units = match w.units {
+        Some(u) if u.len() == nch => u,
+        Some(u) => {
+            return Err(bad(format!(
+                "has {} units for {nch} channels; give one unit per channel",
+                u.len()
+            )))
+        }
+        None => vec![String::new(); nch],
+    };
+    Ok((w.channels, units))
 }
 
 /// The JSON sidecar of a raw binary file.

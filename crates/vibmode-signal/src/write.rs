@@ -1,7 +1,7 @@
 //! Writing recordings: CSV, 32-bit float WAV, raw binary + JSON sidecar.
 
 use crate::error::{io_err, Result, SignalError};
-use crate::read::{Format, Sidecar};
+use crate::read::{Format, Sidecar, WavSidecar};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use vibmode_core::{check_fs, Recording};
@@ -12,7 +12,8 @@ use vibmode_core::{check_fs, Recording};
 ///   with the time in seconds (`start_s + i / fs_hz`) and the shortest decimal that reads back to
 ///   the same f64 (lossless);
 /// - `.wav`: 32-bit float WAV, rate rounded to whole Hz (error if `fs_hz` is not an integer),
-///   channel names and units are lost;
+///   plus a sidecar `<path>.json` with the channel names and units (which WAV cannot hold; the
+///   reader uses it);
 /// - `.f32`, `.f64`, `.bin`, `.raw`: interleaved little-endian samples (`f32` for `.f32`,
 ///   otherwise `f64`) plus a sidecar `<path>.json` (`fs_hz`, `dtype`, `channels`, `units`).
 ///
@@ -111,7 +112,19 @@ fn write_wav(path: &Path, rec: &Recording) -> Result<()> {
             w.write_sample(c.samples[i] as f32).map_err(werr)?;
         }
     }
-    w.finalize().map_err(werr)
+    w.finalize().map_err(werr)?;
+    let side = WavSidecar {
+        channels: rec.channels.iter().map(|c| c.name.clone()).collect(),
+        units: Some(rec.channels.iter().map(|c| c.unit.clone()).collect()),
+    };
+    let mut full = path.as_os_str().to_owned();
+    full.push(".json");
+    let sp = PathBuf::from(full);
+    let text = serde_json::to_string_pretty(&side).map_err(|e| SignalError::Sidecar {
+        path: sp.display().to_string(),
+        reason: e.to_string(),
+    })?;
+    std::fs::write(&sp, text).map_err(|e| io_err("write", &sp, &e))
 }
 
 fn write_raw(path: &Path, rec: &Recording, f32_out: bool) -> Result<()> {

@@ -633,3 +633,33 @@ fn large_file_parallel_parse_reports_exact_lines() {
         "{e}"
     );
 }
+
+#[test]
+fn wav_keeps_channel_names_and_units_through_its_sidecar() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("r.wav");
+    let rec = vibmode_core::Recording {
+        fs_hz: 100.0,
+        channels: vec![
+            vibmode_core::Channel::new("FL_unsprung", "m/s^2", vec![0.0, 1.0, -1.0, 0.5]),
+            vibmode_core::Channel::new("RR_sprung", "g", vec![0.25, 0.0, 0.5, -0.25]),
+        ],
+        time_axis: None,
+    };
+    vibmode_signal::write_path(&path, &rec).unwrap();
+    let back = vibmode_signal::read_path(&path, &vibmode_signal::ReadOptions::default()).unwrap();
+    let names: Vec<&str> = back.channels.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(names, ["FL_unsprung", "RR_sprung"]);
+    assert_eq!(back.channels[1].unit, "g");
+    assert_eq!(back.channels[1].samples, rec.channels[1].samples);
+    // a sidecar naming the wrong number of channels is a clear error
+    std::fs::write(dir.path().join("r.wav.json"), r#"{"channels": ["a"]}"#).unwrap();
+    let e = vibmode_signal::read_path(&path, &vibmode_signal::ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("names 1 channels but the WAV has 2"), "{e}");
+    // without a sidecar: ch0, ch1
+    std::fs::remove_file(dir.path().join("r.wav.json")).unwrap();
+    let plain = vibmode_signal::read_path(&path, &vibmode_signal::ReadOptions::default()).unwrap();
+    assert_eq!(plain.channels[0].name, "ch0");
+}

@@ -121,6 +121,18 @@ pub struct ModeInfo {
 }
 
 impl ModeInfo {
+    /// This mode as a reference for the identified modes: frequency, damping, label and the
+    /// shape at the sensors (named after them).
+    pub fn to_reference(&self) -> vibmode_core::ReferenceMode {
+        vibmode_core::ReferenceMode {
+            frequency_hz: self.frequency_hz,
+            damping_ratio: self.damping_ratio,
+            label: self.label.to_string(),
+            shape: (!self.sensor_names.is_empty()).then(|| self.sensor_shape()),
+            shape_channels: self.sensor_names.clone(),
+        }
+    }
+
     /// The sensor mode shape as `[re, im]` pairs (empty when the sensors are unknown).
     pub fn sensor_shape(&self) -> Vec<[f64; 2]> {
         self.sensor_shape_re

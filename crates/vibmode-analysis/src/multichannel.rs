@@ -1,0 +1,186 @@
+//! Stage 3b, multichannel identification: SSI-cov of all channels of each record at once, with
+//! complex mode shapes; the poles pooled over records and orders and clustered with their shapes
+//! (1 - MAC in the distance), the clusters classed with the line evidence, and matched to the
+//! physical model by frequency and MAC.
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use vibmode_core::{
+    ClusterParams, InvariantMode, ModeMatch, PoleObservation, ReferenceMode, SsiParams,
+};
+use vibmode_signal::Preprocessed;
+use vibmode_ssi::SsiCov;
+
+use crate::lines::{LineStage, LineTrack};
+use crate::AnalysisError;
+
+/// A physical-model mode is matched to an identified mode whose shape has at least this MAC with
+/// the model's shape at the sensors (and whose frequency is within 25 %).
+pub const MATCH_MAC_MIN: f64 = 0.5;
+
+/// Name of the pseudo-channel of the multichannel poles in the pole store and the clusters.
+pub const SSI_CHANNEL: &str = "ssi-cov";
+
+/// One pole of one SSI-cov order of one record, with its shape.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ShapedPole {
+    /// Record index.
+    pub record: usize,
+    /// Model order (state dimension).
+    pub order: usize,
+    /// Natural frequency, Hz.
+    pub frequency_hz: f64,
+    /// Damping ratio.
+    pub damping_ratio: f64,
+    /// Modal phase collinearity of the shape (1 = a real, normal mode).
+    pub mpc: f64,
+    /// Complex shape, one `[re, im]` per channel of [`SsiAnalysis::channels`].
+    pub shape: Vec<[f64; 2]>,
+}
+
+/// Everything the multichannel identification found.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SsiAnalysis {
+    /// Channels identified together, in the order of every shape.
+    pub channels: Vec<String>,
+    /// Orders identified.
+    pub orders: Vec<usize>,
+    /// Every pole kept (stable, complex, inside the valid band).
+    pub poles: Vec<ShapedPole>,
+    /// Clusters of the poles over records and orders, with mean shapes.
+    pub invariant_modes: Vec<InvariantMode>,
+    /// Physical-model modes matched by frequency and MAC, one to one.
+    pub matches: Vec<ModeMatch>,
+    /// Periodic lines of all the channels, tracked over the records.
+    pub lines: Vec<LineTrack>,
+    /// Records whose identification failed, with the reason.
+    pub failed_records: Vec<(usize, String)>,
+}
+
+pub(crate) struct SsiStage<'a> {
+    pub pre: &'a [Preprocessed],
+    pub active: &'a [Option<usize>],
+    pub n_active: usize,
+    pub params: &'a SsiParams,
+    pub cluster: &'a ClusterParams,
+    pub drop_band_edge: bool,
+}
+
+impl SsiStage<'_> {
+    /// Orders actually identifiable: the configured ones up to the Hankel rank of `n_channels`.
+    fn orders(&self, n_channels: usize) -> Vec<usize> {
+        let max = self.params.block_rows.saturating_sub(1) * n_channels;
+        self.params
+            .orders()
+            .into_iter()
+            .filter(|&o| o <= max)
+            .collect()
+    }
+
+    fn record_poles(&self, r: usize, orders: &[usize]) -> Result<Vec<ShapedPole>, String> {
+        let p = &self.pre[r];
+        let chans: Vec<&[f64]> = p
+            .recording
+            .channels
+            .iter()
+            .map(|c| c.samples.as_slice())
+            .collect();
+        let plan = SsiCov::new(&chans, p.band.fs_hz, self.params).map_err(|e| e.to_string())?;
+        let res = plan.sweep(orders).map_err(|e| e.to_string())?;
+        let f_max = if self.drop_band_edge {
+            p.band.valid_max_hz()
+        } else {
+            p.band.fs_hz / 2.0
+        };
+        Ok(res
+            .orders
+            .into_iter()
+            .flat_map(|o| {
+                let order = o.order;
+                o.modes.into_iter().map(move |m| ShapedPole {
+                    record: r,
+                    order,
+                    frequency_hz: m.frequency_hz,
+                    damping_ratio: m.damping_ratio,
+                    mpc: m.mpc,
+                    shape: m.shape,
+                })
+            })
+            .filter(|q| q.frequency_hz < f_max)
+            .collect())
+    }
+
+    pub fn run(
+        &self,
+        lines: &LineStage<'_>,
+        reference: &[ReferenceMode],
+    ) -> Result<SsiAnalysis, AnalysisError> {
+        let channels: Vec<String> = self
+            .pre
+            .first()
+            .map(|p| {
+                p.recording
+                    .channels
+                    .iter()
+                    .map(|c| c.name.clone())
+                    .collect()
+            })
+            .unwrap_or_default();
+        let orders = self.orders(channels.len());
+        let per: Vec<Result<Vec<ShapedPole>, String>> = (0..self.pre.len())
+            .into_par_iter()
+            .map(|r| self.record_poles(r, &orders))
+            .collect();
+        let mut poles = Vec::new();
+        let mut failed_records = Vec::new();
+        for (r, out) in per.into_iter().enumerate() {
+            match out {
+                Ok(p) => poles.extend(p),
+                Err(e) => failed_records.push((r, e)),
+            }
+        }
+        let obs: Vec<PoleObservation> = poles
+            .iter()
+            .filter_map(|q| {
+                let rec = self.active.get(q.record).copied().flatten()?;
+                let mut o = PoleObservation::new(
+                    q.frequency_hz,
+                    q.damping_ratio,
+                    q.order,
+                    rec,
+                    SSI_CHANNEL,
+                );
+                o.shape = Some(q.shape.clone());
+                Some(o)
+            })
+            .collect();
+        let mut invariant_modes = if orders.is_empty() || self.n_active == 0 {
+            Vec::new()
+        } else {
+            vibmode_modal::find_invariant_modes(&obs, self.n_active, &orders, self.cluster)?
+        };
+        let all: Vec<usize> = (0..channels.len()).collect();
+        let tracks = lines.tracks(&all);
+        lines.classify(&mut invariant_modes, &all, &tracks);
+        let matches = if reference.is_empty() {
+            Vec::new()
+        } else {
+            vibmode_modal::match_reference_shapes(
+                &invariant_modes,
+                reference,
+                &channels,
+                crate::pipeline::MATCH_MAX_FREQ_DIFF_REL,
+                MATCH_MAC_MIN,
+            )
+        };
+        Ok(SsiAnalysis {
+            channels,
+            orders,
+            poles,
+            invariant_modes,
+            matches,
+            lines: tracks,
+            failed_records,
+        })
+    }
+}
