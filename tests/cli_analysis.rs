@@ -90,7 +90,7 @@ fn analyze_writes_the_report_and_finds_the_resonance() {
     // 2 x 60 s files -> 2 x 5 records of 10.24 s; the resonance is a structural mode.
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
-    assert_eq!(v["schema_version"], 2);
+    assert_eq!(v["schema_version"], 3);
     assert_eq!(v["records"].as_array().map(Vec::len), Some(10));
     let csv = std::fs::read_to_string(out.join("modes.csv")).unwrap();
     let found = csv.lines().skip(1).any(|l| {

@@ -77,14 +77,49 @@ impl SsiStage<'_> {
             .collect()
     }
 
-    fn record_poles(&self, r: usize, orders: &[usize]) -> Result<Vec<ShapedPole>, String> {
+    /// RMS of each channel over the records used (1 where it is zero): SSI sees every channel
+    /// divided by it, so that strong channels (the wheels) do not hide the modes of weak ones
+    /// (the body); the shapes are scaled back.
+    fn channel_scales(&self) -> Vec<f64> {
+        let n_ch = self.pre.first().map_or(0, |p| p.recording.n_channels());
+        (0..n_ch)
+            .map(|c| {
+                let (mut ss, mut n) = (0.0, 0usize);
+                for (r, p) in self.pre.iter().enumerate() {
+                    if self.active.get(r).copied().flatten().is_none() {
+                        continue;
+                    }
+                    if let Some(ch) = p.recording.channels.get(c) {
+                        let m = ch.samples.iter().sum::<f64>() / ch.samples.len().max(1) as f64;
+                        ss += ch.samples.iter().map(|v| (v - m) * (v - m)).sum::<f64>();
+                        n += ch.samples.len();
+                    }
+                }
+                let rms = (ss / n.max(1) as f64).sqrt();
+                if rms > 0.0 && rms.is_finite() {
+                    rms
+                } else {
+                    1.0
+                }
+            })
+            .collect()
+    }
+
+    fn record_poles(
+        &self,
+        r: usize,
+        orders: &[usize],
+        scales: &[f64],
+    ) -> Result<Vec<ShapedPole>, String> {
         let p = &self.pre[r];
-        let chans: Vec<&[f64]> = p
+        let scaled: Vec<Vec<f64>> = p
             .recording
             .channels
             .iter()
-            .map(|c| c.samples.as_slice())
+            .zip(scales)
+            .map(|(c, s)| c.samples.iter().map(|v| v / s).collect())
             .collect();
+        let chans: Vec<&[f64]> = scaled.iter().map(Vec::as_slice).collect();
         let plan = SsiCov::new(&chans, p.band.fs_hz, self.params).map_err(|e| e.to_string())?;
         let res = plan.sweep(orders).map_err(|e| e.to_string())?;
         let f_max = if self.drop_band_edge {
@@ -103,7 +138,13 @@ impl SsiStage<'_> {
                     frequency_hz: m.frequency_hz,
                     damping_ratio: m.damping_ratio,
                     mpc: m.mpc,
-                    shape: m.shape,
+                    shape: vibmode_modal::shapes::normalise(
+                        &m.shape
+                            .iter()
+                            .zip(scales)
+                            .map(|(x, s)| [x[0] * s, x[1] * s])
+                            .collect::<Vec<_>>(),
+                    ),
                 })
             })
             .filter(|q| q.frequency_hz < f_max)
@@ -127,9 +168,10 @@ impl SsiStage<'_> {
             })
             .unwrap_or_default();
         let orders = self.orders(channels.len());
+        let scales = self.channel_scales();
         let per: Vec<Result<Vec<ShapedPole>, String>> = (0..self.pre.len())
             .into_par_iter()
-            .map(|r| self.record_poles(r, &orders))
+            .map(|r| self.record_poles(r, &orders, &scales))
             .collect();
         let mut poles = Vec::new();
         let mut failed_records = Vec::new();
