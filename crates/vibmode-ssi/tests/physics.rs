@@ -138,7 +138,7 @@ fn three_modes_recovered_over_seeds() {
 /// 6..=30 of one simulated record: from order 8 on, each has a mode labelled `Stable` at (at
 /// least) 80 % of the orders. (The 9 Hz / 0.1 mode is left out: from order to order its damping
 /// estimate moves by more than the 5 % relative tolerance: 0.09-0.12 on seed 100 with 20 000
-/// samples, where it was labelled `Frequency` at 9 of 12 orders and `Stable` at 4.)
+/// samples, where a `Stable` mode within 1 % of 9 Hz was found at 4 of the 12 orders.)
 #[test]
 fn true_modes_stabilise() {
     let y = simulate(40_000, 100);
