@@ -45,6 +45,9 @@ Two cases are stored, at orders 2, 4, ..., 20 with br = 10:
   numpy from vibmode's estimator (means removed, R_k = 1/(Ndat-k) ..., lags 1..2br-1). Same
   definitions end to end. Rust tolerance: 1e-9 relative on frequency and damping, 1 - MAC < 1e-9
   on shapes (achieved 4e-13, 2e-12 and 6e-16: crates/vibmode-ssi/tests/reference.rs).
+* "toeplitz_refs": the same with channels 0 and 2 as the references (reference-based SSI-cov;
+  pyOMA2's build_hank(Y, Yref, ...) correlates every channel with Yref = Y[ref_ind]): the block
+  Hankel matrix is (br l) x (br r), r = 2. Same tolerance.
 * "pyoma2_cov": pyOMA2's own pipeline (build_hank "cov" + SSI_fast + SSI_poles) on the same
   data. Only the estimator of the correlations differs (edge windows of 2br - 1 samples out of
   3000); the Rust test compares the three physical modes at order 6 (tolerances there).
@@ -71,6 +74,7 @@ N = 3000
 BR = 10
 ORDMAX = 20
 STEP = 2
+REFS = [0, 2]  # reference channels of the reference-based case
 MODES = [(1.2, 0.05), (4.5, 0.02), (9.0, 0.1)]
 SHAPES = np.array(
     [
@@ -105,11 +109,13 @@ def simulate():
     return np.array([[float(f"{v:.9g}") for v in ch] for ch in y])
 
 
-def vibmode_hankel(y, br):
-    """vibmode's correlations in pyOMA2's block Hankel layout: block (a, b) = R_{1+a+b}."""
+def vibmode_hankel(y, br, refs=None):
+    """vibmode's correlations in pyOMA2's block Hankel layout: block (a, b) = R_{1+a+b}, with
+    R_k = E[y_{t+k} y_ref,t^T] (l x r) for the reference channels `refs` (all when None)."""
     l, n = y.shape
     y = y - y.mean(axis=1, keepdims=True)
-    r = [None] + [y[:, k:] @ y[:, : n - k].T / (n - k) for k in range(1, 2 * br)]
+    yr = y if refs is None else y[refs, :]
+    r = [None] + [y[:, k:] @ yr[:, : n - k].T / (n - k) for k in range(1, 2 * br)]
     return np.block([[r[1 + a + b] for b in range(br)] for a in range(br)])
 
 
@@ -163,6 +169,8 @@ def main():
         "block_rows": BR,
         "fs_hz": FS_HZ,
         "toeplitz": poles(vibmode_hankel(y, BR)),
+        "reference_channels": REFS,
+        "toeplitz_refs": poles(vibmode_hankel(y, BR, REFS)),
         "pyoma2_cov": poles(pyssi.build_hank(y, y, BR, "cov")[0]),
     }
     with open(os.path.join(OUT, "ssi.json"), "w") as f:

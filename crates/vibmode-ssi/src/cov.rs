@@ -41,7 +41,8 @@ pub struct SsiResult {
     pub block_rows: usize,
     /// One entry per identified order, in the order asked for.
     pub orders: Vec<SsiOrder>,
-    /// Singular values of the block Toeplitz matrix, largest first (`i * l` of them).
+    /// Singular values of the block Toeplitz matrix, largest first (`i * min(l, r)` of them for
+    /// `l` channels and `r` references).
     pub singular_values: Vec<f64>,
 }
 
@@ -51,9 +52,11 @@ pub struct SsiResult {
 /// Definitions, for `l` channels `y_t` (each with its mean removed), `N` samples and
 /// `i = block_rows`:
 ///
-/// * output correlations `R_k = 1/(N - k) sum_{t=0}^{N-1-k} y_{t+k} y_t^T` (`l x l`) for the lags
-///   `k = 1..=2i-1` (lag 0, which carries the measurement noise, is not used);
-/// * block Toeplitz matrix `T` (`il x il`) with block `(a, b) = R_{i+a-b}`
+/// * output correlations `R_k = 1/(N - k) sum_{t=0}^{N-1-k} y_{t+k} y_ref,t^T` (`l x r`) for the
+///   lags `k = 1..=2i-1` (lag 0, which carries the measurement noise, is not used), where
+///   `y_ref` are the `r` reference channels ([`SsiParams::reference_channels`]; by default all
+///   channels, `r = l`);
+/// * block Toeplitz matrix `T` (`il x ir`) with block `(a, b) = R_{i+a-b}`
 ///   (`[R_i ... R_1; R_{i+1} ... R_2; ...; R_{2i-1} ... R_i]`), of rank `n` for an `n`-state
 ///   system: `T = O_i G_i` with the observability matrix `O_i = [C; CA; ...; CA^{i-1}]`;
 /// * its SVD `T = U S V^T`; at order `n`, `O = U_n S_n^{1/2}` (first `n` columns), `C` = the
@@ -64,6 +67,7 @@ pub struct SsiCov {
     fs_hz: f64,
     block_rows: usize,
     n_channels: usize,
+    n_references: usize,
     n_samples: usize,
     u: DMatrix<f64>,
     singular_values: Vec<f64>,
@@ -106,16 +110,16 @@ fn check_channels(channels: &[&[f64]]) -> Result<usize, SsiError> {
     Ok(n)
 }
 
-/// `R_k` for `k = 1..=max_lag` of the demeaned channels, each `l x l`, entry `(a, b)` =
-/// `1/(N-k) sum_t y_a[t+k] y_b[t]`.
-fn correlations(channels: &[Vec<f64>], max_lag: usize) -> Vec<DMatrix<f64>> {
+/// `R_k` for `k = 1..=max_lag` of the demeaned channels, each `l x r`, entry `(a, b)` =
+/// `1/(N-k) sum_t y_a[t+k] y_refs[b][t]`.
+fn correlations(channels: &[Vec<f64>], refs: &[usize], max_lag: usize) -> Vec<DMatrix<f64>> {
     let l = channels.len();
     let n = channels.first().map_or(0, Vec::len);
     (1..=max_lag)
         .map(|k| {
-            DMatrix::from_fn(l, l, |a, b| {
+            DMatrix::from_fn(l, refs.len(), |a, b| {
                 let ya = &channels[a][k..];
-                let yb = &channels[b][..n - k];
+                let yb = &channels[refs[b]][..n - k];
                 ya.iter().zip(yb).map(|(x, y)| x * y).sum::<f64>() / (n - k) as f64
             })
         })
@@ -124,9 +128,9 @@ fn correlations(channels: &[Vec<f64>], max_lag: usize) -> Vec<DMatrix<f64>> {
 
 impl SsiCov {
     /// Plans SSI-cov for `channels` (equal lengths, finite) sampled at `fs_hz`, with
-    /// `params.block_rows` block rows (the orders in `params` are used by [`SsiCov::sweep`]'s
-    /// callers such as [`crate::ssi_cov`], not here). Removes each channel's mean, computes the
-    /// correlations, the block Toeplitz matrix and its SVD.
+    /// `params.block_rows` block rows and `params.reference_channels` (the orders in `params`
+    /// are used by [`SsiCov::sweep`]'s callers such as [`crate::ssi_cov`], not here). Removes
+    /// each channel's mean, computes the correlations, the block Toeplitz matrix and its SVD.
     pub fn new(channels: &[&[f64]], fs_hz: f64, params: &SsiParams) -> Result<SsiCov, SsiError> {
         params.validate()?;
         if !(fs_hz.is_finite() && fs_hz > 0.0) {
@@ -150,13 +154,26 @@ impl SsiCov {
                 ch.iter().map(|v| v - m).collect()
             })
             .collect();
-        let r = correlations(&demeaned, max_lag);
+        let refs: Vec<usize> = match &params.reference_channels {
+            Some(refs) => {
+                if let Some(&index) = refs.iter().find(|&&r| r >= channels.len()) {
+                    return Err(SsiError::ReferenceChannel {
+                        index,
+                        n_channels: channels.len(),
+                        last: channels.len() - 1,
+                    });
+                }
+                refs.clone()
+            }
+            None => (0..channels.len()).collect(),
+        };
+        let r = correlations(&demeaned, &refs, max_lag);
         let mut cov = SsiCov::from_correlations(&r, fs_hz, i)?;
         cov.n_samples = n;
         Ok(cov)
     }
 
-    /// From given correlations `r[k - 1] = R_k`, `k = 1..=2i-1`, each `l x l` (checked by the
+    /// From given correlations `r[k - 1] = R_k`, `k = 1..=2i-1`, each `l x r` (checked by the
     /// callers).
     pub(crate) fn from_correlations(
         r: &[DMatrix<f64>],
@@ -165,12 +182,13 @@ impl SsiCov {
     ) -> Result<SsiCov, SsiError> {
         let i = block_rows;
         let l = r.first().map_or(0, DMatrix::nrows);
-        let dim = i * l;
-        let t = DMatrix::from_fn(dim, dim, |row, col| {
+        let n_refs = r.first().map_or(0, DMatrix::ncols);
+        let t = DMatrix::from_fn(i * l, i * n_refs, |row, col| {
             let (a, ra) = (row / l, row % l);
-            let (b, cb) = (col / l, col % l);
+            let (b, cb) = (col / n_refs, col % n_refs);
             r[i + a - b - 1][(ra, cb)]
         });
+        let dim = i * l.max(n_refs);
         let iterations = 60 * dim.max(1) + 100;
         let svd =
             SVD::try_new(t, true, false, SVD_EPS, iterations).ok_or(SsiError::NotConverged {
@@ -194,6 +212,7 @@ impl SsiCov {
             fs_hz,
             block_rows: i,
             n_channels: l,
+            n_references: n_refs,
             n_samples: 0,
             u,
             singular_values,
@@ -217,6 +236,11 @@ impl SsiCov {
         self.n_channels
     }
 
+    /// Number of reference channels `r` (`l` unless [`SsiParams::reference_channels`] is set).
+    pub fn n_references(&self) -> usize {
+        self.n_references
+    }
+
     /// Samples per channel.
     pub fn n_samples(&self) -> usize {
         self.n_samples
@@ -228,14 +252,20 @@ impl SsiCov {
     }
 
     /// Numerical rank of the block Toeplitz matrix: the singular values above
-    /// `s_max * (i l) * f64::EPSILON` (as numpy's `matrix_rank`).
+    /// `s_max * i max(l, r) * f64::EPSILON` (as numpy's `matrix_rank`).
     pub fn rank(&self) -> usize {
         self.rank
     }
 
-    /// Highest order [`SsiCov::poles_at`] accepts: `min((i - 1) l, rank)`.
+    /// Highest order [`SsiCov::poles_at`] accepts: `min((i - 1) l, i r, rank)`.
     pub fn max_order(&self) -> usize {
-        ((self.block_rows - 1) * self.n_channels).min(self.rank)
+        self.shift_max_order().min(self.rank)
+    }
+
+    /// `min((i - 1) l, i r)`: the shift of `O` needs at least `n` rows, the Toeplitz matrix has
+    /// `i r` columns.
+    fn shift_max_order(&self) -> usize {
+        ((self.block_rows - 1) * self.n_channels).min(self.block_rows * self.n_references)
     }
 
     /// The modes of the order-`order` model, by increasing frequency.
@@ -247,7 +277,7 @@ impl SsiCov {
     /// (damping <= 0: not a stable mode). The mode shape is `C psi` for the right eigenvector
     /// `psi` of `A`, scaled so that its entry of largest modulus is `1 + 0i`.
     ///
-    /// Errors: order 0 ([`SsiError::ZeroOrder`]), above `(i - 1) l`
+    /// Errors: order 0 ([`SsiError::ZeroOrder`]), above `min((i - 1) l, i r)`
     /// ([`SsiError::OrderTooHigh`]) or above the Toeplitz matrix's rank
     /// ([`SsiError::OrderAboveRank`]).
     pub fn poles_at(&self, order: usize) -> Result<Vec<SsiMode>, SsiError> {
@@ -255,14 +285,15 @@ impl SsiCov {
         if order == 0 {
             return Err(SsiError::ZeroOrder);
         }
-        let max_order = (i - 1) * l;
+        let max_order = self.shift_max_order();
         if order > max_order {
             return Err(SsiError::OrderTooHigh {
                 order,
                 block_rows: i,
                 n_channels: l,
+                n_references: self.n_references,
                 max_order,
-                needed_block_rows: order.div_ceil(l) + 1,
+                needed_block_rows: (order.div_ceil(l) + 1).max(order.div_ceil(self.n_references)),
             });
         }
         if order > self.rank {

@@ -8,6 +8,8 @@
 //!   Tolerance: frequencies and damping ratios 1e-9 relative, MAC of the shapes > 1 - 1e-9, at
 //!   every order, same number of modes. Achieved (printed by the test): worst relative
 //!   frequency difference 3.8e-13, damping 1.6e-12, 1 - MAC 5.6e-16.
+//! * `"toeplitz_refs"`: the same with channels 0 and 2 as references (reference-based SSI-cov,
+//!   pyOMA2's `Yref`). Same tolerance. Achieved: 3.6e-13, 1.6e-12, 5.6e-16.
 //! * `"pyoma2_cov"`: pyOMA2's own pipeline (`build_hank(..., "cov")`), whose correlation
 //!   estimator averages each block over its own window of N - 2 br + 1 samples. At order 6 the
 //!   three physical modes agree to 0.5 % in frequency and 0.005 in damping. Achieved (printed):
@@ -62,7 +64,7 @@ fn ref_orders(v: &Value) -> Vec<(usize, Vec<RefMode>)> {
         .collect()
 }
 
-fn identify(reference: &Value) -> (vibmode_ssi::SsiResult, f64) {
+fn identify(reference: &Value, refs: Option<Vec<usize>>) -> (vibmode_ssi::SsiResult, f64) {
     let input = load("ssi_input.json");
     let fs = f(&input["fs_hz"]);
     let channels: Vec<Vec<f64>> = input["channels"]
@@ -77,15 +79,32 @@ fn identify(reference: &Value) -> (vibmode_ssi::SsiResult, f64) {
         order_min: 2,
         order_max: 20,
         order_step: 2,
+        reference_channels: refs,
     };
     (ssi_cov(&ch, fs, &params).unwrap(), fs)
 }
 
 #[test]
 fn same_definitions_agree_to_1e_9() {
+    same_definitions("toeplitz", None);
+}
+
+#[test]
+fn reference_based_same_definitions_agree_to_1e_9() {
     let reference = load("ssi.json");
-    let (result, _) = identify(&reference);
-    let expected = ref_orders(&reference["toeplitz"]);
+    let refs: Vec<usize> = reference["reference_channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_u64().unwrap() as usize)
+        .collect();
+    same_definitions("toeplitz_refs", Some(refs));
+}
+
+fn same_definitions(key: &str, refs: Option<Vec<usize>>) {
+    let reference = load("ssi.json");
+    let (result, _) = identify(&reference, refs);
+    let expected = ref_orders(&reference[key]);
     assert_eq!(result.orders.len(), expected.len());
     let (mut worst_f, mut worst_z, mut worst_mac) = (0.0f64, 0.0f64, 0.0f64);
     for (got, (order, want)) in result.orders.iter().zip(&expected) {
@@ -115,7 +134,7 @@ fn same_definitions_agree_to_1e_9() {
         }
     }
     eprintln!(
-        "vs pyOMA2 on the same Toeplitz: worst relative frequency {worst_f:.1e}, damping \
+        "{key}: vs pyOMA2 on the same Toeplitz: worst relative frequency {worst_f:.1e}, damping \
          {worst_z:.1e}, 1 - MAC {worst_mac:.1e}"
     );
 }
@@ -124,7 +143,7 @@ fn same_definitions_agree_to_1e_9() {
 fn pyoma2_own_estimator_agrees_on_the_physical_modes() {
     let reference = load("ssi.json");
     let input = load("ssi_input.json");
-    let (result, _) = identify(&reference);
+    let (result, _) = identify(&reference, None);
     let expected = ref_orders(&reference["pyoma2_cov"]);
     let order = 6;
     let got = &result
