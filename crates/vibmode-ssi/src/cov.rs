@@ -73,6 +73,12 @@ pub struct SsiCov {
     singular_values: Vec<f64>,
     rank: usize,
     rank_tolerance: f64,
+    /// QR of `O_up` at the order `K = min(order_max, max_order())`: `O_up = Q R`. At order `n <= K` the
+    /// least-squares `A` is `R[..n, ..n]^-1 (Q^T O_down)[..n, ..n]` (the first `n` columns of
+    /// `O_up` are `Q[.., ..n] R[..n, ..n]`), so one QR serves every order.
+    r_full: DMatrix<f64>,
+    /// `Q^T O_down` at order `K`.
+    qt_down_full: DMatrix<f64>,
 }
 
 /// Convergence tolerance of nalgebra's SVD: its own default (`5 eps`). With `eps` alone the
@@ -128,9 +134,11 @@ fn correlations(channels: &[Vec<f64>], refs: &[usize], max_lag: usize) -> Vec<DM
 
 impl SsiCov {
     /// Plans SSI-cov for `channels` (equal lengths, finite) sampled at `fs_hz`, with
-    /// `params.block_rows` block rows and `params.reference_channels` (the orders in `params`
-    /// are used by [`SsiCov::sweep`]'s callers such as [`crate::ssi_cov`], not here). Removes
-    /// each channel's mean, computes the correlations, the block Toeplitz matrix and its SVD.
+    /// `params.block_rows` block rows and `params.reference_channels`. Removes each channel's
+    /// mean, computes the correlations, the block Toeplitz matrix, its SVD, and one QR of the
+    /// shifted observability matrix that serves every order up to `params.order_max` (any
+    /// higher order can still be asked of [`SsiCov::poles_at`]; it gets its own
+    /// least-squares solution).
     pub fn new(channels: &[&[f64]], fs_hz: f64, params: &SsiParams) -> Result<SsiCov, SsiError> {
         params.validate()?;
         if !(fs_hz.is_finite() && fs_hz > 0.0) {
@@ -168,17 +176,19 @@ impl SsiCov {
             None => (0..channels.len()).collect(),
         };
         let r = correlations(&demeaned, &refs, max_lag);
-        let mut cov = SsiCov::from_correlations(&r, fs_hz, i)?;
+        let mut cov = SsiCov::from_correlations(&r, fs_hz, i, params.order_max)?;
         cov.n_samples = n;
         Ok(cov)
     }
 
     /// From given correlations `r[k - 1] = R_k`, `k = 1..=2i-1`, each `l x r` (checked by the
     /// callers).
+    /// `order_max` bounds the orders served by the one QR (higher ones get their own).
     pub(crate) fn from_correlations(
         r: &[DMatrix<f64>],
         fs_hz: f64,
         block_rows: usize,
+        order_max: usize,
     ) -> Result<SsiCov, SsiError> {
         let i = block_rows;
         let l = r.first().map_or(0, DMatrix::nrows);
@@ -208,6 +218,16 @@ impl SsiCov {
             .iter()
             .filter(|&&s| s > rank_tolerance)
             .count();
+        let k_max = ((i - 1) * l).min(i * n_refs).min(rank).min(order_max);
+        let (r_full, qt_down_full) = if k_max == 0 {
+            (DMatrix::zeros(0, 0), DMatrix::zeros(0, 0))
+        } else {
+            let o = observability(&u, &singular_values, i * l, k_max);
+            let rows = (i - 1) * l;
+            let qr = o.rows(0, rows).into_owned().qr();
+            let qt_down = qr.q().tr_mul(&o.rows(l, rows));
+            (qr.r(), qt_down)
+        };
         Ok(SsiCov {
             fs_hz,
             block_rows: i,
@@ -218,6 +238,8 @@ impl SsiCov {
             singular_values,
             rank,
             rank_tolerance,
+            r_full,
+            qt_down_full,
         })
     }
 
@@ -304,13 +326,14 @@ impl SsiCov {
             });
         }
         let dim = i * l;
-        let o = DMatrix::from_fn(dim, order, |r, c| {
-            self.u[(r, c)] * self.singular_values[c].sqrt()
-        });
-        let rows = dim - l;
-        let o_up = o.rows(0, rows).into_owned();
-        let o_down = o.rows(l, rows).into_owned();
-        let a = least_squares(o_up, &o_down)?;
+        let o = observability(&self.u, &self.singular_values, dim, order);
+        let a = match self.shift_from_full_qr(order) {
+            Some(a) => a,
+            None => {
+                let rows = dim - l;
+                least_squares(o.rows(0, rows).into_owned(), &o.rows(l, rows).into_owned())?
+            }
+        };
         let c = o.rows(0, l).into_owned();
         let pairs = complex_eigenpairs(a)?;
         let mut modes: Vec<SsiMode> = pairs
@@ -336,6 +359,24 @@ impl SsiCov {
         Ok(modes)
     }
 
+    /// `A` at `order` from the QR computed once, or `None` when `R[..n, ..n]` has a pivot at
+    /// or below `max |R_jj| * rows * eps` (then the caller solves by SVD).
+    fn shift_from_full_qr(&self, order: usize) -> Option<DMatrix<f64>> {
+        if order > self.r_full.nrows() {
+            return None;
+        }
+        let r = self.r_full.view((0, 0), (order, order));
+        let diag = r.diagonal();
+        let rmax = diag.amax();
+        let rows = (self.block_rows - 1) * self.n_channels;
+        let tiny = rmax * rows.max(order) as f64 * f64::EPSILON;
+        if rmax.is_nan() || rmax <= 0.0 || diag.iter().any(|d| d.abs() <= tiny) {
+            return None;
+        }
+        let b = self.qt_down_full.view((0, 0), (order, order)).into_owned();
+        r.solve_upper_triangular(&b)
+    }
+
     /// [`SsiCov::poles_at`] for every order of `orders`.
     pub fn sweep(&self, orders: &[usize]) -> Result<SsiResult, SsiError> {
         let orders = orders
@@ -354,6 +395,11 @@ impl SsiCov {
             singular_values: self.singular_values.clone(),
         })
     }
+}
+
+/// `O = U[.., ..n] S[..n]^{1/2}` (`rows x n`).
+fn observability(u: &DMatrix<f64>, singular_values: &[f64], rows: usize, n: usize) -> DMatrix<f64> {
+    DMatrix::from_fn(rows, n, |r, c| u[(r, c)] * singular_values[c].sqrt())
 }
 
 /// `C psi`, scaled so that its entry of largest modulus is `1 + 0i` (left as is when zero).
@@ -460,7 +506,7 @@ mod tests {
             (20.0, 0.3, 3),
         ] {
             let r = one_mode_correlations(f, z, 50.0, i);
-            let cov = SsiCov::from_correlations(&r, 50.0, i).unwrap();
+            let cov = SsiCov::from_correlations(&r, 50.0, i, 60).unwrap();
             assert_eq!(
                 cov.rank(),
                 2,
@@ -488,7 +534,7 @@ mod tests {
     #[test]
     fn order_above_the_rank_of_exact_correlations_is_refused() {
         let r = one_mode_correlations(2.0, 0.05, 50.0, 5);
-        let cov = SsiCov::from_correlations(&r, 50.0, 5).unwrap();
+        let cov = SsiCov::from_correlations(&r, 50.0, 5, 60).unwrap();
         let e = cov.poles_at(4).unwrap_err();
         assert!(
             matches!(
@@ -516,7 +562,7 @@ mod tests {
         let mut r = vec![DMatrix::from_element(1, 1, 0.0); 5];
         r[0][(0, 0)] = 1.0;
         r[4][(0, 0)] = 0.5;
-        let cov = SsiCov::from_correlations(&r, 50.0, 3).unwrap();
+        let cov = SsiCov::from_correlations(&r, 50.0, 3, 60).unwrap();
         assert_eq!(cov.rank(), 2);
         let modes = cov.poles_at(2).unwrap();
         for m in modes {

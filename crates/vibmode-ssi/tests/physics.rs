@@ -192,3 +192,31 @@ fn true_modes_stabilise() {
         );
     }
 }
+
+/// `SsiCov::new` solves the shift for the orders up to `order_max` from one QR; higher orders
+/// get their own least-squares solution. Both give the same modes (to rounding).
+#[test]
+fn one_qr_and_per_order_least_squares_agree() {
+    let y = simulate(5_000, 7);
+    let ch: Vec<&[f64]> = y.iter().map(Vec::as_slice).collect();
+    let wide = SsiParams {
+        block_rows: 10,
+        order_max: 30,
+        ..SsiParams::default()
+    };
+    let narrow = SsiParams {
+        order_max: 2,
+        ..wide.clone()
+    };
+    let a = vibmode_ssi::SsiCov::new(&ch, FS, &wide).unwrap();
+    let b = vibmode_ssi::SsiCov::new(&ch, FS, &narrow).unwrap();
+    for order in [4, 6, 12, 30] {
+        let (ma, mb) = (a.poles_at(order).unwrap(), b.poles_at(order).unwrap());
+        assert_eq!(ma.len(), mb.len(), "order {order}");
+        for (x, z) in ma.iter().zip(&mb) {
+            assert!((x.frequency_hz - z.frequency_hz).abs() < 1e-9 * z.frequency_hz);
+            assert!((x.damping_ratio - z.damping_ratio).abs() < 1e-9 * z.damping_ratio);
+            assert!(1.0 - mac(&x.shape, &z.shape) < 1e-9);
+        }
+    }
+}
