@@ -176,6 +176,16 @@ impl SsiCov {
             None => (0..channels.len()).collect(),
         };
         let r = correlations(&demeaned, &refs, max_lag);
+        if let Some(k) = r.iter().position(|m| m.iter().any(|v| !v.is_finite())) {
+            let max_abs = demeaned
+                .iter()
+                .flatten()
+                .fold(0.0f64, |m, v| m.max(v.abs()));
+            return Err(SsiError::Overflow {
+                lag: k + 1,
+                max_abs,
+            });
+        }
         let mut cov = SsiCov::from_correlations(&r, fs_hz, i, params.order_max)?;
         cov.n_samples = n;
         Ok(cov)

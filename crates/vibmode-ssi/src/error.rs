@@ -66,6 +66,14 @@ pub enum SsiError {
         /// Largest valid index.
         last: usize,
     },
+    /// A correlation overflowed (samples so large that their products are not finite).
+    #[error("the correlation at lag {lag} is not finite (largest sample magnitude {max_abs:e}); scale the channels to a moderate range (e.g. divide by {max_abs:e})")]
+    Overflow {
+        /// Lag of the first non-finite correlation.
+        lag: usize,
+        /// Largest absolute sample value (after mean removal).
+        max_abs: f64,
+    },
     /// A parameter out of range.
     #[error(transparent)]
     Param(#[from] ParamError),

@@ -284,3 +284,11 @@ fn order_limited_by_the_references() {
         "{m}"
     );
 }
+
+#[test]
+fn overflowing_correlations() {
+    let a: Vec<f64> = noise(200, 1).iter().map(|v| v * 1e300).collect();
+    let (e, m) = msg(ssi_cov(&[&a], 50.0, &params(5)));
+    assert!(matches!(e, SsiError::Overflow { lag: 1, .. }), "{e:?}");
+    assert!(m.contains("lag 1") && m.contains("e299"), "{m}");
+}
