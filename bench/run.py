@@ -79,6 +79,35 @@ def peers(data_dir, quick):
     except ImportError:
         pass
     res["read_csv_7x204800"] = csv
+    # SSI-cov: pyOMA2's functions (as its SSI class with method "cov" calls them) on the same
+    # 8 records x 7 channels x 512 samples, block rows 20, orders 0..60 step 2, hard criterion
+    # xi < 1 only (vibmode's filter). Skipped with a note when pyOMA2 is not installed.
+    try:
+        os.environ.setdefault("TQDM_DISABLE", "1")
+        import logging
+        from pyoma2.functions import ssi as pyssi
+        logging.disable(logging.CRITICAL)
+        m = meta["ssi"]
+        data = np.fromfile(os.path.join(data_dir, "ssi_8x7x512.f64"), dtype="<f8").reshape(
+            m["records"], m["channels"], m["samples"])
+        br, om, st, dt = m["block_rows"], m["order_max"], m["order_step"], 1.0 / m["fs_hz"]
+
+        def pyoma2_ssi():
+            n = 0
+            for y in data:
+                h, _ = pyssi.build_hank(y, y, br, "cov")
+                obs, a, c, _ = pyssi.SSI_fast(h, br, om, step=st)
+                fn, *_ = pyssi.SSI_poles(obs, a, c, om, dt, step=st, HC=True, xi_max=1.0)
+                n += int(np.sum(~np.isnan(fn)))
+            return n
+
+        case = "ssi_cov_8x7x512_br20_orders2-60"
+        res[case] = {"pyOMA2 1.4 SSI-cov (build_hank cov + SSI_fast + SSI_poles)": median_time(pyoma2_ssi, 1 if quick else 3),
+                     "_n_modes_pyoma2": pyoma2_ssi()}
+        import importlib.metadata
+        res.setdefault("_versions", {})["pyoma2"] = importlib.metadata.version("pyoma-2")
+    except ImportError as e:
+        print(f"note: SSI peer skipped, pyOMA2 is not importable ({e})", file=sys.stderr)
     # ARMA fits (statsmodels exact-likelihood ARIMA), same data as vibmode.
     try:
         import statsmodels
@@ -106,7 +135,7 @@ def peers(data_dir, quick):
             w = ss.lfilter(a, [1.0], yd)[p:]
             eps = ss.lfilter([1.0], c, w)
             res[f"arma_{p}_{p}_n2048"] = {"statsmodels ARIMA": t, "_lambda_statsmodels": float(np.mean(eps ** 2))}
-        res["_versions"] = {"statsmodels": statsmodels.__version__}
+        res.setdefault("_versions", {})["statsmodels"] = statsmodels.__version__
     except ImportError:
         pass
     res.setdefault("_versions", {}).update({"numpy": np.__version__, "scipy": scipy.__version__, "python": sys.version.split()[0]})

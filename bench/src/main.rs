@@ -126,6 +126,50 @@ fn write_pole_cloud(dir: &Path, rng: &mut Rng) -> Result<()> {
     Ok(())
 }
 
+/// SSI input of the demo's size: 8 records x 7 channels x 512 samples at 50 Hz (record-major,
+/// then channel, then sample). Four modes of the brief (1.1, 1.5, 9.5, 11 Hz; damping 0.25, 0.2,
+/// 0.15, 0.12), each a noise-driven AR(2), mixed into the 7 channels with fixed real shapes,
+/// plus 10 % white noise.
+fn write_ssi_input(dir: &Path, rng: &mut Rng) -> Result<()> {
+    let fs = SSI_FS_HZ;
+    let modes = [(1.1, 0.25), (1.5, 0.2), (9.5, 0.15), (11.0, 0.12)];
+    let shapes = [
+        [1.0, 0.9, 0.8, 0.7, 0.3, 0.2, 0.2],
+        [1.0, -0.9, 0.8, -0.7, 0.3, -0.2, 0.2],
+        [0.2, 0.3, -0.2, -0.3, 1.0, 0.8, -0.9],
+        [0.1, -0.2, 0.3, -0.1, -0.8, 1.0, 0.9],
+    ];
+    let mut out = Vec::with_capacity(SSI_RECORDS * SSI_CHANNELS * SSI_SAMPLES);
+    for _ in 0..SSI_RECORDS {
+        let burn = 500;
+        let mut q = vec![vec![0.0f64; SSI_SAMPLES + burn]; modes.len()];
+        for (m, &(f, z)) in modes.iter().enumerate() {
+            let w = 2.0 * std::f64::consts::PI * f;
+            let r = (-z * w / fs).exp();
+            let a1 = 2.0 * r * (w * (1.0f64 - z * z).sqrt() / fs).cos();
+            let a2 = -r * r;
+            for t in 2..SSI_SAMPLES + burn {
+                q[m][t] = a1 * q[m][t - 1] + a2 * q[m][t - 2] + rng.normal();
+            }
+        }
+        for shape in (0..SSI_CHANNELS).map(|c| shapes.map(|s| s[c])) {
+            for t in burn..SSI_SAMPLES + burn {
+                let v: f64 = q.iter().zip(&shape).map(|(qm, s)| s * qm[t]).sum();
+                out.push(v + 0.1 * rng.normal());
+            }
+        }
+    }
+    write_f64(&dir.join("ssi_8x7x512.f64"), &out)
+}
+
+/// The SSI case: the demo's size, block rows 20, orders 2..=60 step 2.
+const SSI_RECORDS: usize = 8;
+const SSI_CHANNELS: usize = 7;
+const SSI_SAMPLES: usize = 512;
+const SSI_FS_HZ: f64 = 50.0;
+const SSI_BLOCK_ROWS: usize = 20;
+const SSI_ORDER_MAX: usize = 60;
+
 /// The settings of tools/reference/modal.py (vibmode-modal 0.1's defaults, fixed radius).
 fn script_cluster_params() -> vibmode_core::ClusterParams {
     vibmode_core::ClusterParams {
@@ -169,9 +213,14 @@ fn gen(dir: &Path) -> Result<()> {
         )?;
     }
     write_pole_cloud(dir, &mut rng)?;
+    write_ssi_input(dir, &mut rng)?;
     std::fs::write(
         dir.join("meta.json"),
-        json!({"arma_orders": ARMA_ORDERS, "n": n, "fs_hz": 20000.0}).to_string(),
+        json!({"arma_orders": ARMA_ORDERS, "n": n, "fs_hz": 20000.0,
+            "ssi": {"records": SSI_RECORDS, "channels": SSI_CHANNELS, "samples": SSI_SAMPLES,
+                "fs_hz": SSI_FS_HZ, "block_rows": SSI_BLOCK_ROWS, "order_max": SSI_ORDER_MAX,
+                "order_step": 2}})
+        .to_string(),
     )?;
     Ok(())
 }
@@ -280,6 +329,29 @@ fn run(dir: &Path, quick: bool) -> Result<Value> {
     out.insert(
         "cluster_poles".into(),
         json!({"vibmode_modal::analyse_poles": t_cl, "_n_poles": poles.len(), "_invariant_modes": n_modes}),
+    );
+    // SSI-cov of 8 records x 7 channels x 512 samples, block rows 20, orders 2..=60 step 2.
+    let ssi = read_f64(&dir.join("ssi_8x7x512.f64"))?;
+    let ssi_params = vibmode_ssi::SsiParams {
+        block_rows: SSI_BLOCK_ROWS,
+        order_min: 2,
+        order_max: SSI_ORDER_MAX,
+        order_step: 2,
+        reference_channels: None,
+    };
+    let mut n_ssi_modes = 0;
+    let t_ssi = median_time(if quick { 3 } else { 11 }, || {
+        n_ssi_modes = 0;
+        for record in ssi.chunks_exact(SSI_CHANNELS * SSI_SAMPLES) {
+            let ch: Vec<&[f64]> = record.chunks_exact(SSI_SAMPLES).collect();
+            let res = vibmode_ssi::ssi_cov(&ch, SSI_FS_HZ, &ssi_params)?;
+            n_ssi_modes += res.orders.iter().map(|o| o.modes.len()).sum::<usize>();
+        }
+        Ok(())
+    })?;
+    out.insert(
+        "ssi_cov_8x7x512_br20_orders2-60".into(),
+        json!({"vibmode_ssi::ssi_cov": t_ssi, "_n_modes": n_ssi_modes}),
     );
     // ARMA fits, quadratic criterion (as statsmodels), N = 2048.
     for p in ARMA_ORDERS {

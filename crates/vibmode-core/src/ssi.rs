@@ -20,6 +20,11 @@ pub struct SsiParams {
     pub order_max: usize,
     /// Step between identified orders (default 2: one mode per step).
     pub order_step: usize,
+    /// Reference-based SSI-cov: the 0-based indices of the reference channels `r`, with which
+    /// every channel is correlated (`R_k = E[y_{t+k} y_ref,t^T]`, `l x r`). The Toeplitz matrix
+    /// is then `(i l) x (i r)`, smaller to decompose, and the highest order also at most `i r`.
+    /// Default none: every channel is a reference.
+    pub reference_channels: Option<Vec<usize>>,
 }
 
 impl Default for SsiParams {
@@ -29,6 +34,7 @@ impl Default for SsiParams {
             order_min: 2,
             order_max: 60,
             order_step: 2,
+            reference_channels: None,
         }
     }
 }
@@ -46,7 +52,8 @@ impl SsiParams {
     }
 
     /// Checks ranges: `block_rows >= 1`, `order_min >= 2`, `order_step >= 1`,
-    /// `order_max >= order_min`.
+    /// `order_max >= order_min`, and `reference_channels` (when given) not empty and without
+    /// repeated indices. Whether the indices exist is checked against the data.
     pub fn validate(&self) -> Result<(), ParamError> {
         let d = SsiParams::default();
         if self.block_rows < 1 {
@@ -80,6 +87,27 @@ impl SsiParams {
                 "must be >= order_min",
                 self.order_min.max(d.order_max),
             ));
+        }
+        if let Some(refs) = &self.reference_channels {
+            if refs.is_empty() {
+                return Err(ParamError::out_of_range(
+                    "reference_channels",
+                    "[]",
+                    "must list at least one channel (or be left out: all channels)",
+                    "[0]",
+                ));
+            }
+            let mut sorted = refs.clone();
+            sorted.sort_unstable();
+            if sorted.windows(2).any(|w| w[0] == w[1]) {
+                sorted.dedup();
+                return Err(ParamError::out_of_range(
+                    "reference_channels",
+                    format!("{refs:?}"),
+                    "must not repeat a channel",
+                    format!("{sorted:?}"),
+                ));
+            }
         }
         Ok(())
     }
@@ -154,8 +182,10 @@ mod tests {
             order_min: 3,
             order_max: 10,
             order_step: 3,
+            reference_channels: Some(vec![0, 2]),
             ..p
         };
+        assert!(p.validate().is_ok());
         assert_eq!(p.orders(), vec![3, 6, 9]);
         assert!(StabilityParams::default().validate().is_ok());
     }
@@ -223,6 +253,9 @@ mod tests {
         assert_eq!(p.block_rows, 30);
         assert_eq!(p.order_max, 40);
         assert_eq!(p.order_min, 2);
+        assert_eq!(p.reference_channels, None);
+        let p: SsiParams = toml::from_str("reference_channels = [0, 3]").unwrap();
+        assert_eq!(p.reference_channels, Some(vec![0, 3]));
         assert!(toml::from_str::<SsiParams>("block_row = 30").is_err());
         let s: StabilityParams = toml::from_str("mac_min = 0.9").unwrap();
         assert_eq!(s.mac_min, 0.9);

@@ -41,7 +41,8 @@ pub struct SsiResult {
     pub block_rows: usize,
     /// One entry per identified order, in the order asked for.
     pub orders: Vec<SsiOrder>,
-    /// Singular values of the block Toeplitz matrix, largest first (`i * l` of them).
+    /// Singular values of the block Toeplitz matrix, largest first (`i * min(l, r)` of them for
+    /// `l` channels and `r` references).
     pub singular_values: Vec<f64>,
 }
 
@@ -51,9 +52,11 @@ pub struct SsiResult {
 /// Definitions, for `l` channels `y_t` (each with its mean removed), `N` samples and
 /// `i = block_rows`:
 ///
-/// * output correlations `R_k = 1/(N - k) sum_{t=0}^{N-1-k} y_{t+k} y_t^T` (`l x l`) for the lags
-///   `k = 1..=2i-1` (lag 0, which carries the measurement noise, is not used);
-/// * block Toeplitz matrix `T` (`il x il`) with block `(a, b) = R_{i+a-b}`
+/// * output correlations `R_k = 1/(N - k) sum_{t=0}^{N-1-k} y_{t+k} y_ref,t^T` (`l x r`) for the
+///   lags `k = 1..=2i-1` (lag 0, which carries the measurement noise, is not used), where
+///   `y_ref` are the `r` reference channels ([`SsiParams::reference_channels`]; by default all
+///   channels, `r = l`);
+/// * block Toeplitz matrix `T` (`il x ir`) with block `(a, b) = R_{i+a-b}`
 ///   (`[R_i ... R_1; R_{i+1} ... R_2; ...; R_{2i-1} ... R_i]`), of rank `n` for an `n`-state
 ///   system: `T = O_i G_i` with the observability matrix `O_i = [C; CA; ...; CA^{i-1}]`;
 /// * its SVD `T = U S V^T`; at order `n`, `O = U_n S_n^{1/2}` (first `n` columns), `C` = the
@@ -64,11 +67,18 @@ pub struct SsiCov {
     fs_hz: f64,
     block_rows: usize,
     n_channels: usize,
+    n_references: usize,
     n_samples: usize,
     u: DMatrix<f64>,
     singular_values: Vec<f64>,
     rank: usize,
     rank_tolerance: f64,
+    /// QR of `O_up` at the order `K = min(order_max, max_order())`: `O_up = Q R`. At order `n <= K` the
+    /// least-squares `A` is `R[..n, ..n]^-1 (Q^T O_down)[..n, ..n]` (the first `n` columns of
+    /// `O_up` are `Q[.., ..n] R[..n, ..n]`), so one QR serves every order.
+    r_full: DMatrix<f64>,
+    /// `Q^T O_down` at order `K`.
+    qt_down_full: DMatrix<f64>,
 }
 
 /// Convergence tolerance of nalgebra's SVD: its own default (`5 eps`). With `eps` alone the
@@ -106,16 +116,16 @@ fn check_channels(channels: &[&[f64]]) -> Result<usize, SsiError> {
     Ok(n)
 }
 
-/// `R_k` for `k = 1..=max_lag` of the demeaned channels, each `l x l`, entry `(a, b)` =
-/// `1/(N-k) sum_t y_a[t+k] y_b[t]`.
-fn correlations(channels: &[Vec<f64>], max_lag: usize) -> Vec<DMatrix<f64>> {
+/// `R_k` for `k = 1..=max_lag` of the demeaned channels, each `l x r`, entry `(a, b)` =
+/// `1/(N-k) sum_t y_a[t+k] y_refs[b][t]`.
+fn correlations(channels: &[Vec<f64>], refs: &[usize], max_lag: usize) -> Vec<DMatrix<f64>> {
     let l = channels.len();
     let n = channels.first().map_or(0, Vec::len);
     (1..=max_lag)
         .map(|k| {
-            DMatrix::from_fn(l, l, |a, b| {
+            DMatrix::from_fn(l, refs.len(), |a, b| {
                 let ya = &channels[a][k..];
-                let yb = &channels[b][..n - k];
+                let yb = &channels[refs[b]][..n - k];
                 ya.iter().zip(yb).map(|(x, y)| x * y).sum::<f64>() / (n - k) as f64
             })
         })
@@ -124,9 +134,11 @@ fn correlations(channels: &[Vec<f64>], max_lag: usize) -> Vec<DMatrix<f64>> {
 
 impl SsiCov {
     /// Plans SSI-cov for `channels` (equal lengths, finite) sampled at `fs_hz`, with
-    /// `params.block_rows` block rows (the orders in `params` are used by [`SsiCov::sweep`]'s
-    /// callers such as [`crate::ssi_cov`], not here). Removes each channel's mean, computes the
-    /// correlations, the block Toeplitz matrix and its SVD.
+    /// `params.block_rows` block rows and `params.reference_channels`. Removes each channel's
+    /// mean, computes the correlations, the block Toeplitz matrix, its SVD, and one QR of the
+    /// shifted observability matrix that serves every order up to `params.order_max` (any
+    /// higher order can still be asked of [`SsiCov::poles_at`]; it gets its own
+    /// least-squares solution).
     pub fn new(channels: &[&[f64]], fs_hz: f64, params: &SsiParams) -> Result<SsiCov, SsiError> {
         params.validate()?;
         if !(fs_hz.is_finite() && fs_hz > 0.0) {
@@ -150,27 +162,53 @@ impl SsiCov {
                 ch.iter().map(|v| v - m).collect()
             })
             .collect();
-        let r = correlations(&demeaned, max_lag);
-        let mut cov = SsiCov::from_correlations(&r, fs_hz, i)?;
+        let refs: Vec<usize> = match &params.reference_channels {
+            Some(refs) => {
+                if let Some(&index) = refs.iter().find(|&&r| r >= channels.len()) {
+                    return Err(SsiError::ReferenceChannel {
+                        index,
+                        n_channels: channels.len(),
+                        last: channels.len() - 1,
+                    });
+                }
+                refs.clone()
+            }
+            None => (0..channels.len()).collect(),
+        };
+        let r = correlations(&demeaned, &refs, max_lag);
+        if let Some(k) = r.iter().position(|m| m.iter().any(|v| !v.is_finite())) {
+            let max_abs = demeaned
+                .iter()
+                .flatten()
+                .fold(0.0f64, |m, v| m.max(v.abs()));
+            return Err(SsiError::Overflow {
+                lag: k + 1,
+                max_abs,
+            });
+        }
+        let mut cov = SsiCov::from_correlations(&r, fs_hz, i, params.order_max)?;
         cov.n_samples = n;
         Ok(cov)
     }
 
-    /// From given correlations `r[k - 1] = R_k`, `k = 1..=2i-1`, each `l x l` (checked by the
+    /// From given correlations `r[k - 1] = R_k`, `k = 1..=2i-1`, each `l x r` (checked by the
     /// callers).
+    /// `order_max` bounds the orders served by the one QR (higher ones get their own).
     pub(crate) fn from_correlations(
         r: &[DMatrix<f64>],
         fs_hz: f64,
         block_rows: usize,
+        order_max: usize,
     ) -> Result<SsiCov, SsiError> {
         let i = block_rows;
         let l = r.first().map_or(0, DMatrix::nrows);
-        let dim = i * l;
-        let t = DMatrix::from_fn(dim, dim, |row, col| {
+        let n_refs = r.first().map_or(0, DMatrix::ncols);
+        let t = DMatrix::from_fn(i * l, i * n_refs, |row, col| {
             let (a, ra) = (row / l, row % l);
-            let (b, cb) = (col / l, col % l);
+            let (b, cb) = (col / n_refs, col % n_refs);
             r[i + a - b - 1][(ra, cb)]
         });
+        let dim = i * l.max(n_refs);
         let iterations = 60 * dim.max(1) + 100;
         let svd =
             SVD::try_new(t, true, false, SVD_EPS, iterations).ok_or(SsiError::NotConverged {
@@ -190,15 +228,28 @@ impl SsiCov {
             .iter()
             .filter(|&&s| s > rank_tolerance)
             .count();
+        let k_max = ((i - 1) * l).min(i * n_refs).min(rank).min(order_max);
+        let (r_full, qt_down_full) = if k_max == 0 {
+            (DMatrix::zeros(0, 0), DMatrix::zeros(0, 0))
+        } else {
+            let o = observability(&u, &singular_values, i * l, k_max);
+            let rows = (i - 1) * l;
+            let qr = o.rows(0, rows).into_owned().qr();
+            let qt_down = qr.q().tr_mul(&o.rows(l, rows));
+            (qr.r(), qt_down)
+        };
         Ok(SsiCov {
             fs_hz,
             block_rows: i,
             n_channels: l,
+            n_references: n_refs,
             n_samples: 0,
             u,
             singular_values,
             rank,
             rank_tolerance,
+            r_full,
+            qt_down_full,
         })
     }
 
@@ -217,6 +268,11 @@ impl SsiCov {
         self.n_channels
     }
 
+    /// Number of reference channels `r` (`l` unless [`SsiParams::reference_channels`] is set).
+    pub fn n_references(&self) -> usize {
+        self.n_references
+    }
+
     /// Samples per channel.
     pub fn n_samples(&self) -> usize {
         self.n_samples
@@ -228,14 +284,20 @@ impl SsiCov {
     }
 
     /// Numerical rank of the block Toeplitz matrix: the singular values above
-    /// `s_max * (i l) * f64::EPSILON` (as numpy's `matrix_rank`).
+    /// `s_max * i max(l, r) * f64::EPSILON` (as numpy's `matrix_rank`).
     pub fn rank(&self) -> usize {
         self.rank
     }
 
-    /// Highest order [`SsiCov::poles_at`] accepts: `min((i - 1) l, rank)`.
+    /// Highest order [`SsiCov::poles_at`] accepts: `min((i - 1) l, i r, rank)`.
     pub fn max_order(&self) -> usize {
-        ((self.block_rows - 1) * self.n_channels).min(self.rank)
+        self.shift_max_order().min(self.rank)
+    }
+
+    /// `min((i - 1) l, i r)`: the shift of `O` needs at least `n` rows, the Toeplitz matrix has
+    /// `i r` columns.
+    fn shift_max_order(&self) -> usize {
+        ((self.block_rows - 1) * self.n_channels).min(self.block_rows * self.n_references)
     }
 
     /// The modes of the order-`order` model, by increasing frequency.
@@ -247,7 +309,7 @@ impl SsiCov {
     /// (damping <= 0: not a stable mode). The mode shape is `C psi` for the right eigenvector
     /// `psi` of `A`, scaled so that its entry of largest modulus is `1 + 0i`.
     ///
-    /// Errors: order 0 ([`SsiError::ZeroOrder`]), above `(i - 1) l`
+    /// Errors: order 0 ([`SsiError::ZeroOrder`]), above `min((i - 1) l, i r)`
     /// ([`SsiError::OrderTooHigh`]) or above the Toeplitz matrix's rank
     /// ([`SsiError::OrderAboveRank`]).
     pub fn poles_at(&self, order: usize) -> Result<Vec<SsiMode>, SsiError> {
@@ -255,14 +317,15 @@ impl SsiCov {
         if order == 0 {
             return Err(SsiError::ZeroOrder);
         }
-        let max_order = (i - 1) * l;
+        let max_order = self.shift_max_order();
         if order > max_order {
             return Err(SsiError::OrderTooHigh {
                 order,
                 block_rows: i,
                 n_channels: l,
+                n_references: self.n_references,
                 max_order,
-                needed_block_rows: order.div_ceil(l) + 1,
+                needed_block_rows: (order.div_ceil(l) + 1).max(order.div_ceil(self.n_references)),
             });
         }
         if order > self.rank {
@@ -273,13 +336,14 @@ impl SsiCov {
             });
         }
         let dim = i * l;
-        let o = DMatrix::from_fn(dim, order, |r, c| {
-            self.u[(r, c)] * self.singular_values[c].sqrt()
-        });
-        let rows = dim - l;
-        let o_up = o.rows(0, rows).into_owned();
-        let o_down = o.rows(l, rows).into_owned();
-        let a = least_squares(o_up, &o_down)?;
+        let o = observability(&self.u, &self.singular_values, dim, order);
+        let a = match self.shift_from_full_qr(order) {
+            Some(a) => a,
+            None => {
+                let rows = dim - l;
+                least_squares(o.rows(0, rows).into_owned(), &o.rows(l, rows).into_owned())?
+            }
+        };
         let c = o.rows(0, l).into_owned();
         let pairs = complex_eigenpairs(a)?;
         let mut modes: Vec<SsiMode> = pairs
@@ -305,6 +369,24 @@ impl SsiCov {
         Ok(modes)
     }
 
+    /// `A` at `order` from the QR computed once, or `None` when `R[..n, ..n]` has a pivot at
+    /// or below `max |R_jj| * rows * eps` (then the caller solves by SVD).
+    fn shift_from_full_qr(&self, order: usize) -> Option<DMatrix<f64>> {
+        if order > self.r_full.nrows() {
+            return None;
+        }
+        let r = self.r_full.view((0, 0), (order, order));
+        let diag = r.diagonal();
+        let rmax = diag.amax();
+        let rows = (self.block_rows - 1) * self.n_channels;
+        let tiny = rmax * rows.max(order) as f64 * f64::EPSILON;
+        if rmax.is_nan() || rmax <= 0.0 || diag.iter().any(|d| d.abs() <= tiny) {
+            return None;
+        }
+        let b = self.qt_down_full.view((0, 0), (order, order)).into_owned();
+        r.solve_upper_triangular(&b)
+    }
+
     /// [`SsiCov::poles_at`] for every order of `orders`.
     pub fn sweep(&self, orders: &[usize]) -> Result<SsiResult, SsiError> {
         let orders = orders
@@ -323,6 +405,11 @@ impl SsiCov {
             singular_values: self.singular_values.clone(),
         })
     }
+}
+
+/// `O = U[.., ..n] S[..n]^{1/2}` (`rows x n`).
+fn observability(u: &DMatrix<f64>, singular_values: &[f64], rows: usize, n: usize) -> DMatrix<f64> {
+    DMatrix::from_fn(rows, n, |r, c| u[(r, c)] * singular_values[c].sqrt())
 }
 
 /// `C psi`, scaled so that its entry of largest modulus is `1 + 0i` (left as is when zero).
@@ -429,7 +516,7 @@ mod tests {
             (20.0, 0.3, 3),
         ] {
             let r = one_mode_correlations(f, z, 50.0, i);
-            let cov = SsiCov::from_correlations(&r, 50.0, i).unwrap();
+            let cov = SsiCov::from_correlations(&r, 50.0, i, 60).unwrap();
             assert_eq!(
                 cov.rank(),
                 2,
@@ -457,7 +544,7 @@ mod tests {
     #[test]
     fn order_above_the_rank_of_exact_correlations_is_refused() {
         let r = one_mode_correlations(2.0, 0.05, 50.0, 5);
-        let cov = SsiCov::from_correlations(&r, 50.0, 5).unwrap();
+        let cov = SsiCov::from_correlations(&r, 50.0, 5, 60).unwrap();
         let e = cov.poles_at(4).unwrap_err();
         assert!(
             matches!(
@@ -485,7 +572,7 @@ mod tests {
         let mut r = vec![DMatrix::from_element(1, 1, 0.0); 5];
         r[0][(0, 0)] = 1.0;
         r[4][(0, 0)] = 0.5;
-        let cov = SsiCov::from_correlations(&r, 50.0, 3).unwrap();
+        let cov = SsiCov::from_correlations(&r, 50.0, 3, 60).unwrap();
         assert_eq!(cov.rank(), 2);
         let modes = cov.poles_at(2).unwrap();
         for m in modes {

@@ -56,6 +56,24 @@ pub enum SsiError {
         /// Smallest number of samples accepted, `2 * block_rows`.
         min_samples: usize,
     },
+    /// A reference channel index that is not a channel of the data.
+    #[error("reference channel {index} does not exist: there are {n_channels} channels (0-based indices 0..={last}); list existing channels in reference_channels")]
+    ReferenceChannel {
+        /// The index given.
+        index: usize,
+        /// Number of channels.
+        n_channels: usize,
+        /// Largest valid index.
+        last: usize,
+    },
+    /// A correlation overflowed (samples so large that their products are not finite).
+    #[error("the correlation at lag {lag} is not finite (largest sample magnitude {max_abs:e}); scale the channels to a moderate range (e.g. divide by {max_abs:e})")]
+    Overflow {
+        /// Lag of the first non-finite correlation.
+        lag: usize,
+        /// Largest absolute sample value (after mean removal).
+        max_abs: f64,
+    },
     /// A parameter out of range.
     #[error(transparent)]
     Param(#[from] ParamError),
@@ -63,7 +81,7 @@ pub enum SsiError {
     #[error("model order 0 identifies nothing; ask for an order >= 1 (2 per mode)")]
     ZeroOrder,
     /// An order above what the shift invariance of the observability matrix can determine.
-    #[error("order {order} is too high for block_rows = {block_rows} with {n_channels} channels: the largest is (block_rows - 1) x channels = {max_order}; lower the order or raise block_rows to {needed_block_rows}")]
+    #[error("order {order} is too high for block_rows = {block_rows} with {n_channels} channels and {n_references} references: the largest is min((block_rows - 1) x channels, block_rows x references) = {max_order}; lower the order or raise block_rows to {needed_block_rows}")]
     OrderTooHigh {
         /// Order asked for.
         order: usize,
@@ -71,7 +89,10 @@ pub enum SsiError {
         block_rows: usize,
         /// Number of channels.
         n_channels: usize,
-        /// Largest order for these block rows, `(block_rows - 1) * n_channels`.
+        /// Number of reference channels (all channels unless references are given).
+        n_references: usize,
+        /// Largest order for these block rows,
+        /// `min((block_rows - 1) * n_channels, block_rows * n_references)`.
         max_order: usize,
         /// Smallest number of block rows that allows the order.
         needed_block_rows: usize,

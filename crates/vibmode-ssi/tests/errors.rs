@@ -25,6 +25,7 @@ fn params(block_rows: usize) -> SsiParams {
         order_min: 2,
         order_max: 4,
         order_step: 2,
+        reference_channels: None,
     }
 }
 
@@ -176,6 +177,7 @@ fn order_too_high_for_the_block_rows() {
             order: 10,
             block_rows: 5,
             n_channels: 2,
+            n_references: 2,
             max_order: 8,
             needed_block_rows: 6
         }
@@ -226,4 +228,67 @@ fn order_above_the_rank() {
         "{e:?}"
     );
     assert!(m.contains("order 2") && m.contains("rank 0"), "{m}");
+}
+
+#[test]
+fn reference_channel_out_of_range() {
+    let (a, b) = (noise(200, 1), noise(200, 2));
+    let p = SsiParams {
+        reference_channels: Some(vec![0, 2]),
+        ..params(5)
+    };
+    let (e, m) = msg(ssi_cov(&[&a, &b], 50.0, &p));
+    assert_eq!(
+        e,
+        SsiError::ReferenceChannel {
+            index: 2,
+            n_channels: 2,
+            last: 1
+        }
+    );
+    assert!(
+        m.contains("reference channel 2") && m.contains("0..=1"),
+        "{m}"
+    );
+}
+
+#[test]
+fn order_limited_by_the_references() {
+    // 3 channels, 1 reference, 4 block rows: the Toeplitz matrix is 12 x 4, so at most order 4
+    // (and (4 - 1) x 3 = 9 from the shift).
+    let ch: Vec<Vec<f64>> = (0..3).map(|s| noise(500, s)).collect();
+    let refs: Vec<&[f64]> = ch.iter().map(Vec::as_slice).collect();
+    let p = SsiParams {
+        reference_channels: Some(vec![1]),
+        ..params(4)
+    };
+    let cov = SsiCov::new(&refs, 50.0, &p).unwrap();
+    assert_eq!(cov.n_references(), 1);
+    assert_eq!(cov.singular_values().len(), 4);
+    let (e, m) = msg(cov.poles_at(6));
+    assert!(
+        matches!(
+            e,
+            SsiError::OrderTooHigh {
+                order: 6,
+                max_order: 4,
+                n_references: 1,
+                needed_block_rows: 6,
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    assert!(
+        m.contains("1 references") && m.contains("= 4") && m.contains("block_rows to 6"),
+        "{m}"
+    );
+}
+
+#[test]
+fn overflowing_correlations() {
+    let a: Vec<f64> = noise(200, 1).iter().map(|v| v * 1e300).collect();
+    let (e, m) = msg(ssi_cov(&[&a], 50.0, &params(5)));
+    assert!(matches!(e, SsiError::Overflow { lag: 1, .. }), "{e:?}");
+    assert!(m.contains("lag 1") && m.contains("e299"), "{m}");
 }
