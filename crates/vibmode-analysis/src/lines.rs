@@ -3,8 +3,8 @@
 //! to record, and the evidence used to class the invariant modes.
 //!
 //! Rule (documented in docs/analysis.md): with line detection on (`max_kurtosis > 0`), each
-//! supported cluster gets the median narrow-band kurtosis of its frequency over the records used
-//! and the channels of its pool. It is a periodic disturbance, whatever its damping, when that
+//! supported cluster gets the narrow-band kurtosis of its frequency from the moments pooled over
+//! the records used (median over the channels of its pool). It is a periodic disturbance, whatever its damping, when that
 //! kurtosis is below `max_kurtosis`, or below [`GAUSSIAN_KURTOSIS_MIN`] with a line track of the
 //! pool within half a band-width of its frequency. A cluster the damping rule calls periodic is a
 //! structural mode when that kurtosis is at least [`GAUSSIAN_KURTOSIS_MIN`] (clearly random).
@@ -12,7 +12,7 @@
 use serde::{Deserialize, Serialize};
 use vibmode_core::{InvariantMode, LineParams, ModeClass};
 use vibmode_signal::Preprocessed;
-use vibmode_spectra::{line_candidates, narrowband_kurtosis, LineCandidate};
+use vibmode_spectra::{line_candidates, narrowband_moments, LineCandidate};
 
 /// A cluster the damping rule calls periodic is structural when its narrow-band kurtosis is at
 /// least this. Gaussian noise has 3, but in a 10 s record a 0.5 Hz band holds only ~5 DFT bins
@@ -31,7 +31,9 @@ pub struct LineTrack {
     pub record_hz: Vec<Option<f64>>,
     /// Share of the records used in which it was found.
     pub record_share: f64,
-    /// Median narrow-band kurtosis (1.5 for a sine, 3 for noise).
+    /// Narrow-band kurtosis around the track's frequency in each of its records, from the
+    /// moments pooled over those records (median over the pool's channels; 1.5 for a sine of
+    /// steady amplitude, 3 for noise).
     pub kurtosis: f64,
 }
 
@@ -89,32 +91,54 @@ impl LineStage<'_> {
         }
         let per_record = self.record_lines(channels);
         let n_used = self.used.iter().filter(|&&u| u).count().max(1);
+        // A track must also look periodic with its records pooled (see `pooled_kurtosis`).
         track(&per_record, self.params, n_used)
+            .into_iter()
+            .filter_map(|mut t| {
+                let k = self.pooled_kurtosis(&t.record_hz, channels)?;
+                t.kurtosis = k;
+                (k < self.params.max_kurtosis).then_some(t)
+            })
+            .collect()
     }
 
-    /// Median narrow-band kurtosis at `freq_hz` over the records used and `channels`.
-    fn kurtosis_at(&self, freq_hz: f64, channels: &[usize]) -> Option<f64> {
+    /// Kurtosis of the band around `freq_hz[r]` in each record used, from the moments pooled
+    /// over the records, per channel; the median over `channels`. Pooling matters: a lightly
+    /// damped mode whose correlation time is a fair part of a record looks like a sine in each
+    /// record, but its amplitude differs from record to record, which the pooled moments show.
+    fn pooled_kurtosis(&self, freq_hz: &[Option<f64>], channels: &[usize]) -> Option<f64> {
         let mut ks: Vec<f64> = Vec::new();
-        for (p, &used) in self.pre.iter().zip(&self.used) {
-            if !used || freq_hz + self.params.half_width_hz >= p.band.fs_hz / 2.0 {
-                continue;
-            }
-            for &c in channels {
-                if let Some(ch) = p.recording.channels.get(c) {
-                    if let Ok(k) = narrowband_kurtosis(
-                        &ch.samples,
-                        p.band.fs_hz,
-                        freq_hz,
-                        self.params.half_width_hz,
-                    ) {
-                        if k.is_finite() {
-                            ks.push(k);
-                        }
-                    }
+        for &c in channels {
+            let (mut s2, mut s4, mut n) = (0.0, 0.0, 0usize);
+            for ((p, &used), f) in self.pre.iter().zip(&self.used).zip(freq_hz) {
+                let Some(f) = *f else { continue };
+                if !used || f + self.params.half_width_hz >= p.band.fs_hz / 2.0 {
+                    continue;
                 }
+                let Some(ch) = p.recording.channels.get(c) else {
+                    continue;
+                };
+                if let Ok((m2, m4)) =
+                    narrowband_moments(&ch.samples, p.band.fs_hz, f, self.params.half_width_hz)
+                {
+                    let len = ch.samples.len() as f64;
+                    s2 += m2 * len;
+                    s4 += m4 * len;
+                    n += ch.samples.len();
+                }
+            }
+            if n > 0 && s2 > 0.0 {
+                let (m2, m4) = (s2 / n as f64, s4 / n as f64);
+                ks.push(m4 / (m2 * m2));
             }
         }
         median(&mut ks)
+    }
+
+    /// Pooled kurtosis at one frequency in every record.
+    fn kurtosis_at(&self, freq_hz: f64, channels: &[usize]) -> Option<f64> {
+        let f = vec![Some(freq_hz); self.pre.len()];
+        self.pooled_kurtosis(&f, channels)
     }
 
     /// Sets each mode's `line_kurtosis` and, for supported clusters, its class by the rule of

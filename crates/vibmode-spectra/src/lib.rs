@@ -54,7 +54,7 @@ mod window;
 
 pub use error::SpectraError;
 pub use integrate::{band_rms, peak, rms};
-pub use lines::{line_candidates, narrowband_kurtosis, LineCandidate};
+pub use lines::{line_candidates, narrowband_kurtosis, narrowband_moments, LineCandidate};
 pub use num_complex::Complex64;
 pub use params::{Average, Detrend, PeriodogramParams, Scaling, ShortRecord, WelchParams, Window};
 pub use vibmode_core::LineParams;

@@ -39,10 +39,27 @@ pub fn narrowband_kurtosis(
     center_hz: f64,
     half_width_hz: f64,
 ) -> Result<f64, SpectraError> {
+    let (m2, m4) = narrowband_moments(x, fs_hz, center_hz, half_width_hz)?;
+    Ok(if m2 > 0.0 { m4 / (m2 * m2) } else { f64::NAN })
+}
+
+/// The second and fourth moments `(E[y^2], E[y^4])` of `x` ideally band-passed to
+/// `center_hz +- half_width_hz` (as [`narrowband_kurtosis`]; `(0, 0)` when the band holds less
+/// than 1e-20 of the variance). Moments of several records can be pooled (averaged, weighted by
+/// their lengths) before forming the kurtosis: a randomly excited mode whose amplitude differs
+/// from record to record then shows a Gaussian-like kurtosis even when each record is too short
+/// for it.
+/// Errors: fs_hz not positive/finite, empty `x`, NaN/Inf sample.
+pub fn narrowband_moments(
+    x: &[f64],
+    fs_hz: f64,
+    center_hz: f64,
+    half_width_hz: f64,
+) -> Result<(f64, f64), SpectraError> {
     check_fs(fs_hz)?;
     check_samples(x, "x")?;
     let mut planner = RealFftPlanner::<f64>::new();
-    Ok(band_kurtosis(
+    Ok(band_moments(
         &mut planner,
         x,
         fs_hz,
@@ -58,6 +75,21 @@ fn band_kurtosis(
     center_hz: f64,
     half_width_hz: f64,
 ) -> f64 {
+    let (m2, m4) = band_moments(planner, x, fs_hz, center_hz, half_width_hz);
+    if m2 > 0.0 {
+        m4 / (m2 * m2)
+    } else {
+        f64::NAN
+    }
+}
+
+fn band_moments(
+    planner: &mut RealFftPlanner<f64>,
+    x: &[f64],
+    fs_hz: f64,
+    center_hz: f64,
+    half_width_hz: f64,
+) -> (f64, f64) {
     let n = x.len();
     let mean = x.iter().sum::<f64>() / n as f64;
     let mut buf: Vec<f64> = x.iter().map(|v| v - mean).collect();
@@ -66,7 +98,7 @@ fn band_kurtosis(
     let inv = planner.plan_fft_inverse(n);
     let mut spec = fwd.make_output_vec();
     if fwd.process(&mut buf, &mut spec).is_err() {
-        return f64::NAN;
+        return (0.0, 0.0);
     }
     let df = fs_hz / n as f64;
     let last = spec.len() - 1;
@@ -82,15 +114,17 @@ fn band_kurtosis(
     }
     let mut y = inv.make_output_vec();
     if inv.process(&mut spec, &mut y).is_err() {
-        return f64::NAN;
+        return (0.0, 0.0);
     }
-    let m2 = y.iter().map(|v| v * v).sum::<f64>() / n as f64;
-    let m4 = y.iter().map(|v| v.powi(4)).sum::<f64>() / n as f64;
+    // realfft's inverse is unnormalised: divide by n.
+    let k = 1.0 / n as f64;
+    let m2 = y.iter().map(|v| (v * k).powi(2)).sum::<f64>() / n as f64;
+    let m4 = y.iter().map(|v| (v * k).powi(4)).sum::<f64>() / n as f64;
     // Below ~1e-20 of the signal's variance the band holds only rounding residue.
     if m2 > 1e-20 * var && m2 > 0.0 {
-        m4 / (m2 * m2)
+        (m2, m4)
     } else {
-        f64::NAN
+        (0.0, 0.0)
     }
 }
 

@@ -133,3 +133,42 @@ fn bad_input_is_an_error() {
         Err(SpectraError::InvalidSampleRate { .. })
     ));
 }
+
+#[test]
+fn pooled_moments_reveal_a_lightly_damped_mode_that_one_record_cannot() {
+    // 1.5 Hz, damping 0.02: correlation time 1 / (zeta omega) = 5.3 s, half a 10 s record. In one
+    // record the band looks like a sine; over records its amplitude is random, so the pooled
+    // kurtosis is Gaussian-like. A sine of fixed amplitude stays at 1.5 either way.
+    use vibmode_spectra::narrowband_moments;
+    let (fs, n, hw) = (50.0, 512, 0.25);
+    let (mut low_single, mut pooled_mode) = (0, Vec::new());
+    for seed in 0..10u64 {
+        let (mut s2, mut s4) = (0.0, 0.0);
+        for r in 0..8u64 {
+            let x = mode(n, fs, 1.5, 0.02, 100 * seed + r);
+            let k = narrowband_kurtosis(&x, fs, 1.5, hw).unwrap();
+            if k < 2.0 {
+                low_single += 1;
+            }
+            let (m2, m4) = narrowband_moments(&x, fs, 1.5, hw).unwrap();
+            s2 += m2;
+            s4 += m4;
+        }
+        pooled_mode.push((s4 / 8.0) / (s2 / 8.0).powi(2));
+    }
+    assert!(
+        low_single >= 20,
+        "single records looked periodic only {low_single} of 80 times"
+    );
+    let below = pooled_mode.iter().filter(|k| **k < 2.0).count();
+    assert!(below <= 1, "pooled kurtosis of the mode: {pooled_mode:?}");
+    // the moments are those of the band-passed signal: a unit sine has m2 = 1/2, m4 = 3/8
+    let x: Vec<f64> = (0..256)
+        .map(|i| (2.0 * PI * 8.0 * i as f64 / 64.0).sin())
+        .collect();
+    let (m2, m4) = narrowband_moments(&x, 64.0, 8.0, 0.5).unwrap();
+    assert!(
+        (m2 - 0.5).abs() < 1e-12 && (m4 - 0.375).abs() < 1e-12,
+        "{m2} {m4}"
+    );
+}
