@@ -53,6 +53,10 @@ pub struct AnalyzeArgs {
     /// Corner of a channel, `NAME=FL|FR|RL|RR` (repeat for several).
     #[arg(long = "corner", value_name = "NAME=CORNER")]
     pub corners: Vec<String>,
+    /// Identification: arma (per channel, the default), ssi-cov (all channels at once, with
+    /// mode shapes) or both; overrides the config's `method`.
+    #[arg(long)]
+    pub method: Option<String>,
 }
 
 /// `NAME=VALUE` of `--role` / `--corner`.
@@ -117,6 +121,9 @@ fn load_config(config: Option<&Path>, preset: Option<&str>) -> Result<AnalysisCo
 pub fn run(a: &AnalyzeArgs) -> Result<()> {
     let mut cfg = load_config(a.config.as_deref(), a.preset.as_deref())?;
     apply_placements(&mut cfg, &a.roles, &a.corners)?;
+    if let Some(m) = &a.method {
+        cfg.method = m.parse()?;
+    }
     let opts = ReadOptions {
         fs_hz: a.fs_hz,
         scale: a.scale,
@@ -234,6 +241,9 @@ pub struct DemoArgs {
     /// No progress bar.
     #[arg(long, short = 'q')]
     pub quiet: bool,
+    /// Identification: arma (the default), ssi-cov or both.
+    #[arg(long)]
+    pub method: Option<String>,
 }
 
 /// Runs `vibmode demo`: simulate the shipped city bus and analyse it.
@@ -242,7 +252,10 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
     if a.records == 0 {
         bail!("--records 0: give at least one record");
     }
-    let cfg = load_config(None, a.preset.as_deref())?;
+    let mut cfg = load_config(None, a.preset.as_deref())?;
+    if let Some(m) = &a.method {
+        cfg.method = m.parse()?;
+    }
     let vehicle = vibmode_vehicle::VehicleParams::city_bus_flexible();
     let p = vibmode_vehicle::SimParams::demo(a.records, a.seed);
     p.validate()?;

@@ -8,6 +8,7 @@ mod cmd_analyze;
 mod cmd_fit;
 mod cmd_psd;
 mod cmd_resample;
+mod cmd_ssi;
 mod cmd_sweep;
 mod cmd_vehicle;
 mod hints;
@@ -39,6 +40,9 @@ enum Command {
     /// Fit every model order and collect every mode (stabilisation diagram).
     #[command(allow_negative_numbers = true)]
     Sweep(cmd_sweep::SweepArgs),
+    /// Multichannel SSI-cov of one record: stabilisation diagram and modes with shapes.
+    #[command(allow_negative_numbers = true)]
+    Ssi(cmd_ssi::SsiArgs),
     /// The paper's whole analysis over many records, with an HTML report.
     #[command(allow_negative_numbers = true)]
     Analyze(cmd_analyze::AnalyzeArgs),
@@ -60,6 +64,7 @@ fn main() -> ExitCode {
         Command::Resample(a) => cmd_resample::run(&a),
         Command::Fit(a) => cmd_fit::run(&a),
         Command::Sweep(a) => cmd_sweep::run(&a),
+        Command::Ssi(a) => cmd_ssi::run(&a),
         Command::Analyze(a) => cmd_analyze::run(&a),
         Command::Demo(a) => cmd_analyze::run_demo(&a),
         Command::Fullcar(a) => cmd_vehicle::run_fullcar(&a),

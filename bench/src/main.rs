@@ -338,6 +338,7 @@ fn run(dir: &Path, quick: bool) -> Result<Value> {
         order_max: SSI_ORDER_MAX,
         order_step: 2,
         reference_channels: None,
+        pool_records: false,
     };
     let mut n_ssi_modes = 0;
     let t_ssi = median_time(if quick { 3 } else { 11 }, || {

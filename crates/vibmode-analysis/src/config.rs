@@ -179,7 +179,14 @@ impl AnalysisConfig {
             cluster: ClusterParams::default(),
             lines: LineParams::default(),
             method: IdentMethod::default(),
-            ssi: SsiParams::default(),
+            // Measured on the demo (docs/ssi.md): 40 block rows (lags to 1.6 s at 50 Hz) and
+            // correlations pooled over the records find the body modes; per record, 10 s is too
+            // short.
+            ssi: SsiParams {
+                block_rows: 40,
+                pool_records: true,
+                ..SsiParams::default()
+            },
             report: ReportParams::default(),
         };
         match p {

@@ -4,7 +4,7 @@
 //!
 //! Rule (documented in docs/analysis.md): with line detection on (`max_kurtosis > 0`), each
 //! supported cluster gets the narrow-band kurtosis of its frequency from the moments pooled over
-//! the records used (median over the channels of its pool). It is a periodic disturbance, whatever its damping, when that
+//! the records used (lowest over the channels of its pool). It is a periodic disturbance, whatever its damping, when that
 //! kurtosis is below `max_kurtosis`, or below [`GAUSSIAN_KURTOSIS_MIN`] with a line track of the
 //! pool within half a band-width of its frequency. A cluster the damping rule calls periodic is a
 //! structural mode when that kurtosis is at least [`GAUSSIAN_KURTOSIS_MIN`] (clearly random).
@@ -20,6 +20,13 @@ use vibmode_spectra::{line_candidates, narrowband_moments, LineCandidate};
 /// (sines 1.5-1.75).
 pub const GAUSSIAN_KURTOSIS_MIN: f64 = 2.3;
 
+/// A cluster on a tracked line's frequency range with a median damping below this is the line:
+/// a line that moves between records looks like a lightly damped mode to an identification over
+/// all records (SSI-cov with pooled correlations), and its kurtosis at one frequency is then
+/// diluted by the records where the line is elsewhere. A structural mode that light, on a line,
+/// cannot be told from it.
+pub const LINE_DAMPING_MAX: f64 = 0.05;
+
 /// A periodic line followed over the records.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LineTrack {
@@ -32,7 +39,7 @@ pub struct LineTrack {
     /// Share of the records used in which it was found.
     pub record_share: f64,
     /// Narrow-band kurtosis around the track's frequency in each of its records, from the
-    /// moments pooled over those records (median over the pool's channels; 1.5 for a sine of
+    /// moments pooled over those records (lowest over the pool's channels; 1.5 for a sine of
     /// steady amplitude, 3 for noise).
     pub kurtosis: f64,
 }
@@ -103,7 +110,8 @@ impl LineStage<'_> {
     }
 
     /// Kurtosis of the band around `freq_hz[r]` in each record used, from the moments pooled
-    /// over the records, per channel; the median over `channels`. Pooling matters: a lightly
+    /// over the records, per channel; the lowest over `channels` (a line is clean where it
+    /// enters, near the engine, and buried under wheel hop elsewhere). Pooling matters: a lightly
     /// damped mode whose correlation time is a fair part of a record looks like a sine in each
     /// record, but its amplitude differs from record to record, which the pooled moments show.
     fn pooled_kurtosis(&self, freq_hz: &[Option<f64>], channels: &[usize]) -> Option<f64> {
@@ -132,7 +140,7 @@ impl LineStage<'_> {
                 ks.push(m4 / (m2 * m2));
             }
         }
-        median(&mut ks)
+        ks.into_iter().filter(|k| k.is_finite()).reduce(f64::min)
     }
 
     /// Pooled kurtosis at one frequency in every record.
@@ -158,7 +166,8 @@ impl LineStage<'_> {
                 t.frequency_range_hz.0 - 0.5 * hw <= m.frequency_hz
                     && m.frequency_hz <= t.frequency_range_hz.1 + 0.5 * hw
             });
-            let periodic = k < self.params.max_kurtosis || (on_track && k < GAUSSIAN_KURTOSIS_MIN);
+            let periodic = k < self.params.max_kurtosis
+                || (on_track && (k < GAUSSIAN_KURTOSIS_MIN || m.damping_ratio < LINE_DAMPING_MAX));
             match m.class {
                 ModeClass::Structural if periodic => {
                     m.class = ModeClass::PeriodicDisturbance;

@@ -105,30 +105,54 @@ impl SsiStage<'_> {
             .collect()
     }
 
-    fn record_poles(
-        &self,
-        r: usize,
-        orders: &[usize],
-        scales: &[f64],
-    ) -> Result<Vec<ShapedPole>, String> {
-        let p = &self.pre[r];
-        let scaled: Vec<Vec<f64>> = p
-            .recording
-            .channels
+    /// One identification from the correlations averaged over the records used (record index
+    /// 0 for every pole).
+    fn pooled_poles(&self, orders: &[usize], scales: &[f64]) -> Result<Vec<ShapedPole>, String> {
+        let used: Vec<&Preprocessed> = self
+            .pre
             .iter()
-            .zip(scales)
-            .map(|(c, s)| c.samples.iter().map(|v| v / s).collect())
+            .enumerate()
+            .filter(|(r, _)| self.active.get(*r).copied().flatten().is_some())
+            .map(|(_, p)| p)
             .collect();
-        let chans: Vec<&[f64]> = scaled.iter().map(Vec::as_slice).collect();
-        let plan = SsiCov::new(&chans, p.band.fs_hz, self.params).map_err(|e| e.to_string())?;
-        let res = plan.sweep(orders).map_err(|e| e.to_string())?;
-        let f_max = if self.drop_band_edge {
-            p.band.valid_max_hz()
-        } else {
-            p.band.fs_hz / 2.0
+        let Some(first) = used.first() else {
+            return Ok(Vec::new());
         };
-        Ok(res
-            .orders
+        let scaled: Vec<Vec<Vec<f64>>> = used
+            .iter()
+            .map(|p| {
+                p.recording
+                    .channels
+                    .iter()
+                    .zip(scales)
+                    .map(|(c, s)| c.samples.iter().map(|v| v / s).collect())
+                    .collect()
+            })
+            .collect();
+        let segments: Vec<Vec<&[f64]>> = scaled
+            .iter()
+            .map(|rec| rec.iter().map(Vec::as_slice).collect())
+            .collect();
+        let plan = SsiCov::from_segments(&segments, first.band.fs_hz, self.params)
+            .map_err(|e| e.to_string())?;
+        let res = plan.sweep(orders).map_err(|e| e.to_string())?;
+        Ok(self.kept(res, 0, &first.band, scales))
+    }
+
+    /// The poles of an SSI result below the valid band, with shapes scaled back.
+    fn kept(
+        &self,
+        res: vibmode_ssi::SsiResult,
+        r: usize,
+        band: &vibmode_core::BandLimit,
+        scales: &[f64],
+    ) -> Vec<ShapedPole> {
+        let f_max = if self.drop_band_edge {
+            band.valid_max_hz()
+        } else {
+            band.fs_hz / 2.0
+        };
+        res.orders
             .into_iter()
             .flat_map(|o| {
                 let order = o.order;
@@ -148,7 +172,27 @@ impl SsiStage<'_> {
                 })
             })
             .filter(|q| q.frequency_hz < f_max)
-            .collect())
+            .collect()
+    }
+
+    fn record_poles(
+        &self,
+        r: usize,
+        orders: &[usize],
+        scales: &[f64],
+    ) -> Result<Vec<ShapedPole>, String> {
+        let p = &self.pre[r];
+        let scaled: Vec<Vec<f64>> = p
+            .recording
+            .channels
+            .iter()
+            .zip(scales)
+            .map(|(c, s)| c.samples.iter().map(|v| v / s).collect())
+            .collect();
+        let chans: Vec<&[f64]> = scaled.iter().map(Vec::as_slice).collect();
+        let plan = SsiCov::new(&chans, p.band.fs_hz, self.params).map_err(|e| e.to_string())?;
+        let res = plan.sweep(orders).map_err(|e| e.to_string())?;
+        Ok(self.kept(res, r, &p.band, scales))
     }
 
     pub fn run(
@@ -169,10 +213,14 @@ impl SsiStage<'_> {
             .unwrap_or_default();
         let orders = self.orders(channels.len());
         let scales = self.channel_scales();
-        let per: Vec<Result<Vec<ShapedPole>, String>> = (0..self.pre.len())
-            .into_par_iter()
-            .map(|r| self.record_poles(r, &orders, &scales))
-            .collect();
+        let per: Vec<Result<Vec<ShapedPole>, String>> = if self.params.pool_records {
+            vec![self.pooled_poles(&orders, &scales)]
+        } else {
+            (0..self.pre.len())
+                .into_par_iter()
+                .map(|r| self.record_poles(r, &orders, &scales))
+                .collect()
+        };
         let mut poles = Vec::new();
         let mut failed_records = Vec::new();
         for (r, out) in per.into_iter().enumerate() {
@@ -181,10 +229,15 @@ impl SsiStage<'_> {
                 Err(e) => failed_records.push((r, e)),
             }
         }
+        let pooled = self.params.pool_records;
         let obs: Vec<PoleObservation> = poles
             .iter()
             .filter_map(|q| {
-                let rec = self.active.get(q.record).copied().flatten()?;
+                let rec = if pooled {
+                    0
+                } else {
+                    self.active.get(q.record).copied().flatten()?
+                };
                 let mut o = PoleObservation::new(
                     q.frequency_hz,
                     q.damping_ratio,
@@ -196,10 +249,11 @@ impl SsiStage<'_> {
                 Some(o)
             })
             .collect();
+        let n_records = if pooled { 1 } else { self.n_active };
         let mut invariant_modes = if orders.is_empty() || self.n_active == 0 {
             Vec::new()
         } else {
-            vibmode_modal::find_invariant_modes(&obs, self.n_active, &orders, self.cluster)?
+            vibmode_modal::find_invariant_modes(&obs, n_records, &orders, self.cluster)?
         };
         let all: Vec<usize> = (0..channels.len()).collect();
         let tracks = lines.tracks(&all);

@@ -25,6 +25,11 @@ pub struct SsiParams {
     /// is then `(i l) x (i r)`, smaller to decompose, and the highest order also at most `i r`.
     /// Default none: every channel is a reference.
     pub reference_channels: Option<Vec<usize>>,
+    /// In the analysis of many records: `true` identifies once from the correlations averaged
+    /// over all records used (long data for lightly damped, low modes; the poles then vary over
+    /// orders only); `false` (default) identifies each record alone, as the ARMA sweep does, so
+    /// that a mode must recur over records.
+    pub pool_records: bool,
 }
 
 impl Default for SsiParams {
@@ -35,6 +40,7 @@ impl Default for SsiParams {
             order_max: 60,
             order_step: 2,
             reference_channels: None,
+            pool_records: false,
         }
     }
 }

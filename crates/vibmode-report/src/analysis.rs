@@ -104,6 +104,25 @@ fn pools(r: &AnalysisResults) -> Vec<Pool<'_>> {
             lines: &ch.lines,
         });
     }
+    if let Some(ssi) = &r.ssi {
+        let how = if r.config.ssi.pool_records {
+            "correlations pooled over the records"
+        } else {
+            "each record alone"
+        };
+        out.push(Pool {
+            title: format!(
+                "all channels together (SSI-cov, {how}, {} block rows: {})",
+                r.config.ssi.block_rows,
+                ssi.channels.join(", ")
+            ),
+            subject: "the multichannel identification (SSI-cov)".into(),
+            modes: &ssi.invariant_modes,
+            matches: &ssi.matches,
+            channels: r.channels.iter().collect(),
+            lines: &ssi.lines,
+        });
+    }
     out
 }
 
@@ -202,12 +221,53 @@ pub fn modes_table_text(r: &AnalysisResults, truth: Option<&[TruthRow]>) -> Stri
             s.push_str(&candidates_text(r, pool.modes, "  "));
         }
         s.push_str(&lines_text(r, pool.lines, "  "));
+        s.push_str(&matches_text(pool.matches, pool.modes, "  "));
     }
     if let Some(t) = truth {
         s.push_str("\nTrue values (simulation):\n");
         let _ = writeln!(s, "  {:>9} {:>9}  what", "freq_hz", "damping");
         for (label, f, z) in t {
             let _ = writeln!(s, "  {f:>9.3} {z:>9.4}  {label}");
+        }
+    }
+    s
+}
+
+/// The physical-model modes and the identified mode each was matched to (with the MAC of their
+/// shapes when both have one), or nothing when there is no model.
+fn matches_text(
+    matches: &[vibmode_core::ModeMatch],
+    modes: &[InvariantMode],
+    indent: &str,
+) -> String {
+    let mut s = String::new();
+    if matches.is_empty() {
+        return s;
+    }
+    let _ = writeln!(s, "{indent}Model modes matched:");
+    for m in matches {
+        let found = m.invariant.and_then(|i| modes.get(i));
+        match found {
+            Some(inv) => {
+                let mac = m.mac.map_or(String::new(), |v| format!(", MAC {v:.2}"));
+                let _ = writeln!(
+                    s,
+                    "{indent}  {:<20} {:>7.3} Hz -> {:>7.3} Hz ({:+.1} %), damping {:.3} -> {:.3}{mac}",
+                    m.reference.label,
+                    m.reference.frequency_hz,
+                    inv.frequency_hz,
+                    100.0 * m.freq_diff_rel,
+                    m.reference.damping_ratio,
+                    inv.damping_ratio
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    s,
+                    "{indent}  {:<20} {:>7.3} Hz -> not found",
+                    m.reference.label, m.reference.frequency_hz
+                );
+            }
         }
     }
     s
@@ -289,6 +349,11 @@ pub fn modes_csv(r: &AnalysisResults) -> String {
     for ch in &r.channels {
         for m in shown(&ch.invariant_modes) {
             row(format!("channel:{}", ch.name), ch.name.clone(), m);
+        }
+    }
+    if let Some(ssi) = &r.ssi {
+        for m in shown(&ssi.invariant_modes) {
+            row("ssi-cov".into(), ssi.channels.join(" "), m);
         }
     }
     s
@@ -684,6 +749,7 @@ fn modes_tables(html: &mut HtmlReport, r: &AnalysisResults) {
                         or_dash(inv.map(|i| format!("{:.3}", i.damping_ratio))),
                         or_dash(inv.map(|_| format!("{:+.1} %", 100.0 * m.freq_diff_rel))),
                         or_dash(inv.map(|_| format!("{:+.3}", m.damping_diff))),
+                        or_dash(m.mac.map(|v| format!("{v:.2}"))),
                     ]
                 })
                 .collect();
@@ -696,6 +762,7 @@ fn modes_tables(html: &mut HtmlReport, r: &AnalysisResults) {
                     "identified damping",
                     "f difference",
                     "damping difference",
+                    "MAC",
                 ],
                 &rows,
             );

@@ -191,6 +191,98 @@ impl SsiCov {
         Ok(cov)
     }
 
+    /// Plans SSI-cov from several segments (records) of the same channels, for example records
+    /// of one drive cut apart: the correlations are averaged over the segments,
+    /// `R_k = sum_s sum_t y_s[t+k] y_s[t]^T / sum_s (N_s - k)` (each segment's means removed; no
+    /// product straddles two segments), then as [`SsiCov::new`]. Long identification data
+    /// without the joins of a concatenation. Every segment needs the same channel count and at
+    /// least `2 block_rows` samples; segments may differ in length.
+    pub fn from_segments(
+        segments: &[Vec<&[f64]>],
+        fs_hz: f64,
+        params: &SsiParams,
+    ) -> Result<SsiCov, SsiError> {
+        params.validate()?;
+        if !(fs_hz.is_finite() && fs_hz > 0.0) {
+            return Err(SsiError::InvalidSampleRate { fs_hz });
+        }
+        let first = segments.first().ok_or(SsiError::NoChannels)?;
+        let l = first.len();
+        let i = params.block_rows;
+        let max_lag = 2 * i - 1;
+        let refs: Vec<usize> = match &params.reference_channels {
+            Some(refs) => {
+                if let Some(&index) = refs.iter().find(|&&r| r >= l.max(1)) {
+                    return Err(SsiError::ReferenceChannel {
+                        index,
+                        n_channels: l,
+                        last: l.saturating_sub(1),
+                    });
+                }
+                refs.clone()
+            }
+            None => (0..l).collect(),
+        };
+        let mut sums: Vec<DMatrix<f64>> = vec![DMatrix::zeros(l, refs.len()); max_lag];
+        let mut counts = vec![0usize; max_lag];
+        let mut n_total = 0;
+        let mut max_abs = 0.0f64;
+        for seg in segments {
+            if seg.len() != l {
+                return Err(SsiError::LengthMismatch {
+                    channel: seg.len().min(l),
+                    found: seg.len(),
+                    expected: l,
+                });
+            }
+            let n = check_channels(seg)?;
+            if n < 2 * i {
+                return Err(SsiError::TooFewSamples {
+                    n_samples: n,
+                    block_rows: i,
+                    max_lag,
+                    min_samples: 2 * i,
+                });
+            }
+            let demeaned: Vec<Vec<f64>> = seg
+                .iter()
+                .map(|ch| {
+                    let m = ch.iter().sum::<f64>() / n as f64;
+                    ch.iter().map(|v| v - m).collect()
+                })
+                .collect();
+            max_abs = demeaned
+                .iter()
+                .flatten()
+                .fold(max_abs, |m, v| m.max(v.abs()));
+            for (k, (sum, count)) in (1..=max_lag).zip(sums.iter_mut().zip(counts.iter_mut())) {
+                for a in 0..l {
+                    for (b, &rb) in refs.iter().enumerate() {
+                        let ya = &demeaned[a][k..];
+                        let yb = &demeaned[rb][..n - k];
+                        sum[(a, b)] += ya.iter().zip(yb).map(|(x, y)| x * y).sum::<f64>();
+                    }
+                }
+                *count += n - k;
+            }
+            n_total += n;
+        }
+        let r: Vec<DMatrix<f64>> = sums
+            .into_iter()
+            .zip(&counts)
+            .map(|(m, &c)| m / c as f64)
+            .collect();
+        if let Some(k) = r.iter().position(|m| m.iter().any(|v| !v.is_finite())) {
+            return Err(SsiError::Overflow {
+                lag: k + 1,
+                max_abs,
+            });
+        }
+        let mut cov = SsiCov::from_correlations(&r, fs_hz, i, params.order_max)?;
+        cov.n_samples = n_total;
+        Ok(cov)
+    }
+
     /// From given correlations `r[k - 1] = R_k`, `k = 1..=2i-1`, each `l x r` (checked by the
     /// callers).
     /// `order_max` bounds the orders served by the one QR (higher ones get their own).

@@ -26,6 +26,7 @@ fn params(block_rows: usize) -> SsiParams {
         order_max: 4,
         order_step: 2,
         reference_channels: None,
+        pool_records: false,
     }
 }
 

@@ -1,0 +1,273 @@
+//! `vibmode ssi`: multichannel SSI-cov of one record, with a stabilisation diagram and the modes
+//! that stay over the orders (frequency, damping, shape).
+
+use crate::cmd_sweep::parse_orders;
+use crate::input::InputArgs;
+use crate::output::{ensure_parent, write_json};
+use anyhow::{Context, Result};
+use clap::Args;
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use vibmode_core::{ClusterParams, InvariantMode, ModeClass, SsiParams, StabilityParams};
+use vibmode_report::panels as figures;
+use vibmode_ssi::{SsiCov, SsiResult, Stability};
+
+/// Arguments of `vibmode ssi`.
+#[derive(Args, Debug)]
+pub struct SsiArgs {
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// Block rows of the Toeplitz matrix of output correlations (lags 1..2i-1; default 20).
+    #[arg(long)]
+    pub block_rows: Option<usize>,
+    /// Model orders (state dimensions): `2:60:2` (default), `2:40`, or a list `10,20,30`.
+    #[arg(long)]
+    pub orders: Option<String>,
+    /// Reference channels (0-based indices among the selected channels), comma-separated:
+    /// reference-based SSI-cov.
+    #[arg(long)]
+    pub references: Option<String>,
+    /// Write JSON results to this path (`-` for standard output).
+    #[arg(long)]
+    pub json: Option<String>,
+    /// Write the stabilisation diagram (.svg or .png).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+}
+
+#[derive(Serialize)]
+struct SsiOutput {
+    source: String,
+    fs_hz: f64,
+    n_samples: usize,
+    channels: Vec<String>,
+    params: SsiParams,
+    stability_params: StabilityParams,
+    /// Every order's modes.
+    result: SsiResult,
+    /// Stability label of every mode of every order against the previous order.
+    stability: Vec<Vec<Stability>>,
+    /// Clusters of the poles over the orders (mean shape, spread), structural ones first.
+    modes: Vec<InvariantMode>,
+}
+
+fn params(a: &SsiArgs) -> Result<SsiParams> {
+    let d = SsiParams::default();
+    let orders = match &a.orders {
+        Some(o) => parse_orders(o)?,
+        None => d.orders(),
+    };
+    let (lo, hi) = (
+        orders.iter().copied().min().unwrap_or(d.order_min),
+        orders.iter().copied().max().unwrap_or(d.order_max),
+    );
+    let step = if orders.len() > 1 {
+        orders
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .min()
+            .unwrap_or(1)
+            .max(1)
+    } else {
+        1
+    };
+    let references = match &a.references {
+        Some(s) => Some(
+            s.split(',')
+                .map(|x| {
+                    x.trim().parse::<usize>().map_err(|_| {
+                        anyhow::anyhow!(
+                            "invalid --references '{s}'; give 0-based channel indices like 0,2"
+                        )
+                    })
+                })
+                .collect::<Result<Vec<_>>>()?,
+        ),
+        None => None,
+    };
+    let p = SsiParams {
+        block_rows: a.block_rows.unwrap_or(d.block_rows),
+        order_min: lo,
+        order_max: hi,
+        order_step: step,
+        reference_channels: references,
+        ..d
+    };
+    p.validate()?;
+    Ok(p)
+}
+
+/// Runs `vibmode ssi`.
+pub fn run(a: &SsiArgs) -> Result<()> {
+    let (rec, band) = a.input.load_with_band()?;
+    let p = params(a)?;
+    let chans: Vec<&[f64]> = rec.channels.iter().map(|c| c.samples.as_slice()).collect();
+    let plan = SsiCov::new(&chans, rec.fs_hz, &p)?;
+    let orders: Vec<usize> = p
+        .orders()
+        .into_iter()
+        .filter(|&o| o <= plan.max_order())
+        .collect();
+    anyhow::ensure!(
+        !orders.is_empty(),
+        "no order up to {} is identifiable from {} channel(s) with {} block rows (highest: {}); raise the block rows or lower the orders",
+        p.order_max,
+        rec.n_channels(),
+        p.block_rows,
+        plan.max_order()
+    );
+    let result = plan.sweep(&orders)?;
+    let stability_params = StabilityParams::default();
+    let stability = vibmode_ssi::stabilisation(&result, &stability_params);
+    let f_max = band.map_or(rec.fs_hz / 2.0, |b| b.valid_max_hz());
+    let obs: Vec<vibmode_core::PoleObservation> = result
+        .orders
+        .iter()
+        .flat_map(|o| {
+            o.modes
+                .iter()
+                .filter(|m| m.frequency_hz < f_max)
+                .map(move |m| {
+                    let mut q = vibmode_core::PoleObservation::new(
+                        m.frequency_hz,
+                        m.damping_ratio,
+                        o.order,
+                        0,
+                        "ssi-cov",
+                    );
+                    q.shape = Some(m.shape.clone());
+                    q
+                })
+        })
+        .collect();
+    let cluster = ClusterParams {
+        freq_max_hz: Some(f_max),
+        ..ClusterParams::default()
+    };
+    let mut modes = vibmode_modal::find_invariant_modes(&obs, 1, &orders, &cluster)?;
+    modes.sort_by_key(|m| m.class != ModeClass::Structural);
+    let out = SsiOutput {
+        source: a.input.input.display().to_string(),
+        fs_hz: rec.fs_hz,
+        n_samples: rec.len(),
+        channels: rec.channels.iter().map(|c| c.name.clone()).collect(),
+        params: p,
+        stability_params,
+        result,
+        stability,
+        modes,
+    };
+    if let Some(path) = &a.plot {
+        write_plot(path, &out, &rec, f_max)?;
+    }
+    match &a.json {
+        Some(dest) => write_json(dest, &out)?,
+        None => crate::output::print_stdout(&summary(&out))?,
+    }
+    Ok(())
+}
+
+/// The modes that stay over the orders, with their shapes (modulus and phase per channel).
+fn summary(out: &SsiOutput) -> String {
+    let mut s = format!(
+        "{}: SSI-cov of {} channels ({} samples at {} Hz), {} block rows, orders {}..{}\n",
+        out.source,
+        out.channels.len(),
+        out.n_samples,
+        out.fs_hz,
+        out.params.block_rows,
+        out.result.orders.first().map_or(0, |o| o.order),
+        out.result.orders.last().map_or(0, |o| o.order),
+    );
+    let structural: Vec<&InvariantMode> = out
+        .modes
+        .iter()
+        .filter(|m| m.class == ModeClass::Structural)
+        .collect();
+    if structural.is_empty() {
+        s.push_str(
+            "No mode stays over half the orders (poles scattered); try more block rows, more samples or a longer record.\n",
+        );
+    }
+    for m in structural {
+        let _ = write!(
+            s,
+            "  {:>8.3} Hz  damping {:.4}  in {:.0} % of orders",
+            m.frequency_hz,
+            m.damping_ratio,
+            100.0 * m.order_share
+        );
+        if let Some((med, _)) = m.shape_mac {
+            let _ = write!(s, ", shape MAC {med:.2}");
+        }
+        s.push('\n');
+        if let Some(shape) = &m.shape {
+            let parts: Vec<String> = out
+                .channels
+                .iter()
+                .zip(shape)
+                .map(|(c, v)| {
+                    format!(
+                        "{c} {:.2}/{:+.0}deg",
+                        v[0].hypot(v[1]),
+                        v[1].atan2(v[0]).to_degrees()
+                    )
+                })
+                .collect();
+            let _ = writeln!(s, "      shape: {}", parts.join(", "));
+        }
+    }
+    s
+}
+
+fn write_plot(
+    path: &std::path::Path,
+    out: &SsiOutput,
+    rec: &vibmode_core::Recording,
+    f_max: f64,
+) -> Result<()> {
+    ensure_parent(path)?;
+    let pts: Vec<(usize, f64, f64)> = out
+        .result
+        .orders
+        .iter()
+        .flat_map(|o| {
+            o.modes
+                .iter()
+                .map(move |m| (o.order, m.frequency_hz, m.damping_ratio))
+        })
+        .collect();
+    // The Welch PSD summed over the channels, drawn behind the poles.
+    let mut freq = Vec::new();
+    let mut psd: Vec<f64> = Vec::new();
+    for ch in &rec.channels {
+        let wp = vibmode_spectra::WelchParams {
+            nperseg: Some(256.min(ch.samples.len())),
+            ..Default::default()
+        };
+        let w = vibmode_spectra::welch(&ch.samples, rec.fs_hz, &wp)?;
+        if psd.is_empty() {
+            psd = vec![0.0; w.psd.len()];
+            freq = w.freq_hz;
+        }
+        for (a, b) in psd.iter_mut().zip(&w.psd) {
+            *a += b;
+        }
+    }
+    let panel = figures::stabilisation_panel(
+        &format!(
+            "SSI-cov stabilisation diagram ({} channels)",
+            out.channels.len()
+        ),
+        &pts,
+        &freq,
+        &psd,
+        f_max,
+    );
+    figures::grid(vec![panel], 1, 1000, 520)
+        .save(path)
+        .with_context(|| format!("writing plot {}", path.display()))?;
+    eprintln!("wrote {}", path.display());
+    Ok(())
+}
