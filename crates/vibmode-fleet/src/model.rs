@@ -110,7 +110,7 @@ pub struct KindLimit {
 }
 
 /// Margin over the largest leave-one-out score of the nominal records.
-pub const LOO_MARGIN: f64 = 1.5;
+pub const LOO_MARGIN: f64 = 1.0;
 
 /// The nominal model set of one vehicle.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -144,7 +144,7 @@ impl ModelSet {
 }
 
 /// Classification of a record.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Classification {
     /// Excitation and vehicle inside the nominal set.

@@ -584,3 +584,105 @@ fn row_to_record(r: &rusqlite::Row<'_>) -> rusqlite::Result<RowResult> {
         road: r.get(5)?,
     }))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::features::{ChannelFeatures, RecordFeatures};
+    use vibmode_analysis::{Corner, Role};
+
+    fn features() -> RecordFeatures {
+        RecordFeatures {
+            analysis_fs_hz: 50.0,
+            duration_s: 10.24,
+            n_segments: 1,
+            bands_hz: vec![[2.0, 5.0]],
+            channels: vec![ChannelFeatures {
+                name: "RL_unsprung".into(),
+                role: Role::Unsprung,
+                corner: Some(Corner::RL),
+                band_rms: vec![Some(0.5)],
+                modes: Vec::new(),
+            }],
+            transmissibility: Vec::new(),
+            notes: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn fresh_store_reopens_with_its_schema_version() {
+        let d = tempfile::tempdir().expect("tempdir");
+        let p = d.path().join("f.db");
+        let (s, created) = Store::init(&p).expect("init");
+        assert!(created);
+        assert_eq!(s.schema_version().expect("version"), SCHEMA_VERSION);
+        drop(s);
+        let (s, created) = Store::init(&p).expect("init again");
+        assert!(!created);
+        assert_eq!(s.schema_version().expect("version"), 1);
+        let s = Store::open(&p).expect("open");
+        assert!(s.vehicles().expect("vehicles").is_empty());
+    }
+
+    #[test]
+    fn foreign_corrupt_newer_and_missing_files_are_clear_errors() {
+        let d = tempfile::tempdir().expect("tempdir");
+        // Random bytes (a fixed pseudo-random sequence, not a chosen pattern).
+        let junk: Vec<u8> = (0u32..8192)
+            .map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8)
+            .collect();
+        let p = d.path().join("junk.db");
+        std::fs::write(&p, &junk).expect("write");
+        let e = Store::open(&p).expect_err("junk opens");
+        assert!(matches!(e, FleetError::NotAStore { .. }), "{e}");
+        let e = Store::init(&p).expect_err("junk inits");
+        assert!(e.to_string().contains("not a vibmode fleet store"), "{e}");
+        // A foreign SQLite database.
+        let q = d.path().join("other.db");
+        let c = Connection::open(&q).expect("sqlite");
+        c.execute_batch("CREATE TABLE t (x); PRAGMA user_version = 1;")
+            .expect("foreign");
+        drop(c);
+        assert!(matches!(Store::open(&q), Err(FleetError::NotAStore { .. })));
+        // A newer schema.
+        let r = d.path().join("newer.db");
+        drop(Store::init(&r).expect("init"));
+        let c = Connection::open(&r).expect("sqlite");
+        c.execute_batch("PRAGMA user_version = 99;").expect("bump");
+        drop(c);
+        match Store::open(&r) {
+            Err(FleetError::NewerSchema { found: 99, .. }) => {}
+            other => panic!("{other:?}"),
+        }
+        assert!(matches!(
+            Store::open(&d.path().join("none.db")),
+            Err(FleetError::NoStore { .. })
+        ));
+    }
+
+    #[test]
+    fn the_same_content_twice_is_one_record() {
+        let d = tempfile::tempdir().expect("tempdir");
+        let (mut s, _) = Store::init(&d.path().join("f.db")).expect("init");
+        let rec = NewRecord {
+            vehicle: "bus-1",
+            sha256: "abc",
+            file_name: "a.csv",
+            condition: Condition::Nominal,
+            road: Some("B"),
+            metadata: serde_json::json!({}),
+        };
+        let id = s.insert_record(&rec, &features()).expect("insert");
+        let found = s.find_record("bus-1", "abc").expect("find");
+        assert_eq!(found.map(|r| r.id), Some(id));
+        // The unique constraint refuses a second row with the same hash.
+        assert!(s.insert_record(&rec, &features()).is_err());
+        assert_eq!(s.nominal_records("bus-1").expect("nominal").len(), 1);
+        assert_eq!(s.features(id).expect("features"), features());
+        assert!(matches!(
+            s.latest_model_set("bus-9"),
+            Err(FleetError::UnknownVehicle { .. })
+        ));
+        assert_eq!(s.latest_model_set("bus-1").expect("none"), None);
+    }
+}
