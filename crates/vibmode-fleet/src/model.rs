@@ -330,6 +330,9 @@ pub fn scalar_features(
     out
 }
 
+/// A channel's role, corner and (record, frequency) of its modes.
+type ChannelModes = (Role, Option<Corner>, Vec<(usize, f64)>);
+
 fn mode_name(role: Role, f: f64) -> &'static str {
     if role == Role::Unsprung && f >= 5.0 {
         "wheel-hop"
@@ -343,8 +346,7 @@ fn mode_name(role: Role, f: f64) -> &'static str {
 /// The modes of the model set: per channel, groups of modes whose neighbours lie within
 /// `mode_group_tol` of each other, present in at least `mode_min_share` of the records.
 pub fn mode_slots(records: &[RecordFeatures], cfg: &FleetConfig) -> Vec<ModeSlot> {
-    let mut by_channel: BTreeMap<String, (Role, Option<Corner>, Vec<(usize, f64)>)> =
-        BTreeMap::new();
+    let mut by_channel: BTreeMap<String, ChannelModes> = BTreeMap::new();
     for (r, rf) in records.iter().enumerate() {
         for ch in &rf.channels {
             let e = by_channel
@@ -629,4 +631,104 @@ fn summary(evidence: &[Evidence]) -> String {
         out.push(format!("road: {}", road.join(", ")));
     }
     out.join("; ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::features::{ChannelFeatures, CornerTransmissibility};
+
+    /// A record with one unsprung level and one transmissibility in band 2-5 Hz.
+    fn record(level: f64, trans: f64) -> RecordFeatures {
+        RecordFeatures {
+            analysis_fs_hz: 50.0,
+            duration_s: 10.0,
+            n_segments: 1,
+            bands_hz: vec![[2.0, 5.0]],
+            channels: vec![ChannelFeatures {
+                name: "RL_unsprung".into(),
+                role: Role::Unsprung,
+                corner: Some(Corner::RL),
+                band_rms: vec![Some(level)],
+                modes: Vec::new(),
+            }],
+            transmissibility: vec![CornerTransmissibility {
+                corner: Corner::RL,
+                sprung: "RL_sprung".into(),
+                unsprung: "RL_unsprung".into(),
+                values: vec![Some(trans)],
+            }],
+            notes: Vec::new(),
+        }
+    }
+
+    fn baseline() -> ModelSet {
+        // Levels 1.0 .. 1.2 and transmissibility 0.20 .. 0.22 over six records.
+        let recs: Vec<RecordFeatures> = (0..6)
+            .map(|i| record(1.0 + 0.04 * i as f64, 0.20 + 0.004 * i as f64))
+            .collect();
+        let names: Vec<String> = (0..6).map(|i| format!("n{i}")).collect();
+        build_model_set("bus", &names, &recs, &FleetConfig::default()).expect("model set")
+    }
+
+    #[test]
+    fn centre_spread_and_limits_by_hand() {
+        let set = baseline();
+        let t = set
+            .features
+            .iter()
+            .find(|f| f.meta.kind == Kind::Transmissibility)
+            .expect("trans");
+        // Median of ln(0.208) and ln(0.212); MAD of the logs is below the floor 0.10.
+        let want = 0.5 * (0.208f64.ln() + 0.212f64.ln());
+        assert!((t.centre - want).abs() < 1e-12);
+        assert_eq!(t.sigma, 0.10);
+        // One vehicle feature: Bonferroni limit Phi^-1(1 - 0.01 / 2) = 2.5758.
+        let l = set
+            .limits
+            .iter()
+            .find(|l| l.kind == Kind::Transmissibility)
+            .expect("limit");
+        assert!((l.bonferroni - 2.575_829_304).abs() < 1e-6);
+        assert!(l.limit >= l.bonferroni);
+    }
+
+    #[test]
+    fn classification_of_constructed_records() {
+        let set = baseline();
+        // Inside both ranges.
+        let a = assess(&set, &record(1.1, 0.21));
+        assert_eq!(a.classification, Classification::Normal, "{a:?}");
+        // Level 3x the largest nominal one, transmissibility unchanged: road.
+        let a = assess(&set, &record(3.6, 0.21));
+        assert_eq!(a.classification, Classification::Road, "{a:?}");
+        // Transmissibility -50 % (z = ln(0.5) / 0.1 = -6.9), level nominal: vehicle, named.
+        let a = assess(&set, &record(1.1, 0.105));
+        assert_eq!(a.classification, Classification::Vehicle, "{a:?}");
+        assert!(
+            a.summary.starts_with("RL: transmissibility 2-5 Hz -5"),
+            "{}",
+            a.summary
+        );
+        let e = &a.evidence[0];
+        assert!((e.change_pct - 100.0 * (0.105 / e.centre - 1.0)).abs() < 1e-9);
+        assert!((e.z - (0.105f64.ln() - e.centre.ln()) / 0.10).abs() < 1e-9);
+        // Both.
+        let a = assess(&set, &record(3.6, 0.105));
+        assert_eq!(a.classification, Classification::Both, "{a:?}");
+        // A record without the transmissibility: the feature is listed as missing, not scored.
+        let mut r = record(1.1, 0.21);
+        r.transmissibility.clear();
+        let a = assess(&set, &r);
+        assert_eq!(a.classification, Classification::Normal);
+        assert_eq!(a.missing, vec!["RL: transmissibility 2-5 Hz".to_string()]);
+        assert_eq!(a.scores.n_vehicle, 0);
+    }
+
+    #[test]
+    fn too_few_nominal_records_is_an_error() {
+        let recs: Vec<RecordFeatures> = (0..4).map(|_| record(1.0, 0.2)).collect();
+        let e = build_model_set("bus", &[], &recs, &FleetConfig::default()).expect_err("4 < 5");
+        assert!(e.to_string().contains("needs at least 5"), "{e}");
+    }
 }
