@@ -6,6 +6,7 @@
 
 mod cmd_analyze;
 mod cmd_fit;
+mod cmd_fleet;
 mod cmd_psd;
 mod cmd_resample;
 mod cmd_ssi;
@@ -55,6 +56,10 @@ enum Command {
     /// Simulate in-service acceleration records of a vehicle on an ISO 8608 road.
     #[command(allow_negative_numbers = true)]
     Simulate(cmd_vehicle::SimulateArgs),
+    /// Fleet monitoring: nominal model sets per vehicle in an SQLite store; records classified
+    /// as normal, road, vehicle or both.
+    #[command(allow_negative_numbers = true)]
+    Fleet(cmd_fleet::FleetArgs),
 }
 
 fn main() -> ExitCode {
@@ -69,6 +74,7 @@ fn main() -> ExitCode {
         Command::Demo(a) => cmd_analyze::run_demo(&a),
         Command::Fullcar(a) => cmd_vehicle::run_fullcar(&a),
         Command::Simulate(a) => cmd_vehicle::run_simulate(&a),
+        Command::Fleet(a) => cmd_fleet::run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

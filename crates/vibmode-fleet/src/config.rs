@@ -1,0 +1,151 @@
+//! Settings of feature extraction and scoring, kept in every model set.
+
+use serde::{Deserialize, Serialize};
+use vibmode_analysis::AnalysisConfig;
+
+use crate::error::{FleetError, Result};
+
+/// Feature bands, statistics floors and the false-alarm rate. Every model set stores the
+/// settings it was built with; checks use the model set's.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FleetConfig {
+    /// The per-record analysis (pre-processing, spectra, order sweep, clustering).
+    pub analysis: AnalysisConfig,
+    /// Bands of levels and transmissibility, Hz (default 0.5-2, 2-5, 5-8, 8-12, 12-20).
+    pub bands_hz: Vec<[f64; 2]>,
+    /// Family-wise false-alarm probability per record and feature group (default 0.01).
+    pub false_alarm_rate: f64,
+    /// Nominal records a baseline needs (default 5).
+    pub min_nominal: usize,
+    /// Scale of the excitation score, ln units (default 0.15: the road level of a band, averaged
+    /// over the unsprung channels, scatters by about 15 % between 10 s records at constant
+    /// conditions).
+    pub floor_level: f64,
+    /// Floor of the spread of ln(transmissibility) (default 0.10).
+    pub floor_transmissibility: f64,
+    /// Floor of the spread of ln(mode frequency) (default 0.05).
+    pub floor_frequency: f64,
+    /// Floor of the spread of ln(damping ratio) (default 0.35).
+    pub floor_damping: f64,
+    /// Modes closer than this relative distance belong to one mode of the model set
+    /// (default 0.08).
+    pub mode_group_tol: f64,
+    /// Largest relative distance at which a record's mode is matched to a model-set mode
+    /// (default 0.15; never beyond half-way to the next mode of the channel).
+    pub mode_match_tol: f64,
+    /// Share of nominal records that must contain a mode for it to enter the model set
+    /// (default 0.6).
+    pub mode_min_share: f64,
+}
+
+impl Default for FleetConfig {
+    fn default() -> Self {
+        FleetConfig {
+            analysis: AnalysisConfig::default(),
+            bands_hz: vec![
+                [0.5, 2.0],
+                [2.0, 5.0],
+                [5.0, 8.0],
+                [8.0, 12.0],
+                [12.0, 20.0],
+            ],
+            false_alarm_rate: 0.01,
+            min_nominal: 5,
+            floor_level: 0.15,
+            floor_transmissibility: 0.10,
+            floor_frequency: 0.05,
+            floor_damping: 0.35,
+            mode_group_tol: 0.08,
+            mode_match_tol: 0.15,
+            mode_min_share: 0.6,
+        }
+    }
+}
+
+fn bad(key: &'static str, value: impl ToString, fix: &str) -> FleetError {
+    FleetError::Config {
+        key,
+        value: value.to_string(),
+        fix: fix.to_string(),
+    }
+}
+
+impl FleetConfig {
+    /// Checks every value; errors name the key and a valid value.
+    pub fn validate(&self) -> Result<()> {
+        self.analysis.validate()?;
+        let nyquist = self.analysis.preprocess.analysis_fs_hz / 2.0;
+        if self.bands_hz.is_empty() {
+            return Err(bad(
+                "bands_hz",
+                "[]",
+                "must list at least one band, e.g. [[2, 5]]",
+            ));
+        }
+        for b in &self.bands_hz {
+            if !(b[0].is_finite()
+                && b[1].is_finite()
+                && 0.0 <= b[0]
+                && b[0] < b[1]
+                && b[1] <= nyquist)
+            {
+                return Err(bad(
+                    "bands_hz",
+                    format!("[{}, {}]", b[0], b[1]),
+                    &format!("must be increasing bands between 0 and the analysis Nyquist frequency {nyquist} Hz"),
+                ));
+            }
+        }
+        if !(self.false_alarm_rate > 0.0 && self.false_alarm_rate < 0.5) {
+            return Err(bad(
+                "false_alarm_rate",
+                self.false_alarm_rate,
+                "must be in (0, 0.5), e.g. 0.01",
+            ));
+        }
+        if self.min_nominal < 3 {
+            return Err(bad(
+                "min_nominal",
+                self.min_nominal,
+                "must be at least 3, e.g. 5",
+            ));
+        }
+        for (key, v) in [
+            ("floor_level", self.floor_level),
+            ("floor_transmissibility", self.floor_transmissibility),
+            ("floor_frequency", self.floor_frequency),
+            ("floor_damping", self.floor_damping),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(bad(
+                    key,
+                    v,
+                    "must be positive (a spread of a logarithm), e.g. 0.1",
+                ));
+            }
+        }
+        if !(self.mode_group_tol > 0.0 && self.mode_group_tol < 1.0) {
+            return Err(bad(
+                "mode_group_tol",
+                self.mode_group_tol,
+                "must be in (0, 1), e.g. 0.08",
+            ));
+        }
+        if !(self.mode_match_tol > 0.0 && self.mode_match_tol < 1.0) {
+            return Err(bad(
+                "mode_match_tol",
+                self.mode_match_tol,
+                "must be in (0, 1), e.g. 0.15",
+            ));
+        }
+        if !(self.mode_min_share > 0.0 && self.mode_min_share <= 1.0) {
+            return Err(bad(
+                "mode_min_share",
+                self.mode_min_share,
+                "must be in (0, 1], e.g. 0.6",
+            ));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,31 @@
+//! Fleet monitoring: per vehicle, a nominal model set from repeated healthy runs, kept in an
+//! embedded SQLite store; every later record is classified `normal`, `road` (excitation out of
+//! the nominal range), `vehicle` (transmissibility or modes of a corner moved) or `both`.
+//!
+//! The stages: [`compute_features`] (band levels, transmissibility, modes of one file),
+//! [`build_model_set`] (median and MAD of every feature over the nominal records, control
+//! limits from a false-alarm rate), [`assess`] (robust z-scores and the classification), and
+//! [`Store`] (the SQLite file: vehicles, records, features, model sets). See docs/fleet.md.
+
+pub mod config;
+pub mod error;
+pub mod features;
+pub mod fleet;
+pub mod model;
+pub mod stats;
+pub mod store;
+
+pub use config::FleetConfig;
+pub use error::{FleetError, Result};
+pub use features::{
+    compute_features, ChannelFeatures, CornerTransmissibility, ModeEstimate, RecordFeatures,
+};
+pub use fleet::{
+    build_baseline, check_file, check_recording, check_vehicle_id, ingest_file, ingest_recording,
+    recording_hash, require_baseline, sha256_hex, Checked, IngestLabels, Ingested,
+};
+pub use model::{
+    assess, build_model_set, Assessment, Classification, Evidence, FeatureMeta, FeatureStat, Group,
+    Kind, KindLimit, ModeSlot, ModelSet, Scores, LOO_MARGIN,
+};
+pub use store::{Condition, RecordRow, Store, VehicleStatus, SCHEMA_VERSION};

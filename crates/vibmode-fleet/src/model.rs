@@ -1,0 +1,734 @@
+//! The nominal model set of a vehicle (robust centre and spread of every feature) and the
+//! scoring and classification of a record against it.
+
+use std::collections::BTreeMap;
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+use vibmode_analysis::{Corner, Role};
+
+use crate::config::FleetConfig;
+use crate::error::{FleetError, Result};
+use crate::features::RecordFeatures;
+use crate::stats::{bonferroni_limit, median, robust_sigma};
+
+/// Version of the model-set JSON.
+pub const MODEL_SET_SCHEMA: u32 = 1;
+
+/// Which question a feature answers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Group {
+    /// How hard the road drives the vehicle (unsprung band levels).
+    Excitation,
+    /// How the vehicle answers (transmissibility, modes).
+    Vehicle,
+}
+
+/// What a feature measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Kind {
+    /// Band RMS of the unsprung channels (mean of their logarithms).
+    Level,
+    /// Sprung over unsprung band RMS of a corner.
+    Transmissibility,
+    /// Natural frequency of a mode of a channel.
+    ModeFrequency,
+    /// Damping ratio of a mode of a channel.
+    ModeDamping,
+}
+
+/// Where a feature comes from, and its name in tables.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FeatureMeta {
+    /// Unique key, e.g. `trans:RL:8-12Hz`, `mode:RL_unsprung:1:damping`.
+    pub key: String,
+    /// Excitation or vehicle.
+    pub group: Group,
+    /// What it measures.
+    pub kind: Kind,
+    /// The corner, if any.
+    pub corner: Option<Corner>,
+    /// The channel (for transmissibility, the sprung one).
+    pub channel: String,
+    /// Name in tables, e.g. `transmissibility 8-12 Hz`, `wheel-hop 10.9 Hz damping`.
+    pub label: String,
+}
+
+/// Robust statistics of one feature over the nominal records (of ln of the feature).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FeatureStat {
+    /// The feature.
+    #[serde(flatten)]
+    pub meta: FeatureMeta,
+    /// Median of ln(value).
+    pub centre: f64,
+    /// max(1.4826 MAD, floor) of ln(value).
+    pub sigma: f64,
+    /// Smallest ln(value) of the nominal records.
+    pub lo: f64,
+    /// Largest ln(value) of the nominal records.
+    pub hi: f64,
+    /// Nominal records that have the feature.
+    pub n: usize,
+}
+
+/// A mode of the model set: one channel's mode found in most nominal records.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModeSlot {
+    /// The channel.
+    pub channel: String,
+    /// Its role.
+    pub role: Role,
+    /// Its corner.
+    pub corner: Option<Corner>,
+    /// Median frequency over the nominal records, Hz.
+    pub frequency_hz: f64,
+    /// `wheel-hop` (unsprung, >= 5 Hz), `body` (< 3 Hz) or `mode`.
+    pub name: String,
+    /// Share of nominal records that contain it.
+    pub share: f64,
+}
+
+/// The control limit of one kind of feature.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct KindLimit {
+    /// The kind.
+    pub kind: Kind,
+    /// Its group.
+    pub group: Group,
+    /// Features of this kind in the model set.
+    pub n_features: usize,
+    /// Bonferroni limit of the group: `Phi^-1(1 - false_alarm_rate / (2 m))`, m = features of
+    /// the group.
+    pub bonferroni: f64,
+    /// Largest |score| of this kind when each nominal record is scored against the others.
+    pub loo_max_abs_z: f64,
+    /// The limit in force: `max(bonferroni, LOO_MARGIN * loo_max_abs_z)`.
+    pub limit: f64,
+}
+
+/// Margin over the largest leave-one-out score of the nominal records.
+pub const LOO_MARGIN: f64 = 1.0;
+
+/// The nominal model set of one vehicle.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModelSet {
+    /// [`MODEL_SET_SCHEMA`].
+    pub schema: u32,
+    /// Vehicle id.
+    pub vehicle: String,
+    /// Version in the store (1, 2, ...; 0 before it is stored).
+    pub version: i64,
+    /// Nominal records it was built from (file names).
+    pub records: Vec<String>,
+    /// Settings it was built with.
+    pub config: FleetConfig,
+    /// Modes of the model set.
+    pub slots: Vec<ModeSlot>,
+    /// Statistics per feature.
+    pub features: Vec<FeatureStat>,
+    /// Control limit per kind of feature.
+    pub limits: Vec<KindLimit>,
+}
+
+impl ModelSet {
+    /// The limit of `kind` (infinite for a kind the model set has not).
+    pub fn limit(&self, kind: Kind) -> f64 {
+        self.limits
+            .iter()
+            .find(|l| l.kind == kind)
+            .map_or(f64::INFINITY, |l| l.limit)
+    }
+}
+
+/// Classification of a record.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Classification {
+    /// Excitation and vehicle inside the nominal set.
+    Normal,
+    /// Excitation outside, vehicle inside.
+    Road,
+    /// Vehicle features outside, excitation inside.
+    Vehicle,
+    /// Both outside.
+    Both,
+}
+
+impl Classification {
+    /// From the two alarms.
+    pub fn from_alarms(vehicle: bool, road: bool) -> Self {
+        match (vehicle, road) {
+            (false, false) => Classification::Normal,
+            (false, true) => Classification::Road,
+            (true, false) => Classification::Vehicle,
+            (true, true) => Classification::Both,
+        }
+    }
+}
+
+impl fmt::Display for Classification {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Classification::Normal => "normal",
+            Classification::Road => "road",
+            Classification::Vehicle => "vehicle",
+            Classification::Both => "both",
+        })
+    }
+}
+
+/// One feature's comparison with the model set.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Evidence {
+    /// The feature.
+    #[serde(flatten)]
+    pub meta: FeatureMeta,
+    /// The record's value (Hz, ratio, m/s^2 or damping ratio).
+    pub value: f64,
+    /// The nominal centre in the same unit.
+    pub centre: f64,
+    /// The score: robust z for vehicle features, distance outside the nominal range in spreads
+    /// for excitation features.
+    pub z: f64,
+    /// Relative change from the centre, %.
+    pub change_pct: f64,
+    /// The control limit of its kind.
+    pub limit: f64,
+    /// |z| above the limit.
+    pub flagged: bool,
+}
+
+/// Summary scores of a record.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Scores {
+    /// Largest |z| of the vehicle features (0 without any).
+    pub vehicle_max_abs_z: f64,
+    /// Largest excitation score.
+    pub excitation_max_abs_z: f64,
+    /// Vehicle features scored.
+    pub n_vehicle: usize,
+    /// Excitation features scored.
+    pub n_excitation: usize,
+}
+
+/// The verdict on one record.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Assessment {
+    /// normal, road, vehicle or both.
+    pub classification: Classification,
+    /// Summary scores and limits.
+    pub scores: Scores,
+    /// The flagged features, largest |z| first.
+    pub evidence: Vec<Evidence>,
+    /// One line: the flagged vehicle features per corner, e.g.
+    /// `RL: transmissibility 8-12 Hz +35 %, wheel-hop 10.9 Hz damping -40 %`.
+    pub summary: String,
+    /// Features of the model set the record lacks (e.g. a mode not identified in it).
+    pub missing: Vec<String>,
+}
+
+fn band_label(b: &[f64; 2]) -> String {
+    format!("{}-{} Hz", b[0], b[1])
+}
+
+fn band_key(b: &[f64; 2]) -> String {
+    format!("{}-{}Hz", b[0], b[1])
+}
+
+/// Scalar features of a record, as ln(value), given the model set's modes.
+pub fn scalar_features(
+    rf: &RecordFeatures,
+    slots: &[ModeSlot],
+    cfg: &FleetConfig,
+) -> Vec<(FeatureMeta, f64)> {
+    let mut out = Vec::new();
+    // Road level per band: the mean of ln(band RMS) over the unsprung channels that have it.
+    for (k, b) in rf.bands_hz.iter().enumerate() {
+        let logs: Vec<f64> = rf
+            .channels
+            .iter()
+            .filter(|c| c.role == Role::Unsprung)
+            .filter_map(|c| c.band_rms.get(k).copied().flatten())
+            .map(f64::ln)
+            .collect();
+        if !logs.is_empty() {
+            out.push((
+                FeatureMeta {
+                    key: format!("level:unsprung:{}", band_key(b)),
+                    group: Group::Excitation,
+                    kind: Kind::Level,
+                    corner: None,
+                    channel: "unsprung".into(),
+                    label: format!("road level {}", band_label(b)),
+                },
+                logs.iter().sum::<f64>() / logs.len() as f64,
+            ));
+        }
+    }
+    for t in &rf.transmissibility {
+        for (b, v) in rf.bands_hz.iter().zip(&t.values) {
+            if let Some(v) = v {
+                out.push((
+                    FeatureMeta {
+                        key: format!("trans:{}:{}", t.corner, band_key(b)),
+                        group: Group::Vehicle,
+                        kind: Kind::Transmissibility,
+                        corner: Some(t.corner),
+                        channel: t.sprung.clone(),
+                        label: format!("transmissibility {}", band_label(b)),
+                    },
+                    v.ln(),
+                ));
+            }
+        }
+    }
+    // Each record mode goes to its nearest slot of the channel (in ln f) if within the match
+    // tolerance and nearer than half-way to the next slot; each slot takes its nearest mode.
+    let mut best: BTreeMap<usize, (f64, f64, f64)> = BTreeMap::new();
+    for ch in &rf.channels {
+        let ch_slots: Vec<(usize, &ModeSlot)> = slots
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.channel == ch.name)
+            .collect();
+        for m in &ch.modes {
+            if !(m.frequency_hz > 0.0 && m.damping_ratio > 0.0) {
+                continue;
+            }
+            let lf = m.frequency_hz.ln();
+            let nearest = ch_slots
+                .iter()
+                .map(|(i, s)| (*i, (lf - s.frequency_hz.ln()).abs()))
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            if let Some((i, d)) = nearest {
+                let better = match best.get(&i) {
+                    Some((bd, _, _)) => d < *bd,
+                    None => true,
+                };
+                if d <= (1.0 + cfg.mode_match_tol).ln() && better {
+                    best.insert(i, (d, m.frequency_hz, m.damping_ratio));
+                }
+            }
+        }
+    }
+    for (i, (_, f, z)) in best {
+        let s = &slots[i];
+        let meta = |kind: Kind, what: &str| FeatureMeta {
+            key: format!("mode:{}:{}:{}", s.channel, i, what),
+            group: Group::Vehicle,
+            kind,
+            corner: s.corner,
+            channel: s.channel.clone(),
+            label: format!("{} {:.1} Hz {}", s.name, s.frequency_hz, what),
+        };
+        out.push((meta(Kind::ModeFrequency, "frequency"), f.ln()));
+        out.push((meta(Kind::ModeDamping, "damping"), z.ln()));
+    }
+    out
+}
+
+/// A channel's role, corner and (record, frequency) of its modes.
+type ChannelModes = (Role, Option<Corner>, Vec<(usize, f64)>);
+
+fn mode_name(role: Role, f: f64) -> &'static str {
+    if role == Role::Unsprung && f >= 5.0 {
+        "wheel-hop"
+    } else if f < 3.0 {
+        "body"
+    } else {
+        "mode"
+    }
+}
+
+/// The modes of the model set: per channel, groups of modes whose neighbours lie within
+/// `mode_group_tol` of each other, present in at least `mode_min_share` of the records.
+pub fn mode_slots(records: &[RecordFeatures], cfg: &FleetConfig) -> Vec<ModeSlot> {
+    let mut by_channel: BTreeMap<String, ChannelModes> = BTreeMap::new();
+    for (r, rf) in records.iter().enumerate() {
+        for ch in &rf.channels {
+            let e = by_channel
+                .entry(ch.name.clone())
+                .or_insert((ch.role, ch.corner, Vec::new()));
+            for m in &ch.modes {
+                if m.frequency_hz > 0.0 && m.frequency_hz.is_finite() && m.damping_ratio > 0.0 {
+                    e.2.push((r, m.frequency_hz));
+                }
+            }
+        }
+    }
+    let n = records.len().max(1) as f64;
+    let mut slots = Vec::new();
+    for (name, (role, corner, mut modes)) in by_channel {
+        modes.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let mut groups: Vec<Vec<(usize, f64)>> = Vec::new();
+        for m in modes {
+            match groups.last_mut() {
+                Some(g)
+                    if g.last()
+                        .is_some_and(|l| m.1 / l.1 - 1.0 <= cfg.mode_group_tol) =>
+                {
+                    g.push(m)
+                }
+                _ => groups.push(vec![m]),
+            }
+        }
+        for g in groups {
+            let mut recs: Vec<usize> = g.iter().map(|m| m.0).collect();
+            recs.sort_unstable();
+            recs.dedup();
+            let share = recs.len() as f64 / n;
+            if share + 1e-12 < cfg.mode_min_share {
+                continue;
+            }
+            let freqs: Vec<f64> = g.iter().map(|m| m.1).collect();
+            let Some(f) = median(&freqs) else { continue };
+            slots.push(ModeSlot {
+                channel: name.clone(),
+                role,
+                corner,
+                frequency_hz: f,
+                name: mode_name(role, f).to_string(),
+                share,
+            });
+        }
+    }
+    slots
+}
+
+fn floor_of(kind: Kind, cfg: &FleetConfig) -> f64 {
+    match kind {
+        Kind::Level => cfg.floor_level,
+        Kind::Transmissibility => cfg.floor_transmissibility,
+        Kind::ModeFrequency => cfg.floor_frequency,
+        Kind::ModeDamping => cfg.floor_damping,
+    }
+}
+
+/// Statistics of every feature present in at least `max(3, mode_min_share * n)` records.
+fn feature_stats(values: &[Vec<(FeatureMeta, f64)>], cfg: &FleetConfig) -> Vec<FeatureStat> {
+    let mut by_key: BTreeMap<String, (FeatureMeta, Vec<f64>)> = BTreeMap::new();
+    for rec in values {
+        for (meta, v) in rec {
+            by_key
+                .entry(meta.key.clone())
+                .or_insert_with(|| (meta.clone(), Vec::new()))
+                .1
+                .push(*v);
+        }
+    }
+    let need = ((cfg.mode_min_share * values.len() as f64).ceil() as usize).max(3);
+    let mut out = Vec::new();
+    for (_, (meta, v)) in by_key {
+        if v.len() < need {
+            continue;
+        }
+        let floor = floor_of(meta.kind, cfg);
+        let (Some(centre), Some(sigma)) = (median(&v), robust_sigma(&v, floor)) else {
+            continue;
+        };
+        let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        out.push(FeatureStat {
+            meta,
+            centre,
+            sigma,
+            lo,
+            hi,
+            n: v.len(),
+        });
+    }
+    out
+}
+
+/// Builds the model set of `vehicle` from its nominal records (`names` for the record list).
+///
+/// Errors: fewer than `cfg.min_nominal` records; no feature present in enough records.
+pub fn build_model_set(
+    vehicle: &str,
+    names: &[String],
+    records: &[RecordFeatures],
+    cfg: &FleetConfig,
+) -> Result<ModelSet> {
+    cfg.validate()?;
+    if records.len() < cfg.min_nominal {
+        return Err(FleetError::TooFewNominal {
+            vehicle: vehicle.to_string(),
+            found: records.len(),
+            needed: cfg.min_nominal,
+        });
+    }
+    let slots = mode_slots(records, cfg);
+    let values: Vec<Vec<(FeatureMeta, f64)>> = records
+        .iter()
+        .map(|r| scalar_features(r, &slots, cfg))
+        .collect();
+    let features = feature_stats(&values, cfg);
+    if !features.iter().any(|f| f.meta.group == Group::Vehicle) {
+        return Err(FleetError::Features {
+            record: format!("the nominal records of vehicle '{vehicle}'"),
+            reason: "no vehicle feature (transmissibility or mode) is present in enough of them; name channels by role and corner (e.g. RL_unsprung, RL_sprung)".into(),
+        });
+    }
+    let count = |g: Group| features.iter().filter(|f| f.meta.group == g).count();
+    // Leave-one-out: record i against the statistics of the others (same modes).
+    let mut loo_max: BTreeMap<Kind, f64> = BTreeMap::new();
+    for i in 0..values.len() {
+        let others: Vec<Vec<(FeatureMeta, f64)>> = values
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| *j != i)
+            .map(|(_, v)| v.clone())
+            .collect();
+        let stats = feature_stats(&others, cfg);
+        let by_key: BTreeMap<&str, f64> = values[i]
+            .iter()
+            .map(|(m, v)| (m.key.as_str(), *v))
+            .collect();
+        for f in &stats {
+            if let Some(&x) = by_key.get(f.meta.key.as_str()) {
+                let z = score(f, x, cfg).abs();
+                let e = loo_max.entry(f.meta.kind).or_insert(0.0);
+                *e = e.max(z);
+            }
+        }
+    }
+    let mut limits = Vec::new();
+    for kind in [
+        Kind::Level,
+        Kind::Transmissibility,
+        Kind::ModeFrequency,
+        Kind::ModeDamping,
+    ] {
+        let n_features = features.iter().filter(|f| f.meta.kind == kind).count();
+        if n_features == 0 {
+            continue;
+        }
+        let group = group_of(kind);
+        let bonferroni = bonferroni_limit(cfg.false_alarm_rate, count(group));
+        let loo_max_abs_z = loo_max.get(&kind).copied().unwrap_or(0.0);
+        limits.push(KindLimit {
+            kind,
+            group,
+            n_features,
+            bonferroni,
+            loo_max_abs_z,
+            limit: bonferroni.max(LOO_MARGIN * loo_max_abs_z),
+        });
+    }
+    Ok(ModelSet {
+        schema: MODEL_SET_SCHEMA,
+        vehicle: vehicle.to_string(),
+        version: 0,
+        records: names.to_vec(),
+        config: cfg.clone(),
+        slots,
+        features,
+        limits,
+    })
+}
+
+fn group_of(kind: Kind) -> Group {
+    match kind {
+        Kind::Level => Group::Excitation,
+        _ => Group::Vehicle,
+    }
+}
+
+/// The score of ln-value `x` against `f`: the robust z for vehicle features; for excitation
+/// features the distance outside the nominal range `[lo, hi]` in units of `floor_level`.
+fn score(f: &FeatureStat, x: f64, cfg: &FleetConfig) -> f64 {
+    match f.meta.group {
+        Group::Vehicle => (x - f.centre) / f.sigma,
+        Group::Excitation => (x - x.clamp(f.lo, f.hi)) / cfg.floor_level,
+    }
+}
+
+/// Scores a record against the model set.
+pub fn assess(set: &ModelSet, rf: &RecordFeatures) -> Assessment {
+    let values = scalar_features(rf, &set.slots, &set.config);
+    score_values(set, &values)
+}
+
+fn score_values(set: &ModelSet, values: &[(FeatureMeta, f64)]) -> Assessment {
+    let by_key: BTreeMap<&str, f64> = values.iter().map(|(m, v)| (m.key.as_str(), *v)).collect();
+    let mut evidence = Vec::new();
+    let mut missing = Vec::new();
+    let mut scores = Scores {
+        vehicle_max_abs_z: 0.0,
+        excitation_max_abs_z: 0.0,
+        n_vehicle: 0,
+        n_excitation: 0,
+    };
+    for f in &set.features {
+        let Some(&x) = by_key.get(f.meta.key.as_str()) else {
+            let where_ = f
+                .meta
+                .corner
+                .map_or(f.meta.channel.clone(), |c| c.to_string());
+            missing.push(format!("{where_}: {}", f.meta.label));
+            continue;
+        };
+        let z = score(f, x, &set.config);
+        let (n, max) = match f.meta.group {
+            Group::Vehicle => (&mut scores.n_vehicle, &mut scores.vehicle_max_abs_z),
+            Group::Excitation => (&mut scores.n_excitation, &mut scores.excitation_max_abs_z),
+        };
+        *n += 1;
+        *max = max.max(z.abs());
+        let limit = set.limit(f.meta.kind);
+        if z.abs() > limit {
+            evidence.push(Evidence {
+                meta: f.meta.clone(),
+                value: x.exp(),
+                centre: f.centre.exp(),
+                z,
+                change_pct: 100.0 * ((x - f.centre).exp() - 1.0),
+                limit,
+                flagged: true,
+            });
+        }
+    }
+    evidence.sort_by(|a, b| b.z.abs().total_cmp(&a.z.abs()));
+    let vehicle = evidence.iter().any(|e| e.meta.group == Group::Vehicle);
+    let road = evidence.iter().any(|e| e.meta.group == Group::Excitation);
+    Assessment {
+        classification: Classification::from_alarms(vehicle, road),
+        scores,
+        summary: summary(&evidence),
+        evidence,
+        missing,
+    }
+}
+
+/// `RL: transmissibility 8-12 Hz +35 %, ...; RR: ...` for the flagged vehicle features, then
+/// `road: ...` for the flagged excitation features (at most three).
+fn summary(evidence: &[Evidence]) -> String {
+    let mut parts: BTreeMap<String, Vec<String>> = BTreeMap::new();
+    for e in evidence.iter().filter(|e| e.meta.group == Group::Vehicle) {
+        let place = e
+            .meta
+            .corner
+            .map_or_else(|| e.meta.channel.clone(), |c| c.to_string());
+        parts
+            .entry(place)
+            .or_default()
+            .push(format!("{} {:+.0} %", e.meta.label, e.change_pct));
+    }
+    let mut out: Vec<String> = parts
+        .into_iter()
+        .map(|(place, items)| format!("{place}: {}", items.join(", ")))
+        .collect();
+    let road: Vec<String> = evidence
+        .iter()
+        .filter(|e| e.meta.group == Group::Excitation)
+        .take(3)
+        .map(|e| format!("{} {:+.0} %", e.meta.label, e.change_pct))
+        .collect();
+    if !road.is_empty() {
+        out.push(format!("road: {}", road.join(", ")));
+    }
+    out.join("; ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::features::{ChannelFeatures, CornerTransmissibility};
+
+    /// A record with one unsprung level and one transmissibility in band 2-5 Hz.
+    fn record(level: f64, trans: f64) -> RecordFeatures {
+        RecordFeatures {
+            analysis_fs_hz: 50.0,
+            duration_s: 10.0,
+            n_segments: 1,
+            bands_hz: vec![[2.0, 5.0]],
+            channels: vec![ChannelFeatures {
+                name: "RL_unsprung".into(),
+                role: Role::Unsprung,
+                corner: Some(Corner::RL),
+                band_rms: vec![Some(level)],
+                modes: Vec::new(),
+            }],
+            transmissibility: vec![CornerTransmissibility {
+                corner: Corner::RL,
+                sprung: "RL_sprung".into(),
+                unsprung: "RL_unsprung".into(),
+                values: vec![Some(trans)],
+            }],
+            notes: Vec::new(),
+        }
+    }
+
+    fn baseline() -> ModelSet {
+        // Levels 1.0 .. 1.2 and transmissibility 0.20 .. 0.22 over six records.
+        let recs: Vec<RecordFeatures> = (0..6)
+            .map(|i| record(1.0 + 0.04 * i as f64, 0.20 + 0.004 * i as f64))
+            .collect();
+        let names: Vec<String> = (0..6).map(|i| format!("n{i}")).collect();
+        build_model_set("bus", &names, &recs, &FleetConfig::default()).expect("model set")
+    }
+
+    #[test]
+    fn centre_spread_and_limits_by_hand() {
+        let set = baseline();
+        let t = set
+            .features
+            .iter()
+            .find(|f| f.meta.kind == Kind::Transmissibility)
+            .expect("trans");
+        // Median of ln(0.208) and ln(0.212); MAD of the logs is below the floor 0.10.
+        let want = 0.5 * (0.208f64.ln() + 0.212f64.ln());
+        assert!((t.centre - want).abs() < 1e-12);
+        assert_eq!(t.sigma, 0.10);
+        // One vehicle feature: Bonferroni limit Phi^-1(1 - 0.01 / 2) = 2.5758.
+        let l = set
+            .limits
+            .iter()
+            .find(|l| l.kind == Kind::Transmissibility)
+            .expect("limit");
+        assert!((l.bonferroni - 2.575_829_304).abs() < 1e-6);
+        assert!(l.limit >= l.bonferroni);
+    }
+
+    #[test]
+    fn classification_of_constructed_records() {
+        let set = baseline();
+        // Inside both ranges.
+        let a = assess(&set, &record(1.1, 0.21));
+        assert_eq!(a.classification, Classification::Normal, "{a:?}");
+        // Level 3x the largest nominal one, transmissibility unchanged: road.
+        let a = assess(&set, &record(3.6, 0.21));
+        assert_eq!(a.classification, Classification::Road, "{a:?}");
+        // Transmissibility -50 % (z = ln(0.5) / 0.1 = -6.9), level nominal: vehicle, named.
+        let a = assess(&set, &record(1.1, 0.105));
+        assert_eq!(a.classification, Classification::Vehicle, "{a:?}");
+        assert!(
+            a.summary.starts_with("RL: transmissibility 2-5 Hz -5"),
+            "{}",
+            a.summary
+        );
+        let e = &a.evidence[0];
+        assert!((e.change_pct - 100.0 * (0.105 / e.centre - 1.0)).abs() < 1e-9);
+        assert!((e.z - (0.105f64.ln() - e.centre.ln()) / 0.10).abs() < 1e-9);
+        // Both.
+        let a = assess(&set, &record(3.6, 0.105));
+        assert_eq!(a.classification, Classification::Both, "{a:?}");
+        // A record without the transmissibility: the feature is listed as missing, not scored.
+        let mut r = record(1.1, 0.21);
+        r.transmissibility.clear();
+        let a = assess(&set, &r);
+        assert_eq!(a.classification, Classification::Normal);
+        assert_eq!(a.missing, vec!["RL: transmissibility 2-5 Hz".to_string()]);
+        assert_eq!(a.scores.n_vehicle, 0);
+    }
+
+    #[test]
+    fn too_few_nominal_records_is_an_error() {
+        let recs: Vec<RecordFeatures> = (0..4).map(|_| record(1.0, 0.2)).collect();
+        let e = build_model_set("bus", &[], &recs, &FleetConfig::default()).expect_err("4 < 5");
+        assert!(e.to_string().contains("needs at least 5"), "{e}");
+    }
+}

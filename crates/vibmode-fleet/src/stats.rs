@@ -1,0 +1,155 @@
+//! Robust statistics of the nominal model set: median, MAD, robust z-scores, and the control
+//! limit from a false-alarm rate.
+
+/// Factor that makes the MAD of normal data an estimate of its standard deviation
+/// (1 / Phi^-1(3/4)).
+pub const MAD_TO_SIGMA: f64 = 1.482_602_218_505_602;
+
+/// Median of the finite values (mean of the two middle ones for an even count); `None` when
+/// there is no finite value.
+pub fn median(values: &[f64]) -> Option<f64> {
+    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    Some(if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    })
+}
+
+/// Median absolute deviation from the median (unscaled); `None` when there is no finite value.
+pub fn mad(values: &[f64]) -> Option<f64> {
+    let m = median(values)?;
+    let dev: Vec<f64> = values
+        .iter()
+        .filter(|x| x.is_finite())
+        .map(|x| (x - m).abs())
+        .collect();
+    median(&dev)
+}
+
+/// Robust spread: `max(MAD_TO_SIGMA * MAD, floor)`; `None` without finite values.
+pub fn robust_sigma(values: &[f64], floor: f64) -> Option<f64> {
+    Some((MAD_TO_SIGMA * mad(values)?).max(floor))
+}
+
+/// Robust z-score `(x - centre) / sigma`.
+pub fn z_score(x: f64, centre: f64, sigma: f64) -> f64 {
+    (x - centre) / sigma
+}
+
+/// The standard normal quantile Phi^-1(p) for 0 < p < 1 (Acklam's rational approximation,
+/// relative error below 1.2e-9); NaN outside (0, 1).
+pub fn normal_quantile(p: f64) -> f64 {
+    if !(p > 0.0 && p < 1.0) {
+        return f64::NAN;
+    }
+    const A: [f64; 6] = [
+        -3.969_683_028_665_376e1,
+        2.209_460_984_245_205e2,
+        -2.759_285_104_469_687e2,
+        1.383_577_518_672_69e2,
+        -3.066_479_806_614_716e1,
+        2.506_628_277_459_239,
+    ];
+    const B: [f64; 5] = [
+        -5.447_609_879_822_406e1,
+        1.615_858_368_580_409e2,
+        -1.556_989_798_598_866e2,
+        6.680_131_188_771_972e1,
+        -1.328_068_155_288_572e1,
+    ];
+    const C: [f64; 6] = [
+        -7.784_894_002_430_293e-3,
+        -3.223_964_580_411_365e-1,
+        -2.400_758_277_161_838,
+        -2.549_732_539_343_734,
+        4.374_664_141_464_968,
+        2.938_163_982_698_783,
+    ];
+    const D: [f64; 4] = [
+        7.784_695_709_041_462e-3,
+        3.224_671_290_700_398e-1,
+        2.445_134_137_142_996,
+        3.754_408_661_907_416,
+    ];
+    let p_low = 0.02425;
+    let tail = |q: f64| {
+        (((((C[0] * q + C[1]) * q + C[2]) * q + C[3]) * q + C[4]) * q + C[5])
+            / ((((D[0] * q + D[1]) * q + D[2]) * q + D[3]) * q + 1.0)
+    };
+    if p < p_low {
+        tail((-2.0 * p.ln()).sqrt())
+    } else if p <= 1.0 - p_low {
+        let q = p - 0.5;
+        let r = q * q;
+        (((((A[0] * r + A[1]) * r + A[2]) * r + A[3]) * r + A[4]) * r + A[5]) * q
+            / (((((B[0] * r + B[1]) * r + B[2]) * r + B[3]) * r + B[4]) * r + 1.0)
+    } else {
+        -tail((-2.0 * (1.0 - p).ln()).sqrt())
+    }
+}
+
+/// Two-sided Bonferroni control limit on |z| for `n_features` scores so that a nominal record
+/// raises an alarm with probability at most `false_alarm_rate` (normal scores):
+/// `Phi^-1(1 - alpha / (2 m))`. `n_features = 0` counts as 1.
+pub fn bonferroni_limit(false_alarm_rate: f64, n_features: usize) -> f64 {
+    let m = n_features.max(1) as f64;
+    normal_quantile(1.0 - false_alarm_rate / (2.0 * m))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_and_mad_by_hand() {
+        // Sorted 1 2 3 4 100: median 3; deviations 2 1 0 1 97 -> sorted 0 1 1 2 97 -> MAD 1.
+        let v = [3.0, 1.0, 100.0, 2.0, 4.0];
+        assert_eq!(median(&v), Some(3.0));
+        assert_eq!(mad(&v), Some(1.0));
+        // Even count: 1 2 4 7 -> median 3; deviations 2 1 1 4 -> sorted 1 1 2 4 -> MAD 1.5.
+        let w = [7.0, 1.0, 4.0, 2.0];
+        assert_eq!(median(&w), Some(3.0));
+        assert_eq!(mad(&w), Some(1.5));
+        // Non-finite values are ignored; none left is None.
+        assert_eq!(median(&[f64::NAN, 5.0]), Some(5.0));
+        assert_eq!(median(&[f64::NAN]), None);
+        assert_eq!(mad(&[]), None);
+    }
+
+    #[test]
+    fn sigma_has_a_floor_and_z_is_in_sigmas() {
+        let v = [10.0, 10.0, 10.0, 10.0, 11.0];
+        // MAD 0 -> the floor.
+        assert_eq!(robust_sigma(&v, 0.5), Some(0.5));
+        let s = robust_sigma(&[1.0, 2.0, 3.0, 4.0, 5.0], 0.0).unwrap_or(f64::NAN);
+        assert!((s - 1.482_602_218_505_602).abs() < 1e-12, "{s}");
+        assert_eq!(z_score(13.0, 10.0, 0.5), 6.0);
+        assert_eq!(z_score(9.0, 10.0, 0.5), -2.0);
+    }
+
+    #[test]
+    fn normal_quantiles_match_tables() {
+        // Textbook values of the standard normal quantile.
+        for (p, q) in [
+            (0.5, 0.0),
+            (0.975, 1.959_963_985),
+            (0.995, 2.575_829_304),
+            (0.999_9, 3.719_016_485),
+            (0.01, -2.326_347_874),
+            (1e-6, -4.753_424_309),
+        ] {
+            let got = normal_quantile(p);
+            assert!((got - q).abs() < 1e-7, "p {p}: {got} vs {q}");
+        }
+        assert!(normal_quantile(0.0).is_nan() && normal_quantile(1.0).is_nan());
+        // alpha 0.01 over 50 features: Phi^-1(1 - 1e-4) = 3.719.
+        assert!((bonferroni_limit(0.01, 50) - 3.719_016_485).abs() < 1e-7);
+        assert!((bonferroni_limit(0.05, 1) - 1.959_963_985).abs() < 1e-7);
+    }
+}

@@ -1,0 +1,688 @@
+//! The SQLite store: vehicles, records (content hash, file name, ingest time, condition, road
+//! label, metadata), features per record, versioned model sets and checks.
+
+use std::path::Path;
+
+use rusqlite::{params, Connection, OpenFlags, OptionalExtension};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{FleetError, Result};
+use crate::features::RecordFeatures;
+use crate::model::{Assessment, Classification, ModelSet};
+
+/// The application id kept in the `meta` table.
+pub const APP_ID: &str = "vibmode-fleet";
+
+/// Migrations in order; `user_version` is the number applied.
+const MIGRATIONS: &[&str] = &[
+    // 1: the first schema.
+    "CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+     INSERT INTO meta (key, value) VALUES ('app', 'vibmode-fleet');
+     CREATE TABLE vehicles (
+        id INTEGER PRIMARY KEY,
+        name TEXT NOT NULL UNIQUE,
+        created TEXT NOT NULL);
+     CREATE TABLE records (
+        id INTEGER PRIMARY KEY,
+        vehicle_id INTEGER NOT NULL REFERENCES vehicles(id),
+        sha256 TEXT NOT NULL,
+        file_name TEXT NOT NULL,
+        ingested TEXT NOT NULL,
+        condition TEXT NOT NULL CHECK (condition IN ('nominal', 'test')),
+        road TEXT,
+        metadata TEXT NOT NULL,
+        UNIQUE (vehicle_id, sha256));
+     CREATE TABLE features (
+        record_id INTEGER PRIMARY KEY REFERENCES records(id) ON DELETE CASCADE,
+        json TEXT NOT NULL);
+     CREATE TABLE model_sets (
+        id INTEGER PRIMARY KEY,
+        vehicle_id INTEGER NOT NULL REFERENCES vehicles(id),
+        version INTEGER NOT NULL,
+        created TEXT NOT NULL,
+        json TEXT NOT NULL,
+        UNIQUE (vehicle_id, version));
+     CREATE TABLE checks (
+        id INTEGER PRIMARY KEY,
+        record_id INTEGER NOT NULL REFERENCES records(id) ON DELETE CASCADE,
+        model_version INTEGER NOT NULL,
+        checked TEXT NOT NULL,
+        classification TEXT NOT NULL,
+        json TEXT NOT NULL);",
+];
+
+/// The schema version this build writes.
+pub const SCHEMA_VERSION: i64 = MIGRATIONS.len() as i64;
+
+/// Nominal (healthy, for the baseline) or test (to be checked).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Condition {
+    /// Healthy run for the nominal model set.
+    Nominal,
+    /// Later measurement.
+    Test,
+}
+
+impl Condition {
+    fn as_str(self) -> &'static str {
+        match self {
+            Condition::Nominal => "nominal",
+            Condition::Test => "test",
+        }
+    }
+}
+
+impl std::str::FromStr for Condition {
+    type Err = FleetError;
+    fn from_str(s: &str) -> Result<Self> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "nominal" => Ok(Condition::Nominal),
+            "test" => Ok(Condition::Test),
+            _ => Err(FleetError::BadCondition {
+                value: s.to_string(),
+            }),
+        }
+    }
+}
+
+/// What to store with a new record.
+#[derive(Clone, Debug)]
+pub struct NewRecord<'a> {
+    /// Vehicle id.
+    pub vehicle: &'a str,
+    /// SHA-256 of the file's bytes, hex.
+    pub sha256: &'a str,
+    /// File name.
+    pub file_name: &'a str,
+    /// Nominal or test.
+    pub condition: Condition,
+    /// Road label, e.g. `B`, `cobbles`.
+    pub road: Option<&'a str>,
+    /// Free metadata (JSON).
+    pub metadata: serde_json::Value,
+}
+
+/// A record row.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RecordRow {
+    /// Row id.
+    pub id: i64,
+    /// File name.
+    pub file_name: String,
+    /// SHA-256, hex.
+    pub sha256: String,
+    /// Ingest time, UTC, RFC 3339.
+    pub ingested: String,
+    /// Nominal or test.
+    pub condition: Condition,
+    /// Road label.
+    pub road: Option<String>,
+}
+
+/// Status of one vehicle.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct VehicleStatus {
+    /// Vehicle id.
+    pub vehicle: String,
+    /// Nominal records.
+    pub n_nominal: usize,
+    /// Test records.
+    pub n_test: usize,
+    /// Latest model-set version, if any.
+    pub baseline_version: Option<i64>,
+    /// The latest checks, newest first: (file, classification, summary).
+    pub last_checks: Vec<(String, Classification, String)>,
+}
+
+/// An open fleet store.
+#[derive(Debug)]
+pub struct Store {
+    conn: Connection,
+    path: String,
+}
+
+/// Now as UTC RFC 3339 (seconds).
+pub fn now_utc() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs()) as i64;
+    let days = secs.div_euclid(86_400);
+    let rem = secs.rem_euclid(86_400);
+    // Howard Hinnant's civil_from_days.
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!(
+        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        (rem / 60) % 60,
+        rem % 60
+    )
+}
+
+impl Store {
+    fn sql(&self, operation: &'static str) -> impl Fn(rusqlite::Error) -> FleetError + '_ {
+        move |e| FleetError::Sql {
+            path: self.path.clone(),
+            operation,
+            reason: e.to_string(),
+        }
+    }
+
+    fn not_a_store(path: &str, reason: impl ToString) -> FleetError {
+        FleetError::NotAStore {
+            path: path.to_string(),
+            reason: reason.to_string(),
+        }
+    }
+
+    /// Creates a new store at `path`, or opens the store already there. Returns the store and
+    /// whether it was created. A file that is not a fleet store is an error (it is not touched).
+    pub fn init(path: &Path) -> Result<(Store, bool)> {
+        if path.exists() {
+            return Ok((Store::open(path)?, false));
+        }
+        let p = path.display().to_string();
+        let conn = Connection::open(path).map_err(|e| Store::not_a_store(&p, e))?;
+        let mut store = Store { conn, path: p };
+        store.configure()?;
+        store.migrate(0)?;
+        Ok((store, true))
+    }
+
+    /// Opens an existing store, migrating an older schema. Errors: no file, a file that is not
+    /// a fleet store (corrupt, foreign SQLite), a newer schema.
+    pub fn open(path: &Path) -> Result<Store> {
+        let p = path.display().to_string();
+        if !path.is_file() {
+            return Err(FleetError::NoStore { path: p });
+        }
+        let conn = Connection::open_with_flags(
+            path,
+            OpenFlags::SQLITE_OPEN_READ_WRITE | OpenFlags::SQLITE_OPEN_NO_MUTEX,
+        )
+        .map_err(|e| Store::not_a_store(&p, e))?;
+        let version: i64 = conn
+            .query_row("PRAGMA user_version", [], |r| r.get(0))
+            .map_err(|e| Store::not_a_store(&p, e))?;
+        if version > SCHEMA_VERSION {
+            return Err(FleetError::NewerSchema {
+                path: p,
+                found: version,
+                supported: SCHEMA_VERSION,
+            });
+        }
+        if version == 0 {
+            return Err(Store::not_a_store(&p, "no fleet schema (user_version 0)"));
+        }
+        let app: Option<String> = conn
+            .query_row("SELECT value FROM meta WHERE key = 'app'", [], |r| r.get(0))
+            .optional()
+            .map_err(|e| Store::not_a_store(&p, e))?;
+        if app.as_deref() != Some(APP_ID) {
+            return Err(Store::not_a_store(
+                &p,
+                format!("meta app is {app:?}, not {APP_ID}"),
+            ));
+        }
+        let mut store = Store { conn, path: p };
+        store.configure()?;
+        store.migrate(version)?;
+        Ok(store)
+    }
+
+    fn configure(&mut self) -> Result<()> {
+        let p = self.path.clone();
+        self.conn
+            .query_row("PRAGMA journal_mode=WAL", [], |r| r.get::<_, String>(0))
+            .map_err(|e| Store::not_a_store(&p, e))?;
+        self.conn
+            .execute_batch("PRAGMA foreign_keys=ON;")
+            .map_err(|e| Store::not_a_store(&p, e))?;
+        Ok(())
+    }
+
+    /// Applies the migrations after `from`, each in a transaction with its `user_version`.
+    fn migrate(&mut self, from: i64) -> Result<()> {
+        for (i, sql) in MIGRATIONS.iter().enumerate().skip(from.max(0) as usize) {
+            let path = self.path.clone();
+            let err = |e: rusqlite::Error| FleetError::Sql {
+                path: path.clone(),
+                operation: "schema migration",
+                reason: e.to_string(),
+            };
+            let tx = self.conn.transaction().map_err(err)?;
+            tx.execute_batch(sql).map_err(err)?;
+            tx.execute_batch(&format!("PRAGMA user_version = {}", i + 1))
+                .map_err(err)?;
+            tx.commit().map_err(err)?;
+        }
+        Ok(())
+    }
+
+    /// The schema version (`user_version`).
+    pub fn schema_version(&self) -> Result<i64> {
+        self.conn
+            .query_row("PRAGMA user_version", [], |r| r.get(0))
+            .map_err(self.sql("reading user_version"))
+    }
+
+    /// The path of the file.
+    pub fn path(&self) -> &str {
+        &self.path
+    }
+
+    /// The vehicles, sorted.
+    pub fn vehicles(&self) -> Result<Vec<String>> {
+        let mut st = self
+            .conn
+            .prepare("SELECT name FROM vehicles ORDER BY name")
+            .map_err(self.sql("listing vehicles"))?;
+        let rows = st
+            .query_map([], |r| r.get::<_, String>(0))
+            .map_err(self.sql("listing vehicles"))?;
+        rows.collect::<rusqlite::Result<Vec<_>>>()
+            .map_err(self.sql("listing vehicles"))
+    }
+
+    fn vehicle_id(&self, vehicle: &str) -> Result<Option<i64>> {
+        self.conn
+            .query_row("SELECT id FROM vehicles WHERE name = ?1", [vehicle], |r| {
+                r.get(0)
+            })
+            .optional()
+            .map_err(self.sql("looking up a vehicle"))
+    }
+
+    /// The id of a known vehicle; an unknown one is an error listing the known ones.
+    pub fn require_vehicle(&self, vehicle: &str) -> Result<i64> {
+        match self.vehicle_id(vehicle)? {
+            Some(id) => Ok(id),
+            None => {
+                let known = self.vehicles()?;
+                Err(FleetError::UnknownVehicle {
+                    vehicle: vehicle.to_string(),
+                    known: if known.is_empty() {
+                        "none".into()
+                    } else {
+                        known.join(", ")
+                    },
+                })
+            }
+        }
+    }
+
+    /// The record of `vehicle` with this content hash, if stored.
+    pub fn find_record(&self, vehicle: &str, sha256: &str) -> Result<Option<RecordRow>> {
+        let Some(vid) = self.vehicle_id(vehicle)? else {
+            return Ok(None);
+        };
+        self.conn
+            .query_row(
+                "SELECT id, file_name, sha256, ingested, condition, road FROM records
+                 WHERE vehicle_id = ?1 AND sha256 = ?2",
+                params![vid, sha256],
+                row_to_record,
+            )
+            .optional()
+            .map_err(self.sql("looking up a record"))?
+            .transpose()
+            .map_err(|e| self.corrupt("a record row", e))
+    }
+
+    fn corrupt(&self, what: &str, reason: impl ToString) -> FleetError {
+        FleetError::CorruptRow {
+            path: self.path.clone(),
+            what: what.to_string(),
+            reason: reason.to_string(),
+        }
+    }
+
+    /// Stores a record and its features in one transaction (creating the vehicle if new).
+    /// Returns the record id.
+    pub fn insert_record(&mut self, rec: &NewRecord<'_>, features: &RecordFeatures) -> Result<i64> {
+        let json = serde_json::to_string(features).map_err(|e| self.corrupt("features", e))?;
+        let meta = rec.metadata.to_string();
+        let now = now_utc();
+        let path = self.path.clone();
+        let err = |e: rusqlite::Error| FleetError::Sql {
+            path: path.clone(),
+            operation: "storing a record",
+            reason: e.to_string(),
+        };
+        let tx = self.conn.transaction().map_err(err)?;
+        tx.execute(
+            "INSERT OR IGNORE INTO vehicles (name, created) VALUES (?1, ?2)",
+            params![rec.vehicle, now],
+        )
+        .map_err(err)?;
+        let vid: i64 = tx
+            .query_row(
+                "SELECT id FROM vehicles WHERE name = ?1",
+                [rec.vehicle],
+                |r| r.get(0),
+            )
+            .map_err(err)?;
+        tx.execute(
+            "INSERT INTO records (vehicle_id, sha256, file_name, ingested, condition, road, metadata)
+             VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)",
+            params![
+                vid,
+                rec.sha256,
+                rec.file_name,
+                now,
+                rec.condition.as_str(),
+                rec.road,
+                meta
+            ],
+        )
+        .map_err(err)?;
+        let id = tx.last_insert_rowid();
+        tx.execute(
+            "INSERT INTO features (record_id, json) VALUES (?1, ?2)",
+            params![id, json],
+        )
+        .map_err(err)?;
+        tx.commit().map_err(err)?;
+        Ok(id)
+    }
+
+    /// The features of a record.
+    pub fn features(&self, record_id: i64) -> Result<RecordFeatures> {
+        let json: String = self
+            .conn
+            .query_row(
+                "SELECT json FROM features WHERE record_id = ?1",
+                [record_id],
+                |r| r.get(0),
+            )
+            .map_err(self.sql("reading features"))?;
+        serde_json::from_str(&json)
+            .map_err(|e| self.corrupt(&format!("features of record {record_id}"), e))
+    }
+
+    /// The nominal records of a vehicle with their features, oldest first.
+    pub fn nominal_records(&self, vehicle: &str) -> Result<Vec<(RecordRow, RecordFeatures)>> {
+        let vid = self.require_vehicle(vehicle)?;
+        let mut st = self
+            .conn
+            .prepare(
+                "SELECT r.id, r.file_name, r.sha256, r.ingested, r.condition, r.road, f.json
+                 FROM records r JOIN features f ON f.record_id = r.id
+                 WHERE r.vehicle_id = ?1 AND r.condition = 'nominal' ORDER BY r.id",
+            )
+            .map_err(self.sql("reading nominal records"))?;
+        let rows = st
+            .query_map([vid], |r| Ok((row_to_record(r)?, r.get::<_, String>(6)?)))
+            .map_err(self.sql("reading nominal records"))?
+            .collect::<rusqlite::Result<Vec<_>>>()
+            .map_err(self.sql("reading nominal records"))?;
+        rows.into_iter()
+            .map(|(row, json)| {
+                let row = row.map_err(|e| self.corrupt("a record row", e))?;
+                let f = serde_json::from_str(&json).map_err(|e| {
+                    self.corrupt(&format!("features of record {}", row.file_name), e)
+                })?;
+                Ok((row, f))
+            })
+            .collect()
+    }
+
+    /// Stores a model set as the vehicle's next version (set in `set.version`).
+    pub fn save_model_set(&mut self, set: &mut ModelSet) -> Result<i64> {
+        let vid = self.require_vehicle(&set.vehicle)?;
+        let path = self.path.clone();
+        let err = |e: rusqlite::Error| FleetError::Sql {
+            path: path.clone(),
+            operation: "storing a model set",
+            reason: e.to_string(),
+        };
+        let tx = self.conn.transaction().map_err(err)?;
+        let last: Option<i64> = tx
+            .query_row(
+                "SELECT MAX(version) FROM model_sets WHERE vehicle_id = ?1",
+                [vid],
+                |r| r.get(0),
+            )
+            .map_err(err)?;
+        set.version = last.unwrap_or(0) + 1;
+        let json = serde_json::to_string(set).map_err(|e| FleetError::CorruptRow {
+            path: path.clone(),
+            what: "model set".into(),
+            reason: e.to_string(),
+        })?;
+        tx.execute(
+            "INSERT INTO model_sets (vehicle_id, version, created, json) VALUES (?1, ?2, ?3, ?4)",
+            params![vid, set.version, now_utc(), json],
+        )
+        .map_err(err)?;
+        tx.commit().map_err(err)?;
+        Ok(set.version)
+    }
+
+    /// The newest model set of a vehicle, if any.
+    pub fn latest_model_set(&self, vehicle: &str) -> Result<Option<ModelSet>> {
+        let vid = self.require_vehicle(vehicle)?;
+        let json: Option<String> = self
+            .conn
+            .query_row(
+                "SELECT json FROM model_sets WHERE vehicle_id = ?1 ORDER BY version DESC LIMIT 1",
+                [vid],
+                |r| r.get(0),
+            )
+            .optional()
+            .map_err(self.sql("reading a model set"))?;
+        json.map(|j| {
+            serde_json::from_str(&j)
+                .map_err(|e| self.corrupt(&format!("the model set of '{vehicle}'"), e))
+        })
+        .transpose()
+    }
+
+    /// Stores the outcome of a check.
+    pub fn save_check(&mut self, record_id: i64, version: i64, a: &Assessment) -> Result<()> {
+        let json = serde_json::to_string(a).map_err(|e| self.corrupt("assessment", e))?;
+        let path = self.path.clone();
+        let err = |e: rusqlite::Error| FleetError::Sql {
+            path: path.clone(),
+            operation: "storing a check",
+            reason: e.to_string(),
+        };
+        let tx = self.conn.transaction().map_err(err)?;
+        tx.execute(
+            "INSERT INTO checks (record_id, model_version, checked, classification, json)
+             VALUES (?1, ?2, ?3, ?4, ?5)",
+            params![
+                record_id,
+                version,
+                now_utc(),
+                a.classification.to_string(),
+                json
+            ],
+        )
+        .map_err(err)?;
+        tx.commit().map_err(err)?;
+        Ok(())
+    }
+
+    /// Status of every vehicle, with its `last` latest checks.
+    pub fn status(&self, last: usize) -> Result<Vec<VehicleStatus>> {
+        let mut out = Vec::new();
+        for v in self.vehicles()? {
+            let vid = self.require_vehicle(&v)?;
+            let count = |cond: &str| -> Result<usize> {
+                self.conn
+                    .query_row(
+                        "SELECT COUNT(*) FROM records WHERE vehicle_id = ?1 AND condition = ?2",
+                        params![vid, cond],
+                        |r| r.get::<_, i64>(0),
+                    )
+                    .map(|n| n.max(0) as usize)
+                    .map_err(self.sql("counting records"))
+            };
+            let baseline_version: Option<i64> = self
+                .conn
+                .query_row(
+                    "SELECT MAX(version) FROM model_sets WHERE vehicle_id = ?1",
+                    [vid],
+                    |r| r.get(0),
+                )
+                .map_err(self.sql("reading model sets"))?;
+            let mut st = self
+                .conn
+                .prepare(
+                    "SELECT r.file_name, c.json FROM checks c JOIN records r ON r.id = c.record_id
+                     WHERE r.vehicle_id = ?1 ORDER BY c.id DESC LIMIT ?2",
+                )
+                .map_err(self.sql("reading checks"))?;
+            let rows = st
+                .query_map(params![vid, last as i64], |r| {
+                    Ok((r.get::<_, String>(0)?, r.get::<_, String>(1)?))
+                })
+                .map_err(self.sql("reading checks"))?
+                .collect::<rusqlite::Result<Vec<_>>>()
+                .map_err(self.sql("reading checks"))?;
+            let mut last_checks = Vec::new();
+            for (file, json) in rows {
+                let a: Assessment = serde_json::from_str(&json)
+                    .map_err(|e| self.corrupt(&format!("the check of {file}"), e))?;
+                last_checks.push((file, a.classification, a.summary));
+            }
+            out.push(VehicleStatus {
+                vehicle: v,
+                n_nominal: count("nominal")?,
+                n_test: count("test")?,
+                baseline_version,
+                last_checks,
+            });
+        }
+        Ok(out)
+    }
+}
+
+type RowResult = std::result::Result<RecordRow, String>;
+
+fn row_to_record(r: &rusqlite::Row<'_>) -> rusqlite::Result<RowResult> {
+    let cond: String = r.get(4)?;
+    let condition = match cond.parse::<Condition>() {
+        Ok(c) => c,
+        Err(e) => return Ok(Err(e.to_string())),
+    };
+    Ok(Ok(RecordRow {
+        id: r.get(0)?,
+        file_name: r.get(1)?,
+        sha256: r.get(2)?,
+        ingested: r.get(3)?,
+        condition,
+        road: r.get(5)?,
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::features::{ChannelFeatures, RecordFeatures};
+    use vibmode_analysis::{Corner, Role};
+
+    fn features() -> RecordFeatures {
+        RecordFeatures {
+            analysis_fs_hz: 50.0,
+            duration_s: 10.24,
+            n_segments: 1,
+            bands_hz: vec![[2.0, 5.0]],
+            channels: vec![ChannelFeatures {
+                name: "RL_unsprung".into(),
+                role: Role::Unsprung,
+                corner: Some(Corner::RL),
+                band_rms: vec![Some(0.5)],
+                modes: Vec::new(),
+            }],
+            transmissibility: Vec::new(),
+            notes: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn fresh_store_reopens_with_its_schema_version() {
+        let d = tempfile::tempdir().expect("tempdir");
+        let p = d.path().join("f.db");
+        let (s, created) = Store::init(&p).expect("init");
+        assert!(created);
+        assert_eq!(s.schema_version().expect("version"), SCHEMA_VERSION);
+        drop(s);
+        let (s, created) = Store::init(&p).expect("init again");
+        assert!(!created);
+        assert_eq!(s.schema_version().expect("version"), 1);
+        let s = Store::open(&p).expect("open");
+        assert!(s.vehicles().expect("vehicles").is_empty());
+    }
+
+    #[test]
+    fn foreign_corrupt_newer_and_missing_files_are_clear_errors() {
+        let d = tempfile::tempdir().expect("tempdir");
+        // Random bytes (a fixed pseudo-random sequence, not a chosen pattern).
+        let junk: Vec<u8> = (0u32..8192)
+            .map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8)
+            .collect();
+        let p = d.path().join("junk.db");
+        std::fs::write(&p, &junk).expect("write");
+        let e = Store::open(&p).expect_err("junk opens");
+        assert!(matches!(e, FleetError::NotAStore { .. }), "{e}");
+        let e = Store::init(&p).expect_err("junk inits");
+        assert!(e.to_string().contains("not a vibmode fleet store"), "{e}");
+        // A foreign SQLite database.
+        let q = d.path().join("other.db");
+        let c = Connection::open(&q).expect("sqlite");
+        c.execute_batch("CREATE TABLE t (x); PRAGMA user_version = 1;")
+            .expect("foreign");
+        drop(c);
+        assert!(matches!(Store::open(&q), Err(FleetError::NotAStore { .. })));
+        // A newer schema.
+        let r = d.path().join("newer.db");
+        drop(Store::init(&r).expect("init"));
+        let c = Connection::open(&r).expect("sqlite");
+        c.execute_batch("PRAGMA user_version = 99;").expect("bump");
+        drop(c);
+        match Store::open(&r) {
+            Err(FleetError::NewerSchema { found: 99, .. }) => {}
+            other => panic!("{other:?}"),
+        }
+        assert!(matches!(
+            Store::open(&d.path().join("none.db")),
+            Err(FleetError::NoStore { .. })
+        ));
+    }
+
+    #[test]
+    fn the_same_content_twice_is_one_record() {
+        let d = tempfile::tempdir().expect("tempdir");
+        let (mut s, _) = Store::init(&d.path().join("f.db")).expect("init");
+        let rec = NewRecord {
+            vehicle: "bus-1",
+            sha256: "abc",
+            file_name: "a.csv",
+            condition: Condition::Nominal,
+            road: Some("B"),
+            metadata: serde_json::json!({}),
+        };
+        let id = s.insert_record(&rec, &features()).expect("insert");
+        let found = s.find_record("bus-1", "abc").expect("find");
+        assert_eq!(found.map(|r| r.id), Some(id));
+        // The unique constraint refuses a second row with the same hash.
+        assert!(s.insert_record(&rec, &features()).is_err());
+        assert_eq!(s.nominal_records("bus-1").expect("nominal").len(), 1);
+        assert_eq!(s.features(id).expect("features"), features());
+        assert!(matches!(
+            s.latest_model_set("bus-9"),
+            Err(FleetError::UnknownVehicle { .. })
+        ));
+        assert_eq!(s.latest_model_set("bus-1").expect("none"), None);
+    }
+}

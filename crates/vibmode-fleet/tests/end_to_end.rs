@@ -1,0 +1,148 @@
+//! End to end over seeds: simulated city-bus runs through the store, a baseline from nominal
+//! runs (class B and C roads, 30-50 km/h, two records each), then (a) a nominal run at another speed, (b) a
+//! class D and a class E road, (c) the rear dampers weakened by 45 %, (d) both.
+
+use std::collections::BTreeMap;
+
+use vibmode_fleet::{
+    build_baseline, check_recording, ingest_recording, recording_hash, Classification, Condition,
+    FleetConfig, IngestLabels, Store,
+};
+use vibmode_vehicle::{simulate, RoadClass, SimParams, VehicleParams};
+
+/// A faster analysis than the default (AR sweep to order 16) so five seeds run in seconds.
+fn config() -> FleetConfig {
+    let mut c = FleetConfig::default();
+    c.analysis.sweep.model = vibmode_analysis::SweepModel::Ar;
+    c.analysis.sweep.order_max = 16;
+    c
+}
+
+fn runs(
+    v: &VehicleParams,
+    road: RoadClass,
+    kmh: f64,
+    seed: u64,
+    n: usize,
+) -> Vec<vibmode_core::Recording> {
+    let p = SimParams {
+        road,
+        speed_kmh: kmh,
+        fs_hz: 200.0,
+        records: n,
+        seed,
+        ..SimParams::default()
+    };
+    simulate(v, &p)
+        .expect("simulate")
+        .records
+        .into_iter()
+        .map(|r| r.recording)
+        .collect()
+}
+
+#[test]
+fn classification_over_seeds() {
+    let bus = VehicleParams::city_bus();
+    let mut weak = bus.clone();
+    weak.rear.damper_n_s_per_m *= 0.55;
+    let cfg = config();
+    // confusion[(scenario, classification)] = count
+    let mut confusion: BTreeMap<(&str, Classification), usize> = BTreeMap::new();
+    let mut rear_named = 0;
+    let mut n_vehicle_flags = 0;
+    for seed in 1..=5u64 {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let (mut store, created) = Store::init(&dir.path().join("fleet.db")).expect("init");
+        assert!(created);
+        let nominal = IngestLabels {
+            vehicle: "bus-1",
+            condition: Condition::Nominal,
+            road: None,
+        };
+        let conditions = [
+            (RoadClass::B, 30.0),
+            (RoadClass::C, 40.0),
+            (RoadClass::B, 50.0),
+            (RoadClass::C, 30.0),
+            (RoadClass::B, 40.0),
+            (RoadClass::C, 50.0),
+        ];
+        for (i, (road, kmh)) in conditions.into_iter().enumerate() {
+            for (j, rec) in runs(&bus, road, kmh, seed * 100 + i as u64, 2)
+                .iter()
+                .enumerate()
+            {
+                let name = format!("nominal-{i}-{j}");
+                ingest_recording(&mut store, &nominal, &name, &recording_hash(rec), rec, &cfg)
+                    .expect("ingest");
+            }
+        }
+        let set = build_baseline(&mut store, "bus-1", &cfg).expect("baseline");
+        let scenarios: [(&str, &VehicleParams, RoadClass, f64); 5] = [
+            ("a normal 35 km/h C", &bus, RoadClass::C, 35.0),
+            ("b road D", &bus, RoadClass::D, 40.0),
+            ("b road E", &bus, RoadClass::E, 40.0),
+            ("c vehicle", &weak, RoadClass::C, 40.0),
+            ("d both", &weak, RoadClass::E, 40.0),
+        ];
+        for (k, (label, v, road, kmh)) in scenarios.into_iter().enumerate() {
+            for (j, rec) in runs(v, road, kmh, seed * 1000 + k as u64, 2)
+                .iter()
+                .enumerate()
+            {
+                let c = check_recording(
+                    &mut store,
+                    &set,
+                    &format!("{label}-{j}"),
+                    &recording_hash(rec),
+                    rec,
+                )
+                .expect("check");
+                *confusion
+                    .entry((label, c.assessment.classification))
+                    .or_default() += 1;
+                if matches!(
+                    c.assessment.classification,
+                    Classification::Vehicle | Classification::Both
+                ) && v.rear.damper_n_s_per_m < bus.rear.damper_n_s_per_m
+                {
+                    n_vehicle_flags += 1;
+                    if c.assessment.summary.contains("RL:") || c.assessment.summary.contains("RR:")
+                    {
+                        rear_named += 1;
+                    }
+                }
+            }
+        }
+    }
+    let table: Vec<String> = confusion
+        .iter()
+        .map(|((s, c), n)| format!("{s} -> {c}: {n}"))
+        .collect();
+    let table = table.join("; ");
+    eprintln!("confusion over 5 seeds x 2 records: {table}");
+    let count = |s: &str, c: Classification| confusion.get(&(s, c)).copied().unwrap_or(0);
+    // 10 records per scenario.
+    assert!(
+        count("a normal 35 km/h C", Classification::Normal) >= 9,
+        "{table}"
+    );
+    assert!(count("b road D", Classification::Road) >= 8, "{table}");
+    assert_eq!(count("b road E", Classification::Road), 10, "{table}");
+    assert!(count("c vehicle", Classification::Vehicle) >= 9, "{table}");
+    assert!(count("d both", Classification::Both) >= 9, "{table}");
+    // Healthy runs called a vehicle fault: at most 2 of 30 (the limits aim at 1 % per record).
+    let false_vehicle: usize = ["a normal 35 km/h C", "b road D", "b road E"]
+        .iter()
+        .map(|s| count(s, Classification::Vehicle) + count(s, Classification::Both))
+        .sum();
+    assert!(
+        false_vehicle <= 2,
+        "{false_vehicle} false vehicle alarms: {table}"
+    );
+    assert_eq!(
+        rear_named, n_vehicle_flags,
+        "every vehicle flag of the weak rear dampers names RL or RR: {table}"
+    );
+}

@@ -1,0 +1,271 @@
+//! `vibmode fleet`: fleet monitoring on an SQLite store (init, ingest, baseline, check, status).
+
+use anyhow::{bail, Result};
+use clap::{Args, Subcommand};
+use serde::Serialize;
+use std::path::PathBuf;
+use vibmode_fleet::{
+    build_baseline, check_file, ingest_file, require_baseline, Checked, Condition, FleetConfig,
+    IngestLabels, Store,
+};
+use vibmode_signal::ReadOptions;
+
+/// Arguments of `vibmode fleet`.
+#[derive(Args, Debug)]
+pub struct FleetArgs {
+    #[command(subcommand)]
+    pub command: FleetCommand,
+}
+
+/// The fleet subcommands.
+#[derive(Subcommand, Debug)]
+pub enum FleetCommand {
+    /// Create a fleet store (or confirm an existing one).
+    Init {
+        /// The store file (SQLite).
+        #[arg(long)]
+        db: PathBuf,
+    },
+    /// Analyse records and store their features (the same file twice is a no-op).
+    #[command(allow_negative_numbers = true)]
+    Ingest(IngestArgs),
+    /// Build a new nominal model-set version from a vehicle's nominal records.
+    Baseline {
+        /// The store file.
+        #[arg(long)]
+        db: PathBuf,
+        /// Vehicle id.
+        #[arg(long)]
+        vehicle: String,
+    },
+    /// Classify records against the vehicle's latest model set: normal, road, vehicle, both.
+    #[command(allow_negative_numbers = true)]
+    Check(CheckArgs),
+    /// Per vehicle: records, baseline version, last classifications.
+    Status {
+        /// The store file.
+        #[arg(long)]
+        db: PathBuf,
+    },
+}
+
+/// How record files are read.
+#[derive(Args, Debug)]
+pub struct ReadArgs {
+    /// Sampling rate in Hz for files without a time column.
+    #[arg(long = "fs")]
+    pub fs_hz: Option<f64>,
+    /// Multiplier for WAV integer samples (after scaling to [-1, 1)).
+    #[arg(long, default_value_t = 1.0)]
+    pub scale: f64,
+    /// Unit of the samples when the files do not say (e.g. m/s^2).
+    #[arg(long)]
+    pub unit: Option<String>,
+}
+
+impl ReadArgs {
+    fn options(&self) -> ReadOptions {
+        ReadOptions {
+            fs_hz: self.fs_hz,
+            scale: self.scale,
+            unit: self.unit.clone(),
+            ..ReadOptions::default()
+        }
+    }
+}
+
+/// Arguments of `vibmode fleet ingest`.
+#[derive(Args, Debug)]
+pub struct IngestArgs {
+    /// The store file.
+    #[arg(long)]
+    pub db: PathBuf,
+    /// Vehicle id (created on first ingest).
+    #[arg(long)]
+    pub vehicle: String,
+    /// nominal (healthy runs for the baseline) or test.
+    #[arg(long, default_value = "nominal")]
+    pub condition: String,
+    /// Road label kept with the records (e.g. B, cobbles).
+    #[arg(long)]
+    pub road: Option<String>,
+    #[command(flatten)]
+    pub read: ReadArgs,
+    /// Record files.
+    #[arg(required = true)]
+    pub files: Vec<PathBuf>,
+}
+
+/// Arguments of `vibmode fleet check`.
+#[derive(Args, Debug)]
+pub struct CheckArgs {
+    /// The store file.
+    #[arg(long)]
+    pub db: PathBuf,
+    /// Vehicle id.
+    #[arg(long)]
+    pub vehicle: String,
+    /// Write the results as JSON to this file, or `-` for standard output.
+    #[arg(long)]
+    pub json: Option<String>,
+    #[command(flatten)]
+    pub read: ReadArgs,
+    /// Record files.
+    #[arg(required = true)]
+    pub files: Vec<PathBuf>,
+}
+
+/// Runs `vibmode fleet ...`.
+pub fn run(a: &FleetArgs) -> Result<()> {
+    match &a.command {
+        FleetCommand::Init { db } => {
+            let (store, created) = Store::init(db)?;
+            eprintln!(
+                "{} fleet store {} (schema version {})",
+                if created { "created" } else { "already a" },
+                db.display(),
+                store.schema_version()?
+            );
+            Ok(())
+        }
+        FleetCommand::Ingest(i) => ingest(i),
+        FleetCommand::Baseline { db, vehicle } => baseline(db, vehicle),
+        FleetCommand::Check(c) => check(c),
+        FleetCommand::Status { db } => status(db),
+    }
+}
+
+fn ingest(a: &IngestArgs) -> Result<()> {
+    let mut store = Store::open(&a.db)?;
+    let condition: Condition = a.condition.parse()?;
+    let labels = IngestLabels {
+        vehicle: &a.vehicle,
+        condition,
+        road: a.road.as_deref(),
+    };
+    let cfg = FleetConfig::default();
+    for f in &a.files {
+        let r = ingest_file(&mut store, &labels, f, &a.read.options(), &cfg)?;
+        if r.already_stored {
+            eprintln!(
+                "{}: already stored for vehicle {} (record {}), nothing to do",
+                r.file, a.vehicle, r.record_id
+            );
+        } else {
+            eprintln!(
+                "{}: stored as {} record {} of vehicle {}",
+                r.file, a.condition, r.record_id, a.vehicle
+            );
+            for n in &r.notes {
+                eprintln!("  note: {n}");
+            }
+        }
+    }
+    Ok(())
+}
+
+fn baseline(db: &std::path::Path, vehicle: &str) -> Result<()> {
+    let mut store = Store::open(db)?;
+    let set = build_baseline(&mut store, vehicle, &FleetConfig::default())?;
+    let mut text = format!(
+        "vehicle {}: model set version {} from {} nominal records, {} features, {} modes\n",
+        set.vehicle,
+        set.version,
+        set.records.len(),
+        set.features.len(),
+        set.slots.len()
+    );
+    text.push_str("kind               features  Bonferroni  LOO max |z|  limit\n");
+    for l in &set.limits {
+        text.push_str(&format!(
+            "{:<18} {:>8}  {:>10.2}  {:>11.2}  {:>5.2}\n",
+            format!("{:?}", l.kind),
+            l.n_features,
+            l.bonferroni,
+            l.loo_max_abs_z,
+            l.limit
+        ));
+    }
+    crate::output::print_stdout(&text)
+}
+
+#[derive(Serialize)]
+struct CheckJson<'a> {
+    vehicle: &'a str,
+    model_version: i64,
+    records: &'a [Checked],
+}
+
+fn check(a: &CheckArgs) -> Result<()> {
+    let mut store = Store::open(&a.db)?;
+    store.require_vehicle(&a.vehicle)?;
+    let set = require_baseline(&store, &a.vehicle)?;
+    let mut out = Vec::new();
+    for f in &a.files {
+        out.push(check_file(&mut store, &set, f, &a.read.options())?);
+    }
+    let mut text = format!(
+        "vehicle {} against model set version {}\nfile                            class     vehicle |z|  road score  evidence\n",
+        a.vehicle, set.version
+    );
+    for c in &out {
+        text.push_str(&format!(
+            "{:<31} {:<9} {:>11.1}  {:>10.1}  {}\n",
+            c.file,
+            c.assessment.classification.to_string(),
+            c.assessment.scores.vehicle_max_abs_z,
+            c.assessment.scores.excitation_max_abs_z,
+            if c.assessment.summary.is_empty() {
+                "-"
+            } else {
+                &c.assessment.summary
+            }
+        ));
+    }
+    match a.json.as_deref() {
+        Some("-") => {
+            eprint!("{text}");
+        }
+        _ => crate::output::print_stdout(&text)?,
+    }
+    if let Some(dest) = &a.json {
+        crate::output::write_json(
+            dest,
+            &CheckJson {
+                vehicle: &a.vehicle,
+                model_version: set.version,
+                records: &out,
+            },
+        )?;
+    }
+    Ok(())
+}
+
+fn status(db: &std::path::Path) -> Result<()> {
+    let store = Store::open(db)?;
+    let st = store.status(5)?;
+    if st.is_empty() {
+        bail!(
+            "the store {} has no vehicle yet; ingest nominal records first (vibmode fleet ingest --vehicle ID)",
+            db.display()
+        );
+    }
+    let mut text = String::new();
+    for v in &st {
+        text.push_str(&format!(
+            "vehicle {}: {} nominal, {} test records, baseline {}\n",
+            v.vehicle,
+            v.n_nominal,
+            v.n_test,
+            v.baseline_version
+                .map_or("none".to_string(), |n| format!("version {n}"))
+        ));
+        for (file, class, summary) in &v.last_checks {
+            text.push_str(&format!(
+                "  {file:<31} {:<8} {summary}\n",
+                class.to_string()
+            ));
+        }
+    }
+    crate::output::print_stdout(&text)
+}

@@ -1,0 +1,164 @@
+//! `vibmode fleet` as a user meets it: init, ingest (twice), baseline, check, status, and the
+//! one-line errors with exit code 2.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn vibmode(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_vibmode"))
+        .args(args)
+        .output()
+        .expect("run vibmode")
+}
+
+fn fails_with(args: &[&str], needles: &[&str]) {
+    let o = vibmode(args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "args {args:?}: stderr {err}");
+    assert!(!err.contains("panicked"), "panic: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
+    for n in needles {
+        assert!(err.contains(n), "'{n}' not in: {err}");
+    }
+}
+
+fn ok(args: &[&str]) -> Output {
+    let o = vibmode(args);
+    assert!(
+        o.status.success(),
+        "args {args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+/// Simulated bus records (CSV, 200 Hz) from `vibmode simulate` into `dir`.
+fn simulate(dir: &Path, road: &str, speed: &str, seed: &str, records: &str) -> Vec<String> {
+    let params = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/city_bus.toml");
+    ok(&[
+        "simulate",
+        params,
+        "--road",
+        road,
+        "--speed-kmh",
+        speed,
+        "--duration-s",
+        "10.24",
+        "--records",
+        records,
+        "--seed",
+        seed,
+        "--fs",
+        "200",
+        "--format",
+        "csv",
+        "-o",
+        dir.to_str().unwrap(),
+    ]);
+    let mut files: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "csv"))
+        .map(|p| p.to_string_lossy().to_string())
+        .collect();
+    files.sort();
+    files
+}
+
+#[test]
+fn fleet_workflow_and_errors() {
+    let d = tempfile::tempdir().unwrap();
+    let db = d.path().join("fleet.db");
+    let db = db.to_str().unwrap();
+    let o = ok(&["fleet", "init", "--db", db]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("created"));
+    let nominal = simulate(&d.path().join("nominal"), "C", "40", "3", "6");
+    assert_eq!(nominal.len(), 6, "{nominal:?}");
+    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1"];
+    args.extend(nominal.iter().map(String::as_str));
+    let o = ok(&args);
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("already stored"));
+    let o = ok(&args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.matches("already stored").count(), 6, "{err}");
+    // No baseline yet.
+    fails_with(
+        &[
+            "fleet",
+            "check",
+            "--db",
+            db,
+            "--vehicle",
+            "bus-1",
+            &nominal[0],
+        ],
+        &["no baseline", "bus-1"],
+    );
+    let o = ok(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("version 1"));
+    let test = simulate(&d.path().join("test"), "C", "40", "4", "1");
+    let o = ok(&[
+        "fleet",
+        "check",
+        "--db",
+        db,
+        "--vehicle",
+        "bus-1",
+        "--json",
+        "-",
+        &test[0],
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let recs = v["records"].as_array().unwrap();
+    assert_eq!(recs.len(), 1);
+    let class = recs[0]["classification"].as_str().unwrap();
+    assert!(
+        ["normal", "road", "vehicle", "both"].contains(&class),
+        "{class}"
+    );
+    assert!(recs[0]["scores"].is_object() && recs[0]["evidence"].is_array());
+    assert!(recs[0]["file"].as_str().unwrap().ends_with(".csv"));
+    let o = ok(&["fleet", "status", "--db", db]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("bus-1") && out.contains("6 nominal") && out.contains("version 1"),
+        "{out}"
+    );
+    // Errors.
+    fails_with(
+        &["fleet", "check", "--db", db, "--vehicle", "bus-9", &test[0]],
+        &["bus-9", "not in the store"],
+    );
+    fails_with(
+        &[
+            "fleet",
+            "ingest",
+            "--db",
+            db,
+            "--vehicle",
+            "bus-1",
+            "no-such-file.csv",
+        ],
+        &["no-such-file.csv"],
+    );
+    let junk = d.path().join("junk.db");
+    std::fs::write(
+        &junk,
+        b"this is not sqlite at all, just some text bytes........",
+    )
+    .unwrap();
+    fails_with(
+        &["fleet", "status", "--db", junk.to_str().unwrap()],
+        &["not a vibmode fleet store"],
+    );
+    fails_with(
+        &[
+            "fleet",
+            "status",
+            "--db",
+            d.path().join("none.db").to_str().unwrap(),
+        ],
+        &["no fleet store", "init"],
+    );
+}
