@@ -102,7 +102,17 @@ impl LineStage<'_> {
         track(&per_record, self.params, n_used)
             .into_iter()
             .filter_map(|mut t| {
-                let k = self.pooled_kurtosis(&t.record_hz, channels)?;
+                // A steady track is tested in every record used (pooling only the records where
+                // it was found would favour a mode that happened to look periodic there); a
+                // moving one in its own records.
+                let steady =
+                    t.frequency_range_hz.1 - t.frequency_range_hz.0 <= self.params.half_width_hz;
+                let at: Vec<Option<f64>> = if steady {
+                    vec![Some(t.frequency_hz); self.pre.len()]
+                } else {
+                    t.record_hz.clone()
+                };
+                let k = self.pooled_kurtosis(&at, channels)?;
                 t.kurtosis = k;
                 (k < self.params.max_kurtosis).then_some(t)
             })

@@ -195,9 +195,12 @@ impl SsiStage<'_> {
         Ok(self.kept(res, r, &p.band, scales))
     }
 
+    /// Identifies, clusters, classes (with the pool's own line tracks and `other_tracks`, those
+    /// of the role pools) and matches to `reference`.
     pub fn run(
         &self,
         lines: &LineStage<'_>,
+        other_tracks: &[LineTrack],
         reference: &[ReferenceMode],
     ) -> Result<SsiAnalysis, AnalysisError> {
         let channels: Vec<String> = self
@@ -257,7 +260,11 @@ impl SsiStage<'_> {
         };
         let all: Vec<usize> = (0..channels.len()).collect();
         let tracks = lines.tracks(&all);
-        lines.classify(&mut invariant_modes, &all, &tracks);
+        // The lines of the role pools count too: a line seen clearly on the sprung channels may
+        // be lost among the wheels' response when all channels are merged.
+        let mut known: Vec<LineTrack> = tracks.clone();
+        known.extend(other_tracks.iter().cloned());
+        lines.classify(&mut invariant_modes, &all, &known);
         let matches = if reference.is_empty() {
             Vec::new()
         } else {

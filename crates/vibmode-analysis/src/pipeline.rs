@@ -178,7 +178,9 @@ pub fn analyze_with(
             cluster: &cluster,
             drop_band_edge: cfg.poles.drop_band_edge,
         };
-        Some(stage.run(&lines, reference)?)
+        let role_tracks: Vec<crate::LineTrack> =
+            roles.iter().flat_map(|r| r.lines.iter().cloned()).collect();
+        Some(stage.run(&lines, &role_tracks, reference)?)
     } else {
         None
     };

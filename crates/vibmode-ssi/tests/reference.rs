@@ -80,6 +80,7 @@ fn identify(reference: &Value, refs: Option<Vec<usize>>) -> (vibmode_ssi::SsiRes
         order_max: 20,
         order_step: 2,
         reference_channels: refs,
+        pool_records: false,
     };
     (ssi_cov(&ch, fs, &params).unwrap(), fs)
 }
