@@ -237,7 +237,7 @@ fn segments_average_their_correlations() {
     let y = simulate(4000, 99);
     let ch: Vec<&[f64]> = y.iter().map(Vec::as_slice).collect();
     let one = SsiCov::new(&ch, FS, &params).unwrap().poles_at(6).unwrap();
-    let seg = SsiCov::from_segments(&[ch.clone()], FS, &params)
+    let seg = SsiCov::from_segments(std::slice::from_ref(&ch), FS, &params)
         .unwrap()
         .poles_at(6)
         .unwrap();
