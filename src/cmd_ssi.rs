@@ -34,6 +34,11 @@ pub struct SsiArgs {
     /// Write the stabilisation diagram (.svg or .png).
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Identify the channels as they are; by default each is divided by its RMS first (as the
+    /// analysis does, so that strong channels do not hide weak ones) and the shapes are scaled
+    /// back to the channels' units.
+    #[arg(long)]
+    pub no_normalise: bool,
 }
 
 #[derive(Serialize)]
@@ -102,7 +107,27 @@ fn params(a: &SsiArgs) -> Result<SsiParams> {
 pub fn run(a: &SsiArgs) -> Result<()> {
     let (rec, band) = a.input.load_with_band()?;
     let p = params(a)?;
-    let chans: Vec<&[f64]> = rec.channels.iter().map(|c| c.samples.as_slice()).collect();
+    let scales: Vec<f64> = rec
+        .channels
+        .iter()
+        .map(|c| {
+            let n = c.samples.len().max(1) as f64;
+            let m = c.samples.iter().sum::<f64>() / n;
+            let rms = (c.samples.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / n).sqrt();
+            if a.no_normalise || !(rms > 0.0 && rms.is_finite()) {
+                1.0
+            } else {
+                rms
+            }
+        })
+        .collect();
+    let scaled: Vec<Vec<f64>> = rec
+        .channels
+        .iter()
+        .zip(&scales)
+        .map(|(c, s)| c.samples.iter().map(|v| v / s).collect())
+        .collect();
+    let chans: Vec<&[f64]> = scaled.iter().map(Vec::as_slice).collect();
     let plan = SsiCov::new(&chans, rec.fs_hz, &p)?;
     let orders: Vec<usize> = p
         .orders()
@@ -117,7 +142,18 @@ pub fn run(a: &SsiArgs) -> Result<()> {
         p.block_rows,
         plan.max_order()
     );
-    let result = plan.sweep(&orders)?;
+    let mut result = plan.sweep(&orders)?;
+    for o in &mut result.orders {
+        for m in &mut o.modes {
+            let back: Vec<[f64; 2]> = m
+                .shape
+                .iter()
+                .zip(&scales)
+                .map(|(x, s)| [x[0] * s, x[1] * s])
+                .collect();
+            m.shape = vibmode_modal::shapes::normalise(&back);
+        }
+    }
     let stability_params = StabilityParams::default();
     let stability = vibmode_ssi::stabilisation(&result, &stability_params);
     let f_max = band.map_or(rec.fs_hz / 2.0, |b| b.valid_max_hz());

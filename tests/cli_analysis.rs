@@ -251,3 +251,78 @@ fn channels_without_a_role_are_analysed_alone_and_roles_can_be_given() {
         &["'XX'", "FL, FR, RL, RR"],
     );
 }
+
+/// `vibmode ssi` on a simulated bus record (written by `vibmode simulate`, names kept by the WAV
+/// sidecar): the table lists modes with their shapes, the JSON holds every order, the plot is
+/// written; errors are one line with exit code 2.
+#[test]
+fn ssi_identifies_a_simulated_record_and_reports_errors() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path().join("sim");
+    let o = vibmode(&[
+        "simulate",
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/examples/city_bus_flexible.toml"
+        ),
+        "--records",
+        "1",
+        "--duration-s",
+        "60",
+        "--fs",
+        "100",
+        "-o",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let wav = dir.join("record_01.wav");
+    let wav = wav.to_str().unwrap();
+    let plot = d.path().join("stab.svg");
+    let o = vibmode(&[
+        "ssi",
+        wav,
+        "--resample-to",
+        "50",
+        "--block-rows",
+        "30",
+        "--plot",
+        plot.to_str().unwrap(),
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.contains("SSI-cov of 7 channels"), "{out}");
+    assert!(out.contains("shape: FL_unsprung"), "{out}");
+    assert!(plot.is_file());
+    // The bending mode (9.0 Hz, damping 0.03) is among the modes that stay over the orders.
+    let j = vibmode(&[
+        "ssi",
+        wav,
+        "--resample-to",
+        "50",
+        "--block-rows",
+        "30",
+        "--json",
+        "-",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&j.stdout).unwrap();
+    let modes = v["modes"].as_array().unwrap();
+    assert!(
+        modes.iter().any(|m| m["class"] == "structural"
+            && (m["frequency_hz"].as_f64().unwrap() - 9.0).abs() < 0.2),
+        "{out}"
+    );
+    assert_eq!(v["channels"].as_array().map(Vec::len), Some(7));
+    fails_with(&["ssi", wav, "--block-rows", "0"], &["block_rows"]);
+    fails_with(&["ssi", wav, "--references", "0,9"], &["9"]);
+    fails_with(
+        &[
+            "analyze",
+            wav,
+            "--method",
+            "fdd",
+            "-o",
+            d.path().join("r").to_str().unwrap(),
+        ],
+        &["fdd", "arma, ssi-cov, both"],
+    );
+}
