@@ -669,6 +669,77 @@ fn inputs_table(html: &mut HtmlReport, r: &AnalysisResults) {
     );
 }
 
+/// The mode shapes of the multichannel structural modes (modulus and phase per channel) and, with
+/// a physical model, the MAC matrix between the model's modes and the identified ones.
+fn shape_tables(
+    html: &mut HtmlReport,
+    ssi: &vibmode_analysis::SsiAnalysis,
+    reference: &[vibmode_core::ReferenceMode],
+) {
+    let modes: Vec<&InvariantMode> = ssi
+        .invariant_modes
+        .iter()
+        .filter(|m| m.class == vibmode_core::ModeClass::Structural && m.shape.is_some())
+        .collect();
+    if modes.is_empty() {
+        return;
+    }
+    html.paragraph(
+        "Mode shapes of the structural modes (all channels identified together): modulus / phase in degrees per channel, the largest entry 1 / 0; the shape's spread is the median and lowest MAC of the cluster's poles with the mean shape.",
+    );
+    let mut headers: Vec<String> =
+        vec!["frequency [Hz]".into(), "shape MAC (median, lowest)".into()];
+    headers.extend(ssi.channels.iter().cloned());
+    let rows: Vec<Vec<String>> = modes
+        .iter()
+        .map(|m| {
+            let mut row = vec![
+                format!("{:.3}", m.frequency_hz),
+                m.shape_mac
+                    .map_or("-".into(), |(a, b)| format!("{a:.2}, {b:.2}")),
+            ];
+            if let Some(shape) = &m.shape {
+                row.extend(shape.iter().map(|v| {
+                    format!(
+                        "{:.2} / {:+.0}",
+                        v[0].hypot(v[1]),
+                        v[1].atan2(v[0]).to_degrees()
+                    )
+                }));
+            }
+            row
+        })
+        .collect();
+    let h: Vec<&str> = headers.iter().map(String::as_str).collect();
+    html.table(&h, &rows);
+    let with_shape: Vec<(&vibmode_core::ReferenceMode, Vec<[f64; 2]>)> = reference
+        .iter()
+        .filter_map(|r| r.shape_for(&ssi.channels).map(|s| (r, s)))
+        .collect();
+    if with_shape.is_empty() {
+        return;
+    }
+    html.paragraph(
+        "MAC between the physical model's modes (rows, their shapes at the sensors) and the identified structural modes (columns); 1 = the same shape.",
+    );
+    let mut headers: Vec<String> = vec!["model mode".into(), "model f [Hz]".into()];
+    headers.extend(modes.iter().map(|m| format!("{:.2} Hz", m.frequency_hz)));
+    let rows: Vec<Vec<String>> = with_shape
+        .iter()
+        .map(|(r, rs)| {
+            let mut row = vec![r.label.clone(), format!("{:.3}", r.frequency_hz)];
+            row.extend(modes.iter().map(|m| {
+                m.shape.as_ref().map_or("-".into(), |ms| {
+                    format!("{:.2}", vibmode_modal::shapes::mac(rs, ms))
+                })
+            }));
+            row
+        })
+        .collect();
+    let h: Vec<&str> = headers.iter().map(String::as_str).collect();
+    html.table(&h, &rows);
+}
+
 /// The pool's periodic lines: one row per track with its frequency in every record.
 fn lines_table(html: &mut HtmlReport, r: &AnalysisResults, lines: &[vibmode_analysis::LineTrack]) {
     if r.config.lines.max_kurtosis <= 0.0 {
@@ -733,6 +804,13 @@ fn modes_tables(html: &mut HtmlReport, r: &AnalysisResults) {
             html.table(&headers, &rows);
         }
         lines_table(html, r, pool.lines);
+        if let Some(ssi) = r
+            .ssi
+            .as_ref()
+            .filter(|ssi| std::ptr::eq(pool.modes, ssi.invariant_modes.as_slice()))
+        {
+            shape_tables(html, ssi, &r.reference_modes);
+        }
         if !pool.matches.is_empty() {
             html.paragraph("Physical model modes matched to the invariant structural modes:");
             let rows: Vec<Vec<String>> = pool
