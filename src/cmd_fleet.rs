@@ -47,6 +47,16 @@ pub enum FleetCommand {
         #[arg(long)]
         db: PathBuf,
     },
+    /// HTML report: every vehicle's status, feature trends with the nominal band, flagged
+    /// records with their evidence.
+    Report {
+        /// The store file.
+        #[arg(long)]
+        db: PathBuf,
+        /// Output folder (index.html is written there).
+        #[arg(short = 'o', long = "output", default_value = "vibmode-fleet-report")]
+        output: PathBuf,
+    },
 }
 
 /// How record files are read.
@@ -132,6 +142,12 @@ pub fn run(a: &FleetArgs) -> Result<()> {
         FleetCommand::Baseline { db, vehicle } => baseline(db, vehicle),
         FleetCommand::Check(c) => check(c),
         FleetCommand::Status { db } => status(db),
+        FleetCommand::Report { db, output } => {
+            let store = Store::open(db)?;
+            let path = vibmode_fleet::write_fleet_report(&store, output)?;
+            eprintln!("report: {}", path.display());
+            Ok(())
+        }
     }
 }
 

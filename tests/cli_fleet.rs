@@ -125,6 +125,16 @@ fn fleet_workflow_and_errors() {
         out.contains("bus-1") && out.contains("6 nominal") && out.contains("version 1"),
         "{out}"
     );
+    // The HTML report: the vehicle's section, its trend figure and the status table.
+    let rep = d.path().join("fleet-report");
+    ok(&["fleet", "report", "--db", db, "-o", rep.to_str().unwrap()]);
+    let page = std::fs::read_to_string(rep.join("index.html")).unwrap();
+    assert!(
+        page.contains("Vehicle bus-1") && page.contains("<svg"),
+        "{page}"
+    );
+    assert!(page.contains("Model set version 1 from 6 nominal record(s)"));
+    assert!(!rep.join(".index.html.partial").exists());
     // Errors.
     fails_with(
         &["fleet", "check", "--db", db, "--vehicle", "bus-9", &test[0]],

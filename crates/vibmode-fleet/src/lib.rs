@@ -12,6 +12,7 @@ pub mod error;
 pub mod features;
 pub mod fleet;
 pub mod model;
+pub mod report;
 pub mod stats;
 pub mod store;
 
@@ -28,4 +29,5 @@ pub use model::{
     assess, build_model_set, Assessment, Classification, Evidence, FeatureMeta, FeatureStat, Group,
     Kind, KindLimit, ModeSlot, ModelSet, Scores, LOO_MARGIN,
 };
+pub use report::write_fleet_report;
 pub use store::{Condition, RecordRow, Store, VehicleStatus, SCHEMA_VERSION};

@@ -435,6 +435,51 @@ impl Store {
             .collect()
     }
 
+    /// Every record of a vehicle, oldest first, with its features and its latest check (none for
+    /// records never checked).
+    pub fn records_with_checks(
+        &self,
+        vehicle: &str,
+    ) -> Result<Vec<(RecordRow, RecordFeatures, Option<Assessment>)>> {
+        let vid = self.require_vehicle(vehicle)?;
+        let mut st = self
+            .conn
+            .prepare(
+                "SELECT r.id, r.file_name, r.sha256, r.ingested, r.condition, r.road, f.json,
+                        (SELECT c.json FROM checks c WHERE c.record_id = r.id
+                         ORDER BY c.id DESC LIMIT 1)
+                 FROM records r JOIN features f ON f.record_id = r.id
+                 WHERE r.vehicle_id = ?1 ORDER BY r.id",
+            )
+            .map_err(self.sql("reading records"))?;
+        let rows = st
+            .query_map([vid], |r| {
+                Ok((
+                    row_to_record(r)?,
+                    r.get::<_, String>(6)?,
+                    r.get::<_, Option<String>>(7)?,
+                ))
+            })
+            .map_err(self.sql("reading records"))?
+            .collect::<rusqlite::Result<Vec<_>>>()
+            .map_err(self.sql("reading records"))?;
+        rows.into_iter()
+            .map(|(row, json, check)| {
+                let row = row.map_err(|e| self.corrupt("a record row", e))?;
+                let f = serde_json::from_str(&json).map_err(|e| {
+                    self.corrupt(&format!("features of record {}", row.file_name), e)
+                })?;
+                let a = match check {
+                    Some(c) => Some(serde_json::from_str(&c).map_err(|e| {
+                        self.corrupt(&format!("the check of {}", row.file_name), e)
+                    })?),
+                    None => None,
+                };
+                Ok((row, f, a))
+            })
+            .collect()
+    }
+
     /// Stores a model set as the vehicle's next version (set in `set.version`).
     pub fn save_model_set(&mut self, set: &mut ModelSet) -> Result<i64> {
         let vid = self.require_vehicle(&set.vehicle)?;

@@ -1,0 +1,243 @@
+//! The fleet report: one self-contained HTML page with every vehicle's status, the trend of each
+//! vehicle feature of its model set over the records (nominal band drawn), and the flagged
+//! records with their evidence.
+
+use std::path::{Path, PathBuf};
+
+use vibmode_report::panels::grid;
+use vibmode_report::{HtmlReport, Marker, Panel, Series};
+
+use crate::error::{FleetError, Result};
+use crate::model::{scalar_features, Classification, Group, ModelSet};
+use crate::store::{Condition, Store};
+
+/// Most trend panels drawn per vehicle (the features with the largest scores first).
+pub const MAX_TREND_PANELS: usize = 12;
+
+fn io(path: &Path, e: impl ToString) -> FleetError {
+    FleetError::Io {
+        path: path.display().to_string(),
+        reason: e.to_string(),
+    }
+}
+
+/// Writes `dir/index.html` for every vehicle of `store` and returns its path. The folder is
+/// created when missing; the page is written to a temporary name and renamed, so an old report
+/// is never left half-overwritten.
+pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
+    let mut html = HtmlReport::new("vibmode fleet report");
+    let vehicles = store.vehicles()?;
+    html.paragraph(&format!(
+        "Store {}: {} vehicle(s). Each record is classified against its vehicle's nominal model set: normal, road (excitation outside the nominal range), vehicle (transmissibility or modes of a corner moved) or both (docs/fleet.md).",
+        store.path(),
+        vehicles.len()
+    ));
+    let status = store.status(usize::MAX / 2)?;
+    let rows: Vec<Vec<String>> = status
+        .iter()
+        .map(|s| {
+            let count = |c: Classification| {
+                s.last_checks
+                    .iter()
+                    .filter(|(_, k, _)| *k == c)
+                    .count()
+                    .to_string()
+            };
+            vec![
+                s.vehicle.clone(),
+                s.n_nominal.to_string(),
+                s.n_test.to_string(),
+                s.baseline_version.map_or("none".into(), |v| v.to_string()),
+                count(Classification::Normal),
+                count(Classification::Road),
+                count(Classification::Vehicle),
+                count(Classification::Both),
+            ]
+        })
+        .collect();
+    html.heading(2, "Status");
+    html.table(
+        &[
+            "vehicle",
+            "nominal records",
+            "test records",
+            "model set",
+            "normal",
+            "road",
+            "vehicle",
+            "both",
+        ],
+        &rows,
+    );
+    for v in &vehicles {
+        vehicle_section(&mut html, store, v)?;
+    }
+    std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
+    let path = dir.join("index.html");
+    let tmp = dir.join(".index.html.partial");
+    html.save(&tmp).map_err(|e| io(&tmp, e))?;
+    std::fs::rename(&tmp, &path).map_err(|e| io(&path, e))?;
+    Ok(path)
+}
+
+fn vehicle_section(html: &mut HtmlReport, store: &Store, vehicle: &str) -> Result<()> {
+    html.heading(2, &format!("Vehicle {vehicle}"));
+    let records = store.records_with_checks(vehicle)?;
+    let Some(set) = store.latest_model_set(vehicle)? else {
+        html.paragraph(&format!(
+            "{} record(s), no model set yet: build one from at least 5 nominal records (vibmode fleet baseline).",
+            records.len()
+        ));
+        return Ok(());
+    };
+    html.paragraph(&format!(
+        "Model set version {} from {} nominal record(s). Trends: each vehicle feature per record in ingest order (circles: nominal records, squares: test records, triangles: flagged); the horizontal lines are the nominal band, centre x exp(+-limit x spread).",
+        set.version,
+        set.records.len()
+    ));
+    trend_figure(html, &set, &records)?;
+    let flagged: Vec<Vec<String>> = records
+        .iter()
+        .filter_map(|(row, _, a)| {
+            let a = a.as_ref()?;
+            (a.classification != Classification::Normal).then(|| {
+                let evidence: Vec<String> = a
+                    .evidence
+                    .iter()
+                    .filter(|e| e.flagged)
+                    .take(6)
+                    .map(|e| {
+                        format!(
+                            "{}{} {:+.0} % (z {:.1})",
+                            e.meta.corner.map_or(String::new(), |c| format!("{c}: ")),
+                            e.meta.label,
+                            e.change_pct,
+                            e.z
+                        )
+                    })
+                    .collect();
+                vec![
+                    row.file_name.clone(),
+                    row.ingested.clone(),
+                    format!("{:?}", a.classification).to_lowercase(),
+                    evidence.join("; "),
+                ]
+            })
+        })
+        .collect();
+    if flagged.is_empty() {
+        html.paragraph("No flagged record.");
+    } else {
+        html.heading(3, "Flagged records");
+        html.table(
+            &["file", "ingested", "classification", "evidence"],
+            &flagged,
+        );
+    }
+    Ok(())
+}
+
+type RecordEntry = (
+    crate::store::RecordRow,
+    crate::features::RecordFeatures,
+    Option<crate::model::Assessment>,
+);
+
+fn trend_figure(html: &mut HtmlReport, set: &ModelSet, records: &[RecordEntry]) -> Result<()> {
+    // ln of each feature per record (as the model set keeps them).
+    let values: Vec<Vec<(String, f64)>> = records
+        .iter()
+        .map(|(_, f, _)| {
+            scalar_features(f, &set.slots, &set.config)
+                .into_iter()
+                .map(|(m, v)| (m.key, v))
+                .collect()
+        })
+        .collect();
+    // Vehicle features, most-moved first (largest |z| seen in any record).
+    let mut feats: Vec<(&crate::model::FeatureStat, f64)> = set
+        .features
+        .iter()
+        .filter(|f| f.meta.group == Group::Vehicle)
+        .map(|f| {
+            let worst = values
+                .iter()
+                .filter_map(|vs| vs.iter().find(|(k, _)| *k == f.meta.key))
+                .map(|(_, v)| (v - f.centre).abs() / f.sigma)
+                .fold(0.0, f64::max);
+            (f, worst)
+        })
+        .collect();
+    feats.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let panels: Vec<Panel> = feats
+        .iter()
+        .take(MAX_TREND_PANELS)
+        .map(|(f, _)| {
+            let limit = set
+                .limits
+                .iter()
+                .find(|l| l.kind == f.meta.kind)
+                .map_or(3.0, |l| l.limit);
+            let (mut nx, mut ny, mut tx, mut ty, mut fx, mut fy) =
+                (vec![], vec![], vec![], vec![], vec![], vec![]);
+            for (i, ((row, _, a), vs)) in records.iter().zip(&values).enumerate() {
+                let Some((_, v)) = vs.iter().find(|(k, _)| *k == f.meta.key) else {
+                    continue;
+                };
+                let x = (i + 1) as f64;
+                let flagged = a.as_ref().is_some_and(|a| {
+                    a.evidence
+                        .iter()
+                        .any(|e| e.flagged && e.meta.key == f.meta.key)
+                });
+                // The features are kept as logarithms; drawn in their units.
+                let y = v.exp();
+                if flagged {
+                    fx.push(x);
+                    fy.push(y);
+                } else if row.condition == Condition::Nominal {
+                    nx.push(x);
+                    ny.push(y);
+                } else {
+                    tx.push(x);
+                    ty.push(y);
+                }
+            }
+            let n = records.len().max(1) as f64;
+            let band = |k: f64| {
+                Series::line(
+                    vec![0.5, n + 0.5],
+                    vec![(f.centre + k * limit * f.sigma).exp(); 2],
+                )
+                .with_label(if k > 0.0 { "nominal band" } else { "" })
+            };
+            let title = match f.meta.corner {
+                Some(c) => format!("{c}: {}", f.meta.label),
+                None => format!("{}: {}", f.meta.channel, f.meta.label),
+            };
+            let unit = match f.meta.kind {
+                crate::model::Kind::ModeFrequency => "Hz",
+                crate::model::Kind::ModeDamping => "damping ratio",
+                crate::model::Kind::Transmissibility => "sprung / unsprung RMS",
+                crate::model::Kind::Level => "m/s^2",
+            };
+            Panel::new(title, "record (ingest order)", unit)
+                .with_series(band(1.0))
+                .with_series(band(-1.0))
+                .with_series(Series::points(nx, ny, Marker::Circle).with_label("nominal"))
+                .with_series(Series::points(tx, ty, Marker::Square).with_label("test"))
+                .with_series(Series::points(fx, fy, Marker::Triangle).with_label("flagged"))
+                .without_legend()
+        })
+        .collect();
+    if panels.is_empty() {
+        html.paragraph("The model set has no vehicle feature to draw.");
+        return Ok(());
+    }
+    let fig = grid(panels, 3, 420, 300);
+    html.figure(&fig, "Vehicle features per record with the nominal band")
+        .map_err(|e| FleetError::Io {
+            path: "the trend figure".into(),
+            reason: e.to_string(),
+        })
+}
