@@ -11,7 +11,8 @@ use crate::error::{FleetError, Result};
 use crate::model::{scalar_features, Classification, Group, ModelSet};
 use crate::store::{Condition, Store};
 
-/// Most trend panels drawn per vehicle (the features with the largest scores first).
+/// Most transmissibility / level trend panels drawn per vehicle (the features with the largest
+/// scores first); every mode's frequency and damping is drawn besides.
 pub const MAX_TREND_PANELS: usize = 12;
 
 fn io(path: &Path, e: impl ToString) -> FleetError {
@@ -168,10 +169,23 @@ fn trend_figure(html: &mut HtmlReport, set: &ModelSet, records: &[RecordEntry]) 
             (f, worst)
         })
         .collect();
+    // Every mode's frequency and damping, then the most-moved other features up to
+    // MAX_TREND_PANELS more.
     feats.sort_by(|a, b| b.1.total_cmp(&a.1));
-    let panels: Vec<Panel> = feats
+    let is_mode = |f: &crate::model::FeatureStat| {
+        matches!(
+            f.meta.kind,
+            crate::model::Kind::ModeFrequency | crate::model::Kind::ModeDamping
+        )
+    };
+    let mut chosen: Vec<&(&crate::model::FeatureStat, f64)> = feats
         .iter()
+        .filter(|(f, _)| !is_mode(f))
         .take(MAX_TREND_PANELS)
+        .collect();
+    chosen.extend(feats.iter().filter(|(f, _)| is_mode(f)));
+    let panels: Vec<Panel> = chosen
+        .into_iter()
         .map(|(f, _)| {
             let limit = set
                 .limits
