@@ -194,17 +194,9 @@ impl LineStage<'_> {
     }
 }
 
+/// Median (`vibmode_modal::stats::median`), `None` for no value.
 fn median(v: &mut [f64]) -> Option<f64> {
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    Some(if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    })
+    (!v.is_empty()).then(|| vibmode_modal::stats::median(v))
 }
 
 struct Building {

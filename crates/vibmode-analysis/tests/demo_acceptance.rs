@@ -2,7 +2,9 @@
 //! the periodic lines are found within 0.05 Hz and classed as disturbances, the wheel-hop modes
 //! within 5 %, the body modes within 10 %, and no structural mode is classed as a disturbance.
 
-use vibmode_analysis::{analyze, AnalysisConfig, RecordInput, Role};
+mod common;
+
+use vibmode_analysis::{analyze, AnalysisConfig, Role};
 use vibmode_modal::{ModeClass, ReferenceMode};
 use vibmode_vehicle::{simulate, ModeLabel, SimParams, VehicleParams};
 
@@ -10,15 +12,7 @@ use vibmode_vehicle::{simulate, ModeLabel, SimParams, VehicleParams};
 fn demo_data_gives_the_true_modes_and_lines() {
     let vehicle = VehicleParams::city_bus();
     let sim = simulate(&vehicle, &SimParams::demo_ideal(8, 1)).expect("simulation");
-    let records: Vec<RecordInput> = sim
-        .records
-        .iter()
-        .enumerate()
-        .map(|(i, r)| RecordInput {
-            name: format!("record {i}"),
-            recording: r.recording.clone(),
-        })
-        .collect();
+    let records = common::inputs(&sim);
     let reference: Vec<ReferenceMode> = sim.truth.modes.iter().map(|m| m.to_reference()).collect();
     let cfg = AnalysisConfig::default();
     let res = analyze(&records, &cfg, &reference, &|_, _| {}).expect("analysis");

@@ -10,33 +10,18 @@
 //! Simulated at 500 Hz (the lines and modes lie below 15 Hz) and with a short order sweep: the
 //! line stage does not depend on the sweep.
 
-use vibmode_analysis::{analyze, AnalysisConfig, RecordInput, Role};
+mod common;
+
+use vibmode_analysis::{analyze, AnalysisConfig, Role};
 use vibmode_core::{ModeClass, SweepParams};
-use vibmode_vehicle::{simulate, SimParams, VehicleParams};
 
 #[test]
 fn lines_are_found_per_record_over_five_seeds() {
-    let vehicle = VehicleParams::city_bus_flexible();
     let (mut true_lines, mut found, mut entries, mut correct) = (0, 0, 0, 0);
     let mut wrongly_periodic = Vec::new();
     for seed in 1..=5u64 {
-        let sim = simulate(
-            &vehicle,
-            &SimParams {
-                fs_hz: 500.0,
-                ..SimParams::demo(8, seed)
-            },
-        )
-        .expect("simulation");
-        let records: Vec<RecordInput> = sim
-            .records
-            .iter()
-            .enumerate()
-            .map(|(i, r)| RecordInput {
-                name: format!("record {i}"),
-                recording: r.recording.clone(),
-            })
-            .collect();
+        let (_, sim) = common::realistic_demo(seed);
+        let records = common::inputs(&sim);
         let cfg = AnalysisConfig {
             sweep: SweepParams {
                 order_max: 8,

@@ -15,9 +15,11 @@
 //! much data (a 1.05-1.28 Hz mixture with MAC 0.57-0.67 to heave; no pitch); printed, not
 //! asserted.
 
-use vibmode_analysis::{analyze, AnalysisConfig, RecordInput};
+mod common;
+
+use vibmode_analysis::{analyze, AnalysisConfig};
 use vibmode_core::IdentMethod;
-use vibmode_vehicle::{simulate, FullCar, SimParams, VehicleParams};
+use vibmode_vehicle::{FullCar, VehicleParams};
 
 #[test]
 fn ssi_finds_roll_and_bending_over_five_seeds() {
@@ -31,23 +33,8 @@ fn ssi_finds_roll_and_bending_over_five_seeds() {
     let (mut roll, mut bending) = (0, 0);
     let mut table = Vec::new();
     for seed in 1..=5u64 {
-        let sim = simulate(
-            &vehicle,
-            &SimParams {
-                fs_hz: 500.0,
-                ..SimParams::demo(8, seed)
-            },
-        )
-        .expect("simulation");
-        let records: Vec<RecordInput> = sim
-            .records
-            .iter()
-            .enumerate()
-            .map(|(i, r)| RecordInput {
-                name: format!("record {i}"),
-                recording: r.recording.clone(),
-            })
-            .collect();
+        let (_, sim) = common::realistic_demo(seed);
+        let records = common::inputs(&sim);
         let cfg = AnalysisConfig {
             method: IdentMethod::SsiCov,
             ..AnalysisConfig::default()

@@ -116,22 +116,6 @@ fn check_channels(channels: &[&[f64]]) -> Result<usize, SsiError> {
     Ok(n)
 }
 
-/// `R_k` for `k = 1..=max_lag` of the demeaned channels, each `l x r`, entry `(a, b)` =
-/// `1/(N-k) sum_t y_a[t+k] y_refs[b][t]`.
-fn correlations(channels: &[Vec<f64>], refs: &[usize], max_lag: usize) -> Vec<DMatrix<f64>> {
-    let l = channels.len();
-    let n = channels.first().map_or(0, Vec::len);
-    (1..=max_lag)
-        .map(|k| {
-            DMatrix::from_fn(l, refs.len(), |a, b| {
-                let ya = &channels[a][k..];
-                let yb = &channels[refs[b]][..n - k];
-                ya.iter().zip(yb).map(|(x, y)| x * y).sum::<f64>() / (n - k) as f64
-            })
-        })
-        .collect()
-}
-
 impl SsiCov {
     /// Plans SSI-cov for `channels` (equal lengths, finite) sampled at `fs_hz`, with
     /// `params.block_rows` block rows and `params.reference_channels`. Removes each channel's
@@ -140,55 +124,8 @@ impl SsiCov {
     /// higher order can still be asked of [`SsiCov::poles_at`]; it gets its own
     /// least-squares solution).
     pub fn new(channels: &[&[f64]], fs_hz: f64, params: &SsiParams) -> Result<SsiCov, SsiError> {
-        params.validate()?;
-        if !(fs_hz.is_finite() && fs_hz > 0.0) {
-            return Err(SsiError::InvalidSampleRate { fs_hz });
-        }
-        let n = check_channels(channels)?;
-        let i = params.block_rows;
-        let max_lag = 2 * i - 1;
-        if n < 2 * i {
-            return Err(SsiError::TooFewSamples {
-                n_samples: n,
-                block_rows: i,
-                max_lag,
-                min_samples: 2 * i,
-            });
-        }
-        let demeaned: Vec<Vec<f64>> = channels
-            .iter()
-            .map(|ch| {
-                let m = ch.iter().sum::<f64>() / n as f64;
-                ch.iter().map(|v| v - m).collect()
-            })
-            .collect();
-        let refs: Vec<usize> = match &params.reference_channels {
-            Some(refs) => {
-                if let Some(&index) = refs.iter().find(|&&r| r >= channels.len()) {
-                    return Err(SsiError::ReferenceChannel {
-                        index,
-                        n_channels: channels.len(),
-                        last: channels.len() - 1,
-                    });
-                }
-                refs.clone()
-            }
-            None => (0..channels.len()).collect(),
-        };
-        let r = correlations(&demeaned, &refs, max_lag);
-        if let Some(k) = r.iter().position(|m| m.iter().any(|v| !v.is_finite())) {
-            let max_abs = demeaned
-                .iter()
-                .flatten()
-                .fold(0.0f64, |m, v| m.max(v.abs()));
-            return Err(SsiError::Overflow {
-                lag: k + 1,
-                max_abs,
-            });
-        }
-        let mut cov = SsiCov::from_correlations(&r, fs_hz, i, params.order_max)?;
-        cov.n_samples = n;
-        Ok(cov)
+        // One segment: the same correlations (sum over t divided by N - k).
+        Self::from_segments(&[channels.to_vec()], fs_hz, params)
     }
 
     /// Plans SSI-cov from several segments (records) of the same channels, for example records

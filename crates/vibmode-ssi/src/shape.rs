@@ -1,23 +1,8 @@
 //! Mode-shape comparisons: the modal assurance criterion and modal phase collinearity.
 
-/// Complex modal assurance criterion of two mode shapes given as `[re, im]` per channel:
-/// `|a^H b|^2 / ((a^H a) (b^H b))`, in [0, 1]; 1 when one is a complex multiple of the other,
-/// 0 when they are orthogonal. 0 when either vector is zero (or contains no channel).
-/// Only the first `min(a.len(), b.len())` channels are compared.
-pub fn mac(a: &[[f64; 2]], b: &[[f64; 2]]) -> f64 {
-    let (mut re, mut im, mut aa, mut bb) = (0.0, 0.0, 0.0, 0.0);
-    for (x, y) in a.iter().zip(b) {
-        // conj(x) * y
-        re += x[0] * y[0] + x[1] * y[1];
-        im += x[0] * y[1] - x[1] * y[0];
-        aa += x[0] * x[0] + x[1] * x[1];
-        bb += y[0] * y[0] + y[1] * y[1];
-    }
-    if aa <= 0.0 || bb <= 0.0 || !(aa.is_finite() && bb.is_finite()) {
-        return 0.0;
-    }
-    ((re * re + im * im) / (aa * bb)).clamp(0.0, 1.0)
-}
+/// Complex modal assurance criterion `|a^H b|^2 / ((a^H a) (b^H b))` of two shapes given as
+/// `[re, im]` per channel (one definition, shared with the clustering: `vibmode_modal::shapes`).
+pub use vibmode_modal::shapes::mac;
 
 /// Modal phase collinearity (Pappa, Elliott & Schenk 1993) of a complex mode shape given as
 /// `[re, im]` per channel, in [0, 1]: 1 when the real and imaginary parts are collinear (a
