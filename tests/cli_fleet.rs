@@ -172,3 +172,61 @@ fn fleet_workflow_and_errors() {
         &["no fleet store", "init"],
     );
 }
+
+/// Two ingests into one store at the same time (two processes): both succeed (the second waits
+/// for the first's transaction) and both records are stored.
+#[test]
+fn concurrent_ingests_both_succeed() {
+    let d = tempfile::tempdir().unwrap();
+    let files = simulate(&d.path().join("sim"), "B", "30", "3", "2");
+    let db = d.path().join("fleet.db");
+    let db = db.to_str().unwrap();
+    ok(&["fleet", "init", "--db", db]);
+    let spawn = |file: &str| {
+        Command::new(env!("CARGO_BIN_EXE_vibmode"))
+            .args(["fleet", "ingest", "--db", db, "--vehicle", "bus-2", file])
+            .output()
+    };
+    let (a, b) = std::thread::scope(|s| {
+        let ta = s.spawn(|| spawn(&files[0]));
+        let tb = s.spawn(|| spawn(&files[1]));
+        (ta.join().unwrap().unwrap(), tb.join().unwrap().unwrap())
+    });
+    for o in [&a, &b] {
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let o = ok(&["fleet", "status", "--db", db]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("bus-2") && out.contains("2 nominal"), "{out}");
+}
+
+/// An ingest killed (SIGKILL) part-way leaves a store that opens, holds only whole records, and
+/// takes the rest on the next ingest (the committed ones are reported as already stored).
+#[test]
+fn killed_ingest_leaves_a_consistent_store() {
+    let d = tempfile::tempdir().unwrap();
+    let files = simulate(&d.path().join("sim"), "B", "30", "4", "6");
+    let db = d.path().join("fleet.db");
+    let db = db.to_str().unwrap();
+    ok(&["fleet", "init", "--db", db]);
+    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-3"];
+    args.extend(files.iter().map(String::as_str));
+    let mut child = Command::new(env!("CARGO_BIN_EXE_vibmode"))
+        .args(&args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Let it store a few records, then kill it (SIGKILL: no cleanup at all).
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let o = ok(&args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    let again = err.matches("already stored").count();
+    let stored = err.matches("stored as").count();
+    assert_eq!(again + stored, files.len(), "{err}");
+    let o = ok(&["fleet", "status", "--db", db]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("6 nominal"), "{out}");
+}

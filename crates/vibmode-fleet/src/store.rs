@@ -51,6 +51,9 @@ const MIGRATIONS: &[&str] = &[
         json TEXT NOT NULL);",
 ];
 
+/// How long a write waits for another process's transaction before giving up.
+pub const BUSY_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(60);
+
 /// The schema version this build writes.
 pub const SCHEMA_VERSION: i64 = MIGRATIONS.len() as i64;
 
@@ -246,6 +249,10 @@ impl Store {
         self.conn
             .execute_batch("PRAGMA foreign_keys=ON;")
             .map_err(|e| Store::not_a_store(&p, e))?;
+        // Another process writing: wait for it (up to BUSY_TIMEOUT) instead of failing.
+        self.conn
+            .busy_timeout(BUSY_TIMEOUT)
+            .map_err(|e| Store::not_a_store(&p, e))?;
         Ok(())
     }
 
@@ -258,7 +265,10 @@ impl Store {
                 operation: "schema migration",
                 reason: e.to_string(),
             };
-            let tx = self.conn.transaction().map_err(err)?;
+            let tx = self
+                .conn
+                .transaction_with_behavior(rusqlite::TransactionBehavior::Immediate)
+                .map_err(err)?;
             tx.execute_batch(sql).map_err(err)?;
             tx.execute_batch(&format!("PRAGMA user_version = {}", i + 1))
                 .map_err(err)?;
@@ -357,7 +367,10 @@ impl Store {
             operation: "storing a record",
             reason: e.to_string(),
         };
-        let tx = self.conn.transaction().map_err(err)?;
+        let tx = self
+            .conn
+            .transaction_with_behavior(rusqlite::TransactionBehavior::Immediate)
+            .map_err(err)?;
         tx.execute(
             "INSERT OR IGNORE INTO vehicles (name, created) VALUES (?1, ?2)",
             params![rec.vehicle, now],
@@ -489,7 +502,10 @@ impl Store {
             operation: "storing a model set",
             reason: e.to_string(),
         };
-        let tx = self.conn.transaction().map_err(err)?;
+        let tx = self
+            .conn
+            .transaction_with_behavior(rusqlite::TransactionBehavior::Immediate)
+            .map_err(err)?;
         let last: Option<i64> = tx
             .query_row(
                 "SELECT MAX(version) FROM model_sets WHERE vehicle_id = ?1",
@@ -540,7 +556,10 @@ impl Store {
             operation: "storing a check",
             reason: e.to_string(),
         };
-        let tx = self.conn.transaction().map_err(err)?;
+        let tx = self
+            .conn
+            .transaction_with_behavior(rusqlite::TransactionBehavior::Immediate)
+            .map_err(err)?;
         tx.execute(
             "INSERT INTO checks (record_id, model_version, checked, classification, json)
              VALUES (?1, ?2, ?3, ?4, ?5)",
