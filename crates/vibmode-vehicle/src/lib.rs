@@ -43,7 +43,8 @@ pub use error::{Result, VehicleError};
 pub use lines::LineTruth;
 pub use model::{FullCar, ModeInfo, ModeLabel, SensorPsd};
 pub use params::{
-    default_sensors, Axle, Bending, Body, Corner, Geometry, SensorKind, SensorSpec, VehicleParams,
+    default_sensors, Axle, Bending, Body, Corner, CornerCondition, Geometry, SensorKind,
+    SensorSpec, VehicleParams,
 };
 pub use road::{
     LateralCoherence, RoadClass, RoadInput, RoadProfile, DEFAULT_TYRE_ENVELOPE_CYCLES_PER_M,

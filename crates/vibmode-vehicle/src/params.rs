@@ -198,6 +198,43 @@ pub struct VehicleParams {
     /// Accelerometers; empty means the 7 defaults.
     #[serde(default)]
     pub sensors: Vec<SensorSpec>,
+    /// `[[corner_condition]]`: one wheel station that differs from its axle (a worn damper, a
+    /// soft tyre, a leaking air spring), as factors on the axle's values. Default none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub corner_condition: Vec<CornerCondition>,
+}
+
+/// One wheel station's condition relative to its axle's values (factors; 1 = as the axle).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CornerCondition {
+    /// The wheel station.
+    pub corner: Corner,
+    /// Factor on the damper (0.5 = a damper at 50 %).
+    #[serde(default = "one")]
+    pub damper_factor: f64,
+    /// Factor on the suspension spring (0.8 = 20 % softer).
+    #[serde(default = "one")]
+    pub spring_factor: f64,
+    /// Factor on the tyre stiffness (0.7 = 30 % softer, e.g. under-inflated).
+    #[serde(default = "one")]
+    pub tyre_stiffness_factor: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+impl CornerCondition {
+    /// A corner as its axle (every factor 1).
+    pub fn nominal(corner: Corner) -> Self {
+        CornerCondition {
+            corner,
+            damper_factor: 1.0,
+            spring_factor: 1.0,
+            tyre_stiffness_factor: 1.0,
+        }
+    }
 }
 
 const CITY_BUS_TOML: &str = include_str!("../../../examples/city_bus.toml");
@@ -438,6 +475,21 @@ impl VehicleParams {
                 ));
             }
         }
+        for (i, cc) in self.corner_condition.iter().enumerate() {
+            for (key, v) in [
+                ("damper_factor", cc.damper_factor),
+                ("spring_factor", cc.spring_factor),
+                ("tyre_stiffness_factor", cc.tyre_stiffness_factor),
+            ] {
+                if !(v.is_finite() && v > 0.0 && v <= 10.0) {
+                    return Err(invalid(
+                        format!("corner_condition[{i}].{key}"),
+                        v,
+                        "must be a factor in (0, 10], e.g. 0.5 for a damper at 50 %",
+                    ));
+                }
+            }
+        }
         Ok(())
     }
 
@@ -454,12 +506,19 @@ impl VehicleParams {
         }
     }
 
-    /// The axle parameters of a corner.
-    pub fn axle(&self, c: Corner) -> &Axle {
-        if c.is_front() {
-            &self.front
+    /// The parameters of a wheel station: its axle's, with the corner's condition factors
+    /// (`corner_condition`) applied.
+    pub fn axle(&self, c: Corner) -> Axle {
+        let mut ax = if c.is_front() {
+            self.front.clone()
         } else {
-            &self.rear
+            self.rear.clone()
+        };
+        for cc in self.corner_condition.iter().filter(|cc| cc.corner == c) {
+            ax.damper_n_s_per_m *= cc.damper_factor;
+            ax.spring_stiffness_n_per_m *= cc.spring_factor;
+            ax.tyre_stiffness_n_per_m *= cc.tyre_stiffness_factor;
         }
+        ax
     }
 }

@@ -221,3 +221,33 @@ fn psd_symmetry_and_scaling() {
     };
     assert!(car.acceleration_psd(&bad, 40.0, &freqs).is_err());
 }
+
+/// A corner condition acts on its wheel station only, by its factor: the wheel's diagonal
+/// entries of the damping and stiffness matrices change by exactly the scaled damper, spring
+/// and tyre; the other wheels do not move. Read from TOML as a user writes it.
+#[test]
+fn corner_condition_changes_that_corner_only() {
+    let bus = VehicleParams::city_bus();
+    let text = bus.to_toml_string().unwrap()
+        + "\n[[corner_condition]]\ncorner = \"RL\"\ndamper_factor = 0.5\ntyre_stiffness_factor = 0.7\n";
+    let worn = VehicleParams::from_toml_str(&text).unwrap();
+    assert_eq!(worn.corner_condition.len(), 1);
+    let (a, b) = (FullCar::new(&bus).unwrap(), FullCar::new(&worn).unwrap());
+    let (ca, cb) = (a.damping_matrix(), b.damping_matrix());
+    let (ka, kb) = (a.stiffness_matrix(), b.stiffness_matrix());
+    // DOFs: heave, pitch, roll, FL, FR, RL, RR.
+    let rl = 5;
+    let d = bus.rear.damper_n_s_per_m;
+    let kt = bus.rear.tyre_stiffness_n_per_m;
+    assert!((ca[(rl, rl)] - cb[(rl, rl)] - 0.5 * d).abs() < 1e-9 * d);
+    assert!((ka[(rl, rl)] - kb[(rl, rl)] - 0.3 * kt).abs() < 1e-9 * kt);
+    for w in [3, 4, 6] {
+        assert_eq!(ca[(w, w)], cb[(w, w)]);
+        assert_eq!(ka[(w, w)], kb[(w, w)]);
+    }
+    // A factor out of range is an error naming the key.
+    let bad = bus.to_toml_string().unwrap()
+        + "\n[[corner_condition]]\ncorner = \"FL\"\ndamper_factor = -1\n";
+    let e = VehicleParams::from_toml_str(&bad).unwrap_err().to_string();
+    assert!(e.contains("corner_condition[0].damper_factor"), "{e}");
+}
