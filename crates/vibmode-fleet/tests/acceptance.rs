@@ -39,6 +39,15 @@ fn record(v: &VehicleParams, road: RoadClass, kmh: f64, seed: u64) -> vibmode_co
         .recording
 }
 
+/// (label, vehicle, road, speeds km/h, corner that must be named).
+type Scenario = (
+    String,
+    VehicleParams,
+    RoadClass,
+    Vec<f64>,
+    Option<&'static str>,
+);
+
 fn with(bus: &VehicleParams, cc: CornerCondition) -> VehicleParams {
     let mut v = bus.clone();
     v.corner_condition.push(cc);
@@ -92,7 +101,7 @@ fn issue_scenarios_over_three_baselines() {
             .expect("ingest");
         }
         let set = build_baseline(&mut store, "bus-1", &cfg).expect("baseline");
-        let mut scen: Vec<(String, VehicleParams, RoadClass, Vec<f64>, Option<&str>)> = vec![
+        let mut scen: Vec<Scenario> = vec![
             (
                 "healthy 20-40 km/h".into(),
                 bus.clone(),
