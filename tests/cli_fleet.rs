@@ -125,6 +125,30 @@ fn fleet_workflow_and_errors() {
         out.contains("bus-1") && out.contains("6 nominal") && out.contains("version 1"),
         "{out}"
     );
+    // A record with another channel layout is refused before anything is stored.
+    let odd = d.path().join("odd.csv");
+    let text = std::fs::read_to_string(&test[0])
+        .unwrap()
+        .replacen("FL_unsprung", "FL_wheel", 1);
+    std::fs::write(&odd, text).unwrap();
+    fails_with(
+        &[
+            "fleet",
+            "check",
+            "--db",
+            db,
+            "--vehicle",
+            "bus-1",
+            odd.to_str().unwrap(),
+        ],
+        &["odd.csv", "FL_wheel", "new baseline"],
+    );
+    let after = ok(&["fleet", "status", "--db", db]);
+    assert_eq!(
+        String::from_utf8_lossy(&after.stdout),
+        out,
+        "nothing stored"
+    );
     // The HTML report: the vehicle's section, its trend figure and the status table.
     let rep = d.path().join("fleet-report");
     ok(&["fleet", "report", "--db", db, "-o", rep.to_str().unwrap()]);

@@ -65,6 +65,18 @@ pub enum FleetError {
         /// Minimum.
         needed: usize,
     },
+    /// A record whose channels differ from those of the baseline it is checked against.
+    #[error("'{record}' has channels {found}, but the baseline of vehicle '{vehicle}' was built from {baseline}; record the same sensors with the same names, or build a new baseline for the new layout")]
+    LayoutDiffers {
+        /// The record (file) name.
+        record: String,
+        /// The vehicle.
+        vehicle: String,
+        /// The record's channels, comma-separated.
+        found: String,
+        /// The baseline's channels, comma-separated.
+        baseline: String,
+    },
     /// A check without a baseline.
     #[error("vehicle '{vehicle}' has no baseline yet; build one from its nominal records first (fleet baseline)")]
     NoBaseline {

@@ -199,8 +199,30 @@ pub fn check_recording(
         condition: Condition::Test,
         road: None,
     };
+    check_layout(set, name, rec)?;
     let ing = ingest_recording(store, &labels, name, sha256, rec, &set.config)?;
     finish_check(store, set, ing)
+}
+
+/// A record must have the channels the baseline was built from (same names, any order); else
+/// an error, before anything is stored.
+fn check_layout(set: &ModelSet, name: &str, rec: &Recording) -> Result<()> {
+    if set.channels.is_empty() {
+        return Ok(());
+    }
+    let mut found: Vec<&str> = rec.channels.iter().map(|c| c.name.as_str()).collect();
+    let mut base: Vec<&str> = set.channels.iter().map(String::as_str).collect();
+    found.sort_unstable();
+    base.sort_unstable();
+    if found == base {
+        return Ok(());
+    }
+    Err(FleetError::LayoutDiffers {
+        record: name.to_string(),
+        vehicle: set.vehicle.clone(),
+        found: found.join(", "),
+        baseline: base.join(", "),
+    })
 }
 
 /// Checks a file against `set` (stored as a test record unless already stored).
@@ -215,7 +237,21 @@ pub fn check_file(
         condition: Condition::Test,
         road: None,
     };
-    let ing = ingest_file(store, &labels, path, opts, &set.config)?;
+    check_vehicle_id(labels.vehicle)?;
+    let sha = hash_file(path)?;
+    let ing = match store.find_record(labels.vehicle, &sha)? {
+        Some(row) => Ingested {
+            file: file_name(path),
+            record_id: row.id,
+            already_stored: true,
+            notes: Vec::new(),
+        },
+        None => {
+            let rec = vibmode_signal::read_path(path, opts)?;
+            check_layout(set, &file_name(path), &rec)?;
+            ingest_recording(store, &labels, &file_name(path), &sha, &rec, &set.config)?
+        }
+    };
     finish_check(store, set, ing)
 }
 

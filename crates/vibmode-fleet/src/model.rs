@@ -131,6 +131,10 @@ pub struct ModelSet {
     pub features: Vec<FeatureStat>,
     /// Control limit per kind of feature.
     pub limits: Vec<KindLimit>,
+    /// Channels of the nominal records (a record checked against the set must have these;
+    /// empty in model sets stored before this field existed: not checked).
+    #[serde(default)]
+    pub channels: Vec<String>,
 }
 
 impl ModelSet {
@@ -527,6 +531,10 @@ pub fn build_model_set(
         slots,
         features,
         limits,
+        channels: records
+            .first()
+            .map(|r| r.channels.iter().map(|c| c.name.clone()).collect())
+            .unwrap_or_default(),
     })
 }
 
