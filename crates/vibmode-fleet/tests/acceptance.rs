@@ -20,6 +20,10 @@ fn config() -> FleetConfig {
     let mut c = FleetConfig::default();
     c.analysis.sweep.model = vibmode_analysis::SweepModel::Ar;
     c.analysis.sweep.order_max = 16;
+    // `FAR=0.05 cargo test ...` repeats the run at another false-alarm rate (docs/fleet.md).
+    if let Some(v) = std::env::var("FAR").ok().and_then(|v| v.parse().ok()) {
+        c.false_alarm_rate = v;
+    }
     c
 }
 
