@@ -145,13 +145,7 @@ pub fn run(a: &SsiArgs) -> Result<()> {
     let mut result = plan.sweep(&orders)?;
     for o in &mut result.orders {
         for m in &mut o.modes {
-            let back: Vec<[f64; 2]> = m
-                .shape
-                .iter()
-                .zip(&scales)
-                .map(|(x, s)| [x[0] * s, x[1] * s])
-                .collect();
-            m.shape = vibmode_modal::shapes::normalise(&back);
+            m.shape = vibmode_modal::shapes::rescaled(&m.shape, &scales);
         }
     }
     let stability_params = StabilityParams::default();

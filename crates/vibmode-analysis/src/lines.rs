@@ -51,32 +51,65 @@ pub struct LineTrack {
 
 /// The signals of the analysis, for the line evidence.
 pub(crate) struct LineStage<'a> {
-    pub pre: &'a [Preprocessed],
+    pre: &'a [Preprocessed],
     /// Records used for the modes (stops excluded).
-    pub used: Vec<bool>,
-    pub params: &'a LineParams,
+    used: Vec<bool>,
+    params: &'a LineParams,
+    /// Periodic candidates below the cutoff per record and channel, computed once (a channel is
+    /// in its own pool, its role's and the multichannel one); empty for records not used.
+    candidates: Vec<Vec<Vec<LineCandidate>>>,
 }
 
-impl LineStage<'_> {
+impl<'a> LineStage<'a> {
+    /// The stage over the pre-processed records; `used[r]` is false for stops.
+    pub fn new(pre: &'a [Preprocessed], used: Vec<bool>, params: &'a LineParams) -> Self {
+        let enabled = params.max_kurtosis > 0.0;
+        let candidates = pre
+            .iter()
+            .zip(&used)
+            .map(|(p, &u)| {
+                if !(u && enabled) {
+                    return Vec::new();
+                }
+                p.recording
+                    .channels
+                    .iter()
+                    .map(|ch| {
+                        line_candidates(&ch.samples, p.band.fs_hz, params)
+                            .unwrap_or_default()
+                            .into_iter()
+                            .filter(|l| l.periodic && l.frequency_hz < p.band.cutoff_hz)
+                            .collect()
+                    })
+                    .collect()
+            })
+            .collect();
+        LineStage {
+            pre,
+            used,
+            params,
+            candidates,
+        }
+    }
+
     fn enabled(&self) -> bool {
         self.params.max_kurtosis > 0.0
     }
 
     /// Periodic line candidates of each record used, merged over the `channels` (indices).
     fn record_lines(&self, channels: &[usize]) -> Vec<Option<Vec<LineCandidate>>> {
-        self.pre
+        self.candidates
             .iter()
             .zip(&self.used)
-            .map(|(p, &used)| {
+            .map(|(per_channel, &used)| {
                 if !used {
                     return None;
                 }
                 let mut all: Vec<LineCandidate> = channels
                     .iter()
-                    .filter_map(|&c| p.recording.channels.get(c))
-                    .filter_map(|ch| line_candidates(&ch.samples, p.band.fs_hz, self.params).ok())
+                    .filter_map(|&c| per_channel.get(c))
                     .flatten()
-                    .filter(|l| l.periodic && l.frequency_hz < p.band.cutoff_hz)
+                    .copied()
                     .collect();
                 all.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
                 // One line per half-width: channels see the same line.

@@ -162,13 +162,7 @@ impl SsiStage<'_> {
                     frequency_hz: m.frequency_hz,
                     damping_ratio: m.damping_ratio,
                     mpc: m.mpc,
-                    shape: vibmode_modal::shapes::normalise(
-                        &m.shape
-                            .iter()
-                            .zip(scales)
-                            .map(|(x, s)| [x[0] * s, x[1] * s])
-                            .collect::<Vec<_>>(),
-                    ),
+                    shape: vibmode_modal::shapes::rescaled(&m.shape, scales),
                 })
             })
             .filter(|q| q.frequency_hz < f_max)

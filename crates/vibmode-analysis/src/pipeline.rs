@@ -153,11 +153,7 @@ pub fn analyze_with(
         orders: &orders,
         cluster: &cluster,
     };
-    let lines = LineStage {
-        pre: &pre,
-        used: stationary.iter().map(|s| !s).collect(),
-        params: &cfg.lines,
-    };
+    let lines = LineStage::new(&pre, stationary.iter().map(|s| !s).collect(), &cfg.lines);
     let mut store = PoleStore::new();
     let channels = channel_modes(
         &records[0].recording,

@@ -10,22 +10,14 @@
 
 use std::collections::BTreeMap;
 
+mod common;
+
+use common::config;
 use vibmode_fleet::{
     build_baseline, check_recording, ingest_recording, recording_hash, Classification, Condition,
-    FleetConfig, IngestLabels, Store,
+    IngestLabels, Store,
 };
 use vibmode_vehicle::{simulate, Corner, CornerCondition, RoadClass, SimParams, VehicleParams};
-
-fn config() -> FleetConfig {
-    let mut c = FleetConfig::default();
-    c.analysis.sweep.model = vibmode_analysis::SweepModel::Ar;
-    c.analysis.sweep.order_max = 16;
-    // `FAR=0.05 cargo test ...` repeats the run at another false-alarm rate (docs/fleet.md).
-    if let Some(v) = std::env::var("FAR").ok().and_then(|v| v.parse().ok()) {
-        c.false_alarm_rate = v;
-    }
-    c
-}
 
 fn record(v: &VehicleParams, road: RoadClass, kmh: f64, seed: u64) -> vibmode_core::Recording {
     let p = SimParams {

@@ -4,19 +4,14 @@
 
 use std::collections::BTreeMap;
 
+mod common;
+
+use common::config;
 use vibmode_fleet::{
     build_baseline, check_recording, ingest_recording, recording_hash, Classification, Condition,
-    FleetConfig, IngestLabels, Store,
+    IngestLabels, Store,
 };
 use vibmode_vehicle::{simulate, RoadClass, SimParams, VehicleParams};
-
-/// A faster analysis than the default (AR sweep to order 16) so five seeds run in seconds.
-fn config() -> FleetConfig {
-    let mut c = FleetConfig::default();
-    c.analysis.sweep.model = vibmode_analysis::SweepModel::Ar;
-    c.analysis.sweep.order_max = 16;
-    c
-}
 
 fn runs(
     v: &VehicleParams,

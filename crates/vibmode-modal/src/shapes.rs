@@ -47,6 +47,21 @@ pub fn normalise(shape: &[[f64; 2]]) -> Vec<[f64; 2]> {
         .collect()
 }
 
+/// The shape with each entry multiplied by its channel's real factor, normalised
+/// ([`normalise`]): a shape identified from channels divided by their RMS, back in the channels'
+/// units (`factors` = the RMS values). Entries without a factor are kept.
+pub fn rescaled(shape: &[[f64; 2]], factors: &[f64]) -> Vec<[f64; 2]> {
+    let back: Vec<[f64; 2]> = shape
+        .iter()
+        .enumerate()
+        .map(|(i, x)| {
+            let f = factors.get(i).copied().unwrap_or(1.0);
+            [x[0] * f, x[1] * f]
+        })
+        .collect();
+    normalise(&back)
+}
+
 /// Mean of shapes of one length: each is scaled by the complex factor that brings it closest (least
 /// squares) to the first, the scaled shapes are averaged, and the mean is normalised
 /// ([`normalise`]). `None` when there is no shape or the lengths differ.
@@ -94,6 +109,13 @@ mod tests {
         assert!((mac(&[[1.0, 0.0], [0.0, 0.0]], &[[1.0, 0.0], [1.0, 0.0]]) - 0.5).abs() < 1e-15);
         assert_eq!(mac(&a, &[[0.0, 0.0], [0.0, 0.0]]), 0.0);
         assert_eq!(mac(&a, &[[1.0, 0.0]]), 0.0);
+    }
+
+    #[test]
+    fn rescaled_by_hand() {
+        // [0.5, 1] with factors [4, 1] -> [2, 1] -> normalised [1, 0.5]
+        let r = rescaled(&[[0.5, 0.0], [1.0, 0.0]], &[4.0, 1.0]);
+        assert_eq!(r, vec![[1.0, 0.0], [0.5, 0.0]]);
     }
 
     #[test]
