@@ -100,7 +100,7 @@ fn load_config(config: Option<&Path>, preset: Option<&str>) -> Result<AnalysisCo
     let cfg = match (config, preset) {
         (Some(path), None) => AnalysisConfig::from_path(path)?,
         (Some(path), Some(p)) => {
-            let text = std::fs::read_to_string(path)
+            let text = vibmode_core::limits::read_text_capped(path)
                 .with_context(|| format!("cannot read config {}", path.display()))?;
             let p: Preset = p.parse()?;
             let name = match p {

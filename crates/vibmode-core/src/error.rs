@@ -1,12 +1,14 @@
 //! Errors of the core types. Messages name the offending value and the fix, never a
 //! command-line flag: the front end (CLI, Python) adds its own hints.
 
+use crate::limits::{num, FS_HZ_MAX, FS_HZ_MIN, SAMPLE_ABS_MAX, SAMPLE_PEAK_MIN};
+
 /// A recording that breaks its invariants, or a channel that cannot be found.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum RecordingError {
     /// A NaN or infinite sample.
-    #[error("channel '{channel}' sample {index} is {value}; clean the data first (remove or interpolate the bad samples)")]
+    #[error("channel '{channel}' sample {index} is {}; clean the data first (remove or interpolate the bad samples)", num(.value))]
     NonFinite {
         /// Channel name.
         channel: String,
@@ -16,12 +18,48 @@ pub enum RecordingError {
         value: f64,
     },
     /// A sampling rate that is not a positive finite number.
-    #[error("sampling rate {fs_hz} Hz ({what}) must be a positive finite number")]
+    #[error("sampling rate {} Hz ({what}) must be a positive finite number", num(.fs_hz))]
     InvalidSampleRate {
         /// Where the rate came from.
         what: String,
         /// The value.
         fs_hz: f64,
+    },
+    /// A sampling rate outside [`FS_HZ_MIN`, `FS_HZ_MAX`].
+    #[error("sampling rate {} Hz ({what}) is outside {} to {} Hz; check its unit (a time column in ms read as s, say)", num(.fs_hz), num(&FS_HZ_MIN), num(&FS_HZ_MAX))]
+    SampleRateOutOfRange {
+        /// Where the rate came from.
+        what: String,
+        /// The value.
+        fs_hz: f64,
+    },
+    /// A sample whose magnitude exceeds [`SAMPLE_ABS_MAX`]: its powers would overflow.
+    #[error("channel '{channel}' sample {index} is {}, beyond the largest magnitude vibmode accepts ({}); rescale the data (another unit) or remove the bad samples", num(.value), num(&SAMPLE_ABS_MAX))]
+    SampleTooLarge {
+        /// Channel name.
+        channel: String,
+        /// 0-based sample index.
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+    /// A channel whose largest magnitude is below [`SAMPLE_PEAK_MIN`] but not zero.
+    #[error("channel '{channel}' peaks at {}, below the smallest magnitude vibmode accepts ({}); rescale the data (another unit)", num(.peak), num(&SAMPLE_PEAK_MIN))]
+    SamplesTooSmall {
+        /// Channel name.
+        channel: String,
+        /// Largest |sample|.
+        peak: f64,
+    },
+    /// More channels than [`CHANNELS_MAX`].
+    #[error("{what} has {count} channels; vibmode reads at most {max}: select the columns you need or split the file")]
+    TooManyChannels {
+        /// Where.
+        what: String,
+        /// Number found.
+        count: usize,
+        /// The limit.
+        max: usize,
     },
     /// A channel name not present in the recording.
     #[error("no channel named '{name}'; available: {available}{hint}")]

@@ -19,6 +19,7 @@
 //! ```
 
 pub mod error;
+pub mod limits;
 pub mod modes;
 pub mod params;
 pub mod placement;
@@ -26,6 +27,7 @@ pub mod recording;
 pub mod ssi;
 
 pub use error::{ParamError, RecordingError};
+pub use limits::{num, Num};
 pub use modes::{
     FitSummary, InvariantMode, ModeClass, ModeMatch, ModelCoefficients, PoleObservation,
     ReferenceMode, SupportFailure,

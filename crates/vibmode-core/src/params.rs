@@ -22,7 +22,7 @@ fn positive(name: &'static str, v: f64, default: f64) -> Result<(), ParamError> 
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
-        Err(bad(name, v, "must be finite and > 0", default))
+        Err(bad(name, crate::Num(v), "must be finite and > 0", default))
     }
 }
 
@@ -30,7 +30,7 @@ fn share(name: &'static str, v: f64, default: f64) -> Result<(), ParamError> {
     if (0.0..=1.0).contains(&v) {
         Ok(())
     } else {
-        Err(bad(name, v, "must be in [0, 1]", default))
+        Err(bad(name, crate::Num(v), "must be in [0, 1]", default))
     }
 }
 
@@ -614,7 +614,15 @@ impl ClusterParams {
     /// Check every field; returns the first invalid one.
     pub fn validate(&self) -> Result<(), ParamError> {
         let d = ClusterParams::default();
-        positive("freq_tol_rel", self.freq_tol_rel, d.freq_tol_rel)?;
+        // Below 1e-4 the clustering grid has more cells than poles can fill (and hangs).
+        if !(1e-4..=1.0).contains(&self.freq_tol_rel) {
+            return Err(bad(
+                "freq_tol_rel",
+                crate::Num(self.freq_tol_rel),
+                "must be in [1e-4, 1]",
+                d.freq_tol_rel,
+            ));
+        }
         if !(self.freq_tol_per_damping.is_finite() && self.freq_tol_per_damping >= 0.0) {
             return Err(bad(
                 "freq_tol_per_damping",

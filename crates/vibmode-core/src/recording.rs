@@ -104,14 +104,22 @@ impl fmt::Display for ChannelSelector {
 }
 
 /// Checks that a sampling rate is positive and finite; `what` names where it came from.
+/// Rates outside [`FS_HZ_MIN`](crate::limits::FS_HZ_MIN) to
+/// [`FS_HZ_MAX`](crate::limits::FS_HZ_MAX) are refused as well (a unit mistake, and a resource
+/// bomb downstream).
 pub fn check_fs(fs_hz: f64, what: &str) -> Result<(), RecordingError> {
-    if fs_hz.is_finite() && fs_hz > 0.0 {
-        Ok(())
-    } else {
+    if !(fs_hz.is_finite() && fs_hz > 0.0) {
         Err(RecordingError::InvalidSampleRate {
             what: what.to_string(),
             fs_hz,
         })
+    } else if !(crate::limits::FS_HZ_MIN..=crate::limits::FS_HZ_MAX).contains(&fs_hz) {
+        Err(RecordingError::SampleRateOutOfRange {
+            what: what.to_string(),
+            fs_hz,
+        })
+    } else {
+        Ok(())
     }
 }
 
@@ -286,14 +294,41 @@ impl Recording {
     }
 }
 
-/// Checks that every sample of every channel is finite (the first bad one is named).
+/// Checks the samples against [`crate::limits`]: every sample finite and at most
+/// `SAMPLE_ABS_MAX` in magnitude, a channel not all zeros peaking at `SAMPLE_PEAK_MIN` or more,
+/// at most `CHANNELS_MAX` channels. The first bad sample is named.
 pub fn check_finite(channels: &[Channel]) -> Result<(), RecordingError> {
+    use crate::limits::{CHANNELS_MAX, SAMPLE_ABS_MAX, SAMPLE_PEAK_MIN};
+    if channels.len() > CHANNELS_MAX {
+        return Err(RecordingError::TooManyChannels {
+            what: "the recording".into(),
+            count: channels.len(),
+            max: CHANNELS_MAX,
+        });
+    }
     for c in channels {
-        if let Some(i) = c.samples.iter().position(|v| !v.is_finite()) {
-            return Err(RecordingError::NonFinite {
+        let mut peak = 0.0f64;
+        for (i, &v) in c.samples.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(RecordingError::NonFinite {
+                    channel: c.name.clone(),
+                    index: i,
+                    value: v,
+                });
+            }
+            if v.abs() > SAMPLE_ABS_MAX {
+                return Err(RecordingError::SampleTooLarge {
+                    channel: c.name.clone(),
+                    index: i,
+                    value: v,
+                });
+            }
+            peak = peak.max(v.abs());
+        }
+        if peak > 0.0 && peak < SAMPLE_PEAK_MIN {
+            return Err(RecordingError::SamplesTooSmall {
                 channel: c.name.clone(),
-                index: i,
-                value: c.samples[i],
+                peak,
             });
         }
     }

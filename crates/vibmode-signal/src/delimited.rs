@@ -30,6 +30,8 @@ use crate::error::{Result, SignalError};
 use crate::number::{parse_slow, scan_number, Scan};
 use serde::{Deserialize, Serialize};
 use std::io::BufRead;
+use vibmode_core::limits::CHANNELS_MAX;
+use vibmode_core::RecordingError;
 
 /// The cell separator of a delimited text file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -58,6 +60,38 @@ fn mixed_whitespace_numbers(line: &[u8]) -> bool {
     spans
         .iter()
         .all(|&(a, b)| parse_slow(&line[a..b], true, &mut scratch).is_some())
+}
+
+/// Refuses a line with NUL or other control bytes (tab, CR and form feed aside): binary data
+/// read as text would otherwise be echoed into messages.
+fn check_text(line: &[u8], path: &str, line_no: usize) -> Result<()> {
+    if line
+        .iter()
+        .any(|&b| (b < 0x20 && !matches!(b, b'\t' | b'\r' | 0x0c)) || b == 0x7f)
+    {
+        return Err(SignalError::NotText {
+            path: path.to_string(),
+            line: line_no,
+        });
+    }
+    Ok(())
+}
+
+/// Excel's separator directive `sep=X` (optionally quoted): `Some(Some(sep))` for a separator
+/// vibmode reads, `Some(None)` for another one, `None` when the line is no directive.
+fn sep_directive(t: &[u8]) -> Option<Option<Separator>> {
+    let t = t.strip_prefix(b"\"").unwrap_or(t);
+    let t = t.strip_suffix(b"\"").unwrap_or(t);
+    if t.len() < 4 || !t[..4].eq_ignore_ascii_case(b"sep=") {
+        return None;
+    }
+    Some(match &t[4..] {
+        b"," => Some(Separator::Comma),
+        b";" => Some(Separator::Semicolon),
+        b"\t" => Some(Separator::Tab),
+        b" " | b"" => Some(Separator::Whitespace),
+        _ => None,
+    })
 }
 
 impl Separator {
@@ -310,6 +344,8 @@ impl<R: BufRead> DelimitedReader<R> {
             spans: Vec::new(),
             scratch: Vec::new(),
         };
+        // Excel's `sep=X` first line, when present.
+        let mut forced_sep: Option<Separator> = None;
         // First content line (skipping blanks and comment lines).
         let first = loop {
             match r.next_line()? {
@@ -325,17 +361,37 @@ impl<R: BufRead> DelimitedReader<R> {
                     } else {
                         &l[..]
                     };
+                    check_text(l, &r.path, n)?;
                     let t = trim_cell(l);
                     if t.is_empty() || t[0] == b'#' || t[0] == b'%' {
                         continue;
+                    }
+                    if forced_sep.is_none() {
+                        if let Some(sep) = sep_directive(t) {
+                            forced_sep =
+                                Some(sep.ok_or_else(|| SignalError::UnsupportedSeparator {
+                                    path: r.path.clone(),
+                                    line: n,
+                                    sep: String::from_utf8_lossy(&t[4..]).into_owned(),
+                                })?);
+                            continue;
+                        }
                     }
                     break (n, l.to_vec());
                 }
             }
         };
-        r.sep = Separator::sniff(&first.1);
+        r.sep = forced_sep.unwrap_or_else(|| Separator::sniff(&first.1));
         let mut spans = Vec::new();
         split_spans(&first.1, r.sep, &mut spans);
+        if spans.len() > CHANNELS_MAX + 1 {
+            return Err(RecordingError::TooManyChannels {
+                what: r.path.clone(),
+                count: spans.len(),
+                max: CHANNELS_MAX,
+            }
+            .into());
+        }
         let allow_comma = r.sep != Separator::Comma;
         let mut scratch = Vec::new();
         let is_header = spans
@@ -354,10 +410,14 @@ impl<R: BufRead> DelimitedReader<R> {
                         })
                     }
                     Some(n) => {
+                        check_text(&r.buf, &r.path, n)?;
                         if trim_cell(&r.buf).is_empty() {
                             continue;
                         }
-                        if r.sep == Separator::Tab && mixed_whitespace_numbers(&r.buf) {
+                        if forced_sep.is_none()
+                            && r.sep == Separator::Tab
+                            && mixed_whitespace_numbers(&r.buf)
+                        {
                             // Data aligned with spaces and tabs: split header and rows on runs.
                             r.sep = Separator::Whitespace;
                             split_spans(&first.1, r.sep, &mut spans);
@@ -836,6 +896,7 @@ impl RowCtx<'_> {
 
     /// Parses one line into `block` (blank lines are skipped).
     fn parse_row(&mut self, line: &[u8], line_no: usize, block: &mut Block) -> Result<()> {
+        check_text(line, self.path, line_no)?;
         let nc = self.columns.len();
         split_spans(line, self.sep, self.spans);
         if self.spans.is_empty() {

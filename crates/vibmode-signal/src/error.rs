@@ -25,6 +25,25 @@ pub enum SignalError {
         /// The file.
         path: String,
     },
+    /// Bytes that are not text (NUL or other control characters) where delimited text was
+    /// expected.
+    #[error("{path} is not a text file (line {line} has control bytes); give a CSV/text export, a .wav, or raw samples with a .json sidecar")]
+    NotText {
+        /// The file.
+        path: String,
+        /// 1-based line number.
+        line: usize,
+    },
+    /// Excel's `sep=X` directive names a separator vibmode does not read.
+    #[error("{path}: the separator directive on line {line} names '{sep}'; vibmode reads comma, semicolon, tab or whitespace separators")]
+    UnsupportedSeparator {
+        /// The file.
+        path: String,
+        /// 1-based line number.
+        line: usize,
+        /// The separator named.
+        sep: String,
+    },
     /// A header row but no data rows.
     #[error("{path} has a header row but no data rows; check that the file was fully exported")]
     NoDataRows {

@@ -24,8 +24,23 @@ pub struct Preprocessed {
 /// below `analysis_fs_hz` (425.08 Hz -> 49.998 Hz). A record already at the analysis rate is
 /// still low-passed at the cutoff.
 ///
-/// Errors: invalid parameters, non-finite samples, a record too short to resample.
+/// Errors: invalid parameters, an analysis rate more than
+/// [`UPSAMPLE_RATIO_MAX`](vibmode_core::limits::UPSAMPLE_RATIO_MAX) times the record's, non-finite
+/// samples, a record too short to resample.
 pub fn preprocess(rec: &Recording, p: &PreprocessParams) -> Result<Preprocessed> {
+    let ratio = p.analysis_fs_hz / rec.fs_hz;
+    if ratio > vibmode_core::limits::UPSAMPLE_RATIO_MAX {
+        return Err(crate::SignalError::InvalidParam {
+            name: "analysis_fs_hz",
+            value: vibmode_core::Num(p.analysis_fs_hz).to_string(),
+            fix: format!(
+                "it is {} times the record's rate of {} Hz (at most {} allowed); check the unit of the time column or of fs_hz, or lower analysis_fs_hz",
+                vibmode_core::Num(ratio),
+                vibmode_core::Num(rec.fs_hz),
+                vibmode_core::limits::UPSAMPLE_RATIO_MAX
+            ),
+        });
+    }
     let wanted = ResampleParams {
         to_hz: p.analysis_fs_hz,
         cutoff_hz: Some(p.cutoff_hz.min(rec.fs_hz / 2.0)),

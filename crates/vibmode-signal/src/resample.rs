@@ -42,7 +42,8 @@ use num_complex::Complex;
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
-use vibmode_core::{check_fs, Channel, Recording, RecordingError, TimeAxis};
+use vibmode_core::limits::{SAMPLES_OUT_MAX, UPSAMPLE_RATIO_MAX};
+use vibmode_core::{check_fs, Channel, Num, Recording, RecordingError, TimeAxis};
 
 /// Parameters of [`resample`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -132,7 +133,7 @@ impl std::fmt::Debug for Resampler {
 fn invalid(name: &'static str, value: f64, fix: String) -> SignalError {
     SignalError::InvalidParam {
         name,
-        value: value.to_string(),
+        value: vibmode_core::Num(value).to_string(),
         fix,
     }
 }
@@ -279,6 +280,29 @@ impl Resampler {
                 "to_hz",
                 p.to_hz,
                 "the target rate must be a positive finite number of Hz, e.g. 200".into(),
+            ));
+        }
+        check_fs(p.to_hz, "target rate to_hz")?;
+        let ratio = p.to_hz / fs_hz;
+        if ratio > UPSAMPLE_RATIO_MAX {
+            return Err(invalid(
+                "to_hz",
+                p.to_hz,
+                format!(
+                    "it is {} times the input rate {} Hz; vibmode upsamples at most {UPSAMPLE_RATIO_MAX} times: check the rates' units",
+                    Num(ratio),
+                    Num(fs_hz)
+                ),
+            ));
+        }
+        if (n_in as f64 * ratio) > SAMPLES_OUT_MAX as f64 {
+            return Err(invalid(
+                "to_hz",
+                p.to_hz,
+                format!(
+                    "{n_in} samples would become {} samples, more than the {SAMPLES_OUT_MAX} vibmode makes at once; cut the recording into parts",
+                    Num((n_in as f64 * ratio).round())
+                ),
             ));
         }
         let (kind, factor, n_out, fs_out) = plan_kind(n_in, fs_hz, p);
@@ -511,6 +535,18 @@ impl ResampleRecording for Recording {
     /// with `fs_hz` the new rate and `jitter_rel` 0.
     fn resample(&self, p: &ResampleParams) -> Result<Recording> {
         let mut r = Resampler::new(self.len(), self.fs_hz, p)?;
+        let total = r.n_out() as u64 * self.channels.len() as u64;
+        if total > SAMPLES_OUT_MAX {
+            return Err(invalid(
+                "to_hz",
+                p.to_hz,
+                format!(
+                    "{} channels of {} samples each are more than the {SAMPLES_OUT_MAX} samples vibmode makes at once; cut the recording into parts",
+                    self.channels.len(),
+                    r.n_out()
+                ),
+            ));
+        }
         let mut channels = Vec::with_capacity(self.channels.len());
         for c in &self.channels {
             let mut out = vec![0.0; r.n_out()];

@@ -311,10 +311,11 @@ impl VehicleParams {
     /// Read, parse and validate a TOML file.
     pub fn from_path(path: impl AsRef<std::path::Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| VehicleError::Io {
-            path: path.display().to_string(),
-            source,
-        })?;
+        let text =
+            vibmode_core::limits::read_text_capped(path).map_err(|source| VehicleError::Io {
+                path: path.display().to_string(),
+                source,
+            })?;
         Self::from_toml_str(&text)
     }
 
