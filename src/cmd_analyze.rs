@@ -100,7 +100,7 @@ fn load_config(config: Option<&Path>, preset: Option<&str>) -> Result<AnalysisCo
     let cfg = match (config, preset) {
         (Some(path), None) => AnalysisConfig::from_path(path)?,
         (Some(path), Some(p)) => {
-            let text = vibmode_core::limits::read_text_capped(path)
+            let text = vibmode_core::files::read_text_capped(path)
                 .with_context(|| format!("cannot read config {}", path.display()))?;
             let p: Preset = p.parse()?;
             let name = match p {
@@ -120,6 +120,8 @@ fn load_config(config: Option<&Path>, preset: Option<&str>) -> Result<AnalysisCo
 /// Runs `vibmode analyze`.
 pub fn run(a: &AnalyzeArgs) -> Result<()> {
     let mut cfg = load_config(a.config.as_deref(), a.preset.as_deref())?;
+    // The output folder is checked and locked before any work, and written as a whole.
+    let out = crate::output::StagedDir::begin(&a.output, &a.inputs)?;
     apply_placements(&mut cfg, &a.roles, &a.corners)?;
     if let Some(m) = &a.method {
         cfg.method = m.parse()?;
@@ -152,9 +154,29 @@ pub fn run(a: &AnalyzeArgs) -> Result<()> {
         None => Vec::new(),
     };
     let results = run_analysis(&records, &cfg, &reference, a.quiet)?;
-    write_report(&a.output, &records, &results, None)?;
+    check_some_fit(&results)?;
+    write_report(out.path(), &records, &results, None)?;
+    out.commit()?;
     print_modes(&results, None)?;
     eprintln!("report: {}", a.output.join("index.html").display());
+    Ok(())
+}
+
+/// An analysis in which every fit failed has nothing to report: an error, with the first
+/// failure's reason (not an empty table and exit 0).
+fn check_some_fit(r: &AnalysisResults) -> Result<()> {
+    if r.n_fits > 0 && r.n_failed == r.n_fits {
+        let why = r
+            .channels
+            .iter()
+            .flat_map(|c| c.fits.iter())
+            .find_map(|f| f.error.clone())
+            .unwrap_or_else(|| "no reason recorded".into());
+        bail!(
+            "every one of the {} fits failed, so nothing was identified; the first failure: {why}",
+            r.n_fits
+        );
+    }
     Ok(())
 }
 
@@ -256,6 +278,7 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
     if let Some(m) = &a.method {
         cfg.method = m.parse()?;
     }
+    let out = crate::output::StagedDir::begin(&a.output, &[])?;
     let vehicle = vibmode_vehicle::VehicleParams::city_bus_flexible();
     let p = vibmode_vehicle::SimParams::demo(a.records, a.seed);
     p.validate()?;
@@ -265,7 +288,9 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
     );
     let sim = vibmode_vehicle::simulate(&vehicle, &p)?;
     if a.keep_records {
-        write_simulation(&a.output.join("records"), &sim, RecordFormat::Wav)?;
+        let dir = out.path().join("records");
+        std::fs::create_dir(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        write_simulation(&dir, &sim, RecordFormat::Wav)?;
     }
     let records: Vec<RecordInput> = sim
         .records
@@ -299,7 +324,8 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
             .collect::<Vec<_>>()
             .join(", "),
     );
-    write_report(&a.output, &records, &results, Some(&intro))?;
+    write_report(out.path(), &records, &results, Some(&intro))?;
+    out.commit()?;
     let mut truth: Vec<TruthRow> = sim
         .truth
         .modes

@@ -2,7 +2,7 @@
 
 use crate::cmd_psd::SpectralArgs;
 use crate::input::InputArgs;
-use crate::output::{ensure_parent, write_json};
+use crate::output::write_json;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
@@ -205,6 +205,7 @@ pub fn channel_fit(
 
 /// Runs `vibmode fit`.
 pub fn run(a: &FitArgs) -> Result<()> {
+    crate::output::check_outputs(&a.input.input, &[], &[a.plot.as_deref()], a.json.as_deref())?;
     let (rec, band) = a.input.load_with_band()?;
     let robust = parse_robust(a.robust.as_deref())?;
     let params = ArmaParams {
@@ -244,7 +245,6 @@ pub fn run(a: &FitArgs) -> Result<()> {
     };
     if let Some(path) = &a.plot {
         let fig = fit_figure(&rec, &models, &out.channels, a)?;
-        ensure_parent(path)?;
         fig.save(path)
             .with_context(|| format!("writing plot {}", path.display()))?;
     }

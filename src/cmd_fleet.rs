@@ -144,8 +144,14 @@ pub fn run(a: &FleetArgs) -> Result<()> {
         FleetCommand::Status { db } => status(db),
         FleetCommand::Report { db, output } => {
             let store = Store::open(db)?;
-            let path = vibmode_fleet::write_fleet_report(&store, output)?;
-            eprintln!("report: {}", path.display());
+            let out = crate::output::StagedDir::begin(output, std::slice::from_ref(db))?;
+            let path = vibmode_fleet::write_fleet_report(&store, out.path())?;
+            out.commit()?;
+            let name = path
+                .file_name()
+                .map(|n| n.to_os_string())
+                .unwrap_or_default();
+            eprintln!("report: {}", output.join(name).display());
             Ok(())
         }
     }

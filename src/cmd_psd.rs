@@ -1,7 +1,7 @@
 //! `vibmode psd`: Welch and periodogram spectra with scipy.signal's parameters.
 
 use crate::input::InputArgs;
-use crate::output::{ensure_parent, write_json};
+use crate::output::write_json;
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
@@ -263,6 +263,19 @@ fn compute(
 
 /// Runs `vibmode psd`.
 pub fn run(a: &PsdArgs) -> Result<()> {
+    crate::output::check_outputs(
+        &a.input.input,
+        &[a.csv.as_deref()],
+        &[a.plot.as_deref()],
+        a.json.as_deref(),
+    )?;
+    if let Some(f) = a.fmax_hz {
+        if !(f.is_finite() && f > 0.0) {
+            anyhow::bail!(
+                "--fmax {f}: the plot's highest frequency must be a positive number of Hz"
+            );
+        }
+    }
     let rec = a.input.load()?;
     let (channels, mut used) = compute(&rec, a.method, &a.spectral)?;
     used.resampled_to_hz = a.input.resample_to_hz;
@@ -281,7 +294,6 @@ pub fn run(a: &PsdArgs) -> Result<()> {
     }
     if let Some(path) = &a.plot {
         let fig = psd_figure(&output, a.xscale.into(), a.yscale.into(), a.fmax_hz);
-        ensure_parent(path)?;
         fig.save(path)
             .with_context(|| format!("writing plot {}", path.display()))?;
     }
@@ -338,24 +350,25 @@ fn print_summary(o: &PsdOutput) -> Result<()> {
 
 fn write_csv(path: &std::path::Path, o: &PsdOutput) -> Result<()> {
     use std::io::Write;
-    ensure_parent(path)?;
-    let f = std::fs::File::create(path)
-        .with_context(|| format!("cannot create CSV file {}", path.display()))?;
-    let mut w = std::io::BufWriter::new(f);
-    let mut header = vec!["frequency_hz".to_string()];
-    header.extend(o.channels.iter().map(|c| c.name.replace(',', "_")));
-    writeln!(w, "{}", header.join(","))?;
-    if let Some(c0) = o.channels.first() {
-        for (i, f) in c0.frequency_hz.iter().enumerate() {
-            write!(w, "{f}")?;
-            for c in &o.channels {
-                write!(w, ",{:e}", c.psd.get(i).copied().unwrap_or(f64::NAN))?;
+    vibmode_core::files::write_atomic(path, anyhow::Error::from, |tmp| {
+        let f = std::fs::File::create(tmp)?;
+        let mut w = std::io::BufWriter::new(f);
+        let mut header = vec!["frequency_hz".to_string()];
+        header.extend(o.channels.iter().map(|c| c.name.replace(',', "_")));
+        writeln!(w, "{}", header.join(","))?;
+        if let Some(c0) = o.channels.first() {
+            for (i, f) in c0.frequency_hz.iter().enumerate() {
+                write!(w, "{f}")?;
+                for c in &o.channels {
+                    write!(w, ",{:e}", c.psd.get(i).copied().unwrap_or(f64::NAN))?;
+                }
+                writeln!(w)?;
             }
-            writeln!(w)?;
         }
-    }
-    w.flush()?;
-    Ok(())
+        w.flush()?;
+        Ok(())
+    })
+    .with_context(|| format!("cannot write CSV file {}", path.display()))
 }
 
 fn psd_figure(o: &PsdOutput, xs: Scale, ys: Scale, fmax: Option<f64>) -> Figure {

@@ -1,7 +1,6 @@
 //! `vibmode resample`: the paper's ideal DFT anti-alias filter and resampling.
 
 use crate::input::InputArgs;
-use crate::output::ensure_parent;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -36,14 +35,19 @@ pub fn run(a: &ResampleArgs) -> Result<()> {
     if a.input.resample_to_hz.is_some() {
         bail!("use --to HZ with `vibmode resample` (--resample-to is for the analysis commands)");
     }
-    // Refuse early to overwrite the input (it would be truncated while still being read).
-    if let (Ok(i), Ok(o)) = (a.input.input.canonicalize(), a.output.canonicalize()) {
-        if i == o {
-            bail!(
-                "the output {} is the input file; write to another file (-o OUT.csv)",
-                a.output.display()
-            );
-        }
+    // Every output checked before any work (an output that is the input would be truncated
+    // while still being read).
+    crate::output::check_outputs(
+        &a.input.input,
+        &[Some(a.output.as_path())],
+        &[a.plot.as_deref()],
+        None,
+    )?;
+    if !(a.plot_seconds.is_finite() && a.plot_seconds > 0.0) {
+        bail!(
+            "--plot-seconds {}: the time panel needs a positive number of seconds, e.g. 0.5",
+            a.plot_seconds
+        );
     }
     let raw = a.input.load_raw()?;
     let p = ResampleParams {
@@ -52,7 +56,6 @@ pub fn run(a: &ResampleArgs) -> Result<()> {
         filter: !a.no_filter,
     };
     let out = raw.resample(&p)?;
-    ensure_parent(&a.output)?;
     vibmode_signal::write_path(&a.output, &out)
         .with_context(|| format!("writing {}", a.output.display()))?;
     eprintln!(
@@ -76,7 +79,6 @@ pub fn run(a: &ResampleArgs) -> Result<()> {
     if let Some(path) = &a.plot {
         let fig =
             vibmode_report::antialias_figure(&raw, a.to_hz, a.input.cutoff_hz, a.plot_seconds)?;
-        ensure_parent(path)?;
         fig.save(path)
             .with_context(|| format!("writing plot {}", path.display()))?;
     }

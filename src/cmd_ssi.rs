@@ -3,7 +3,7 @@
 
 use crate::cmd_sweep::parse_orders;
 use crate::input::InputArgs;
-use crate::output::{ensure_parent, write_json};
+use crate::output::write_json;
 use anyhow::{Context, Result};
 use clap::Args;
 use serde::Serialize;
@@ -105,6 +105,7 @@ fn params(a: &SsiArgs) -> Result<SsiParams> {
 
 /// Runs `vibmode ssi`.
 pub fn run(a: &SsiArgs) -> Result<()> {
+    crate::output::check_outputs(&a.input.input, &[], &[a.plot.as_deref()], a.json.as_deref())?;
     let (rec, band) = a.input.load_with_band()?;
     let p = params(a)?;
     let scales: Vec<f64> = rec
@@ -257,7 +258,6 @@ fn write_plot(
     rec: &vibmode_core::Recording,
     f_max: f64,
 ) -> Result<()> {
-    ensure_parent(path)?;
     let pts: Vec<(usize, f64, f64)> = out
         .result
         .orders

@@ -2,7 +2,7 @@
 
 use crate::cmd_fit::{FitMethod, ModelKind};
 use crate::input::InputArgs;
-use crate::output::{ensure_parent, write_json};
+use crate::output::write_json;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde::Serialize;
@@ -152,7 +152,6 @@ fn sweep_settings(a: &SweepArgs, band: Option<BandLimit>) -> Result<(Vec<usize>,
 
 /// The stabilisation diagram at `path` and the frequency-damping plot beside it.
 fn write_plots(path: &std::path::Path, out: &SweepOutput) -> Result<()> {
-    ensure_parent(path)?;
     let mut stab = Vec::new();
     let mut damp = Vec::new();
     for c in &out.channels {
@@ -244,6 +243,7 @@ fn collect_fits(
 
 /// Runs `vibmode sweep`.
 pub fn run(a: &SweepArgs) -> Result<()> {
+    crate::output::check_outputs(&a.input.input, &[], &[a.plot.as_deref()], a.json.as_deref())?;
     let (rec, band) = a.input.load_with_band()?;
     let (orders, params) = sweep_settings(a, band)?;
     let filter_band = band.unwrap_or_else(|| BandLimit::full(rec.fs_hz));

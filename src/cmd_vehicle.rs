@@ -25,6 +25,7 @@ struct FullcarOutput {
 
 /// Runs `vibmode fullcar`.
 pub fn run_fullcar(a: &FullcarArgs) -> Result<()> {
+    crate::output::check_json_dest(a.json.as_deref(), &[a.params.as_path()])?;
     let params = VehicleParams::from_path(&a.params)?;
     let car = FullCar::new(&params)?;
     let modes = car.modes()?;
@@ -134,14 +135,12 @@ pub fn sim_params(
     Ok(p)
 }
 
-/// Writes the records and truth.json of a simulation into `dir`.
+/// Writes the records and truth.json of a simulation into `dir`, which must exist.
 pub fn write_simulation(
     dir: &Path,
     sim: &Simulation,
     format: RecordFormat,
 ) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create folder {}", dir.display()))?;
     let ext = match format {
         RecordFormat::Wav => "wav",
         RecordFormat::Csv => "csv",
@@ -173,8 +172,10 @@ pub fn run_simulate(a: &SimulateArgs) -> Result<()> {
         a.seed,
         a.effects,
     )?;
+    let out = crate::output::StagedDir::begin(&a.output, std::slice::from_ref(&a.params))?;
     let sim = vibmode_vehicle::simulate(&vehicle, &p)?;
-    let paths = write_simulation(&a.output, &sim, a.format)?;
+    let paths = write_simulation(out.path(), &sim, a.format)?;
+    out.commit()?;
     eprintln!(
         "wrote {} record(s) of {} s at {} Hz and truth.json to {}",
         paths.len(),

@@ -241,12 +241,11 @@ impl AnalysisConfig {
 
     /// Reads a TOML config file.
     pub fn from_path(path: &Path) -> Result<Self, AnalysisError> {
-        let text = vibmode_core::limits::read_text_capped(path).map_err(|e| {
-            AnalysisError::ConfigFile {
+        let text =
+            vibmode_core::files::read_text_capped(path).map_err(|e| AnalysisError::ConfigFile {
                 path: path.display().to_string(),
                 message: e.to_string(),
-            }
-        })?;
+            })?;
         Self::from_toml_str(&text).map_err(|e| match e {
             AnalysisError::Config { message, .. } => AnalysisError::ConfigFile {
                 path: path.display().to_string(),

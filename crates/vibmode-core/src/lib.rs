@@ -1,6 +1,7 @@
 //! # vibmode-core: the types every vibmode stage shares
 //!
-//! No I/O and no numerics: the in-memory [`Recording`] (and a borrowed [`RecordingView`]),
+//! No numerics, and no I/O but the shared file helpers of [`files`] (bounded reads, atomic
+//! writes): the in-memory [`Recording`] (and a borrowed [`RecordingView`]),
 //! where each sensor sits ([`Placement`]: [`Role`], [`Corner`], [`Direction`]), the pole
 //! observations identification hands to clustering ([`PoleObservation`], with an optional mode
 //! shape), the invariant-mode results ([`InvariantMode`], [`ModeMatch`]), fit summaries, and one
@@ -19,6 +20,7 @@
 //! ```
 
 pub mod error;
+pub mod files;
 pub mod limits;
 pub mod modes;
 pub mod params;

@@ -492,7 +492,10 @@ fn filter_forward(
         replace.skip(pred);
         let loss_keep = lookahead_loss(&raw[t + 1..=t + look], keep, k);
         let loss_replace = lookahead_loss(&raw[t + 1..=t + look], replace, k);
-        if loss_replace < REPLACE_MARGIN * loss_keep {
+        // The last sample (the first, in the backward run) has nothing after it to tell a spike
+        // from the start of a step: it is replaced when it lies beyond END_FACTOR x threshold.
+        let at_end = look == 0 && r * r > (END_FACTOR * k) * (END_FACTOR * k) * var;
+        if at_end || loss_replace < REPLACE_MARGIN * loss_keep {
             kf.skip(pred);
             x[t] = pred;
             flags[t] = true;
@@ -501,6 +504,10 @@ fn filter_forward(
         }
     }
 }
+
+/// A last (or first) sample is replaced beyond this many times the threshold (no look-ahead
+/// there): a 1e12 spike in the last of 2048 samples was kept and made the noise variance 5e20.
+const END_FACTOR: f64 = 2.0;
 
 /// Loss of the standardised residuals `r / sqrt(var)` of the samples `next` when filtered by `kf`
 /// with the simple rule: a residual beyond `k` costs `k^2` and its sample is skipped, otherwise it
@@ -525,6 +532,38 @@ fn lookahead_loss(next: &[f64], mut kf: ArKalman<'_>, k: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A spike in the first or last sample is replaced like one inside the signal (it was kept:
+    /// no look-ahead there), over many seeds; a sample at the end within the noise is kept.
+    #[test]
+    fn spikes_at_the_ends_are_replaced() {
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, Normal};
+        for seed in 0..20u64 {
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+            let noise = Normal::new(0.0, 1.0).unwrap();
+            let y0: Vec<f64> = (0..2048).map(|_| noise.sample(&mut rng)).collect();
+            for (pos, size) in [(0usize, 1e12), (2047, 1e12), (2047, -50.0), (0, 40.0)] {
+                let mut y = y0.clone();
+                y[pos] += size;
+                let c = clean_additive_outliers(&y, &CleanerParams::default()).unwrap();
+                assert!(
+                    c.replaced.contains(&pos),
+                    "seed {seed}: spike {size} at {pos} kept"
+                );
+                assert!(
+                    c.y[pos].abs() < 10.0,
+                    "seed {seed}: replaced by {}",
+                    c.y[pos]
+                );
+            }
+            let c = clean_additive_outliers(&y0, &CleanerParams::default()).unwrap();
+            assert!(
+                !c.replaced.contains(&0) && !c.replaced.contains(&2047),
+                "seed {seed}: a noise sample at an end replaced"
+            );
+        }
+    }
 
     /// AR(2) x_t = 1.5 x_{t-1} - 0.7 x_{t-2} + e_t with a deterministic small innovation.
     fn ar2(n: usize) -> Vec<f64> {

@@ -145,8 +145,23 @@ pub fn run_summary_line(r: &AnalysisResults) -> String {
 
 /// What the support tests rejected, for a pool without any invariant mode: the densest
 /// candidates (most poles) with the tests each failed.
-fn candidates_text(r: &AnalysisResults, modes: &[InvariantMode], indent: &str) -> String {
+fn candidates_text(r: &AnalysisResults, pool: &Pool<'_>, indent: &str) -> String {
+    let modes = pool.modes;
     let n_active = r.records.len() - r.n_stationary;
+    let fits: Vec<&vibmode_core::FitSummary> =
+        pool.channels.iter().flat_map(|c| c.fits.iter()).collect();
+    let failed: Vec<&vibmode_core::FitSummary> =
+        fits.iter().copied().filter(|f| f.failed).collect();
+    if !fits.is_empty() && failed.len() == fits.len() {
+        let why = failed
+            .iter()
+            .find_map(|f| f.error.as_deref())
+            .unwrap_or("no reason recorded");
+        return format!(
+            "{indent}every one of the {} fits failed, so there are no poles; the first failure: {why}\n",
+            fits.len()
+        );
+    }
     let mut cands: Vec<&InvariantMode> = modes
         .iter()
         .filter(|m| m.class == ModeClass::Spurious)
@@ -218,7 +233,7 @@ pub fn modes_table_text(r: &AnalysisResults, truth: Option<&[TruthRow]>) -> Stri
             );
         }
         if !any {
-            s.push_str(&candidates_text(r, pool.modes, "  "));
+            s.push_str(&candidates_text(r, &pool, "  "));
         }
         s.push_str(&lines_text(r, pool.lines, "  "));
         s.push_str(&matches_text(pool.matches, pool.modes, "  "));
@@ -799,7 +814,7 @@ fn modes_tables(html: &mut HtmlReport, r: &AnalysisResults) {
         html.heading(3, &pool.title);
         let rows: Vec<Vec<String>> = shown(pool.modes).map(mode_row).collect();
         if rows.is_empty() {
-            html.paragraph(&candidates_text(r, pool.modes, ""));
+            html.paragraph(&candidates_text(r, &pool, ""));
         } else {
             html.table(&headers, &rows);
         }

@@ -757,13 +757,21 @@ impl Figure {
             .and_then(|e| e.to_str())
             .unwrap_or("")
             .to_ascii_lowercase();
-        match ext.as_str() {
-            "svg" => self.save_svg(path),
-            "png" => self.save_png(path),
-            _ => Err(ReportError::UnsupportedExtension {
+        if !matches!(ext.as_str(), "svg" | "png") {
+            return Err(ReportError::UnsupportedExtension {
                 ext,
                 path: path.to_path_buf(),
-            }),
+            });
         }
+        self.validate()?;
+        // Drawn under a temporary name and renamed when complete (never half a figure).
+        let on_io = |e: std::io::Error| ReportError::Write {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        };
+        vibmode_core::files::write_atomic(path, on_io, |tmp| match ext.as_str() {
+            "svg" => self.save_svg(tmp),
+            _ => self.save_png(tmp),
+        })
     }
 }

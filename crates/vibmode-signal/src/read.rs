@@ -455,7 +455,7 @@ fn wav_names(path: &Path, nch: usize) -> Result<(Vec<String>, Vec<String>)> {
     }
     let sp = side.display().to_string();
     let text =
-        vibmode_core::limits::read_text_capped(&side).map_err(|e| io_err("read", &side, &e))?;
+        vibmode_core::files::read_text_capped(&side).map_err(|e| io_err("read", &side, &e))?;
     let bad = |reason: String| SignalError::Sidecar {
         path: sp.clone(),
         reason,
@@ -521,7 +521,7 @@ fn read_raw(path: &Path, opts: &ReadOptions) -> Result<Recording> {
         reason: "not found; a raw file needs a JSON sidecar like {\"fs_hz\": 20000, \"dtype\": \"f32\", \"channels\": [\"FL\"]}".into(),
     })?;
     let sp = side_path.display().to_string();
-    let text = vibmode_core::limits::read_text_capped(side_path)
+    let text = vibmode_core::files::read_text_capped(side_path)
         .map_err(|e| io_err("read", side_path, &e))?;
     let side: Sidecar = serde_json::from_str(&text).map_err(|e| SignalError::Sidecar {
         path: sp.clone(),

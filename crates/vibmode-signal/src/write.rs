@@ -4,6 +4,7 @@ use crate::error::{io_err, Result, SignalError};
 use crate::read::{Format, Sidecar, WavSidecar};
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use vibmode_core::files::write_atomic;
 use vibmode_core::{check_fs, Recording};
 
 /// Writes `rec` to `path`, choosing the format by extension (case-insensitive):
@@ -32,18 +33,53 @@ pub fn write_path(path: &Path, rec: &Recording) -> Result<()> {
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
-    match Format::from_extension(&ext) {
-        Some(Format::Delimited) => write_csv(path, rec, if ext == "tsv" { b'\t' } else { b',' }),
-        Some(Format::Wav) => write_wav(path, rec),
-        Some(Format::Raw) => write_raw(path, rec, ext == "f32"),
-        None => Err(SignalError::UnknownFormat {
-            given: if ext.is_empty() {
-                format!("(no extension) {}", path.display())
-            } else {
-                format!(".{ext}")
-            },
-        }),
-    }
+    let on_io = |e: std::io::Error| io_err("write", path, &e);
+    let format = Format::from_extension(&ext);
+    // Each file (data, then its sidecar) is written under a temporary name and renamed when
+    // complete: an interrupted run leaves the old file or the new one, never part of one.
+    let sidecar = match format {
+        Some(Format::Delimited) => {
+            let sep = if ext == "tsv" { b'\t' } else { b',' };
+            return write_atomic(path, on_io, |tmp| write_csv(tmp, rec, sep));
+        }
+        Some(Format::Wav) => {
+            write_atomic(path, on_io, |tmp| write_wav(tmp, rec))?;
+            serde_json::to_string_pretty(&WavSidecar {
+                channels: rec.channels.iter().map(|c| c.name.clone()).collect(),
+                units: Some(rec.channels.iter().map(|c| c.unit.clone()).collect()),
+            })
+        }
+        Some(Format::Raw) => {
+            let f32_out = ext == "f32";
+            write_atomic(path, on_io, |tmp| write_raw(tmp, rec, f32_out))?;
+            serde_json::to_string_pretty(&Sidecar {
+                fs_hz: rec.fs_hz,
+                dtype: if f32_out { "f32" } else { "f64" }.into(),
+                channels: rec.channels.iter().map(|c| c.name.clone()).collect(),
+                units: Some(rec.channels.iter().map(|c| c.unit.clone()).collect()),
+            })
+        }
+        None => {
+            return Err(SignalError::UnknownFormat {
+                given: if ext.is_empty() {
+                    format!("(no extension) {}", path.display())
+                } else {
+                    format!(".{ext}")
+                },
+            })
+        }
+    };
+    let mut sp = path.as_os_str().to_owned();
+    sp.push(".json");
+    let sp = PathBuf::from(sp);
+    let text = sidecar.map_err(|e| SignalError::Sidecar {
+        path: sp.display().to_string(),
+        reason: format!("cannot serialise: {e}"),
+    })?;
+    let on_io = |e: std::io::Error| io_err("write", &sp, &e);
+    write_atomic(&sp, on_io, |tmp| {
+        std::fs::write(tmp, text + "\n").map_err(|e| io_err("write", &sp, &e))
+    })
 }
 
 fn create(path: &Path) -> Result<std::io::BufWriter<std::fs::File>> {
@@ -112,19 +148,7 @@ fn write_wav(path: &Path, rec: &Recording) -> Result<()> {
             w.write_sample(c.samples[i] as f32).map_err(werr)?;
         }
     }
-    w.finalize().map_err(werr)?;
-    let side = WavSidecar {
-        channels: rec.channels.iter().map(|c| c.name.clone()).collect(),
-        units: Some(rec.channels.iter().map(|c| c.unit.clone()).collect()),
-    };
-    let mut full = path.as_os_str().to_owned();
-    full.push(".json");
-    let sp = PathBuf::from(full);
-    let text = serde_json::to_string_pretty(&side).map_err(|e| SignalError::Sidecar {
-        path: sp.display().to_string(),
-        reason: e.to_string(),
-    })?;
-    std::fs::write(&sp, text).map_err(|e| io_err("write", &sp, &e))
+    w.finalize().map_err(werr)
 }
 
 fn write_raw(path: &Path, rec: &Recording, f32_out: bool) -> Result<()> {
@@ -140,19 +164,5 @@ fn write_raw(path: &Path, rec: &Recording, f32_out: bool) -> Result<()> {
             }
         }
     }
-    w.flush().map_err(we)?;
-    let side = Sidecar {
-        fs_hz: rec.fs_hz,
-        dtype: if f32_out { "f32" } else { "f64" }.into(),
-        channels: rec.channels.iter().map(|c| c.name.clone()).collect(),
-        units: Some(rec.channels.iter().map(|c| c.unit.clone()).collect()),
-    };
-    let mut sp = path.as_os_str().to_owned();
-    sp.push(".json");
-    let sp = PathBuf::from(sp);
-    let text = serde_json::to_string_pretty(&side).map_err(|e| SignalError::Sidecar {
-        path: sp.display().to_string(),
-        reason: format!("cannot serialise: {e}"),
-    })?;
-    std::fs::write(&sp, text + "\n").map_err(|e| io_err("write", &sp, &e))
+    w.flush().map_err(we)
 }

@@ -312,7 +312,7 @@ impl VehicleParams {
     pub fn from_path(path: impl AsRef<std::path::Path>) -> Result<Self> {
         let path = path.as_ref();
         let text =
-            vibmode_core::limits::read_text_capped(path).map_err(|source| VehicleError::Io {
+            vibmode_core::files::read_text_capped(path).map_err(|source| VehicleError::Io {
                 path: path.display().to_string(),
                 source,
             })?;

@@ -1,0 +1,87 @@
+//! The physical and resource bounds every input is checked against before work starts, defined
+//! once. Each bound is far beyond what a measurement needs and well inside what f64 arithmetic
+//! and the machine's memory can carry; `docs/formats.md` lists them.
+
+use std::fmt;
+
+/// Lowest sampling rate accepted, Hz (one sample every 1000 s).
+pub const FS_HZ_MIN: f64 = 1e-3;
+/// Highest sampling rate accepted, Hz (10 MHz).
+pub const FS_HZ_MAX: f64 = 1e7;
+/// Largest sample magnitude accepted. The fourth powers summed over 10^9 samples (kurtosis)
+/// stay finite: (1e60)^4 x 1e9 = 1e249 < 1.8e308.
+pub const SAMPLE_ABS_MAX: f64 = 1e60;
+/// Smallest peak magnitude of a channel that is not all zeros. Fourth powers stay normal
+/// numbers: (1e-60)^4 = 1e-240 > 2.2e-308.
+pub const SAMPLE_PEAK_MIN: f64 = 1e-60;
+/// Most channels in one recording.
+pub const CHANNELS_MAX: usize = 1024;
+/// Largest upsampling ratio (output rate / input rate). vibmode's resampling is for
+/// decimation; a larger ratio is almost always a rate in the wrong unit.
+pub const UPSAMPLE_RATIO_MAX: f64 = 16.0;
+/// Most samples (all channels together) a resampling may produce: 2^30, 8 GiB as f64.
+pub const SAMPLES_OUT_MAX: u64 = 1 << 30;
+/// Largest configuration or vehicle file read, bytes (1 MiB).
+pub const CONFIG_BYTES_MAX: u64 = 1 << 20;
+
+/// A number for messages: plain below 1e9 and above 1e-4 in magnitude, otherwise in exponent
+/// form, never 300 digits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Num(pub f64);
+
+impl fmt::Display for Num {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let v = self.0;
+        let a = v.abs();
+        let plain = !v.is_finite() || v == 0.0 || (1e-4..1e9).contains(&a);
+        let exact = if plain {
+            format!("{v}")
+        } else {
+            format!("{v:e}")
+        };
+        if exact.len() <= 12 {
+            return f.write_str(&exact);
+        }
+        // Six significant digits, trailing zeros dropped.
+        if plain {
+            let decimals = (5 - a.log10().floor() as i32).max(0) as usize;
+            let s = format!("{v:.decimals$}");
+            let s = if s.contains('.') {
+                s.trim_end_matches('0').trim_end_matches('.')
+            } else {
+                &s
+            };
+            f.write_str(s)
+        } else {
+            let s = format!("{v:.5e}");
+            let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
+            let m = m.trim_end_matches('0').trim_end_matches('.');
+            write!(f, "{m}e{e}")
+        }
+    }
+}
+
+/// `Num(*v)`, for `#[error(...)]` attributes that see fields by reference.
+pub fn num(v: &f64) -> Num {
+    Num(*v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn num_is_short() {
+        assert_eq!(Num(1.5).to_string(), "1.5");
+        assert_eq!(Num(200.0).to_string(), "200");
+        assert_eq!(Num(1e300).to_string(), "1e300");
+        assert_eq!(Num(-1.25e-200).to_string(), "-1.25e-200");
+        assert_eq!(Num(0.0).to_string(), "0");
+        assert_eq!(Num(f64::NAN).to_string(), "NaN");
+        assert_eq!(Num(1.2881847531554629e154).to_string(), "1.28818e154");
+        assert_eq!(Num(14999.999999999998).to_string(), "15000");
+        assert_eq!(Num(0.0033333333333333335).to_string(), "0.00333333");
+        assert_eq!(Num(3.2837746232756027e-200).to_string(), "3.28377e-200");
+        assert_eq!(Num(-1.0000001).to_string(), "-1.0000001");
+    }
+}
