@@ -93,6 +93,17 @@ pub struct StagedDir {
     target: PathBuf,
     stage: Option<tempfile::TempDir>,
     _lock: std::fs::File,
+    /// The target did not exist before: a failed run removes the empty folder it made.
+    created: bool,
+}
+
+impl Drop for StagedDir {
+    fn drop(&mut self) {
+        if self.created && self.stage.is_some() {
+            // Only an empty folder goes (remove_dir fails on anything else).
+            let _ = std::fs::remove_dir(&self.target);
+        }
+    }
 }
 
 /// Files that mark a folder as vibmode's own output (which may be replaced as a whole).
@@ -121,7 +132,8 @@ impl StagedDir {
                     target.display()
                 )
             })?;
-        if target.exists() {
+        let created = !target.exists();
+        if !created {
             if !target.is_dir() {
                 bail!(
                     "{} is a file, not a folder; give a folder name",
@@ -180,6 +192,7 @@ impl StagedDir {
             target: target.to_path_buf(),
             stage: Some(stage),
             _lock: lock,
+            created,
         })
     }
 

@@ -140,7 +140,7 @@ fn analyze_and_sweep_errors_are_one_line_with_exit_code_2() {
     let before = std::fs::read(a).unwrap();
     fails_with(
         &["resample", a, "--to", "25", "-o", a],
-        &["is the input file"],
+        &["is an input file"],
     );
     assert_eq!(std::fs::read(a).unwrap(), before);
     // Used to panic (exit 101) in the ARMA search.

@@ -507,7 +507,7 @@ fn filter_forward(
 
 /// A last (or first) sample is replaced beyond this many times the threshold (no look-ahead
 /// there): a 1e12 spike in the last of 2048 samples was kept and made the noise variance 5e20.
-const END_FACTOR: f64 = 2.0;
+const END_FACTOR: f64 = 5.0;
 
 /// Loss of the standardised residuals `r / sqrt(var)` of the samples `next` when filtered by `kf`
 /// with the simple rule: a residual beyond `k` costs `k^2` and its sample is skipped, otherwise it

@@ -431,7 +431,7 @@ fn invalid_params_are_errors() {
     let e = find_invariant_modes(&[], 2, &[4, 6], &bad[0]).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "freq_tol_rel = 0 must be finite and > 0; use e.g. freq_tol_rel = 0.02"
+        "freq_tol_rel = 0 must be in [1e-4, 1]; use e.g. freq_tol_rel = 0.02"
     );
     let sp = StabilisationParams {
         damping_tol_rel: 0.0,

@@ -55,18 +55,27 @@ pub fn sibling(path: &Path, suffix: &str) -> PathBuf {
     path.with_file_name(format!("{stem}{suffix}{ext}"))
 }
 
-/// A figure of `panels` in `columns` columns, each panel about `w` x `h` pixels.
+/// A figure of `panels` in `columns` columns, each panel about `w` x `h` pixels. Many panels
+/// (one per channel of a 90-channel file) get more columns, so that the figure stays within
+/// [`crate::MAX_SIDE_PX`] (it used to fail after the whole analysis), and panels shrink if even
+/// that is not enough.
 pub fn grid(panels: Vec<Panel>, columns: usize, w: u32, h: u32) -> Figure {
-    let cols = columns.max(1);
+    let max = crate::MAX_SIDE_PX as usize;
+    let (w, h) = (w as usize, h as usize);
+    let mut cols = columns.max(1);
+    while panels.len().div_ceil(cols) * h > max && (cols + 1) * w <= max {
+        cols += 1;
+    }
     let rows = panels.len().div_ceil(cols).max(1);
     Figure {
         title: None,
         panels,
         columns: cols,
-        width_px: w * cols as u32,
-        height_px: h * rows as u32,
+        width_px: (w * cols).min(max) as u32,
+        height_px: (h * rows).min(max) as u32,
     }
 }
+
 
 /// Stabilisation diagram: every pole pair as (frequency, order), with the Welch PSD drawn
 /// faintly behind, mapped onto the order axis (log PSD scaled to the order range).
@@ -196,4 +205,22 @@ pub fn positive_freq(f: &[f64], p: &[f64]) -> (Vec<f64>, Vec<f64>) {
         .filter(|(f, _)| **f > 0.0)
         .map(|(f, p)| (*f, *p))
         .unzip()
+}
+
+#[cfg(test)]
+mod grid_tests {
+    use super::*;
+
+    /// Up to the 1024 channels a file may have, the figure is within the size limits.
+    #[test]
+    fn grids_of_many_panels_stay_drawable() {
+        for n in [1usize, 2, 7, 63, 64, 90, 200, 1024] {
+            let panels: Vec<Panel> = (0..n)
+                .map(|i| Panel::new(format!("p{i}"), "x", "y"))
+                .collect();
+            let f = grid(panels, 2, 600, 260);
+            assert!(f.validate().is_ok(), "{n} panels: {:?}", f.validate());
+            assert_eq!(f.panels.len(), n);
+        }
+    }
 }

@@ -282,12 +282,21 @@ impl VehicleParams {
     /// Parse and validate TOML text. Missing sensors are replaced by the 7 defaults.
     pub fn from_toml_str(text: &str) -> Result<Self> {
         let mut p: VehicleParams = toml::from_str(text).map_err(|e| {
+            let mut message = e.message().replace('\n', " ").trim().to_string();
             let location = match e.span() {
                 Some(span) => {
                     let start = span.start.min(text.len());
                     let line_no = text[..start].matches('\n').count() + 1;
                     let line = text.lines().nth(line_no - 1).unwrap_or("").trim();
                     let line: String = line.chars().take(80).collect();
+                    if let Some(key) = line.strip_suffix('=') {
+                        // `mass_kg =` with nothing after it: toml's own message is about quotes.
+                        message = format!(
+                            "{} has no value; give one, e.g. {} = 12000 (a number in the key's unit)",
+                            key.trim(),
+                            key.trim()
+                        );
+                    }
                     if line.is_empty() {
                         format!(" at line {line_no}")
                     } else {
@@ -296,10 +305,7 @@ impl VehicleParams {
                 }
                 None => String::new(),
             };
-            VehicleError::Toml {
-                location,
-                message: e.message().replace('\n', " ").trim().to_string(),
-            }
+            VehicleError::Toml { location, message }
         })?;
         if p.sensors.is_empty() {
             p.sensors = default_sensors();
@@ -348,6 +354,22 @@ impl VehicleParams {
                 ))
             }
         }
+        /// Positive and at most `max`: far beyond any road vehicle, well inside what the
+        /// simulator's arithmetic carries (1e100 km/h or a 1e10 m track made NaN records).
+        fn upto(key: &str, v: f64, max: f64, unit: &str) -> Result<()> {
+            if v.is_finite() && v > 0.0 && v <= max {
+                Ok(())
+            } else {
+                Err(invalid(
+                    key,
+                    vibmode_core::Num(v),
+                    format!(
+                        "must be positive and at most {} ({unit})",
+                        vibmode_core::Num(max)
+                    ),
+                ))
+            }
+        }
         fn nonneg(key: &str, v: f64, unit: &str) -> Result<()> {
             if v.is_finite() && v >= 0.0 {
                 Ok(())
@@ -360,15 +382,25 @@ impl VehicleParams {
             }
         }
         let b = &self.body;
-        pos("body.mass_kg", b.mass_kg, "kg")?;
-        pos("body.pitch_inertia_kgm2", b.pitch_inertia_kgm2, "kg m^2")?;
-        pos("body.roll_inertia_kgm2", b.roll_inertia_kgm2, "kg m^2")?;
+        upto("body.mass_kg", b.mass_kg, 1e6, "kg")?;
+        upto(
+            "body.pitch_inertia_kgm2",
+            b.pitch_inertia_kgm2,
+            1e9,
+            "kg m^2",
+        )?;
+        upto("body.roll_inertia_kgm2", b.roll_inertia_kgm2, 1e9, "kg m^2")?;
         nonneg("body.cg_height_m", b.cg_height_m, "m")?;
         let g = &self.geometry;
-        pos("geometry.wheelbase_m", g.wheelbase_m, "m")?;
-        pos("geometry.cg_to_front_axle_m", g.cg_to_front_axle_m, "m")?;
-        pos("geometry.track_front_m", g.track_front_m, "m")?;
-        pos("geometry.track_rear_m", g.track_rear_m, "m")?;
+        upto("geometry.wheelbase_m", g.wheelbase_m, 100.0, "m")?;
+        upto(
+            "geometry.cg_to_front_axle_m",
+            g.cg_to_front_axle_m,
+            100.0,
+            "m",
+        )?;
+        upto("geometry.track_front_m", g.track_front_m, 20.0, "m")?;
+        upto("geometry.track_rear_m", g.track_rear_m, 20.0, "m")?;
         if g.cg_to_front_axle_m >= g.wheelbase_m {
             return Err(invalid(
                 "geometry.cg_to_front_axle_m",
@@ -380,14 +412,16 @@ impl VehicleParams {
             ));
         }
         for (name, a) in [("front", &self.front), ("rear", &self.rear)] {
-            pos(
+            upto(
                 &format!("{name}.unsprung_mass_kg"),
                 a.unsprung_mass_kg,
+                1e5,
                 "kg",
             )?;
-            pos(
+            upto(
                 &format!("{name}.spring_stiffness_n_per_m"),
                 a.spring_stiffness_n_per_m,
+                1e10,
                 "N/m",
             )?;
             nonneg(
@@ -395,9 +429,10 @@ impl VehicleParams {
                 a.damper_n_s_per_m,
                 "N s/m",
             )?;
-            pos(
+            upto(
                 &format!("{name}.tyre_stiffness_n_per_m"),
                 a.tyre_stiffness_n_per_m,
+                1e10,
                 "N/m",
             )?;
             nonneg(
@@ -412,7 +447,7 @@ impl VehicleParams {
             )?;
         }
         if let Some(bd) = &self.bending {
-            pos("bending.frequency_hz", bd.frequency_hz, "Hz")?;
+            upto("bending.frequency_hz", bd.frequency_hz, 1000.0, "Hz")?;
             nonneg("bending.damping_ratio", bd.damping_ratio, "dimensionless")?;
             pos("bending.modal_mass_kg", bd.modal_mass_kg, "kg")?;
             if bd.corner_shape.iter().any(|v| !v.is_finite()) {
@@ -455,14 +490,14 @@ impl VehicleParams {
                 SensorKind::Sprung => match (s.corner, s.x_m, s.y_m) {
                     (Some(_), None, None) => {}
                     (None, Some(x), Some(y)) => {
-                        if !x.is_finite() || !y.is_finite() {
-                            return Err(invalid(format!("{key}.x_m"), format!("{x}, y_m = {y}"), "must be finite (m)"));
+                        if !(x.is_finite() && y.is_finite() && x.abs() <= 100.0 && y.abs() <= 100.0) {
+                            return Err(invalid(format!("{key}.x_m"), format!("{}, y_m = {}", vibmode_core::Num(x), vibmode_core::Num(y)), "must be finite and within 100 m of the centre of gravity"));
                         }
                     }
                     _ => {
                         return Err(invalid(
                             format!("{key}.corner"),
-                            format!("{:?}", s.corner.map(|c| c.to_string())),
+                            s.corner.map_or("(missing)".to_string(), |c| format!("\"{c}\"")),
                             "a sprung sensor needs either corner = \"FR\" or both x_m and y_m, not a mix",
                         ))
                     }

@@ -350,14 +350,17 @@ impl SimParams {
 
     /// Check every value; errors name the field and the fix.
     pub fn validate(&self) -> Result<()> {
-        if !(self.speed_kmh.is_finite() && self.speed_kmh >= 1.0) {
+        if !(self.speed_kmh.is_finite() && (1.0..=500.0).contains(&self.speed_kmh)) {
             return Err(invalid(
                 "speed_kmh",
-                self.speed_kmh,
-                "must be at least 1 km/h, e.g. 40",
+                vibmode_core::Num(self.speed_kmh),
+                "must be 1 to 500 km/h, e.g. 40",
             ));
         }
-        if !(self.fs_hz.is_finite() && self.fs_hz > 0.0) {
+        if !(self.fs_hz.is_finite()
+            && self.fs_hz > 0.0
+            && self.fs_hz <= vibmode_core::limits::FS_HZ_MAX)
+        {
             return Err(invalid(
                 "fs_hz",
                 self.fs_hz,
