@@ -226,6 +226,17 @@ pub fn run(a: &FitArgs) -> Result<()> {
     for ch in &rec.channels {
         let (m, method) = fit_channel(&ch.samples, a.model, a.method, a.order, q, &params)
             .with_context(|| format!("channel '{}'", ch.name))?;
+        // A non-finite estimate is never printed or written (it used to read "noise variance
+        // NaN").
+        if !(m.noise_variance.is_finite() && m.loss.is_finite())
+            || m.a.iter().chain(&m.c).any(|v| !v.is_finite())
+        {
+            bail!(
+                "channel '{}': the fit produced a non-finite estimate (noise variance {}); rescale the signal or lower the order",
+                ch.name,
+                m.noise_variance
+            );
+        }
         channels.push(channel_fit(
             &ch.name,
             &ch.unit,

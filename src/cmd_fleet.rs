@@ -219,6 +219,8 @@ struct CheckJson<'a> {
 }
 
 fn check(a: &CheckArgs) -> Result<()> {
+    let inputs: Vec<&std::path::Path> = a.files.iter().map(|f| f.as_path()).collect();
+    crate::output::check_json_dest(a.json.as_deref(), &inputs)?;
     let mut store = Store::open(&a.db)?;
     store.require_vehicle(&a.vehicle)?;
     let set = require_baseline(&store, &a.vehicle)?;

@@ -278,6 +278,16 @@ pub fn run(a: &PsdArgs) -> Result<()> {
     }
     let rec = a.input.load()?;
     let (channels, mut used) = compute(&rec, a.method, &a.spectral)?;
+    // A non-finite value is never printed or written (the input limits should make this
+    // impossible; this is the last guard).
+    for c in &channels {
+        if c.psd.iter().any(|v| !v.is_finite()) {
+            anyhow::bail!(
+                "the spectrum of channel '{}' has a non-finite value; rescale the signal (another unit)",
+                c.name
+            );
+        }
+    }
     used.resampled_to_hz = a.input.resample_to_hz;
     used.cutoff_hz = a
         .input

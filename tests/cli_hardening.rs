@@ -514,15 +514,15 @@ fn kill_9_leaves_the_old_or_the_new_output_never_a_mix() {
         "--records",
         "5",
         "--duration-s",
-        "2",
+        "10",
         "--fs",
-        "1000",
+        "4000",
         "--format",
         "csv",
         "-o",
         s(&sim),
     ]);
-    for delay_ms in [0u64, 20, 60, 150, 300, 600] {
+    for delay_ms in [0u64, 20, 60, 150, 300, 500, 800, 1200] {
         let mut child = bin()
             .args([
                 "simulate",
@@ -532,9 +532,9 @@ fn kill_9_leaves_the_old_or_the_new_output_never_a_mix() {
                 "--seed",
                 "2",
                 "--duration-s",
-                "2",
+                "10",
                 "--fs",
-                "1000",
+                "4000",
                 "--format",
                 "csv",
                 "-o",
@@ -571,9 +571,9 @@ fn kill_9_leaves_the_old_or_the_new_output_never_a_mix() {
         "--seed",
         "2",
         "--duration-s",
-        "2",
+        "10",
         "--fs",
-        "1000",
+        "4000",
         "--format",
         "csv",
         "-o",

@@ -21,6 +21,9 @@ use vibmode_core::{check_fs, Recording};
 /// Errors: unknown extension, empty recording, I/O errors.
 pub fn write_path(path: &Path, rec: &Recording) -> Result<()> {
     check_fs(rec.fs_hz, "fs_hz of the recording to write")?;
+    // Never write what vibmode itself would refuse to read (resampling extreme values once
+    // wrote +-inf).
+    vibmode_core::check_finite(&rec.channels)?;
     if rec.channels.is_empty() || rec.is_empty() {
         return Err(SignalError::TooShort {
             what: format!("writing {}", path.display()),
