@@ -12,8 +12,7 @@ pub enum IdentError {
     },
     /// A sample is NaN or infinite.
     #[error(
-        "sample {index} is {value} (not finite); remove or interpolate non-finite samples first"
-    )]
+        "sample {index} is {} (not finite); remove or interpolate non-finite samples first", vibmode_core::num(.value))]
     NonFinite {
         /// Index of the first offending sample.
         index: usize,
@@ -22,8 +21,7 @@ pub enum IdentError {
     },
     /// The signal is constant (all samples equal), so it carries no dynamics.
     #[error(
-        "signal is constant (every sample equals {value}); identification needs a varying signal"
-    )]
+        "signal is constant (every sample equals {}); identification needs a varying signal", vibmode_core::num(.value))]
     Constant {
         /// The constant value.
         value: f64,
@@ -59,8 +57,7 @@ pub enum IdentError {
     },
     /// A polynomial coefficient is NaN or infinite.
     #[error(
-        "polynomial coefficient {index} is {value} (not finite); all coefficients must be finite"
-    )]
+        "polynomial coefficient {index} is {} (not finite); all coefficients must be finite", vibmode_core::num(.value))]
     BadCoefficient {
         /// Index of the coefficient.
         index: usize,
@@ -68,7 +65,7 @@ pub enum IdentError {
         value: f64,
     },
     /// The leading coefficient of a polynomial is zero (or the polynomial is empty).
-    #[error("leading polynomial coefficient is {value}; pass coefficients (highest power first) with a nonzero first entry")]
+    #[error("leading polynomial coefficient is {}; pass coefficients (highest power first) with a nonzero first entry", vibmode_core::num(.value))]
     ZeroLeading {
         /// The leading coefficient.
         value: f64,
@@ -105,7 +102,7 @@ pub enum IdentError {
         init_q: usize,
     },
     /// Simulation of an unstable model was requested.
-    #[error("A(z) has a root of modulus {modulus} >= 1 (unstable); simulation needs every root of A inside the unit circle")]
+    #[error("A(z) has a root of modulus {} >= 1 (unstable); simulation needs every root of A inside the unit circle", vibmode_core::num(.modulus))]
     UnstableModel {
         /// Largest root modulus of A.
         modulus: f64,

@@ -8,7 +8,7 @@ pub enum ModalError {
     #[error(transparent)]
     Param(#[from] vibmode_core::ParamError),
     /// A pole has a NaN or infinite frequency (Hz).
-    #[error("pole {index} has a non-finite frequency_hz ({value}); drop or fix that pole before clustering")]
+    #[error("pole {index} has a non-finite frequency_hz ({}); drop or fix that pole before clustering", vibmode_core::num(.value))]
     NonFiniteFrequency {
         /// Index of the pole in the input slice.
         index: usize,
@@ -16,7 +16,7 @@ pub enum ModalError {
         value: f64,
     },
     /// A pole has a NaN or infinite damping ratio.
-    #[error("pole {index} has a non-finite damping_ratio ({value}); drop or fix that pole before clustering")]
+    #[error("pole {index} has a non-finite damping_ratio ({}); drop or fix that pole before clustering", vibmode_core::num(.value))]
     NonFiniteDamping {
         /// Index of the pole in the input slice.
         index: usize,

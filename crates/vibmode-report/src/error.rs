@@ -57,7 +57,7 @@ pub enum ReportError {
         y_len: usize,
     },
     /// Series opacity outside [0, 1] or not finite.
-    #[error("panel '{panel}', series '{series}': alpha ({alpha}) must be within [0, 1]; use e.g. alpha: 0.3")]
+    #[error("panel '{panel}', series '{series}': alpha ({}) must be within [0, 1]; use e.g. alpha: 0.3", vibmode_core::num(.alpha))]
     InvalidAlpha {
         /// Panel title.
         panel: String,
@@ -81,7 +81,7 @@ pub enum ReportError {
         max: u32,
     },
     /// An explicit axis range is unusable.
-    #[error("panel '{panel}': {axis} range ({lo}, {hi}) is invalid: {reason}; {fix}")]
+    #[error("panel '{panel}': {axis} range ({}, {}) is invalid: {reason}; {fix}", vibmode_core::num(.lo), vibmode_core::num(.hi))]
     InvalidRange {
         /// Panel title.
         panel: String,

@@ -76,7 +76,6 @@ pub fn grid(panels: Vec<Panel>, columns: usize, w: u32, h: u32) -> Figure {
     }
 }
 
-
 /// Stabilisation diagram: every pole pair as (frequency, order), with the Welch PSD drawn
 /// faintly behind, mapped onto the order axis (log PSD scaled to the order range).
 pub fn stabilisation_panel(

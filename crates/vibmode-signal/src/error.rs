@@ -85,7 +85,7 @@ pub enum SignalError {
         path: String,
     },
     /// The rate given by the user and the one found in the file disagree by more than 1 %.
-    #[error("{path}: the sampling rate from {source_name} is {file_fs_hz} Hz but {given_fs_hz} Hz was given (more than 1% apart); give no rate or fix the file")]
+    #[error("{path}: the sampling rate from {source_name} is {} Hz but {} Hz was given (more than 1% apart); give no rate or fix the file", vibmode_core::num(.file_fs_hz), vibmode_core::num(.given_fs_hz))]
     SampleRateMismatch {
         /// The file.
         path: String,
@@ -111,7 +111,7 @@ pub enum SignalError {
         mean_fs_hz: f64,
     },
     /// The time column does not strictly increase.
-    #[error("time column '{column}' of {path} does not increase at line {line} ({previous} then {value}); sort the rows or remove duplicates")]
+    #[error("time column '{column}' of {path} does not increase at line {line} ({} then {}); sort the rows or remove duplicates", vibmode_core::num(.previous), vibmode_core::num(.value))]
     TimeNotIncreasing {
         /// The file.
         path: String,

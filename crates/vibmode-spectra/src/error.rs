@@ -7,7 +7,7 @@
 #[non_exhaustive]
 pub enum SpectraError {
     /// The sampling rate is zero, negative, NaN or infinite.
-    #[error("sampling rate fs_hz = {fs_hz} must be positive and finite; check the recording's sampling rate")]
+    #[error("sampling rate fs_hz = {} must be positive and finite; check the recording's sampling rate", vibmode_core::num(.fs_hz))]
     InvalidSampleRate {
         /// The rejected sampling rate, Hz.
         fs_hz: f64,
@@ -19,7 +19,7 @@ pub enum SpectraError {
         name: &'static str,
     },
     /// An input sample is NaN or infinite.
-    #[error("{name}[{index}] = {value} is not finite; remove or interpolate NaN/Inf samples before computing spectra")]
+    #[error("{name}[{index}] = {} is not finite; remove or interpolate NaN/Inf samples before computing spectra", vibmode_core::num(.value))]
     NonFiniteSample {
         /// Which input ("x" or "y").
         name: &'static str,
@@ -69,7 +69,7 @@ pub enum SpectraError {
         nperseg: usize,
     },
     /// A Tukey window's alpha is outside [0, 1] or not finite.
-    #[error("tukey alpha ({alpha}) must be in [0, 1]; use e.g. tukey:0.5")]
+    #[error("tukey alpha ({}) must be in [0, 1]; use e.g. tukey:0.5", vibmode_core::num(.alpha))]
     InvalidTukeyAlpha {
         /// The rejected alpha.
         alpha: f64,

@@ -29,7 +29,7 @@ pub enum SsiError {
         expected: usize,
     },
     /// A NaN or infinite sample.
-    #[error("channel {channel} sample {index} is {value}; remove or interpolate non-finite samples first")]
+    #[error("channel {channel} sample {index} is {}; remove or interpolate non-finite samples first", vibmode_core::num(.value))]
     NonFinite {
         /// 0-based channel index.
         channel: usize,
@@ -39,7 +39,7 @@ pub enum SsiError {
         value: f64,
     },
     /// A sampling rate that is not a positive finite number.
-    #[error("sampling rate {fs_hz} Hz must be a positive finite number")]
+    #[error("sampling rate {} Hz must be a positive finite number", vibmode_core::num(.fs_hz))]
     InvalidSampleRate {
         /// The value.
         fs_hz: f64,
