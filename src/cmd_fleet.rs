@@ -25,6 +25,10 @@ pub enum FleetCommand {
         /// The store file (SQLite).
         #[arg(long)]
         db: PathBuf,
+        /// Settings (TOML; docs/fleet.md): feature bands, false-alarm rate, spread floors and
+        /// the per-record analysis under [analysis]. Fixed once the first record is stored.
+        #[arg(long)]
+        config: Option<PathBuf>,
     },
     /// Analyse records and store their features (the same file twice is a no-op).
     #[command(allow_negative_numbers = true)]
@@ -128,8 +132,13 @@ pub struct CheckArgs {
 /// Runs `vibmode fleet ...`.
 pub fn run(a: &FleetArgs) -> Result<()> {
     match &a.command {
-        FleetCommand::Init { db } => {
-            let (store, created) = Store::init(db)?;
+        FleetCommand::Init { db, config } => {
+            // The settings are read and checked before the store is created.
+            let cfg = config.as_deref().map(FleetConfig::from_path).transpose()?;
+            let (mut store, created) = Store::init(db)?;
+            if let Some(cfg) = &cfg {
+                store.set_config(cfg)?;
+            }
             eprintln!(
                 "{} fleet store {} (schema version {})",
                 if created { "created" } else { "already a" },
@@ -165,7 +174,7 @@ fn ingest(a: &IngestArgs) -> Result<()> {
         condition,
         road: a.road.as_deref(),
     };
-    let cfg = FleetConfig::default();
+    let cfg = store.config()?;
     for f in &a.files {
         let r = ingest_file(&mut store, &labels, f, &a.read.options(), &cfg)?;
         if r.already_stored {
@@ -188,7 +197,8 @@ fn ingest(a: &IngestArgs) -> Result<()> {
 
 fn baseline(db: &std::path::Path, vehicle: &str) -> Result<()> {
     let mut store = Store::open(db)?;
-    let set = build_baseline(&mut store, vehicle, &FleetConfig::default())?;
+    let cfg = store.config()?;
+    let set = build_baseline(&mut store, vehicle, &cfg)?;
     let mut text = format!(
         "vehicle {}: model set version {} from {} nominal records, {} features, {} modes\n",
         set.vehicle,

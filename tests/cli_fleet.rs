@@ -254,3 +254,71 @@ fn killed_ingest_leaves_a_consistent_store() {
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(out.contains("6 nominal"), "{out}");
 }
+
+/// `fleet init --config` fixes the settings for every later ingest and baseline: a baseline
+/// built from a store initialised with other bands has exactly those bands' level features.
+#[test]
+fn init_config_sets_the_fleet_settings() {
+    let d = tempfile::tempdir().unwrap();
+    let db = d.path().join("fleet.db");
+    let db = db.to_str().unwrap();
+    let cfg = d.path().join("fleet.toml");
+    std::fs::write(
+        &cfg,
+        "false_alarm_rate = 0.05\nmin_nominal = 3\nbands_hz = [[1.0, 3.0], [8.0, 12.0]]\n[analysis.sweep]\norder_max = 8\n",
+    )
+    .unwrap();
+    // A bad settings file is refused before any store exists.
+    let bad = d.path().join("bad.toml");
+    std::fs::write(&bad, "false_alarm_rate = 2\n").unwrap();
+    fails_with(
+        &[
+            "fleet",
+            "init",
+            "--db",
+            db,
+            "--config",
+            bad.to_str().unwrap(),
+        ],
+        &["false_alarm_rate = 2", "(0, 0.5)"],
+    );
+    assert!(!Path::new(db).exists());
+    ok(&[
+        "fleet",
+        "init",
+        "--db",
+        db,
+        "--config",
+        cfg.to_str().unwrap(),
+    ]);
+    let files = simulate(&d.path().join("n"), "A", "30", "7", "3");
+    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus1"];
+    args.extend(files.iter().map(|s| s.as_str()));
+    ok(&args);
+    let o = ok(&["fleet", "baseline", "--db", db, "--vehicle", "bus1"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    // Two level bands (not the default five), and the Bonferroni limit of a 5 % family-wise
+    // false-alarm rate over them: z(1 - 0.05 / (2 x 2)) = 2.24 (at the default 1 %: 2.81).
+    let level = text
+        .lines()
+        .find(|l| l.starts_with("Level"))
+        .unwrap_or_else(|| panic!("no Level row in:\n{text}"));
+    let cols: Vec<&str> = level.split_whitespace().collect();
+    assert_eq!(cols[1], "2", "{level}");
+    assert_eq!(cols[2], "2.24", "{level}");
+    let status = ok(&["fleet", "status", "--db", db]);
+    assert!(status.status.success());
+    // Other settings once records are stored: refused, the store unchanged.
+    std::fs::write(&cfg, "false_alarm_rate = 0.02\n").unwrap();
+    fails_with(
+        &[
+            "fleet",
+            "init",
+            "--db",
+            db,
+            "--config",
+            cfg.to_str().unwrap(),
+        ],
+        &["already holds 3 record(s)", "new store"],
+    );
+}

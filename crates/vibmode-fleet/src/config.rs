@@ -72,6 +72,28 @@ fn bad(key: &'static str, value: impl ToString, fix: &str) -> FleetError {
 }
 
 impl FleetConfig {
+    /// Parses and validates TOML settings (every key optional: the defaults above; the
+    /// per-record analysis under `[analysis]`, with the keys of docs/analysis.md).
+    pub fn from_toml_str(text: &str, path: &str) -> Result<Self> {
+        let cfg: FleetConfig = toml::from_str(text).map_err(|e| FleetError::ConfigFile {
+            path: path.to_string(),
+            reason: e.message().replace('\n', " ").trim().to_string(),
+        })?;
+        cfg.validate()?;
+        Ok(cfg)
+    }
+
+    /// Reads [`FleetConfig::from_toml_str`] from a file of at most 1 MiB.
+    pub fn from_path(path: &std::path::Path) -> Result<Self> {
+        let shown = path.display().to_string();
+        let text =
+            vibmode_core::files::read_text_capped(path).map_err(|e| FleetError::ConfigFile {
+                path: shown.clone(),
+                reason: e.to_string(),
+            })?;
+        Self::from_toml_str(&text, &shown)
+    }
+
     /// Checks every value; errors name the key and a valid value.
     pub fn validate(&self) -> Result<()> {
         self.analysis.validate()?;

@@ -115,6 +115,22 @@ pub enum FleetError {
         /// The operating system's message.
         reason: String,
     },
+    /// A settings file that cannot be read or parsed.
+    #[error("fleet config {path}: {reason}; see docs/fleet.md for the keys")]
+    ConfigFile {
+        /// The file.
+        path: String,
+        /// What is wrong (with the line).
+        reason: String,
+    },
+    /// New settings for a store that already holds records analysed with other settings.
+    #[error("{path} already holds {records} record(s) analysed with other settings; settings are fixed when the first record is stored: use a new store for new settings")]
+    ConfigAfterRecords {
+        /// The store.
+        path: String,
+        /// Records stored.
+        records: i64,
+    },
     /// A fleet setting is out of range.
     #[error("fleet config: {key} = {value} {fix}")]
     Config {

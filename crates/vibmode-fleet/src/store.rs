@@ -6,6 +6,7 @@ use std::path::Path;
 use rusqlite::{params, Connection, OpenFlags, OptionalExtension};
 use serde::{Deserialize, Serialize};
 
+use crate::config::FleetConfig;
 use crate::error::{FleetError, Result};
 use crate::features::RecordFeatures;
 use crate::model::{Assessment, Classification, ModelSet};
@@ -526,6 +527,70 @@ impl Store {
         .map_err(err)?;
         tx.commit().map_err(err)?;
         Ok(set.version)
+    }
+
+    /// The settings new records are analysed with: those given to `fleet init --config`, or
+    /// the defaults.
+    pub fn config(&self) -> Result<FleetConfig> {
+        let json: Option<String> = self
+            .conn
+            .query_row(
+                "SELECT value FROM meta WHERE key = 'fleet_config'",
+                [],
+                |r| r.get(0),
+            )
+            .optional()
+            .map_err(self.sql("reading the settings"))?;
+        match json {
+            None => Ok(FleetConfig::default()),
+            Some(j) => {
+                let cfg: FleetConfig =
+                    serde_json::from_str(&j).map_err(|e| self.corrupt("the settings", e))?;
+                cfg.validate()?;
+                Ok(cfg)
+            }
+        }
+    }
+
+    /// Stores the settings. Refused when the store already holds records and the settings
+    /// differ (their features were computed with the old ones); the same settings again are
+    /// a no-op.
+    pub fn set_config(&mut self, cfg: &FleetConfig) -> Result<()> {
+        cfg.validate()?;
+        if self.config()? == *cfg {
+            return Ok(());
+        }
+        let path = self.path.clone();
+        let err = |e: rusqlite::Error| FleetError::Sql {
+            path: path.clone(),
+            operation: "storing the settings",
+            reason: e.to_string(),
+        };
+        let tx = self
+            .conn
+            .transaction_with_behavior(rusqlite::TransactionBehavior::Immediate)
+            .map_err(err)?;
+        let records: i64 = tx
+            .query_row("SELECT COUNT(*) FROM records", [], |r| r.get(0))
+            .map_err(err)?;
+        if records > 0 {
+            return Err(FleetError::ConfigAfterRecords {
+                path: path.clone(),
+                records,
+            });
+        }
+        let json = serde_json::to_string(cfg).map_err(|e| FleetError::CorruptRow {
+            path: path.clone(),
+            what: "settings".into(),
+            reason: e.to_string(),
+        })?;
+        tx.execute(
+            "INSERT INTO meta (key, value) VALUES ('fleet_config', ?1)
+             ON CONFLICT(key) DO UPDATE SET value = excluded.value",
+            [json],
+        )
+        .map_err(err)?;
+        tx.commit().map_err(err)
     }
 
     /// The newest model set of a vehicle, if any.
