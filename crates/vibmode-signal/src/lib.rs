@@ -46,6 +46,7 @@ pub mod read;
 pub mod resample;
 pub mod stream;
 pub mod stream_resample;
+pub mod stream_write;
 pub mod write;
 
 pub use delimited::{Block, ColumnInfo, DelimitedReader, Separator};
@@ -58,7 +59,10 @@ pub use read::{
 pub use resample::ResampleRecording;
 pub use resample::{resample, ResampleMethod, ResampleParams, Resampler};
 pub use stream::{open_stream, FrameBlock, FrameStream, StreamInfo, DEFAULT_BLOCK_FRAMES};
-pub use stream_resample::{FirDecimator, FirDesign, StreamResampleParams};
+pub use stream_resample::{
+    resample_stream, FirDecimator, FirDesign, StreamResampleParams, StreamResampleSummary,
+};
+pub use stream_write::StreamWriter;
 pub use vibmode_core::{
     Channel, ChannelSelector, Recording, RecordingError, RecordingView, TimeAxis,
 };

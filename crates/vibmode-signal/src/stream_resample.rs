@@ -423,3 +423,43 @@ impl FirDecimator {
         self.run(j_last + 1, total)
     }
 }
+
+/// What [`resample_stream`] did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StreamResampleSummary {
+    /// The filter.
+    pub design: FirDesign,
+    /// Input frames read.
+    pub frames_in: u64,
+    /// Output frames written.
+    pub frames_out: u64,
+}
+
+/// Reads `stream` block by block, filters and resamples it with a [`FirDecimator`] and writes
+/// the result to `out` as it goes ([`crate::StreamWriter`]: nothing is left at `out` if anything
+/// fails). `progress(frames_read)` is called after every block.
+pub fn resample_stream(
+    stream: &mut crate::FrameStream,
+    out: &std::path::Path,
+    p: &StreamResampleParams,
+    progress: &mut dyn FnMut(u64),
+) -> Result<StreamResampleSummary> {
+    let info = stream.info().clone();
+    let mut fir = FirDecimator::new(info.fs_hz, info.n_channels(), p)?;
+    let mut w =
+        crate::StreamWriter::create(out, &info.names, &info.units, fir.fs_out_hz(), info.start_s)?;
+    while let Some(b) = stream.next_block(crate::DEFAULT_BLOCK_FRAMES)? {
+        let y = fir.process(&b.channels)?;
+        w.write_block(&y)?;
+        progress(fir.n_in());
+    }
+    let y = fir.finish();
+    w.write_block(&y)?;
+    let frames_out = w.frames_written();
+    w.finish()?;
+    Ok(StreamResampleSummary {
+        design: fir.design().clone(),
+        frames_in: fir.n_in(),
+        frames_out,
+    })
+}
