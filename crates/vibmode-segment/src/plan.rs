@@ -125,6 +125,10 @@ pub fn fixed_cuts(
     Ok(seg)
 }
 
+/// Fixes before and after a fix between which its heading is measured when the receiver gives
+/// no course.
+const HEADING_BASELINE: usize = 3;
+
 /// A fix on the recording's axis with speed and heading.
 struct Point {
     t: f64,
@@ -148,9 +152,17 @@ fn points(track: &GpsTrack, base: f64, offset_s: f64) -> Vec<Point> {
             };
             let derived = if dt > 0.0 { dist / dt * 3.6 } else { 0.0 };
             let speed = f[i].speed_kmh.unwrap_or(derived);
+            // Bearings over a longer baseline (fixes 3 before to 3 after) so that position noise
+            // (a few metres) does not pass for a turn.
+            let (ha, hb) = (
+                i.saturating_sub(HEADING_BASELINE),
+                (i + HEADING_BASELINE).min(n - 1),
+            );
             let heading = match f[i].course_deg {
                 Some(c) if speed > 3.0 => Some(c),
-                _ if dist > 1.0 => Some(bearing_deg(&f[a], &f[b])),
+                _ if ha != hb && distance_m(&f[ha], &f[hb]) > 10.0 => {
+                    Some(bearing_deg(&f[ha], &f[hb]))
+                }
                 _ => None,
             };
             Point {
