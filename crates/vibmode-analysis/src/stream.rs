@@ -178,8 +178,7 @@ impl StreamRecords {
             Some(s) => s,
             None => {
                 self.fill_to(2 * n_per64)?;
-                let s = self.eof && self.buf_end() < 2 * n_per64;
-                s
+                self.eof && self.buf_end() < 2 * n_per64
             }
         };
         if single {

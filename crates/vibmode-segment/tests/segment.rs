@@ -253,7 +253,13 @@ fn vibration_drive(seed: u64, dir: &Path) -> (PathBuf, Vec<(f64, f64, &'static s
     let mut chans = vec![vec![0.0; n]; 3];
     // Road input: a sum of random sines in 1-8 Hz.
     let tones: Vec<(f64, f64, usize)> = (0..30)
-        .map(|k| (r.gen_range(1.0..8.0), r.gen_range(0.0..6.28), k % 3))
+        .map(|k| {
+            (
+                r.gen_range(1.0..8.0),
+                r.gen_range(0.0..std::f64::consts::TAU),
+                k % 3,
+            )
+        })
         .collect();
     for i in 0..n {
         let t = i as f64 / fs;

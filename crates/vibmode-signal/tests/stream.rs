@@ -329,7 +329,10 @@ fn tones(seed: u64, n: usize, fs: f64, pass: f64, stop: f64) -> Vec<f64> {
             r.gen_range(stop..fs / 2.0 - 1.0)
         };
         let bin = (f / df).round();
-        let (a, ph) = (r.gen_range(0.1..2.0), r.gen_range(0.0..6.28));
+        let (a, ph) = (
+            r.gen_range(0.1..2.0),
+            r.gen_range(0.0..std::f64::consts::TAU),
+        );
         for (i, v) in x.iter_mut().enumerate() {
             *v += a * (2.0 * std::f64::consts::PI * bin * i as f64 / n as f64 + ph).cos();
         }
