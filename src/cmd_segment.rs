@@ -41,9 +41,9 @@ pub struct SegmentArgs {
     pub input: PathBuf,
     #[command(flatten)]
     pub seg: SegmentOptions,
-    /// Record length in seconds.
-    #[arg(long = "record-length-s", default_value_t = 10.24)]
-    pub record_length_s: f64,
+    /// Record length in seconds (default: the analysis's `record_length_s`, 10.24).
+    #[arg(long = "record-length-s")]
+    pub record_length_s: Option<f64>,
     /// Channels to keep, by name or 0-based index (default: all).
     #[arg(long = "channel", short = 'c')]
     pub channels: Vec<String>,
@@ -170,7 +170,10 @@ pub fn run(a: &SegmentArgs) -> Result<()> {
         .iter()
         .map(|s| s.parse::<ChannelSelector>())
         .collect::<Result<Vec<_>, _>>()?;
-    let mut seg = plan(&a.input, &opts, &sel, &a.seg, a.record_length_s)?;
+    let record_length_s = a
+        .record_length_s
+        .unwrap_or(vibmode_analysis::AnalysisConfig::default().record_length_s);
+    let mut seg = plan(&a.input, &opts, &sel, &a.seg, record_length_s)?;
     let stream = open(&a.input, &opts, &sel)?;
     let ext = match &a.format {
         Some(f) => match f.as_str() {
