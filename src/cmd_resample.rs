@@ -197,6 +197,7 @@ fn run_streamed(a: &ResampleArgs) -> Result<()> {
         };
         let fig =
             vibmode_report::antialias_figure(&raw, a.to_hz, a.input.cutoff_hz, a.plot_seconds)?;
+        ensure_parent(path)?;
         fig.save(path)
             .with_context(|| format!("writing plot {}", path.display()))?;
     }
