@@ -53,8 +53,13 @@ fn streamed_and_in_memory_analyses_agree_over_seeds() {
         let rec = recording(seed, 33.0 + seed as f64 * 5.0);
         let p = dir.path().join(format!("r{seed}.f64"));
         write_path(&p, &rec).unwrap();
-        let mem = analyze(&cut_records("r", &rec, cfg.record_length_s), &cfg, &[], &|_, _| {})
-            .unwrap();
+        let mem = analyze(
+            &cut_records("r", &rec, cfg.record_length_s),
+            &cfg,
+            &[],
+            &|_, _| {},
+        )
+        .unwrap();
         let mut src = ChainedRecords::new(1, |_| {
             Ok(StreamRecords::cut(
                 "r",
@@ -90,7 +95,11 @@ fn a_short_file_is_one_record_and_channels_must_agree() {
     let rec = recording(9, 15.0);
     let p = dir.path().join("short.f32");
     write_path(&p, &rec).unwrap();
-    let mut s = StreamRecords::cut("short", open_stream(&p, &ReadOptions::default()).unwrap(), 10.24);
+    let mut s = StreamRecords::cut(
+        "short",
+        open_stream(&p, &ReadOptions::default()).unwrap(),
+        10.24,
+    );
     let one = s.next_record().unwrap().unwrap();
     assert_eq!(one.recording.len(), 7500);
     assert!(s.next_record().is_none());
