@@ -25,6 +25,30 @@ pub struct SegmentOptions {
     /// Without GPS: skip stops, idling and strong manoeuvres found from the vibration itself.
     #[arg(long = "by-vibration")]
     pub by_vibration: bool,
+    /// Segmentation tolerances (TOML with keys of docs/segment.md, e.g. `min_speed_kmh = 15`);
+    /// keys not given keep their defaults.
+    #[arg(long = "segment-config")]
+    pub segment_config: Option<PathBuf>,
+}
+
+impl SegmentOptions {
+    /// The tolerances: the defaults, overridden by `--segment-config`.
+    pub fn params(&self) -> Result<SegmentParams> {
+        match &self.segment_config {
+            None => Ok(SegmentParams::default()),
+            Some(p) => {
+                let text = std::fs::read_to_string(p)
+                    .with_context(|| format!("cannot read --segment-config {}", p.display()))?;
+                toml::from_str(&text).map_err(|e| {
+                    anyhow::anyhow!(
+                        "--segment-config {}: {}",
+                        p.display(),
+                        e.to_string().replace('\n', " ")
+                    )
+                })
+            }
+        }
+    }
 }
 
 impl SegmentOptions {
@@ -83,7 +107,7 @@ pub fn plan(
     seg: &SegmentOptions,
     record_length_s: f64,
 ) -> Result<Segmentation> {
-    let p = SegmentParams::default();
+    let p = seg.params()?;
     if let Some(track_path) = &seg.gps {
         if seg.by_vibration {
             bail!("give either --gps TRACK or --by-vibration, not both");

@@ -180,6 +180,41 @@ fn segment_and_analyze_by_gps_carry_speed_and_position() {
         .unwrap()
         .iter()
         .any(|s| s["reason"] == "stop"));
+    // Tolerances from a TOML file: no record can reach 200 km/h.
+    let cfg = d.path().join("seg.toml");
+    std::fs::write(&cfg, "min_speed_kmh = 200\n").unwrap();
+    let strict = d.path().join("strict");
+    let c = cfg.to_str().unwrap();
+    ok(&[
+        "segment",
+        i,
+        "--gps",
+        t,
+        "--segment-config",
+        c,
+        "--plan-only",
+        "-o",
+        strict.to_str().unwrap(),
+    ]);
+    let json2: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(strict.join("segments.json")).unwrap())
+            .unwrap();
+    assert_eq!(json2["records"].as_array().unwrap().len(), 0);
+    assert_eq!(json2["params"]["min_speed_kmh"], 200.0);
+    std::fs::write(&cfg, "min_sped_kmh = 20\n").unwrap();
+    fails_with(
+        &[
+            "segment",
+            i,
+            "--gps",
+            t,
+            "--segment-config",
+            c,
+            "-o",
+            strict.to_str().unwrap(),
+        ],
+        &["min_sped_kmh"],
+    );
     let rep = d.path().join("rep");
     ok(&["analyze", i, "--gps", t, "-q", "-o", rep.to_str().unwrap()]);
     let res: serde_json::Value =
