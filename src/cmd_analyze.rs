@@ -6,7 +6,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use vibmode_analysis::{
-    analyze, cut_records, AnalysisConfig, AnalysisResults, Preset, RecordInput,
+    analyze, AnalysisConfig, AnalysisResults, ChainedRecords, Preset, RecordInput, StreamRecords,
 };
 use vibmode_modal::ReferenceMode;
 use vibmode_report::TruthRow;
@@ -57,6 +57,12 @@ pub struct AnalyzeArgs {
     /// mode shapes) or both; overrides the config's `method`.
     #[arg(long)]
     pub method: Option<String>,
+    /// Records of this length in seconds from long files (overrides the config's
+    /// `record_length_s`).
+    #[arg(long = "record-length-s")]
+    pub record_length_s: Option<f64>,
+    #[command(flatten)]
+    pub seg: crate::cmd_segment::SegmentOptions,
 }
 
 /// `NAME=VALUE` of `--role` / `--corner`.
@@ -121,7 +127,9 @@ fn load_config(config: Option<&Path>, preset: Option<&str>) -> Result<AnalysisCo
 pub fn run(a: &AnalyzeArgs) -> Result<()> {
     let mut cfg = load_config(a.config.as_deref(), a.preset.as_deref())?;
     // The output folder is checked and locked before any work, and written as a whole.
-    let out = crate::output::StagedDir::begin(&a.output, &a.inputs)?;
+    let mut inputs = a.inputs.clone();
+    inputs.extend(a.seg.gps.iter().cloned());
+    let out = crate::output::StagedDir::begin(&a.output, &inputs)?;
     apply_placements(&mut cfg, &a.roles, &a.corners)?;
     if let Some(m) = &a.method {
         cfg.method = m.parse()?;
@@ -137,25 +145,61 @@ pub fn run(a: &AnalyzeArgs) -> Result<()> {
         .iter()
         .map(|s| s.parse::<ChannelSelector>())
         .collect::<Result<Vec<_>, _>>()?;
-    let mut records = Vec::new();
-    for path in &a.inputs {
-        let mut rec = vibmode_signal::read_path(path, &opts)?;
-        if !sel.is_empty() {
-            rec = rec.select(&sel)?;
-        }
-        let name = path
-            .file_name()
-            .map(|s| s.to_string_lossy().to_string())
-            .unwrap_or_else(|| path.display().to_string());
-        records.extend(cut_records(&name, &rec, cfg.record_length_s));
-    }
     let reference = match &a.vehicle {
         Some(p) => vehicle_reference(p)?,
         None => Vec::new(),
     };
-    let results = run_analysis(&records, &cfg, &reference, a.quiet)?;
+    // Each file is read as a stream and cut into records as it is read; each record is brought
+    // to the analysis rate as it arrives, so memory does not grow with the file.
+    if let Some(l) = a.record_length_s {
+        cfg.record_length_s = l;
+        cfg.validate()?;
+    }
+    let record_length_s = cfg.record_length_s;
+    // With --gps / --by-vibration each file is segmented first (a pass over it), then its
+    // records are cut where the segmentation says.
+    let plans = if a.seg.active() {
+        if a.seg.gps.is_some() && a.inputs.len() > 1 {
+            bail!("--gps TRACK goes with one recording; give one input file");
+        }
+        let mut plans = Vec::new();
+        for path in &a.inputs {
+            let plan = crate::cmd_segment::plan(path, &opts, &sel, &a.seg, record_length_s)?;
+            eprintln!("{}", crate::cmd_segment::summary(&plan));
+            if plan.records.is_empty() {
+                bail!(
+                    "no steady stretch of {record_length_s} s in {}; see the reasons above, or analyse without segmentation",
+                    path.display()
+                );
+            }
+            plans.push(plan);
+        }
+        Some(plans)
+    } else {
+        None
+    };
+    let mut source = ChainedRecords::new(a.inputs.len(), |i| {
+        let path = &a.inputs[i];
+        let mut stream = vibmode_signal::open_stream(path, &opts)?;
+        stream.select(&sel)?;
+        Ok(match &plans {
+            Some(p) => StreamRecords::windows(&display_name(path), stream, p[i].windows()),
+            None => StreamRecords::cut(&display_name(path), stream, record_length_s),
+        })
+    });
+    let (results, first) = run_stream_analysis(&mut source, &cfg, &reference, a.quiet)?;
     check_some_fit(&results)?;
-    write_report(out.path(), &records, &results, None)?;
+    write_report(out.path(), std::slice::from_ref(&first), &results, None)?;
+    if let Some(plans) = &plans {
+        let path = out.path().join("segments.json");
+        let text = if plans.len() == 1 {
+            serde_json::to_string_pretty(&plans[0])?
+        } else {
+            serde_json::to_string_pretty(plans)?
+        };
+        std::fs::write(&path, text + "\n")
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
     out.commit()?;
     print_modes(&results, None)?;
     eprintln!("report: {}", a.output.join("index.html").display());
@@ -223,6 +267,63 @@ pub fn run_analysis(
     let res = analyze(records, cfg, reference, &progress)?;
     pb.finish_and_clear();
     Ok(res)
+}
+
+/// The file name of `path` (the whole path if it has none).
+pub fn display_name(path: &Path) -> String {
+    path.file_name()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_else(|| path.display().to_string())
+}
+
+/// Runs the streamed analysis of `source` with a progress display on a terminal; returns the
+/// results and the first record (for the report's figures).
+pub fn run_stream_analysis(
+    source: &mut dyn vibmode_analysis::RecordSource,
+    cfg: &AnalysisConfig,
+    reference: &[ReferenceMode],
+    quiet: bool,
+) -> Result<(AnalysisResults, RecordInput)> {
+    let show = !quiet && std::io::stderr().is_terminal();
+    let pb = ProgressBar::with_draw_target(
+        None,
+        if show {
+            ProgressDrawTarget::stderr()
+        } else {
+            ProgressDrawTarget::hidden()
+        },
+    );
+    if let Ok(style) =
+        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} {msg}")
+    {
+        pb.set_style(style);
+    }
+    pb.set_message("records read and resampled");
+    let on_record = |n: usize| {
+        pb.set_position(n as u64);
+        pb.tick();
+    };
+    let progress = |done: usize, total: usize| {
+        if done == 1 {
+            pb.set_message("record x channel sweeps");
+        }
+        pb.set_length(total as u64);
+        pb.set_position(done as u64);
+    };
+    let identifier = vibmode_analysis::SweepIdentifier {
+        sweep: cfg.sweep.clone(),
+        poles: cfg.poles.clone(),
+    };
+    let out = vibmode_analysis::analyze_source(
+        source,
+        cfg,
+        &identifier,
+        reference,
+        &on_record,
+        &progress,
+    )?;
+    pb.finish_and_clear();
+    Ok(out)
 }
 
 /// Prints the invariant-mode table per role; with `truth`, the true modes beside it.

@@ -3,9 +3,11 @@
 use crate::input::InputArgs;
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
 use std::path::PathBuf;
-use vibmode_signal::ResampleParams;
 use vibmode_signal::ResampleRecording;
+use vibmode_signal::{ResampleParams, StreamResampleParams};
 
 /// Arguments of `vibmode resample`.
 #[derive(Args, Debug)]
@@ -28,7 +30,18 @@ pub struct ResampleArgs {
     /// Seconds of signal shown in the time panel of the plot (default: 0.5 s).
     #[arg(long = "plot-seconds", default_value_t = 0.5)]
     pub plot_seconds: f64,
+    /// Filter: `ideal` (the paper's DFT low-pass over the whole record, in memory), `fir`
+    /// (streamed block by block: linear-phase FIR, pass band to the cutoff, >= 100 dB stop band;
+    /// any length in bounded memory) or `auto` (ideal up to 64 MiB of input file, fir above).
+    #[arg(long, default_value = "auto")]
+    pub method: String,
+    /// No progress bar.
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
 }
+
+/// Input files up to this size are resampled whole with the ideal filter by `--method auto`.
+const AUTO_IDEAL_MAX_BYTES: u64 = 64 << 20;
 
 /// Runs `vibmode resample`.
 pub fn run(a: &ResampleArgs) -> Result<()> {
@@ -48,6 +61,23 @@ pub fn run(a: &ResampleArgs) -> Result<()> {
             "--plot-seconds {}: the time panel needs a positive number of seconds, e.g. 0.5",
             a.plot_seconds
         );
+    }
+    let streamed = match a.method.as_str() {
+        "fir" => true,
+        "ideal" => false,
+        "auto" => {
+            !a.no_filter
+                && std::fs::metadata(&a.input.input)
+                    .map(|m| m.len() > AUTO_IDEAL_MAX_BYTES)
+                    .unwrap_or(false)
+        }
+        other => bail!("--method {other}: use ideal, fir or auto"),
+    };
+    if streamed {
+        if a.no_filter {
+            bail!("--no-filter applies to --method ideal (plain decimation of the whole record); drop one of them");
+        }
+        return run_streamed(a);
     }
     let raw = a.input.load_raw()?;
     let p = ResampleParams {
@@ -77,6 +107,95 @@ pub fn run(a: &ResampleArgs) -> Result<()> {
         a.output.display()
     );
     if let Some(path) = &a.plot {
+        let fig =
+            vibmode_report::antialias_figure(&raw, a.to_hz, a.input.cutoff_hz, a.plot_seconds)?;
+        fig.save(path)
+            .with_context(|| format!("writing plot {}", path.display()))?;
+    }
+    Ok(())
+}
+
+/// `--method fir`: read, filter and write block by block.
+fn run_streamed(a: &ResampleArgs) -> Result<()> {
+    let mut stream = a.input.open_stream()?;
+    let info = stream.info().clone();
+    let p = StreamResampleParams {
+        to_hz: a.to_hz,
+        cutoff_hz: a.input.cutoff_hz,
+        ..StreamResampleParams::default()
+    };
+    let show = !a.quiet && std::io::stderr().is_terminal();
+    let pb = ProgressBar::with_draw_target(
+        info.n_frames,
+        if show {
+            ProgressDrawTarget::stderr()
+        } else {
+            ProgressDrawTarget::hidden()
+        },
+    );
+    if let Ok(style) = ProgressStyle::with_template(
+        "{spinner} [{elapsed_precise}] {bar:40} {percent}% {msg} ETA {eta}",
+    ) {
+        pb.set_style(style);
+    }
+    let t0 = std::time::Instant::now();
+    let fs = info.fs_hz;
+    let mut progress = |frames: u64| {
+        let secs = t0.elapsed().as_secs_f64().max(1e-9);
+        let rt = frames as f64 / fs / secs;
+        pb.set_message(format!(
+            "{:.1} Mframes/s, {:.0}x real time",
+            frames as f64 / secs / 1e6,
+            rt
+        ));
+        pb.set_position(frames);
+    };
+    let sum = vibmode_signal::resample_stream(&mut stream, &a.output, &p, &mut progress)
+        .with_context(|| {
+            format!(
+                "resampling {} to {}",
+                a.input.input.display(),
+                a.output.display()
+            )
+        })?;
+    pb.finish_and_clear();
+    let secs = t0.elapsed().as_secs_f64();
+    let d = &sum.design;
+    eprintln!(
+        "{}: {} channel(s), {} samples at {} Hz -> {} samples at {} Hz (streamed FIR: pass band 0-{} Hz flat within {:.1e}, stop band from {} Hz at -{} dB, {} taps) written to {} in {:.1} s ({:.0}x real time)",
+        a.input.input.display(),
+        info.n_channels(),
+        sum.frames_in,
+        info.fs_hz,
+        sum.frames_out,
+        d.fs_out_hz,
+        d.pass_hz,
+        10f64.powf(-d.attenuation_db / 20.0),
+        d.stop_hz,
+        d.attenuation_db,
+        d.n_taps,
+        a.output.display(),
+        secs,
+        sum.frames_in as f64 / info.fs_hz / secs.max(1e-9),
+    );
+    if let Some(path) = &a.plot {
+        // The figure needs the raw signal: the first 20 s of the file.
+        let mut head = a.input.open_stream()?;
+        let n = (20.0 * info.fs_hz) as usize;
+        let block = head
+            .next_block(n.max(1))?
+            .context("the input has no samples to plot")?;
+        let raw = vibmode_signal::Recording {
+            fs_hz: info.fs_hz,
+            channels: info
+                .names
+                .iter()
+                .zip(&info.units)
+                .zip(block.channels)
+                .map(|((n, u), d)| vibmode_signal::Channel::new(n.clone(), u.clone(), d))
+                .collect(),
+            time_axis: None,
+        };
         let fig =
             vibmode_report::antialias_figure(&raw, a.to_hz, a.input.cutoff_hz, a.plot_seconds)?;
         fig.save(path)

@@ -105,6 +105,11 @@ pub struct SimulateArgs {
     /// Output folder: record_01.wav ... and truth.json.
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
+    /// Also write a GPS track of a city drive (stops, turns, speed changes) as long as all the
+    /// records together, starting at 2024-05-02T07:31:00Z: track.gpx, track.nmea, track.csv and
+    /// the true phases in drive_truth.json.
+    #[arg(long = "gps-track")]
+    pub gps_track: bool,
 }
 
 /// Simulation settings from the command-line values.
@@ -175,6 +180,27 @@ pub fn run_simulate(a: &SimulateArgs) -> Result<()> {
     let out = crate::output::StagedDir::begin(&a.output, std::slice::from_ref(&a.params))?;
     let sim = vibmode_vehicle::simulate(&vehicle, &p)?;
     let paths = write_simulation(out.path(), &sim, a.format)?;
+    if a.gps_track {
+        let drive = vibmode_vehicle::drive::simulate_drive(
+            &vibmode_vehicle::drive::DriveParams::new(a.duration_s * a.records as f64, a.seed),
+        );
+        for (name, text) in [
+            ("track.gpx", drive.to_gpx()),
+            ("track.nmea", drive.to_nmea()),
+            ("track.csv", drive.to_csv()),
+            (
+                "drive_truth.json",
+                serde_json::to_string_pretty(&drive)? + "\n",
+            ),
+        ] {
+            let path = out.path().join(name);
+            std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
+        }
+        eprintln!(
+            "wrote a {:.0} s GPS track (track.gpx, track.nmea, track.csv) and its true phases (drive_truth.json)",
+            a.duration_s * a.records as f64
+        );
+    }
     out.commit()?;
     eprintln!(
         "wrote {} record(s) of {} s at {} Hz and truth.json to {}",

@@ -67,6 +67,28 @@ impl InputArgs {
         Ok((rec, band))
     }
 
+    /// Opens the file as a stream of blocks with the channels selected (for any length).
+    pub fn open_stream(&self) -> Result<vibmode_signal::FrameStream> {
+        let mut s = vibmode_signal::open_stream(&self.input, &self.read_options())?;
+        let sel = self
+            .channels
+            .iter()
+            .map(|s| s.parse::<ChannelSelector>())
+            .collect::<Result<Vec<_>, _>>()?;
+        s.select(&sel)?;
+        Ok(s)
+    }
+
+    fn read_options(&self) -> ReadOptions {
+        ReadOptions {
+            fs_hz: self.fs_hz,
+            scale: self.scale,
+            allow_nonuniform: self.resample_nonuniform,
+            unit: self.unit.clone(),
+            ..ReadOptions::default()
+        }
+    }
+
     /// Reads the file and selects channels, without resampling.
     pub fn load_raw(&self) -> Result<Recording> {
         let opts = ReadOptions {

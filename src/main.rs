@@ -9,6 +9,7 @@ mod cmd_fit;
 mod cmd_fleet;
 mod cmd_psd;
 mod cmd_resample;
+mod cmd_segment;
 mod cmd_ssi;
 mod cmd_sweep;
 mod cmd_vehicle;
@@ -35,6 +36,10 @@ enum Command {
     /// Ideal DFT anti-alias filter and resampling to a new rate.
     #[command(allow_negative_numbers = true)]
     Resample(cmd_resample::ResampleArgs),
+    /// Cut a long recording into records where the vehicle drives steadily (by GPS or by the
+    /// vibration), writing the records and segments.json.
+    #[command(allow_negative_numbers = true)]
+    Segment(cmd_segment::SegmentArgs),
     /// Fit an AR or ARMA model to each channel and report its modes.
     #[command(allow_negative_numbers = true)]
     Fit(cmd_fit::FitArgs),
@@ -67,6 +72,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Psd(a) => cmd_psd::run(&a),
         Command::Resample(a) => cmd_resample::run(&a),
+        Command::Segment(a) => cmd_segment::run(&a),
         Command::Fit(a) => cmd_fit::run(&a),
         Command::Sweep(a) => cmd_sweep::run(&a),
         Command::Ssi(a) => cmd_ssi::run(&a),

@@ -107,7 +107,13 @@ impl Drop for StagedDir {
 }
 
 /// Files that mark a folder as vibmode's own output (which may be replaced as a whole).
-const OUTPUT_MARKERS: &[&str] = &["results.json", "index.html", "truth.json", "fleet.json"];
+const OUTPUT_MARKERS: &[&str] = &[
+    "results.json",
+    "index.html",
+    "truth.json",
+    "fleet.json",
+    "segments.json",
+];
 
 impl StagedDir {
     /// Prepares writing `target`: its parent must exist; `target` must be new, empty, or an

@@ -33,18 +33,23 @@ pub mod results;
 pub mod source;
 pub mod stops;
 pub mod store;
+pub mod stream;
 
 pub use config::{AnalysisConfig, ChannelRole, Preset, ReportParams};
 pub use first_record::{first_record_spectra, FirstRecordSpectra, ModelPsd};
 pub use identify::{Identifier, PoleOut, SignalFits, SweepIdentifier};
 pub use lines::LineTrack;
 pub use multichannel::{ShapedPole, SsiAnalysis, MATCH_MAC_MIN};
-pub use pipeline::{analyze, analyze_with, check_records, cluster_params_for, preprocess_records};
+pub use pipeline::{
+    analyze, analyze_prepared, analyze_with, check_records, cluster_params_for, preprocess_records,
+    RecordFacts,
+};
 pub use results::{
     AnalysisResults, ChannelAnalysis, RecordSummary, RoleAnalysis, Timing, SCHEMA_VERSION,
 };
 pub use source::{cut_records, CutRecords, RecordInput, RecordSource};
 pub use store::PoleStore;
+pub use stream::{analyze_source, ChainedRecords, RecordWindow, StreamRecords};
 pub use vibmode_core::{
     ClusterParams, Corner, FitSummary, ModelCoefficients, Placement, PoleFilterParams,
     PreprocessParams, Robust, Role, SpectrumParams, StopParams, SweepModel, SweepParams,
@@ -133,6 +138,18 @@ pub enum AnalysisError {
         needed: usize,
         /// Duration needed, s.
         needed_s: f64,
+    },
+    /// A record window (segmentation) that reaches past the end of the recording.
+    #[error("record '{record}' (frames {start_frame}.. +{n_frames}) reaches past the end of the recording ({file_frames} frames); the segmentation does not fit this file")]
+    WindowOutside {
+        /// The record.
+        record: String,
+        /// Its first frame.
+        start_frame: u64,
+        /// Its length in frames.
+        n_frames: usize,
+        /// Frames in the file.
+        file_frames: u64,
     },
     /// A recording breaks its invariants.
     #[error(transparent)]

@@ -34,24 +34,30 @@ struct SignalOut {
 /// Checks that all records have the same channels and rate.
 pub fn check_records(records: &[RecordInput]) -> Result<(), AnalysisError> {
     let first = records.first().ok_or(AnalysisError::NoRecords)?;
-    let names = first.recording.names();
     for r in records {
-        if r.recording.names() != names {
-            return Err(AnalysisError::ChannelsDiffer {
-                record: r.name.clone(),
-                channels: r.recording.names().join(", "),
-                first: first.name.clone(),
-                first_channels: names.join(", "),
-            });
-        }
-        if (r.recording.fs_hz - first.recording.fs_hz).abs() > 1e-9 * first.recording.fs_hz {
-            return Err(AnalysisError::RatesDiffer {
-                record: r.name.clone(),
-                fs_hz: r.recording.fs_hz,
-                first: first.name.clone(),
-                first_fs_hz: first.recording.fs_hz,
-            });
-        }
+        check_same_layout(first, r)?;
+    }
+    Ok(())
+}
+
+/// Checks that `r` has the channels and rate of `first`.
+pub fn check_same_layout(first: &RecordInput, r: &RecordInput) -> Result<(), AnalysisError> {
+    let names = first.recording.names();
+    if r.recording.names() != names {
+        return Err(AnalysisError::ChannelsDiffer {
+            record: r.name.clone(),
+            channels: r.recording.names().join(", "),
+            first: first.name.clone(),
+            first_channels: names.join(", "),
+        });
+    }
+    if (r.recording.fs_hz - first.recording.fs_hz).abs() > 1e-9 * first.recording.fs_hz {
+        return Err(AnalysisError::RatesDiffer {
+            record: r.name.clone(),
+            fs_hz: r.recording.fs_hz,
+            first: first.name.clone(),
+            first_fs_hz: first.recording.fs_hz,
+        });
     }
     Ok(())
 }
@@ -67,16 +73,24 @@ pub fn check_lengths(
     pre: &[Preprocessed],
     cfg: &AnalysisConfig,
 ) -> Result<(), AnalysisError> {
+    check_lengths_named(records.iter().map(|r| r.name.as_str()), pre, cfg)
+}
+
+fn check_lengths_named<'n>(
+    names: impl Iterator<Item = &'n str>,
+    pre: &[Preprocessed],
+    cfg: &AnalysisConfig,
+) -> Result<(), AnalysisError> {
     let params = match cfg.sweep.model {
         vibmode_core::SweepModel::Arma => 2 * cfg.sweep.order_min,
         vibmode_core::SweepModel::Ar => cfg.sweep.order_min,
     };
     let needed = (SAMPLES_PER_PARAMETER * params).max(8);
-    for (r, p) in records.iter().zip(pre) {
+    for (name, p) in names.zip(pre) {
         let n = p.recording.len();
         if n < needed {
             return Err(AnalysisError::RecordTooShort {
-                record: r.name.clone(),
+                record: name.to_string(),
                 n_samples: n,
                 fs_hz: p.band.fs_hz,
                 duration_s: n as f64 / p.band.fs_hz,
@@ -137,10 +151,54 @@ pub fn analyze_with(
     cfg.validate()?;
     check_records(records)?;
     let pre = preprocess_records(records, cfg)?;
-    check_lengths(records, &pre, cfg)?;
+    let facts = records.iter().map(RecordFacts::of).collect();
+    analyze_prepared(facts, pre, cfg, identifier, reference, progress, t0)
+}
+
+/// What the results keep of a record at its original rate (the samples themselves are not kept).
+#[derive(Clone, Debug)]
+pub struct RecordFacts {
+    /// Display name.
+    pub name: String,
+    /// Original sampling rate, Hz.
+    pub fs_hz: f64,
+    /// Original number of samples.
+    pub n_samples: usize,
+    /// Where the record was cut from a long recording (segmentation), if it was.
+    pub meta: Option<vibmode_core::RecordMeta>,
+}
+
+impl RecordFacts {
+    /// The facts of `r` (no segmentation facts).
+    pub fn of(r: &RecordInput) -> RecordFacts {
+        RecordFacts {
+            name: r.name.clone(),
+            fs_hz: r.recording.fs_hz,
+            n_samples: r.recording.len(),
+            meta: None,
+        }
+    }
+}
+
+/// Stages 3-7 on records already pre-processed (`pre[i]` is `facts[i]` at the analysis rate):
+/// what [`analyze_with`] runs after stage 2, and what a streamed analysis runs once every record
+/// has arrived and been pre-processed.
+pub fn analyze_prepared(
+    facts: Vec<RecordFacts>,
+    pre: Vec<Preprocessed>,
+    cfg: &AnalysisConfig,
+    identifier: &dyn Identifier,
+    reference: &[ReferenceMode],
+    progress: &(dyn Fn(usize, usize) + Sync),
+    t0: Instant,
+) -> Result<AnalysisResults, AnalysisError> {
+    if pre.is_empty() {
+        return Err(AnalysisError::NoRecords);
+    }
+    check_lengths_named(facts.iter().map(|f| f.name.as_str()), &pre, cfg)?;
     let outs = identify_all(&pre, cfg, identifier, progress)?;
     let n_ch = pre.first().map_or(0, |p| p.recording.n_channels());
-    let activity_rms = record_activity(&outs, records.len(), n_ch, cfg);
+    let activity_rms = record_activity(&outs, facts.len(), n_ch, cfg);
     let activity_ratio = activity_ratios(&activity_rms, n_ch);
     let stationary = detect_stops(&activity_ratio, &cfg.stops);
     let active = renumber_active(&stationary);
@@ -156,7 +214,7 @@ pub fn analyze_with(
     let lines = LineStage::new(&pre, stationary.iter().map(|s| !s).collect(), &cfg.lines);
     let mut store = PoleStore::new();
     let channels = channel_modes(
-        &records[0].recording,
+        &pre[0].recording,
         &outs,
         &stationary,
         cfg,
@@ -184,15 +242,16 @@ pub fn analyze_with(
     let n_fits = fits.clone().count();
     let n_not_converged = fits.clone().filter(|f| !f.converged).count();
     let n_failed = fits.filter(|f| f.failed).count();
-    let records = records
-        .iter()
+    let records = facts
+        .into_iter()
         .zip(&pre)
         .enumerate()
         .map(|(i, (r, p))| RecordSummary {
-            name: r.name.clone(),
-            fs_hz: r.recording.fs_hz,
-            n_samples: r.recording.len(),
-            duration_s: r.recording.duration_s(),
+            name: r.name,
+            fs_hz: r.fs_hz,
+            n_samples: r.n_samples,
+            duration_s: r.n_samples as f64 / r.fs_hz,
+            segment: r.meta,
             band: p.band,
             activity_rms: activity_rms[i].clone(),
             activity_ratio: activity_ratio[i],

@@ -47,6 +47,10 @@ pub struct RecordSummary {
     pub stationary: bool,
     /// Why the record is left out of the mode statistics (None = used).
     pub excluded_reason: Option<String>,
+    /// Where the record was cut from a long recording: start, and with a GPS track the mean
+    /// speed and position (absent for record files analysed whole).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub segment: Option<vibmode_core::RecordMeta>,
 }
 
 /// Everything found for one channel.

@@ -19,6 +19,12 @@ pub trait RecordSource {
     /// The next record, `None` when the source is exhausted.
     fn next_record(&mut self) -> Option<Result<RecordInput, AnalysisError>>;
 
+    /// Where the record last returned by [`RecordSource::next_record`] was cut from (start,
+    /// speed and position), for sources that know it; `None` by default.
+    fn meta(&self) -> Option<vibmode_core::RecordMeta> {
+        None
+    }
+
     /// Every remaining record.
     fn collect_records(&mut self) -> Result<Vec<RecordInput>, AnalysisError> {
         let mut out = Vec::new();

@@ -25,6 +25,7 @@ pub mod limits;
 pub mod modes;
 pub mod params;
 pub mod placement;
+pub mod record_meta;
 pub mod recording;
 pub mod ssi;
 
@@ -40,6 +41,7 @@ pub use params::{
     EMPTY_BAND_MAX_CUTOFF_SHARE,
 };
 pub use placement::{Corner, Direction, Placement, Role};
+pub use record_meta::RecordMeta;
 pub use recording::{
     check_finite, check_fs, Channel, ChannelSelector, Recording, RecordingView, TimeAxis,
 };

@@ -543,6 +543,36 @@ fn time_records_figure(name: &str, rec: &Recording) -> Figure {
     grid(panels, 2, 600, 260)
 }
 
+/// Mean speed of each record cut by GPS against its time in the recording; `None` when no
+/// record has a speed.
+fn drive_figure(r: &AnalysisResults) -> Option<Figure> {
+    let segs: Vec<&vibmode_core::RecordMeta> = r
+        .records
+        .iter()
+        .filter_map(|x| x.segment.as_ref())
+        .collect();
+    if !segs.iter().any(|m| m.mean_speed_kmh.is_some()) {
+        return None;
+    }
+    let mut panel = Panel::new(
+        "records over the drive",
+        "Time in the recording [s]",
+        "Mean speed [km/h]",
+    );
+    for m in segs {
+        if let Some(v) = m.mean_speed_kmh {
+            panel = panel.with_series(line(
+                "record",
+                vec![m.start_s, m.start_s + m.duration_s],
+                vec![v, v],
+                3,
+                1.0,
+            ));
+        }
+    }
+    Some(grid(vec![panel.without_legend()], 1, 900, 300))
+}
+
 fn spectra_figures(
     r: &AnalysisResults,
     spectra: &[FirstRecordSpectra],
@@ -666,6 +696,16 @@ fn inputs_table(html: &mut HtmlReport, r: &AnalysisResults) {
                 format!("{:.2}", rec.duration_s),
                 format!("{:.3}", rec.band.fs_hz),
                 format!("{:.2}", rec.activity_ratio),
+                rec.segment.as_ref().map_or("-".into(), |m| {
+                    let mut t = format!("{:.1} s", m.start_s);
+                    if let Some(v) = m.mean_speed_kmh {
+                        t.push_str(&format!(", {v:.1} km/h"));
+                    }
+                    if let (Some(la), Some(lo)) = (m.lat_deg, m.lon_deg) {
+                        t.push_str(&format!(", {la:.5} {lo:.5}"));
+                    }
+                    t
+                }),
                 rec.excluded_reason.clone().unwrap_or_else(|| "used".into()),
             ]
         })
@@ -678,6 +718,7 @@ fn inputs_table(html: &mut HtmlReport, r: &AnalysisResults) {
             "duration [s]",
             "analysis rate [Hz]",
             "activity",
+            "start, speed, position",
             "status",
         ],
         &rows,
@@ -903,6 +944,14 @@ fn add_figures(
                 "First channel: raw at {} Hz, resampled to {} Hz without filter (aliased), and with the ideal DFT low-pass at {} Hz.",
                 first.recording.fs_hz, cfg.preprocess.analysis_fs_hz, cutoff
             ),
+        )?;
+    }
+    if let Some(fig) = drive_figure(r) {
+        w.add(
+            "drive",
+            "records over the drive",
+            &fig,
+            "Each record cut from the long recording: its mean speed from the GPS track (a bar from its start to its end) against the time in the recording; the gaps are what the segmentation skipped (stops, braking, turns; segments.json says why).",
         )?;
     }
     let (fig5, fig67) = spectra_figures(r, spectra, fmax);

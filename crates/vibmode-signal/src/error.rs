@@ -152,6 +152,23 @@ pub enum SignalError {
         /// Bytes per value.
         dtype_bytes: usize,
     },
+    /// A raw file that ends inside a frame: cut off mid-write, or a sidecar whose `dtype` or
+    /// `channels` do not fit the data (found by the stream reader before any sample is used).
+    #[error("{path} has {bytes} bytes, not a whole number of {frame_bytes}-byte frames ({channels} channels x {dtype_bytes} bytes): it was cut off mid-write or the sidecar's dtype/channels are wrong; check the sidecar, or keep the whole frames by cutting the file to {whole_bytes} bytes (truncate -s {whole_bytes})")]
+    PartialFrame {
+        /// The file.
+        path: String,
+        /// File size.
+        bytes: u64,
+        /// Bytes per frame.
+        frame_bytes: u64,
+        /// Channels.
+        channels: usize,
+        /// Bytes per value.
+        dtype_bytes: usize,
+        /// The size of the whole frames it holds.
+        whole_bytes: u64,
+    },
     /// A WAV file that cannot be used.
     #[error("WAV {path}: {reason}")]
     Wav {

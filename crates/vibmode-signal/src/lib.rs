@@ -44,6 +44,9 @@ mod number;
 mod preprocess;
 pub mod read;
 pub mod resample;
+pub mod stream;
+pub mod stream_resample;
+pub mod stream_write;
 pub mod write;
 
 pub use delimited::{Block, ColumnInfo, DelimitedReader, Separator};
@@ -55,6 +58,11 @@ pub use read::{
 };
 pub use resample::ResampleRecording;
 pub use resample::{resample, ResampleMethod, ResampleParams, Resampler};
+pub use stream::{open_stream, FrameBlock, FrameStream, StreamInfo, DEFAULT_BLOCK_FRAMES};
+pub use stream_resample::{
+    resample_stream, FirDecimator, FirDesign, StreamResampleParams, StreamResampleSummary,
+};
+pub use stream_write::StreamWriter;
 pub use vibmode_core::{
     Channel, ChannelSelector, Recording, RecordingError, RecordingView, TimeAxis,
 };

@@ -146,7 +146,12 @@ pub fn read_path(path: &Path, opts: &ReadOptions) -> Result<Recording> {
     Ok(rec)
 }
 
-fn reconcile_fs(path: &str, source_name: String, file_fs: f64, given: Option<f64>) -> Result<f64> {
+pub(crate) fn reconcile_fs(
+    path: &str,
+    source_name: String,
+    file_fs: f64,
+    given: Option<f64>,
+) -> Result<f64> {
     check_fs(file_fs, &source_name)?;
     match given {
         None => Ok(file_fs),
@@ -443,7 +448,7 @@ pub struct WavSidecar {
 }
 
 /// Channel names and units of a WAV: from `<path>.json` when it exists, else `ch0`, `ch1`, ...
-fn wav_names(path: &Path, nch: usize) -> Result<(Vec<String>, Vec<String>)> {
+pub(crate) fn wav_names(path: &Path, nch: usize) -> Result<(Vec<String>, Vec<String>)> {
     let mut full = path.as_os_str().to_owned();
     full.push(".json");
     let side = PathBuf::from(full);
@@ -509,8 +514,18 @@ pub fn sidecar_candidates(path: &Path) -> Vec<PathBuf> {
     v
 }
 
-fn read_raw(path: &Path, opts: &ReadOptions) -> Result<Recording> {
-    let p = path.display().to_string();
+/// A raw file's sidecar, checked: where it is, what it says and the bytes per value.
+pub(crate) struct RawLayout {
+    /// The sidecar's path, for messages.
+    pub sidecar_path: String,
+    /// Its content.
+    pub side: Sidecar,
+    /// Bytes per value (4 or 8).
+    pub width: usize,
+}
+
+/// Finds, reads and checks the sidecar of the raw file `path`.
+pub(crate) fn raw_layout(path: &Path) -> Result<RawLayout> {
     let cands = sidecar_candidates(path);
     let side_path = cands.iter().find(|c| c.is_file()).ok_or_else(|| SignalError::Sidecar {
         path: cands
@@ -562,6 +577,21 @@ fn read_raw(path: &Path, opts: &ReadOptions) -> Result<Recording> {
             side.fs_hz
         )));
     }
+    Ok(RawLayout {
+        sidecar_path: sp,
+        side,
+        width,
+    })
+}
+
+fn read_raw(path: &Path, opts: &ReadOptions) -> Result<Recording> {
+    let p = path.display().to_string();
+    let RawLayout {
+        sidecar_path: sp,
+        side,
+        width,
+    } = raw_layout(path)?;
+    let nch = side.channels.len();
     let bytes = std::fs::read(path).map_err(|e| io_err("read", path, &e))?;
     let frame = width * nch;
     if bytes.len() % frame != 0 {

@@ -32,6 +32,7 @@
 
 #![warn(missing_docs)]
 
+pub mod drive;
 pub mod error;
 pub mod lines;
 pub mod model;

@@ -1,0 +1,454 @@
+//! GPS tracks: GPX (`gpx` crate), NMEA 0183 RMC/GGA (`nmea` crate) and CSV (`csv` crate).
+//!
+//! - **GPX**: every `<trkpt>` of every track and segment (then `<rtept>`, `<wpt>` if there are no
+//!   track points) with a `<time>`; `<speed>` (m/s) when present.
+//! - **NMEA**: one sentence per line. RMC sentences give date, time, position, speed (knots) and
+//!   course; GGA sentences (time and position only) are used when the file has no RMC. A line
+//!   that is not a valid sentence (bad checksum, malformed fields, not starting with `$`) is
+//!   skipped and counted (`n_bad_sentences`); sentences of other types (GSV, VTG...) are ignored
+//!   and counted (`n_other_sentences`). RMC with status `V` (no fix) is skipped. Without any date
+//!   (GGA only) times are seconds of the day, rolled over at midnight.
+//! - **CSV**: a header row naming the columns `time` (or `t`, `time_s`, `timestamp`, `datetime`,
+//!   `utc`), `lat`/`latitude`, `lon`/`lng`/`longitude` and optionally `speed`; separator `,` or
+//!   `;`. Time cells are seconds (Unix time when above 1e8) or RFC 3339 (`2024-05-02T07:31:00Z`).
+//!   Speed is m/s unless the header says km/h (`speed_kmh`, `speed (km/h)`) or knots (`kn`).
+//!
+//! Times must not go backwards ([`crate::SegmentError::TimeBackwards`]); repeated times keep the
+//! first fix.
+
+use crate::{parse_rfc3339, SegmentError};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// One GPS fix.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GpsFix {
+    /// Time, s: Unix time when the track is absolute, else seconds as written (e.g. of the day).
+    pub t_s: f64,
+    /// Latitude, degrees.
+    pub lat_deg: f64,
+    /// Longitude, degrees.
+    pub lon_deg: f64,
+    /// Speed from the receiver, km/h.
+    pub speed_kmh: Option<f64>,
+    /// Course over ground from the receiver, degrees from north.
+    pub course_deg: Option<f64>,
+}
+
+/// A GPS track format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TrackFormat {
+    /// GPX 1.0/1.1.
+    Gpx,
+    /// NMEA 0183 sentences.
+    Nmea,
+    /// CSV with time, latitude, longitude, speed.
+    Csv,
+}
+
+/// A GPS track, fixes in time order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GpsTrack {
+    /// The file.
+    pub path: String,
+    /// Its format.
+    pub format: TrackFormat,
+    /// The fixes.
+    pub fixes: Vec<GpsFix>,
+    /// True when `t_s` is Unix time (dates known).
+    pub absolute: bool,
+    /// NMEA lines that could not be parsed.
+    pub n_bad_sentences: usize,
+    /// NMEA sentences of other types.
+    pub n_other_sentences: usize,
+}
+
+fn track_err(path: &str, reason: String) -> SegmentError {
+    SegmentError::Track {
+        path: path.to_string(),
+        reason,
+    }
+}
+
+/// Reads a track; the format from the extension (`.gpx`, `.nmea`/`.nma`/`.log`, `.csv`/`.txt`)
+/// or, failing that, from the first character (`<` GPX, `$` NMEA, else CSV).
+pub fn read_track(path: &Path) -> Result<GpsTrack, SegmentError> {
+    let p = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| SegmentError::Io {
+        path: p.clone(),
+        message: e.to_string(),
+    })?;
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    let first = text
+        .trim_start_matches('\u{feff}')
+        .trim_start()
+        .chars()
+        .next();
+    let format = match ext.as_str() {
+        "gpx" => TrackFormat::Gpx,
+        "nmea" | "nma" => TrackFormat::Nmea,
+        "csv" | "tsv" => TrackFormat::Csv,
+        _ => match first {
+            Some('<') => TrackFormat::Gpx,
+            Some('$') => TrackFormat::Nmea,
+            _ => TrackFormat::Csv,
+        },
+    };
+    let mut track = match format {
+        TrackFormat::Gpx => read_gpx(&text, &p)?,
+        TrackFormat::Nmea => read_nmea(&text, &p)?,
+        TrackFormat::Csv => read_csv(&text, &p)?,
+    };
+    if track.fixes.is_empty() {
+        return Err(SegmentError::NoFixes {
+            path: p,
+            detail: if track.format == TrackFormat::Nmea {
+                format!(
+                    " ({} unparseable and {} other sentences)",
+                    track.n_bad_sentences, track.n_other_sentences
+                )
+            } else {
+                String::new()
+            },
+        });
+    }
+    track.fixes.dedup_by(|b, a| b.t_s == a.t_s);
+    Ok(track)
+}
+
+/// Checks that `t` does not go backwards; `at(i)` names fix i.
+fn check_order(
+    path: &str,
+    fixes: &[GpsFix],
+    at: impl Fn(usize) -> String,
+    show: impl Fn(f64) -> String,
+) -> Result<(), SegmentError> {
+    for i in 1..fixes.len() {
+        if fixes[i].t_s < fixes[i - 1].t_s {
+            return Err(SegmentError::TimeBackwards {
+                path: path.to_string(),
+                at: at(i),
+                previous: show(fixes[i - 1].t_s),
+                value: show(fixes[i].t_s),
+            });
+        }
+    }
+    Ok(())
+}
+
+fn show_time(absolute: bool) -> impl Fn(f64) -> String {
+    move |t| {
+        if absolute {
+            crate::format_rfc3339(t).unwrap_or_else(|| format!("{t} s"))
+        } else {
+            format!("{t} s")
+        }
+    }
+}
+
+fn read_gpx(text: &str, p: &str) -> Result<GpsTrack, SegmentError> {
+    let g = gpx::read(text.as_bytes())
+        .map_err(|e| track_err(p, format!("{e}; check that it is a valid GPX file")))?;
+    let mut points: Vec<&gpx::Waypoint> = g
+        .tracks
+        .iter()
+        .flat_map(|t| t.segments.iter())
+        .flat_map(|s| s.points.iter())
+        .collect();
+    if points.is_empty() {
+        points = g.routes.iter().flat_map(|r| r.points.iter()).collect();
+    }
+    if points.is_empty() {
+        points = g.waypoints.iter().collect();
+    }
+    let mut fixes = Vec::with_capacity(points.len());
+    for w in points {
+        let Some(t) = w.time else { continue };
+        let t: time::OffsetDateTime = t.into();
+        let pt = w.point();
+        fixes.push(GpsFix {
+            t_s: t.unix_timestamp_nanos() as f64 / 1e9,
+            lat_deg: pt.y(),
+            lon_deg: pt.x(),
+            speed_kmh: w.speed.map(|v| v * 3.6),
+            course_deg: None,
+        });
+    }
+    check_order(p, &fixes, |i| format!("point {}", i + 1), show_time(true))?;
+    Ok(GpsTrack {
+        path: p.to_string(),
+        format: TrackFormat::Gpx,
+        fixes,
+        absolute: true,
+        n_bad_sentences: 0,
+        n_other_sentences: 0,
+    })
+}
+
+fn read_nmea(text: &str, p: &str) -> Result<GpsTrack, SegmentError> {
+    use chrono::Timelike;
+    let mut rmc: Vec<(GpsFix, usize)> = Vec::new();
+    let mut gga: Vec<(f64, f64, f64, usize)> = Vec::new();
+    let (mut bad, mut other) = (0usize, 0usize);
+    for (k, line) in text.lines().enumerate() {
+        let line = line.trim().trim_start_matches('\u{feff}');
+        if line.is_empty() {
+            continue;
+        }
+        if !line.starts_with('$') {
+            bad += 1;
+            continue;
+        }
+        match nmea::parse_str(line) {
+            Ok(nmea::ParseResult::RMC(r)) => {
+                let valid = !matches!(
+                    r.status_of_fix,
+                    nmea::sentences::rmc::RmcStatusOfFix::Invalid
+                );
+                if let (true, Some(tm), Some(date), Some(lat), Some(lon)) =
+                    (valid, r.fix_time, r.fix_date, r.lat, r.lon)
+                {
+                    let dt = date.and_time(tm).and_utc();
+                    let t = dt.timestamp() as f64 + dt.timestamp_subsec_nanos() as f64 / 1e9;
+                    rmc.push((
+                        GpsFix {
+                            t_s: t,
+                            lat_deg: lat,
+                            lon_deg: lon,
+                            speed_kmh: r.speed_over_ground.map(|v| v as f64 * 1.852),
+                            course_deg: r.true_course.map(|v| v as f64),
+                        },
+                        k + 1,
+                    ));
+                }
+            }
+            Ok(nmea::ParseResult::GGA(g)) => {
+                if let (Some(tm), Some(lat), Some(lon)) = (g.fix_time, g.latitude, g.longitude) {
+                    let t = tm.num_seconds_from_midnight() as f64 + tm.nanosecond() as f64 / 1e9;
+                    gga.push((t, lat, lon, k + 1));
+                }
+            }
+            Ok(_) => other += 1,
+            Err(
+                nmea::Error::DisabledSentence
+                | nmea::Error::Unsupported(_)
+                | nmea::Error::Unknown(_),
+            ) => other += 1,
+            Err(_) => bad += 1,
+        }
+    }
+    let (fixes, lines, absolute) = if !rmc.is_empty() {
+        other += gga.len();
+        let lines: Vec<usize> = rmc.iter().map(|f| f.1).collect();
+        (
+            rmc.into_iter().map(|f| f.0).collect::<Vec<_>>(),
+            lines,
+            true,
+        )
+    } else {
+        // Seconds of the day; a step back of more than 12 h is midnight.
+        let mut day = 0.0;
+        let mut prev = f64::NEG_INFINITY;
+        let mut fixes = Vec::with_capacity(gga.len());
+        let mut lines = Vec::with_capacity(gga.len());
+        for (t, lat, lon, line) in gga {
+            if t + day < prev - 43_200.0 {
+                day += 86_400.0;
+            }
+            prev = t + day;
+            fixes.push(GpsFix {
+                t_s: t + day,
+                lat_deg: lat,
+                lon_deg: lon,
+                speed_kmh: None,
+                course_deg: None,
+            });
+            lines.push(line);
+        }
+        (fixes, lines, false)
+    };
+    check_order(
+        p,
+        &fixes,
+        |i| format!("line {}", lines.get(i).copied().unwrap_or(0)),
+        show_time(absolute),
+    )?;
+    Ok(GpsTrack {
+        path: p.to_string(),
+        format: TrackFormat::Nmea,
+        fixes,
+        absolute,
+        n_bad_sentences: bad,
+        n_other_sentences: other,
+    })
+}
+
+fn find_col(header: &[String], names: &[&str]) -> Option<usize> {
+    header.iter().position(|h| {
+        let base = h
+            .split(['(', '['])
+            .next()
+            .unwrap_or("")
+            .trim()
+            .to_ascii_lowercase();
+        names.contains(&base.as_str())
+    })
+}
+
+fn read_csv(text: &str, p: &str) -> Result<GpsTrack, SegmentError> {
+    let text = text.trim_start_matches('\u{feff}');
+    let first_line = text.lines().next().unwrap_or("");
+    let delim = if first_line.contains(';') { b';' } else { b',' };
+    let mut rdr = csv::ReaderBuilder::new()
+        .delimiter(delim)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let header: Vec<String> = rdr
+        .headers()
+        .map_err(|e| {
+            track_err(
+                p,
+                format!("{e}; expected a header row like time,lat,lon,speed"),
+            )
+        })?
+        .iter()
+        .map(str::to_string)
+        .collect();
+    let need = |names: &[&str], what: &str| {
+        find_col(&header, names).ok_or_else(|| {
+            track_err(
+                p,
+                format!(
+                    "no {what} column in the header [{}]; name the columns time, lat, lon and (optionally) speed",
+                    header.join(", ")
+                ),
+            )
+        })
+    };
+    let tc = need(
+        &[
+            "time",
+            "t",
+            "time_s",
+            "timestamp",
+            "datetime",
+            "utc",
+            "date_time",
+        ],
+        "time",
+    )?;
+    let la = need(&["lat", "latitude"], "latitude")?;
+    let lo = need(&["lon", "lng", "long", "longitude"], "longitude")?;
+    let sc = find_col(
+        &header,
+        &[
+            "speed",
+            "speed_kmh",
+            "speed_mps",
+            "speed_ms",
+            "velocity",
+            "v",
+        ],
+    );
+    let speed_factor = sc.map_or(3.6, |i| {
+        let h = header[i].to_ascii_lowercase();
+        if h.contains("km") {
+            1.0
+        } else if h.contains("kn") {
+            1.852
+        } else {
+            3.6
+        }
+    });
+    let mut fixes = Vec::new();
+    let mut lines = Vec::new();
+    let mut absolute = None;
+    for (k, rec) in rdr.records().enumerate() {
+        let line = k + 2;
+        let rec = rec.map_err(|e| track_err(p, format!("line {line}: {e}")))?;
+        let cell = |i: usize| rec.get(i).unwrap_or("");
+        if rec.iter().all(str::is_empty) {
+            continue;
+        }
+        let num = |i: usize, what: &str| -> Result<f64, SegmentError> {
+            cell(i)
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    track_err(
+                        p,
+                        format!("line {line}: {what} '{}' is not a number; fix the cell or delete the row", cell(i)),
+                    )
+                })
+        };
+        let (t, abs) = match cell(tc).parse::<f64>() {
+            Ok(v) if v.is_finite() => (v, v > 1e8),
+            _ => match parse_rfc3339(cell(tc)) {
+                Some(v) => (v, true),
+                None => {
+                    return Err(track_err(
+                        p,
+                        format!(
+                            "line {line}: time '{}' is neither seconds nor an RFC 3339 time such as 2024-05-02T07:31:00Z",
+                            cell(tc)
+                        ),
+                    ))
+                }
+            },
+        };
+        absolute.get_or_insert(abs);
+        let speed_kmh = match sc {
+            Some(i) if !cell(i).is_empty() => Some(num(i, "speed")? * speed_factor),
+            _ => None,
+        };
+        fixes.push(GpsFix {
+            t_s: t,
+            lat_deg: num(la, "latitude")?,
+            lon_deg: num(lo, "longitude")?,
+            speed_kmh,
+            course_deg: None,
+        });
+        lines.push(line);
+    }
+    let absolute = absolute.unwrap_or(false);
+    check_order(
+        p,
+        &fixes,
+        |i| format!("line {}", lines.get(i).copied().unwrap_or(0)),
+        show_time(absolute),
+    )?;
+    Ok(GpsTrack {
+        path: p.to_string(),
+        format: TrackFormat::Csv,
+        fixes,
+        absolute,
+        n_bad_sentences: 0,
+        n_other_sentences: 0,
+    })
+}
+
+/// Great-circle distance between two fixes, m (haversine, mean Earth radius 6 371 008.8 m).
+pub fn distance_m(a: &GpsFix, b: &GpsFix) -> f64 {
+    let r = 6_371_008.8;
+    let (p1, p2) = (a.lat_deg.to_radians(), b.lat_deg.to_radians());
+    let dp = p2 - p1;
+    let dl = (b.lon_deg - a.lon_deg).to_radians();
+    let h = (dp / 2.0).sin().powi(2) + p1.cos() * p2.cos() * (dl / 2.0).sin().powi(2);
+    2.0 * r * h.sqrt().min(1.0).asin()
+}
+
+/// Initial bearing from `a` to `b`, degrees from north in 0..360.
+pub fn bearing_deg(a: &GpsFix, b: &GpsFix) -> f64 {
+    let (p1, p2) = (a.lat_deg.to_radians(), b.lat_deg.to_radians());
+    let dl = (b.lon_deg - a.lon_deg).to_radians();
+    let y = dl.sin() * p2.cos();
+    let x = p1.cos() * p2.sin() - p1.sin() * p2.cos() * dl.cos();
+    (y.atan2(x).to_degrees() + 360.0) % 360.0
+}

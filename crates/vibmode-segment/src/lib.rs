@@ -1,0 +1,420 @@
+//! # vibmode-segment
+//!
+//! Cuts an hours-long acceleration recording into records of `record_length_s` where the vehicle
+//! drives steadily, as the paper's records were cut with a GPS track recorder
+//! (`../shared/paper/METHOD.md` section 1), and says why the rest was skipped:
+//!
+//! - [`gps`]: GPS tracks from GPX (`gpx` crate), NMEA 0183 RMC/GGA sentences (`nmea` crate;
+//!   unparseable sentences are skipped and counted) or CSV (time, latitude, longitude, speed);
+//! - [`by_gps`]: records where the speed is steady and the heading nearly constant for a whole
+//!   record; stops, braking, accelerating and turns are skipped;
+//! - [`by_vibration`]: without GPS, stops and idling (low broadband vibration) and strong
+//!   manoeuvres (low-frequency longitudinal/lateral acceleration) found from the signals;
+//! - [`write_segments`]: the records as files plus `segments.json`.
+//!
+//! The rules and their tolerances: `docs/segment.md`.
+
+pub mod gps;
+mod plan;
+mod vibration;
+mod write;
+
+pub use gps::{read_track, GpsFix, GpsTrack, TrackFormat};
+pub use plan::{by_gps, fixed_cuts, GpsAlignment};
+pub use vibration::{by_vibration, VibrationWindow};
+pub use write::{write_segments, Written};
+
+use serde::{Deserialize, Serialize};
+use vibmode_analysis::RecordWindow;
+use vibmode_core::RecordMeta;
+
+/// Settings of the segmentation; the defaults are the documented tolerances.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SegmentParams {
+    /// A record's mean speed must be at least this, km/h (below: a stop or creeping). Default 10.
+    pub min_speed_kmh: f64,
+    /// Every fix of a record must be within this fraction of the record's mean speed... Default
+    /// 0.15 (15 %).
+    pub speed_tolerance_rel: f64,
+    /// ... or within this many km/h, whichever is larger. Default 3.
+    pub speed_tolerance_kmh: f64,
+    /// The heading may vary by at most this over a record, degrees. Default 20.
+    pub max_heading_change_deg: f64,
+    /// Largest gap between GPS fixes inside a record (and at its ends), s. Default 5.
+    pub max_gps_gap_s: f64,
+    /// Step by which the search moves on after a rejected stretch, s. Default 1.
+    pub step_s: f64,
+    /// Vibration segmentation: window length of the vibration-state features, s. Default 1.
+    pub window_s: f64,
+    /// Vibration segmentation: a window whose activity (RMS in about 1-8 Hz relative to the
+    /// channel's median window, median over channels) is below this is a stop or idling.
+    /// Default 0.4.
+    pub stop_activity_ratio: f64,
+    /// Vibration segmentation: a window whose mean longitudinal or lateral acceleration (x / y
+    /// channels, below 0.5 Hz) departs from the recording's median by more than this, m/s^2, is a
+    /// strong manoeuvre (braking, accelerating, turning). Default 1.0 (about 0.1 g).
+    pub manoeuvre_mps2: f64,
+    /// Vibration segmentation: windows this close to a stop or manoeuvre are skipped too
+    /// (pulling away, slowing down), s. Default 2.
+    pub guard_s: f64,
+}
+
+impl Default for SegmentParams {
+    fn default() -> Self {
+        SegmentParams {
+            min_speed_kmh: 10.0,
+            speed_tolerance_rel: 0.15,
+            speed_tolerance_kmh: 3.0,
+            max_heading_change_deg: 20.0,
+            max_gps_gap_s: 5.0,
+            step_s: 1.0,
+            window_s: 1.0,
+            stop_activity_ratio: 0.4,
+            manoeuvre_mps2: 1.0,
+            guard_s: 2.0,
+        }
+    }
+}
+
+impl SegmentParams {
+    /// Checks every value (finite, in range).
+    pub fn validate(&self, record_length_s: f64) -> Result<(), SegmentError> {
+        let checks: [(&'static str, f64, bool, &str); 11] = [
+            (
+                "record_length_s",
+                record_length_s,
+                record_length_s > 0.0,
+                "a positive duration, e.g. 10.24",
+            ),
+            (
+                "min_speed_kmh",
+                self.min_speed_kmh,
+                self.min_speed_kmh >= 0.0,
+                ">= 0, e.g. 10",
+            ),
+            (
+                "speed_tolerance_rel",
+                self.speed_tolerance_rel,
+                self.speed_tolerance_rel >= 0.0,
+                ">= 0, e.g. 0.15",
+            ),
+            (
+                "speed_tolerance_kmh",
+                self.speed_tolerance_kmh,
+                self.speed_tolerance_kmh >= 0.0,
+                ">= 0, e.g. 3",
+            ),
+            (
+                "max_heading_change_deg",
+                self.max_heading_change_deg,
+                self.max_heading_change_deg >= 0.0,
+                ">= 0, e.g. 20",
+            ),
+            (
+                "max_gps_gap_s",
+                self.max_gps_gap_s,
+                self.max_gps_gap_s > 0.0,
+                "> 0, e.g. 5",
+            ),
+            ("step_s", self.step_s, self.step_s > 0.0, "> 0, e.g. 1"),
+            (
+                "window_s",
+                self.window_s,
+                self.window_s > 0.0 && self.window_s <= record_length_s,
+                "> 0 and at most the record length, e.g. 1",
+            ),
+            (
+                "stop_activity_ratio",
+                self.stop_activity_ratio,
+                self.stop_activity_ratio >= 0.0,
+                ">= 0, e.g. 0.4",
+            ),
+            (
+                "manoeuvre_mps2",
+                self.manoeuvre_mps2,
+                self.manoeuvre_mps2 > 0.0,
+                "> 0, e.g. 1.0",
+            ),
+            ("guard_s", self.guard_s, self.guard_s >= 0.0, ">= 0, e.g. 2"),
+        ];
+        for (name, value, ok, rule) in checks {
+            if !(value.is_finite() && ok) {
+                return Err(SegmentError::InvalidParam {
+                    name,
+                    value,
+                    rule: rule.to_string(),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Why a stretch of the recording holds no record.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SkipReason {
+    /// Standing or creeping (GPS speed below `min_speed_kmh`).
+    Stop,
+    /// Speed falling by more than the tolerance.
+    Braking,
+    /// Speed rising by more than the tolerance.
+    Accelerating,
+    /// Heading changing by more than `max_heading_change_deg`.
+    Turn,
+    /// No GPS fix close enough (gap above `max_gps_gap_s`, or outside the track).
+    NoGps,
+    /// Low broadband vibration: standing with the engine idling or off.
+    StopOrIdle,
+    /// Strong low-frequency longitudinal/lateral acceleration.
+    Manoeuvre,
+    /// Next to a stop or manoeuvre (`guard_s`).
+    Transition,
+    /// A steady stretch shorter than one record, or the end of the recording.
+    Remainder,
+}
+
+/// A stretch of the recording without records.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SkippedSpan {
+    /// Start, s after the recording's start.
+    pub start_s: f64,
+    /// End, s.
+    pub end_s: f64,
+    /// Why.
+    pub reason: SkipReason,
+}
+
+/// One record of the segmentation.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SegmentRecord {
+    /// File written for it (by [`write_segments`]), relative to the output folder.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+    /// First frame in the recording.
+    pub start_frame: u64,
+    /// Frames.
+    pub n_frames: usize,
+    /// Start, duration, absolute time, mean speed, position.
+    #[serde(flatten)]
+    pub meta: RecordMeta,
+    /// Mean heading from the GPS track, degrees from north (clockwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub heading_deg: Option<f64>,
+}
+
+/// What the GPS track contributed.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GpsSummary {
+    /// The track file.
+    pub path: String,
+    /// Its format.
+    pub format: TrackFormat,
+    /// Fixes read.
+    pub n_fixes: usize,
+    /// NMEA sentences that could not be parsed (bad checksum, malformed), skipped.
+    pub n_bad_sentences: usize,
+    /// NMEA sentences of other types (GSV, VTG...), ignored.
+    pub n_other_sentences: usize,
+    /// How GPS times were mapped onto the recording.
+    pub alignment: GpsAlignment,
+    /// The part of the recording the track covers, s.
+    pub covered_s: [f64; 2],
+}
+
+/// The result: records to cut and the skipped stretches, written as `segments.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Segmentation {
+    /// The recording.
+    pub source: String,
+    /// `"gps"`, `"vibration"` or `"fixed"` (consecutive records).
+    pub method: String,
+    /// Record length, s.
+    pub record_length_s: f64,
+    /// Sampling rate, Hz.
+    pub fs_hz: f64,
+    /// Recording duration, s.
+    pub duration_s: f64,
+    /// Absolute start of the recording, when known (RFC 3339).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start_time: Option<String>,
+    /// Settings used.
+    pub params: SegmentParams,
+    /// The GPS track, when one was used.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gps: Option<GpsSummary>,
+    /// The records, in time order.
+    pub records: Vec<SegmentRecord>,
+    /// The stretches without records, in time order, with the reason.
+    pub skipped: Vec<SkippedSpan>,
+    /// Seconds skipped per reason.
+    pub skipped_s_by_reason: std::collections::BTreeMap<String, f64>,
+}
+
+impl Segmentation {
+    /// The records as windows for [`vibmode_analysis::StreamRecords::windows`].
+    pub fn windows(&self) -> Vec<RecordWindow> {
+        self.records
+            .iter()
+            .map(|r| RecordWindow {
+                start_frame: r.start_frame,
+                n_frames: r.n_frames,
+                meta: r.meta.clone(),
+            })
+            .collect()
+    }
+
+    pub(crate) fn tally(&mut self) {
+        // A record rounded past the last frame is dropped.
+        let total = (self.duration_s * self.fs_hz).round() as u64;
+        self.records
+            .retain(|r| r.start_frame + r.n_frames as u64 <= total);
+        self.skipped_s_by_reason.clear();
+        for s in &self.skipped {
+            let key = serde_json::to_value(s.reason)
+                .ok()
+                .and_then(|v| v.as_str().map(str::to_string))
+                .unwrap_or_default();
+            *self.skipped_s_by_reason.entry(key).or_insert(0.0) += s.end_s - s.start_s;
+        }
+    }
+}
+
+/// Appends a skipped span, merging it with the previous one when they touch and agree.
+pub(crate) fn push_skip(
+    spans: &mut Vec<SkippedSpan>,
+    start_s: f64,
+    end_s: f64,
+    reason: SkipReason,
+) {
+    if end_s <= start_s {
+        return;
+    }
+    if let Some(last) = spans.last_mut() {
+        if last.reason == reason && (start_s - last.end_s).abs() < 1e-9 {
+            last.end_s = end_s;
+            return;
+        }
+    }
+    spans.push(SkippedSpan {
+        start_s,
+        end_s,
+        reason,
+    });
+}
+
+/// Errors of segmentation; one line each, naming the value and the fix (never a command-line
+/// flag).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SegmentError {
+    /// A GPS track that cannot be read.
+    #[error("cannot read GPS track {path}: {message}; check the path and permissions")]
+    Io {
+        /// The file.
+        path: String,
+        /// The system's message.
+        message: String,
+    },
+    /// A GPS track in a format that cannot be parsed.
+    #[error("GPS track {path}: {reason}")]
+    Track {
+        /// The file.
+        path: String,
+        /// What is wrong and how to fix it.
+        reason: String,
+    },
+    /// A track without usable fixes.
+    #[error("GPS track {path} has no usable fix (with time, latitude and longitude){detail}; check the file and its format")]
+    NoFixes {
+        /// The file.
+        path: String,
+        /// Counts of what was found.
+        detail: String,
+    },
+    /// Time going backwards in the track.
+    #[error("GPS track {path}: time goes backwards at {at} ({previous} then {value}); sort the fixes by time or remove the repeated stretch")]
+    TimeBackwards {
+        /// The file.
+        path: String,
+        /// Where (line or point number).
+        at: String,
+        /// The time before, as written.
+        previous: String,
+        /// The time after, as written.
+        value: String,
+    },
+    /// A track that does not overlap the recording.
+    #[error("GPS track {path} covers {track_start_s:.1} to {track_end_s:.1} s of the recording's time axis but the recording runs from 0 to {duration_s:.1} s ({alignment}); they do not overlap: check the recording's start time, or give the offset between the two clocks (gps_offset_s)")]
+    NoOverlap {
+        /// The track.
+        path: String,
+        /// First fix, s on the recording's axis.
+        track_start_s: f64,
+        /// Last fix, s.
+        track_end_s: f64,
+        /// Recording duration, s.
+        duration_s: f64,
+        /// How the times were aligned.
+        alignment: String,
+    },
+    /// A start time that cannot be parsed.
+    #[error("start time '{value}' of {path} is not an RFC 3339 time such as 2024-05-02T07:31:00Z; fix \"start_time\" in the sidecar")]
+    StartTime {
+        /// The file.
+        path: String,
+        /// The text.
+        value: String,
+    },
+    /// A recording shorter than one record.
+    #[error("{path} lasts {duration_s:.2} s, shorter than one record ({record_length_s} s); give a longer recording or a shorter record length")]
+    TooShort {
+        /// The file.
+        path: String,
+        /// Its duration, s.
+        duration_s: f64,
+        /// The record length, s.
+        record_length_s: f64,
+    },
+    /// A setting out of range.
+    #[error("segmentation setting {name} = {value} is invalid: it must be {rule}")]
+    InvalidParam {
+        /// Name.
+        name: &'static str,
+        /// Value.
+        value: f64,
+        /// The rule.
+        rule: String,
+    },
+    /// Writing the records or segments.json failed.
+    #[error("cannot write {path}: {message}; check the folder and free space")]
+    Write {
+        /// The file.
+        path: String,
+        /// What failed.
+        message: String,
+    },
+    /// Reading the recording failed.
+    #[error(transparent)]
+    Signal(#[from] vibmode_signal::SignalError),
+    /// Cutting records failed.
+    #[error(transparent)]
+    Analysis(#[from] vibmode_analysis::AnalysisError),
+}
+
+/// Unix seconds of an RFC 3339 time.
+pub fn parse_rfc3339(text: &str) -> Option<f64> {
+    let t =
+        time::OffsetDateTime::parse(text.trim(), &time::format_description::well_known::Rfc3339)
+            .ok()?;
+    Some(t.unix_timestamp_nanos() as f64 / 1e9)
+}
+
+/// RFC 3339 (UTC, millisecond precision) of Unix seconds.
+pub fn format_rfc3339(unix_s: f64) -> Option<String> {
+    let ns = (unix_s * 1e3).round() as i128 * 1_000_000;
+    let t = time::OffsetDateTime::from_unix_timestamp_nanos(ns).ok()?;
+    t.format(&time::format_description::well_known::Rfc3339)
+        .ok()
+}

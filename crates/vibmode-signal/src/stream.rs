@@ -1,0 +1,777 @@
+//! Recordings of any length read as a stream of frame blocks, in bounded memory.
+//!
+//! [`open_stream`] opens delimited text, WAV or raw + sidecar (the same formats, options and
+//! checks as [`crate::read_path`], see `docs/formats.md`) and [`FrameStream::next_block`] yields
+//! [`FrameBlock`]s of at most `max_frames` frames, channel by channel. Memory is bounded by the
+//! block, never by the file:
+//!
+//! - **raw**: the sidecar is read first; the file size must be a whole number of frames (a file
+//!   cut off mid-write is refused before any sample is used, [`SignalError::PartialFrame`]);
+//! - **WAV**: samples come from hound's sample iterator; a file cut off mid-write (its header
+//!   announces more samples than it holds) fails with a message saying so;
+//! - **delimited text**: parsed by [`crate::DelimitedReader`] block by block. With a time column
+//!   the file is read twice: a first pass over the time column gives the rate
+//!   `(n - 1) / (t_last - t_first)`, the jitter and the check that time increases (exactly as
+//!   [`crate::read_path`] does), the second pass yields the samples; with a non-uniform time column
+//!   and `allow_nonuniform` the samples are interpolated linearly onto the uniform grid as they
+//!   pass.
+//!
+//! Every sample is checked to be finite, naming the channel and the sample's index in the file.
+
+use crate::delimited::{Block, DelimitedReader};
+use crate::error::{io_err, Result, SignalError};
+use crate::read::{raw_layout, reconcile_fs, wav_names, Format, ReadOptions};
+use std::fs::File;
+use std::io::{BufReader, Read};
+use std::path::Path;
+use vibmode_core::{check_fs, Channel, ChannelSelector, Recording, RecordingError};
+
+/// Frames per block read by the command-line tools (65 536: 3.3 s at 20 kHz, 3.7 MB for 7
+/// channels).
+pub const DEFAULT_BLOCK_FRAMES: usize = 1 << 16;
+
+/// What a stream holds, known when it is opened.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StreamInfo {
+    /// The file, for messages.
+    pub path: String,
+    /// Its format.
+    pub format: Format,
+    /// Sampling rate, Hz (the given `fs_hz` when the file's rate agrees within 1 %).
+    pub fs_hz: f64,
+    /// Channel names (selected channels only, after [`FrameStream::select`]).
+    pub names: Vec<String>,
+    /// Channel units, same length as `names`.
+    pub units: Vec<String>,
+    /// Number of frames, when the format tells it up front (WAV, raw, text with a time column).
+    pub n_frames: Option<u64>,
+    /// Time of the first frame on the file's own time axis, s (the first value of a time column,
+    /// else 0).
+    pub start_s: f64,
+    /// The absolute start time written in the sidecar (`"start_time"`, RFC 3339, e.g.
+    /// `"2024-05-02T07:31:00Z"`), as written; `None` when there is none.
+    pub start_time: Option<String>,
+}
+
+impl StreamInfo {
+    /// Number of channels.
+    pub fn n_channels(&self) -> usize {
+        self.names.len()
+    }
+
+    /// Duration in seconds when the frame count is known.
+    pub fn duration_s(&self) -> Option<f64> {
+        self.n_frames.map(|n| n as f64 / self.fs_hz)
+    }
+}
+
+/// Consecutive frames of a stream, stored channel by channel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameBlock {
+    /// Index of the block's first frame in the file (0-based).
+    pub first_frame: u64,
+    /// `channels[c][k]`: channel `c`, frame `first_frame + k`.
+    pub channels: Vec<Vec<f64>>,
+}
+
+impl FrameBlock {
+    /// Number of frames in the block.
+    pub fn n_frames(&self) -> usize {
+        self.channels.first().map_or(0, |c| c.len())
+    }
+}
+
+/// Linear interpolation of a non-uniform time column onto `t0 + i dt`, i = 0..n, as rows pass.
+struct Interp {
+    t0: f64,
+    dt: f64,
+    n: u64,
+    emitted: u64,
+    prev: Option<(f64, Vec<f64>)>,
+}
+
+enum Inner {
+    Delimited {
+        reader: Box<DelimitedReader<BufReader<File>>>,
+        time_col: Option<(usize, f64)>,
+        interp: Option<Interp>,
+        /// Frames parsed but not yet handed out (channel-major).
+        pending: Vec<Vec<f64>>,
+        eof: bool,
+    },
+    Wav {
+        reader: Box<hound::WavReader<BufReader<File>>>,
+        float: bool,
+        scale: f64,
+        remaining: u64,
+    },
+    Raw {
+        file: BufReader<File>,
+        width: usize,
+        remaining: u64,
+        buf: Vec<u8>,
+    },
+}
+
+/// A recording read block by block; see the module documentation.
+pub struct FrameStream {
+    info: StreamInfo,
+    /// File channel index of each channel handed out.
+    selection: Vec<usize>,
+    /// Channel names as in the file (for non-finite messages).
+    file_names: Vec<String>,
+    next_frame: u64,
+    inner: Inner,
+}
+
+impl std::fmt::Debug for FrameStream {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FrameStream")
+            .field("info", &self.info)
+            .field("selection", &self.selection)
+            .field("next_frame", &self.next_frame)
+            .finish()
+    }
+}
+
+fn open_file(path: &Path) -> Result<File> {
+    File::open(path).map_err(|e| io_err("read", path, &e))
+}
+
+/// Opens `path` as a stream of frame blocks (see the module documentation). The options are
+/// those of [`crate::read_path`] (`unit` fills in missing units).
+pub fn open_stream(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
+    if let Some(fs) = opts.fs_hz {
+        check_fs(fs, "the given fs_hz")?;
+    }
+    if !(opts.max_jitter_rel.is_finite() && opts.max_jitter_rel >= 0.0) {
+        return Err(SignalError::InvalidParam {
+            name: "max_jitter_rel",
+            value: opts.max_jitter_rel.to_string(),
+            fix: "must be a finite number >= 0, e.g. 0.01".into(),
+        });
+    }
+    let format = opts.format.unwrap_or_else(|| Format::from_path(path));
+    let mut s = match format {
+        Format::Raw => open_raw(path, opts)?,
+        Format::Wav => open_wav(path, opts)?,
+        Format::Delimited => open_delimited(path, opts)?,
+    };
+    if let Some(u) = &opts.unit {
+        for unit in &mut s.info.units {
+            if unit.is_empty() {
+                unit.clone_from(u);
+            }
+        }
+    }
+    Ok(s)
+}
+
+fn stream(info: StreamInfo, inner: Inner) -> FrameStream {
+    let n = info.names.len();
+    FrameStream {
+        file_names: info.names.clone(),
+        info,
+        selection: (0..n).collect(),
+        next_frame: 0,
+        inner,
+    }
+}
+
+/// `"start_time"` of a JSON sidecar, if any.
+fn sidecar_start_time(sidecar: &Path) -> Option<String> {
+    let text = std::fs::read_to_string(sidecar).ok()?;
+    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+    v.get("start_time")?.as_str().map(str::to_string)
+}
+
+fn open_raw(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
+    let p = path.display().to_string();
+    let layout = raw_layout(path)?;
+    let nch = layout.side.channels.len();
+    let file = open_file(path)?;
+    let bytes = file.metadata().map_err(|e| io_err("read", path, &e))?.len();
+    let frame = (layout.width * nch) as u64;
+    if bytes % frame != 0 {
+        return Err(SignalError::PartialFrame {
+            path: p,
+            bytes,
+            frame_bytes: frame,
+            channels: nch,
+            dtype_bytes: layout.width,
+            whole_bytes: bytes - bytes % frame,
+        });
+    }
+    let n = bytes / frame;
+    if n == 0 {
+        return Err(SignalError::EmptyFile { path: p });
+    }
+    let fs = reconcile_fs(
+        &p,
+        format!("the sidecar {}", layout.sidecar_path),
+        layout.side.fs_hz,
+        opts.fs_hz,
+    )?;
+    let info = StreamInfo {
+        path: p,
+        format: Format::Raw,
+        fs_hz: fs,
+        units: layout
+            .side
+            .units
+            .clone()
+            .unwrap_or_else(|| vec![String::new(); nch]),
+        names: layout.side.channels.clone(),
+        n_frames: Some(n),
+        start_s: 0.0,
+        start_time: sidecar_start_time(Path::new(&layout.sidecar_path)),
+    };
+    Ok(stream(
+        info,
+        Inner::Raw {
+            file: BufReader::with_capacity(1 << 20, file),
+            width: layout.width,
+            remaining: n,
+            buf: Vec::new(),
+        },
+    ))
+}
+
+fn open_wav(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
+    let p = path.display().to_string();
+    let wav_err = |reason: String| SignalError::Wav {
+        path: p.clone(),
+        reason,
+    };
+    let file = open_file(path)?;
+    let reader = hound::WavReader::new(BufReader::with_capacity(1 << 20, file))
+        .map_err(|e| wav_err(format!("{e}; check that it is a valid WAV file")))?;
+    let spec = reader.spec();
+    let nch = spec.channels as usize;
+    if nch == 0 {
+        return Err(wav_err(
+            "the header declares 0 channels; re-export the file".into(),
+        ));
+    }
+    if !(opts.scale.is_finite() && opts.scale != 0.0) {
+        return Err(SignalError::InvalidParam {
+            name: "scale",
+            value: opts.scale.to_string(),
+            fix:
+                "the WAV scale must be a finite non-zero number, e.g. 19.62 (m/s^2 per full scale)"
+                    .into(),
+        });
+    }
+    let (float, scale) = match spec.sample_format {
+        hound::SampleFormat::Float => {
+            if spec.bits_per_sample != 32 {
+                return Err(wav_err(format!(
+                    "{}-bit float samples are not supported; convert to 32-bit float or PCM",
+                    spec.bits_per_sample
+                )));
+            }
+            (true, opts.scale)
+        }
+        hound::SampleFormat::Int => {
+            let bits = spec.bits_per_sample;
+            if !(1..=32).contains(&bits) {
+                return Err(wav_err(format!(
+                    "{bits}-bit integer samples are not supported; use 8, 16, 24 or 32 bits"
+                )));
+            }
+            (false, opts.scale / f64::powi(2.0, bits as i32 - 1))
+        }
+    };
+    let n = u64::from(reader.duration());
+    if n == 0 {
+        return Err(wav_err(
+            "it contains zero samples; check the recording".into(),
+        ));
+    }
+    let fs = reconcile_fs(
+        &p,
+        "the WAV header".into(),
+        spec.sample_rate as f64,
+        opts.fs_hz,
+    )?;
+    let (names, units) = wav_names(path, nch)?;
+    let mut side = path.as_os_str().to_owned();
+    side.push(".json");
+    let info = StreamInfo {
+        path: p,
+        format: Format::Wav,
+        fs_hz: fs,
+        names,
+        units,
+        n_frames: Some(n),
+        start_s: 0.0,
+        start_time: sidecar_start_time(Path::new(&side)),
+    };
+    Ok(stream(
+        info,
+        Inner::Wav {
+            reader: Box::new(reader),
+            float,
+            scale,
+            remaining: n,
+        },
+    ))
+}
+
+fn delimited_reader(path: &Path) -> Result<DelimitedReader<BufReader<File>>> {
+    let file = open_file(path)?;
+    DelimitedReader::new(
+        BufReader::with_capacity(1 << 20, file),
+        &path.display().to_string(),
+    )
+}
+
+/// First pass over a time column: count, first and last value, strictly increasing, jitter.
+struct TimeScan {
+    n: u64,
+    t0: f64,
+    t_last: f64,
+    max_dt: f64,
+    min_dt: f64,
+}
+
+fn scan_time(path: &Path, col: usize, scale: f64, name: &str) -> Result<TimeScan> {
+    let p = path.display().to_string();
+    let mut r = delimited_reader(path)?;
+    let mut scan = TimeScan {
+        n: 0,
+        t0: 0.0,
+        t_last: 0.0,
+        max_dt: f64::NEG_INFINITY,
+        min_dt: f64::INFINITY,
+    };
+    while let Some(block) = r.next_block(DEFAULT_BLOCK_FRAMES)? {
+        for (k, &raw) in block.columns[col].iter().enumerate() {
+            let t = raw * scale;
+            if !t.is_finite() {
+                return Err(RecordingError::NonFinite {
+                    channel: name.to_string(),
+                    index: scan.n as usize,
+                    value: t,
+                }
+                .into());
+            }
+            if scan.n == 0 {
+                scan.t0 = t;
+            } else {
+                if t <= scan.t_last {
+                    return Err(SignalError::TimeNotIncreasing {
+                        path: p,
+                        column: name.to_string(),
+                        line: block.lines[k],
+                        previous: scan.t_last,
+                        value: t,
+                    });
+                }
+                let dt = t - scan.t_last;
+                scan.max_dt = scan.max_dt.max(dt);
+                scan.min_dt = scan.min_dt.min(dt);
+            }
+            scan.t_last = t;
+            scan.n += 1;
+        }
+    }
+    Ok(scan)
+}
+
+fn open_delimited(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
+    let p = path.display().to_string();
+    let reader = delimited_reader(path)?;
+    let cols = reader.columns().to_vec();
+    let tcol = cols.iter().position(|c| c.time_scale_s.is_some());
+    let names: Vec<String> = cols
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| Some(*i) != tcol)
+        .map(|(_, c)| c.name.clone())
+        .collect();
+    let units: Vec<String> = cols
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| Some(*i) != tcol)
+        .map(|(_, c)| c.unit.clone())
+        .collect();
+    if names.is_empty() {
+        return Err(SignalError::NoChannels { path: p });
+    }
+    let (fs_hz, n_frames, start_s, time_col, interp) = match tcol {
+        Some(ti) => {
+            let name = cols[ti].name.clone();
+            let scale = cols[ti].time_scale_s.unwrap_or(1.0);
+            let scan = scan_time(path, ti, scale, &name)?;
+            if scan.n == 0 {
+                return Err(SignalError::NoDataRows { path: p });
+            }
+            if scan.n < 2 {
+                return Err(SignalError::TooShort {
+                    what: format!("time column '{name}' of {p}"),
+                    n: scan.n as usize,
+                    fix: "need at least 2 rows to derive the sampling rate; or drop the time column and give the sampling rate (fs_hz)".into(),
+                });
+            }
+            let mean_dt = (scan.t_last - scan.t0) / (scan.n - 1) as f64;
+            let jitter = (scan.max_dt - mean_dt)
+                .abs()
+                .max((scan.min_dt - mean_dt).abs())
+                / mean_dt;
+            let mean_fs = 1.0 / mean_dt;
+            let interp = if jitter > opts.max_jitter_rel {
+                if !opts.allow_nonuniform {
+                    return Err(SignalError::NonUniformTime {
+                        path: p,
+                        column: name,
+                        jitter_rel: jitter,
+                        max_jitter_rel: opts.max_jitter_rel,
+                        mean_fs_hz: mean_fs,
+                    });
+                }
+                Some(Interp {
+                    t0: scan.t0,
+                    dt: mean_dt,
+                    n: scan.n,
+                    emitted: 0,
+                    prev: None,
+                })
+            } else {
+                None
+            };
+            let fs = reconcile_fs(&p, format!("the time column '{name}'"), mean_fs, opts.fs_hz)?;
+            (fs, Some(scan.n), scan.t0, Some((ti, scale)), interp)
+        }
+        None => match opts.fs_hz {
+            Some(fs) => (fs, None, 0.0, None, None),
+            None => return Err(SignalError::NoSampleRate { path: p }),
+        },
+    };
+    let nch = names.len();
+    let info = StreamInfo {
+        path: p,
+        format: Format::Delimited,
+        fs_hz,
+        names,
+        units,
+        n_frames,
+        start_s,
+        start_time: None,
+    };
+    Ok(stream(
+        info,
+        Inner::Delimited {
+            reader: Box::new(reader),
+            time_col,
+            interp,
+            pending: vec![Vec::new(); nch],
+            eof: false,
+        },
+    ))
+}
+
+/// Appends a parsed block's rows (time column removed) to `pending`.
+fn push_rows(block: Block, time_col: Option<(usize, f64)>, pending: &mut [Vec<f64>]) {
+    let data = block
+        .columns
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| time_col.map(|(t, _)| t) != Some(*i))
+        .map(|(_, c)| c);
+    for (p, d) in pending.iter_mut().zip(data) {
+        p.extend_from_slice(&d);
+    }
+}
+
+impl Interp {
+    /// Feeds one row (time `t`, values `y`) and emits every grid point at or before `t`.
+    fn feed(&mut self, t: f64, y: &[f64], pending: &mut [Vec<f64>]) {
+        while self.emitted < self.n {
+            let ti = self.t0 + self.emitted as f64 * self.dt;
+            if ti > t {
+                break;
+            }
+            match &self.prev {
+                Some((ta, ya)) if ti > *ta => {
+                    let w = ((ti - ta) / (t - ta)).clamp(0.0, 1.0);
+                    for ((p, a), b) in pending.iter_mut().zip(ya).zip(y) {
+                        p.push(a + w * (b - a));
+                    }
+                }
+                Some((_, ya)) => {
+                    for (p, a) in pending.iter_mut().zip(ya) {
+                        p.push(*a);
+                    }
+                }
+                None => {
+                    for (p, b) in pending.iter_mut().zip(y) {
+                        p.push(*b);
+                    }
+                }
+            }
+            self.emitted += 1;
+        }
+        self.prev = Some((t, y.to_vec()));
+    }
+
+    /// At the end of the file: the grid points left (rounding past the last time) take the last
+    /// row's values.
+    fn finish(&mut self, pending: &mut [Vec<f64>]) {
+        if let Some((_, y)) = &self.prev {
+            while self.emitted < self.n {
+                for (p, v) in pending.iter_mut().zip(y) {
+                    p.push(*v);
+                }
+                self.emitted += 1;
+            }
+        }
+    }
+}
+
+impl FrameStream {
+    /// What the stream holds.
+    pub fn info(&self) -> &StreamInfo {
+        &self.info
+    }
+
+    /// Index of the next frame [`FrameStream::next_block`] returns.
+    pub fn position(&self) -> u64 {
+        self.next_frame
+    }
+
+    /// Keeps only the selected channels, in the order given (as [`Recording::select`], with the
+    /// same errors). An empty selection keeps every channel.
+    pub fn select(&mut self, sel: &[ChannelSelector]) -> Result<()> {
+        if sel.is_empty() {
+            return Ok(());
+        }
+        // Resolve through Recording::select (same matching and messages): channel i holds the
+        // single sample i.
+        let probe = Recording {
+            fs_hz: self.info.fs_hz,
+            channels: self
+                .info
+                .names
+                .iter()
+                .zip(&self.info.units)
+                .enumerate()
+                .map(|(i, (n, u))| Channel::new(n.clone(), u.clone(), vec![i as f64]))
+                .collect(),
+            time_axis: None,
+        };
+        let picked = probe.select(sel)?;
+        let idx: Vec<usize> = picked
+            .channels
+            .iter()
+            .map(|c| c.samples.first().map_or(0, |&v| v as usize))
+            .collect();
+        self.selection = idx.iter().map(|&i| self.selection[i]).collect();
+        self.info.names = picked.channels.iter().map(|c| c.name.clone()).collect();
+        self.info.units = picked.channels.iter().map(|c| c.unit.clone()).collect();
+        Ok(())
+    }
+
+    /// The next block of at most `max_frames` frames (at least one), `Ok(None)` at the end.
+    ///
+    /// Errors: read errors (a WAV cut off mid-write), parse errors of text files (naming line and
+    /// column), non-finite samples (naming channel and frame), `max_frames` = 0.
+    pub fn next_block(&mut self, max_frames: usize) -> Result<Option<FrameBlock>> {
+        if max_frames == 0 {
+            return Err(SignalError::InvalidParam {
+                name: "max_frames",
+                value: "0".into(),
+                fix: "ask for at least 1 frame per block".into(),
+            });
+        }
+        let all = match &mut self.inner {
+            Inner::Raw {
+                file,
+                width,
+                remaining,
+                buf,
+            } => {
+                if *remaining == 0 {
+                    return Ok(None);
+                }
+                let nch = self.file_names.len();
+                let n = (*remaining).min(max_frames as u64) as usize;
+                buf.resize(n * nch * *width, 0);
+                file.read_exact(buf).map_err(|e| SignalError::Io {
+                    action: "read",
+                    path: self.info.path.clone(),
+                    message: format!("{e} (was the file cut off or changed while being read?)"),
+                })?;
+                *remaining -= n as u64;
+                let mut out = vec![Vec::with_capacity(n); nch];
+                if *width == 4 {
+                    for (k, c) in buf.chunks_exact(4).enumerate() {
+                        out[k % nch].push(f32::from_le_bytes([c[0], c[1], c[2], c[3]]) as f64);
+                    }
+                } else {
+                    for (k, c) in buf.chunks_exact(8).enumerate() {
+                        out[k % nch].push(f64::from_le_bytes([
+                            c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7],
+                        ]));
+                    }
+                }
+                out
+            }
+            Inner::Wav {
+                reader,
+                float,
+                scale,
+                remaining,
+            } => {
+                if *remaining == 0 {
+                    return Ok(None);
+                }
+                let nch = self.file_names.len();
+                let n = (*remaining).min(max_frames as u64) as usize;
+                let mut out = vec![Vec::with_capacity(n); nch];
+                let truncated = |e: hound::Error, frame: u64| {
+                    SignalError::Wav {
+                    path: self.info.path.clone(),
+                    reason: format!(
+                        "{e} at frame {frame} of the {} its header announces: the file is cut off (a recording stopped mid-write?); re-export it, or cut the header's data size to the frames present",
+                        self.next_frame + *remaining
+                    ),
+                }
+                };
+                let mut k = 0usize;
+                if *float {
+                    for s in reader.samples::<f32>().take(n * nch) {
+                        let v = s.map_err(|e| truncated(e, self.next_frame + (k / nch) as u64))?;
+                        out[k % nch].push(v as f64 * *scale);
+                        k += 1;
+                    }
+                } else {
+                    for s in reader.samples::<i32>().take(n * nch) {
+                        let v = s.map_err(|e| truncated(e, self.next_frame + (k / nch) as u64))?;
+                        out[k % nch].push(v as f64 * *scale);
+                        k += 1;
+                    }
+                }
+                if k < n * nch {
+                    return Err(SignalError::Wav {
+                        path: self.info.path.clone(),
+                        reason: format!(
+                            "it ends after frame {} of the {} its header announces: the file is cut off (a recording stopped mid-write?); re-export it",
+                            self.next_frame + (k / nch) as u64,
+                            self.next_frame + *remaining
+                        ),
+                    });
+                }
+                *remaining -= n as u64;
+                out
+            }
+            Inner::Delimited {
+                reader,
+                time_col,
+                interp,
+                pending,
+                eof,
+            } => {
+                while !*eof && pending.first().map_or(0, |p| p.len()) < max_frames {
+                    match reader.next_block(max_frames)? {
+                        Some(block) => match interp.as_mut() {
+                            Some(ip) => {
+                                let (ti, scale) = time_col.unwrap_or((0, 1.0));
+                                let nc = block.columns.len();
+                                let mut row = Vec::with_capacity(nc.saturating_sub(1));
+                                for r in 0..block.n_rows() {
+                                    row.clear();
+                                    row.extend(
+                                        (0..nc).filter(|&c| c != ti).map(|c| block.columns[c][r]),
+                                    );
+                                    ip.feed(block.columns[ti][r] * scale, &row, pending);
+                                }
+                            }
+                            None => push_rows(block, *time_col, pending),
+                        },
+                        None => {
+                            *eof = true;
+                            if let Some(ip) = interp.as_mut() {
+                                ip.finish(pending);
+                            }
+                        }
+                    }
+                }
+                let have = pending.first().map_or(0, |p| p.len());
+                if have == 0 {
+                    if self.next_frame == 0 {
+                        return Err(SignalError::NoDataRows {
+                            path: self.info.path.clone(),
+                        });
+                    }
+                    return Ok(None);
+                }
+                let n = have.min(max_frames);
+                pending
+                    .iter_mut()
+                    .map(|p| {
+                        let rest = p.split_off(n);
+                        std::mem::replace(p, rest)
+                    })
+                    .collect()
+            }
+        };
+        for (c, d) in all.iter().enumerate() {
+            if let Some(k) = d.iter().position(|v| !v.is_finite()) {
+                return Err(RecordingError::NonFinite {
+                    channel: self.file_names[c].clone(),
+                    index: (self.next_frame as usize) + k,
+                    value: d[k],
+                }
+                .into());
+            }
+            if let Some(k) = d
+                .iter()
+                .position(|v| v.abs() > vibmode_core::limits::SAMPLE_ABS_MAX)
+            {
+                return Err(RecordingError::SampleTooLarge {
+                    channel: self.file_names[c].clone(),
+                    index: (self.next_frame as usize) + k,
+                    value: d[k],
+                }
+                .into());
+            }
+        }
+        let first_frame = self.next_frame;
+        let n = all.first().map_or(0, |d| d.len());
+        self.next_frame += n as u64;
+        let identity = self.selection.len() == all.len()
+            && self.selection.iter().enumerate().all(|(k, &i)| k == i);
+        let channels = if identity {
+            all
+        } else {
+            self.selection.iter().map(|&i| all[i].clone()).collect()
+        };
+        Ok(Some(FrameBlock {
+            first_frame,
+            channels,
+        }))
+    }
+
+    /// Reads the rest of the stream into one recording (for short files and tests).
+    pub fn read_to_recording(&mut self) -> Result<Recording> {
+        let mut data: Vec<Vec<f64>> = vec![Vec::new(); self.info.n_channels()];
+        while let Some(b) = self.next_block(DEFAULT_BLOCK_FRAMES)? {
+            for (d, c) in data.iter_mut().zip(b.channels) {
+                d.extend_from_slice(&c);
+            }
+        }
+        Ok(Recording {
+            fs_hz: self.info.fs_hz,
+            channels: self
+                .info
+                .names
+                .iter()
+                .zip(&self.info.units)
+                .zip(data)
+                .map(|((n, u), d)| Channel::new(n.clone(), u.clone(), d))
+                .collect(),
+            time_axis: None,
+        })
+    }
+}

@@ -1,0 +1,420 @@
+//! Streaming readers and the streaming FIR resampler: identities with the whole-file readers
+//! and the ideal filter, the filter's response, and the bad-input errors.
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::path::{Path, PathBuf};
+use vibmode_signal::stream_resample::{bessel_i0, kaiser_beta, rational_ratio};
+use vibmode_signal::{
+    open_stream, read_path, resample, write_path, Channel, ChannelSelector, FirDecimator,
+    FirDesign, ReadOptions, Recording, ResampleParams, StreamResampleParams,
+};
+
+fn random_recording(seed: u64, n: usize, nch: usize, fs: f64) -> Recording {
+    let mut r = ChaCha8Rng::seed_from_u64(seed);
+    Recording {
+        fs_hz: fs,
+        channels: (0..nch)
+            .map(|c| {
+                Channel::new(
+                    format!("c{c}"),
+                    "m/s^2".to_string(),
+                    (0..n).map(|_| r.gen_range(-3.0..3.0)).collect(),
+                )
+            })
+            .collect(),
+        time_axis: None,
+    }
+}
+
+fn stream_all(path: &Path, opts: &ReadOptions, block: usize) -> Recording {
+    let mut s = open_stream(path, opts).unwrap();
+    let mut data = vec![Vec::new(); s.info().n_channels()];
+    let mut expect_first = 0u64;
+    while let Some(b) = s.next_block(block).unwrap() {
+        assert_eq!(b.first_frame, expect_first);
+        assert!(b.n_frames() >= 1 && b.n_frames() <= block);
+        expect_first += b.n_frames() as u64;
+        for (d, c) in data.iter_mut().zip(b.channels) {
+            d.extend(c);
+        }
+    }
+    Recording {
+        fs_hz: s.info().fs_hz,
+        channels: s
+            .info()
+            .names
+            .iter()
+            .zip(&s.info().units)
+            .zip(data)
+            .map(|((n, u), d)| Channel::new(n.clone(), u.clone(), d))
+            .collect(),
+        time_axis: None,
+    }
+}
+
+fn same(a: &Recording, b: &Recording) {
+    assert_eq!(a.fs_hz, b.fs_hz);
+    assert_eq!(a.names(), b.names());
+    for (x, y) in a.channels.iter().zip(&b.channels) {
+        assert_eq!(x.unit, y.unit);
+        assert_eq!(x.samples, y.samples, "channel {}", x.name);
+    }
+}
+
+fn tmp() -> tempfile::TempDir {
+    tempfile::tempdir().unwrap()
+}
+
+#[test]
+fn every_format_streams_like_the_whole_file_reader_over_seeds_and_block_sizes() {
+    let dir = tmp();
+    for seed in 0..6u64 {
+        let n = 1000 + 377 * seed as usize;
+        let rec = random_recording(seed, n, 1 + (seed as usize % 4), 1000.0);
+        for ext in ["f32", "f64", "wav", "csv"] {
+            let p: PathBuf = dir.path().join(format!("r{seed}.{ext}"));
+            write_path(&p, &rec).unwrap();
+            let whole = read_path(&p, &ReadOptions::default()).unwrap();
+            for block in [1, 7, 256, 100_000] {
+                let s = stream_all(&p, &ReadOptions::default(), block);
+                same(&s, &whole);
+            }
+            let s = open_stream(&p, &ReadOptions::default()).unwrap();
+            assert_eq!(s.info().n_frames, Some(n as u64), "{ext}");
+        }
+    }
+}
+
+#[test]
+fn delimited_time_column_rate_and_nonuniform_interpolation_match_read_path() {
+    let dir = tmp();
+    let mut r = ChaCha8Rng::seed_from_u64(9);
+    for case in 0..4 {
+        let mut text = String::from("Time (ms);a [g];b\n");
+        let mut t = 5.0;
+        for _ in 0..3000 {
+            let jitter = if case % 2 == 1 {
+                r.gen_range(-0.2..0.2)
+            } else {
+                0.0
+            };
+            text.push_str(
+                &format!(
+                    "{};{};{}\n",
+                    t + jitter,
+                    r.gen_range(-1.0..1.0),
+                    r.gen_range(-1.0..1.0)
+                )
+                .replace('.', ","),
+            );
+            t += 2.0;
+        }
+        let p = dir.path().join(format!("t{case}.csv"));
+        std::fs::write(&p, text).unwrap();
+        let opts = ReadOptions {
+            allow_nonuniform: true,
+            ..ReadOptions::default()
+        };
+        let whole = read_path(&p, &opts).unwrap();
+        let s = stream_all(&p, &opts, 333);
+        assert!((s.fs_hz - whole.fs_hz).abs() < 1e-12 * whole.fs_hz);
+        assert!((whole.fs_hz - 500.0).abs() < 1.0);
+        for (x, y) in s.channels.iter().zip(&whole.channels) {
+            assert_eq!(x.samples.len(), y.samples.len());
+            for (a, b) in x.samples.iter().zip(&y.samples) {
+                assert!((a - b).abs() < 1e-12, "{a} vs {b}");
+            }
+        }
+        let info = open_stream(&p, &opts).unwrap().info().clone();
+        assert!((info.start_s - 0.005).abs() < 1e-3);
+        if case % 2 == 1 {
+            let e = open_stream(&p, &ReadOptions::default())
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("not uniform"), "{e}");
+        }
+    }
+}
+
+#[test]
+fn channel_selection_and_start_time_from_the_sidecar() {
+    let dir = tmp();
+    let rec = random_recording(3, 500, 3, 200.0);
+    let p = dir.path().join("s.f32");
+    write_path(&p, &rec).unwrap();
+    let side = dir.path().join("s.f32.json");
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&side).unwrap()).unwrap();
+    v["start_time"] = "2024-05-02T07:31:00Z".into();
+    std::fs::write(&side, v.to_string()).unwrap();
+    let mut s = open_stream(&p, &ReadOptions::default()).unwrap();
+    assert_eq!(s.info().start_time.as_deref(), Some("2024-05-02T07:31:00Z"));
+    s.select(&[
+        ChannelSelector::Name("c2".into()),
+        ChannelSelector::Index(0),
+    ])
+    .unwrap();
+    let got = s.read_to_recording().unwrap();
+    let want = read_path(&p, &ReadOptions::default()).unwrap();
+    assert_eq!(got.names(), ["c2", "c0"]);
+    assert_eq!(got.channels[0].samples, want.channels[2].samples);
+    assert_eq!(got.channels[1].samples, want.channels[0].samples);
+    let mut s = open_stream(&p, &ReadOptions::default()).unwrap();
+    let e = s
+        .select(&[ChannelSelector::Name("zz".into())])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("zz") && e.contains("c0"), "{e}");
+}
+
+#[test]
+fn cut_off_files_are_refused_with_one_line_naming_the_size_and_the_fix() {
+    let dir = tmp();
+    let rec = random_recording(4, 1000, 3, 1000.0);
+    let p = dir.path().join("cut.f32");
+    write_path(&p, &rec).unwrap();
+    let bytes = std::fs::read(&p).unwrap();
+    std::fs::write(&p, &bytes[..bytes.len() - 5]).unwrap();
+    let e = open_stream(&p, &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(!e.contains('\n'));
+    assert!(
+        e.contains("11995 bytes")
+            && e.contains("12-byte frames")
+            && e.contains("truncate -s 11988"),
+        "{e}"
+    );
+    // A WAV whose data chunk is cut off: the header announces more than the file holds.
+    let w = dir.path().join("cut.wav");
+    write_path(&w, &rec).unwrap();
+    let bytes = std::fs::read(&w).unwrap();
+    std::fs::write(&w, &bytes[..bytes.len() - 1000]).unwrap();
+    let mut s = open_stream(&w, &ReadOptions::default()).unwrap();
+    let mut err = None;
+    loop {
+        match s.next_block(100) {
+            Ok(Some(_)) => {}
+            Ok(None) => break,
+            Err(e) => {
+                err = Some(e.to_string());
+                break;
+            }
+        }
+    }
+    let e = err.expect("a cut-off WAV must fail");
+    assert!(!e.contains('\n') && e.contains("cut off"), "{e}");
+    // Non-finite samples name channel and frame.
+    let mut bad = rec.clone();
+    bad.channels[1].samples[777] = 0.0;
+    let q = dir.path().join("nan.f64");
+    write_path(&q, &bad).unwrap();
+    let mut raw = std::fs::read(&q).unwrap();
+    let at = (777 * 3 + 1) * 8;
+    raw[at..at + 8].copy_from_slice(&f64::NAN.to_le_bytes());
+    std::fs::write(&q, raw).unwrap();
+    let mut s = open_stream(&q, &ReadOptions::default()).unwrap();
+    let e = loop {
+        match s.next_block(100) {
+            Ok(Some(_)) => {}
+            Ok(None) => panic!("NaN not found"),
+            Err(e) => break e.to_string(),
+        }
+    };
+    assert!(e.contains("c1") && e.contains("777"), "{e}");
+}
+
+#[test]
+fn design_hand_checks() {
+    assert_eq!(bessel_i0(0.0), 1.0);
+    assert!((bessel_i0(1.0) - 1.266_065_877_752_008_4).abs() < 1e-15);
+    assert!((kaiser_beta(110.0) - 0.1102 * 101.3).abs() < 1e-12);
+    assert_eq!(rational_ratio(0.01, 1024), Some((1, 100)));
+    assert_eq!(rational_ratio(200.0 / 44100.0, 1024), Some((2, 441)));
+    assert_eq!(rational_ratio(3.0, 1024), Some((3, 1)));
+    assert_eq!(rational_ratio(50.0 / 425.0803, 1024), None);
+    let d = FirDesign::new(20_000.0, &StreamResampleParams::default()).unwrap();
+    assert_eq!((d.up, d.down), (1, 100));
+    assert_eq!((d.pass_hz, d.stop_hz), (80.0, 100.0));
+    // N = (110 - 7.95) / (2.285 * 2 pi 20 / 20000) + 1 = 7108.x + 1, rounded up to odd.
+    assert_eq!(d.n_taps, 7109);
+    let h = d.taps();
+    assert!((h.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+    for k in 0..h.len() / 2 {
+        assert_eq!(h[k], h[h.len() - 1 - k]);
+    }
+    let e = FirDesign::new(
+        20_000.0,
+        &StreamResampleParams {
+            cutoff_hz: Some(100.0),
+            ..Default::default()
+        },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("cutoff_hz = 100") && e.contains("Nyquist"),
+        "{e}"
+    );
+}
+
+/// |H(f)| of the taps at the up-sampled rate.
+fn response(h: &[f64], f_rel: f64) -> f64 {
+    let (mut re, mut im) = (0.0, 0.0);
+    for (k, v) in h.iter().enumerate() {
+        let w = 2.0 * std::f64::consts::PI * f_rel * k as f64;
+        re += v * w.cos();
+        im -= v * w.sin();
+    }
+    (re * re + im * im).sqrt()
+}
+
+#[test]
+fn pass_band_flat_to_1e_5_and_stop_band_below_minus_100_db() {
+    for (fs, to, cutoff) in [
+        (20_000.0, 200.0, None),
+        (20_000.0, 200.0, Some(25.0)),
+        (44_100.0, 200.0, None),
+        (500.0, 50.0, None),
+    ] {
+        let d = FirDesign::new(
+            fs,
+            &StreamResampleParams {
+                to_hz: to,
+                cutoff_hz: cutoff,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let h = d.taps();
+        let fs_up = fs * d.up as f64;
+        let mut worst_pass = 0.0f64;
+        let mut worst_stop = 0.0f64;
+        for i in 0..=200 {
+            let f = d.pass_hz * i as f64 / 200.0;
+            worst_pass = worst_pass.max((response(&h, f / fs_up) - 1.0).abs());
+        }
+        // The stop band up to a few times the output rate, and a sample beyond.
+        for i in 0..=400 {
+            let f = d.stop_hz + (4.0 * to) * i as f64 / 400.0;
+            worst_stop = worst_stop.max(response(&h, f / fs_up));
+        }
+        for i in 0..=100 {
+            let f = d.stop_hz + (fs_up / 2.0 - d.stop_hz) * i as f64 / 100.0;
+            worst_stop = worst_stop.max(response(&h, f / fs_up));
+        }
+        assert!(
+            worst_pass < 1e-5,
+            "{fs}->{to}: pass-band deviation {worst_pass}"
+        );
+        assert!(
+            20.0 * worst_stop.log10() < -100.0,
+            "{fs}->{to}: stop band {} dB",
+            20.0 * worst_stop.log10()
+        );
+    }
+}
+
+/// Tones on DFT bins of the record (so the ideal filter is exact): some in the pass band, some
+/// in the stop band up to the input Nyquist.
+fn tones(seed: u64, n: usize, fs: f64, pass: f64, stop: f64) -> Vec<f64> {
+    let mut r = ChaCha8Rng::seed_from_u64(seed);
+    let df = fs / n as f64;
+    let mut x = vec![0.0; n];
+    for k in 0..12 {
+        let f = if k < 6 {
+            r.gen_range(0.5..pass)
+        } else {
+            r.gen_range(stop..fs / 2.0 - 1.0)
+        };
+        let bin = (f / df).round();
+        let (a, ph) = (
+            r.gen_range(0.1..2.0),
+            r.gen_range(0.0..std::f64::consts::TAU),
+        );
+        for (i, v) in x.iter_mut().enumerate() {
+            *v += a * (2.0 * std::f64::consts::PI * bin * i as f64 / n as f64 + ph).cos();
+        }
+    }
+    x
+}
+
+#[test]
+fn agrees_with_the_whole_record_ideal_filter_away_from_the_ends_over_seeds() {
+    let fs = 20_000.0;
+    let n = 200_000; // 10 s
+    let p = StreamResampleParams {
+        to_hz: 200.0,
+        ..Default::default()
+    };
+    let mut worst_db = f64::NEG_INFINITY;
+    for seed in 0..5u64 {
+        let x = tones(seed, n, fs, 75.0, 105.0);
+        let ideal = resample(
+            &x,
+            fs,
+            &ResampleParams {
+                to_hz: 200.0,
+                cutoff_hz: Some(90.0),
+                filter: true,
+            },
+        )
+        .unwrap();
+        let mut fir = FirDecimator::new(fs, 1, &p).unwrap();
+        let mut out = Vec::new();
+        for chunk in x.chunks(9_973) {
+            out.extend(fir.process(&[chunk.to_vec()]).unwrap().remove(0));
+        }
+        out.extend(fir.finish().remove(0));
+        assert_eq!(out.len(), ideal.len());
+        let edge = (fir.design().edge_s() * 200.0).ceil() as usize + 1;
+        let rms = (ideal.iter().map(|v| v * v).sum::<f64>() / ideal.len() as f64).sqrt();
+        let err = out[edge..out.len() - edge]
+            .iter()
+            .zip(&ideal[edge..ideal.len() - edge])
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        let db = 20.0 * (err / rms).log10();
+        worst_db = worst_db.max(db);
+    }
+    eprintln!("worst max-error / rms over 5 seeds: {worst_db:.1} dB");
+    assert!(worst_db < -100.0, "{worst_db} dB");
+}
+
+#[test]
+fn output_does_not_depend_on_block_sizes_and_has_ceil_n_l_over_m_samples() {
+    let fs = 44_100.0;
+    let x = random_recording(1, 30_011, 2, fs);
+    let p = StreamResampleParams {
+        to_hz: 200.0,
+        ..Default::default()
+    };
+    let run = |block: usize| {
+        let mut f = FirDecimator::new(fs, 2, &p).unwrap();
+        let mut out = vec![Vec::new(); 2];
+        let n = x.len();
+        let mut i = 0;
+        while i < n {
+            let j = (i + block).min(n);
+            let b: Vec<Vec<f64>> = x
+                .channels
+                .iter()
+                .map(|c| c.samples[i..j].to_vec())
+                .collect();
+            for (o, v) in out.iter_mut().zip(f.process(&b).unwrap()) {
+                o.extend(v);
+            }
+            i = j;
+        }
+        for (o, v) in out.iter_mut().zip(f.finish()) {
+            o.extend(v);
+        }
+        out
+    };
+    let a = run(30_011);
+    assert_eq!(a[0].len(), (30_011usize * 2).div_ceil(441));
+    for block in [1, 441, 5000] {
+        assert_eq!(run(block), a);
+    }
+}

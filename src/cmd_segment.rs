@@ -1,0 +1,228 @@
+//! `vibmode segment`: cut a long recording into records where the vehicle drives steadily (by a
+//! GPS track or by the vibration), writing the records and `segments.json`.
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use std::path::{Path, PathBuf};
+use vibmode_segment::{SegmentParams, Segmentation};
+use vibmode_signal::{ChannelSelector, FrameStream, ReadOptions, DEFAULT_BLOCK_FRAMES};
+
+/// Segmentation options shared by `segment` and `analyze`.
+#[derive(Args, Debug, Clone, Default)]
+pub struct SegmentOptions {
+    /// GPS track (GPX, NMEA RMC/GGA, or CSV with time,lat,lon,speed): records are cut where the
+    /// speed is steady and the heading nearly constant for a whole record.
+    #[arg(long)]
+    pub gps: Option<PathBuf>,
+    /// Seconds added to the GPS times to put them on the recording's clock (the recording's start
+    /// is its sidecar's start_time, else the track's first fix).
+    #[arg(
+        long = "gps-offset-s",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    pub gps_offset_s: f64,
+    /// Without GPS: skip stops, idling and strong manoeuvres found from the vibration itself.
+    #[arg(long = "by-vibration")]
+    pub by_vibration: bool,
+    /// Segmentation tolerances (TOML with keys of docs/segment.md, e.g. `min_speed_kmh = 15`);
+    /// keys not given keep their defaults.
+    #[arg(long = "segment-config")]
+    pub segment_config: Option<PathBuf>,
+}
+
+impl SegmentOptions {
+    /// The tolerances: the defaults, overridden by `--segment-config`.
+    pub fn params(&self) -> Result<SegmentParams> {
+        match &self.segment_config {
+            None => Ok(SegmentParams::default()),
+            Some(p) => {
+                let text = std::fs::read_to_string(p)
+                    .with_context(|| format!("cannot read --segment-config {}", p.display()))?;
+                toml::from_str(&text).map_err(|e| {
+                    anyhow::anyhow!(
+                        "--segment-config {}: {}",
+                        p.display(),
+                        e.to_string().replace('\n', " ")
+                    )
+                })
+            }
+        }
+    }
+}
+
+impl SegmentOptions {
+    /// True when records are to be cut by GPS or vibration rather than consecutively.
+    pub fn active(&self) -> bool {
+        self.gps.is_some() || self.by_vibration
+    }
+}
+
+/// Arguments of `vibmode segment`.
+#[derive(Args, Debug)]
+pub struct SegmentArgs {
+    /// The recording (delimited text, WAV, raw + sidecar), of any length.
+    pub input: PathBuf,
+    #[command(flatten)]
+    pub seg: SegmentOptions,
+    /// Record length in seconds (default: the analysis's `record_length_s`, 10.24).
+    #[arg(long = "record-length-s")]
+    pub record_length_s: Option<f64>,
+    /// Channels to keep, by name or 0-based index (default: all).
+    #[arg(long = "channel", short = 'c')]
+    pub channels: Vec<String>,
+    /// Sampling rate in Hz for text files without a time column.
+    #[arg(long = "fs")]
+    pub fs_hz: Option<f64>,
+    /// Multiplier for WAV integer samples (after scaling to [-1, 1)).
+    #[arg(long, default_value_t = 1.0)]
+    pub scale: f64,
+    /// Unit of the samples when the file does not say (e.g. m/s^2).
+    #[arg(long)]
+    pub unit: Option<String>,
+    /// Format of the record files: csv, wav, f32 or f64 (default: f32 for raw input, wav for
+    /// WAV, csv for text).
+    #[arg(long)]
+    pub format: Option<String>,
+    /// Only write segments.json, not the records.
+    #[arg(long)]
+    pub plan_only: bool,
+    /// Output folder.
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+}
+
+/// Opens `path` as a stream with `sel` selected.
+pub fn open(path: &Path, opts: &ReadOptions, sel: &[ChannelSelector]) -> Result<FrameStream> {
+    let mut s = vibmode_signal::open_stream(path, opts)?;
+    s.select(sel)?;
+    Ok(s)
+}
+
+/// The segmentation of `path`: by GPS, by vibration, or consecutive records.
+pub fn plan(
+    path: &Path,
+    opts: &ReadOptions,
+    sel: &[ChannelSelector],
+    seg: &SegmentOptions,
+    record_length_s: f64,
+) -> Result<Segmentation> {
+    let p = seg.params()?;
+    if let Some(track_path) = &seg.gps {
+        if seg.by_vibration {
+            bail!("give either --gps TRACK or --by-vibration, not both");
+        }
+        let track = vibmode_segment::read_track(track_path)?;
+        let mut s = open(path, opts, sel)?;
+        let n = frames(&mut s)?;
+        let s = open(path, opts, sel)?;
+        return Ok(vibmode_segment::by_gps(
+            s.info(),
+            n,
+            &track,
+            seg.gps_offset_s,
+            record_length_s,
+            &p,
+        )?);
+    }
+    let mut s = open(path, opts, sel)?;
+    if seg.by_vibration {
+        let (plan, _) = vibmode_segment::by_vibration(&mut s, record_length_s, &p)?;
+        return Ok(plan);
+    }
+    let n = frames(&mut s)?;
+    Ok(vibmode_segment::fixed_cuts(
+        s.info(),
+        n,
+        record_length_s,
+        &p,
+    )?)
+}
+
+/// The number of frames of a stream (reading it to the end when its format does not say).
+fn frames(s: &mut FrameStream) -> Result<u64> {
+    if let Some(n) = s.info().n_frames {
+        return Ok(n);
+    }
+    while s.next_block(DEFAULT_BLOCK_FRAMES)?.is_some() {}
+    Ok(s.position())
+}
+
+/// One line per reason: how much was skipped.
+pub fn summary(seg: &Segmentation) -> String {
+    let skipped: Vec<String> = seg
+        .skipped_s_by_reason
+        .iter()
+        .map(|(k, v)| format!("{k} {v:.1} s"))
+        .collect();
+    let gps = seg
+        .gps
+        .as_ref()
+        .map(|g| {
+            format!(
+                "; GPS: {} fixes, {} unparseable sentences skipped",
+                g.n_fixes, g.n_bad_sentences
+            )
+        })
+        .unwrap_or_default();
+    format!(
+        "{}: {:.1} s, {} records of {} s cut by {}; skipped: {}{}",
+        seg.source,
+        seg.duration_s,
+        seg.records.len(),
+        seg.record_length_s,
+        seg.method,
+        if skipped.is_empty() {
+            "nothing".to_string()
+        } else {
+            skipped.join(", ")
+        },
+        gps
+    )
+}
+
+/// Runs `vibmode segment`.
+pub fn run(a: &SegmentArgs) -> Result<()> {
+    // The output folder is checked and locked before any work, and written as a whole.
+    let mut inputs = vec![a.input.clone()];
+    inputs.extend(a.seg.gps.iter().cloned());
+    let out = crate::output::StagedDir::begin(&a.output, &inputs)?;
+    let opts = ReadOptions {
+        fs_hz: a.fs_hz,
+        scale: a.scale,
+        unit: a.unit.clone(),
+        ..ReadOptions::default()
+    };
+    let sel = a
+        .channels
+        .iter()
+        .map(|s| s.parse::<ChannelSelector>())
+        .collect::<Result<Vec<_>, _>>()?;
+    let record_length_s = a
+        .record_length_s
+        .unwrap_or(vibmode_analysis::AnalysisConfig::default().record_length_s);
+    let mut seg = plan(&a.input, &opts, &sel, &a.seg, record_length_s)?;
+    let stream = open(&a.input, &opts, &sel)?;
+    let ext = match &a.format {
+        Some(f) => match f.as_str() {
+            "csv" | "wav" | "f32" | "f64" => f.clone(),
+            other => bail!("--format {other}: use csv, wav, f32 or f64"),
+        },
+        None => match stream.info().format {
+            vibmode_signal::Format::Raw => "f32".into(),
+            vibmode_signal::Format::Wav => "wav".into(),
+            vibmode_signal::Format::Delimited => "csv".into(),
+        },
+    };
+    if a.plan_only {
+        let path = out.path().join("segments.json");
+        std::fs::write(&path, serde_json::to_string_pretty(&seg)? + "\n")
+            .with_context(|| format!("writing {}", path.display()))?;
+    } else {
+        vibmode_segment::write_segments(stream, &mut seg, out.path(), &ext)?;
+    }
+    out.commit()?;
+    eprintln!("{}", summary(&seg));
+    eprintln!("written: {}", a.output.join("segments.json").display());
+    Ok(())
+}
