@@ -5,10 +5,12 @@
 use pyo3::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
+use vibmode_fleet::store::NewRecord;
 use vibmode_fleet::{
     build_baseline, check_file, ingest_file, require_baseline, Condition, FleetConfig,
     IngestLabels, Store,
 };
+use vibmode_fleet::{compute_features, sha256_hex, FleetError, Ingested, RecordFeatures};
 use vibmode_signal::ReadOptions;
 
 use crate::errors::{fleet_err, json_err};
@@ -20,6 +22,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fleet_baseline, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_check, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_status, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet_features, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet_store_features, m)?)?;
     Ok(())
 }
 
@@ -131,6 +135,109 @@ fn fleet_check(
 fn fleet_status(py: Python<'_>, db: PathBuf, last: usize) -> PyResult<String> {
     let out = py
         .detach(|| Store::open(&db)?.status(last))
+        .map_err(fleet_err)?;
+    serde_json::to_string(&out).map_err(json_err)
+}
+
+/// A record's fleet features, computed away from the store (e.g. on a Dask worker).
+#[derive(Serialize, serde::Deserialize)]
+struct FeaturesOut {
+    file: String,
+    sha256: String,
+    metadata: serde_json::Value,
+    features: RecordFeatures,
+}
+
+/// Reads a file and computes what the store keeps of it (the expensive part of an ingest),
+/// without touching a store; JSON for [`fleet_store_features`].
+#[pyfunction]
+#[pyo3(signature = (path, fs=None, scale=1.0, unit=None))]
+fn fleet_features(
+    py: Python<'_>,
+    path: PathBuf,
+    fs: Option<f64>,
+    scale: f64,
+    unit: Option<String>,
+) -> PyResult<String> {
+    let opts = read_options(fs, scale, unit);
+    let out = py
+        .detach(|| {
+            let bytes = std::fs::read(&path).map_err(|e| FleetError::Io {
+                path: path.display().to_string(),
+                reason: e.to_string(),
+            })?;
+            let sha256 = sha256_hex(&bytes);
+            let rec = vibmode_signal::read_path(&path, &opts)?;
+            let file = path
+                .file_name()
+                .map(|s| s.to_string_lossy().to_string())
+                .unwrap_or_else(|| path.display().to_string());
+            let features = compute_features(&file, &rec, &FleetConfig::default())?;
+            Ok::<_, FleetError>(FeaturesOut {
+                file,
+                sha256,
+                metadata: serde_json::json!({
+                    "fs_hz": rec.fs_hz,
+                    "n_samples": rec.len(),
+                    "channels": rec.names(),
+                }),
+                features,
+            })
+        })
+        .map_err(fleet_err)?;
+    serde_json::to_string(&out).map_err(json_err)
+}
+
+/// Stores features from [`fleet_features`] (a JSON list) for a vehicle, as `fleet ingest` does
+/// (a record whose bytes are already stored is left alone); JSON list of `Ingested`.
+#[pyfunction]
+#[pyo3(signature = (db, vehicle, items_json, condition="nominal", road=None))]
+fn fleet_store_features(
+    py: Python<'_>,
+    db: PathBuf,
+    vehicle: &str,
+    items_json: &str,
+    condition: &str,
+    road: Option<&str>,
+) -> PyResult<String> {
+    let condition: Condition = condition.parse().map_err(fleet_err)?;
+    let items: Vec<FeaturesOut> =
+        serde_json::from_str(items_json).map_err(crate::errors::value_err)?;
+    let out = py
+        .detach(|| {
+            vibmode_fleet::check_vehicle_id(vehicle)?;
+            let mut store = Store::open(&db)?;
+            let mut out = Vec::with_capacity(items.len());
+            for it in items {
+                if let Some(row) = store.find_record(vehicle, &it.sha256)? {
+                    out.push(Ingested {
+                        file: it.file,
+                        record_id: row.id,
+                        already_stored: true,
+                        notes: Vec::new(),
+                    });
+                    continue;
+                }
+                let id = store.insert_record(
+                    &NewRecord {
+                        vehicle,
+                        sha256: &it.sha256,
+                        file_name: &it.file,
+                        condition,
+                        road,
+                        metadata: it.metadata,
+                    },
+                    &it.features,
+                )?;
+                out.push(Ingested {
+                    file: it.file,
+                    record_id: id,
+                    already_stored: false,
+                    notes: it.features.notes,
+                });
+            }
+            Ok::<_, FleetError>(out)
+        })
         .map_err(fleet_err)?;
     serde_json::to_string(&out).map_err(json_err)
 }

@@ -152,3 +152,18 @@ def test_fleet_store(tmp_path):
     assert vibmode.fleet.status(db)[0]["vehicle"] == "bus-1"
     with pytest.raises(OSError):
         vibmode.fleet.status(tmp_path / "nostore.db")
+
+
+def test_fleet_features_then_store_equals_ingest(tmp_path):
+    s = vibmode.simulate("city_bus", records=2, fs=200.0, effects="none", seed=9, out_dir=tmp_path)
+    db1, db2 = tmp_path / "a.db", tmp_path / "b.db"
+    vibmode.fleet.init(db1)
+    vibmode.fleet.init(db2)
+    direct = vibmode.fleet.ingest(db1, "bus-2", s.paths)
+    feats = [json.loads(json.dumps(vibmode.fleet.features(p))) for p in s.paths]
+    stored = vibmode.fleet.store_features(db2, "bus-2", feats)
+    assert stored == direct
+    assert vibmode.fleet.store_features(db2, "bus-2", feats[:1])[0]["already_stored"] is True
+    a = vibmode.fleet.status(db1)[0]
+    b = vibmode.fleet.status(db2)[0]
+    assert a == b

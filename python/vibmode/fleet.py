@@ -66,3 +66,22 @@ def check(
 def status(db: PathLike, last: int = 10) -> List[Dict[str, Any]]:
     """Status of every vehicle in the store, with its last ``last`` records."""
     return json.loads(_native.fleet_status(os.fspath(db), int(last)))
+
+
+def features(path: PathLike, fs: Optional[float] = None, scale: float = 1.0, unit: Optional[str] = None) -> Dict[str, Any]:
+    """What the store keeps of one file (band levels, transmissibility, modes), computed without
+    a store: the expensive part of :func:`ingest`, to run on many workers (e.g. Dask). Returns a
+    JSON-ready dict ``{'file', 'sha256', 'metadata', 'features'}`` for :func:`store_features`."""
+    return json.loads(_native.fleet_features(os.fspath(path), fs, float(scale), unit))
+
+
+def store_features(
+    db: PathLike,
+    vehicle: str,
+    items: Sequence[Dict[str, Any]],
+    condition: str = "nominal",
+    road: Optional[str] = None,
+) -> List[Dict[str, Any]]:
+    """Stores features from :func:`features` for ``vehicle``, exactly as :func:`ingest` would
+    (a file whose bytes are already stored is left alone). One writer: call it from one process."""
+    return json.loads(_native.fleet_store_features(os.fspath(db), vehicle, json.dumps(list(items)), condition, road))
