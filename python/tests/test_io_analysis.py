@@ -128,6 +128,15 @@ def test_analyze_arrays_files_and_config(sim, tmp_path):
         vibmode.analyze(sim.records, sweep={"order_max": -1})
     with pytest.raises(ValueError, match="fs"):
         vibmode.analyze(np.zeros((2, 100)))
+    # An array with its rate, or a (data, fs) tuple, is the same record as the Recording.
+    rec = sim.records[0]
+    a1 = vibmode.analyze(rec, order_max=6, as_frames=False)
+    a2 = vibmode.analyze((rec.data, rec.fs), channels=None, order_max=6, as_frames=False)
+    assert [c["name"] for c in a2["channels"]] == [f"ch{i}" for i in range(7)]
+    np.testing.assert_allclose(
+        [m["frequency_hz"] for m in a1["channels"][0]["invariant_modes"]],
+        [m["frequency_hz"] for m in a2["channels"][0]["invariant_modes"]],
+    )
 
 
 def test_analyze_with_vehicle_matches_modes(sim):

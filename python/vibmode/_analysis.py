@@ -120,7 +120,7 @@ def analyze(
     SSI-cov and the full-car model's modes matched.
 
     ``inputs``: a file path, a :class:`Recording`, an array (n_channels, n_samples) with ``fs``
-    (Hz), a DataFrame from ``read(..., as_frame=True)``, or a list of these (one or more records
+    (Hz), a ``(data, fs)`` tuple, a DataFrame from ``read(..., as_frame=True)``, or a list of these (one or more records
     each; long recordings are cut into records of ``record_length_s``).
     ``config``: a dict, a TOML file or TOML text (docs/analysis.md); ``preset``: 'vibmode'
     (default) or 'paper'; keyword ``settings`` are merged over both, as sections

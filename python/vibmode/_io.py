@@ -134,6 +134,8 @@ def write(path: PathLike, recording: Any, fs: Optional[float] = None, channels=N
 def _as_recording(x: Any, fs: Optional[float], channels=None, units=None, name: str = "record") -> Recording:
     if isinstance(x, Recording):
         return x
+    if isinstance(x, tuple) and len(x) == 2 and fs is None:  # (data, fs)
+        return Recording(x[0], x[1], channels, units, name=name)
     if hasattr(x, "to_numpy") and hasattr(x, "columns"):  # a DataFrame
         rate = fs if fs is not None else x.attrs.get("fs")
         if rate is None:
