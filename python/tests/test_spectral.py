@@ -180,3 +180,13 @@ def test_threads_give_the_same_results(rng):
         got = list(ex.map(lambda x: vibmode.welch(x, nperseg=512)[1], xs))
     for e, g in zip(expected, got):
         np.testing.assert_array_equal(e, g)
+
+
+def test_coherence_of_a_silent_signal_is_nan_as_scipy(rng):
+    x = np.zeros(1000)
+    y = rng.standard_normal(1000)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        _, c2 = ss.coherence(x, y, nperseg=64)
+    _, c = vibmode.coherence(x, y, nperseg=64)
+    assert np.all(np.isnan(c)) and np.all(np.isnan(c2))
