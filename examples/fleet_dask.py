@@ -190,6 +190,9 @@ def run(
               file=sys.stderr)
         if condition == "test":
             local = [f for f in files if os.path.exists(f)]
+            if len(local) < len(files):
+                print(f"{len(files) - len(local)} remote record(s) stored but not checked: run "
+                      "vibmode.fleet.check on local copies", file=sys.stderr)
             checked = vibmode.fleet.check(store, vehicle, local, fs=fs_hz)["records"]
             table = pd.DataFrame([{k: _scalar(v) for k, v in c.items()} for c in checked])
             cfs, cpath = _fs(out.rstrip("/") + "/checks.parquet", so)

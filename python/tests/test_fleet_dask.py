@@ -1,7 +1,6 @@
 """examples/fleet_dask.py on a two-worker LocalCluster gives the single-process results."""
 
 import importlib.util
-import os
 import sys
 from pathlib import Path
 

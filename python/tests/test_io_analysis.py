@@ -1,7 +1,6 @@
 """Reading and writing, resampling, the analysis, the full-car model and the fleet store."""
 
 import json
-import os
 
 import numpy as np
 import pandas as pd
