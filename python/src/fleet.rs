@@ -1,0 +1,243 @@
+//! Fleet monitoring on the SQLite store (`vibmode-fleet`): init, ingest, baseline, check,
+//! status. Every call opens the store, does its work and closes it (SQLite: one writer at a
+//! time; see docs/scaling.md).
+
+use pyo3::prelude::*;
+use serde::Serialize;
+use std::path::PathBuf;
+use vibmode_fleet::store::NewRecord;
+use vibmode_fleet::{
+    build_baseline, check_file, ingest_file, require_baseline, Condition, FleetConfig,
+    IngestLabels, Store,
+};
+use vibmode_fleet::{compute_features, sha256_hex, FleetError, Ingested, RecordFeatures};
+use vibmode_signal::ReadOptions;
+
+use crate::errors::{fleet_err, json_err};
+
+/// Registers the functions of this module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(fleet_init, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet_ingest, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet_baseline, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet_check, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet_status, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet_features, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet_store_features, m)?)?;
+    Ok(())
+}
+
+fn read_options(fs: Option<f64>, scale: f64, unit: Option<String>) -> ReadOptions {
+    ReadOptions {
+        fs_hz: fs,
+        scale,
+        unit,
+        ..ReadOptions::default()
+    }
+}
+
+/// Creates the store if needed; returns whether it was created.
+#[pyfunction]
+fn fleet_init(db: PathBuf) -> PyResult<bool> {
+    let (_, created) = Store::init(&db).map_err(fleet_err)?;
+    Ok(created)
+}
+
+/// Ingests files for a vehicle; JSON list of `Ingested`.
+#[pyfunction]
+#[pyo3(signature = (db, vehicle, files, condition="nominal", road=None, fs=None, scale=1.0, unit=None))]
+#[allow(clippy::too_many_arguments)]
+fn fleet_ingest(
+    py: Python<'_>,
+    db: PathBuf,
+    vehicle: &str,
+    files: Vec<PathBuf>,
+    condition: &str,
+    road: Option<&str>,
+    fs: Option<f64>,
+    scale: f64,
+    unit: Option<String>,
+) -> PyResult<String> {
+    let condition: Condition = condition.parse().map_err(fleet_err)?;
+    let opts = read_options(fs, scale, unit);
+    let out = py
+        .detach(|| {
+            let mut store = Store::open(&db)?;
+            let labels = IngestLabels {
+                vehicle,
+                condition,
+                road,
+            };
+            let cfg = FleetConfig::default();
+            files
+                .iter()
+                .map(|f| ingest_file(&mut store, &labels, f, &opts, &cfg))
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .map_err(fleet_err)?;
+    serde_json::to_string(&out).map_err(json_err)
+}
+
+/// Builds the vehicle's nominal model set; JSON of the `ModelSet`.
+#[pyfunction]
+fn fleet_baseline(py: Python<'_>, db: PathBuf, vehicle: &str) -> PyResult<String> {
+    let set = py
+        .detach(|| {
+            let mut store = Store::open(&db)?;
+            build_baseline(&mut store, vehicle, &FleetConfig::default())
+        })
+        .map_err(fleet_err)?;
+    serde_json::to_string(&set).map_err(json_err)
+}
+
+#[derive(Serialize)]
+struct CheckOut {
+    vehicle: String,
+    model_version: i64,
+    records: Vec<vibmode_fleet::Checked>,
+}
+
+/// Checks files against the vehicle's latest model set; JSON as `vibmode fleet check --json`.
+#[pyfunction]
+#[pyo3(signature = (db, vehicle, files, fs=None, scale=1.0, unit=None))]
+fn fleet_check(
+    py: Python<'_>,
+    db: PathBuf,
+    vehicle: &str,
+    files: Vec<PathBuf>,
+    fs: Option<f64>,
+    scale: f64,
+    unit: Option<String>,
+) -> PyResult<String> {
+    let opts = read_options(fs, scale, unit);
+    let out = py
+        .detach(|| {
+            let mut store = Store::open(&db)?;
+            store.require_vehicle(vehicle)?;
+            let set = require_baseline(&store, vehicle)?;
+            let records = files
+                .iter()
+                .map(|f| check_file(&mut store, &set, f, &opts))
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok::<_, vibmode_fleet::FleetError>(CheckOut {
+                vehicle: vehicle.to_string(),
+                model_version: set.version,
+                records,
+            })
+        })
+        .map_err(fleet_err)?;
+    serde_json::to_string(&out).map_err(json_err)
+}
+
+/// Status of every vehicle (its last `last` records); JSON list of `VehicleStatus`.
+#[pyfunction]
+#[pyo3(signature = (db, last=10))]
+fn fleet_status(py: Python<'_>, db: PathBuf, last: usize) -> PyResult<String> {
+    let out = py
+        .detach(|| Store::open(&db)?.status(last))
+        .map_err(fleet_err)?;
+    serde_json::to_string(&out).map_err(json_err)
+}
+
+/// A record's fleet features, computed away from the store (e.g. on a Dask worker).
+#[derive(Serialize, serde::Deserialize)]
+struct FeaturesOut {
+    file: String,
+    sha256: String,
+    metadata: serde_json::Value,
+    features: RecordFeatures,
+}
+
+/// Reads a file and computes what the store keeps of it (the expensive part of an ingest),
+/// without touching a store; JSON for [`fleet_store_features`].
+#[pyfunction]
+#[pyo3(signature = (path, fs=None, scale=1.0, unit=None))]
+fn fleet_features(
+    py: Python<'_>,
+    path: PathBuf,
+    fs: Option<f64>,
+    scale: f64,
+    unit: Option<String>,
+) -> PyResult<String> {
+    let opts = read_options(fs, scale, unit);
+    let out = py
+        .detach(|| {
+            let bytes = std::fs::read(&path).map_err(|e| FleetError::Io {
+                path: path.display().to_string(),
+                reason: e.to_string(),
+            })?;
+            let sha256 = sha256_hex(&bytes);
+            let rec = vibmode_signal::read_path(&path, &opts)?;
+            let file = path
+                .file_name()
+                .map(|s| s.to_string_lossy().to_string())
+                .unwrap_or_else(|| path.display().to_string());
+            let features = compute_features(&file, &rec, &FleetConfig::default())?;
+            Ok::<_, FleetError>(FeaturesOut {
+                file,
+                sha256,
+                metadata: serde_json::json!({
+                    "fs_hz": rec.fs_hz,
+                    "n_samples": rec.len(),
+                    "channels": rec.names(),
+                }),
+                features,
+            })
+        })
+        .map_err(fleet_err)?;
+    serde_json::to_string(&out).map_err(json_err)
+}
+
+/// Stores features from [`fleet_features`] (a JSON list) for a vehicle, as `fleet ingest` does
+/// (a record whose bytes are already stored is left alone); JSON list of `Ingested`.
+#[pyfunction]
+#[pyo3(signature = (db, vehicle, items_json, condition="nominal", road=None))]
+fn fleet_store_features(
+    py: Python<'_>,
+    db: PathBuf,
+    vehicle: &str,
+    items_json: &str,
+    condition: &str,
+    road: Option<&str>,
+) -> PyResult<String> {
+    let condition: Condition = condition.parse().map_err(fleet_err)?;
+    let items: Vec<FeaturesOut> =
+        serde_json::from_str(items_json).map_err(crate::errors::value_err)?;
+    let out = py
+        .detach(|| {
+            vibmode_fleet::check_vehicle_id(vehicle)?;
+            let mut store = Store::open(&db)?;
+            let mut out = Vec::with_capacity(items.len());
+            for it in items {
+                if let Some(row) = store.find_record(vehicle, &it.sha256)? {
+                    out.push(Ingested {
+                        file: it.file,
+                        record_id: row.id,
+                        already_stored: true,
+                        notes: Vec::new(),
+                    });
+                    continue;
+                }
+                let id = store.insert_record(
+                    &NewRecord {
+                        vehicle,
+                        sha256: &it.sha256,
+                        file_name: &it.file,
+                        condition,
+                        road,
+                        metadata: it.metadata,
+                    },
+                    &it.features,
+                )?;
+                out.push(Ingested {
+                    file: it.file,
+                    record_id: id,
+                    already_stored: false,
+                    notes: it.features.notes,
+                });
+            }
+            Ok::<_, FleetError>(out)
+        })
+        .map_err(fleet_err)?;
+    serde_json::to_string(&out).map_err(json_err)
+}

@@ -1,0 +1,272 @@
+//! AR / ARMA fits, model spectra and order sweeps (`vibmode-ident`).
+
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use serde::Serialize;
+use vibmode_core::{BandLimit, PoleFilterParams};
+use vibmode_ident::{ArMethod, ArmaModel, ArmaParams, IdentError, ModeSet, PoleRejection, Robust};
+
+use crate::errors::{json_err, value_err};
+
+/// Registers the functions of this module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(fit_arma, m)?)?;
+    m.add_function(wrap_pyfunction!(fit_ar, m)?)?;
+    m.add_function(wrap_pyfunction!(arma_psd, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    Ok(())
+}
+
+/// Checks a sampling rate.
+pub fn check_fs(fs: f64) -> PyResult<()> {
+    if fs.is_finite() && fs > 0.0 {
+        Ok(())
+    } else {
+        Err(PyValueError::new_err(format!(
+            "fs = {fs} Hz is invalid: the sampling rate must be positive and finite"
+        )))
+    }
+}
+
+/// The samples of a 1-D array (copied if not contiguous).
+fn samples(y: &PyReadonlyArray1<'_, f64>) -> Vec<f64> {
+    match y.as_slice() {
+        Ok(s) => s.to_vec(),
+        Err(_) => y.as_array().iter().copied().collect(),
+    }
+}
+
+/// A fitted model with its modes at `fs_hz`.
+#[derive(Serialize)]
+struct FitOut<'a> {
+    fs_hz: f64,
+    model: &'a ArmaModel,
+    modes: ModeSet,
+}
+
+fn fit_json(model: &ArmaModel, fs: f64) -> PyResult<String> {
+    let out = FitOut {
+        fs_hz: fs,
+        model,
+        modes: model.modes(fs),
+    };
+    serde_json::to_string(&out).map_err(json_err)
+}
+
+/// The criterion: a Huber factor or `None` for the quadratic one.
+fn robust_of(robust: Option<f64>) -> Robust {
+    match robust {
+        Some(factor) => Robust::Huber { factor },
+        None => Robust::Off,
+    }
+}
+
+/// ARMA(p, q) by prediction-error minimisation; returns the model and its modes as JSON.
+#[pyfunction]
+#[pyo3(signature = (y, fs, p, q, robust, max_iter, tol, demean))]
+#[allow(clippy::too_many_arguments)]
+fn fit_arma(
+    py: Python<'_>,
+    y: PyReadonlyArray1<'_, f64>,
+    fs: f64,
+    p: usize,
+    q: usize,
+    robust: Option<f64>,
+    max_iter: usize,
+    tol: f64,
+    demean: bool,
+) -> PyResult<String> {
+    check_fs(fs)?;
+    let y = samples(&y);
+    let params = ArmaParams {
+        robust: robust_of(robust),
+        max_iter,
+        tol,
+        demean,
+        ..ArmaParams::default()
+    };
+    let model = py
+        .detach(|| vibmode_ident::fit_arma(&y, p, q, &params))
+        .map_err(value_err)?;
+    fit_json(&model, fs)
+}
+
+/// AR(p) by Burg, Yule-Walker or forward-backward least squares; JSON as [`fit_arma`].
+#[pyfunction]
+fn fit_ar(
+    py: Python<'_>,
+    y: PyReadonlyArray1<'_, f64>,
+    fs: f64,
+    p: usize,
+    method: &str,
+) -> PyResult<String> {
+    check_fs(fs)?;
+    let method: ArMethod = method.parse().map_err(value_err)?;
+    let y = samples(&y);
+    let model = py
+        .detach(|| vibmode_ident::fit_ar(&y, p, method))
+        .map_err(value_err)?;
+    fit_json(&model, fs)
+}
+
+/// One-sided model PSD `2 lambda Ts |C / A|^2` at `freq_hz` (units^2/Hz).
+#[pyfunction]
+fn arma_psd<'py>(
+    py: Python<'py>,
+    a: Vec<f64>,
+    c: Vec<f64>,
+    noise_variance: f64,
+    freq_hz: PyReadonlyArray1<'py, f64>,
+    fs: f64,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    check_fs(fs)?;
+    let f = samples(&freq_hz);
+    Ok(vibmode_ident::arma_psd(&a, &c, noise_variance, &f, fs).into_pyarray(py))
+}
+
+/// One pole pair of the sweep.
+#[derive(Serialize)]
+struct SweepMode {
+    order: usize,
+    frequency_hz: f64,
+    damping_ratio: f64,
+}
+
+/// A pole pair the pole filters left out, and why.
+#[derive(Serialize)]
+struct Filtered {
+    order: usize,
+    frequency_hz: f64,
+    damping_ratio: f64,
+    reason: PoleRejection,
+}
+
+/// One fit of the sweep.
+#[derive(Serialize)]
+struct SweepFit {
+    order: usize,
+    loss: Option<f64>,
+    noise_variance: Option<f64>,
+    aic: Option<f64>,
+    converged: bool,
+    iterations: usize,
+    error: Option<String>,
+}
+
+#[derive(Serialize)]
+struct SweepOut {
+    fs_hz: f64,
+    n_samples: usize,
+    model: String,
+    fits: Vec<SweepFit>,
+    modes: Vec<SweepMode>,
+    filtered_out: Vec<Filtered>,
+}
+
+/// Order sweep of one signal (`vibmode sweep`): every order's fit and modes, split by the
+/// analysis' pole filters. Returns JSON.
+#[pyfunction]
+#[pyo3(signature = (y, fs, orders, model, method, robust, max_iter, tol))]
+#[allow(clippy::too_many_arguments)]
+fn sweep(
+    py: Python<'_>,
+    y: PyReadonlyArray1<'_, f64>,
+    fs: f64,
+    orders: Vec<usize>,
+    model: &str,
+    method: &str,
+    robust: Option<f64>,
+    max_iter: usize,
+    tol: f64,
+) -> PyResult<String> {
+    check_fs(fs)?;
+    if orders.is_empty() || orders.contains(&0) {
+        return Err(PyValueError::new_err(format!(
+            "orders {orders:?} must list orders >= 1, e.g. range(2, 31)"
+        )));
+    }
+    let y = samples(&y);
+    let params = ArmaParams {
+        robust: robust_of(robust),
+        max_iter,
+        tol,
+        ..ArmaParams::default()
+    };
+    let fits: Vec<Result<ArmaModel, IdentError>> = match model {
+        "arma" => py.detach(|| vibmode_ident::sweep_arma(&y, &orders, &params)),
+        "ar" => {
+            let m: ArMethod = method.parse().map_err(value_err)?;
+            py.detach(|| {
+                orders
+                    .iter()
+                    .map(|&p| vibmode_ident::fit_ar(&y, p, m))
+                    .collect()
+            })
+        }
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "model = '{other}' is unknown; use 'arma' (ARMA(p, p)) or 'ar'"
+            )))
+        }
+    };
+    if let Some(Err(e)) = fits
+        .iter()
+        .find(|f| f.is_err())
+        .filter(|_| fits.iter().all(|f| f.is_err()))
+    {
+        return Err(value_err(e));
+    }
+    let band = BandLimit::full(fs);
+    let filters = PoleFilterParams::default();
+    let mut out = SweepOut {
+        fs_hz: fs,
+        n_samples: y.len(),
+        model: model.to_string(),
+        fits: Vec::new(),
+        modes: Vec::new(),
+        filtered_out: Vec::new(),
+    };
+    for (&order, f) in orders.iter().zip(fits) {
+        match f {
+            Ok(m) => {
+                out.fits.push(SweepFit {
+                    order,
+                    loss: Some(m.loss),
+                    noise_variance: Some(m.noise_variance),
+                    aic: Some(m.aic),
+                    converged: m.converged,
+                    iterations: m.iterations,
+                    error: None,
+                });
+                for fm in vibmode_ident::filter_modes(&m, &band, &filters) {
+                    let (frequency_hz, damping_ratio) =
+                        (fm.mode.frequency_hz, fm.mode.damping_ratio);
+                    match fm.rejected {
+                        None => out.modes.push(SweepMode {
+                            order,
+                            frequency_hz,
+                            damping_ratio,
+                        }),
+                        Some(reason) => out.filtered_out.push(Filtered {
+                            order,
+                            frequency_hz,
+                            damping_ratio,
+                            reason,
+                        }),
+                    }
+                }
+            }
+            Err(e) => out.fits.push(SweepFit {
+                order,
+                loss: None,
+                noise_variance: None,
+                aic: None,
+                converged: false,
+                iterations: 0,
+                error: Some(e.to_string()),
+            }),
+        }
+    }
+    serde_json::to_string(&out).map_err(json_err)
+}

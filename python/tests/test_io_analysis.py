@@ -1,0 +1,177 @@
+"""Reading and writing, resampling, the analysis, the full-car model and the fleet store."""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+import scipy.signal as ss
+
+import vibmode
+
+
+@pytest.fixture(scope="module")
+def sim():
+    # 4 records of 10.24 s at 200 Hz of the shipped city bus on a class B road (pure road response).
+    return vibmode.simulate("city_bus", records=4, fs=200.0, effects="none", seed=3)
+
+
+@pytest.mark.parametrize("ext", ["csv", "wav", "f64"])
+def test_write_read_round_trip(tmp_path, rng, ext):
+    data = rng.standard_normal((2, 500))
+    rec = vibmode.Recording(data, 250.0, ["z", "y"], ["m/s^2", "m/s^2"])
+    path = tmp_path / f"rec.{ext}"
+    vibmode.write(path, rec)
+    x, fs, names = vibmode.read(path)
+    assert fs == pytest.approx(250.0, rel=1e-9)
+    assert names == ["z", "y"]
+    tol = 1e-6 if ext == "wav" else 1e-12  # WAV stores 32-bit floats
+    np.testing.assert_allclose(x, data, atol=tol * 10, rtol=tol)
+
+
+def test_read_as_frame_and_channel_selection(tmp_path):
+    p = tmp_path / "semi.csv"
+    lines = ["Time (ms);Z-Axis [m/s^2];X [g]"] + [f"{i};{np.sin(i / 5):.6f};{i % 7}".replace(".", ",") for i in range(400)]
+    p.write_text("\n".join(lines) + "\n")
+    df = vibmode.read(p, as_frame=True)
+    assert list(df.columns) == ["Z-Axis", "X"]
+    assert df.attrs["fs"] == pytest.approx(1000.0)
+    assert df.attrs["units"]["Z-Axis"] == "m/s^2"
+    assert df.index.name == "time_s"
+    rec = vibmode.read(p, channels=["X"])
+    assert rec.channels == ["X"] and rec.data.shape == (1, 400)
+    rec = vibmode.read(p, channels=[0])
+    assert rec.channels == ["Z-Axis"]
+
+
+def test_file_errors_are_os_errors(tmp_path):
+    with pytest.raises(FileNotFoundError):
+        vibmode.read(tmp_path / "missing.csv")
+    with pytest.raises(OSError):
+        vibmode.analyze(str(tmp_path / "missing.wav"))
+    bad = tmp_path / "bad.csv"
+    bad.write_text("a,b\n1,2\n3,x\n")
+    with pytest.raises(ValueError, match="not a number"):
+        vibmode.read(bad, fs=10)
+    nofs = tmp_path / "nofs.csv"
+    nofs.write_text("a,b\n1,2\n3,4\n5,6\n")
+    with pytest.raises(ValueError, match="sampling rate"):
+        vibmode.read(nofs)
+
+
+def test_resample_ideal_passes_a_tone_and_matches_scipy_for_fourier_ratios(rng):
+    fs = 1000.0
+    t = np.arange(2000) / fs
+    x = np.stack([np.sin(2 * np.pi * 10 * t), np.sin(2 * np.pi * 10 * t + 1)])
+    y = vibmode.resample_ideal(x, fs, 100.0, 25.0)
+    assert y.shape == (2, 200)
+    np.testing.assert_allclose(y[0], np.sin(2 * np.pi * 10 * np.arange(200) / 100.0), atol=1e-9)
+    # axis=0 gives the transpose
+    np.testing.assert_allclose(vibmode.resample_ideal(x.T, fs, 100.0, 25.0, axis=0), y.T, atol=1e-12)
+    # A 300 Hz tone above the cutoff is removed.
+    z = vibmode.resample_ideal(np.sin(2 * np.pi * 300 * t), fs, 100.0, 25.0)
+    assert np.max(np.abs(z)) < 1e-9
+    # Non-integer ratio without a cutoff: Fourier resampling, as scipy.signal.resample.
+    w = rng.standard_normal(1000)
+    np.testing.assert_allclose(vibmode.resample_ideal(w, 1000.0, 300.0), ss.resample(w, 300), atol=1e-9)
+    with pytest.raises(ValueError):
+        vibmode.resample_ideal(w, 1000.0, -5.0)
+
+
+def test_fullcar_modes():
+    modes = vibmode.fullcar("city_bus")
+    assert isinstance(modes, pd.DataFrame)
+    heave = modes[modes["label"] == "body_heave"]
+    assert len(heave) == 1 and 0.8 < float(heave["frequency_hz"].iloc[0]) < 1.3
+    assert ((modes["damping_ratio"] > 0) & (modes["damping_ratio"] < 1)).all()
+    as_list = vibmode.fullcar("city_bus", as_frame=False)
+    assert [m["frequency_hz"] for m in as_list] == list(modes["frequency_hz"])
+    with pytest.raises(ValueError, match="missing field"):
+        vibmode.fullcar("[body]\nmass_kg = -3\n")
+    with pytest.raises(OSError):
+        vibmode.fullcar("no_such_file.toml")
+
+
+def test_simulate_is_deterministic(sim, tmp_path):
+    again = vibmode.simulate("city_bus", records=4, fs=200.0, effects="none", seed=3, out_dir=tmp_path)
+    assert len(again.records) == 4 and len(again.paths) == 4
+    np.testing.assert_array_equal(again.records[2].data, sim.records[2].data)
+    assert sim.records[0].channels[4] == "FR_sprung"
+    assert json.load(open(tmp_path / "truth.json"))["modes"]
+
+
+def test_analyze_arrays_files_and_config(sim, tmp_path):
+    r = vibmode.analyze(sim.records, order_max=8)
+    assert r["schema_version"] == 3
+    assert r["config"]["sweep"]["order_max"] == 8
+    assert isinstance(r["records"], pd.DataFrame) and len(r["records"]) == 4
+    assert isinstance(r["channels"][0]["poles"], pd.DataFrame)
+    roles = {x["role"]: x for x in r["roles"]}
+    assert "sprung" in roles
+    inv = roles["sprung"]["invariant_modes"]
+    # The body modes of the bus (about 1-1.3 Hz) are among the sprung pool's modes.
+    assert ((inv["frequency_hz"] > 0.8) & (inv["frequency_hz"] < 1.5)).any()
+    # Raw form: exactly json-like; the same numbers as from files written by the package.
+    raw = vibmode.analyze(sim.records, sweep={"order_max": 8}, as_frames=False)
+    assert isinstance(raw["records"], list)
+    paths = vibmode.simulate("city_bus", records=4, fs=200.0, effects="none", seed=3, out_dir=tmp_path, format="f32").paths
+    from_files = vibmode.analyze(paths, config="[sweep]\norder_max = 8\n", as_frames=False)
+    a = [m["frequency_hz"] for m in raw["roles"][0]["invariant_modes"]]
+    b = [m["frequency_hz"] for m in from_files["roles"][0]["invariant_modes"]]
+    np.testing.assert_allclose(a, b, rtol=1e-5)  # f32 files: single precision samples
+    cfg = vibmode.analysis_config(preset="paper")
+    assert cfg["preprocess"]["analysis_fs_hz"] == 200.0
+    with pytest.raises(ValueError, match="no_such_key|unknown"):
+        vibmode.analyze(sim.records, no_such_key=1)
+    with pytest.raises(ValueError):
+        vibmode.analyze(sim.records, sweep={"order_max": -1})
+    with pytest.raises(ValueError, match="fs"):
+        vibmode.analyze(np.zeros((2, 100)))
+    # An array with its rate, or a (data, fs) tuple, is the same record as the Recording.
+    rec = sim.records[0]
+    a1 = vibmode.analyze(rec, order_max=6, as_frames=False)
+    a2 = vibmode.analyze((rec.data, rec.fs), channels=None, order_max=6, as_frames=False)
+    assert [c["name"] for c in a2["channels"]] == [f"ch{i}" for i in range(7)]
+    np.testing.assert_allclose(
+        [m["frequency_hz"] for m in a1["channels"][0]["invariant_modes"]],
+        [m["frequency_hz"] for m in a2["channels"][0]["invariant_modes"]],
+    )
+
+
+def test_analyze_with_vehicle_matches_modes(sim):
+    r = vibmode.analyze(sim.records[:2], vehicle="city_bus", order_max=8, as_frames=False)
+    assert len(r["reference_modes"]) > 0
+
+
+def test_fleet_store(tmp_path):
+    s = vibmode.simulate("city_bus", records=6, fs=200.0, effects="none", seed=5, out_dir=tmp_path)
+    db = tmp_path / "fleet.db"
+    assert vibmode.fleet.init(db) is True
+    assert vibmode.fleet.init(db) is False
+    with pytest.raises(ValueError, match="baseline|nominal"):
+        vibmode.fleet.check(db, "bus-1", s.paths[5:]) if vibmode.fleet.ingest(db, "bus-1", s.paths[:1]) else None
+    ing = vibmode.fleet.ingest(db, "bus-1", s.paths[1:5])
+    assert [i["already_stored"] for i in ing] == [False] * 4
+    assert vibmode.fleet.ingest(db, "bus-1", s.paths[0])[0]["already_stored"] is True
+    b = vibmode.fleet.baseline(db, "bus-1")
+    assert b["vehicle"] == "bus-1" and len(b["records"]) == 5
+    c = vibmode.fleet_check(db, "bus-1", s.paths[5])
+    assert c["records"][0]["classification"] in ("normal", "road", "vehicle", "both")
+    assert vibmode.fleet.status(db)[0]["vehicle"] == "bus-1"
+    with pytest.raises(OSError):
+        vibmode.fleet.status(tmp_path / "nostore.db")
+
+
+def test_fleet_features_then_store_equals_ingest(tmp_path):
+    s = vibmode.simulate("city_bus", records=2, fs=200.0, effects="none", seed=9, out_dir=tmp_path)
+    db1, db2 = tmp_path / "a.db", tmp_path / "b.db"
+    vibmode.fleet.init(db1)
+    vibmode.fleet.init(db2)
+    direct = vibmode.fleet.ingest(db1, "bus-2", s.paths)
+    feats = [json.loads(json.dumps(vibmode.fleet.features(p))) for p in s.paths]
+    stored = vibmode.fleet.store_features(db2, "bus-2", feats)
+    assert stored == direct
+    assert vibmode.fleet.store_features(db2, "bus-2", feats[:1])[0]["already_stored"] is True
+    a = vibmode.fleet.status(db1)[0]
+    b = vibmode.fleet.status(db2)[0]
+    assert a == b

@@ -1,0 +1,172 @@
+"""Recordings: reading, writing, and the ideal DFT resampling."""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Dict, Iterator, List, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _native
+from ._spectral import _check_fs, _real_input
+from ._tables import require_pandas
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+class Recording:
+    """A multichannel recording.
+
+    Attributes
+    ----------
+    data : ndarray (n_channels, n_samples), float64, in each channel's unit.
+    fs : sampling rate, Hz.
+    channels : list of channel names (the time column of a text file is not a channel).
+    units : list of units (e.g. 'm/s^2'; '' when unknown).
+    placements : list of dicts (role, corner, direction) per channel.
+    name : display name (the file name for files read).
+
+    ``data, fs, channels = recording`` unpacks the three main fields.
+    """
+
+    def __init__(
+        self,
+        data: Any,
+        fs: float,
+        channels: Optional[Sequence[str]] = None,
+        units: Optional[Sequence[str]] = None,
+        placements: Optional[List[Dict[str, Any]]] = None,
+        name: str = "record",
+    ):
+        a = _real_input(data, "data")
+        if a.ndim == 1:
+            a = a[np.newaxis, :]
+        if a.ndim != 2:
+            raise ValueError(f"data has shape {a.shape}; give (n_channels, n_samples)")
+        self.data = np.ascontiguousarray(a, dtype=np.float64)
+        self.fs = _check_fs(fs)
+        n = self.data.shape[0]
+        self.channels = list(channels) if channels is not None else [f"ch{i}" for i in range(n)]
+        self.units = list(units) if units is not None else [""] * n
+        if len(self.channels) != n or len(self.units) != n:
+            raise ValueError(
+                f"{n} channels but {len(self.channels)} names and {len(self.units)} units; "
+                "give one per row of data"
+            )
+        self.placements = placements
+        self.name = name
+
+    def __iter__(self) -> Iterator[Any]:
+        return iter((self.data, self.fs, self.channels))
+
+    def __len__(self) -> int:
+        return self.data.shape[1]
+
+    @property
+    def duration_s(self) -> float:
+        """Duration, s."""
+        return self.data.shape[1] / self.fs
+
+    @property
+    def time_s(self) -> np.ndarray:
+        """Sample times from 0, s."""
+        return np.arange(self.data.shape[1]) / self.fs
+
+    def to_frame(self):
+        """A pandas DataFrame: one column per channel, index ``time_s`` (s); ``attrs`` holds
+        ``fs`` (Hz), ``units`` and ``name``."""
+        pd = require_pandas("Recording.to_frame")
+        df = pd.DataFrame(self.data.T, columns=self.channels, index=pd.Index(self.time_s, name="time_s"))
+        df.attrs.update(fs=self.fs, units=dict(zip(self.channels, self.units)), name=self.name)
+        return df
+
+    def _native_tuple(self):
+        placements = json.dumps(self.placements) if self.placements else None
+        return (self.name, self.data, self.fs, list(self.channels), list(self.units), placements)
+
+    def __repr__(self) -> str:
+        return (
+            f"<vibmode.Recording {self.name!r}: {len(self.channels)} channels x "
+            f"{self.data.shape[1]} samples at {self.fs:g} Hz>"
+        )
+
+
+def read(
+    path: PathLike,
+    fs: Optional[float] = None,
+    channels: Optional[Sequence[Union[str, int]]] = None,
+    scale: float = 1.0,
+    unit: Optional[str] = None,
+    allow_nonuniform: bool = False,
+    format: Optional[str] = None,
+    as_frame: bool = False,
+):
+    """Reads a recording: delimited text (separator, header, units, decimal commas and a time
+    column detected), WAV (PCM or float) or raw f32/f64 with a JSON sidecar (docs/formats.md).
+
+    ``fs``: sampling rate in Hz for files without a time column. ``channels``: names or 0-based
+    indices to keep. ``scale``: multiplier of WAV integer samples (full scale = 1.0).
+    ``unit``: unit of channels whose file gives none.
+
+    Returns a :class:`Recording` (``data, fs, names = vibmode.read(path)`` unpacks it), or with
+    ``as_frame=True`` a pandas DataFrame (index ``time_s``, ``attrs['fs']`` in Hz).
+    Raises OSError (FileNotFoundError) for files that cannot be read, ValueError for contents.
+    """
+    sel = None if channels is None else [str(c) for c in channels]
+    data, rate, names, units, placements = _native.read(
+        os.fspath(path), None if fs is None else _check_fs(fs), float(scale), unit,
+        bool(allow_nonuniform), format, sel,
+    )
+    rec = Recording(data, rate, names, units, json.loads(placements), name=os.path.basename(os.fspath(path)))
+    return rec.to_frame() if as_frame else rec
+
+
+def write(path: PathLike, recording: Any, fs: Optional[float] = None, channels=None, units=None) -> None:
+    """Writes a recording (a :class:`Recording`, a DataFrame from ``read(..., as_frame=True)``
+    or an array (n_channels, n_samples) with ``fs`` in Hz). The format follows the extension:
+    .csv (with a time_s column), .wav (32-bit float) or .f32/.f64 (raw + JSON sidecar)."""
+    rec = _as_recording(recording, fs, channels, units)
+    placements = json.dumps(rec.placements) if rec.placements else None
+    _native.write(os.fspath(path), rec.data, rec.fs, rec.channels, rec.units, placements)
+
+
+def _as_recording(x: Any, fs: Optional[float], channels=None, units=None, name: str = "record") -> Recording:
+    if isinstance(x, Recording):
+        return x
+    if isinstance(x, tuple) and len(x) == 2 and fs is None:  # (data, fs)
+        return Recording(x[0], x[1], channels, units, name=name)
+    if hasattr(x, "to_numpy") and hasattr(x, "columns"):  # a DataFrame
+        rate = fs if fs is not None else x.attrs.get("fs")
+        if rate is None:
+            raise ValueError("the DataFrame has no attrs['fs']; give fs (Hz)")
+        u = x.attrs.get("units", {})
+        cols = [str(c) for c in x.columns]
+        return Recording(x.to_numpy().T, rate, cols, [u.get(c, "") for c in cols], name=x.attrs.get("name", name))
+    if fs is None:
+        raise ValueError("an array needs its sampling rate: give fs (Hz)")
+    return Recording(x, fs, channels, units, name=name)
+
+
+def resample_ideal(
+    x: Any,
+    fs: float,
+    fs_out: float,
+    cutoff_hz: Optional[float] = None,
+    axis: int = -1,
+    filter: bool = True,
+) -> np.ndarray:
+    """The paper's ideal anti-alias resampling along ``axis``: every DFT bin above
+    ``cutoff_hz`` (Hz; default the output Nyquist frequency ``fs_out / 2``) is zeroed, then the
+    signal is decimated (integer ``fs / fs_out``) or Fourier-resampled (other ratios, as
+    ``scipy.signal.resample``). ``fs`` and ``fs_out`` in Hz. ``filter=False`` decimates without
+    the filter (aliasing). Returns float64 samples at ``fs_out``."""
+    fs = _check_fs(fs)
+    fs_out = _check_fs(fs_out)
+    a = _real_input(x, "x")
+    moved = np.moveaxis(a, axis, -1)
+    lead = moved.shape[:-1]
+    rows = np.ascontiguousarray(moved.reshape(-1, moved.shape[-1]), dtype=np.float64)
+    y, _ = _native.resample_rows(rows, fs, fs_out, None if cutoff_hz is None else float(cutoff_hz), bool(filter))
+    out = y.reshape(lead + (y.shape[-1],))
+    return np.moveaxis(out, -1, axis if axis >= 0 else a.ndim + axis)
