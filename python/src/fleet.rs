@@ -68,7 +68,8 @@ fn fleet_ingest(
                 condition,
                 road,
             };
-            let cfg = FleetConfig::default();
+            // The settings the store was initialised with (`fleet init --config`).
+            let cfg = store.config()?;
             files
                 .iter()
                 .map(|f| ingest_file(&mut store, &labels, f, &opts, &cfg))
@@ -84,7 +85,8 @@ fn fleet_baseline(py: Python<'_>, db: PathBuf, vehicle: &str) -> PyResult<String
     let set = py
         .detach(|| {
             let mut store = Store::open(&db)?;
-            build_baseline(&mut store, vehicle, &FleetConfig::default())
+            let cfg = store.config()?;
+            build_baseline(&mut store, vehicle, &cfg)
         })
         .map_err(fleet_err)?;
     serde_json::to_string(&set).map_err(json_err)
