@@ -187,7 +187,12 @@ pub fn run(a: &AnalyzeArgs) -> Result<()> {
             None => StreamRecords::cut(&display_name(path), stream, record_length_s),
         })
     });
-    let (results, first) = run_stream_analysis(&mut source, &cfg, &reference, a.quiet)?;
+    let (mut results, first) = run_stream_analysis(&mut source, &cfg, &reference, a.quiet)?;
+    if let Some([plan]) = plans.as_deref() {
+        if let Some(g) = &plan.gps {
+            results.drive_speed_trace = g.speed_trace.clone();
+        }
+    }
     check_some_fit(&results)?;
     write_report(out.path(), std::slice::from_ref(&first), &results, None)?;
     if let Some(plans) = &plans {

@@ -226,6 +226,27 @@ fn segment_and_analyze_by_gps_carry_speed_and_position() {
         assert_eq!(a["segment"]["lat_deg"], b["lat_deg"]);
     }
     assert!(rep.join("segments.json").exists());
+    // The GPS speed over the recording is carried for the report's figure: within the
+    // recording, increasing in time, the records' mean speeds inside its range.
+    let trace = res["drive_speed_trace"]
+        .as_array()
+        .expect("drive_speed_trace");
+    assert!(trace.len() > 10, "{} points", trace.len());
+    let pts: Vec<(f64, f64)> = trace
+        .iter()
+        .map(|p| (p[0].as_f64().unwrap(), p[1].as_f64().unwrap()))
+        .collect();
+    assert!(pts.windows(2).all(|w| w[1].0 > w[0].0));
+    let vmax = pts.iter().map(|p| p.1).fold(0.0, f64::max);
+    for r in rr {
+        let v = r["segment"]["mean_speed_kmh"].as_f64().unwrap();
+        assert!(
+            v > 0.0 && v <= vmax + 1e-9,
+            "record speed {v}, trace max {vmax}"
+        );
+    }
+    let html = std::fs::read_to_string(rep.join("index.html")).unwrap();
+    assert!(html.contains("speed over the drive"));
 }
 
 #[test]

@@ -266,6 +266,7 @@ pub fn analyze_prepared(
         .collect();
     Ok(AnalysisResults {
         schema_version: SCHEMA_VERSION,
+        drive_speed_trace: Vec::new(),
         config: cfg.clone(),
         records,
         channels,

@@ -109,6 +109,10 @@ pub struct Timing {
 pub struct AnalysisResults {
     /// Layout version ([`SCHEMA_VERSION`]).
     pub schema_version: u32,
+    /// The vehicle's speed over the recording from its GPS track, `[time in the recording s,
+    /// speed km/h]`, when records were cut by GPS (one recording); empty otherwise.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub drive_speed_trace: Vec<[f64; 2]>,
     /// Settings used.
     pub config: AnalysisConfig,
     /// Records analysed.

@@ -543,8 +543,8 @@ fn time_records_figure(name: &str, rec: &Recording) -> Figure {
     grid(panels, 2, 600, 260)
 }
 
-/// Mean speed of each record cut by GPS against its time in the recording; `None` when no
-/// record has a speed.
+/// The vehicle's speed over the recording from its GPS track (thin line) with each record cut
+/// by GPS marked at its mean speed (thick segments); `None` when no record has a speed.
 fn drive_figure(r: &AnalysisResults) -> Option<Figure> {
     let segs: Vec<&vibmode_core::RecordMeta> = r
         .records
@@ -555,22 +555,24 @@ fn drive_figure(r: &AnalysisResults) -> Option<Figure> {
         return None;
     }
     let mut panel = Panel::new(
-        "records over the drive",
+        "speed over the drive, records marked",
         "Time in the recording [s]",
-        "Mean speed [km/h]",
+        "Speed [km/h]",
     );
+    if !r.drive_speed_trace.is_empty() {
+        let (t, v): (Vec<f64>, Vec<f64>) = r.drive_speed_trace.iter().map(|p| (p[0], p[1])).unzip();
+        panel = panel.with_series(line("GPS speed", t, v, 1, 0.6));
+    }
+    // One series, the records' segments separated by NaN (which breaks a polyline).
+    let (mut x, mut y) = (Vec::new(), Vec::new());
     for m in segs {
         if let Some(v) = m.mean_speed_kmh {
-            panel = panel.with_series(line(
-                "record",
-                vec![m.start_s, m.start_s + m.duration_s],
-                vec![v, v],
-                3,
-                1.0,
-            ));
+            x.extend([m.start_s, m.start_s + m.duration_s, f64::NAN]);
+            y.extend([v, v, f64::NAN]);
         }
     }
-    Some(grid(vec![panel.without_legend()], 1, 900, 300))
+    panel = panel.with_series(line("record (mean speed)", x, y, 4, 1.0));
+    Some(grid(vec![panel], 1, 900, 300))
 }
 
 fn spectra_figures(
@@ -949,9 +951,9 @@ fn add_figures(
     if let Some(fig) = drive_figure(r) {
         w.add(
             "drive",
-            "records over the drive",
+            "speed over the drive, records marked",
             &fig,
-            "Each record cut from the long recording: its mean speed from the GPS track (a bar from its start to its end) against the time in the recording; the gaps are what the segmentation skipped (stops, braking, turns; segments.json says why).",
+            "The vehicle's speed from the GPS track (thin line) over the time in the recording, and each record cut from it at its mean speed (a bar from its start to its end); the gaps are what the segmentation skipped (stops, braking, turns; segments.json says why).",
         )?;
     }
     let (fig5, fig67) = spectra_figures(r, spectra, fmax);

@@ -221,7 +221,15 @@ pub struct GpsSummary {
     pub alignment: GpsAlignment,
     /// The part of the recording the track covers, s.
     pub covered_s: [f64; 2],
+    /// The track's speed over the recording: `[time in the recording s, speed km/h]` of the
+    /// fixes inside it (at most [`SPEED_TRACE_MAX_POINTS`], evenly thinned), for the report's
+    /// speed-over-time figure.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub speed_trace: Vec<[f64; 2]>,
 }
+
+/// Most points of [`GpsSummary::speed_trace`] (a day at 1 Hz thinned to a drawable line).
+pub const SPEED_TRACE_MAX_POINTS: usize = 4000;
 
 /// The result: records to cut and the skipped stretches, written as `segments.json`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -310,6 +310,15 @@ pub fn by_gps(
         n_other_sentences: track.n_other_sentences,
         alignment,
         covered_s: [t0.max(0.0), t1.min(duration_s)],
+        speed_trace: {
+            let inside: Vec<[f64; 2]> = pts
+                .iter()
+                .filter(|q| q.t >= 0.0 && q.t <= duration_s)
+                .map(|q| [q.t, q.speed_kmh])
+                .collect();
+            let step = inside.len().div_ceil(crate::SPEED_TRACE_MAX_POINTS).max(1);
+            inside.into_iter().step_by(step).collect()
+        },
     });
     let mut t = 0.0;
     while t + record_length_s <= duration_s + 1e-9 {
