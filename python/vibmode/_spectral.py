@@ -119,12 +119,27 @@ def _warn(notes: list) -> None:
         warnings.warn(n, UserWarning, stacklevel=3)
 
 
-def _onesided(return_onesided: bool) -> None:
-    if not return_onesided:
-        raise ValueError(
-            "return_onesided=False is not supported by vibmode (one-sided spectra of real signals "
-            "only); use scipy.signal for two-sided spectra"
-        )
+def _two_sided(f: np.ndarray, p: np.ndarray, fs: float, conj: bool) -> Tuple[np.ndarray, np.ndarray]:
+    """scipy's two-sided spectrum (``return_onesided=False``) of a real signal from vibmode's
+    one-sided one along the last axis: the one-sided bins are doubled except DC and (even nfft)
+    Nyquist, so the two-sided bins are halved back, and the negative frequencies mirror the
+    positive ones (complex conjugate for a cross-spectrum). Frequencies in scipy's FFT order
+    (``fftfreq(nfft, 1 / fs)``)."""
+    m = f.shape[0]
+    if m < 2:
+        nfft = 1
+    else:
+        nfft = int(round(fs / (f[1] - f[0])))
+    even = nfft % 2 == 0
+    half = p.copy()
+    hi = m - 1 if even else m
+    half[..., 1:hi] = half[..., 1:hi] / 2.0
+    out = np.empty(p.shape[:-1] + (nfft,), dtype=p.dtype)
+    out[..., :m] = half
+    k = np.arange(1, nfft - m + 1)  # positive bins whose mirror is a negative bin
+    mirror = half[..., k]
+    out[..., nfft - k] = np.conj(mirror) if conj else mirror
+    return np.fft.fftfreq(nfft, 1.0 / fs), out
 
 
 def welch(
@@ -153,17 +168,18 @@ def welch(
     noverlap : overlap, samples (default nperseg // 2).
     nfft : FFT length, samples, >= nperseg (default nperseg).
     detrend : 'constant' (default), 'linear' or False.
-    return_onesided : only True is supported (ValueError otherwise).
+    return_onesided : True (default): ``nfft // 2 + 1`` bins from 0 Hz; False: scipy's
+        two-sided spectrum, ``nfft`` bins in FFT order (``fftfreq``), each half the one-sided
+        value but DC and Nyquist.
     scaling : 'density' (units**2/Hz, default) or 'spectrum' (units**2).
     axis : axis of the samples (default -1).
     average : 'mean' (default) or 'median'.
 
     Returns
     -------
-    f : ndarray, frequencies in Hz (``nfft // 2 + 1`` bins).
+    f : ndarray, frequencies in Hz (``nfft // 2 + 1`` bins, or ``nfft`` two-sided).
     Pxx : ndarray, the shape of ``x`` with ``axis`` replaced by the bins; units**2/Hz or units**2.
     """
-    _onesided(return_onesided)
     fs = _check_fs(fs)
     a = _real_input(x, "x")
     _, rdt = _out_dtype(a)
@@ -176,6 +192,8 @@ def welch(
         _detrend_name(detrend), str(scaling), str(average),
     )
     _warn(notes)
+    if not return_onesided:
+        f, p = _two_sided(f, p, fs, conj=False)
     return f, _back(p, lead, axis, a.ndim).astype(rdt, copy=False)
 
 
@@ -193,7 +211,6 @@ def periodogram(
     ``axis`` (window 'boxcar' by default; ``window=None`` is boxcar too). ``nfft`` smaller than
     the record uses only its first ``nfft`` samples, larger zero-pads. Frequencies in Hz; Pxx in
     units**2/Hz ('density') or units**2 ('spectrum')."""
-    _onesided(return_onesided)
     fs = _check_fs(fs)
     a = _real_input(x, "x")
     _, rdt = _out_dtype(a)
@@ -204,6 +221,8 @@ def periodogram(
         rows, fs, _window_name("boxcar" if window is None else window),
         _opt_count("nfft", nfft, 1), _detrend_name(detrend), str(scaling),
     )
+    if not return_onesided:
+        f, p = _two_sided(f, p, fs, conj=False)
     return f, _back(p, lead, axis, a.ndim).astype(rdt, copy=False)
 
 
@@ -244,7 +263,6 @@ def csd(
     :func:`welch`; x and y broadcast against each other apart from ``axis`` and must have the
     same length along it). Returns frequencies in Hz and complex Pxy in units_x*units_y/Hz
     ('density') or units_x*units_y ('spectrum')."""
-    _onesided(return_onesided)
     fs = _check_fs(fs)
     a, b, ax, bx = _pair(x, y, axis)
     cdt, _ = _out_dtype(a, b)
@@ -260,6 +278,8 @@ def csd(
         _detrend_name(detrend), str(scaling), str(average),
     )
     _warn(notes)
+    if not return_onesided:
+        f, p = _two_sided(f, p, fs, conj=True)
     return f, _back(p, lead, axis, len(lead) + 1).astype(cdt, copy=False)
 
 
