@@ -449,8 +449,15 @@ fn kill_9_leaves_the_old_or_the_new_output_never_a_mix() {
         .into_iter()
         .map(|(p, n)| (out.join(p.file_name().unwrap()), n))
         .collect();
+    // The visible files (a killed write leaves its hidden temporary file beside them).
+    let visible = |dir: &Path| -> Vec<(PathBuf, u64)> {
+        listing(dir)
+            .into_iter()
+            .filter(|(p, _)| !p.file_name().unwrap().to_string_lossy().starts_with('.'))
+            .collect()
+    };
     for delay_ms in [0u64, 10, 30, 60, 100, 200, 350, 600] {
-        let before = listing(&out);
+        let before = visible(&out);
         let mut child = bin()
             .args(["resample", s(&f), "--to", "200", "-o", s(&target)])
             .stderr(Stdio::null())
@@ -459,10 +466,7 @@ fn kill_9_leaves_the_old_or_the_new_output_never_a_mix() {
         std::thread::sleep(Duration::from_millis(delay_ms));
         let _ = child.kill();
         let _ = child.wait();
-        let now: Vec<(PathBuf, u64)> = listing(&out)
-            .into_iter()
-            .filter(|(p, _)| !p.file_name().unwrap().to_string_lossy().starts_with('.'))
-            .collect();
+        let now = visible(&out);
         assert!(
             now == before || now == new,
             "resample killed at {delay_ms} ms left {now:?} (before {before:?}, complete {new:?})"
@@ -508,38 +512,32 @@ fn kill_9_leaves_the_old_or_the_new_output_never_a_mix() {
     }
     // simulate over an earlier simulation: records and truth.json always from one run.
     let sim = d.path().join("sim");
-    ok(&[
-        "simulate",
-        "examples/city_bus.toml",
-        "--records",
-        "5",
-        "--duration-s",
-        "10",
-        "--fs",
-        "4000",
-        "--format",
-        "csv",
-        "-o",
-        s(&sim),
-    ]);
+    // The old run: seed 1, 5 records; the new one: seed 2, 2 records.
+    let sim_args = |records: &'static str, seed: &'static str| -> Vec<String> {
+        [
+            "simulate",
+            "examples/city_bus.toml",
+            "--records",
+            records,
+            "--seed",
+            seed,
+            "--duration-s",
+            "10",
+            "--fs",
+            "4000",
+            "--format",
+            "csv",
+            "-o",
+            s(&sim),
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    let old_run = sim_args("5", "1");
+    ok(&old_run.iter().map(String::as_str).collect::<Vec<_>>());
     for delay_ms in [0u64, 20, 60, 150, 300, 500, 800, 1200] {
         let mut child = bin()
-            .args([
-                "simulate",
-                "examples/city_bus.toml",
-                "--records",
-                "2",
-                "--seed",
-                "2",
-                "--duration-s",
-                "10",
-                "--fs",
-                "4000",
-                "--format",
-                "csv",
-                "-o",
-                s(&sim),
-            ])
+            .args(sim_args("2", "2"))
             .stdout(Stdio::null())
             .stderr(Stdio::null())
             .spawn()
@@ -563,22 +561,8 @@ fn kill_9_leaves_the_old_or_the_new_output_never_a_mix() {
         );
     }
     // Completed: 2 records, none stale.
-    ok(&[
-        "simulate",
-        "examples/city_bus.toml",
-        "--records",
-        "2",
-        "--seed",
-        "2",
-        "--duration-s",
-        "10",
-        "--fs",
-        "4000",
-        "--format",
-        "csv",
-        "-o",
-        s(&sim),
-    ]);
+    let new_run = sim_args("2", "2");
+    ok(&new_run.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(
         !sim.join("record_03.csv").exists(),
         "stale records beside the new truth.json"

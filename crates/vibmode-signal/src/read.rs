@@ -170,6 +170,51 @@ pub(crate) fn reconcile_fs(
     }
 }
 
+/// Checks a WAV header and the scale option (the whole-file and the streamed readers share
+/// it): `(channels, float samples, factor from a raw sample to the output unit)`. Integer
+/// samples are scaled to [-1, 1) first, then by `opts.scale`.
+pub(crate) fn wav_layout(
+    spec: &hound::WavSpec,
+    opts: &ReadOptions,
+    wav_err: &dyn Fn(String) -> SignalError,
+) -> Result<(usize, bool, f64)> {
+    let nch = spec.channels as usize;
+    if nch == 0 {
+        return Err(wav_err(
+            "the header declares 0 channels; re-export the file".into(),
+        ));
+    }
+    if !(opts.scale.is_finite() && opts.scale != 0.0) {
+        return Err(SignalError::InvalidParam {
+            name: "scale",
+            value: opts.scale.to_string(),
+            fix:
+                "the WAV scale must be a finite non-zero number, e.g. 19.62 (m/s^2 per full scale)"
+                    .into(),
+        });
+    }
+    match spec.sample_format {
+        hound::SampleFormat::Float => {
+            if spec.bits_per_sample != 32 {
+                return Err(wav_err(format!(
+                    "{}-bit float samples are not supported; convert to 32-bit float or PCM",
+                    spec.bits_per_sample
+                )));
+            }
+            Ok((nch, true, opts.scale))
+        }
+        hound::SampleFormat::Int => {
+            let bits = spec.bits_per_sample;
+            if !(1..=32).contains(&bits) {
+                return Err(wav_err(format!(
+                    "{bits}-bit integer samples are not supported; use 8, 16, 24 or 32 bits"
+                )));
+            }
+            Ok((nch, false, opts.scale / f64::powi(2.0, bits as i32 - 1)))
+        }
+    }
+}
+
 /// Reads delimited text from any buffered reader (the whole stream). `path` is used in messages.
 /// Same rules as [`read_path`] for time columns, rates and units (except `opts.unit`, which
 /// [`read_path`] applies afterwards).
@@ -357,49 +402,19 @@ fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Recording> {
     let reader = hound::WavReader::open(path)
         .map_err(|e| wav_err(format!("{e}; check that it is a valid WAV file")))?;
     let spec = reader.spec();
-    let nch = spec.channels as usize;
-    if nch == 0 {
-        return Err(wav_err(
-            "the header declares 0 channels; re-export the file".into(),
-        ));
-    }
-    if !(opts.scale.is_finite() && opts.scale != 0.0) {
-        return Err(SignalError::InvalidParam {
-            name: "scale",
-            value: opts.scale.to_string(),
-            fix:
-                "the WAV scale must be a finite non-zero number, e.g. 19.62 (m/s^2 per full scale)"
-                    .into(),
-        });
-    }
-    let interleaved: Vec<f64> = match spec.sample_format {
-        hound::SampleFormat::Float => {
-            if spec.bits_per_sample != 32 {
-                return Err(wav_err(format!(
-                    "{}-bit float samples are not supported; convert to 32-bit float or PCM",
-                    spec.bits_per_sample
-                )));
-            }
-            reader
-                .into_samples::<f32>()
-                .map(|s| s.map(|v| v as f64 * opts.scale))
-                .collect::<std::result::Result<_, _>>()
-                .map_err(|e| wav_err(format!("{e}; the file may be truncated")))?
-        }
-        hound::SampleFormat::Int => {
-            let bits = spec.bits_per_sample;
-            if !(1..=32).contains(&bits) {
-                return Err(wav_err(format!(
-                    "{bits}-bit integer samples are not supported; use 8, 16, 24 or 32 bits"
-                )));
-            }
-            let k = opts.scale / f64::powi(2.0, bits as i32 - 1);
-            reader
-                .into_samples::<i32>()
-                .map(|s| s.map(|v| v as f64 * k))
-                .collect::<std::result::Result<_, _>>()
-                .map_err(|e| wav_err(format!("{e}; the file may be truncated")))?
-        }
+    let (nch, float, k) = wav_layout(&spec, opts, &wav_err)?;
+    let interleaved: Vec<f64> = if float {
+        reader
+            .into_samples::<f32>()
+            .map(|s| s.map(|v| v as f64 * k))
+            .collect::<std::result::Result<_, _>>()
+            .map_err(|e| wav_err(format!("{e}; the file may be truncated")))?
+    } else {
+        reader
+            .into_samples::<i32>()
+            .map(|s| s.map(|v| v as f64 * k))
+            .collect::<std::result::Result<_, _>>()
+            .map_err(|e| wav_err(format!("{e}; the file may be truncated")))?
     };
     let n = interleaved.len() / nch;
     if n == 0 {

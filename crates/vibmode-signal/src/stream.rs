@@ -247,41 +247,7 @@ fn open_wav(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
     let reader = hound::WavReader::new(BufReader::with_capacity(1 << 20, file))
         .map_err(|e| wav_err(format!("{e}; check that it is a valid WAV file")))?;
     let spec = reader.spec();
-    let nch = spec.channels as usize;
-    if nch == 0 {
-        return Err(wav_err(
-            "the header declares 0 channels; re-export the file".into(),
-        ));
-    }
-    if !(opts.scale.is_finite() && opts.scale != 0.0) {
-        return Err(SignalError::InvalidParam {
-            name: "scale",
-            value: opts.scale.to_string(),
-            fix:
-                "the WAV scale must be a finite non-zero number, e.g. 19.62 (m/s^2 per full scale)"
-                    .into(),
-        });
-    }
-    let (float, scale) = match spec.sample_format {
-        hound::SampleFormat::Float => {
-            if spec.bits_per_sample != 32 {
-                return Err(wav_err(format!(
-                    "{}-bit float samples are not supported; convert to 32-bit float or PCM",
-                    spec.bits_per_sample
-                )));
-            }
-            (true, opts.scale)
-        }
-        hound::SampleFormat::Int => {
-            let bits = spec.bits_per_sample;
-            if !(1..=32).contains(&bits) {
-                return Err(wav_err(format!(
-                    "{bits}-bit integer samples are not supported; use 8, 16, 24 or 32 bits"
-                )));
-            }
-            (false, opts.scale / f64::powi(2.0, bits as i32 - 1))
-        }
-    };
+    let (nch, float, scale) = crate::read::wav_layout(&spec, opts, &wav_err)?;
     let n = u64::from(reader.duration());
     if n == 0 {
         return Err(wav_err(
