@@ -53,8 +53,8 @@ pub struct AnalyzeArgs {
     /// Corner of a channel, `NAME=FL|FR|RL|RR` (repeat for several).
     #[arg(long = "corner", value_name = "NAME=CORNER")]
     pub corners: Vec<String>,
-    /// Identification: arma (per channel, the default), ssi-cov (all channels at once, with
-    /// mode shapes) or both; overrides the config's `method`.
+    /// Identification: both (the default), arma (per channel) or ssi-cov (all channels at once,
+    /// with mode shapes); overrides the config's `method`.
     #[arg(long)]
     pub method: Option<String>,
     /// Records of this length in seconds from long files (overrides the config's
@@ -369,7 +369,7 @@ pub struct DemoArgs {
     /// No progress bar.
     #[arg(long, short = 'q')]
     pub quiet: bool,
-    /// Identification: arma (the default), ssi-cov or both.
+    /// Identification: both (the default), arma or ssi-cov.
     #[arg(long)]
     pub method: Option<String>,
 }

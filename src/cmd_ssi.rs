@@ -21,6 +21,11 @@ pub struct SsiArgs {
     /// Block rows of the Toeplitz matrix of output correlations (lags 1..2i-1; default 20).
     #[arg(long)]
     pub block_rows: Option<usize>,
+    /// First correlation lag of the Toeplitz matrix, samples (default 1). Vehicles: beyond the
+    /// front-to-rear wheel delay, `1 + wheelbase / speed * fs`, the road's own correlation
+    /// no longer biases the body modes (docs/ssi.md).
+    #[arg(long)]
+    pub first_lag: Option<usize>,
     /// Model orders (state dimensions): `2:60:2` (default), `2:40`, or a list `10,20,30`.
     #[arg(long)]
     pub orders: Option<String>,
@@ -97,6 +102,7 @@ fn params(a: &SsiArgs) -> Result<SsiParams> {
         order_max: hi,
         order_step: step,
         reference_channels: references,
+        first_lag: a.first_lag.unwrap_or(d.first_lag),
         ..d
     };
     p.validate()?;

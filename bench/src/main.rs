@@ -339,6 +339,7 @@ fn run(dir: &Path, quick: bool) -> Result<Value> {
         order_step: 2,
         reference_channels: None,
         pool_records: false,
+        first_lag: 1,
     };
     let mut n_ssi_modes = 0;
     let t_ssi = median_time(if quick { 3 } else { 11 }, || {

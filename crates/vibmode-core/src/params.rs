@@ -139,14 +139,15 @@ impl PreprocessParams {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum IdentMethod {
-    /// The paper's per-channel ARMA (or AR) order sweep (the default: on 10 s records it
-    /// finds the body and wheel-hop modes that SSI-cov misses; docs/ssi.md).
-    #[default]
+    /// The paper's per-channel ARMA (or AR) order sweep.
     Arma,
     /// Multichannel covariance-driven stochastic subspace identification (all channels of a
     /// record at once, with mode shapes).
     SsiCov,
-    /// Both, side by side.
+    /// Both, side by side (the default: the ARMA pools find modes of single channels that
+    /// SSI-cov misses, SSI-cov separates close modes by their shapes; measured on the real
+    /// recordings in docs/analysis.md).
+    #[default]
     Both,
 }
 

@@ -30,6 +30,12 @@ pub struct SsiParams {
     /// orders only); `false` (default) identifies each record alone, as the ARMA sweep does, so
     /// that a mode must recur over records.
     pub pool_records: bool,
+    /// First correlation lag of the Toeplitz matrix, samples (default 1): the matrix holds the
+    /// lags `first_lag..=first_lag + 2i - 2`. Lag 0 carries the measurement noise. A larger
+    /// first lag skips the lags at which the excitation itself is correlated, such as the
+    /// delay between a vehicle's front and rear wheels on the same road (`wheelbase / speed`):
+    /// beyond it the correlations are free decays of the modes again (docs/ssi.md).
+    pub first_lag: usize,
 }
 
 impl Default for SsiParams {
@@ -41,6 +47,7 @@ impl Default for SsiParams {
             order_step: 2,
             reference_channels: None,
             pool_records: false,
+            first_lag: 1,
         }
     }
 }
@@ -76,6 +83,14 @@ impl SsiParams {
                 self.order_min,
                 "must be >= 2 (one mode needs two states)",
                 d.order_min,
+            ));
+        }
+        if self.first_lag < 1 {
+            return Err(ParamError::out_of_range(
+                "first_lag",
+                self.first_lag,
+                "must be >= 1 (lag 0 carries the measurement noise)",
+                d.first_lag,
             ));
         }
         if self.order_step < 1 {

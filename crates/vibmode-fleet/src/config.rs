@@ -42,7 +42,11 @@ pub struct FleetConfig {
 impl Default for FleetConfig {
     fn default() -> Self {
         FleetConfig {
-            analysis: AnalysisConfig::default(),
+            // The features use the per-channel modes only: no multichannel identification.
+            analysis: AnalysisConfig {
+                method: vibmode_core::IdentMethod::Arma,
+                ..AnalysisConfig::default()
+            },
             bands_hz: vec![
                 [0.5, 2.0],
                 [2.0, 5.0],

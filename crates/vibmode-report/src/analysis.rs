@@ -989,6 +989,93 @@ fn add_figures(
         &damping_figure(r, fmax),
         &format!("Every pole pair of every order and record, pooled per role; the pool's invariant structural modes (green) and periodic disturbances (orange, dotted) marked{with_model}."),
     )?;
+    if let Some(ssi) = &r.ssi {
+        shape_figures(w, r, ssi)?;
+    }
+    Ok(())
+}
+
+/// The multichannel modes' shapes on the sensor layout, and the MAC matrix against the model.
+fn shape_figures(
+    w: &mut FigureWriter<'_>,
+    r: &AnalysisResults,
+    ssi: &vibmode_analysis::SsiAnalysis,
+) -> Result<(), ReportError> {
+    use crate::shape_figures::{
+        layout_position, mac_matrix, mac_matrix_figure, mode_shapes_figure, shaped_structural,
+    };
+    let modes = shaped_structural(&ssi.invariant_modes);
+    let positions: Vec<Option<(f64, f64)>> = ssi
+        .channels
+        .iter()
+        .map(|name| {
+            r.channels
+                .iter()
+                .find(|c| &c.name == name)
+                .and_then(|c| layout_position(c.role, c.placement.corner))
+        })
+        .collect();
+    let labels: Vec<Option<String>> = modes
+        .iter()
+        .map(|m| {
+            ssi.matches.iter().find_map(|mm| {
+                let k = mm.invariant?;
+                std::ptr::eq(ssi.invariant_modes.get(k)?, *m).then(|| {
+                    format!(
+                        "{}, MAC {}",
+                        mm.reference.label,
+                        mm.mac.map_or("-".into(), |v| format!("{v:.2}"))
+                    )
+                })
+            })
+        })
+        .collect();
+    let unplaced: Vec<&str> = ssi
+        .channels
+        .iter()
+        .zip(&positions)
+        .filter(|(_, p)| p.is_none())
+        .map(|(c, _)| c.as_str())
+        .collect();
+    if let Some(fig) = mode_shapes_figure(&modes, &labels, &positions) {
+        let left_out = if unplaced.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " Channels without a corner are not drawn: {}.",
+                unplaced.join(", ")
+            )
+        };
+        w.add(
+            "mode_shapes",
+            "mode shapes on the sensor layout",
+            &fig,
+            &format!("Each structural mode of all channels identified together, seen from above (front to the right, left up; schematic positions from the channels' corners: wheels outside the body outline, body sensors inside): a circle per sensor whose area grows with the modulus of its shape entry (the largest 1), blue in phase with the largest entry (within 90 degrees), red opposite. The matched model mode and its MAC are in the title.{left_out} Moduli and phases are in the mode-shape table."),
+        )?;
+    }
+    let (rows, mac) = mac_matrix(&r.reference_modes, &ssi.channels, &modes);
+    if let Some(fig) = mac_matrix_figure(&mac) {
+        let cols: Vec<String> = modes
+            .iter()
+            .enumerate()
+            .map(|(j, m)| format!("{} = {:.3} Hz", j + 1, m.frequency_hz))
+            .collect();
+        let rows: Vec<String> = rows
+            .iter()
+            .enumerate()
+            .map(|(i, l)| format!("{} = {l}", i + 1))
+            .collect();
+        w.add(
+            "mac_matrix",
+            "MAC matrix, model against identified modes",
+            &fig,
+            &format!(
+                "MAC between the physical model's mode shapes at the sensors and the identified structural modes' shapes; 1 = the same shape. Columns: {}. Rows, from the bottom: {}.",
+                cols.join(", "),
+                rows.join(", ")
+            ),
+        )?;
+    }
     Ok(())
 }
 

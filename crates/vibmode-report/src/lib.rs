@@ -67,6 +67,7 @@ mod html;
 mod model;
 pub mod panels;
 mod render;
+pub mod shape_figures;
 pub mod signal_figures;
 pub mod spectrum_figures;
 

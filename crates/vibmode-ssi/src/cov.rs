@@ -146,7 +146,8 @@ impl SsiCov {
         let first = segments.first().ok_or(SsiError::NoChannels)?;
         let l = first.len();
         let i = params.block_rows;
-        let max_lag = 2 * i - 1;
+        let skip = params.first_lag - 1;
+        let max_lag = 2 * i - 1 + skip;
         let refs: Vec<usize> = match &params.reference_channels {
             Some(refs) => {
                 if let Some(&index) = refs.iter().find(|&&r| r >= l.max(1)) {
@@ -173,12 +174,12 @@ impl SsiCov {
                 });
             }
             let n = check_channels(seg)?;
-            if n < 2 * i {
+            if n <= max_lag {
                 return Err(SsiError::TooFewSamples {
                     n_samples: n,
                     block_rows: i,
                     max_lag,
-                    min_samples: 2 * i,
+                    min_samples: max_lag + 1,
                 });
             }
             let demeaned: Vec<Vec<f64>> = seg
@@ -215,7 +216,7 @@ impl SsiCov {
                 max_abs,
             });
         }
-        let mut cov = SsiCov::from_correlations(&r, fs_hz, i, params.order_max)?;
+        let mut cov = SsiCov::from_correlations(&r[skip..], fs_hz, i, params.order_max)?;
         cov.n_samples = n_total;
         Ok(cov)
     }

@@ -51,9 +51,9 @@ pub enum SsiError {
         n_samples: usize,
         /// Block rows asked for.
         block_rows: usize,
-        /// Largest lag of the Toeplitz matrix, `2 * block_rows - 1`.
+        /// Largest lag of the Toeplitz matrix, `first_lag + 2 * block_rows - 2`.
         max_lag: usize,
-        /// Smallest number of samples accepted, `2 * block_rows`.
+        /// Smallest number of samples accepted, `max_lag + 1`.
         min_samples: usize,
     },
     /// A reference channel index that is not a channel of the data.

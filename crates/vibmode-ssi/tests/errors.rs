@@ -27,6 +27,7 @@ fn params(block_rows: usize) -> SsiParams {
         order_step: 2,
         reference_channels: None,
         pool_records: false,
+        first_lag: 1,
     }
 }
 
@@ -133,6 +134,35 @@ fn too_few_samples_for_the_block_rows() {
     // Exactly 2 i samples is accepted.
     let a = noise(40, 1);
     assert!(SsiCov::new(&[&a], 50.0, &params(20)).is_ok());
+    // A later first lag needs as many more samples: lags 11..=49 need 50.
+    let p = SsiParams {
+        first_lag: 11,
+        ..params(20)
+    };
+    let (e, m) = msg(ssi_cov(&[&a], 50.0, &p));
+    assert_eq!(
+        e,
+        SsiError::TooFewSamples {
+            n_samples: 40,
+            block_rows: 20,
+            max_lag: 49,
+            min_samples: 50
+        }
+    );
+    assert!(
+        m.contains("lags up to 49") && m.contains("at least 50"),
+        "{m}"
+    );
+    assert!(SsiCov::new(&[&noise(50, 1)], 50.0, &p).is_ok());
+    let (_, m) = msg(ssi_cov(
+        &[&a],
+        50.0,
+        &SsiParams {
+            first_lag: 0,
+            ..params(5)
+        },
+    ));
+    assert!(m.contains("first_lag = 0") && m.contains(">= 1"), "{m}");
 }
 
 #[test]

@@ -81,6 +81,7 @@ fn identify(reference: &Value, refs: Option<Vec<usize>>) -> (vibmode_ssi::SsiRes
         order_step: 2,
         reference_channels: refs,
         pool_records: false,
+        first_lag: 1,
     };
     (ssi_cov(&ch, fs, &params).unwrap(), fs)
 }
