@@ -29,6 +29,8 @@ WELCH_PARAMS = [
     dict(window="flattop", nperseg=333, average="median"),
     dict(window=("tukey", 0.25), nperseg=256, noverlap=64, scaling="spectrum", average="median"),
     dict(window="tukey", nperseg=255, nfft=300),
+    dict(window=("kaiser", 8.6), nperseg=200, noverlap=150),
+    dict(window=("ksr", 0.5), nperseg=128, scaling="spectrum", detrend="linear"),
 ]
 
 
@@ -160,8 +162,10 @@ def test_empty_input_returns_empty_like_scipy():
     "kwargs,match",
     [
         (dict(window="kaiser"), "kaiser"),
-        (dict(window=("kaiser", 8.0)), "kaiser"),
-        (dict(window="kaiser"), "get_window"),
+        (dict(window=("gaussian", 7.0)), r"gaussian.*get_window\(\('gaussian', 7.0\), nperseg\)"),
+        (dict(window="kaiser"), r"needs its beta.*\('kaiser', 8.6\)"),
+        (dict(window=("kaiser", 800.0)), "kaiser beta"),
+        (dict(window=("kaiser", "big")), "must be a number"),
         (dict(nperseg=0), "nperseg"),
         (dict(nperseg=-5), "nperseg"),
         (dict(nperseg=64, noverlap=64), "noverlap"),
@@ -324,3 +328,11 @@ def test_array_window_length_errors_in_every_function(rng):
     # get_window takes names only.
     with pytest.raises(ValueError, match="not a window name"):
         vibmode.get_window(w, 128)
+
+
+@pytest.mark.parametrize("beta", [0.0, 1.5, 5.0, 8.6, 14.0, 40.0, -6.0])
+@pytest.mark.parametrize("n", [1, 2, 7, 64, 255, 256])
+def test_kaiser_matches_scipy_get_window(beta, n):
+    got = vibmode.get_window(("kaiser", beta), n)
+    want = ss.get_window(("kaiser", beta), n)
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-15)

@@ -20,8 +20,9 @@ _WINDOW_ALIASES = {
     "rectangular": "boxcar",
     "flattop": "flattop", "flat": "flattop", "flt": "flattop",
     "tukey": "tukey", "tuk": "tukey",
+    "kaiser": "kaiser", "ksr": "kaiser",
 }
-_VALID_WINDOWS = "hann, hamming, blackman, boxcar, flattop, tukey or ('tukey', alpha)"
+_VALID_WINDOWS = "hann, hamming, blackman, boxcar, flattop, tukey, ('tukey', alpha) or ('kaiser', beta)"
 
 
 def _unsupported(window: Any) -> ValueError:
@@ -37,15 +38,20 @@ def _window_name(window: Any) -> str:
         key = window.strip().lower()
         if key.startswith("tukey:"):
             return key
+        if _WINDOW_ALIASES.get(key) == "kaiser":
+            raise ValueError(f"window '{window}' needs its beta (as scipy): give ('kaiser', beta), e.g. ('kaiser', 8.6)")
         if key in _WINDOW_ALIASES:
             return _WINDOW_ALIASES[key]
         raise _unsupported(window)
     if isinstance(window, tuple) and window and isinstance(window[0], str):
         name = _WINDOW_ALIASES.get(window[0].strip().lower())
-        if name == "tukey" and len(window) == 2:
-            alpha = float(window[1])
-            return f"tukey:{alpha!r}"
-        if name is not None and len(window) == 1:
+        if name in ("tukey", "kaiser") and len(window) == 2:
+            try:
+                param = float(window[1])
+            except (TypeError, ValueError):
+                raise ValueError(f"window {window!r}: the {name} parameter must be a number") from None
+            return f"{name}:{param!r}"
+        if name is not None and name != "kaiser" and len(window) == 1:
             return name
         raise _unsupported(window)
     raise ValueError(
@@ -262,10 +268,11 @@ def welch(
     ----------
     x : array_like of real numbers, any shape; the spectrum is taken along ``axis``.
     fs : sampling rate, Hz (default 1.0).
-    window : 'hann' (default), 'hamming', 'blackman', 'boxcar', 'flattop', 'tukey' or
-        ('tukey', alpha); or a 1-D array of coefficients (dimensionless, e.g. ``np.hanning(256)``
-        or ``scipy.signal.get_window(('kaiser', 8.0), 256)``; no normalisation needed), whose
-        length is the segment length. Other names raise ValueError (pass their coefficients).
+    window : 'hann' (default), 'hamming', 'blackman', 'boxcar', 'flattop', 'tukey',
+        ('tukey', alpha) or ('kaiser', beta); or a 1-D array of coefficients (dimensionless,
+        e.g. ``np.hanning(256)`` or ``scipy.signal.get_window(('gaussian', 30), 256)``; no
+        normalisation needed), whose length is the segment length. Other names raise
+        ValueError (pass their coefficients).
     nperseg : segment length, samples (default 256, clamped to the record with a UserWarning;
         with an array window its length, and a different nperseg is a ValueError; an array
         window longer than the record is a ValueError, as scipy).
@@ -350,6 +357,6 @@ def coherence(
 
 def get_window(window: Any, nx: int) -> np.ndarray:
     """The periodic window of length ``nx`` (as ``scipy.signal.get_window(window, nx)``),
-    dimensionless. Takes a window name or ('tukey', alpha)."""
+    dimensionless. Takes a window name, ('tukey', alpha) or ('kaiser', beta)."""
     n = _opt_count("nx", nx, 0)
     return _native.window_values(_window_name(window), n)

@@ -74,8 +74,14 @@ pub enum SpectraError {
         /// The rejected alpha.
         alpha: f64,
     },
+    /// A Kaiser window's beta is not finite or beyond 700 in magnitude (I0 overflows).
+    #[error("kaiser beta ({}) must be finite with |beta| <= 700; use e.g. kaiser:8.6", vibmode_core::num(.beta))]
+    InvalidKaiserBeta {
+        /// The rejected beta.
+        beta: f64,
+    },
     /// A window name that [`crate::Window`]'s `FromStr` does not know.
-    #[error("unknown window '{name}'; valid windows: hann, hamming, blackman, boxcar (or rect), flattop, tukey (alpha 0.5), tukey:ALPHA with ALPHA in [0, 1]")]
+    #[error("unknown window '{name}'; valid windows: hann, hamming, blackman, boxcar (or rect), flattop, tukey (alpha 0.5), tukey:ALPHA with ALPHA in [0, 1], kaiser:BETA (e.g. kaiser:8.6), or custom coefficients")]
     UnknownWindow {
         /// The rejected name.
         name: String,

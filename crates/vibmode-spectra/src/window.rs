@@ -114,7 +114,8 @@ const FLATTOP: [f64; 5] = [
 /// its last sample. `n = 0` gives an empty vector, `n = 1` gives `[1.0]`.
 ///
 /// A Tukey alpha outside [0, 1] is clamped as scipy does (<= 0: boxcar, >= 1: Hann);
-/// a NaN alpha gives a boxcar. [`Window::validate`] rejects such alphas, and the spectral
+/// a NaN alpha gives a boxcar; a Kaiser |beta| beyond about 713 gives NaN coefficients.
+/// [`Window::validate`] rejects such parameters, and the spectral
 /// functions call it, so only direct callers of this function see the clamping.
 /// Never panics.
 pub fn window_values(w: &Window, n: usize) -> Vec<f64> {
@@ -128,7 +129,41 @@ pub fn window_values(w: &Window, n: usize) -> Vec<f64> {
         Window::Boxcar => vec![1.0; n],
         Window::Flattop => general_cosine(n, &FLATTOP),
         Window::Tukey { alpha } => tukey(n, alpha),
+        Window::Kaiser { beta } => kaiser(n, beta),
     }
+}
+
+/// Periodic Kaiser window of length n (symmetric length n + 1, last point dropped):
+/// `I0(beta sqrt(1 - r^2)) / I0(beta)` with `r = 2 j / n - 1`. A |beta| beyond about 713
+/// overflows I0 (NaN coefficients); [`Window::validate`] rejects |beta| > 700.
+fn kaiser(n: usize, beta: f64) -> Vec<f64> {
+    let den = bessel_i0(beta);
+    let m1 = n as f64;
+    (0..n)
+        .map(|j| {
+            let r = 2.0 * j as f64 / m1 - 1.0;
+            bessel_i0(beta * (1.0 - r * r).max(0.0).sqrt()) / den
+        })
+        .collect()
+}
+
+/// Modified Bessel function of the first kind, order 0: `sum_k ((x/2)^k / k!)^2`. All terms are
+/// positive (no cancellation): relative error a few ulps times the number of terms (about
+/// |x| + 40).
+fn bessel_i0(x: f64) -> f64 {
+    let q = x * x / 4.0;
+    let mut term = 1.0;
+    let mut sum = 1.0;
+    let mut k = 1.0;
+    while k < 2000.0 {
+        term *= q / (k * k);
+        sum += term;
+        if term <= sum * 1e-17 {
+            break;
+        }
+        k += 1.0;
+    }
+    sum
 }
 
 /// Periodic generalized cosine window: sum_k a_k cos(k * phi_j), phi_j running from -pi in
