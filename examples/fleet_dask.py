@@ -15,7 +15,9 @@ OUT/checks.parquet (the store's classification of each record).
 
 The fleet store is SQLite: one writer. The workers compute each record's store features
 (vibmode.fleet.features, the expensive part); this process alone writes them
-(vibmode.fleet.store_features). See docs/scaling.md.
+(vibmode.fleet.store_features). The workers use the store's settings (vibmode.fleet.settings,
+read once by this process): initialise the store with `vibmode fleet init --db fleet.db --config
+fleet.toml` first for other settings than the defaults. See docs/scaling.md.
 """
 
 from __future__ import annotations
@@ -116,15 +118,17 @@ def analyze_record(
     fs_hz: Optional[float] = None,
     with_features: bool = False,
     storage_options: Optional[Dict[str, Any]] = None,
+    settings: Optional[Dict[str, Any]] = None,
 ) -> Dict[str, Any]:
     """The per-record task: analyse one recording, write OUT/modes/<record>.parquet, return its
-    summary row (and its fleet-store features when asked)."""
+    summary row (and its fleet-store features when asked, computed with the store's `settings`,
+    vibmode.fleet.settings(db))."""
     so = storage_options or {}
     t0 = time.perf_counter()
     name = os.path.basename(url.rstrip("/"))
     with local_copy(url, so) as path:
         res = vibmode.analyze(path, fs=fs_hz, as_frames=False, **analysis)
-        feats = vibmode.fleet.features(path, fs=fs_hz) if with_features else None
+        feats = vibmode.fleet.features(path, fs=fs_hz, settings=settings) if with_features else None
     table = modes_table(name, res)
     target = out.rstrip("/") + "/modes/" + os.path.splitext(name)[0] + ".parquet"
     ofs, opath = _fs(target, so)
@@ -170,12 +174,18 @@ def run(
     if store is not None and not vehicle:
         raise ValueError("--store needs --vehicle ID")
     feats = store is not None
+    settings = None
+    if store is not None:
+        # The store's settings (`vibmode fleet init --config`, or the defaults), read once here and
+        # shipped to every task: the workers' features are then the ones `fleet ingest` stores.
+        vibmode.fleet.init(store)
+        settings = vibmode.fleet.settings(store)
     if client is None:
-        results = [analyze_record(f, out, analysis, fs_hz, feats, so) for f in files]
+        results = [analyze_record(f, out, analysis, fs_hz, feats, so, settings) for f in files]
     else:
         # A lambda is shipped by value (cloudpickle), with analyze_record inside it: the workers
         # need vibmode installed, not this script.
-        task = lambda url: analyze_record(url, out, analysis, fs_hz, feats, so)  # noqa: E731
+        task = lambda url: analyze_record(url, out, analysis, fs_hz, feats, so, settings)  # noqa: E731
         futures = client.map(task, files, pure=False)
         results = client.gather(futures)
     records = pd.DataFrame([r["summary"] for r in results])
@@ -184,7 +194,6 @@ def run(
         records.to_parquet(f, index=False)
     if store is not None:
         # One writer: the store is fed from this process only.
-        vibmode.fleet.init(store)
         stored = vibmode.fleet.store_features(store, vehicle, [r["features"] for r in results], condition, road)
         print(f"store {store}: {sum(not s['already_stored'] for s in stored)} new {condition} record(s) of {vehicle}",
               file=sys.stderr)
@@ -230,7 +239,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     ap.add_argument("--config", help="analysis settings (TOML file)")
     ap.add_argument("--preset", help="vibmode (default) or paper")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="analysis setting, e.g. order_max=12")
-    ap.add_argument("--store", help="fleet store (SQLite file on this machine) to feed")
+    ap.add_argument("--store", help="fleet store (SQLite file on this machine) to feed, with its own settings")
     ap.add_argument("--vehicle", help="vehicle id for --store")
     ap.add_argument("--condition", default="nominal", choices=["nominal", "test"])
     ap.add_argument("--road", help="road label for --store")

@@ -75,7 +75,7 @@ pub struct PsdArgs {
 /// scipy.signal's spectral parameters, shared by several commands.
 #[derive(Args, Debug, Clone)]
 pub struct SpectralArgs {
-    /// Window: hann, hamming, blackman, boxcar, flattop, tukey or tukey:ALPHA
+    /// Window: hann, hamming, blackman, boxcar, flattop, tukey, tukey:ALPHA or kaiser:BETA
     /// (default: hann for Welch, boxcar for the periodogram, as in scipy).
     #[arg(long)]
     pub window: Option<String>,

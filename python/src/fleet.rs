@@ -18,6 +18,7 @@ use crate::errors::{fleet_err, json_err};
 /// Registers the functions of this module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fleet_init, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet_settings, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_ingest, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_baseline, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_check, m)?)?;
@@ -36,11 +37,45 @@ fn read_options(fs: Option<f64>, scale: f64, unit: Option<String>) -> ReadOption
     }
 }
 
-/// Creates the store if needed; returns whether it was created.
+/// Creates the store if needed, with the settings `config_toml` (TOML text of a
+/// `FleetConfig`, as `vibmode fleet init --config`; checked before the store is created);
+/// returns whether it was created.
 #[pyfunction]
-fn fleet_init(db: PathBuf) -> PyResult<bool> {
-    let (_, created) = Store::init(&db).map_err(fleet_err)?;
+#[pyo3(signature = (db, config_toml=None))]
+fn fleet_init(db: PathBuf, config_toml: Option<&str>) -> PyResult<bool> {
+    let cfg = config_toml
+        .map(|t| FleetConfig::from_toml_str(t, "config"))
+        .transpose()
+        .map_err(fleet_err)?;
+    let (mut store, created) = Store::init(&db).map_err(fleet_err)?;
+    if let Some(cfg) = &cfg {
+        store.set_config(cfg).map_err(fleet_err)?;
+    }
     Ok(created)
+}
+
+/// The settings new records of the store are analysed with (`Store::config`: those given at
+/// init, or the defaults), as JSON.
+#[pyfunction]
+fn fleet_settings(py: Python<'_>, db: PathBuf) -> PyResult<String> {
+    let cfg = py
+        .detach(|| Store::open(&db)?.config())
+        .map_err(fleet_err)?;
+    serde_json::to_string(&cfg).map_err(json_err)
+}
+
+/// Settings from JSON (from [`fleet_settings`]), checked; `None`: the defaults.
+fn settings_from_json(json: Option<&str>) -> PyResult<FleetConfig> {
+    let Some(json) = json else {
+        return Ok(FleetConfig::default());
+    };
+    let cfg: FleetConfig = serde_json::from_str(json).map_err(|e| {
+        crate::errors::value_err(format!(
+            "settings are not fleet settings ({e}); pass what vibmode.fleet.settings(db) returns"
+        ))
+    })?;
+    cfg.validate().map_err(fleet_err)?;
+    Ok(cfg)
 }
 
 /// Ingests files for a vehicle; JSON list of `Ingested`.
@@ -151,16 +186,19 @@ struct FeaturesOut {
 }
 
 /// Reads a file and computes what the store keeps of it (the expensive part of an ingest),
-/// without touching a store; JSON for [`fleet_store_features`].
+/// without touching a store, with the settings `settings_json` (from [`fleet_settings`]; `None`:
+/// the defaults); JSON for [`fleet_store_features`].
 #[pyfunction]
-#[pyo3(signature = (path, fs=None, scale=1.0, unit=None))]
+#[pyo3(signature = (path, fs=None, scale=1.0, unit=None, settings_json=None))]
 fn fleet_features(
     py: Python<'_>,
     path: PathBuf,
     fs: Option<f64>,
     scale: f64,
     unit: Option<String>,
+    settings_json: Option<&str>,
 ) -> PyResult<String> {
+    let cfg = settings_from_json(settings_json)?;
     let opts = read_options(fs, scale, unit);
     let out = py
         .detach(|| {
@@ -174,7 +212,7 @@ fn fleet_features(
                 .file_name()
                 .map(|s| s.to_string_lossy().to_string())
                 .unwrap_or_else(|| path.display().to_string());
-            let features = compute_features(&file, &rec, &FleetConfig::default())?;
+            let features = compute_features(&file, &rec, &cfg)?;
             Ok::<_, FleetError>(FeaturesOut {
                 file,
                 sha256,

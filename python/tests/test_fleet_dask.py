@@ -1,6 +1,8 @@
 """examples/fleet_dask.py on a two-worker LocalCluster gives the single-process results."""
 
 import importlib.util
+import json
+import sqlite3
 import sys
 from pathlib import Path
 
@@ -13,6 +15,20 @@ EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "fleet_dask.py"
 
 distributed = pytest.importorskip("dask.distributed")
 pytest.importorskip("pyarrow")
+
+
+# Store settings other than the defaults (five bands 0.5-20 Hz): they change every band feature.
+BANDS = [[1.0, 3.0], [3.0, 7.0], [7.0, 15.0]]
+CONFIG_TOML = "bands_hz = [[1.0, 3.0], [3.0, 7.0], [7.0, 15.0]]\nfloor_level = 0.2\n"
+
+
+def stored_features(db):
+    """{file name: features} as the store keeps them (the features table's JSON)."""
+    with sqlite3.connect(str(db)) as c:
+        rows = c.execute(
+            "SELECT r.file_name, f.json FROM records r JOIN features f ON f.record_id = r.id"
+        ).fetchall()
+    return {name: json.loads(j) for name, j in rows}
 
 
 def load_example():
@@ -28,6 +44,9 @@ def test_two_workers_equal_single_process(tmp_path):
     rec_dir = tmp_path / "records"
     vibmode.simulate("city_bus", records=4, fs=200.0, effects="none", seed=11, out_dir=rec_dir)
     settings = {"order_max": 8}
+    # Both stores with non-default settings: the workers must use them, not the defaults.
+    for db in ("single.db", "dask.db", "ingest.db"):
+        vibmode.fleet.init(tmp_path / db, config=CONFIG_TOML)
 
     single = fd.run(str(rec_dir), str(tmp_path / "single"), None, settings,
                     store=str(tmp_path / "single.db"), vehicle="bus-9")
@@ -54,6 +73,14 @@ def test_two_workers_equal_single_process(tmp_path):
     # The two stores hold the same records.
     assert vibmode.fleet.status(tmp_path / "single.db") == vibmode.fleet.status(tmp_path / "dask.db")
     assert vibmode.fleet.status(tmp_path / "dask.db")[0]["n_nominal"] == 4
+    # The workers' features are those `ingest` computes with the store's settings.
+    files = sorted(rec_dir.glob("record_*.wav"))
+    vibmode.fleet.ingest(tmp_path / "ingest.db", "bus-9", files)
+    by_ingest = stored_features(tmp_path / "ingest.db")
+    by_workers = stored_features(tmp_path / "dask.db")
+    assert len(by_ingest) == 4 and by_workers == by_ingest
+    default = vibmode.fleet.features(files[0])["features"]
+    assert default != by_ingest[files[0].name]
 
 
 def test_cli_single_process(tmp_path):
@@ -63,3 +90,51 @@ def test_cli_single_process(tmp_path):
     assert len(pd.read_parquet(tmp_path / "o" / "records.parquet")) == 2
     with pytest.raises(FileNotFoundError):
         fd.run(str(tmp_path / "empty"), str(tmp_path / "o2"))
+
+
+def test_store_settings_reach_features(tmp_path):
+    vibmode.simulate("city_bus", records=1, fs=200.0, effects="none", seed=13, out_dir=tmp_path / "r")
+    path = tmp_path / "r" / "record_01.wav"
+    db = tmp_path / "custom.db"
+    assert vibmode.fleet.init(db, config={"bands_hz": BANDS, "floor_level": 0.2}) is True
+    s = vibmode.fleet.settings(db)
+    assert s["bands_hz"] == BANDS and s["floor_level"] == 0.2
+    assert json.loads(json.dumps(s)) == s  # plain values: ships to workers as JSON or pickle
+    # A default store's settings are the defaults.
+    vibmode.fleet.init(tmp_path / "default.db")
+    d = vibmode.fleet.settings(tmp_path / "default.db")
+    assert len(d["bands_hz"]) == 5 and d != s
+    # Features with the store's settings are what ingest stores; with the defaults they differ.
+    vibmode.fleet.ingest(db, "bus-1", path)
+    stored = stored_features(db)["record_01.wav"]
+    with_settings = vibmode.fleet.features(path, settings=s)
+    assert with_settings["features"] == stored
+    assert vibmode.fleet.features(path, settings=d)["features"] == vibmode.fleet.features(path)["features"]
+    assert vibmode.fleet.features(path)["features"] != stored
+    # The same features stored through store_features are a no-op on that store.
+    assert vibmode.fleet.store_features(db, "bus-1", [with_settings])[0]["already_stored"] is True
+    # The same settings again are a no-op; other settings once records exist are refused.
+    assert vibmode.fleet.init(db, config=CONFIG_TOML) is False
+    with pytest.raises(ValueError, match="already holds 1 record"):
+        vibmode.fleet.init(db, config={"bands_hz": [[1.0, 2.0]]})
+
+
+def test_bad_settings_raise(tmp_path):
+    vibmode.simulate("city_bus", records=1, fs=200.0, effects="none", seed=14, out_dir=tmp_path / "r")
+    path = tmp_path / "r" / "record_01.wav"
+    vibmode.fleet.init(tmp_path / "s.db")
+    good = vibmode.fleet.settings(tmp_path / "s.db")
+    cases = [
+        ("bands", "settings of type str"),
+        ({**good, "bands_hz": [[5.0, 2.0]]}, "bands_hz"),
+        ({**good, "no_such_key": 1}, "no_such_key"),
+    ]
+    for settings, match in cases:
+        with pytest.raises(ValueError, match=match) as e:
+            vibmode.fleet.features(path, settings=settings)
+        assert "\n" not in str(e.value)
+    with pytest.raises(ValueError, match="bands_hz"):
+        vibmode.fleet.init(tmp_path / "bad.db", config={"bands_hz": [[1.0, 100.0]]})
+    assert not (tmp_path / "bad.db").exists()  # checked before the store is created
+    with pytest.raises(OSError):
+        vibmode.fleet.settings(tmp_path / "missing.db")

@@ -29,6 +29,8 @@ WELCH_PARAMS = [
     dict(window="flattop", nperseg=333, average="median"),
     dict(window=("tukey", 0.25), nperseg=256, noverlap=64, scaling="spectrum", average="median"),
     dict(window="tukey", nperseg=255, nfft=300),
+    dict(window=("kaiser", 8.6), nperseg=200, noverlap=150),
+    dict(window=("ksr", 0.5), nperseg=128, scaling="spectrum", detrend="linear"),
 ]
 
 
@@ -160,7 +162,10 @@ def test_empty_input_returns_empty_like_scipy():
     "kwargs,match",
     [
         (dict(window="kaiser"), "kaiser"),
-        (dict(window=np.hanning(256)), "window arrays"),
+        (dict(window=("gaussian", 7.0)), r"gaussian.*get_window\(\('gaussian', 7.0\), nperseg\)"),
+        (dict(window="kaiser"), r"needs its beta.*\('kaiser', 8.6\)"),
+        (dict(window=("kaiser", 800.0)), "kaiser beta"),
+        (dict(window=("kaiser", "big")), "must be a number"),
         (dict(nperseg=0), "nperseg"),
         (dict(nperseg=-5), "nperseg"),
         (dict(nperseg=64, noverlap=64), "noverlap"),
@@ -213,3 +218,121 @@ def test_coherence_of_a_silent_signal_is_nan_as_scipy(rng):
         _, c2 = ss.coherence(x, y, nperseg=64)
     _, c = vibmode.coherence(x, y, nperseg=64)
     assert np.all(np.isnan(c)) and np.all(np.isnan(c2))
+
+
+# Window arrays (scipy's `window=` as coefficients): nperseg is the window's length.
+ARRAY_WINDOWS = [
+    ("np.hanning(256)", lambda: np.hanning(256), {}),
+    ("get_window hann 200", lambda: ss.get_window("hann", 200), dict(noverlap=150, average="median")),
+    ("kaiser 8 as list", lambda: list(ss.get_window(("kaiser", 8.0), 128)), dict(detrend="linear", nfft=300)),
+    ("hamming 255 + nperseg", lambda: ss.get_window("hamming", 255), dict(nperseg=255, noverlap=100, scaling="spectrum")),
+    ("random positive 100", lambda: np.random.default_rng(7).uniform(0.1, 2.0, 100), dict(detrend=False)),
+]
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+@pytest.mark.parametrize("shape,axis", SHAPES_AXES)
+@pytest.mark.parametrize("name,make,params", ARRAY_WINDOWS, ids=[w[0] for w in ARRAY_WINDOWS])
+def test_array_windows_match_scipy(seed, shape, axis, name, make, params):
+    rng = np.random.default_rng(seed)
+    x = rng.standard_normal(shape) * 2.0 + 0.7
+    y = 0.6 * x + rng.standard_normal(shape)
+    w = make()
+    for ours, theirs, args, kw in [
+        (vibmode.welch, ss.welch, (x,), params),
+        (vibmode.csd, ss.csd, (x, y), params),
+        (vibmode.coherence, ss.coherence, (x, y),
+         {k: v for k, v in params.items() if k not in ("scaling", "average")}),
+    ]:
+        f, p = ours(*args, fs=256.0, window=w, axis=axis, **kw)
+        f2, p2 = theirs(*args, fs=256.0, window=w, axis=axis, **kw)
+        np.testing.assert_allclose(f, f2, rtol=1e-12)
+        assert p.shape == p2.shape and p.dtype == p2.dtype, (ours.__name__, p.shape, p2.shape)
+        assert rel_err(p, p2) < TOL, (ours.__name__, rel_err(p, p2))
+    # Two-sided with an array window.
+    f, p = vibmode.welch(x, fs=256.0, window=w, axis=axis, return_onesided=False, **params)
+    f2, p2 = ss.welch(x, fs=256.0, window=w, axis=axis, return_onesided=False, **params)
+    np.testing.assert_allclose(f, f2, rtol=1e-12, atol=1e-12)
+    assert rel_err(p, p2) < TOL
+
+
+@pytest.mark.parametrize("seed", [4, 5])
+@pytest.mark.parametrize("shape,axis", SHAPES_AXES)
+@pytest.mark.parametrize("nfft_less", [False, True])
+def test_periodogram_array_window_matches_scipy(seed, shape, axis, nfft_less):
+    rng = np.random.default_rng(seed)
+    x = rng.standard_normal(shape)
+    n = shape[axis]
+    m = n - 300 if nfft_less else n  # nfft < n: the window covers the first nfft samples
+    kw = dict(nfft=m) if nfft_less else {}
+    for w in (ss.get_window(("kaiser", 6.0), m), rng.uniform(0.0, 1.0, m)):
+        for scaling in ("density", "spectrum"):
+            f, p = vibmode.periodogram(x, fs=50.0, window=w, axis=axis, scaling=scaling, **kw)
+            f2, p2 = ss.periodogram(x, fs=50.0, window=w, axis=axis, scaling=scaling, **kw)
+            np.testing.assert_allclose(f, f2, rtol=1e-12)
+            assert p.shape == p2.shape
+            assert rel_err(p, p2) < TOL
+
+
+def test_array_window_equals_the_named_window_exactly(rng):
+    x = rng.standard_normal((3, 5000))
+    for name in ("hann", "flattop", ("tukey", 0.3)):
+        for nperseg in (256, 333):
+            w = vibmode.get_window(name, nperseg)
+            np.testing.assert_array_equal(
+                vibmode.welch(x, window=w)[1], vibmode.welch(x, window=name, nperseg=nperseg)[1]
+            )
+    # Any positive multiple of a window gives the same spectra (normalised by sum(w**2)).
+    w = ss.get_window("hann", 128)
+    assert rel_err(vibmode.welch(x, window=5.0 * w)[1], vibmode.welch(x, window=w)[1]) < 1e-14
+
+
+@pytest.mark.parametrize(
+    "kwargs,match",
+    [
+        # scipy's length rules (scipy refuses these too).
+        (dict(window=np.hanning(128), nperseg=100), r"nperseg = 100 differs from the window's length 128"),
+        (dict(window=np.ones(2000)), r"window has 2000 coefficients but the record only 1000 samples"),
+        # Coefficients vibmode refuses (scipy gives NaN/inf spectra or errors of its own).
+        (dict(window=np.array([])), "0 coefficients"),
+        (dict(window=[1.0, np.nan, 1.0]), r"window\[1\] = NaN is not finite"),
+        (dict(window=[1.0, np.inf]), r"window\[1\] = inf is not finite"),
+        (dict(window=np.zeros(64)), "64 coefficients are all 0"),
+        (dict(window=np.ones((8, 8))), r"1-D.*\(8, 8\)"),
+        (dict(window=np.hanning(8) + 1j), "real coefficients"),
+        (dict(window=["a", "b"]), "real coefficients"),
+        (dict(window=None), "NoneType"),
+        (dict(window=[1.0, -1.0, 1.0, -1.0], scaling="spectrum"), r"sum\(w\) is 0"),
+    ],
+)
+def test_bad_array_windows_raise_value_error(rng, kwargs, match):
+    x = rng.standard_normal((2, 1000))
+    with pytest.raises(ValueError, match=match) as e:
+        vibmode.welch(x, **kwargs)
+    assert "\n" not in str(e.value)
+    if "differs" in match or "record only" in match:
+        with pytest.raises(ValueError):
+            ss.welch(x, **kwargs)
+
+
+def test_array_window_length_errors_in_every_function(rng):
+    x = rng.standard_normal(1000)
+    w = np.hanning(128)
+    for fn, args in [(vibmode.welch, (x,)), (vibmode.csd, (x, x)), (vibmode.coherence, (x, x))]:
+        with pytest.raises(ValueError, match="nperseg = 64 differs from the window's length 128"):
+            fn(*args, window=w, nperseg=64)
+    with pytest.raises(ValueError, match="128 coefficients but the periodogram uses 1000 samples"):
+        vibmode.periodogram(x, window=w)
+    with pytest.raises(ValueError):
+        ss.periodogram(x, window=w)
+    # get_window takes names only.
+    with pytest.raises(ValueError, match="not a window name"):
+        vibmode.get_window(w, 128)
+
+
+@pytest.mark.parametrize("beta", [0.0, 1.5, 5.0, 8.6, 14.0, 40.0, -6.0])
+@pytest.mark.parametrize("n", [1, 2, 7, 64, 255, 256])
+def test_kaiser_matches_scipy_get_window(beta, n):
+    got = vibmode.get_window(("kaiser", beta), n)
+    want = ss.get_window(("kaiser", beta), n)
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-15)

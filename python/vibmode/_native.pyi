@@ -1,7 +1,7 @@
 """Type stubs of the native extension (vibmode._native). Use the public functions of
 `vibmode` instead: they take scipy's arguments and return numpy arrays, models and DataFrames."""
 
-from typing import List, Optional, Sequence, Tuple
+from typing import List, Optional, Sequence, Tuple, TypedDict, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -12,21 +12,21 @@ F64 = npt.NDArray[np.float64]
 C128 = npt.NDArray[np.complex128]
 _PyRecording = Tuple[F64, float, List[str], List[str], str]
 
-def welch_rows(
-    x: F64, fs: float, window: str, nperseg: Optional[int], noverlap: Optional[int],
-    nfft: Optional[int], detrend: str, scaling: str, average: str,
-) -> Tuple[F64, F64, List[str]]: ...
-def periodogram_rows(
-    x: F64, fs: float, window: str, nfft: Optional[int], detrend: str, scaling: str,
-) -> Tuple[F64, F64, List[str]]: ...
-def csd_rows(
-    x: F64, y: F64, fs: float, window: str, nperseg: Optional[int], noverlap: Optional[int],
-    nfft: Optional[int], detrend: str, scaling: str, average: str,
-) -> Tuple[F64, C128, List[str]]: ...
-def coherence_rows(
-    x: F64, y: F64, fs: float, window: str, nperseg: Optional[int], noverlap: Optional[int],
-    nfft: Optional[int], detrend: str,
-) -> Tuple[F64, F64, List[str]]: ...
+class _SegmentArgs(TypedDict):
+    """scipy's segment arguments as vibmode._spectral._segment_args gives them."""
+
+    window: Union[str, F64]  # a crate window name ('hann', 'tukey:0.25') or 1-D coefficients
+    nperseg: Optional[int]
+    noverlap: Optional[int]
+    nfft: Optional[int]
+    detrend: str
+    scaling: str
+    average: str
+
+def welch_rows(x: F64, fs: float, args: _SegmentArgs) -> Tuple[F64, F64, List[str]]: ...
+def periodogram_rows(x: F64, fs: float, args: _SegmentArgs) -> Tuple[F64, F64, List[str]]: ...
+def csd_rows(x: F64, y: F64, fs: float, args: _SegmentArgs) -> Tuple[F64, C128, List[str]]: ...
+def coherence_rows(x: F64, y: F64, fs: float, args: _SegmentArgs) -> Tuple[F64, F64, List[str]]: ...
 def window_values(name: str, n: int) -> F64: ...
 def fit_arma(
     y: F64, fs: float, p: int, q: int, robust: Optional[float], max_iter: int, tol: float, demean: bool,
@@ -57,7 +57,8 @@ def simulate(
     kind: str, value: str, road: str, speed_kmh: float, duration_s: float, records: int,
     fs: float, seed: int, effects: str,
 ) -> Tuple[List[Tuple[_PyRecording, float, float]], str]: ...
-def fleet_init(db: str) -> bool: ...
+def fleet_init(db: str, config_toml: Optional[str] = None) -> bool: ...
+def fleet_settings(db: str) -> str: ...
 def fleet_ingest(
     db: str, vehicle: str, files: List[str], condition: str = "nominal", road: Optional[str] = None,
     fs: Optional[float] = None, scale: float = 1.0, unit: Optional[str] = None,
@@ -67,5 +68,8 @@ def fleet_check(
     db: str, vehicle: str, files: List[str], fs: Optional[float] = None, scale: float = 1.0, unit: Optional[str] = None,
 ) -> str: ...
 def fleet_status(db: str, last: int = 10) -> str: ...
-def fleet_features(path: str, fs: Optional[float] = None, scale: float = 1.0, unit: Optional[str] = None) -> str: ...
+def fleet_features(
+    path: str, fs: Optional[float] = None, scale: float = 1.0, unit: Optional[str] = None,
+    settings_json: Optional[str] = None,
+) -> str: ...
 def fleet_store_features(db: str, vehicle: str, items_json: str, condition: str = "nominal", road: Optional[str] = None) -> str: ...

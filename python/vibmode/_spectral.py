@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import operator
 import warnings
-from typing import Any, Optional, Tuple
+from typing import Any, Callable, Dict, Optional, Tuple, Union
 
 import numpy as np
 
@@ -20,8 +20,16 @@ _WINDOW_ALIASES = {
     "rectangular": "boxcar",
     "flattop": "flattop", "flat": "flattop", "flt": "flattop",
     "tukey": "tukey", "tuk": "tukey",
+    "kaiser": "kaiser", "ksr": "kaiser",
 }
-_VALID_WINDOWS = "hann, hamming, blackman, boxcar, flattop, tukey or ('tukey', alpha)"
+_VALID_WINDOWS = "hann, hamming, blackman, boxcar, flattop, tukey, ('tukey', alpha) or ('kaiser', beta)"
+
+
+def _unsupported(window: Any) -> ValueError:
+    return ValueError(
+        f"window {window!r} is not supported by vibmode; use {_VALID_WINDOWS}, or pass its "
+        f"coefficients as an array, e.g. window=scipy.signal.get_window({window!r}, nperseg)"
+    )
 
 
 def _window_name(window: Any) -> str:
@@ -30,21 +38,46 @@ def _window_name(window: Any) -> str:
         key = window.strip().lower()
         if key.startswith("tukey:"):
             return key
+        if _WINDOW_ALIASES.get(key) == "kaiser":
+            raise ValueError(f"window '{window}' needs its beta (as scipy): give ('kaiser', beta), e.g. ('kaiser', 8.6)")
         if key in _WINDOW_ALIASES:
             return _WINDOW_ALIASES[key]
-        raise ValueError(f"window '{window}' is not supported by vibmode; use {_VALID_WINDOWS}")
+        raise _unsupported(window)
     if isinstance(window, tuple) and window and isinstance(window[0], str):
         name = _WINDOW_ALIASES.get(window[0].strip().lower())
-        if name == "tukey" and len(window) == 2:
-            alpha = float(window[1])
-            return f"tukey:{alpha!r}"
-        if name is not None and len(window) == 1:
+        if name in ("tukey", "kaiser") and len(window) == 2:
+            try:
+                param = float(window[1])
+            except (TypeError, ValueError):
+                raise ValueError(f"window {window!r}: the {name} parameter must be a number") from None
+            return f"{name}:{param!r}"
+        if name is not None and name != "kaiser" and len(window) == 1:
             return name
-        raise ValueError(f"window {window!r} is not supported by vibmode; use {_VALID_WINDOWS}")
+        raise _unsupported(window)
     raise ValueError(
-        f"window of type {type(window).__name__} is not supported by vibmode (window arrays are "
-        f"not); give a window name: {_VALID_WINDOWS}"
+        f"window of type {type(window).__name__} is not a window name; give one of {_VALID_WINDOWS}"
     )
+
+
+def _window_arg(window: Any) -> Union[str, np.ndarray]:
+    """scipy's `window`: a name or (name, parameter) tuple (the crate's name), or an array of
+    coefficients (1-D float64; the crate checks them: non-empty, finite, not all zero)."""
+    if isinstance(window, (str, tuple)):
+        return _window_name(window)
+    try:
+        a = np.asarray(window)
+    except (TypeError, ValueError):
+        a = np.asarray(None)
+    if a.dtype.kind not in "fiub":
+        raise ValueError(
+            f"window of type {type(window).__name__} is not supported; give a name ({_VALID_WINDOWS}) "
+            "or a 1-D array of real coefficients"
+        )
+    if a.ndim != 1:
+        raise ValueError(
+            f"window must be 1-D: got an array of shape {a.shape}; give one coefficient per sample of a segment"
+        )
+    return np.ascontiguousarray(a, dtype=np.float64)
 
 
 def _detrend_name(detrend: Any) -> str:
@@ -100,15 +133,6 @@ def _out_dtype(*arrays: np.ndarray) -> Tuple[np.dtype, np.dtype]:
     return np.dtype(c), np.dtype(np.finfo(c).dtype)
 
 
-def _rows(a: np.ndarray, axis: int) -> Tuple[np.ndarray, Tuple[int, ...]]:
-    """`a` with `axis` moved last, as C-contiguous float64 rows (copies only when needed)."""
-    moved = np.moveaxis(a, axis, -1)  # AxisError is a ValueError
-    lead = moved.shape[:-1]
-    n = moved.shape[-1]
-    rows = np.ascontiguousarray(moved.reshape(-1, n), dtype=np.float64)
-    return rows, lead
-
-
 def _back(p: np.ndarray, lead: Tuple[int, ...], axis: int, ndim: int) -> np.ndarray:
     out = p.reshape(lead + (p.shape[-1],))
     return np.moveaxis(out, -1, axis if axis >= 0 else ndim + axis)
@@ -116,7 +140,7 @@ def _back(p: np.ndarray, lead: Tuple[int, ...], axis: int, ndim: int) -> np.ndar
 
 def _warn(notes: list) -> None:
     for n in notes:
-        warnings.warn(n, UserWarning, stacklevel=3)
+        warnings.warn(n, UserWarning, stacklevel=4)
 
 
 def _two_sided(f: np.ndarray, p: np.ndarray, fs: float, conj: bool) -> Tuple[np.ndarray, np.ndarray]:
@@ -142,6 +166,88 @@ def _two_sided(f: np.ndarray, p: np.ndarray, fs: float, conj: bool) -> Tuple[np.
     return np.fft.fftfreq(nfft, 1.0 / fs), out
 
 
+def _segment_args(
+    window: Any,
+    nperseg: Any = None,
+    noverlap: Any = None,
+    nfft: Any = None,
+    detrend: Any = "constant",
+    scaling: Any = "density",
+    average: Any = "mean",
+) -> Dict[str, Any]:
+    """scipy's segment arguments, checked and translated for the native functions (one dict,
+    read by the extension in one place). An array window sets ``nperseg`` to its length; a
+    different ``nperseg`` is a ValueError (both checked by the extension, as scipy)."""
+    return {
+        "window": _window_arg(window),
+        "nperseg": _opt_count("nperseg", nperseg, 1),
+        "noverlap": _opt_count("noverlap", noverlap, 0),
+        "nfft": _opt_count("nfft", nfft, 1),
+        "detrend": _detrend_name(detrend),
+        "scaling": str(scaling),
+        "average": str(average),
+    }
+
+
+def _pair(x: Any, y: Any, axis: int):
+    a = _real_input(x, "x")
+    b = _real_input(y, "y")
+    ax = np.moveaxis(a, axis, -1)  # AxisError is a ValueError
+    bx = np.moveaxis(b, axis, -1)
+    if ax.shape[-1] != bx.shape[-1]:
+        raise ValueError(
+            f"x and y have {ax.shape[-1]} and {bx.shape[-1]} samples along axis {axis}; vibmode "
+            "needs equal lengths (scipy zero-pads the shorter): trim or pad them yourself"
+        )
+    try:
+        ax, bx = np.broadcast_arrays(ax, bx)
+    except ValueError:
+        raise ValueError(
+            f"x and y shapes {a.shape} and {b.shape} do not broadcast (apart from axis {axis})"
+        ) from None
+    return a, b, ax, bx
+
+
+def _spectra(
+    native: Callable[..., Tuple[np.ndarray, np.ndarray, list]],
+    x: Any,
+    y: Any,
+    fs: Any,
+    axis: int,
+    args: Dict[str, Any],
+    complex_out: bool = False,
+    onesided: bool = True,
+    warn: bool = True,
+) -> Tuple[np.ndarray, np.ndarray]:
+    """The shared path of welch, periodogram, csd and coherence: checks ``fs`` and the input(s)
+    (``y`` None for auto-spectra), puts ``axis`` last as C-contiguous float64 rows (x and y
+    broadcast), calls ``native(x_rows[, y_rows], fs, args)``, warns its notes, makes the
+    spectrum two-sided if asked and restores the axis, in scipy's output dtype."""
+    fs = _check_fs(fs)
+    if y is None:
+        a = _real_input(x, "x")
+        arrays: Tuple[np.ndarray, ...] = (a,)
+        moved = (np.moveaxis(a, axis, -1),)
+        empty_shape = a.shape
+    else:
+        a, b, ax, bx = _pair(x, y, axis)
+        arrays = (a, b)
+        moved = (ax, bx)
+        empty_shape = ax.shape
+    cdt, rdt = _out_dtype(*arrays)
+    if moved[0].size == 0:
+        return np.empty(empty_shape), np.empty(empty_shape, dtype=cdt if complex_out else np.float64)
+    n = moved[0].shape[-1]
+    lead = moved[0].shape[:-1]
+    rows = [np.ascontiguousarray(m.reshape(-1, n), dtype=np.float64) for m in moved]
+    f, p, notes = native(*rows, fs, args)
+    if warn:
+        _warn(notes)
+    if not onesided:
+        f, p = _two_sided(f, p, fs, conj=complex_out)
+    return f, _back(p, lead, axis, len(lead) + 1).astype(cdt if complex_out else rdt, copy=False)
+
+
 def welch(
     x: Any,
     fs: float = 1.0,
@@ -162,16 +268,22 @@ def welch(
     ----------
     x : array_like of real numbers, any shape; the spectrum is taken along ``axis``.
     fs : sampling rate, Hz (default 1.0).
-    window : 'hann' (default), 'hamming', 'blackman', 'boxcar', 'flattop', 'tukey' or
-        ('tukey', alpha). Other windows and window arrays raise ValueError.
-    nperseg : segment length, samples (default 256, clamped to the record with a UserWarning).
+    window : 'hann' (default), 'hamming', 'blackman', 'boxcar', 'flattop', 'tukey',
+        ('tukey', alpha) or ('kaiser', beta); or a 1-D array of coefficients (dimensionless,
+        e.g. ``np.hanning(256)`` or ``scipy.signal.get_window(('gaussian', 30), 256)``; no
+        normalisation needed), whose length is the segment length. Other names raise
+        ValueError (pass their coefficients).
+    nperseg : segment length, samples (default 256, clamped to the record with a UserWarning;
+        with an array window its length, and a different nperseg is a ValueError; an array
+        window longer than the record is a ValueError, as scipy).
     noverlap : overlap, samples (default nperseg // 2).
     nfft : FFT length, samples, >= nperseg (default nperseg).
     detrend : 'constant' (default), 'linear' or False.
     return_onesided : True (default): ``nfft // 2 + 1`` bins from 0 Hz; False: scipy's
         two-sided spectrum, ``nfft`` bins in FFT order (``fftfreq``), each half the one-sided
         value but DC and Nyquist.
-    scaling : 'density' (units**2/Hz, default) or 'spectrum' (units**2).
+    scaling : 'density' (units**2/Hz, default; divides by ``fs * sum(w**2)``) or 'spectrum'
+        (units**2; divides by ``sum(w)**2``).
     axis : axis of the samples (default -1).
     average : 'mean' (default) or 'median'.
 
@@ -180,21 +292,8 @@ def welch(
     f : ndarray, frequencies in Hz (``nfft // 2 + 1`` bins, or ``nfft`` two-sided).
     Pxx : ndarray, the shape of ``x`` with ``axis`` replaced by the bins; units**2/Hz or units**2.
     """
-    fs = _check_fs(fs)
-    a = _real_input(x, "x")
-    _, rdt = _out_dtype(a)
-    if a.size == 0:
-        return np.empty(a.shape), np.empty(a.shape)
-    rows, lead = _rows(a, axis)
-    f, p, notes = _native.welch_rows(
-        rows, fs, _window_name(window), _opt_count("nperseg", nperseg, 1),
-        _opt_count("noverlap", noverlap, 0), _opt_count("nfft", nfft, 1),
-        _detrend_name(detrend), str(scaling), str(average),
-    )
-    _warn(notes)
-    if not return_onesided:
-        f, p = _two_sided(f, p, fs, conj=False)
-    return f, _back(p, lead, axis, a.ndim).astype(rdt, copy=False)
+    args = _segment_args(window, nperseg, noverlap, nfft, detrend, scaling, average)
+    return _spectra(_native.welch_rows, x, None, fs, axis, args, onesided=return_onesided)
 
 
 def periodogram(
@@ -208,41 +307,12 @@ def periodogram(
     axis: int = -1,
 ) -> Tuple[np.ndarray, np.ndarray]:
     """Periodogram, as :func:`scipy.signal.periodogram`: one segment of the whole record along
-    ``axis`` (window 'boxcar' by default; ``window=None`` is boxcar too). ``nfft`` smaller than
-    the record uses only its first ``nfft`` samples, larger zero-pads. Frequencies in Hz; Pxx in
-    units**2/Hz ('density') or units**2 ('spectrum')."""
-    fs = _check_fs(fs)
-    a = _real_input(x, "x")
-    _, rdt = _out_dtype(a)
-    if a.size == 0:
-        return np.empty(a.shape), np.empty(a.shape)
-    rows, lead = _rows(a, axis)
-    f, p, notes = _native.periodogram_rows(
-        rows, fs, _window_name("boxcar" if window is None else window),
-        _opt_count("nfft", nfft, 1), _detrend_name(detrend), str(scaling),
-    )
-    if not return_onesided:
-        f, p = _two_sided(f, p, fs, conj=False)
-    return f, _back(p, lead, axis, a.ndim).astype(rdt, copy=False)
-
-
-def _pair(x: Any, y: Any, axis: int):
-    a = _real_input(x, "x")
-    b = _real_input(y, "y")
-    ax = np.moveaxis(a, axis, -1)
-    bx = np.moveaxis(b, axis, -1)
-    if ax.shape[-1] != bx.shape[-1]:
-        raise ValueError(
-            f"x and y have {ax.shape[-1]} and {bx.shape[-1]} samples along axis {axis}; vibmode "
-            "needs equal lengths (scipy zero-pads the shorter): trim or pad them yourself"
-        )
-    try:
-        ax, bx = np.broadcast_arrays(ax, bx)
-    except ValueError:
-        raise ValueError(
-            f"x and y shapes {a.shape} and {b.shape} do not broadcast (apart from axis {axis})"
-        ) from None
-    return a, b, ax, bx
+    ``axis`` (window 'boxcar' by default; ``window=None`` is boxcar too; an array window needs
+    one coefficient per sample used, else ValueError). ``nfft`` smaller than the record uses
+    only its first ``nfft`` samples, larger zero-pads. Frequencies in Hz; Pxx in units**2/Hz
+    ('density') or units**2 ('spectrum')."""
+    args = _segment_args("boxcar" if window is None else window, None, None, nfft, detrend, scaling)
+    return _spectra(_native.periodogram_rows, x, None, fs, axis, args, onesided=return_onesided, warn=False)
 
 
 def csd(
@@ -260,27 +330,11 @@ def csd(
     average: str = "mean",
 ) -> Tuple[np.ndarray, np.ndarray]:
     """Cross-spectral density ``Pxy = conj(X) Y``, as :func:`scipy.signal.csd` (arguments as
-    :func:`welch`; x and y broadcast against each other apart from ``axis`` and must have the
-    same length along it). Returns frequencies in Hz and complex Pxy in units_x*units_y/Hz
-    ('density') or units_x*units_y ('spectrum')."""
-    fs = _check_fs(fs)
-    a, b, ax, bx = _pair(x, y, axis)
-    cdt, _ = _out_dtype(a, b)
-    n = ax.shape[-1]
-    lead = ax.shape[:-1]
-    if ax.size == 0:
-        return np.empty(ax.shape), np.empty(ax.shape, dtype=cdt)
-    xr = np.ascontiguousarray(ax.reshape(-1, n), dtype=np.float64)
-    yr = np.ascontiguousarray(bx.reshape(-1, n), dtype=np.float64)
-    f, p, notes = _native.csd_rows(
-        xr, yr, fs, _window_name(window), _opt_count("nperseg", nperseg, 1),
-        _opt_count("noverlap", noverlap, 0), _opt_count("nfft", nfft, 1),
-        _detrend_name(detrend), str(scaling), str(average),
-    )
-    _warn(notes)
-    if not return_onesided:
-        f, p = _two_sided(f, p, fs, conj=True)
-    return f, _back(p, lead, axis, len(lead) + 1).astype(cdt, copy=False)
+    :func:`welch`, including array windows; x and y broadcast against each other apart from
+    ``axis`` and must have the same length along it). Returns frequencies in Hz and complex Pxy
+    in units_x*units_y/Hz ('density') or units_x*units_y ('spectrum')."""
+    args = _segment_args(window, nperseg, noverlap, nfft, detrend, scaling, average)
+    return _spectra(_native.csd_rows, x, y, fs, axis, args, complex_out=True, onesided=return_onesided)
 
 
 def coherence(
@@ -295,28 +349,14 @@ def coherence(
     axis: int = -1,
 ) -> Tuple[np.ndarray, np.ndarray]:
     """Magnitude-squared coherence ``|Pxy|**2 / (Pxx Pyy)`` (dimensionless, in [0, 1]), as
-    :func:`scipy.signal.coherence` (mean of the segments; NaN where Pxx Pyy is 0, as scipy).
-    Returns frequencies in Hz and Cxy."""
-    fs = _check_fs(fs)
-    a, b, ax, bx = _pair(x, y, axis)
-    _, rdt = _out_dtype(a, b)
-    n = ax.shape[-1]
-    lead = ax.shape[:-1]
-    if ax.size == 0:
-        return np.empty(ax.shape), np.empty(ax.shape)
-    xr = np.ascontiguousarray(ax.reshape(-1, n), dtype=np.float64)
-    yr = np.ascontiguousarray(bx.reshape(-1, n), dtype=np.float64)
-    f, c, notes = _native.coherence_rows(
-        xr, yr, fs, _window_name(window), _opt_count("nperseg", nperseg, 1),
-        _opt_count("noverlap", noverlap, 0), _opt_count("nfft", nfft, 1),
-        _detrend_name(detrend),
-    )
-    _warn(notes)
-    return f, _back(c, lead, axis, len(lead) + 1).astype(rdt, copy=False)
+    :func:`scipy.signal.coherence` (arguments as :func:`welch`, including array windows; mean of
+    the segments; NaN where Pxx Pyy is 0, as scipy). Returns frequencies in Hz and Cxy."""
+    args = _segment_args(window, nperseg, noverlap, nfft, detrend)
+    return _spectra(_native.coherence_rows, x, y, fs, axis, args)
 
 
 def get_window(window: Any, nx: int) -> np.ndarray:
     """The periodic window of length ``nx`` (as ``scipy.signal.get_window(window, nx)``),
-    dimensionless."""
+    dimensionless. Takes a window name, ('tukey', alpha) or ('kaiser', beta)."""
     n = _opt_count("nx", nx, 0)
     return _native.window_values(_window_name(window), n)

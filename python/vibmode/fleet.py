@@ -22,9 +22,25 @@ def _paths(files: Union[PathLike, Sequence[PathLike]]) -> List[str]:
     return [os.fspath(f) for f in files]
 
 
-def init(db: PathLike) -> bool:
-    """Creates the store ``db`` if it does not exist; returns True if it was created."""
-    return _native.fleet_init(os.fspath(db))
+def init(db: PathLike, config: Any = None) -> bool:
+    """Creates the store ``db`` if it does not exist; returns True if it was created.
+
+    ``config``: the store's settings (bands, floors, the per-record analysis; docs/fleet.md), as
+    ``vibmode fleet init --config fleet.toml``: a dict, a TOML file or TOML text; None keeps the
+    store's settings (the defaults for a new store). Settings are fixed once the store holds a
+    record: other settings are then a ValueError, the same ones a no-op."""
+    from ._analysis import _config_toml
+
+    toml = None if config is None else _config_toml(config, {})
+    return _native.fleet_init(os.fspath(db), toml)
+
+
+def settings(db: PathLike) -> Dict[str, Any]:
+    """The settings the store ``db`` analyses new records with (those given to :func:`init` /
+    ``vibmode fleet init --config``, or the defaults), as a JSON-ready dict of plain values:
+    pass it to :func:`features` (``settings=``), e.g. once to every Dask worker, so that their
+    features are the ones :func:`ingest` would store."""
+    return json.loads(_native.fleet_settings(os.fspath(db)))
 
 
 def ingest(
@@ -68,11 +84,26 @@ def status(db: PathLike, last: int = 10) -> List[Dict[str, Any]]:
     return json.loads(_native.fleet_status(os.fspath(db), int(last)))
 
 
-def features(path: PathLike, fs: Optional[float] = None, scale: float = 1.0, unit: Optional[str] = None) -> Dict[str, Any]:
+def features(
+    path: PathLike,
+    fs: Optional[float] = None,
+    scale: float = 1.0,
+    unit: Optional[str] = None,
+    settings: Optional[Dict[str, Any]] = None,
+) -> Dict[str, Any]:
     """What the store keeps of one file (band levels, transmissibility, modes), computed without
     a store: the expensive part of :func:`ingest`, to run on many workers (e.g. Dask). Returns a
-    JSON-ready dict ``{'file', 'sha256', 'metadata', 'features'}`` for :func:`store_features`."""
-    return json.loads(_native.fleet_features(os.fspath(path), fs, float(scale), unit))
+    JSON-ready dict ``{'file', 'sha256', 'metadata', 'features'}`` for :func:`store_features`.
+
+    ``settings``: the store's settings, :func:`settings` ``(db)`` (read once, passed to every
+    worker); None computes with the default settings, which differ from a store initialised
+    with other ones."""
+    if settings is not None and not isinstance(settings, dict):
+        raise ValueError(
+            f"settings of type {type(settings).__name__}: pass the dict vibmode.fleet.settings(db) returns, or None"
+        )
+    text = None if settings is None else json.dumps(settings)
+    return json.loads(_native.fleet_features(os.fspath(path), fs, float(scale), unit, text))
 
 
 def store_features(

@@ -74,11 +74,69 @@ pub enum SpectraError {
         /// The rejected alpha.
         alpha: f64,
     },
+    /// A Kaiser window's beta is not finite or beyond 700 in magnitude (I0 overflows).
+    #[error("kaiser beta ({}) must be finite with |beta| <= 700; use e.g. kaiser:8.6", vibmode_core::num(.beta))]
+    InvalidKaiserBeta {
+        /// The rejected beta.
+        beta: f64,
+    },
     /// A window name that [`crate::Window`]'s `FromStr` does not know.
-    #[error("unknown window '{name}'; valid windows: hann, hamming, blackman, boxcar (or rect), flattop, tukey (alpha 0.5), tukey:ALPHA with ALPHA in [0, 1]")]
+    #[error("unknown window '{name}'; valid windows: hann, hamming, blackman, boxcar (or rect), flattop, tukey (alpha 0.5), tukey:ALPHA with ALPHA in [0, 1], kaiser:BETA (e.g. kaiser:8.6), or custom coefficients")]
     UnknownWindow {
         /// The rejected name.
         name: String,
+    },
+    /// Custom window coefficients ([`crate::WindowSpec::Custom`]) with no coefficient.
+    #[error("the window has 0 coefficients; give at least one coefficient, or a window name such as hann")]
+    EmptyWindow,
+    /// A custom window coefficient is NaN or infinite.
+    #[error("window[{index}] = {} is not finite; window coefficients must be finite numbers", vibmode_core::num(.value))]
+    NonFiniteWindow {
+        /// Index (0-based) of the first non-finite coefficient.
+        index: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// Every custom window coefficient is zero.
+    #[error("the window's {len} coefficients are all 0; a window needs a non-zero coefficient (e.g. hann or boxcar)")]
+    ZeroWindow {
+        /// Number of coefficients.
+        len: usize,
+    },
+    /// The window's scale factor is 0: `sum(w)` with [`crate::Scaling::Spectrum`] (a window
+    /// whose positive and negative coefficients cancel), or `sum(w^2)` underflowing.
+    #[error("the window's {what} is 0 (scaling = {scaling} divides by it); use a window whose {what} is not 0, e.g. hann")]
+    WindowScaleZero {
+        /// "sum(w)" or "sum(w^2)".
+        what: &'static str,
+        /// The scaling in force ("spectrum" or "density").
+        scaling: &'static str,
+    },
+    /// `nperseg` was given and differs from the length of custom window coefficients
+    /// (scipy: "value specified for nperseg is different from length of window").
+    #[error("nperseg = {nperseg} differs from the window's length {window_len}; leave nperseg unset (it defaults to the window's length) or give a window of {nperseg} coefficients")]
+    WindowLengthMismatch {
+        /// Number of window coefficients.
+        window_len: usize,
+        /// The requested segment length, samples.
+        nperseg: usize,
+    },
+    /// Custom window coefficients longer than the record (scipy: "window is longer than input
+    /// signal"); a custom window is never shortened.
+    #[error("the window has {window_len} coefficients but the record only {n_samples} samples; give a window of at most {n_samples} coefficients")]
+    WindowLongerThanRecord {
+        /// Number of window coefficients.
+        window_len: usize,
+        /// Samples in the record.
+        n_samples: usize,
+    },
+    /// A periodogram's custom window must have one coefficient per sample used.
+    #[error("the window has {window_len} coefficients but the periodogram uses {n_samples} samples (the record, or nfft if smaller); give a window of {n_samples} coefficients")]
+    PeriodogramWindowLength {
+        /// Number of window coefficients.
+        window_len: usize,
+        /// Samples the periodogram uses.
+        n_samples: usize,
     },
     /// An unknown detrend name.
     #[error("unknown detrend '{name}'; valid values: none, constant, linear")]

@@ -7,7 +7,9 @@
 //! is detrended, then windowed, then zero-padded to `nfft`; density scaling divides by
 //! `fs_hz * sum(w^2)`, spectrum scaling by `sum(w)^2`; the output is one-sided with every bin
 //! doubled except DC and, for even `nfft`, Nyquist; Welch is the CSD of a signal with itself;
-//! the median average is divided by scipy's bias factor.
+//! the median average is divided by scipy's bias factor. The taper is a named [`Window`] or
+//! custom coefficients ([`WindowSpec`], scipy's window arrays: [`WelchPlan::with_window`],
+//! [`periodogram_with_window`]).
 //!
 //! Differences from scipy, all reported as errors rather than silent behaviour: empty or
 //! non-finite input, `x` and `y` of different lengths (scipy zero-pads the shorter),
@@ -59,7 +61,7 @@ pub use num_complex::Complex64;
 pub use params::{Average, Detrend, PeriodogramParams, Scaling, ShortRecord, WelchParams, Window};
 pub use vibmode_core::LineParams;
 pub use welch::{Coherence, CrossSpectrum, Spectrum, WelchPlan};
-pub use window::window_values;
+pub use window::{window_values, WindowSpec};
 
 use welch::{check_fs, check_pair_samples, check_samples};
 
@@ -81,9 +83,24 @@ fn pair_plan(x: &[f64], y: &[f64], fs_hz: f64, p: &WelchParams) -> Result<WelchP
 /// Errors: fs_hz not positive/finite, empty `x`, NaN/Inf sample, `nfft = Some(0)`,
 /// Tukey alpha outside [0, 1].
 pub fn periodogram(x: &[f64], fs_hz: f64, p: &PeriodogramParams) -> Result<Spectrum, SpectraError> {
+    periodogram_with_window(x, fs_hz, p, &WindowSpec::Named(p.window))
+}
+
+/// [`periodogram`] with the taper `window` in place of `p.window` (which is not used): a named
+/// window, or custom coefficients, one per sample used (the record, or its first `nfft` samples
+/// when `nfft` is smaller), as `scipy.signal.periodogram` with a window array.
+///
+/// Errors: those of [`periodogram`], and custom coefficients that are empty, non-finite, all
+/// zero or of another length than the samples used.
+pub fn periodogram_with_window(
+    x: &[f64],
+    fs_hz: f64,
+    p: &PeriodogramParams,
+    window: &WindowSpec,
+) -> Result<Spectrum, SpectraError> {
     check_fs(fs_hz)?;
     check_samples(x, "x")?;
-    p.window.validate()?;
+    window.validate()?;
     let n = x.len();
     let mut note = None;
     let (xs, nfft) = match p.nfft {
@@ -98,6 +115,14 @@ pub fn periodogram(x: &[f64], fs_hz: f64, p: &PeriodogramParams) -> Result<Spect
             (&x[..m], m)
         }
     };
+    if let Some(window_len) = window.fixed_len() {
+        if window_len != xs.len() {
+            return Err(SpectraError::PeriodogramWindowLength {
+                window_len,
+                n_samples: xs.len(),
+            });
+        }
+    }
     let wp = WelchParams {
         window: p.window,
         nperseg: Some(xs.len()),
@@ -108,7 +133,7 @@ pub fn periodogram(x: &[f64], fs_hz: f64, p: &PeriodogramParams) -> Result<Spect
         average: Average::Mean,
         short_record: ShortRecord::Clamp,
     };
-    let mut s = WelchPlan::new(xs.len(), fs_hz, &wp)?.welch(xs)?;
+    let mut s = WelchPlan::with_window(xs.len(), fs_hz, &wp, window)?.welch(xs)?;
     s.notes.extend(note);
     Ok(s)
 }

@@ -13,8 +13,10 @@ const DEFAULT_TUKEY_ALPHA: f64 = 0.5;
 /// with its last sample dropped.
 ///
 /// `FromStr` (case-insensitive) accepts `hann`, `hamming`, `blackman`, `boxcar` (or `rect`),
-/// `flattop`, `tukey` (alpha 0.5) and `tukey:ALPHA` (e.g. `tukey:0.25`, ALPHA in [0, 1]).
-/// `Display` writes the same names (`tukey:0.25`), so the two round-trip.
+/// `flattop`, `tukey` (alpha 0.5), `tukey:ALPHA` (e.g. `tukey:0.25`, ALPHA in [0, 1]) and
+/// `kaiser:BETA` (e.g. `kaiser:8.6`; scipy's `('kaiser', beta)`, which has no default beta).
+/// `Display` writes the same names (`tukey:0.25`, `kaiser:8.6`), so the two round-trip.
+/// Other windows: give their coefficients ([`crate::WindowSpec::Custom`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Window {
@@ -34,14 +36,27 @@ pub enum Window {
         /// Fraction of the window inside the cosine tapers, in [0, 1].
         alpha: f64,
     },
+    /// Kaiser: `I0(beta sqrt(1 - (2 j / n - 1)^2)) / I0(beta)` (periodic, as scipy's
+    /// `('kaiser', beta)`); `beta` (dimensionless, |beta| <= 700) trades main-lobe width for
+    /// side-lobe level: 0 is boxcar, about 5 Hamming-like, 8.6 Blackman-like.
+    Kaiser {
+        /// Shape parameter; the window depends on |beta| only.
+        beta: f64,
+    },
 }
 
+/// Largest Kaiser |beta|: I0(beta) overflows a double beyond about 713.
+const MAX_KAISER_BETA: f64 = 700.0;
+
 impl Window {
-    /// Checks the window's parameters (Tukey alpha in [0, 1]).
+    /// Checks the window's parameters (Tukey alpha in [0, 1], Kaiser |beta| <= 700).
     pub fn validate(&self) -> Result<(), SpectraError> {
         match *self {
             Window::Tukey { alpha } if !(0.0..=1.0).contains(&alpha) => {
                 Err(SpectraError::InvalidTukeyAlpha { alpha })
+            }
+            Window::Kaiser { beta } if !(-MAX_KAISER_BETA..=MAX_KAISER_BETA).contains(&beta) => {
+                Err(SpectraError::InvalidKaiserBeta { beta })
             }
             _ => Ok(()),
         }
@@ -57,6 +72,7 @@ impl fmt::Display for Window {
             Window::Boxcar => f.write_str("boxcar"),
             Window::Flattop => f.write_str("flattop"),
             Window::Tukey { alpha } => write!(f, "tukey:{alpha}"),
+            Window::Kaiser { beta } => write!(f, "kaiser:{beta}"),
         }
     }
 }
@@ -78,9 +94,14 @@ impl FromStr for Window {
                 alpha: DEFAULT_TUKEY_ALPHA,
             },
             _ => {
-                let rest = t.strip_prefix("tukey:").ok_or_else(unknown)?;
-                let alpha: f64 = rest.trim().parse().map_err(|_| unknown())?;
-                Window::Tukey { alpha }
+                if let Some(rest) = t.strip_prefix("kaiser:") {
+                    let beta: f64 = rest.trim().parse().map_err(|_| unknown())?;
+                    Window::Kaiser { beta }
+                } else {
+                    let rest = t.strip_prefix("tukey:").ok_or_else(unknown)?;
+                    let alpha: f64 = rest.trim().parse().map_err(|_| unknown())?;
+                    Window::Tukey { alpha }
+                }
             }
         };
         w.validate()?;

@@ -1,7 +1,6 @@
 //! Welch's method: [`WelchPlan`] and the results it produces.
 
-use crate::window::window_values;
-use crate::{Average, Detrend, Scaling, ShortRecord, SpectraError, WelchParams};
+use crate::{Average, Detrend, Scaling, ShortRecord, SpectraError, WelchParams, WindowSpec};
 use num_complex::Complex64;
 use realfft::{RealFftPlanner, RealToComplex};
 use serde::{Deserialize, Serialize};
@@ -67,6 +66,13 @@ pub struct Coherence {
     pub n_segments: usize,
     /// Human-readable notes on deviations from the request.
     pub notes: Vec<String>,
+}
+
+/// Resolved segment sizes of a plan, samples.
+struct Sizes {
+    nperseg: usize,
+    noverlap: usize,
+    nfft: usize,
 }
 
 /// Segment length when [`WelchParams::nperseg`] is `None`: scipy.signal.welch's default.
@@ -200,34 +206,70 @@ impl WelchPlan {
     /// nperseg / 2; nfft defaults to nperseg. Errors: invalid fs_hz, `n_samples == 0`,
     /// nperseg = 0, noverlap >= nperseg, nfft < nperseg, Tukey alpha outside [0, 1].
     pub fn new(n_samples: usize, fs_hz: f64, p: &WelchParams) -> Result<Self, SpectraError> {
+        Self::with_window(n_samples, fs_hz, p, &WindowSpec::Named(p.window))
+    }
+
+    /// As [`WelchPlan::new`], with the taper `window` in place of `p.window` (which is not
+    /// used). Custom coefficients follow scipy's rules for a window array: they set the segment
+    /// length, so `p.nperseg` must be `None` or their length, and the record must be at least
+    /// that long (never clamped, whatever [`WelchParams::short_record`] says).
+    ///
+    /// Errors: those of [`WelchPlan::new`]; custom coefficients that are empty, non-finite or
+    /// all zero, differ in length from `p.nperseg`, or are longer than the record; a window
+    /// whose `sum(w)` (spectrum scaling) or `sum(w^2)` (density) is 0.
+    pub fn with_window(
+        n_samples: usize,
+        fs_hz: f64,
+        p: &WelchParams,
+        window: &WindowSpec,
+    ) -> Result<Self, SpectraError> {
         check_fs(fs_hz)?;
-        p.window.validate()?;
+        window.validate()?;
         if n_samples == 0 {
             return Err(SpectraError::EmptyInput { name: "x" });
         }
-        let requested = p.nperseg.unwrap_or(DEFAULT_NPERSEG);
-        if requested == 0 {
+        if p.nperseg == Some(0) {
             return Err(SpectraError::ZeroNperseg);
         }
         let mut notes = Vec::new();
-        let nperseg = if requested > n_samples {
-            match p.short_record {
-                ShortRecord::Error => {
-                    return Err(SpectraError::ShortRecord {
-                        n_samples,
-                        nperseg: requested,
-                    })
+        let nperseg = match window.fixed_len() {
+            Some(window_len) => {
+                if let Some(nperseg) = p.nperseg.filter(|&m| m != window_len) {
+                    return Err(SpectraError::WindowLengthMismatch {
+                        window_len,
+                        nperseg,
+                    });
                 }
-                ShortRecord::Clamp => {
-                    notes.push(format!(
-                        "nperseg = {requested} is greater than the record length {n_samples}; \
-                         using nperseg = {n_samples} (one segment, as scipy.signal)"
-                    ));
-                    n_samples
+                if window_len > n_samples {
+                    return Err(SpectraError::WindowLongerThanRecord {
+                        window_len,
+                        n_samples,
+                    });
+                }
+                window_len
+            }
+            None => {
+                let requested = p.nperseg.unwrap_or(DEFAULT_NPERSEG);
+                if requested > n_samples {
+                    match p.short_record {
+                        ShortRecord::Error => {
+                            return Err(SpectraError::ShortRecord {
+                                n_samples,
+                                nperseg: requested,
+                            })
+                        }
+                        ShortRecord::Clamp => {
+                            notes.push(format!(
+                                "nperseg = {requested} is greater than the record length {n_samples}; \
+                                 using nperseg = {n_samples} (one segment, as scipy.signal)"
+                            ));
+                            n_samples
+                        }
+                    }
+                } else {
+                    requested
                 }
             }
-        } else {
-            requested
         };
         let nfft = match p.nfft {
             None => nperseg,
@@ -243,31 +285,53 @@ impl WelchPlan {
                 suggested: nperseg / 2,
             });
         }
+        let coefficients = window.values(nperseg);
+        let (scale, what, scaling) = match p.scaling {
+            Scaling::Density => (
+                1.0 / (fs_hz * coefficients.iter().map(|w| w * w).sum::<f64>()),
+                "sum(w^2)",
+                "density",
+            ),
+            Scaling::Spectrum => {
+                let s: f64 = coefficients.iter().sum();
+                (1.0 / (s * s), "sum(w)", "spectrum")
+            }
+        };
+        if !scale.is_finite() {
+            return Err(SpectraError::WindowScaleZero { what, scaling });
+        }
         Ok(Self::build(
-            n_samples, fs_hz, nperseg, noverlap, nfft, p, notes,
+            n_samples,
+            fs_hz,
+            Sizes {
+                nperseg,
+                noverlap,
+                nfft,
+            },
+            p,
+            coefficients,
+            scale,
+            notes,
         ))
     }
 
-    /// Builds a plan from already-validated, resolved sizes.
+    /// Builds a plan from already-validated, resolved sizes, window and scale factor.
     fn build(
         n_samples: usize,
         fs_hz: f64,
-        nperseg: usize,
-        noverlap: usize,
-        nfft: usize,
+        sizes: Sizes,
         p: &WelchParams,
+        window: Vec<f64>,
+        scale: f64,
         notes: Vec<String>,
     ) -> Self {
+        let Sizes {
+            nperseg,
+            noverlap,
+            nfft,
+        } = sizes;
         let step = nperseg - noverlap;
         let n_segments = (n_samples - nperseg) / step + 1;
-        let window = window_values(&p.window, nperseg);
-        let scale = match p.scaling {
-            Scaling::Density => 1.0 / (fs_hz * window.iter().map(|w| w * w).sum::<f64>()),
-            Scaling::Spectrum => {
-                let s: f64 = window.iter().sum();
-                1.0 / (s * s)
-            }
-        };
         let nfreq = nfft / 2 + 1;
         let df = 1.0 / (nfft as f64 * (1.0 / fs_hz));
         let freq_hz = (0..nfreq).map(|k| k as f64 * df).collect();

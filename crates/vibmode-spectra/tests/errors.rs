@@ -213,6 +213,7 @@ fn unknown_names_list_valid_values() {
         "boxcar",
         "flattop",
         "tukey:ALPHA",
+        "kaiser:BETA",
     ] {
         assert!(m.contains(w), "{m} lacks {w}");
     }

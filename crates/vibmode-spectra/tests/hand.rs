@@ -141,6 +141,55 @@ fn hann_window_by_hand() {
 }
 
 #[test]
+fn kaiser_window() {
+    // beta = 0: I0(0) / I0(0) = 1 everywhere (boxcar); the window depends on |beta| only.
+    close(
+        &window_values(&Window::Kaiser { beta: 0.0 }, 5),
+        &[1.0; 5],
+        0.0,
+    );
+    assert_eq!(
+        window_values(&Window::Kaiser { beta: -3.0 }, 6),
+        window_values(&Window::Kaiser { beta: 3.0 }, 6)
+    );
+    // scipy.signal.get_window(('kaiser', 8.0), 8) and (('kaiser', 14.0), 5), scipy 1.17.
+    close(
+        &window_values(&Window::Kaiser { beta: 8.0 }, 8),
+        &[
+            0.00233883051273333,
+            0.08273981505097754,
+            0.36897272261583314,
+            0.788752446605349,
+            1.0,
+            0.788752446605349,
+            0.36897272261583314,
+            0.08273981505097754,
+        ],
+        1e-14,
+    );
+    close(
+        &window_values(&Window::Kaiser { beta: 14.0 }, 5),
+        &[
+            7.726866835270368e-06,
+            6.815374319396057e-02,
+            7.615093990873935e-01,
+            7.615093990873935e-01,
+            6.815374319396057e-02,
+        ],
+        1e-14,
+    );
+    // |beta| beyond 700 (I0 overflows) and NaN are refused.
+    for beta in [701.0, f64::NAN, f64::INFINITY] {
+        let e = Window::Kaiser { beta }.validate().unwrap_err();
+        assert!(e.to_string().contains("kaiser beta"), "{e}");
+    }
+    assert!("kaiser:800".parse::<Window>().is_err());
+    assert!("kaiser".parse::<Window>().is_err()); // scipy: kaiser needs its beta
+    let w = window_values(&Window::Kaiser { beta: 700.0 }, 64);
+    assert!(w.iter().all(|v| v.is_finite()));
+}
+
+#[test]
 fn window_names_round_trip() {
     for w in [
         Window::Hann,
@@ -149,6 +198,7 @@ fn window_names_round_trip() {
         Window::Boxcar,
         Window::Flattop,
         Window::Tukey { alpha: 0.25 },
+        Window::Kaiser { beta: 8.6 },
     ] {
         assert_eq!(w.to_string().parse::<Window>().unwrap(), w);
     }
