@@ -42,6 +42,8 @@ fn demo_report_renders_in_headless_chromium() {
         "fig04_model_psd",
         "fig05_stabilisation",
         "fig06_frequency_damping",
+        "fig07_mode_shapes",
+        "fig08_mac_matrix",
     ];
     for name in expected {
         for ext in ["svg", "png"] {

@@ -6,7 +6,8 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use vibmode_core::{
-    ClusterParams, InvariantMode, ModeMatch, PoleObservation, ReferenceMode, SsiParams,
+    ClusterParams, InvariantMode, ModeMatch, ModeUncertainty, PoleObservation, ReferenceMode,
+    SsiParams,
 };
 use vibmode_signal::Preprocessed;
 use vibmode_ssi::SsiCov;
@@ -17,6 +18,22 @@ use crate::AnalysisError;
 /// A physical-model mode is matched to an identified mode whose shape has at least this MAC with
 /// the model's shape at the sensors (and whose frequency is within 25 %).
 pub const MATCH_MAC_MIN: f64 = 0.5;
+
+/// Most groups of the jackknife over records (each group one more identification).
+pub const JACKKNIFE_GROUPS: usize = 20;
+
+fn median(v: &mut [f64]) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    Some(if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    })
+}
 
 /// Name of the pseudo-channel of the multichannel poles in the pole store and the clusters.
 pub const SSI_CHANNEL: &str = "ssi-cov";
@@ -105,9 +122,11 @@ impl SsiStage<'_> {
             .collect()
     }
 
-    /// One identification from the correlations averaged over the records used (record index
-    /// 0 for every pole).
-    fn pooled_poles(&self, orders: &[usize], scales: &[f64]) -> Result<Vec<ShapedPole>, String> {
+    /// The records used, each channel divided by its scale, and the first one's band.
+    fn pooled_segments(
+        &self,
+        scales: &[f64],
+    ) -> Option<(Vec<Vec<Vec<f64>>>, vibmode_core::BandLimit)> {
         let used: Vec<&Preprocessed> = self
             .pre
             .iter()
@@ -115,10 +134,8 @@ impl SsiStage<'_> {
             .filter(|(r, _)| self.active.get(*r).copied().flatten().is_some())
             .map(|(_, p)| p)
             .collect();
-        let Some(first) = used.first() else {
-            return Ok(Vec::new());
-        };
-        let scaled: Vec<Vec<Vec<f64>>> = used
+        let band = used.first()?.band;
+        let scaled = used
             .iter()
             .map(|p| {
                 p.recording
@@ -129,14 +146,88 @@ impl SsiStage<'_> {
                     .collect()
             })
             .collect();
+        Some((scaled, band))
+    }
+
+    /// One identification from the correlations averaged over the records used (record index
+    /// 0 for every pole).
+    fn pooled_poles(&self, orders: &[usize], scales: &[f64]) -> Result<Vec<ShapedPole>, String> {
+        let Some((scaled, band)) = self.pooled_segments(scales) else {
+            return Ok(Vec::new());
+        };
         let segments: Vec<Vec<&[f64]>> = scaled
             .iter()
             .map(|rec| rec.iter().map(Vec::as_slice).collect())
             .collect();
-        let plan = SsiCov::from_segments(&segments, first.band.fs_hz, self.params)
-            .map_err(|e| e.to_string())?;
+        let plan =
+            SsiCov::from_segments(&segments, band.fs_hz, self.params).map_err(|e| e.to_string())?;
         let res = plan.sweep(orders).map_err(|e| e.to_string())?;
-        Ok(self.kept(res, 0, &first.band, scales))
+        Ok(self.kept(res, 0, &band, scales))
+    }
+
+    /// Standard deviations of the supported modes' frequency and damping by a delete-a-group
+    /// jackknife over the records (at most [`JACKKNIFE_GROUPS`] groups of consecutive records):
+    /// the pooled identification repeated without each group, each mode's median frequency and
+    /// damping over the repetition's poles near it (within the clustering's radius, shapes with
+    /// MAC at least `1 - shape_tol`). Nothing is set with fewer than 2 records or when a
+    /// repetition fails.
+    fn jackknife(&self, modes: &mut [InvariantMode], orders: &[usize], scales: &[f64]) {
+        let Some((scaled, band)) = self.pooled_segments(scales) else {
+            return;
+        };
+        let groups = scaled.len().min(JACKKNIFE_GROUPS);
+        if groups < 2 || !modes.iter().any(InvariantMode::is_invariant) {
+            return;
+        }
+        let segments: Vec<Vec<&[f64]>> = scaled
+            .iter()
+            .map(|rec| rec.iter().map(Vec::as_slice).collect())
+            .collect();
+        let Ok(plans) = SsiCov::jackknife(&segments, band.fs_hz, self.params, groups) else {
+            return;
+        };
+        let reps: Vec<Vec<ShapedPole>> = match plans
+            .par_iter()
+            .map(|p| p.sweep(orders).map(|r| self.kept(r, 0, &band, scales)))
+            .collect::<Result<Vec<_>, _>>()
+        {
+            Ok(r) => r,
+            Err(_) => return,
+        };
+        for m in modes.iter_mut().filter(|m| m.is_invariant()) {
+            let Some(shape) = m.shape.clone() else {
+                continue;
+            };
+            let tol = self
+                .cluster
+                .freq_tol_rel
+                .max(self.cluster.freq_tol_per_damping * m.damping_ratio);
+            let (mut fs, mut zs) = (Vec::new(), Vec::new());
+            for rep in &reps {
+                let (mut f, mut z): (Vec<f64>, Vec<f64>) = rep
+                    .iter()
+                    .filter(|q| (q.frequency_hz / m.frequency_hz - 1.0).abs() <= tol)
+                    .filter(|q| {
+                        self.cluster.shape_tol <= 0.0
+                            || vibmode_modal::shapes::mac(&q.shape, &shape)
+                                >= 1.0 - self.cluster.shape_tol
+                    })
+                    .map(|q| (q.frequency_hz, q.damping_ratio))
+                    .unzip();
+                if let (Some(fm), Some(zm)) = (median(&mut f), median(&mut z)) {
+                    fs.push(fm);
+                    zs.push(zm);
+                }
+            }
+            if fs.len() >= 2 {
+                m.uncertainty = Some(ModeUncertainty {
+                    frequency_std_hz: vibmode_ssi::jackknife_std(&fs),
+                    damping_std: vibmode_ssi::jackknife_std(&zs),
+                    replicates: fs.len(),
+                    of: groups,
+                });
+            }
+        }
     }
 
     /// The poles of an SSI result below the valid band, with shapes scaled back.
@@ -259,6 +350,9 @@ impl SsiStage<'_> {
         let mut known: Vec<LineTrack> = tracks.clone();
         known.extend(other_tracks.iter().cloned());
         lines.classify(&mut invariant_modes, &all, &known);
+        if pooled {
+            self.jackknife(&mut invariant_modes, &orders, &scales);
+        }
         let matches = if reference.is_empty() {
             Vec::new()
         } else {

@@ -41,6 +41,16 @@ fn ssi_finds_roll_and_bending_over_five_seeds() {
         };
         let res = analyze(&records, &cfg, &reference, &|_, _| {}).expect("analysis");
         let ssi = res.ssi.expect("ssi results");
+        // Every supported mode carries its jackknife standard deviations (8 records: 8 groups).
+        for m in ssi.invariant_modes.iter().filter(|m| m.is_invariant()) {
+            let u = m.uncertainty.as_ref().expect("jackknife uncertainty");
+            assert!(
+                u.replicates >= 2 && u.replicates <= u.of && u.of == 8,
+                "{u:?}"
+            );
+            assert!(u.frequency_std_hz > 0.0 && u.frequency_std_hz < 0.1 * m.frequency_hz);
+            assert!(u.damping_std > 0.0 && u.damping_std.is_finite(), "{u:?}");
+        }
         let mut used = std::collections::HashSet::new();
         for m in &ssi.matches {
             let Some(k) = m.invariant else { continue };

@@ -32,8 +32,8 @@ pub mod ssi;
 pub use error::{ParamError, RecordingError};
 pub use limits::{num, Num};
 pub use modes::{
-    FitSummary, InvariantMode, ModeClass, ModeMatch, ModelCoefficients, PoleObservation,
-    ReferenceMode, SupportFailure,
+    FitSummary, InvariantMode, ModeClass, ModeMatch, ModeUncertainty, ModelCoefficients,
+    PoleObservation, ReferenceMode, SupportFailure,
 };
 pub use params::{
     BandLimit, ClusterParams, IdentMethod, LineParams, PoleFilterParams, PreprocessParams, Robust,

@@ -143,6 +143,27 @@ pub struct InvariantMode {
     /// Median and lowest MAC of the poles' shapes with the mean shape (the shape spread).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shape_mac: Option<(f64, f64)>,
+    /// Standard deviations of the frequency and damping estimates themselves (not the spread
+    /// of the poles over orders), when the analysis computed them: SSI-cov from correlations
+    /// pooled over the records, by a leave-one-record-out jackknife.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uncertainty: Option<ModeUncertainty>,
+}
+
+/// Standard deviations of an identified mode's frequency and damping ratio from a
+/// leave-one-record-out jackknife: the identification repeated without each record in turn,
+/// the mode's median frequency and damping over its orders taken each time, and
+/// `sqrt((m - 1) / m * sum (theta_s - mean)^2)` over the `m` repetitions that found it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModeUncertainty {
+    /// Standard deviation of the frequency, Hz.
+    pub frequency_std_hz: f64,
+    /// Standard deviation of the damping ratio.
+    pub damping_std: f64,
+    /// Repetitions (records left out) in which the mode was found.
+    pub replicates: usize,
+    /// Repetitions tried (the records used).
+    pub of: usize,
 }
 
 impl InvariantMode {

@@ -396,6 +396,7 @@ fn summarise(
         line_kurtosis: None,
         shape,
         shape_mac,
+        uncertainty: None,
     };
     (mode, kept)
 }

@@ -162,6 +162,7 @@ mod tests {
             line_kurtosis: None,
             shape: Some(shape),
             shape_mac: None,
+            uncertainty: None,
         }
     }
 

@@ -165,6 +165,7 @@ fn mode(f: f64, z: f64, class: ModeClass) -> InvariantMode {
         line_kurtosis: None,
         shape: None,
         shape_mac: None,
+        uncertainty: None,
     }
 }
 

@@ -56,6 +56,7 @@ fn hand_case_message() {
         line_kurtosis: None,
         shape: None,
         shape_mac: None,
+        uncertainty: None,
     };
     let f = m.support_failures(&ClusterParams::default(), 20);
     assert_eq!(

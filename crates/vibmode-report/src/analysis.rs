@@ -223,13 +223,14 @@ pub fn modes_table_text(r: &AnalysisResults, truth: Option<&[TruthRow]>) -> Stri
             any = true;
             let _ = writeln!(
                 s,
-                "  {:>9.3} {:>8.3} {:>9.4} {:>6.0}% {:>6.0}%  {}",
+                "  {:>9.3} {:>8.3} {:>9.4} {:>6.0}% {:>6.0}%  {}{}",
                 m.frequency_hz,
                 m.frequency_std_hz,
                 m.damping_ratio,
                 100.0 * m.order_share,
                 100.0 * m.record_share,
-                class_name(&m.class)
+                class_name(&m.class),
+                uncertainty_text(m).map_or(String::new(), |u| format!(" ({u})"))
             );
         }
         if !any {
@@ -382,6 +383,16 @@ fn csv_cell(text: &str) -> String {
     }
 }
 
+/// The jackknife standard deviations of a mode, e.g. "jackknife sd 0.012 Hz, damping 0.010".
+fn uncertainty_text(m: &InvariantMode) -> Option<String> {
+    m.uncertainty.as_ref().map(|u| {
+        format!(
+            "jackknife sd {:.3} Hz, damping {:.3}",
+            u.frequency_std_hz, u.damping_std
+        )
+    })
+}
+
 fn mode_row(m: &InvariantMode) -> Vec<String> {
     vec![
         format!("{:.3}", m.frequency_hz),
@@ -391,7 +402,10 @@ fn mode_row(m: &InvariantMode) -> Vec<String> {
         format!("{:.0} %", 100.0 * m.order_share),
         format!("{:.0} %", 100.0 * m.record_share),
         m.n_poles.to_string(),
-        class_name(&m.class).to_string(),
+        match uncertainty_text(m) {
+            Some(u) => format!("{} ({u})", class_name(&m.class)),
+            None => class_name(&m.class).to_string(),
+        },
     ]
 }
 

@@ -116,29 +116,23 @@ fn check_channels(channels: &[&[f64]]) -> Result<usize, SsiError> {
     Ok(n)
 }
 
-impl SsiCov {
-    /// Plans SSI-cov for `channels` (equal lengths, finite) sampled at `fs_hz`, with
-    /// `params.block_rows` block rows and `params.reference_channels`. Removes each channel's
-    /// mean, computes the correlations, the block Toeplitz matrix, its SVD, and one QR of the
-    /// shifted observability matrix that serves every order up to `params.order_max` (any
-    /// higher order can still be asked of [`SsiCov::poles_at`]; it gets its own
-    /// least-squares solution).
-    pub fn new(channels: &[&[f64]], fs_hz: f64, params: &SsiParams) -> Result<SsiCov, SsiError> {
-        // One segment: the same correlations (sum over t divided by N - k).
-        Self::from_segments(&[channels.to_vec()], fs_hz, params)
-    }
+/// The unnormalised correlation sums of each segment, `sum_t y_s[t+k] y_s,ref[t]^T`, and their
+/// product counts `N_s - k`, for the lags `1..=max_lag`.
+struct SegmentSums {
+    block_rows: usize,
+    skip: usize,
+    sums: Vec<Vec<DMatrix<f64>>>,
+    counts: Vec<Vec<usize>>,
+    n_samples: Vec<usize>,
+    max_abs: f64,
+}
 
-    /// Plans SSI-cov from several segments (records) of the same channels, for example records
-    /// of one drive cut apart: the correlations are averaged over the segments,
-    /// `R_k = sum_s sum_t y_s[t+k] y_s[t]^T / sum_s (N_s - k)` (each segment's means removed; no
-    /// product straddles two segments), then as [`SsiCov::new`]. Long identification data
-    /// without the joins of a concatenation. Every segment needs the same channel count and at
-    /// least `2 block_rows` samples; segments may differ in length.
-    pub fn from_segments(
+impl SegmentSums {
+    fn new(
         segments: &[Vec<&[f64]>],
         fs_hz: f64,
         params: &SsiParams,
-    ) -> Result<SsiCov, SsiError> {
+    ) -> Result<SegmentSums, SsiError> {
         params.validate()?;
         if !(fs_hz.is_finite() && fs_hz > 0.0) {
             return Err(SsiError::InvalidSampleRate { fs_hz });
@@ -161,10 +155,14 @@ impl SsiCov {
             }
             None => (0..l).collect(),
         };
-        let mut sums: Vec<DMatrix<f64>> = vec![DMatrix::zeros(l, refs.len()); max_lag];
-        let mut counts = vec![0usize; max_lag];
-        let mut n_total = 0;
-        let mut max_abs = 0.0f64;
+        let mut out = SegmentSums {
+            block_rows: i,
+            skip,
+            sums: Vec::with_capacity(segments.len()),
+            counts: Vec::with_capacity(segments.len()),
+            n_samples: Vec::with_capacity(segments.len()),
+            max_abs: 0.0,
+        };
         for seg in segments {
             if seg.len() != l {
                 return Err(SsiError::LengthMismatch {
@@ -189,11 +187,12 @@ impl SsiCov {
                     ch.iter().map(|v| v - m).collect()
                 })
                 .collect();
-            max_abs = demeaned
+            out.max_abs = demeaned
                 .iter()
                 .flatten()
-                .fold(max_abs, |m, v| m.max(v.abs()));
-            for (k, (sum, count)) in (1..=max_lag).zip(sums.iter_mut().zip(counts.iter_mut())) {
+                .fold(out.max_abs, |m, v| m.max(v.abs()));
+            let mut sums = vec![DMatrix::zeros(l, refs.len()); max_lag];
+            for (k, sum) in (1..=max_lag).zip(sums.iter_mut()) {
                 for a in 0..l {
                     for (b, &rb) in refs.iter().enumerate() {
                         let ya = &demeaned[a][k..];
@@ -201,24 +200,111 @@ impl SsiCov {
                         sum[(a, b)] += ya.iter().zip(yb).map(|(x, y)| x * y).sum::<f64>();
                     }
                 }
-                *count += n - k;
             }
-            n_total += n;
+            out.sums.push(sums);
+            out.counts.push((1..=max_lag).map(|k| n - k).collect());
+            out.n_samples.push(n);
         }
-        let r: Vec<DMatrix<f64>> = sums
-            .into_iter()
-            .zip(&counts)
-            .map(|(m, &c)| m / c as f64)
+        Ok(out)
+    }
+
+    /// The plan from the correlations of every segment `s` but those with `left_out(s)`.
+    fn plan(
+        &self,
+        left_out: impl Fn(usize) -> bool,
+        fs_hz: f64,
+        params: &SsiParams,
+    ) -> Result<SsiCov, SsiError> {
+        let used = || (0..self.sums.len()).filter(|&s| !left_out(s));
+        let max_lag = self.sums.first().map_or(0, Vec::len);
+        let r: Vec<DMatrix<f64>> = (0..max_lag)
+            .map(|k| {
+                let mut total = self.sums[0][k].clone() * 0.0;
+                let mut count = 0usize;
+                for s in used() {
+                    total += &self.sums[s][k];
+                    count += self.counts[s][k];
+                }
+                total / count.max(1) as f64
+            })
             .collect();
         if let Some(k) = r.iter().position(|m| m.iter().any(|v| !v.is_finite())) {
             return Err(SsiError::Overflow {
                 lag: k + 1,
-                max_abs,
+                max_abs: self.max_abs,
             });
         }
-        let mut cov = SsiCov::from_correlations(&r[skip..], fs_hz, i, params.order_max)?;
-        cov.n_samples = n_total;
+        let mut cov =
+            SsiCov::from_correlations(&r[self.skip..], fs_hz, self.block_rows, params.order_max)?;
+        cov.n_samples = used().map(|s| self.n_samples[s]).sum();
         Ok(cov)
+    }
+}
+
+/// The jackknife standard deviation of an estimate from its leave-one-out values `theta`
+/// (`m >= 2` of them): `sqrt((m - 1) / m * sum (theta_s - mean)^2)`. 0 for fewer than two.
+pub fn jackknife_std(theta: &[f64]) -> f64 {
+    let m = theta.len();
+    if m < 2 {
+        return 0.0;
+    }
+    let mean = theta.iter().sum::<f64>() / m as f64;
+    let ss: f64 = theta.iter().map(|t| (t - mean) * (t - mean)).sum();
+    ((m as f64 - 1.0) / m as f64 * ss).sqrt()
+}
+
+impl SsiCov {
+    /// Plans SSI-cov for `channels` (equal lengths, finite) sampled at `fs_hz`, with
+    /// `params.block_rows` block rows and `params.reference_channels`. Removes each channel's
+    /// mean, computes the correlations, the block Toeplitz matrix, its SVD, and one QR of the
+    /// shifted observability matrix that serves every order up to `params.order_max` (any
+    /// higher order can still be asked of [`SsiCov::poles_at`]; it gets its own
+    /// least-squares solution).
+    pub fn new(channels: &[&[f64]], fs_hz: f64, params: &SsiParams) -> Result<SsiCov, SsiError> {
+        // One segment: the same correlations (sum over t divided by N - k).
+        Self::from_segments(&[channels.to_vec()], fs_hz, params)
+    }
+
+    /// Plans SSI-cov from several segments (records) of the same channels, for example records
+    /// of one drive cut apart: the correlations are averaged over the segments,
+    /// `R_k = sum_s sum_t y_s[t+k] y_s[t]^T / sum_s (N_s - k)` (each segment's means removed; no
+    /// product straddles two segments), then as [`SsiCov::new`]. Long identification data
+    /// without the joins of a concatenation. Every segment needs the same channel count and at
+    /// least `2 block_rows` samples; segments may differ in length.
+    pub fn from_segments(
+        segments: &[Vec<&[f64]>],
+        fs_hz: f64,
+        params: &SsiParams,
+    ) -> Result<SsiCov, SsiError> {
+        let sums = SegmentSums::new(segments, fs_hz, params)?;
+        sums.plan(|_| false, fs_hz, params)
+    }
+
+    /// Delete-a-group jackknife plans: the segments are split into `groups` groups of
+    /// consecutive segments (segment `s` of `m` in group `s * groups / m`; `groups = m` leaves
+    /// one segment out at a time), and plan `g` is [`SsiCov::from_segments`] of every segment
+    /// outside group `g` (its correlation sums taken out of the totals; no product is
+    /// recomputed). With an estimate `theta_g` from each plan, the jackknife standard deviation
+    /// of the all-segment estimate is `sqrt((G - 1) / G * sum_g (theta_g - mean)^2)`
+    /// ([`jackknife_std`]). Needs `2 <= groups <= segments.len()`
+    /// (`SsiError::TooFewSegments` otherwise).
+    pub fn jackknife(
+        segments: &[Vec<&[f64]>],
+        fs_hz: f64,
+        params: &SsiParams,
+        groups: usize,
+    ) -> Result<Vec<SsiCov>, SsiError> {
+        let m = segments.len();
+        if groups < 2 || groups > m {
+            return Err(SsiError::TooFewSegments {
+                n_segments: m,
+                groups,
+            });
+        }
+        let sums = SegmentSums::new(segments, fs_hz, params)?;
+        (0..groups)
+            .map(|g| sums.plan(|s| s * groups / m == g, fs_hz, params))
+            .collect()
     }
 
     /// From given correlations `r[k - 1] = R_k`, `k = 1..=2i-1`, each `l x r` (checked by the

@@ -44,6 +44,14 @@ pub enum SsiError {
         /// The value.
         fs_hz: f64,
     },
+    /// A jackknife with fewer than two groups, or more groups than segments.
+    #[error("a jackknife of {groups} groups over {n_segments} segments: give 2 to {n_segments} groups, and at least 2 segments")]
+    TooFewSegments {
+        /// Segments given.
+        n_segments: usize,
+        /// Groups asked for.
+        groups: usize,
+    },
     /// Too few samples for the lags of the block Toeplitz matrix.
     #[error("{n_samples} samples per channel are too few for block_rows = {block_rows} (lags up to {max_lag}); pass at least {min_samples} samples or lower block_rows")]
     TooFewSamples {

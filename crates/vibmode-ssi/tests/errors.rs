@@ -323,3 +323,22 @@ fn overflowing_correlations() {
     assert!(matches!(e, SsiError::Overflow { lag: 1, .. }), "{e:?}");
     assert!(m.contains("lag 1") && m.contains("e299"), "{m}");
 }
+
+#[test]
+fn jackknife_needs_two_segments() {
+    let a = noise(100, 1);
+    let e = SsiCov::jackknife(&[vec![a.as_slice()]], 50.0, &params(5), 2).unwrap_err();
+    assert_eq!(
+        e,
+        SsiError::TooFewSegments {
+            n_segments: 1,
+            groups: 2
+        }
+    );
+    let m = e.to_string();
+    assert!(m.contains("2 groups over 1 segments"), "{m}");
+    let two = [vec![a.as_slice()], vec![a.as_slice()]];
+    assert!(SsiCov::jackknife(&two, 50.0, &params(5), 2).is_ok());
+    assert!(SsiCov::jackknife(&two, 50.0, &params(5), 1).is_err());
+    assert!(SsiCov::jackknife(&two, 50.0, &params(5), 3).is_err());
+}
