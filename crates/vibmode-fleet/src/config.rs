@@ -37,6 +37,15 @@ pub struct FleetConfig {
     /// Share of nominal records that must contain a mode for it to enter the model set
     /// (default 0.6).
     pub mode_min_share: f64,
+    /// Band of the unsprung level ratios (left over right wheel of an axle, front over rear
+    /// wheel of a side), Hz (default 8-20: at and above wheel hop, where a wheel station's tyre
+    /// and damper set the unsprung response).
+    pub ratio_band_hz: [f64; 2],
+    /// Floor of the spread of ln(left/right unsprung level) (default 0.10: the left and right
+    /// wheels roll on different tracks, so the ratio scatters by about 0.1 between 10 s records).
+    pub floor_side_ratio: f64,
+    /// Floor of the spread of ln(front/rear unsprung level) of a side (default 0.03).
+    pub floor_track_ratio: f64,
 }
 
 impl Default for FleetConfig {
@@ -59,6 +68,9 @@ impl Default for FleetConfig {
             mode_group_tol: 0.08,
             mode_match_tol: 0.15,
             mode_min_share: 0.6,
+            ratio_band_hz: [8.0, 20.0],
+            floor_side_ratio: 0.10,
+            floor_track_ratio: 0.03,
         }
     }
 }
@@ -105,7 +117,12 @@ impl FleetConfig {
                 "must list at least one band, e.g. [[2, 5]]",
             ));
         }
-        for b in &self.bands_hz {
+        for (key, b) in self
+            .bands_hz
+            .iter()
+            .map(|b| ("bands_hz", b))
+            .chain([("ratio_band_hz", &self.ratio_band_hz)])
+        {
             if !(b[0].is_finite()
                 && b[1].is_finite()
                 && 0.0 <= b[0]
@@ -113,7 +130,7 @@ impl FleetConfig {
                 && b[1] <= nyquist)
             {
                 return Err(bad(
-                    "bands_hz",
+                    key,
                     format!("[{}, {}]", b[0], b[1]),
                     &format!("must be increasing bands between 0 and the analysis Nyquist frequency {nyquist} Hz"),
                 ));
@@ -138,6 +155,8 @@ impl FleetConfig {
             ("floor_transmissibility", self.floor_transmissibility),
             ("floor_frequency", self.floor_frequency),
             ("floor_damping", self.floor_damping),
+            ("floor_side_ratio", self.floor_side_ratio),
+            ("floor_track_ratio", self.floor_track_ratio),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(bad(
