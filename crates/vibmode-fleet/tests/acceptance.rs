@@ -99,6 +99,21 @@ fn issue_scenarios_over_three_baselines() {
             .expect("ingest");
         }
         let set = build_baseline(&mut store, "bus-1", &cfg).expect("baseline");
+        if std::env::var("FLEET_DEBUG").is_ok() {
+            for f in &set.features {
+                eprintln!(
+                    "baseline {base}: {} {} centre {:.3} sigma {:.3} n {}",
+                    f.meta.key,
+                    f.meta.label,
+                    f.centre.exp(),
+                    f.sigma,
+                    f.n
+                );
+            }
+            for l in &set.limits {
+                eprintln!("baseline {base}: limit {l:?}");
+            }
+        }
         let mut scen: Vec<Scenario> = vec![
             (
                 "healthy 20-40 km/h".into(),
@@ -158,9 +173,16 @@ fn issue_scenarios_over_three_baselines() {
                 .expect("check");
                 let cls = c.assessment.classification;
                 if std::env::var("FLEET_DEBUG").is_ok() && cls != Classification::Normal {
+                    let z: Vec<String> = c
+                        .assessment
+                        .evidence
+                        .iter()
+                        .map(|e| format!("{:.1}/{:.1}", e.z, e.limit))
+                        .collect();
                     eprintln!(
-                        "{label}-{j} (baseline {base}): {cls:?}: {}",
-                        c.assessment.summary
+                        "{label}-{j} (baseline {base}): {cls:?}: {} (z/limit {})",
+                        c.assessment.summary,
+                        z.join(" ")
                     );
                 }
                 *confusion.entry((label.clone(), cls)).or_default() += 1;
