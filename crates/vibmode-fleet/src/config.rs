@@ -190,3 +190,36 @@ impl FleetConfig {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ratio_settings_parse_validate_and_default_in_old_settings() {
+        let c = FleetConfig::from_toml_str(
+            "ratio_band_hz = [9, 18]\nfloor_track_ratio = 0.05\n",
+            "fleet.toml",
+        )
+        .expect("valid");
+        assert_eq!(c.ratio_band_hz, [9.0, 18.0]);
+        assert_eq!(c.floor_track_ratio, 0.05);
+        assert_eq!(c.floor_side_ratio, 0.10);
+        // Beyond the analysis Nyquist frequency (25 Hz) or reversed: the key is named.
+        for text in ["ratio_band_hz = [8, 30]", "ratio_band_hz = [20, 8]"] {
+            let e = FleetConfig::from_toml_str(text, "fleet.toml").expect_err(text);
+            assert!(e.to_string().contains("ratio_band_hz"), "{e}");
+        }
+        let e = FleetConfig::from_toml_str("floor_side_ratio = 0", "fleet.toml").expect_err("0");
+        assert!(e.to_string().contains("floor_side_ratio"), "{e}");
+        // Settings stored before the ratios existed (no such keys) read with the defaults.
+        let mut old = serde_json::to_value(FleetConfig::default()).expect("json");
+        if let Some(map) = old.as_object_mut() {
+            for key in ["ratio_band_hz", "floor_side_ratio", "floor_track_ratio"] {
+                map.remove(key);
+            }
+        }
+        let back: FleetConfig = serde_json::from_value(old).expect("old settings");
+        assert_eq!(back, FleetConfig::default());
+    }
+}

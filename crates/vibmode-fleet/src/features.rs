@@ -1,6 +1,6 @@
 //! Features of one record: band levels per channel (and the level at and above wheel hop for
-//! the unsprung level ratios), transmissibility per corner, and the modes identified per channel. See
-//! docs/fleet.md for the formulas.
+//! the unsprung level ratios), transmissibility per corner, and the modes identified per
+//! channel. See docs/fleet.md for the formulas.
 
 use serde::{Deserialize, Serialize};
 use vibmode_analysis::{analyze, cut_records, AnalysisConfig, Corner, Role};

@@ -920,6 +920,31 @@ mod tests {
     }
 
     #[test]
+    fn records_stored_before_the_ratios_read_and_score_without_them() {
+        // JSON of a channel as stored before `ratio_band_rms` existed.
+        let json =
+            r#"{"name":"FL_unsprung","role":"unsprung","corner":"FL","band_rms":[1.0],"modes":[]}"#;
+        let ch: ChannelFeatures = serde_json::from_str(json).expect("old channel");
+        assert_eq!(ch.ratio_band_rms, None);
+        // A model set with the ratios scores a record without them as missing, not as moved.
+        let recs: Vec<RecordFeatures> = (0..6)
+            .map(|i| wheels([1.0 + 0.01 * i as f64, 1.0, 1.0, 1.0]))
+            .collect();
+        let names: Vec<String> = (0..6).map(|i| format!("n{i}")).collect();
+        let set = build_model_set("bus", &names, &recs, &FleetConfig::default()).expect("set");
+        let mut old = wheels([1.0; 4]);
+        for c in &mut old.channels {
+            c.ratio_band_rms = None;
+        }
+        let a = assess(&set, &old);
+        assert_eq!(a.classification, Classification::Normal);
+        assert_eq!(a.missing.len(), 4, "{:?}", a.missing);
+        assert!(a
+            .missing
+            .contains(&"FL_unsprung/FR_unsprung: FL/FR level 8-20 Hz".to_string()));
+    }
+
+    #[test]
     fn ratio_spreads_are_pooled_by_hand() {
         // FL level exp(d) with d = 0, 0.1, ..., 0.5, the others 1: ln(FL/FR) = ln(FL/RL) = d,
         // ln(RL/RR) = ln(FR/RR) = 0. Deviations from each feature's median (0.25 and 0):
