@@ -37,6 +37,15 @@ pub struct FleetConfig {
     /// Share of nominal records that must contain a mode for it to enter the model set
     /// (default 0.6).
     pub mode_min_share: f64,
+    /// Band of the unsprung level ratios (left over right wheel of an axle, front over rear
+    /// wheel of a side), Hz (default 8-20: at and above wheel hop, where a wheel station's tyre
+    /// and damper set the unsprung response).
+    pub ratio_band_hz: [f64; 2],
+    /// Floor of the spread of ln(left/right unsprung level) (default 0.10: the left and right
+    /// wheels roll on different tracks, so the ratio scatters by about 0.1 between 10 s records).
+    pub floor_side_ratio: f64,
+    /// Floor of the spread of ln(front/rear unsprung level) of a side (default 0.03).
+    pub floor_track_ratio: f64,
 }
 
 impl Default for FleetConfig {
@@ -63,6 +72,9 @@ impl Default for FleetConfig {
             mode_group_tol: 0.08,
             mode_match_tol: 0.15,
             mode_min_share: 0.6,
+            ratio_band_hz: [8.0, 20.0],
+            floor_side_ratio: 0.10,
+            floor_track_ratio: 0.03,
         }
     }
 }
@@ -109,7 +121,12 @@ impl FleetConfig {
                 "must list at least one band, e.g. [[2, 5]]",
             ));
         }
-        for b in &self.bands_hz {
+        for (key, b) in self
+            .bands_hz
+            .iter()
+            .map(|b| ("bands_hz", b))
+            .chain([("ratio_band_hz", &self.ratio_band_hz)])
+        {
             if !(b[0].is_finite()
                 && b[1].is_finite()
                 && 0.0 <= b[0]
@@ -117,7 +134,7 @@ impl FleetConfig {
                 && b[1] <= nyquist)
             {
                 return Err(bad(
-                    "bands_hz",
+                    key,
                     format!("[{}, {}]", b[0], b[1]),
                     &format!("must be increasing bands between 0 and the analysis Nyquist frequency {nyquist} Hz"),
                 ));
@@ -142,6 +159,8 @@ impl FleetConfig {
             ("floor_transmissibility", self.floor_transmissibility),
             ("floor_frequency", self.floor_frequency),
             ("floor_damping", self.floor_damping),
+            ("floor_side_ratio", self.floor_side_ratio),
+            ("floor_track_ratio", self.floor_track_ratio),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(bad(
@@ -173,5 +192,38 @@ impl FleetConfig {
             ));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ratio_settings_parse_validate_and_default_in_old_settings() {
+        let c = FleetConfig::from_toml_str(
+            "ratio_band_hz = [9, 18]\nfloor_track_ratio = 0.05\n",
+            "fleet.toml",
+        )
+        .expect("valid");
+        assert_eq!(c.ratio_band_hz, [9.0, 18.0]);
+        assert_eq!(c.floor_track_ratio, 0.05);
+        assert_eq!(c.floor_side_ratio, 0.10);
+        // Beyond the analysis Nyquist frequency (25 Hz) or reversed: the key is named.
+        for text in ["ratio_band_hz = [8, 30]", "ratio_band_hz = [20, 8]"] {
+            let e = FleetConfig::from_toml_str(text, "fleet.toml").expect_err(text);
+            assert!(e.to_string().contains("ratio_band_hz"), "{e}");
+        }
+        let e = FleetConfig::from_toml_str("floor_side_ratio = 0", "fleet.toml").expect_err("0");
+        assert!(e.to_string().contains("floor_side_ratio"), "{e}");
+        // Settings stored before the ratios existed (no such keys) read with the defaults.
+        let mut old = serde_json::to_value(FleetConfig::default()).expect("json");
+        if let Some(map) = old.as_object_mut() {
+            for key in ["ratio_band_hz", "floor_side_ratio", "floor_track_ratio"] {
+                map.remove(key);
+            }
+        }
+        let back: FleetConfig = serde_json::from_value(old).expect("old settings");
+        assert_eq!(back, FleetConfig::default());
     }
 }

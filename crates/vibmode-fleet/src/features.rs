@@ -1,5 +1,6 @@
-//! Features of one record: band levels per channel, transmissibility per corner, and the modes
-//! identified per channel. See docs/fleet.md for the formulas.
+//! Features of one record: band levels per channel (and the level at and above wheel hop for
+//! the unsprung level ratios), transmissibility per corner, and the modes identified per
+//! channel. See docs/fleet.md for the formulas.
 
 use serde::{Deserialize, Serialize};
 use vibmode_analysis::{analyze, cut_records, AnalysisConfig, Corner, Role};
@@ -32,6 +33,10 @@ pub struct ChannelFeatures {
     pub band_rms: Vec<Option<f64>>,
     /// Structural invariant modes of the file in this channel.
     pub modes: Vec<ModeEstimate>,
+    /// RMS in `ratio_band_hz` (units of the channel), for the unsprung level ratios; absent in
+    /// records stored before it existed (their model sets then lack the ratios).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ratio_band_rms: Option<f64>,
 }
 
 /// Transmissibility of one corner: sprung over unsprung.
@@ -120,7 +125,7 @@ pub fn compute_features(name: &str, rec: &Recording, cfg: &FleetConfig) -> Resul
     let mut channels = Vec::new();
     for (c, ch) in rec.channels.iter().enumerate() {
         let placement = acfg.placement_of(ch);
-        let band_rms: Vec<Option<f64>> = cfg
+        let levels: Vec<Option<f64>> = cfg
             .bands_hz
             .iter()
             .map(|b| {
@@ -143,12 +148,16 @@ pub fn compute_features(name: &str, rec: &Recording, cfg: &FleetConfig) -> Resul
                     .collect()
             })
             .unwrap_or_default();
+        let [rlo, rhi] = cfg.ratio_band_hz;
         channels.push(ChannelFeatures {
             name: ch.name.clone(),
             role: placement.role,
             corner: placement.corner,
-            band_rms,
+            band_rms: levels,
             modes,
+            ratio_band_rms: psd
+                .get(c)
+                .and_then(|p| finite(band_rms(&freq, p, rlo, rhi))),
         });
     }
     let mut transmissibility = Vec::new();

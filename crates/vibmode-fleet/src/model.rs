@@ -37,6 +37,40 @@ pub enum Kind {
     ModeFrequency,
     /// Damping ratio of a mode of a channel.
     ModeDamping,
+    /// Left over right unsprung level of an axle at and above wheel hop.
+    SideRatio,
+    /// Front over rear unsprung level of a side (one track) at and above wheel hop.
+    TrackRatio,
+}
+
+/// Every kind, in the order of the model set's limits.
+const KINDS: [Kind; 6] = [
+    Kind::Level,
+    Kind::Transmissibility,
+    Kind::ModeFrequency,
+    Kind::ModeDamping,
+    Kind::SideRatio,
+    Kind::TrackRatio,
+];
+
+/// The axles (left and right corner) and the sides (front and rear corner) of the unsprung
+/// level ratios.
+const AXLES: [(&str, Corner, Corner); 2] = [
+    ("front", Corner::FL, Corner::FR),
+    ("rear", Corner::RL, Corner::RR),
+];
+const TRACKS: [(&str, Corner, Corner); 2] = [
+    ("left", Corner::FL, Corner::RL),
+    ("right", Corner::FR, Corner::RR),
+];
+
+fn ratio_key(kind: Kind, name: &str, band: &[f64; 2]) -> String {
+    let prefix = if kind == Kind::SideRatio {
+        "side"
+    } else {
+        "track"
+    };
+    format!("{prefix}:{name}:{}", band_key(band))
 }
 
 /// Where a feature comes from, and its name in tables.
@@ -289,6 +323,34 @@ pub fn scalar_features(
             }
         }
     }
+    // Unsprung level ratios at and above wheel hop: left over right wheel of each axle, front
+    // over rear wheel of each side. Both wheels of a pair roll on the same road class at the same
+    // speed (on one side, on the same track), so the road level and its spectrum cancel.
+    let unsprung = |corner: Corner| {
+        rf.channels
+            .iter()
+            .find(|c| c.role == Role::Unsprung && c.corner == Some(corner))
+            .and_then(|c| Some((c, c.ratio_band_rms.and_then(finite_positive)?)))
+    };
+    let band = cfg.ratio_band_hz;
+    for (kind, pairs) in [(Kind::SideRatio, AXLES), (Kind::TrackRatio, TRACKS)] {
+        for (name, a, b) in pairs {
+            let (Some((ca, la)), Some((cb, lb))) = (unsprung(a), unsprung(b)) else {
+                continue;
+            };
+            out.push((
+                FeatureMeta {
+                    key: ratio_key(kind, name, &band),
+                    group: Group::Vehicle,
+                    kind,
+                    corner: None,
+                    channel: format!("{}/{}", ca.name, cb.name),
+                    label: format!("{a}/{b} level {}", band_label(&band)),
+                },
+                (la / lb).ln(),
+            ));
+        }
+    }
     // Each record mode goes to its nearest slot of the channel (in ln f) if within the match
     // tolerance and nearer than half-way to the next slot; each slot takes its nearest mode.
     let mut best: BTreeMap<usize, (f64, f64, f64)> = BTreeMap::new();
@@ -332,6 +394,10 @@ pub fn scalar_features(
         out.push((meta(Kind::ModeDamping, "damping"), z.ln()));
     }
     out
+}
+
+fn finite_positive(x: f64) -> Option<f64> {
+    (x.is_finite() && x > 0.0).then_some(x)
 }
 
 /// A channel's role, corner and (record, frequency) of its modes.
@@ -408,7 +474,16 @@ fn floor_of(kind: Kind, cfg: &FleetConfig) -> f64 {
         Kind::Transmissibility => cfg.floor_transmissibility,
         Kind::ModeFrequency => cfg.floor_frequency,
         Kind::ModeDamping => cfg.floor_damping,
+        Kind::SideRatio => cfg.floor_side_ratio,
+        Kind::TrackRatio => cfg.floor_track_ratio,
     }
+}
+
+/// Kinds whose features are one estimator applied alike to every corner or axle, with one
+/// noise level: their spread is pooled over the features of the kind (the deviations of every
+/// feature from its own median), which a handful of nominal records alone would estimate badly.
+fn pooled(kind: Kind) -> bool {
+    matches!(kind, Kind::SideRatio | Kind::TrackRatio)
 }
 
 /// Statistics of every feature present in at least `max(3, mode_min_share * n)` records.
@@ -425,6 +500,8 @@ fn feature_stats(values: &[Vec<(FeatureMeta, f64)>], cfg: &FleetConfig) -> Vec<F
     }
     let need = ((cfg.mode_min_share * values.len() as f64).ceil() as usize).max(3);
     let mut out = Vec::new();
+    // Deviations from the feature's median, per pooled kind.
+    let mut deviations: BTreeMap<Kind, Vec<f64>> = BTreeMap::new();
     for (_, (meta, v)) in by_key {
         if v.len() < need {
             continue;
@@ -433,6 +510,12 @@ fn feature_stats(values: &[Vec<(FeatureMeta, f64)>], cfg: &FleetConfig) -> Vec<F
         let (Some(centre), Some(sigma)) = (median(&v), robust_sigma(&v, floor)) else {
             continue;
         };
+        if pooled(meta.kind) {
+            deviations
+                .entry(meta.kind)
+                .or_default()
+                .extend(v.iter().filter(|x| x.is_finite()).map(|x| x - centre));
+        }
         let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         out.push(FeatureStat {
@@ -443,6 +526,14 @@ fn feature_stats(values: &[Vec<(FeatureMeta, f64)>], cfg: &FleetConfig) -> Vec<F
             hi,
             n: v.len(),
         });
+    }
+    for f in out.iter_mut().filter(|f| pooled(f.meta.kind)) {
+        if let Some(s) = deviations
+            .get(&f.meta.kind)
+            .and_then(|d| robust_sigma(d, floor_of(f.meta.kind, cfg)))
+        {
+            f.sigma = s;
+        }
     }
     out
 }
@@ -500,12 +591,7 @@ pub fn build_model_set(
         }
     }
     let mut limits = Vec::new();
-    for kind in [
-        Kind::Level,
-        Kind::Transmissibility,
-        Kind::ModeFrequency,
-        Kind::ModeDamping,
-    ] {
+    for kind in KINDS {
         let n_features = features.iter().filter(|f| f.meta.kind == kind).count();
         if n_features == 0 {
             continue;
@@ -599,6 +685,7 @@ fn score_values(set: &ModelSet, values: &[(FeatureMeta, f64)]) -> Assessment {
             });
         }
     }
+    attribute_ratios(set, values, &mut evidence);
     evidence.sort_by(|a, b| b.z.abs().total_cmp(&a.z.abs()));
     let vehicle = evidence.iter().any(|e| e.meta.group == Group::Vehicle);
     let road = evidence.iter().any(|e| e.meta.group == Group::Excitation);
@@ -608,6 +695,71 @@ fn score_values(set: &ModelSet, values: &[(FeatureMeta, f64)]) -> Assessment {
         summary: summary(&evidence),
         evidence,
         missing,
+    }
+}
+
+/// A level ratio of two wheels says that one of them moved, not which. A wheel station's fault
+/// moves the two ratios it takes part in (its axle's left/right and its side's front/rear) the
+/// same way when both are read from that wheel (its level against each neighbour); a healthy
+/// wheel's other ratio stays. A flagged ratio is given to the wheel of its pair whose other
+/// ratio, read from that wheel, lies further from its nominal centre in the flagged direction
+/// (in spreads), and turned to read from that wheel (`FL: level vs FR 8-20 Hz -40 %`). Without
+/// either other ratio it stays on its channel pair.
+fn attribute_ratios(set: &ModelSet, values: &[(FeatureMeta, f64)], evidence: &mut [Evidence]) {
+    let band = set.config.ratio_band_hz;
+    let signed_z = |key: &str| -> Option<f64> {
+        let f = set.features.iter().find(|f| f.meta.key == key)?;
+        let x = values.iter().find(|(m, _)| m.key == key).map(|(_, v)| *v)?;
+        Some(score(f, x, &set.config))
+    };
+    // The other ratio of a corner (its side's for an axle ratio, its axle's for a side's), as
+    // a z-score of the corner's level over its neighbour's.
+    let other = |kind: Kind, corner: Corner| -> Option<f64> {
+        let (other_kind, pairs) = if kind == Kind::SideRatio {
+            (Kind::TrackRatio, TRACKS)
+        } else {
+            (Kind::SideRatio, AXLES)
+        };
+        let (name, first, _) = pairs
+            .iter()
+            .find(|(_, a, b)| *a == corner || *b == corner)?;
+        let z = signed_z(&ratio_key(other_kind, name, &band))?;
+        Some(if *first == corner { z } else { -z })
+    };
+    for e in evidence
+        .iter_mut()
+        .filter(|e| matches!(e.meta.kind, Kind::SideRatio | Kind::TrackRatio))
+    {
+        let pairs = if e.meta.kind == Kind::SideRatio {
+            AXLES
+        } else {
+            TRACKS
+        };
+        let Some((_, a, b)) = pairs
+            .iter()
+            .find(|(name, _, _)| e.meta.key == ratio_key(e.meta.kind, name, &band))
+            .copied()
+        else {
+            continue;
+        };
+        let (za, zb) = (other(e.meta.kind, a), other(e.meta.kind, b));
+        if za.is_none() && zb.is_none() {
+            continue;
+        }
+        // Read from a, the flagged ratio moved by sign(e.z); read from b, by -sign(e.z).
+        let dir = e.z.signum();
+        let label = |o: Corner| format!("level vs {o} {}", band_label(&band));
+        if dir * za.unwrap_or(0.0) >= -dir * zb.unwrap_or(0.0) {
+            e.meta.corner = Some(a);
+            e.meta.label = label(b);
+        } else {
+            e.meta.corner = Some(b);
+            e.meta.label = label(a);
+            e.value = 1.0 / e.value;
+            e.centre = 1.0 / e.centre;
+            e.z = -e.z;
+            e.change_pct = 100.0 * (e.value / e.centre - 1.0);
+        }
     }
 }
 
@@ -645,6 +797,7 @@ fn summary(evidence: &[Evidence]) -> String {
 mod tests {
     use super::*;
     use crate::features::{ChannelFeatures, CornerTransmissibility};
+    use crate::stats::MAD_TO_SIGMA;
 
     /// A record with one unsprung level and one transmissibility in band 2-5 Hz.
     fn record(level: f64, trans: f64) -> RecordFeatures {
@@ -659,6 +812,7 @@ mod tests {
                 corner: Some(Corner::RL),
                 band_rms: vec![Some(level)],
                 modes: Vec::new(),
+                ratio_band_rms: None,
             }],
             transmissibility: vec![CornerTransmissibility {
                 corner: Corner::RL,
@@ -738,5 +892,153 @@ mod tests {
         let recs: Vec<RecordFeatures> = (0..4).map(|_| record(1.0, 0.2)).collect();
         let e = build_model_set("bus", &[], &recs, &FleetConfig::default()).expect_err("4 < 5");
         assert!(e.to_string().contains("needs at least 5"), "{e}");
+    }
+
+    /// Four unsprung channels with levels `l` (FL, FR, RL, RR) in the ratio band.
+    fn wheels(l: [f64; 4]) -> RecordFeatures {
+        let channels = [Corner::FL, Corner::FR, Corner::RL, Corner::RR]
+            .into_iter()
+            .zip(l)
+            .map(|(corner, level)| ChannelFeatures {
+                name: format!("{corner}_unsprung"),
+                role: Role::Unsprung,
+                corner: Some(corner),
+                band_rms: vec![Some(1.0)],
+                modes: Vec::new(),
+                ratio_band_rms: Some(level),
+            })
+            .collect();
+        RecordFeatures {
+            analysis_fs_hz: 50.0,
+            duration_s: 10.0,
+            n_segments: 1,
+            bands_hz: vec![[2.0, 5.0]],
+            channels,
+            transmissibility: Vec::new(),
+            notes: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn records_stored_before_the_ratios_read_and_score_without_them() {
+        // JSON of a channel as stored before `ratio_band_rms` existed.
+        let json =
+            r#"{"name":"FL_unsprung","role":"unsprung","corner":"FL","band_rms":[1.0],"modes":[]}"#;
+        let ch: ChannelFeatures = serde_json::from_str(json).expect("old channel");
+        assert_eq!(ch.ratio_band_rms, None);
+        // A model set with the ratios scores a record without them as missing, not as moved.
+        let recs: Vec<RecordFeatures> = (0..6)
+            .map(|i| wheels([1.0 + 0.01 * i as f64, 1.0, 1.0, 1.0]))
+            .collect();
+        let names: Vec<String> = (0..6).map(|i| format!("n{i}")).collect();
+        let set = build_model_set("bus", &names, &recs, &FleetConfig::default()).expect("set");
+        let mut old = wheels([1.0; 4]);
+        for c in &mut old.channels {
+            c.ratio_band_rms = None;
+        }
+        let a = assess(&set, &old);
+        assert_eq!(a.classification, Classification::Normal);
+        assert_eq!(a.missing.len(), 4, "{:?}", a.missing);
+        assert!(a
+            .missing
+            .contains(&"FL_unsprung/FR_unsprung: FL/FR level 8-20 Hz".to_string()));
+    }
+
+    #[test]
+    fn ratio_spreads_are_pooled_by_hand() {
+        // FL level exp(d) with d = 0, 0.1, ..., 0.5, the others 1: ln(FL/FR) = ln(FL/RL) = d,
+        // ln(RL/RR) = ln(FR/RR) = 0. Deviations from each feature's median (0.25 and 0):
+        // +-0.05, +-0.15, +-0.25 and six zeros; their median is 0, the median of the absolute
+        // values (0 x 6, 0.05, 0.05, 0.15, ...) is (0 + 0.05) / 2 = 0.025.
+        let recs: Vec<RecordFeatures> = (0..6)
+            .map(|i| wheels([(0.1 * i as f64).exp(), 1.0, 1.0, 1.0]))
+            .collect();
+        let cfg = FleetConfig {
+            floor_side_ratio: 1e-3,
+            floor_track_ratio: 1e-3,
+            ..FleetConfig::default()
+        };
+        let names: Vec<String> = (0..6).map(|i| format!("n{i}")).collect();
+        let set = build_model_set("bus", &names, &recs, &cfg).expect("model set");
+        for key in ["side:front:8-20Hz", "side:rear:8-20Hz", "track:left:8-20Hz"] {
+            let f = set
+                .features
+                .iter()
+                .find(|f| f.meta.key == key)
+                .expect("ratio feature");
+            // Unpooled, ln(FL/FR) alone would have 1.4826 x 0.15.
+            assert!(
+                (f.sigma - MAD_TO_SIGMA * 0.025).abs() < 1e-12,
+                "{key}: {}",
+                f.sigma
+            );
+        }
+        let front = set
+            .features
+            .iter()
+            .find(|f| f.meta.key == "side:front:8-20Hz")
+            .expect("front");
+        assert!((front.centre - 0.25).abs() < 1e-12);
+        assert_eq!(front.meta.label, "FL/FR level 8-20 Hz");
+        // With the default floors: 0.10 takes over, 0.03 does not.
+        let set = build_model_set("bus", &names, &recs, &FleetConfig::default()).expect("set");
+        let sigma = |key: &str| {
+            set.features
+                .iter()
+                .find(|f| f.meta.key == key)
+                .map_or(f64::NAN, |f| f.sigma)
+        };
+        assert_eq!(sigma("side:rear:8-20Hz"), 0.10);
+        assert!((sigma("track:right:8-20Hz") - MAD_TO_SIGMA * 0.025).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_wheel_station_fault_is_named_by_its_two_ratios() {
+        // Nominal: levels within +-2 % of 1 (a different pattern per record).
+        let recs: Vec<RecordFeatures> = (0..8)
+            .map(|i| {
+                let e = |k: usize| 1.0 + 0.02 * (((i * 3 + k * 5) % 7) as f64 / 3.0 - 1.0);
+                wheels([e(0), e(1), e(2), e(3)])
+            })
+            .collect();
+        let names: Vec<String> = (0..8).map(|i| format!("n{i}")).collect();
+        let set = build_model_set("bus", &names, &recs, &FleetConfig::default()).expect("set");
+        // A rougher road: every wheel 3x; the ratios do not move.
+        let a = assess(&set, &wheels([3.0, 3.0, 3.0, 3.0]));
+        assert_eq!(a.classification, Classification::Normal, "{a:?}");
+        // FL 40 % lower (a softer tyre): FL/FR and FL/RL move, both named FL.
+        let a = assess(&set, &wheels([0.6, 1.0, 1.0, 1.0]));
+        assert_eq!(a.classification, Classification::Vehicle, "{a:?}");
+        assert!(a.summary.starts_with("FL: level vs "), "{}", a.summary);
+        assert!(!a.summary.contains("RL:") && !a.summary.contains("FR:"));
+        for e in &a.evidence {
+            assert_eq!(e.meta.corner, Some(Corner::FL));
+            assert!((e.value - 0.6).abs() < 1e-12, "{e:?}");
+            assert!((e.change_pct - 100.0 * (0.6 / e.centre - 1.0)).abs() < 1e-9);
+        }
+        // RL 50 % higher (a weak damper): FL/RL and RL/RR move; read from RL, +50 %.
+        let a = assess(&set, &wheels([1.0, 1.0, 1.5, 1.0]));
+        assert_eq!(a.classification, Classification::Vehicle, "{a:?}");
+        assert!(a.summary.starts_with("RL: level vs "), "{}", a.summary);
+        let e = a
+            .evidence
+            .iter()
+            .find(|e| e.meta.kind == Kind::TrackRatio)
+            .expect("track ratio flagged");
+        assert_eq!(e.meta.label, "level vs FL 8-20 Hz");
+        assert!((e.value - 1.5).abs() < 1e-12 && e.z > 0.0, "{e:?}");
+        // Without the right-hand channels only the left track's ratio exists: flagged, it
+        // stays on its channel pair.
+        let mut r = wheels([0.6, 1.0, 1.0, 1.0]);
+        r.channels
+            .retain(|c| matches!(c.corner, Some(Corner::FL | Corner::RL)));
+        let a = assess(&set, &r);
+        assert_eq!(a.classification, Classification::Vehicle, "{a:?}");
+        assert!(
+            a.summary
+                .starts_with("FL_unsprung/RL_unsprung: FL/RL level 8-20 Hz -"),
+            "{}",
+            a.summary
+        );
     }
 }

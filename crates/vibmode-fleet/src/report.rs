@@ -234,6 +234,8 @@ fn trend_figure(html: &mut HtmlReport, set: &ModelSet, records: &[RecordEntry]) 
                 crate::model::Kind::ModeDamping => "damping ratio",
                 crate::model::Kind::Transmissibility => "sprung / unsprung RMS",
                 crate::model::Kind::Level => "m/s^2",
+                crate::model::Kind::SideRatio => "left / right unsprung RMS",
+                crate::model::Kind::TrackRatio => "front / rear unsprung RMS",
             };
             Panel::new(title, "record (ingest order)", unit)
                 .with_series(band(1.0))

@@ -732,6 +732,7 @@ mod tests {
                 corner: Some(Corner::RL),
                 band_rms: vec![Some(0.5)],
                 modes: Vec::new(),
+                ratio_band_rms: None,
             }],
             transmissibility: Vec::new(),
             notes: Vec::new(),

@@ -5,8 +5,10 @@
 //! (10, 20, 30, 50 %). Prints the confusion table; the assertions are what was measured
 //! (docs/fleet.md states it against the issue's targets). Measured (`cargo test --release -p
 //! vibmode-fleet --test acceptance -- --nocapture`): healthy 59/60 normal; road D 23/24 road;
-//! RL damper at 50 % 24/24 vehicle, RL named every time; RL damper -30 % 10/24, -20 % and -10 %
-//! 0/24; FL tyre -30 % 2/24; rear springs -20 % 2/24.
+//! RL damper at 50 % 24/24 vehicle, RL named every time; FL tyre -30 % 24/24 vehicle, FL named
+//! every time; RL damper -30 % 23/24 (RL named in 21), -20 % 9/24, -10 % 0/24; rear springs
+//! -20 % 2/24 (not detected). `FAR=0.05` repeats it at a 5 % false-alarm rate;
+//! `FLEET_DEBUG=1` prints the summary of every record not classed normal.
 
 use std::collections::BTreeMap;
 
@@ -97,6 +99,21 @@ fn issue_scenarios_over_three_baselines() {
             .expect("ingest");
         }
         let set = build_baseline(&mut store, "bus-1", &cfg).expect("baseline");
+        if std::env::var("FLEET_DEBUG").is_ok() {
+            for f in &set.features {
+                eprintln!(
+                    "baseline {base}: {} {} centre {:.3} sigma {:.3} n {}",
+                    f.meta.key,
+                    f.meta.label,
+                    f.centre.exp(),
+                    f.sigma,
+                    f.n
+                );
+            }
+            for l in &set.limits {
+                eprintln!("baseline {base}: limit {l:?}");
+            }
+        }
         let mut scen: Vec<Scenario> = vec![
             (
                 "healthy 20-40 km/h".into(),
@@ -155,6 +172,19 @@ fn issue_scenarios_over_three_baselines() {
                 )
                 .expect("check");
                 let cls = c.assessment.classification;
+                if std::env::var("FLEET_DEBUG").is_ok() && cls != Classification::Normal {
+                    let z: Vec<String> = c
+                        .assessment
+                        .evidence
+                        .iter()
+                        .map(|e| format!("{:.1}/{:.1}", e.z, e.limit))
+                        .collect();
+                    eprintln!(
+                        "{label}-{j} (baseline {base}): {cls:?}: {} (z/limit {})",
+                        c.assessment.summary,
+                        z.join(" ")
+                    );
+                }
                 *confusion.entry((label.clone(), cls)).or_default() += 1;
                 if let Some(corner) = corner {
                     if matches!(cls, Classification::Vehicle | Classification::Both)
@@ -185,7 +215,15 @@ fn issue_scenarios_over_three_baselines() {
         named.get("RL damper 50 %").copied().unwrap_or(0) >= 21,
         "{table}"
     );
-    // The sweep: a 30 % loss is caught in part (measured 10 of 24), 10 and 20 % not at all.
-    assert!(flagged("RL damper -30 %") >= 5, "{table}");
+    // The softer front-left tyre: vehicle with FL named (measured 24 of 24).
+    assert!(flagged("FL tyre -30 %") >= 21, "{table}");
+    assert!(
+        named.get("FL tyre -30 %").copied().unwrap_or(0) >= 21,
+        "{table}"
+    );
+    // The sweep: a 30 % loss is caught (measured 23 of 24 at 1 %, 24 at 5 %), 20 % in part
+    // (9 and 12 of 24), 10 % at the false-alarm rate.
+    assert!(flagged("RL damper -30 %") >= 20, "{table}");
     assert!(flagged("RL damper -10 %") <= 3, "{table}");
+    // Rear springs 20 % softer are not detected (2 of 24, 3 at 5 %): docs/fleet.md.
 }
