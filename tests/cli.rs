@@ -1,27 +1,11 @@
 //! The command line as a user meets it: outputs on small files, and one-line errors with exit
 //! code 2 on bad input.
 
+mod common;
+
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn vibmode(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_vibmode"))
-        .args(args)
-        .output()
-        .expect("run vibmode")
-}
-
-/// Asserts exit code 2, a single line on stderr containing every `needle`, and no panic.
-fn fails_with(args: &[&str], needles: &[&str]) {
-    let o = vibmode(args);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "args {args:?}: stderr {err}");
-    assert!(!err.contains("panicked"), "panic: {err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
-    for n in needles {
-        assert!(err.contains(n), "'{n}' not in: {err}");
-    }
-}
+use common::{fails_with, vibmode};
 
 fn write_csv(path: &Path, n: usize, fs: f64, bad: Option<&str>) {
     let mut s = String::from("time_s,a,b\n");

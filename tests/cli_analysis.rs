@@ -3,26 +3,11 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::Path;
-use std::process::{Command, Output, Stdio};
+use std::process::Stdio;
 
-fn vibmode(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_vibmode"))
-        .args(args)
-        .output()
-        .expect("run vibmode")
-}
+mod common;
 
-/// Exit code 2, one line on stderr holding every needle, no panic.
-fn fails_with(args: &[&str], needles: &[&str]) {
-    let o = vibmode(args);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "args {args:?}: stderr {err}");
-    assert!(!err.contains("panicked"), "panic: {err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
-    for n in needles {
-        assert!(err.contains(n), "'{n}' not in: {err}");
-    }
-}
+use common::{bin, fails_with, vibmode};
 
 /// A lightly damped 1.5 Hz resonance (zeta 0.05) driven by seeded white noise, sampled at
 /// `fs` Hz: an AR(2) filter, plus 5 % measurement noise. Columns `time_s` and `z` (m/s^2).
@@ -182,7 +167,7 @@ fn a_closed_pipe_ends_quietly() {
     let d = tempfile::tempdir().unwrap();
     let a = d.path().join("a.csv");
     write_resonance(&a, 60.0, 50.0, 6);
-    let mut child = Command::new(env!("CARGO_BIN_EXE_vibmode"))
+    let mut child = bin()
         .args([
             "psd",
             a.to_str().unwrap(),

@@ -1,36 +1,11 @@
 //! `vibmode fleet` as a user meets it: init, ingest (twice), baseline, check, status, and the
 //! one-line errors with exit code 2.
 
+mod common;
+
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn vibmode(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_vibmode"))
-        .args(args)
-        .output()
-        .expect("run vibmode")
-}
-
-fn fails_with(args: &[&str], needles: &[&str]) {
-    let o = vibmode(args);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "args {args:?}: stderr {err}");
-    assert!(!err.contains("panicked"), "panic: {err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
-    for n in needles {
-        assert!(err.contains(n), "'{n}' not in: {err}");
-    }
-}
-
-fn ok(args: &[&str]) -> Output {
-    let o = vibmode(args);
-    assert!(
-        o.status.success(),
-        "args {args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
+use common::{bin, fails_with, ok};
 
 /// Simulated bus records (CSV, 200 Hz) from `vibmode simulate` into `dir`.
 fn simulate(dir: &Path, road: &str, speed: &str, seed: &str, records: &str) -> Vec<String> {
@@ -207,7 +182,7 @@ fn concurrent_ingests_both_succeed() {
     let db = db.to_str().unwrap();
     ok(&["fleet", "init", "--db", db]);
     let spawn = |file: &str| {
-        Command::new(env!("CARGO_BIN_EXE_vibmode"))
+        bin()
             .args(["fleet", "ingest", "--db", db, "--vehicle", "bus-2", file])
             .output()
     };
@@ -235,7 +210,7 @@ fn killed_ingest_leaves_a_consistent_store() {
     ok(&["fleet", "init", "--db", db]);
     let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-3"];
     args.extend(files.iter().map(String::as_str));
-    let mut child = Command::new(env!("CARGO_BIN_EXE_vibmode"))
+    let mut child = bin()
         .args(&args)
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::null())

@@ -5,66 +5,12 @@
 //! guard, not a timing measurement).
 
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Stdio;
+use std::time::Duration;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_vibmode"))
-}
+mod common;
 
-/// Runs vibmode; a run still going after 120 s is a hang: killed, and the test fails.
-fn vibmode(args: &[&str]) -> Output {
-    let child = bin()
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start vibmode");
-    wait_or_kill(child, args)
-}
-
-fn wait_or_kill(mut child: Child, args: &[&str]) -> Output {
-    let t0 = Instant::now();
-    loop {
-        if child.try_wait().expect("wait").is_some() {
-            return child.wait_with_output().expect("output");
-        }
-        if t0.elapsed() > Duration::from_secs(120) {
-            let _ = child.kill();
-            panic!("vibmode {args:?} hung (killed after 120 s)");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-}
-
-/// Exit code 2, one line on stderr with every needle, no panic.
-fn fails_with(args: &[&str], needles: &[&str]) -> String {
-    let o = vibmode(args);
-    let err = String::from_utf8_lossy(&o.stderr).to_string();
-    assert_eq!(o.status.code(), Some(2), "args {args:?}: stderr {err}");
-    assert!(!err.contains("panicked"), "panic: {err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
-    assert!(
-        err.len() < 400,
-        "message too long ({} bytes): {err}",
-        err.len()
-    );
-    for n in needles {
-        assert!(err.contains(n), "'{n}' not in: {err}");
-    }
-    err
-}
-
-fn ok(args: &[&str]) -> Output {
-    let o = vibmode(args);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "args {args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
+use common::{bin, fails_with, ok, vibmode};
 
 /// A CSV of `n` rows: a time column at `fs` Hz and the given columns.
 fn csv(path: &Path, fs: f64, n: usize, cols: &[(&str, &dyn Fn(usize) -> f64)]) {

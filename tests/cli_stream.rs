@@ -2,34 +2,12 @@
 //! with and without GPS, and the bad-input paths (one line, exit code 2, nothing half-written).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+
+mod common;
+
+use common::{fails_with, ok, stderr};
 use vibmode_signal::{read_path, write_path, Channel, ReadOptions, Recording};
 use vibmode_vehicle::drive::{simulate_drive, DriveParams};
-
-fn vibmode(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_vibmode"))
-        .args(args)
-        .output()
-        .expect("run vibmode")
-}
-
-fn ok(args: &[&str]) -> String {
-    let o = vibmode(args);
-    let err = String::from_utf8_lossy(&o.stderr).to_string();
-    assert_eq!(o.status.code(), Some(0), "args {args:?}: {err}");
-    err
-}
-
-fn fails_with(args: &[&str], needles: &[&str]) {
-    let o = vibmode(args);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "args {args:?}: stderr {err}");
-    assert!(!err.contains("panicked"), "panic: {err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
-    for n in needles {
-        assert!(err.contains(n), "'{n}' not in: {err}");
-    }
-}
 
 /// Two channels: a 3 Hz and a 7 Hz resonance-like sum of sines plus a 900 Hz tone, at `fs`.
 fn long_recording(dir: &Path, name: &str, fs: f64, seconds: f64, start: Option<&str>) -> PathBuf {
@@ -70,7 +48,7 @@ fn streamed_resample_writes_every_format_and_agrees_with_the_ideal_filter() {
     let s = |p: &Path| p.to_str().unwrap().to_string();
     for ext in ["f32", "csv", "wav"] {
         let out = d.path().join(format!("out.{ext}"));
-        let err = ok(&[
+        let err = stderr(&ok(&[
             "resample",
             &s(&input),
             "--to",
@@ -79,7 +57,7 @@ fn streamed_resample_writes_every_format_and_agrees_with_the_ideal_filter() {
             "fir",
             "-o",
             &s(&out),
-        ]);
+        ]));
         assert!(
             err.contains("streamed FIR") && err.contains("-110 dB"),
             "{err}"
@@ -159,7 +137,14 @@ fn segment_and_analyze_by_gps_carry_speed_and_position() {
     let track = gps_csv(d.path(), 200.0, 4);
     let (i, t) = (input.to_str().unwrap(), track.to_str().unwrap());
     let seg_dir = d.path().join("seg");
-    let err = ok(&["segment", i, "--gps", t, "-o", seg_dir.to_str().unwrap()]);
+    let err = stderr(&ok(&[
+        "segment",
+        i,
+        "--gps",
+        t,
+        "-o",
+        seg_dir.to_str().unwrap(),
+    ]));
     assert!(err.contains("cut by gps"), "{err}");
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(seg_dir.join("segments.json")).unwrap())
@@ -279,7 +264,7 @@ fn bad_input_is_one_line_with_exit_code_2_and_nothing_half_written() {
     nmea.push_str("$GPRMC,broken*11\nnoise\n");
     let np = d.path().join("t.nmea");
     std::fs::write(&np, nmea).unwrap();
-    let err = ok(&[
+    let err = stderr(&ok(&[
         "segment",
         i,
         "--gps",
@@ -287,7 +272,7 @@ fn bad_input_is_one_line_with_exit_code_2_and_nothing_half_written() {
         "--plan-only",
         "-o",
         o,
-    ]);
+    ]));
     assert!(err.contains("2 unparseable sentences skipped"), "{err}");
     // Timestamps going backwards.
     let mut csv: Vec<String> = day.to_csv().lines().map(str::to_string).collect();
