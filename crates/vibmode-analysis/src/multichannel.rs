@@ -10,7 +10,7 @@ use vibmode_core::{
     SsiParams,
 };
 use vibmode_signal::Preprocessed;
-use vibmode_ssi::SsiCov;
+use vibmode_ssi::{SsiCorrelations, SsiCov};
 
 use crate::lines::{LineStage, LineTrack};
 use crate::AnalysisError;
@@ -22,17 +22,10 @@ pub const MATCH_MAC_MIN: f64 = 0.5;
 /// Most groups of the jackknife over records (each group one more identification).
 pub const JACKKNIFE_GROUPS: usize = 20;
 
-fn median(v: &mut [f64]) -> Option<f64> {
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    Some(if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    })
+/// The pooled records' correlations (kept per record) and the band of the first.
+struct Pooled {
+    correlations: SsiCorrelations,
+    band: vibmode_core::BandLimit,
 }
 
 /// Name of the pseudo-channel of the multichannel poles in the pole store and the clusters.
@@ -122,11 +115,9 @@ impl SsiStage<'_> {
             .collect()
     }
 
-    /// The records used, each channel divided by its scale, and the first one's band.
-    fn pooled_segments(
-        &self,
-        scales: &[f64],
-    ) -> Option<(Vec<Vec<Vec<f64>>>, vibmode_core::BandLimit)> {
+    /// The correlations of the records used (each channel divided by its scale), kept per
+    /// record for the jackknife, and the first record's band; `None` when no record is used.
+    fn pooled(&self, scales: &[f64]) -> Result<Option<Pooled>, String> {
         let used: Vec<&Preprocessed> = self
             .pre
             .iter()
@@ -134,8 +125,10 @@ impl SsiStage<'_> {
             .filter(|(r, _)| self.active.get(*r).copied().flatten().is_some())
             .map(|(_, p)| p)
             .collect();
-        let band = used.first()?.band;
-        let scaled = used
+        let Some(first) = used.first() else {
+            return Ok(None);
+        };
+        let scaled: Vec<Vec<Vec<f64>>> = used
             .iter()
             .map(|p| {
                 p.recording
@@ -146,23 +139,29 @@ impl SsiStage<'_> {
                     .collect()
             })
             .collect();
-        Some((scaled, band))
-    }
-
-    /// One identification from the correlations averaged over the records used (record index
-    /// 0 for every pole).
-    fn pooled_poles(&self, orders: &[usize], scales: &[f64]) -> Result<Vec<ShapedPole>, String> {
-        let Some((scaled, band)) = self.pooled_segments(scales) else {
-            return Ok(Vec::new());
-        };
         let segments: Vec<Vec<&[f64]>> = scaled
             .iter()
             .map(|rec| rec.iter().map(Vec::as_slice).collect())
             .collect();
-        let plan =
-            SsiCov::from_segments(&segments, band.fs_hz, self.params).map_err(|e| e.to_string())?;
+        let correlations = SsiCorrelations::new(&segments, first.band.fs_hz, self.params)
+            .map_err(|e| e.to_string())?;
+        Ok(Some(Pooled {
+            correlations,
+            band: first.band,
+        }))
+    }
+
+    /// One identification from the correlations averaged over the records used (record index
+    /// 0 for every pole).
+    fn pooled_poles(
+        &self,
+        pooled: &Pooled,
+        orders: &[usize],
+        scales: &[f64],
+    ) -> Result<Vec<ShapedPole>, String> {
+        let plan = pooled.correlations.plan().map_err(|e| e.to_string())?;
         let res = plan.sweep(orders).map_err(|e| e.to_string())?;
-        Ok(self.kept(res, 0, &band, scales))
+        Ok(self.kept(res, 0, &pooled.band, scales))
     }
 
     /// Standard deviations of the supported modes' frequency and damping by a delete-a-group
@@ -171,24 +170,26 @@ impl SsiStage<'_> {
     /// damping over the repetition's poles near it (within the clustering's radius, shapes with
     /// MAC at least `1 - shape_tol`). Nothing is set with fewer than 2 records or when a
     /// repetition fails.
-    fn jackknife(&self, modes: &mut [InvariantMode], orders: &[usize], scales: &[f64]) {
-        let Some((scaled, band)) = self.pooled_segments(scales) else {
-            return;
-        };
-        let groups = scaled.len().min(JACKKNIFE_GROUPS);
+    fn jackknife(
+        &self,
+        pooled: &Pooled,
+        modes: &mut [InvariantMode],
+        orders: &[usize],
+        scales: &[f64],
+    ) {
+        let groups = pooled.correlations.n_segments().min(JACKKNIFE_GROUPS);
         if groups < 2 || !modes.iter().any(InvariantMode::is_invariant) {
             return;
         }
-        let segments: Vec<Vec<&[f64]>> = scaled
-            .iter()
-            .map(|rec| rec.iter().map(Vec::as_slice).collect())
-            .collect();
-        let Ok(plans) = SsiCov::jackknife(&segments, band.fs_hz, self.params, groups) else {
+        let Ok(plans) = pooled.correlations.jackknife(groups) else {
             return;
         };
         let reps: Vec<Vec<ShapedPole>> = match plans
             .par_iter()
-            .map(|p| p.sweep(orders).map(|r| self.kept(r, 0, &band, scales)))
+            .map(|p| {
+                p.sweep(orders)
+                    .map(|r| self.kept(r, 0, &pooled.band, scales))
+            })
             .collect::<Result<Vec<_>, _>>()
         {
             Ok(r) => r,
@@ -204,7 +205,7 @@ impl SsiStage<'_> {
                 .max(self.cluster.freq_tol_per_damping * m.damping_ratio);
             let (mut fs, mut zs) = (Vec::new(), Vec::new());
             for rep in &reps {
-                let (mut f, mut z): (Vec<f64>, Vec<f64>) = rep
+                let (f, z): (Vec<f64>, Vec<f64>) = rep
                     .iter()
                     .filter(|q| (q.frequency_hz / m.frequency_hz - 1.0).abs() <= tol)
                     .filter(|q| {
@@ -214,9 +215,9 @@ impl SsiStage<'_> {
                     })
                     .map(|q| (q.frequency_hz, q.damping_ratio))
                     .unzip();
-                if let (Some(fm), Some(zm)) = (median(&mut f), median(&mut z)) {
-                    fs.push(fm);
-                    zs.push(zm);
+                if !f.is_empty() {
+                    fs.push(vibmode_modal::stats::median(&f));
+                    zs.push(vibmode_modal::stats::median(&z));
                 }
             }
             if fs.len() >= 2 {
@@ -301,8 +302,17 @@ impl SsiStage<'_> {
             .unwrap_or_default();
         let orders = self.orders(channels.len());
         let scales = self.channel_scales();
-        let per: Vec<Result<Vec<ShapedPole>, String>> = if self.params.pool_records {
-            vec![self.pooled_poles(&orders, &scales)]
+        let correlations = if self.params.pool_records {
+            Some(self.pooled(&scales))
+        } else {
+            None
+        };
+        let per: Vec<Result<Vec<ShapedPole>, String>> = if let Some(p) = &correlations {
+            vec![match p {
+                Ok(Some(p)) => self.pooled_poles(p, &orders, &scales),
+                Ok(None) => Ok(Vec::new()),
+                Err(e) => Err(e.clone()),
+            }]
         } else {
             (0..self.pre.len())
                 .into_par_iter()
@@ -350,8 +360,8 @@ impl SsiStage<'_> {
         let mut known: Vec<LineTrack> = tracks.clone();
         known.extend(other_tracks.iter().cloned());
         lines.classify(&mut invariant_modes, &all, &known);
-        if pooled {
-            self.jackknife(&mut invariant_modes, &orders, &scales);
+        if let Some(Ok(Some(p))) = &correlations {
+            self.jackknife(p, &mut invariant_modes, &orders, &scales);
         }
         let matches = if reference.is_empty() {
             Vec::new()

@@ -116,9 +116,15 @@ fn check_channels(channels: &[&[f64]]) -> Result<usize, SsiError> {
     Ok(n)
 }
 
-/// The unnormalised correlation sums of each segment, `sum_t y_s[t+k] y_s,ref[t]^T`, and their
-/// product counts `N_s - k`, for the lags `1..=max_lag`.
-struct SegmentSums {
+/// The output correlations of several segments (records) kept apart: per segment the
+/// unnormalised sums `sum_t y_s[t+k] y_s,ref[t]^T` and their product counts `N_s - k`, for the
+/// lags `1..=first_lag + 2i - 2`. Computed once; [`SsiCorrelations::plan`] identifies from all
+/// segments ([`SsiCov::from_segments`]), [`SsiCorrelations::jackknife`] from all but one group
+/// at a time, without recomputing a product.
+#[derive(Clone, Debug)]
+pub struct SsiCorrelations {
+    fs_hz: f64,
+    order_max: usize,
     block_rows: usize,
     skip: usize,
     sums: Vec<Vec<DMatrix<f64>>>,
@@ -127,12 +133,15 @@ struct SegmentSums {
     max_abs: f64,
 }
 
-impl SegmentSums {
-    fn new(
+impl SsiCorrelations {
+    /// The correlation sums of `segments` (each the same channels, finite, with at least
+    /// `first_lag + 2 block_rows - 1` samples; each segment's means removed) sampled at `fs_hz`,
+    /// for `params`' block rows, first lag and references.
+    pub fn new(
         segments: &[Vec<&[f64]>],
         fs_hz: f64,
         params: &SsiParams,
-    ) -> Result<SegmentSums, SsiError> {
+    ) -> Result<SsiCorrelations, SsiError> {
         params.validate()?;
         if !(fs_hz.is_finite() && fs_hz > 0.0) {
             return Err(SsiError::InvalidSampleRate { fs_hz });
@@ -155,7 +164,9 @@ impl SegmentSums {
             }
             None => (0..l).collect(),
         };
-        let mut out = SegmentSums {
+        let mut out = SsiCorrelations {
+            fs_hz,
+            order_max: params.order_max,
             block_rows: i,
             skip,
             sums: Vec::with_capacity(segments.len()),
@@ -208,18 +219,43 @@ impl SegmentSums {
         Ok(out)
     }
 
+    /// Number of segments.
+    pub fn n_segments(&self) -> usize {
+        self.sums.len()
+    }
+
+    /// The plan from the correlations averaged over every segment (as [`SsiCov::from_segments`]).
+    pub fn plan(&self) -> Result<SsiCov, SsiError> {
+        self.plan_without(|_| false)
+    }
+
+    /// Delete-a-group jackknife plans: the segments split into `groups` groups of consecutive
+    /// segments (segment `s` of `m` in group `s * groups / m`; `groups = m` leaves one segment
+    /// out at a time), plan `g` from every segment outside group `g`. With an estimate
+    /// `theta_g` from each plan, the jackknife standard deviation of the all-segment estimate
+    /// is `sqrt((G - 1) / G * sum_g (theta_g - mean)^2)` ([`jackknife_std`]). Needs
+    /// `2 <= groups <= n_segments()` (`SsiError::TooFewSegments` otherwise).
+    pub fn jackknife(&self, groups: usize) -> Result<Vec<SsiCov>, SsiError> {
+        let m = self.n_segments();
+        if groups < 2 || groups > m {
+            return Err(SsiError::TooFewSegments {
+                n_segments: m,
+                groups,
+            });
+        }
+        (0..groups)
+            .map(|g| self.plan_without(|s| s * groups / m == g))
+            .collect()
+    }
+
     /// The plan from the correlations of every segment `s` but those with `left_out(s)`.
-    fn plan(
-        &self,
-        left_out: impl Fn(usize) -> bool,
-        fs_hz: f64,
-        params: &SsiParams,
-    ) -> Result<SsiCov, SsiError> {
+    fn plan_without(&self, left_out: impl Fn(usize) -> bool) -> Result<SsiCov, SsiError> {
         let used = || (0..self.sums.len()).filter(|&s| !left_out(s));
         let max_lag = self.sums.first().map_or(0, Vec::len);
         let r: Vec<DMatrix<f64>> = (0..max_lag)
             .map(|k| {
-                let mut total = self.sums[0][k].clone() * 0.0;
+                let (rows, cols) = self.sums[0][k].shape();
+                let mut total = DMatrix::zeros(rows, cols);
                 let mut count = 0usize;
                 for s in used() {
                     total += &self.sums[s][k];
@@ -234,8 +270,12 @@ impl SegmentSums {
                 max_abs: self.max_abs,
             });
         }
-        let mut cov =
-            SsiCov::from_correlations(&r[self.skip..], fs_hz, self.block_rows, params.order_max)?;
+        let mut cov = SsiCov::from_correlations(
+            &r[self.skip..],
+            self.fs_hz,
+            self.block_rows,
+            self.order_max,
+        )?;
         cov.n_samples = used().map(|s| self.n_samples[s]).sum();
         Ok(cov)
     }
@@ -270,41 +310,25 @@ impl SsiCov {
     /// `R_k = sum_s sum_t y_s[t+k] y_s[t]^T / sum_s (N_s - k)` (each segment's means removed; no
     /// product straddles two segments), then as [`SsiCov::new`]. Long identification data
     /// without the joins of a concatenation. Every segment needs the same channel count and at
-    /// least `2 block_rows` samples; segments may differ in length.
+    /// least `first_lag + 2 block_rows - 1` samples; segments may differ in length.
+    /// ([`SsiCorrelations`] keeps the segments' sums for a jackknife as well.)
     pub fn from_segments(
         segments: &[Vec<&[f64]>],
         fs_hz: f64,
         params: &SsiParams,
     ) -> Result<SsiCov, SsiError> {
-        let sums = SegmentSums::new(segments, fs_hz, params)?;
-        sums.plan(|_| false, fs_hz, params)
+        SsiCorrelations::new(segments, fs_hz, params)?.plan()
     }
 
-    /// Delete-a-group jackknife plans: the segments are split into `groups` groups of
-    /// consecutive segments (segment `s` of `m` in group `s * groups / m`; `groups = m` leaves
-    /// one segment out at a time), and plan `g` is [`SsiCov::from_segments`] of every segment
-    /// outside group `g` (its correlation sums taken out of the totals; no product is
-    /// recomputed). With an estimate `theta_g` from each plan, the jackknife standard deviation
-    /// of the all-segment estimate is `sqrt((G - 1) / G * sum_g (theta_g - mean)^2)`
-    /// ([`jackknife_std`]). Needs `2 <= groups <= segments.len()`
-    /// (`SsiError::TooFewSegments` otherwise).
+    /// Delete-a-group jackknife plans of `segments` in `groups` groups
+    /// ([`SsiCorrelations::jackknife`]).
     pub fn jackknife(
         segments: &[Vec<&[f64]>],
         fs_hz: f64,
         params: &SsiParams,
         groups: usize,
     ) -> Result<Vec<SsiCov>, SsiError> {
-        let m = segments.len();
-        if groups < 2 || groups > m {
-            return Err(SsiError::TooFewSegments {
-                n_segments: m,
-                groups,
-            });
-        }
-        let sums = SegmentSums::new(segments, fs_hz, params)?;
-        (0..groups)
-            .map(|g| sums.plan(|s| s * groups / m == g, fs_hz, params))
-            .collect()
+        SsiCorrelations::new(segments, fs_hz, params)?.jackknife(groups)
     }
 
     /// From given correlations `r[k - 1] = R_k`, `k = 1..=2i-1`, each `l x r` (checked by the

@@ -20,7 +20,7 @@ mod error;
 mod shape;
 mod stability;
 
-pub use cov::{jackknife_std, ssi_cov, SsiCov, SsiMode, SsiOrder, SsiResult};
+pub use cov::{jackknife_std, ssi_cov, SsiCorrelations, SsiCov, SsiMode, SsiOrder, SsiResult};
 pub use error::SsiError;
 pub use shape::{mac, mpc};
 pub use stability::{stabilisation, Stability};
