@@ -208,12 +208,14 @@ pub fn run(a: &SsiArgs) -> Result<()> {
 /// The modes that stay over the orders, with their shapes (modulus and phase per channel).
 fn summary(out: &SsiOutput) -> String {
     let mut s = format!(
-        "{}: SSI-cov of {} channels ({} samples at {} Hz), {} block rows, orders {}..{}\n",
+        "{}: SSI-cov of {} channels ({} samples at {} Hz), {} block rows (lags {}..{}), orders {}..{}\n",
         out.source,
         out.channels.len(),
         out.n_samples,
         out.fs_hz,
         out.params.block_rows,
+        out.params.first_lag,
+        out.params.first_lag + 2 * out.params.block_rows - 2,
         out.result.orders.first().map_or(0, |o| o.order),
         out.result.orders.last().map_or(0, |o| o.order),
     );

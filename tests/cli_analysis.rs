@@ -276,6 +276,7 @@ fn ssi_identifies_a_simulated_record_and_reports_errors() {
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(out.contains("SSI-cov of 7 channels"), "{out}");
+    assert!(out.contains("30 block rows (lags 1..59)"), "{out}");
     assert!(out.contains("shape: FL_unsprung"), "{out}");
     assert!(plot.is_file());
     // The bending mode (9.0 Hz, damping 0.03) is among the modes that stay over the orders.
@@ -297,6 +298,24 @@ fn ssi_identifies_a_simulated_record_and_reports_errors() {
         "{out}"
     );
     assert_eq!(v["channels"].as_array().map(Vec::len), Some(7));
+    // A later first lag: reported, and in the JSON's parameters.
+    let later = vibmode(&[
+        "ssi",
+        wav,
+        "--resample-to",
+        "50",
+        "--block-rows",
+        "30",
+        "--first-lag",
+        "37",
+    ]);
+    let text = String::from_utf8_lossy(&later.stdout);
+    assert!(text.contains("(lags 37..95)"), "{text}");
+    assert_eq!(v["params"]["first_lag"], 1);
+    fails_with(
+        &["ssi", wav, "--first-lag", "0"],
+        &["first_lag = 0", ">= 1"],
+    );
     fails_with(&["ssi", wav, "--block-rows", "0"], &["block_rows"]);
     fails_with(&["ssi", wav, "--references", "0,9"], &["9"]);
     fails_with(
