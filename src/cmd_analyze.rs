@@ -10,7 +10,6 @@ use vibmode_analysis::{
 };
 use vibmode_modal::ReferenceMode;
 use vibmode_report::TruthRow;
-use vibmode_signal::{ChannelSelector, ReadOptions};
 
 /// Arguments of `vibmode analyze`.
 #[derive(Args, Debug)]
@@ -31,15 +30,8 @@ pub struct AnalyzeArgs {
     /// Channels to analyse, by name or 0-based index (default: all).
     #[arg(long = "channel", short = 'c')]
     pub channels: Vec<String>,
-    /// Sampling rate in Hz for files without a time column.
-    #[arg(long = "fs")]
-    pub fs_hz: Option<f64>,
-    /// Multiplier for WAV integer samples (after scaling to [-1, 1)).
-    #[arg(long, default_value_t = 1.0)]
-    pub scale: f64,
-    /// Unit of the samples when the files do not say (e.g. m/s^2).
-    #[arg(long)]
-    pub unit: Option<String>,
+    #[command(flatten)]
+    pub read: crate::input::ReadArgs,
     /// Output folder for index.html, results.json and figures/.
     #[arg(short = 'o', long = "output", default_value = "vibmode-report")]
     pub output: PathBuf,
@@ -134,17 +126,8 @@ pub fn run(a: &AnalyzeArgs) -> Result<()> {
     if let Some(m) = &a.method {
         cfg.method = m.parse()?;
     }
-    let opts = ReadOptions {
-        fs_hz: a.fs_hz,
-        scale: a.scale,
-        unit: a.unit.clone(),
-        ..ReadOptions::default()
-    };
-    let sel = a
-        .channels
-        .iter()
-        .map(|s| s.parse::<ChannelSelector>())
-        .collect::<Result<Vec<_>, _>>()?;
+    let opts = a.read.options();
+    let sel = crate::input::selectors(&a.channels)?;
     let reference = match &a.vehicle {
         Some(p) => vehicle_reference(p)?,
         None => Vec::new(),

@@ -8,7 +8,6 @@ use vibmode_fleet::{
     build_baseline, check_file, ingest_file, require_baseline, Checked, Condition, FleetConfig,
     IngestLabels, Store,
 };
-use vibmode_signal::ReadOptions;
 
 /// Arguments of `vibmode fleet`.
 #[derive(Args, Debug)]
@@ -63,31 +62,6 @@ pub enum FleetCommand {
     },
 }
 
-/// How record files are read.
-#[derive(Args, Debug)]
-pub struct ReadArgs {
-    /// Sampling rate in Hz for files without a time column.
-    #[arg(long = "fs")]
-    pub fs_hz: Option<f64>,
-    /// Multiplier for WAV integer samples (after scaling to [-1, 1)).
-    #[arg(long, default_value_t = 1.0)]
-    pub scale: f64,
-    /// Unit of the samples when the files do not say (e.g. m/s^2).
-    #[arg(long)]
-    pub unit: Option<String>,
-}
-
-impl ReadArgs {
-    fn options(&self) -> ReadOptions {
-        ReadOptions {
-            fs_hz: self.fs_hz,
-            scale: self.scale,
-            unit: self.unit.clone(),
-            ..ReadOptions::default()
-        }
-    }
-}
-
 /// Arguments of `vibmode fleet ingest`.
 #[derive(Args, Debug)]
 pub struct IngestArgs {
@@ -104,7 +78,7 @@ pub struct IngestArgs {
     #[arg(long)]
     pub road: Option<String>,
     #[command(flatten)]
-    pub read: ReadArgs,
+    pub read: crate::input::ReadArgs,
     /// Record files.
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
@@ -123,7 +97,7 @@ pub struct CheckArgs {
     #[arg(long)]
     pub json: Option<String>,
     #[command(flatten)]
-    pub read: ReadArgs,
+    pub read: crate::input::ReadArgs,
     /// Record files.
     #[arg(required = true)]
     pub files: Vec<PathBuf>,

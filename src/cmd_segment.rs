@@ -71,15 +71,8 @@ pub struct SegmentArgs {
     /// Channels to keep, by name or 0-based index (default: all).
     #[arg(long = "channel", short = 'c')]
     pub channels: Vec<String>,
-    /// Sampling rate in Hz for text files without a time column.
-    #[arg(long = "fs")]
-    pub fs_hz: Option<f64>,
-    /// Multiplier for WAV integer samples (after scaling to [-1, 1)).
-    #[arg(long, default_value_t = 1.0)]
-    pub scale: f64,
-    /// Unit of the samples when the file does not say (e.g. m/s^2).
-    #[arg(long)]
-    pub unit: Option<String>,
+    #[command(flatten)]
+    pub read: crate::input::ReadArgs,
     /// Format of the record files: csv, wav, f32 or f64 (default: f32 for raw input, wav for
     /// WAV, csv for text).
     #[arg(long)]
@@ -187,17 +180,8 @@ pub fn run(a: &SegmentArgs) -> Result<()> {
     let mut inputs = vec![a.input.clone()];
     inputs.extend(a.seg.gps.iter().cloned());
     let out = crate::output::StagedDir::begin(&a.output, &inputs)?;
-    let opts = ReadOptions {
-        fs_hz: a.fs_hz,
-        scale: a.scale,
-        unit: a.unit.clone(),
-        ..ReadOptions::default()
-    };
-    let sel = a
-        .channels
-        .iter()
-        .map(|s| s.parse::<ChannelSelector>())
-        .collect::<Result<Vec<_>, _>>()?;
+    let opts = a.read.options();
+    let sel = crate::input::selectors(&a.channels)?;
     let record_length_s = a
         .record_length_s
         .unwrap_or(vibmode_analysis::AnalysisConfig::default().record_length_s);

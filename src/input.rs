@@ -5,15 +5,11 @@ use clap::Args;
 use std::path::PathBuf;
 use vibmode_signal::{ChannelSelector, ReadOptions, Recording, ResampleParams, ResampleRecording};
 
-/// Options every analysis command shares for reading its input.
+/// How files are read: rate, WAV scale and unit where the file does not say (every command that
+/// reads recordings flattens this).
 #[derive(Args, Debug, Clone)]
-pub struct InputArgs {
-    /// Input file: delimited text (.csv, .txt, .tsv), WAV (.wav), or raw f32/f64 with a JSON sidecar.
-    pub input: PathBuf,
-    /// Channel to analyse, by name or 0-based index; repeat for several (default: all but time).
-    #[arg(long = "channel", short = 'c')]
-    pub channels: Vec<String>,
-    /// Sampling rate in Hz, required when the file has no time column and no header rate.
+pub struct ReadArgs {
+    /// Sampling rate in Hz, required when a file has no time column and no header rate.
     #[arg(long = "fs")]
     pub fs_hz: Option<f64>,
     /// Multiplier applied to WAV integer samples after scaling to [-1, 1) full scale.
@@ -22,6 +18,38 @@ pub struct InputArgs {
     /// Unit of the samples when the file does not say (e.g. m/s^2).
     #[arg(long)]
     pub unit: Option<String>,
+}
+
+impl ReadArgs {
+    /// The reader's options.
+    pub fn options(&self) -> ReadOptions {
+        ReadOptions {
+            fs_hz: self.fs_hz,
+            scale: self.scale,
+            unit: self.unit.clone(),
+            ..ReadOptions::default()
+        }
+    }
+}
+
+/// Parses `--channel` values (names or 0-based indices).
+pub fn selectors(channels: &[String]) -> Result<Vec<ChannelSelector>> {
+    Ok(channels
+        .iter()
+        .map(|s| s.parse::<ChannelSelector>())
+        .collect::<Result<Vec<_>, _>>()?)
+}
+
+/// Options every analysis command shares for reading its input.
+#[derive(Args, Debug, Clone)]
+pub struct InputArgs {
+    /// Input file: delimited text (.csv, .txt, .tsv), WAV (.wav), or raw f32/f64 with a JSON sidecar.
+    pub input: PathBuf,
+    /// Channel to analyse, by name or 0-based index; repeat for several (default: all but time).
+    #[arg(long = "channel", short = 'c')]
+    pub channels: Vec<String>,
+    #[command(flatten)]
+    pub read: ReadArgs,
     /// Accept a non-uniform time column by interpolating onto a uniform grid at the mean rate.
     #[arg(long)]
     pub resample_nonuniform: bool,
@@ -70,43 +98,23 @@ impl InputArgs {
     /// Opens the file as a stream of blocks with the channels selected (for any length).
     pub fn open_stream(&self) -> Result<vibmode_signal::FrameStream> {
         let mut s = vibmode_signal::open_stream(&self.input, &self.read_options())?;
-        let sel = self
-            .channels
-            .iter()
-            .map(|s| s.parse::<ChannelSelector>())
-            .collect::<Result<Vec<_>, _>>()?;
-        s.select(&sel)?;
+        s.select(&selectors(&self.channels)?)?;
         Ok(s)
     }
 
     fn read_options(&self) -> ReadOptions {
         ReadOptions {
-            fs_hz: self.fs_hz,
-            scale: self.scale,
             allow_nonuniform: self.resample_nonuniform,
-            unit: self.unit.clone(),
-            ..ReadOptions::default()
+            ..self.read.options()
         }
     }
 
     /// Reads the file and selects channels, without resampling.
     pub fn load_raw(&self) -> Result<Recording> {
-        let opts = ReadOptions {
-            fs_hz: self.fs_hz,
-            scale: self.scale,
-            allow_nonuniform: self.resample_nonuniform,
-            unit: self.unit.clone(),
-            ..ReadOptions::default()
-        };
-        let rec = vibmode_signal::read_path(&self.input, &opts)?;
+        let rec = vibmode_signal::read_path(&self.input, &self.read_options())?;
         if self.channels.is_empty() {
             return Ok(rec);
         }
-        let sel = self
-            .channels
-            .iter()
-            .map(|s| s.parse::<ChannelSelector>())
-            .collect::<Result<Vec<_>, _>>()?;
-        Ok(rec.select(&sel)?)
+        Ok(rec.select(&selectors(&self.channels)?)?)
     }
 }
