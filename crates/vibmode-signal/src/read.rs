@@ -113,20 +113,29 @@ impl Default for ReadOptions {
     }
 }
 
+impl ReadOptions {
+    /// Checks the options themselves (a given rate, the jitter tolerance) before any file is
+    /// opened.
+    pub fn check(&self) -> Result<()> {
+        if let Some(fs) = self.fs_hz {
+            check_fs(fs, "the given fs_hz")?;
+        }
+        if !(self.max_jitter_rel.is_finite() && self.max_jitter_rel >= 0.0) {
+            return Err(SignalError::InvalidParam {
+                name: "max_jitter_rel",
+                value: self.max_jitter_rel.to_string(),
+                fix: "must be a finite number >= 0, e.g. 0.01".into(),
+            });
+        }
+        Ok(())
+    }
+}
+
 /// Reads a recording from `path` (delimited text, WAV or raw + sidecar; see `docs/formats.md`).
 ///
 /// All samples are checked to be finite; channel order is file order (time column removed).
 pub fn read_path(path: &Path, opts: &ReadOptions) -> Result<Recording> {
-    if let Some(fs) = opts.fs_hz {
-        check_fs(fs, "the given fs_hz")?;
-    }
-    if !(opts.max_jitter_rel.is_finite() && opts.max_jitter_rel >= 0.0) {
-        return Err(SignalError::InvalidParam {
-            name: "max_jitter_rel",
-            value: opts.max_jitter_rel.to_string(),
-            fix: "must be a finite number >= 0, e.g. 0.01".into(),
-        });
-    }
+    opts.check()?;
     let format = opts.format.unwrap_or_else(|| Format::from_path(path));
     let mut rec = match format {
         Format::Delimited => {

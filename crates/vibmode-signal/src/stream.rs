@@ -24,7 +24,7 @@ use crate::read::{raw_layout, reconcile_fs, wav_names, Format, ReadOptions};
 use std::fs::File;
 use std::io::{BufReader, Read};
 use std::path::Path;
-use vibmode_core::{check_fs, Channel, ChannelSelector, Recording, RecordingError};
+use vibmode_core::{Channel, ChannelSelector, Recording, RecordingError};
 
 /// Frames per block read by the command-line tools (65 536: 3.3 s at 20 kHz, 3.7 MB for 7
 /// channels).
@@ -141,16 +141,7 @@ fn open_file(path: &Path) -> Result<File> {
 /// Opens `path` as a stream of frame blocks (see the module documentation). The options are
 /// those of [`crate::read_path`] (`unit` fills in missing units).
 pub fn open_stream(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
-    if let Some(fs) = opts.fs_hz {
-        check_fs(fs, "the given fs_hz")?;
-    }
-    if !(opts.max_jitter_rel.is_finite() && opts.max_jitter_rel >= 0.0) {
-        return Err(SignalError::InvalidParam {
-            name: "max_jitter_rel",
-            value: opts.max_jitter_rel.to_string(),
-            fix: "must be a finite number >= 0, e.g. 0.01".into(),
-        });
-    }
+    opts.check()?;
     let format = opts.format.unwrap_or_else(|| Format::from_path(path));
     let mut s = match format {
         Format::Raw => open_raw(path, opts)?,

@@ -66,6 +66,7 @@ impl StreamWriter {
         start_s: f64,
     ) -> Result<StreamWriter> {
         check_fs(fs_hz, "fs_hz of the recording to write")?;
+        vibmode_core::files::check_output_file(path).map_err(|e| io_err("write", path, &e))?;
         if names.is_empty() {
             return Err(SignalError::TooShort {
                 what: format!("writing {}", path.display()),
@@ -137,7 +138,7 @@ impl StreamWriter {
                     })?;
                 (
                     Sink::Wav { w: Some(w) },
-                    Some((with_suffix(path, ".json"), text)),
+                    Some((with_suffix(path, ".json"), text + "\n")),
                 )
             }
             Some(Format::Raw) => {
@@ -190,8 +191,10 @@ impl StreamWriter {
     }
 
     /// Appends a block (`block[c]` = channel c, all the same length).
-    pub fn write_block(&mut self, block: &[Vec<f64>]) -> Result<()> {
-        let n = block.first().map_or(0, Vec::len);
+    pub fn write_block<C: AsRef<[f64]>>(&mut self, block: &[C]) -> Result<()> {
+        let block: Vec<&[f64]> = block.iter().map(AsRef::as_ref).collect();
+        let block = block.as_slice();
+        let n = block.first().map_or(0, |c| c.len());
         if block.len() != self.n_channels || block.iter().any(|c| c.len() != n) {
             return Err(SignalError::InvalidParam {
                 name: "block",
