@@ -9,9 +9,9 @@ use clap::Args;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::PathBuf;
-use vibmode_core::{ClusterParams, InvariantMode, ModeClass, SsiParams, StabilityParams};
+use vibmode_core::{InvariantMode, ModeClass, SsiParams};
 use vibmode_report::panels as figures;
-use vibmode_ssi::{SsiCov, SsiResult, Stability};
+use vibmode_ssi::{RecordSsi, RecordSsiOptions};
 
 /// Arguments of `vibmode ssi`.
 #[derive(Args, Debug)]
@@ -49,17 +49,10 @@ pub struct SsiArgs {
 #[derive(Serialize)]
 struct SsiOutput {
     source: String,
-    fs_hz: f64,
-    n_samples: usize,
     channels: Vec<String>,
-    params: SsiParams,
-    stability_params: StabilityParams,
-    /// Every order's modes.
-    result: SsiResult,
-    /// Stability label of every mode of every order against the previous order.
-    stability: Vec<Vec<Stability>>,
-    /// Clusters of the poles over the orders (mean shape, spread), structural ones first.
-    modes: Vec<InvariantMode>,
+    /// Parameters, every order's modes and labels, and the clusters (structural ones first).
+    #[serde(flatten)]
+    found: RecordSsi,
 }
 
 fn params(a: &SsiArgs) -> Result<SsiParams> {
@@ -114,86 +107,18 @@ pub fn run(a: &SsiArgs) -> Result<()> {
     crate::output::check_outputs(&a.input.input, &[], &[a.plot.as_deref()], a.json.as_deref())?;
     let (rec, band) = a.input.load_with_band()?;
     let p = params(a)?;
-    let scales: Vec<f64> = rec
-        .channels
-        .iter()
-        .map(|c| {
-            let n = c.samples.len().max(1) as f64;
-            let m = c.samples.iter().sum::<f64>() / n;
-            let rms = (c.samples.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / n).sqrt();
-            if a.no_normalise || !(rms > 0.0 && rms.is_finite()) {
-                1.0
-            } else {
-                rms
-            }
-        })
-        .collect();
-    let scaled: Vec<Vec<f64>> = rec
-        .channels
-        .iter()
-        .zip(&scales)
-        .map(|(c, s)| c.samples.iter().map(|v| v / s).collect())
-        .collect();
-    let chans: Vec<&[f64]> = scaled.iter().map(Vec::as_slice).collect();
-    let plan = SsiCov::new(&chans, rec.fs_hz, &p)?;
-    let orders: Vec<usize> = p
-        .orders()
-        .into_iter()
-        .filter(|&o| o <= plan.max_order())
-        .collect();
-    anyhow::ensure!(
-        !orders.is_empty(),
-        "no order up to {} is identifiable from {} channel(s) with {} block rows (highest: {}); raise the block rows or lower the orders",
-        p.order_max,
-        rec.n_channels(),
-        p.block_rows,
-        plan.max_order()
-    );
-    let mut result = plan.sweep(&orders)?;
-    for o in &mut result.orders {
-        for m in &mut o.modes {
-            m.shape = vibmode_modal::shapes::rescaled(&m.shape, &scales);
-        }
-    }
-    let stability_params = StabilityParams::default();
-    let stability = vibmode_ssi::stabilisation(&result, &stability_params);
-    let f_max = band.map_or(rec.fs_hz / 2.0, |b| b.valid_max_hz());
-    let obs: Vec<vibmode_core::PoleObservation> = result
-        .orders
-        .iter()
-        .flat_map(|o| {
-            o.modes
-                .iter()
-                .filter(|m| m.frequency_hz < f_max)
-                .map(move |m| {
-                    let mut q = vibmode_core::PoleObservation::new(
-                        m.frequency_hz,
-                        m.damping_ratio,
-                        o.order,
-                        0,
-                        "ssi-cov",
-                    );
-                    q.shape = Some(m.shape.clone());
-                    q
-                })
-        })
-        .collect();
-    let cluster = ClusterParams {
-        freq_max_hz: Some(f_max),
-        ..ClusterParams::default()
+    let chans: Vec<&[f64]> = rec.channels.iter().map(|c| c.samples.as_slice()).collect();
+    let options = RecordSsiOptions {
+        normalise: !a.no_normalise,
+        valid_max_hz: band.map(|b| b.valid_max_hz()),
+        ..RecordSsiOptions::default()
     };
-    let mut modes = vibmode_modal::find_invariant_modes(&obs, 1, &orders, &cluster)?;
-    modes.sort_by_key(|m| m.class != ModeClass::Structural);
+    let found = vibmode_ssi::identify_record(&chans, rec.fs_hz, &p, &options)?;
+    let f_max = options.valid_max_hz.unwrap_or(rec.fs_hz / 2.0);
     let out = SsiOutput {
         source: a.input.input.display().to_string(),
-        fs_hz: rec.fs_hz,
-        n_samples: rec.len(),
         channels: rec.channels.iter().map(|c| c.name.clone()).collect(),
-        params: p,
-        stability_params,
-        result,
-        stability,
-        modes,
+        found,
     };
     if let Some(path) = &a.plot {
         write_plot(path, &out, &rec, f_max)?;
@@ -211,15 +136,16 @@ fn summary(out: &SsiOutput) -> String {
         "{}: SSI-cov of {} channels ({} samples at {} Hz), {} block rows (lags {}..{}), orders {}..{}\n",
         out.source,
         out.channels.len(),
-        out.n_samples,
-        out.fs_hz,
-        out.params.block_rows,
-        out.params.first_lag,
-        out.params.first_lag + 2 * out.params.block_rows - 2,
-        out.result.orders.first().map_or(0, |o| o.order),
-        out.result.orders.last().map_or(0, |o| o.order),
+        out.found.n_samples,
+        out.found.fs_hz,
+        out.found.params.block_rows,
+        out.found.params.first_lag,
+        out.found.params.first_lag + 2 * out.found.params.block_rows - 2,
+        out.found.result.orders.first().map_or(0, |o| o.order),
+        out.found.result.orders.last().map_or(0, |o| o.order),
     );
     let structural: Vec<&InvariantMode> = out
+        .found
         .modes
         .iter()
         .filter(|m| m.class == ModeClass::Structural)
@@ -267,6 +193,7 @@ fn write_plot(
     f_max: f64,
 ) -> Result<()> {
     let pts: Vec<(usize, f64, f64)> = out
+        .found
         .result
         .orders
         .iter()

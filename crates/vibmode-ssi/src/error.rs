@@ -126,4 +126,19 @@ pub enum SsiError {
         /// Iteration cap.
         iterations: usize,
     },
+    /// None of the orders asked for is identifiable from the data.
+    #[error("no order from {order_min} up is identifiable from {n_channels} channel(s) with {block_rows} block rows (the highest is {max_order}); raise block_rows or lower the orders")]
+    NoOrder {
+        /// Lowest order asked for.
+        order_min: usize,
+        /// Number of channels.
+        n_channels: usize,
+        /// Block rows used.
+        block_rows: usize,
+        /// Highest identifiable order.
+        max_order: usize,
+    },
+    /// Clustering the poles over the orders failed (a clustering parameter out of range).
+    #[error(transparent)]
+    Modal(#[from] vibmode_modal::ModalError),
 }

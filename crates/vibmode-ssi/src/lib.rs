@@ -7,7 +7,8 @@
 //! complex mode shape (one entry per channel) and modal phase collinearity
 //! ([`SsiCov::poles_at`]). [`ssi_cov`] does both for the orders of an [`SsiParams`];
 //! [`stabilisation`] labels each mode against the previous order ([`Stability`]); [`mac`] and
-//! [`mpc`] compare and grade mode shapes. The definitions are in `docs/ssi.md`.
+//! [`mpc`] compare and grade mode shapes; [`identify_record`] runs all of it on one record
+//! and clusters the poles over the orders (`vibmode ssi`). The definitions are in `docs/ssi.md`.
 //!
 //! ## Panics
 //!
@@ -17,11 +18,13 @@
 mod cov;
 mod eig;
 mod error;
+mod record;
 mod shape;
 mod stability;
 
 pub use cov::{jackknife_std, ssi_cov, SsiCorrelations, SsiCov, SsiMode, SsiOrder, SsiResult};
 pub use error::SsiError;
+pub use record::{identify_record, RecordSsi, RecordSsiOptions};
 pub use shape::{mac, mpc};
 pub use stability::{stabilisation, Stability};
 pub use vibmode_core::{SsiParams, StabilityParams};

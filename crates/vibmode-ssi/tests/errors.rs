@@ -342,3 +342,27 @@ fn jackknife_needs_two_segments() {
     assert!(SsiCov::jackknife(&two, 50.0, &params(5), 1).is_err());
     assert!(SsiCov::jackknife(&two, 50.0, &params(5), 3).is_err());
 }
+
+#[test]
+fn one_record_pipeline_with_no_identifiable_order() {
+    let y: Vec<Vec<f64>> = (0..2).map(|c| noise(400, c)).collect();
+    let chans: Vec<&[f64]> = y.iter().map(Vec::as_slice).collect();
+    // 2 channels, 3 block rows: the highest order is 4, below order_min 10.
+    let p = SsiParams {
+        block_rows: 3,
+        order_min: 10,
+        order_max: 20,
+        ..SsiParams::default()
+    };
+    let (e, m) = msg(vibmode_ssi::identify_record(
+        &chans,
+        50.0,
+        &p,
+        &vibmode_ssi::RecordSsiOptions::default(),
+    ));
+    assert!(matches!(e, SsiError::NoOrder { max_order: 4, .. }), "{e:?}");
+    assert!(
+        m.contains("highest is 4") && m.contains("block_rows"),
+        "{m}"
+    );
+}

@@ -426,3 +426,97 @@ fn jackknife_std_by_hand() {
     assert_eq!(jackknife_std(&[7.0]), 0.0);
     assert_eq!(jackknife_std(&[]), 0.0);
 }
+
+/// The whole one-record pipeline (`vibmode ssi`, Python `ssi_cov`): the default order sweep
+/// (2..60) clustered over the orders. Over seeds 0..8 (20 000 samples): every true mode is a
+/// structural cluster within 1.5 % in frequency, 0.02 in damping and MAC > 0.99 (recall 24/24).
+/// Precision is lower, and stated: one record swept to order 60 (ten times the 6 states of the
+/// system) also gives clusters of noise poles that recur in half the orders or more, all first
+/// appearing at order 8 or above (14 or above for 10 of them) with shape MAC > 0.9 between orders;
+/// measured 11 such clusters over the 8 seeds (precision 24/35), at 7.6-21.9 Hz. Hence `vibmode
+/// ssi` names the orders a mode first appears at, and the analysis of many records requires a
+/// mode to recur over records.
+#[test]
+fn one_record_pipeline_clusters_the_true_modes_over_seeds() {
+    use vibmode_ssi::{identify_record, RecordSsiOptions};
+    let (mut found, mut spurious) = (0, Vec::new());
+    for seed in 0..8u64 {
+        let y = simulate(20_000, 100 + seed);
+        let chans: Vec<&[f64]> = y.iter().map(Vec::as_slice).collect();
+        let r = identify_record(
+            &chans,
+            FS,
+            &SsiParams::default(),
+            &RecordSsiOptions::default(),
+        )
+        .expect("identify");
+        let structural: Vec<_> = r
+            .modes
+            .iter()
+            .filter(|m| m.class == vibmode_core::ModeClass::Structural)
+            .collect();
+        for (k, &(f, z)) in MODES.iter().enumerate() {
+            let hit = structural.iter().any(|m| {
+                (m.frequency_hz - f).abs() < 0.015 * f
+                    && (m.damping_ratio - z).abs() < 0.02
+                    && m.shape
+                        .as_ref()
+                        .is_some_and(|s| mac(s, &real_shape(&SHAPES[k])) > 0.99)
+            });
+            found += usize::from(hit);
+        }
+        for m in &structural {
+            if !MODES
+                .iter()
+                .any(|&(f, _)| (m.frequency_hz - f).abs() < 0.03 * f)
+            {
+                spurious.push((seed, m.frequency_hz, m.damping_ratio));
+            }
+        }
+    }
+    assert_eq!(found, 24, "recall {found}/24");
+    assert!(
+        spurious.len() <= 11,
+        "spurious structural clusters: {spurious:?}"
+    );
+}
+
+/// Scaling a channel does not change what is identified (each channel is divided by its RMS
+/// first) and scales that channel's shape entry by the same factor (the shapes are in the
+/// channels' units): frequencies equal to 1e-9, shape ratio within 1e-6.
+#[test]
+fn one_record_pipeline_is_invariant_to_channel_units() {
+    use vibmode_ssi::{identify_record, RecordSsiOptions};
+    for seed in 0..4u64 {
+        let y = simulate(8_000, 200 + seed);
+        let mut scaled = y.clone();
+        for v in scaled[2].iter_mut() {
+            *v *= 1000.0;
+        }
+        let p = SsiParams {
+            order_min: 6,
+            order_max: 6,
+            ..SsiParams::default()
+        };
+        let run = |d: &Vec<Vec<f64>>| {
+            let c: Vec<&[f64]> = d.iter().map(Vec::as_slice).collect();
+            identify_record(&c, FS, &p, &RecordSsiOptions::default()).expect("identify")
+        };
+        let (a, b) = (run(&y), run(&scaled));
+        let (ma, mb) = (&a.result.orders[0].modes, &b.result.orders[0].modes);
+        assert_eq!(ma.len(), mb.len());
+        for (x, z) in ma.iter().zip(mb) {
+            assert!((x.frequency_hz - z.frequency_hz).abs() < 1e-9 * x.frequency_hz);
+            // Entry 2 relative to entry 0, in modulus.
+            let m = |s: &[[f64; 2]], i: usize| s[i][0].hypot(s[i][1]);
+            let ra = m(&x.shape, 2) / m(&x.shape, 0);
+            let rb = m(&z.shape, 2) / m(&z.shape, 0);
+            assert!(
+                (rb / ra / 1000.0 - 1.0).abs() < 1e-6,
+                "seed {seed}: ratio {} vs {}",
+                rb,
+                ra
+            );
+        }
+    }
+}

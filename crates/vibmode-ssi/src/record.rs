@@ -1,0 +1,162 @@
+//! One record's SSI-cov from start to end, as `vibmode ssi` and the Python `ssi_cov` run it:
+//! channels divided by their RMS, the order sweep, shapes back in the channels' units, the
+//! stabilisation labels, and the poles clustered over the orders into the modes that stay.
+
+use serde::{Deserialize, Serialize};
+use vibmode_core::{
+    ClusterParams, InvariantMode, ModeClass, PoleObservation, SsiParams, StabilityParams,
+};
+
+use crate::cov::{SsiCov, SsiResult};
+use crate::error::SsiError;
+use crate::stability::{stabilisation, Stability};
+
+/// What [`identify_record`] found.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RecordSsi {
+    /// Sampling rate, Hz.
+    pub fs_hz: f64,
+    /// Samples per channel.
+    pub n_samples: usize,
+    /// The parameters used (orders above what the data allows are dropped from the sweep, not
+    /// from here).
+    pub params: SsiParams,
+    /// The stabilisation criteria used.
+    pub stability_params: StabilityParams,
+    /// Every identified order's modes, shapes in the channels' units.
+    pub result: SsiResult,
+    /// Stability label of every mode of every order against the previous order (same nesting
+    /// as `result.orders[o].modes[m]`).
+    pub stability: Vec<Vec<Stability>>,
+    /// The poles below the valid band's top clustered over the orders (mean shape, spreads):
+    /// structural modes first, then the rest, each group by increasing frequency.
+    pub modes: Vec<InvariantMode>,
+}
+
+/// Options of [`identify_record`] beyond the SSI parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecordSsiOptions {
+    /// Divide each channel by its RMS before identification (so that strong channels do not
+    /// hide weak ones) and scale the shapes back (default true).
+    pub normalise: bool,
+    /// Poles at or above this frequency, Hz, are not clustered (default: Nyquist); give the
+    /// top of the valid band after an anti-alias filter.
+    pub valid_max_hz: Option<f64>,
+    /// Stabilisation criteria.
+    pub stability: StabilityParams,
+    /// Clustering of the poles over the orders (its `freq_max_hz` is set from `valid_max_hz`).
+    pub cluster: ClusterParams,
+}
+
+impl Default for RecordSsiOptions {
+    fn default() -> Self {
+        RecordSsiOptions {
+            normalise: true,
+            valid_max_hz: None,
+            stability: StabilityParams::default(),
+            cluster: ClusterParams::default(),
+        }
+    }
+}
+
+/// The RMS about the mean of each channel, 1 where it is zero or not finite.
+fn rms_scales(channels: &[&[f64]]) -> Vec<f64> {
+    channels
+        .iter()
+        .map(|c| {
+            let n = c.len().max(1) as f64;
+            let m = c.iter().sum::<f64>() / n;
+            let rms = (c.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / n).sqrt();
+            if rms > 0.0 && rms.is_finite() {
+                rms
+            } else {
+                1.0
+            }
+        })
+        .collect()
+}
+
+/// SSI-cov of one record (`channels[c]` = channel c's samples at `fs_hz`): the orders of
+/// `params` that the data can identify (at most [`SsiCov::max_order`]), each mode labelled
+/// against the previous order, and the poles clustered over the orders
+/// (`vibmode_modal::find_invariant_modes` with one record: a structural mode must recur in
+/// `min_order_share` of the orders).
+///
+/// Errors: those of [`SsiCov::new`] (channels, samples, parameters), no order of `params`
+/// identifiable ([`SsiError::NoOrder`]), a clustering parameter out of range.
+pub fn identify_record(
+    channels: &[&[f64]],
+    fs_hz: f64,
+    params: &SsiParams,
+    options: &RecordSsiOptions,
+) -> Result<RecordSsi, SsiError> {
+    params.validate()?;
+    let scales = if options.normalise {
+        rms_scales(channels)
+    } else {
+        vec![1.0; channels.len()]
+    };
+    let scaled: Vec<Vec<f64>> = channels
+        .iter()
+        .zip(&scales)
+        .map(|(c, s)| c.iter().map(|v| v / s).collect())
+        .collect();
+    let chans: Vec<&[f64]> = scaled.iter().map(Vec::as_slice).collect();
+    let plan = SsiCov::new(&chans, fs_hz, params)?;
+    let orders: Vec<usize> = params
+        .orders()
+        .into_iter()
+        .filter(|&o| o <= plan.max_order())
+        .collect();
+    if orders.is_empty() {
+        return Err(SsiError::NoOrder {
+            order_min: params.order_min,
+            n_channels: channels.len(),
+            block_rows: params.block_rows,
+            max_order: plan.max_order(),
+        });
+    }
+    let mut result = plan.sweep(&orders)?;
+    for o in &mut result.orders {
+        for m in &mut o.modes {
+            m.shape = vibmode_modal::shapes::rescaled(&m.shape, &scales);
+        }
+    }
+    let stability = stabilisation(&result, &options.stability);
+    let f_max = options.valid_max_hz.unwrap_or(fs_hz / 2.0);
+    let obs: Vec<PoleObservation> = result
+        .orders
+        .iter()
+        .flat_map(|o| {
+            o.modes
+                .iter()
+                .filter(|m| m.frequency_hz < f_max)
+                .map(move |m| {
+                    let mut q = PoleObservation::new(
+                        m.frequency_hz,
+                        m.damping_ratio,
+                        o.order,
+                        0,
+                        "ssi-cov",
+                    );
+                    q.shape = Some(m.shape.clone());
+                    q
+                })
+        })
+        .collect();
+    let cluster = ClusterParams {
+        freq_max_hz: Some(f_max),
+        ..options.cluster.clone()
+    };
+    let mut modes = vibmode_modal::find_invariant_modes(&obs, 1, &orders, &cluster)?;
+    modes.sort_by_key(|m| m.class != ModeClass::Structural);
+    Ok(RecordSsi {
+        fs_hz,
+        n_samples: channels.first().map_or(0, |c| c.len()),
+        params: params.clone(),
+        stability_params: options.stability.clone(),
+        result,
+        stability,
+        modes,
+    })
+}
