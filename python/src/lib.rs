@@ -15,6 +15,7 @@ mod ident;
 mod pipeline;
 mod signal;
 mod spectral;
+mod ssi;
 
 use pyo3::prelude::*;
 
@@ -27,5 +28,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     signal::register(m)?;
     pipeline::register(m)?;
     fleet::register(m)?;
+    ssi::register(m)?;
     Ok(())
 }

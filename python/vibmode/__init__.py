@@ -2,7 +2,7 @@
 
 scipy-compatible spectra (:func:`welch`, :func:`periodogram`, :func:`csd`, :func:`coherence`),
 the ideal DFT anti-alias resampling (:func:`resample_ideal`), AR / ARMA prediction-error models
-(:func:`fit_ar`, :func:`fit_arma`) and order sweeps (:func:`sweep`), reading recordings
+(:func:`fit_ar`, :func:`fit_arma`) and order sweeps (:func:`sweep`), multichannel SSI-cov with mode shapes (:func:`ssi_cov`), reading recordings
 (:func:`read`), the whole analysis (:func:`analyze`), the full-car model (:func:`fullcar`,
 :func:`simulate`) and fleet monitoring (:mod:`vibmode.fleet`), computed by vibmode's Rust core.
 
@@ -17,6 +17,7 @@ from ._io import Recording, read, resample_ideal, write
 from ._models import ArmaModel, SweepResult, fit_ar, fit_arma, sweep
 from ._native import __version__
 from ._spectral import coherence, csd, get_window, periodogram, welch
+from ._ssi import SsiResult, ssi_cov
 
 fleet_check = fleet.check
 
@@ -24,6 +25,7 @@ __all__ = [
     "ArmaModel",
     "Recording",
     "SimRecord",
+    "SsiResult",
     "Simulation",
     "SweepResult",
     "__version__",
@@ -41,6 +43,7 @@ __all__ = [
     "read",
     "resample_ideal",
     "simulate",
+    "ssi_cov",
     "sweep",
     "welch",
     "write",

@@ -37,6 +37,10 @@ def sweep(
     y: F64, fs: float, orders: Sequence[int], model: str, method: str, robust: Optional[float],
     max_iter: int, tol: float,
 ) -> str: ...
+def ssi_defaults() -> str: ...
+def ssi_cov(
+    data: F64, fs: float, ssi: str, stability: str, normalise: bool, valid_max_hz: Optional[float],
+) -> str: ...
 def read(
     path: str, fs: Optional[float] = None, scale: float = 1.0, unit: Optional[str] = None,
     allow_nonuniform: bool = False, format: Optional[str] = None, channels: Optional[List[str]] = None,
