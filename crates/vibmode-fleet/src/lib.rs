@@ -7,6 +7,7 @@
 //! limits from a false-alarm rate), [`assess`] (robust z-scores and the classification), and
 //! [`Store`] (the SQLite file: vehicles, records, features, model sets). See docs/fleet.md.
 
+pub mod body;
 pub mod config;
 pub mod error;
 pub mod features;
@@ -16,6 +17,7 @@ pub mod report;
 pub mod stats;
 pub mod store;
 
+pub use body::{fit_body_model, BodyModel, BodySpectra};
 pub use config::FleetConfig;
 pub use error::{FleetError, Result};
 pub use features::{
