@@ -239,10 +239,33 @@ mod tests {
         }
         let e = FleetConfig::from_toml_str("floor_side_ratio = 0", "fleet.toml").expect_err("0");
         assert!(e.to_string().contains("floor_side_ratio"), "{e}");
+        // The body response bands lie within the stored body band.
+        let e = FleetConfig::from_toml_str("body_response_bands_hz = [[2, 5]]", "fleet.toml")
+            .expect_err("beyond 4 Hz");
+        assert!(
+            e.to_string().contains("body_response_bands_hz") && e.to_string().contains("[2, 5]"),
+            "{e}"
+        );
+        let e = FleetConfig::from_toml_str("floor_body_response = -1", "fleet.toml")
+            .expect_err("negative");
+        assert!(e.to_string().contains("floor_body_response"), "{e}");
+        let c = FleetConfig::from_toml_str(
+            "body_band_hz = [0.4, 6]\nbody_response_bands_hz = [[2, 4], [4, 6]]",
+            "fleet.toml",
+        )
+        .expect("valid");
+        assert_eq!(c.body_response_bands_hz.len(), 2);
         // Settings stored before the ratios existed (no such keys) read with the defaults.
         let mut old = serde_json::to_value(FleetConfig::default()).expect("json");
         if let Some(map) = old.as_object_mut() {
-            for key in ["ratio_band_hz", "floor_side_ratio", "floor_track_ratio"] {
+            for key in [
+                "ratio_band_hz",
+                "floor_side_ratio",
+                "floor_track_ratio",
+                "body_band_hz",
+                "body_response_bands_hz",
+                "floor_body_response",
+            ] {
                 map.remove(key);
             }
         }

@@ -1007,6 +1007,31 @@ mod tests {
     }
 
     #[test]
+    fn records_without_body_spectra_give_no_body_response_and_say_so() {
+        // The records of `baseline()` have no body spectra (as records stored before them).
+        let set = baseline();
+        assert!(set.body.is_none());
+        assert!(
+            set.notes
+                .iter()
+                .any(|n| n.contains("no body response to wheel motion: 0 of 6")),
+            "{:?}",
+            set.notes
+        );
+        assert!(!set
+            .features
+            .iter()
+            .any(|f| f.meta.kind == Kind::BodyResponse));
+        // A model set stored before the body response (no `body`, no `notes`) reads.
+        let mut json = serde_json::to_value(&set).expect("json");
+        if let Some(map) = json.as_object_mut() {
+            map.remove("notes");
+        }
+        let back: ModelSet = serde_json::from_value(json).expect("old model set");
+        assert!(back.body.is_none() && back.notes.is_empty());
+    }
+
+    #[test]
     fn too_few_nominal_records_is_an_error() {
         let recs: Vec<RecordFeatures> = (0..4).map(|_| record(1.0, 0.2)).collect();
         let e = build_model_set("bus", &[], &recs, &FleetConfig::default()).expect_err("4 < 5");
