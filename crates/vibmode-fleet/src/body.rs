@@ -330,7 +330,7 @@ pub fn body_response(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     fn c(re: f64, im: f64) -> Complex64 {
@@ -410,30 +410,34 @@ mod tests {
     }
 
     /// xorshift64* uniform in (0, 1) and Box-Muller normals: no dependency for a test.
-    struct Rng(u64);
+    pub(crate) struct Rng(pub(crate) u64);
     impl Rng {
-        fn uniform(&mut self) -> f64 {
+        pub(crate) fn uniform(&mut self) -> f64 {
             self.0 ^= self.0 >> 12;
             self.0 ^= self.0 << 25;
             self.0 ^= self.0 >> 27;
             ((self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 + 0.5) / (1u64 << 53) as f64
         }
-        fn normal(&mut self) -> f64 {
+        pub(crate) fn normal(&mut self) -> f64 {
             let (a, b) = (self.uniform(), self.uniform());
             (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
         }
     }
 
-    const FS: f64 = 50.0;
-    const N: usize = 512;
-    const NU: usize = 3;
-    const NY: usize = 2;
-    const TAPS: usize = 4;
+    pub(crate) const FS: f64 = 50.0;
+    pub(crate) const N: usize = 512;
+    pub(crate) const NU: usize = 3;
+    pub(crate) const NY: usize = 2;
+    pub(crate) const TAPS: usize = 4;
 
     /// A record of a known MIMO FIR system `y_i[n] = sum_j sum_k b[i][j][k] u_j[n - k]`: the
     /// wheels share a common input, delayed by a record-specific lag (as the rear wheel sees
     /// the front wheel's road), plus their own.
-    fn fir_record(rng: &mut Rng, b: &[[[f64; TAPS]; NU]; NY], lag: usize) -> BodySpectra {
+    pub(crate) fn fir_record(
+        rng: &mut Rng,
+        b: &[[[f64; TAPS]; NU]; NY],
+        lag: usize,
+    ) -> BodySpectra {
         let warm = 64;
         let common: Vec<f64> = (0..N + warm + lag).map(|_| rng.normal()).collect();
         let u: Vec<Vec<f64>> = (0..NU)

@@ -1031,6 +1031,99 @@ mod tests {
         assert!(back.body.is_none() && back.notes.is_empty());
     }
 
+    /// A record whose body spectra come from the FIR system `b` of the body tests, with
+    /// unsprung channels FL, FR, RL and sprung channels RL, RR.
+    fn body_record(
+        rng: &mut crate::body::tests::Rng,
+        b: &[[[f64; crate::body::tests::TAPS]; 3]; 2],
+        lag: usize,
+    ) -> RecordFeatures {
+        let mut s = crate::body::tests::fir_record(rng, b, lag);
+        s.unsprung = vec![
+            "FL_unsprung".into(),
+            "FR_unsprung".into(),
+            "RL_unsprung".into(),
+        ];
+        s.sprung = vec!["RL_sprung".into(), "RR_sprung".into()];
+        let ch = |name: &str, role: Role, corner: Corner| ChannelFeatures {
+            name: name.into(),
+            role,
+            corner: Some(corner),
+            band_rms: vec![Some(1.0)],
+            modes: Vec::new(),
+            ratio_band_rms: None,
+        };
+        RecordFeatures {
+            analysis_fs_hz: 50.0,
+            duration_s: 10.24,
+            n_segments: 1,
+            bands_hz: vec![[2.0, 5.0]],
+            channels: vec![
+                ch("FL_unsprung", Role::Unsprung, Corner::FL),
+                ch("FR_unsprung", Role::Unsprung, Corner::FR),
+                ch("RL_unsprung", Role::Unsprung, Corner::RL),
+                ch("RL_sprung", Role::Sprung, Corner::RL),
+                ch("RR_sprung", Role::Sprung, Corner::RR),
+            ],
+            transmissibility: Vec::new(),
+            notes: Vec::new(),
+            body_spectra: Some(s),
+        }
+    }
+
+    #[test]
+    fn a_weaker_body_response_is_flagged_on_its_corner() {
+        let mut rng = crate::body::tests::Rng(0x5eed);
+        let mut b = [[[0.0; crate::body::tests::TAPS]; 3]; 2];
+        b.iter_mut()
+            .flatten()
+            .flatten()
+            .for_each(|x| *x = rng.normal());
+        let recs: Vec<RecordFeatures> = (0..8)
+            .map(|r| body_record(&mut rng, &b, 3 + 2 * r))
+            .collect();
+        let names: Vec<String> = (0..8).map(|i| format!("n{i}")).collect();
+        let cfg = FleetConfig {
+            body_band_hz: [1.0, 10.0],
+            body_response_bands_hz: vec![[2.0, 8.0]],
+            ..FleetConfig::default()
+        };
+        let set = build_model_set("bus", &names, &recs, &cfg).expect("set");
+        assert!(
+            set.body.is_some() && set.notes.is_empty(),
+            "{:?}",
+            set.notes
+        );
+        let body: Vec<&FeatureStat> = set
+            .features
+            .iter()
+            .filter(|f| f.meta.kind == Kind::BodyResponse)
+            .collect();
+        assert_eq!(body.len(), 2);
+        for f in &body {
+            // Leave-one-out values of an exact linear system: centred near 0, spread at the
+            // floor.
+            assert!(f.centre.abs() < 0.05 && f.sigma == 0.03, "{f:?}");
+            assert_eq!(f.meta.label, "body response to wheel motion 2-8 Hz");
+        }
+        // The same system: normal.
+        let a = assess(&set, &body_record(&mut rng, &b, 6));
+        assert_eq!(a.classification, Classification::Normal, "{a:?}");
+        // RL's body channel answers 20 % weaker (ln 0.64 = -0.45 in power, about -15
+        // spreads): vehicle, named RL, RR untouched.
+        let mut weak = b;
+        weak[0].iter_mut().flatten().for_each(|x| *x *= 0.8);
+        let a = assess(&set, &body_record(&mut rng, &weak, 6));
+        assert_eq!(a.classification, Classification::Vehicle, "{a:?}");
+        assert!(
+            a.summary
+                .starts_with("RL: body response to wheel motion 2-8 Hz -3"),
+            "{}",
+            a.summary
+        );
+        assert!(!a.summary.contains("RR:"), "{}", a.summary);
+    }
+
     #[test]
     fn too_few_nominal_records_is_an_error() {
         let recs: Vec<RecordFeatures> = (0..4).map(|_| record(1.0, 0.2)).collect();
