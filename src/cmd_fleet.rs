@@ -192,6 +192,9 @@ fn baseline(db: &std::path::Path, vehicle: &str) -> Result<()> {
             l.limit
         ));
     }
+    for n in &set.notes {
+        text.push_str(&format!("note: {n}\n"));
+    }
     crate::output::print_stdout(&text)
 }
 

@@ -46,6 +46,15 @@ pub struct FleetConfig {
     pub floor_side_ratio: f64,
     /// Floor of the spread of ln(front/rear unsprung level) of a side (default 0.03).
     pub floor_track_ratio: f64,
+    /// Band of the body's cross-spectra (sprung and unsprung channels) kept per record, for the
+    /// body's response to the wheel motions, Hz (default 0.4-4: the body modes).
+    pub body_band_hz: [f64; 2],
+    /// Bands of the body's response to the wheel motions (measured over predicted sprung power),
+    /// within `body_band_hz`, Hz (default 2-4: above the body modes, where the measured wheel
+    /// motions predict the body's within 2-3 % and a softer spring lowers it by about 20 %).
+    pub body_response_bands_hz: Vec<[f64; 2]>,
+    /// Floor of the spread of the body response, ln units (default 0.03).
+    pub floor_body_response: f64,
 }
 
 impl Default for FleetConfig {
@@ -75,6 +84,9 @@ impl Default for FleetConfig {
             ratio_band_hz: [8.0, 20.0],
             floor_side_ratio: 0.10,
             floor_track_ratio: 0.03,
+            body_band_hz: [0.4, 4.0],
+            body_response_bands_hz: vec![[2.0, 4.0]],
+            floor_body_response: 0.03,
         }
     }
 }
@@ -121,12 +133,10 @@ impl FleetConfig {
                 "must list at least one band, e.g. [[2, 5]]",
             ));
         }
-        for (key, b) in self
-            .bands_hz
-            .iter()
-            .map(|b| ("bands_hz", b))
-            .chain([("ratio_band_hz", &self.ratio_band_hz)])
-        {
+        for (key, b) in self.bands_hz.iter().map(|b| ("bands_hz", b)).chain([
+            ("ratio_band_hz", &self.ratio_band_hz),
+            ("body_band_hz", &self.body_band_hz),
+        ]) {
             if !(b[0].is_finite()
                 && b[1].is_finite()
                 && 0.0 <= b[0]
@@ -137,6 +147,18 @@ impl FleetConfig {
                     key,
                     format!("[{}, {}]", b[0], b[1]),
                     &format!("must be increasing bands between 0 and the analysis Nyquist frequency {nyquist} Hz"),
+                ));
+            }
+        }
+        for b in &self.body_response_bands_hz {
+            if !(b[0] < b[1] && self.body_band_hz[0] <= b[0] && b[1] <= self.body_band_hz[1]) {
+                return Err(bad(
+                    "body_response_bands_hz",
+                    format!("[{}, {}]", b[0], b[1]),
+                    &format!(
+                        "must be increasing bands within body_band_hz [{}, {}], e.g. [2, 4]",
+                        self.body_band_hz[0], self.body_band_hz[1]
+                    ),
                 ));
             }
         }
@@ -161,6 +183,7 @@ impl FleetConfig {
             ("floor_damping", self.floor_damping),
             ("floor_side_ratio", self.floor_side_ratio),
             ("floor_track_ratio", self.floor_track_ratio),
+            ("floor_body_response", self.floor_body_response),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(bad(
@@ -216,10 +239,33 @@ mod tests {
         }
         let e = FleetConfig::from_toml_str("floor_side_ratio = 0", "fleet.toml").expect_err("0");
         assert!(e.to_string().contains("floor_side_ratio"), "{e}");
+        // The body response bands lie within the stored body band.
+        let e = FleetConfig::from_toml_str("body_response_bands_hz = [[2, 5]]", "fleet.toml")
+            .expect_err("beyond 4 Hz");
+        assert!(
+            e.to_string().contains("body_response_bands_hz") && e.to_string().contains("[2, 5]"),
+            "{e}"
+        );
+        let e = FleetConfig::from_toml_str("floor_body_response = -1", "fleet.toml")
+            .expect_err("negative");
+        assert!(e.to_string().contains("floor_body_response"), "{e}");
+        let c = FleetConfig::from_toml_str(
+            "body_band_hz = [0.4, 6]\nbody_response_bands_hz = [[2, 4], [4, 6]]",
+            "fleet.toml",
+        )
+        .expect("valid");
+        assert_eq!(c.body_response_bands_hz.len(), 2);
         // Settings stored before the ratios existed (no such keys) read with the defaults.
         let mut old = serde_json::to_value(FleetConfig::default()).expect("json");
         if let Some(map) = old.as_object_mut() {
-            for key in ["ratio_band_hz", "floor_side_ratio", "floor_track_ratio"] {
+            for key in [
+                "ratio_band_hz",
+                "floor_side_ratio",
+                "floor_track_ratio",
+                "body_band_hz",
+                "body_response_bands_hz",
+                "floor_body_response",
+            ] {
                 map.remove(key);
             }
         }

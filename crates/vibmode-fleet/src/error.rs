@@ -55,6 +55,12 @@ pub enum FleetError {
         /// The identifier given.
         vehicle: String,
     },
+    /// The body's response to the wheel motions cannot be fitted from the nominal records.
+    #[error("body response to wheel motion: {reason}")]
+    BodyModel {
+        /// Why, with the fix.
+        reason: String,
+    },
     /// Too few nominal records for a baseline.
     #[error("vehicle '{vehicle}' has {found} nominal record(s) with features; a baseline needs at least {needed}: ingest more nominal runs")]
     TooFewNominal {

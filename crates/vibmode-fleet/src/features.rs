@@ -7,6 +7,8 @@ use vibmode_analysis::{analyze, cut_records, AnalysisConfig, Corner, Role};
 use vibmode_core::{ModeClass, Recording};
 use vibmode_spectra::{band_rms, WelchParams, Window};
 
+use crate::body::{body_spectra, BodySpectra};
+
 use crate::config::FleetConfig;
 use crate::error::{FleetError, Result};
 
@@ -70,6 +72,11 @@ pub struct RecordFeatures {
     pub transmissibility: Vec<CornerTransmissibility>,
     /// Why some features are missing.
     pub notes: Vec<String>,
+    /// Cross-spectra of the sprung and unsprung channels in `body_band_hz`, for the body's
+    /// response to the wheel motions; absent in records stored before it existed and in records
+    /// without both a sprung and an unsprung channel with a corner.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body_spectra: Option<BodySpectra>,
 }
 
 fn finite(x: f64) -> Option<f64> {
@@ -93,10 +100,50 @@ pub fn compute_features(name: &str, rec: &Recording, cfg: &FleetConfig) -> Resul
     let mut psd: Vec<Vec<f64>> = Vec::new();
     let mut freq: Vec<f64> = Vec::new();
     let mut fs = acfg.preprocess.analysis_fs_hz;
+    // Sprung and unsprung channels with a corner, in corner order: the body's outputs and
+    // inputs.
+    let by_role = |role: Role| -> Vec<usize> {
+        Corner::ALL
+            .iter()
+            .filter_map(|corner| {
+                rec.channels.iter().position(|ch| {
+                    let p = acfg.placement_of(ch);
+                    p.role == role && p.corner == Some(*corner)
+                })
+            })
+            .collect()
+    };
+    let (body_u, body_y) = (by_role(Role::Unsprung), by_role(Role::Sprung));
+    let mut body: Option<BodySpectra> = None;
     for r in &records {
         let pre = vibmode_signal::preprocess(&r.recording, &acfg.preprocess)
             .map_err(|e| fail(e.to_string()))?;
         fs = pre.band.fs_hz;
+        if !body_u.is_empty() && !body_y.is_empty() {
+            let samples = |idx: &[usize]| -> Vec<&[f64]> {
+                idx.iter()
+                    .map(|&c| pre.recording.channels[c].samples.as_slice())
+                    .collect()
+            };
+            let names = |idx: &[usize]| -> Vec<String> {
+                idx.iter().map(|&c| rec.channels[c].name.clone()).collect()
+            };
+            let s = body_spectra(
+                &samples(&body_u),
+                &samples(&body_y),
+                names(&body_u),
+                names(&body_y),
+                fs,
+                cfg.body_band_hz,
+            )
+            .map_err(|e| fail(e.to_string()))?;
+            body = Some(match body.take() {
+                None => s.scaled(1.0 / records.len() as f64),
+                Some(acc) => acc.add_scaled(&s, 1.0 / records.len() as f64).ok_or_else(|| {
+                    fail("its records give body spectra of different bins; give records of one length".into())
+                })?,
+            });
+        }
         for (c, ch) in pre.recording.channels.iter().enumerate() {
             let wp = WelchParams {
                 window: Window::Hann,
@@ -214,5 +261,6 @@ pub fn compute_features(name: &str, rec: &Recording, cfg: &FleetConfig) -> Resul
         channels,
         transmissibility,
         notes,
+        body_spectra: body,
     })
 }

@@ -2,11 +2,13 @@
 //! embedded SQLite store; every later record is classified `normal`, `road` (excitation out of
 //! the nominal range), `vehicle` (transmissibility or modes of a corner moved) or `both`.
 //!
-//! The stages: [`compute_features`] (band levels, transmissibility, modes of one file),
+//! The stages: [`compute_features`] (band levels, transmissibility, modes and the body
+//! cross-spectra of one file; [`body`]: the body's response to the wheel motions),
 //! [`build_model_set`] (median and MAD of every feature over the nominal records, control
 //! limits from a false-alarm rate), [`assess`] (robust z-scores and the classification), and
 //! [`Store`] (the SQLite file: vehicles, records, features, model sets). See docs/fleet.md.
 
+pub mod body;
 pub mod config;
 pub mod error;
 pub mod features;
@@ -16,6 +18,7 @@ pub mod report;
 pub mod stats;
 pub mod store;
 
+pub use body::{fit_body_model, BodyModel, BodySpectra};
 pub use config::FleetConfig;
 pub use error::{FleetError, Result};
 pub use features::{

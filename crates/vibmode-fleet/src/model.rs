@@ -7,6 +7,7 @@ use std::fmt;
 use serde::{Deserialize, Serialize};
 use vibmode_analysis::{Corner, Role};
 
+use crate::body::{body_response, fit_body_model, BodyModel, BodySpectra};
 use crate::config::FleetConfig;
 use crate::error::{FleetError, Result};
 use crate::features::RecordFeatures;
@@ -41,16 +42,20 @@ pub enum Kind {
     SideRatio,
     /// Front over rear unsprung level of a side (one track) at and above wheel hop.
     TrackRatio,
+    /// A sprung channel's measured power in a band over the power its record's own wheel
+    /// motions predict through the nominal body response `H(f)`.
+    BodyResponse,
 }
 
 /// Every kind, in the order of the model set's limits.
-const KINDS: [Kind; 6] = [
+const KINDS: [Kind; 7] = [
     Kind::Level,
     Kind::Transmissibility,
     Kind::ModeFrequency,
     Kind::ModeDamping,
     Kind::SideRatio,
     Kind::TrackRatio,
+    Kind::BodyResponse,
 ];
 
 /// The axles (left and right corner) and the sides (front and rear corner) of the unsprung
@@ -169,6 +174,13 @@ pub struct ModelSet {
     /// empty in model sets stored before this field existed: not checked).
     #[serde(default)]
     pub channels: Vec<String>,
+    /// The nominal body response to the wheel motions (absent when the nominal records have no
+    /// body spectra, or their pooled wheel cross-spectra are singular: `notes` says so).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body: Option<BodyModel>,
+    /// What the model set lacks and why.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
 }
 
 impl ModelSet {
@@ -276,13 +288,54 @@ fn band_key(b: &[f64; 2]) -> String {
     format!("{}-{}Hz", b[0], b[1])
 }
 
-/// Scalar features of a record, as ln(value), given the model set's modes.
+/// The body response features of a record against the nominal body response `body`: per
+/// sprung channel and band of `body_response_bands_hz`, `ln(sum_band S_yy / sum_band
+/// diag(H S_uu H^H))` (none if the record has no body spectra or other channels).
+fn body_features(
+    rf: &RecordFeatures,
+    body: &BodyModel,
+    cfg: &FleetConfig,
+) -> Vec<(FeatureMeta, f64)> {
+    let Some(s) = &rf.body_spectra else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for band in &cfg.body_response_bands_hz {
+        let Some(values) = body_response(body, s, *band) else {
+            return Vec::new();
+        };
+        for (name, v) in body.sprung.iter().zip(values) {
+            let Some(v) = v else { continue };
+            let corner = rf
+                .channels
+                .iter()
+                .find(|c| &c.name == name)
+                .and_then(|c| c.corner);
+            out.push((
+                FeatureMeta {
+                    key: format!("body:{name}:{}", band_key(band)),
+                    group: Group::Vehicle,
+                    kind: Kind::BodyResponse,
+                    corner,
+                    channel: name.clone(),
+                    label: format!("body response to wheel motion {}", band_label(band)),
+                },
+                v,
+            ));
+        }
+    }
+    out
+}
+
+/// Scalar features of a record, as ln(value), given the model set's modes and nominal body
+/// response.
 pub fn scalar_features(
     rf: &RecordFeatures,
     slots: &[ModeSlot],
+    body: Option<&BodyModel>,
     cfg: &FleetConfig,
 ) -> Vec<(FeatureMeta, f64)> {
-    let mut out = Vec::new();
+    let mut out = body.map_or_else(Vec::new, |b| body_features(rf, b, cfg));
     // Road level per band: the mean of ln(band RMS) over the unsprung channels that have it.
     for (k, b) in rf.bands_hz.iter().enumerate() {
         let logs: Vec<f64> = rf
@@ -476,6 +529,7 @@ fn floor_of(kind: Kind, cfg: &FleetConfig) -> f64 {
         Kind::ModeDamping => cfg.floor_damping,
         Kind::SideRatio => cfg.floor_side_ratio,
         Kind::TrackRatio => cfg.floor_track_ratio,
+        Kind::BodyResponse => cfg.floor_body_response,
     }
 }
 
@@ -483,7 +537,60 @@ fn floor_of(kind: Kind, cfg: &FleetConfig) -> f64 {
 /// noise level: their spread is pooled over the features of the kind (the deviations of every
 /// feature from its own median), which a handful of nominal records alone would estimate badly.
 fn pooled(kind: Kind) -> bool {
-    matches!(kind, Kind::SideRatio | Kind::TrackRatio)
+    matches!(
+        kind,
+        Kind::SideRatio | Kind::TrackRatio | Kind::BodyResponse
+    )
+}
+
+/// The nominal body response from the records' body spectra, and each record's body features
+/// against the response fitted on the other records (leave-one-out: a record's own spectra
+/// pull `H` towards it, so its in-sample residual would understate the scatter of a new
+/// record's). `None` (with a note) when not every record has body spectra or the fit fails.
+type BodyFit = (BodyModel, Vec<Vec<(FeatureMeta, f64)>>);
+
+fn fit_body(
+    records: &[RecordFeatures],
+    cfg: &FleetConfig,
+    notes: &mut Vec<String>,
+) -> Option<BodyFit> {
+    if cfg.body_response_bands_hz.is_empty() {
+        return None;
+    }
+    let spectra: Vec<&BodySpectra> = records
+        .iter()
+        .filter_map(|r| r.body_spectra.as_ref())
+        .collect();
+    if spectra.len() < records.len() {
+        notes.push(format!(
+            "no body response to wheel motion: {} of {} nominal records have body spectra (records stored before them, or without sprung and unsprung channels)",
+            spectra.len(),
+            records.len()
+        ));
+        return None;
+    }
+    let model = match fit_body_model(&spectra) {
+        Ok(m) => m,
+        Err(e) => {
+            notes.push(format!("no {e}"));
+            return None;
+        }
+    };
+    let loo = records
+        .iter()
+        .enumerate()
+        .map(|(i, record)| {
+            let others: Vec<&BodySpectra> = spectra
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != i)
+                .map(|(_, s)| *s)
+                .collect();
+            // A record whose others are singular is left out of the statistics.
+            fit_body_model(&others).map_or_else(|_| Vec::new(), |m| body_features(record, &m, cfg))
+        })
+        .collect();
+    Some((model, loo))
 }
 
 /// Statistics of every feature present in at least `max(3, mode_min_share * n)` records.
@@ -556,9 +663,18 @@ pub fn build_model_set(
         });
     }
     let slots = mode_slots(records, cfg);
+    let mut notes = Vec::new();
+    let body = fit_body(records, cfg, &mut notes);
     let values: Vec<Vec<(FeatureMeta, f64)>> = records
         .iter()
-        .map(|r| scalar_features(r, &slots, cfg))
+        .enumerate()
+        .map(|(i, r)| {
+            let mut v = scalar_features(r, &slots, None, cfg);
+            if let Some((_, loo)) = &body {
+                v.extend(loo[i].iter().cloned());
+            }
+            v
+        })
         .collect();
     let features = feature_stats(&values, cfg);
     if !features.iter().any(|f| f.meta.group == Group::Vehicle) {
@@ -621,6 +737,8 @@ pub fn build_model_set(
             .first()
             .map(|r| r.channels.iter().map(|c| c.name.clone()).collect())
             .unwrap_or_default(),
+        body: body.map(|b| b.0),
+        notes,
     })
 }
 
@@ -642,7 +760,7 @@ fn score(f: &FeatureStat, x: f64, cfg: &FleetConfig) -> f64 {
 
 /// Scores a record against the model set.
 pub fn assess(set: &ModelSet, rf: &RecordFeatures) -> Assessment {
-    let values = scalar_features(rf, &set.slots, &set.config);
+    let values = scalar_features(rf, &set.slots, set.body.as_ref(), &set.config);
     score_values(set, &values)
 }
 
@@ -821,6 +939,7 @@ mod tests {
                 values: vec![Some(trans)],
             }],
             notes: Vec::new(),
+            body_spectra: None,
         }
     }
 
@@ -888,6 +1007,124 @@ mod tests {
     }
 
     #[test]
+    fn records_without_body_spectra_give_no_body_response_and_say_so() {
+        // The records of `baseline()` have no body spectra (as records stored before them).
+        let set = baseline();
+        assert!(set.body.is_none());
+        assert!(
+            set.notes
+                .iter()
+                .any(|n| n.contains("no body response to wheel motion: 0 of 6")),
+            "{:?}",
+            set.notes
+        );
+        assert!(!set
+            .features
+            .iter()
+            .any(|f| f.meta.kind == Kind::BodyResponse));
+        // A model set stored before the body response (no `body`, no `notes`) reads.
+        let mut json = serde_json::to_value(&set).expect("json");
+        if let Some(map) = json.as_object_mut() {
+            map.remove("notes");
+        }
+        let back: ModelSet = serde_json::from_value(json).expect("old model set");
+        assert!(back.body.is_none() && back.notes.is_empty());
+    }
+
+    /// A record whose body spectra come from the FIR system `b` of the body tests, with
+    /// unsprung channels FL, FR, RL and sprung channels RL, RR.
+    fn body_record(
+        rng: &mut crate::body::tests::Rng,
+        b: &[[[f64; crate::body::tests::TAPS]; 3]; 2],
+        lag: usize,
+    ) -> RecordFeatures {
+        let mut s = crate::body::tests::fir_record(rng, b, lag);
+        s.unsprung = vec![
+            "FL_unsprung".into(),
+            "FR_unsprung".into(),
+            "RL_unsprung".into(),
+        ];
+        s.sprung = vec!["RL_sprung".into(), "RR_sprung".into()];
+        let ch = |name: &str, role: Role, corner: Corner| ChannelFeatures {
+            name: name.into(),
+            role,
+            corner: Some(corner),
+            band_rms: vec![Some(1.0)],
+            modes: Vec::new(),
+            ratio_band_rms: None,
+        };
+        RecordFeatures {
+            analysis_fs_hz: 50.0,
+            duration_s: 10.24,
+            n_segments: 1,
+            bands_hz: vec![[2.0, 5.0]],
+            channels: vec![
+                ch("FL_unsprung", Role::Unsprung, Corner::FL),
+                ch("FR_unsprung", Role::Unsprung, Corner::FR),
+                ch("RL_unsprung", Role::Unsprung, Corner::RL),
+                ch("RL_sprung", Role::Sprung, Corner::RL),
+                ch("RR_sprung", Role::Sprung, Corner::RR),
+            ],
+            transmissibility: Vec::new(),
+            notes: Vec::new(),
+            body_spectra: Some(s),
+        }
+    }
+
+    #[test]
+    fn a_weaker_body_response_is_flagged_on_its_corner() {
+        let mut rng = crate::body::tests::Rng(0x5eed);
+        let mut b = [[[0.0; crate::body::tests::TAPS]; 3]; 2];
+        b.iter_mut()
+            .flatten()
+            .flatten()
+            .for_each(|x| *x = rng.normal());
+        let recs: Vec<RecordFeatures> = (0..8)
+            .map(|r| body_record(&mut rng, &b, 3 + 2 * r))
+            .collect();
+        let names: Vec<String> = (0..8).map(|i| format!("n{i}")).collect();
+        let cfg = FleetConfig {
+            body_band_hz: [1.0, 10.0],
+            body_response_bands_hz: vec![[2.0, 8.0]],
+            ..FleetConfig::default()
+        };
+        let set = build_model_set("bus", &names, &recs, &cfg).expect("set");
+        assert!(
+            set.body.is_some() && set.notes.is_empty(),
+            "{:?}",
+            set.notes
+        );
+        let body: Vec<&FeatureStat> = set
+            .features
+            .iter()
+            .filter(|f| f.meta.kind == Kind::BodyResponse)
+            .collect();
+        assert_eq!(body.len(), 2);
+        for f in &body {
+            // Leave-one-out values of an exact linear system: centred near 0, spread at the
+            // floor.
+            assert!(f.centre.abs() < 0.05 && f.sigma == 0.03, "{f:?}");
+            assert_eq!(f.meta.label, "body response to wheel motion 2-8 Hz");
+        }
+        // The same system: normal.
+        let a = assess(&set, &body_record(&mut rng, &b, 6));
+        assert_eq!(a.classification, Classification::Normal, "{a:?}");
+        // RL's body channel answers 20 % weaker (ln 0.64 = -0.45 in power, about -15
+        // spreads): vehicle, named RL, RR untouched.
+        let mut weak = b;
+        weak[0].iter_mut().flatten().for_each(|x| *x *= 0.8);
+        let a = assess(&set, &body_record(&mut rng, &weak, 6));
+        assert_eq!(a.classification, Classification::Vehicle, "{a:?}");
+        assert!(
+            a.summary
+                .starts_with("RL: body response to wheel motion 2-8 Hz -3"),
+            "{}",
+            a.summary
+        );
+        assert!(!a.summary.contains("RR:"), "{}", a.summary);
+    }
+
+    #[test]
     fn too_few_nominal_records_is_an_error() {
         let recs: Vec<RecordFeatures> = (0..4).map(|_| record(1.0, 0.2)).collect();
         let e = build_model_set("bus", &[], &recs, &FleetConfig::default()).expect_err("4 < 5");
@@ -916,6 +1153,7 @@ mod tests {
             channels,
             transmissibility: Vec::new(),
             notes: Vec::new(),
+            body_spectra: None,
         }
     }
 

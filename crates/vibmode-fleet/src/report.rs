@@ -149,7 +149,7 @@ fn trend_figure(html: &mut HtmlReport, set: &ModelSet, records: &[RecordEntry]) 
     let values: Vec<Vec<(String, f64)>> = records
         .iter()
         .map(|(_, f, _)| {
-            scalar_features(f, &set.slots, &set.config)
+            scalar_features(f, &set.slots, set.body.as_ref(), &set.config)
                 .into_iter()
                 .map(|(m, v)| (m.key, v))
                 .collect()
@@ -236,6 +236,7 @@ fn trend_figure(html: &mut HtmlReport, set: &ModelSet, records: &[RecordEntry]) 
                 crate::model::Kind::Level => "m/s^2",
                 crate::model::Kind::SideRatio => "left / right unsprung RMS",
                 crate::model::Kind::TrackRatio => "front / rear unsprung RMS",
+                crate::model::Kind::BodyResponse => "measured / predicted sprung power",
             };
             Panel::new(title, "record (ingest order)", unit)
                 .with_series(band(1.0))

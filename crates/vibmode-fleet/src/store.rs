@@ -736,6 +736,7 @@ mod tests {
             }],
             transmissibility: Vec::new(),
             notes: Vec::new(),
+            body_spectra: None,
         }
     }
 

@@ -6,9 +6,10 @@
 //! (docs/fleet.md states it against the issue's targets). Measured (`cargo test --release -p
 //! vibmode-fleet --test acceptance -- --nocapture`): healthy 59/60 normal; road D 23/24 road;
 //! RL damper at 50 % 24/24 vehicle, RL named every time; FL tyre -30 % 24/24 vehicle, FL named
-//! every time; RL damper -30 % 23/24 (RL named in 21), -20 % 9/24, -10 % 0/24; rear springs
-//! -20 % 2/24 (not detected). `FAR=0.05` repeats it at a 5 % false-alarm rate;
-//! `FLEET_DEBUG=1` prints the summary of every record not classed normal.
+//! every time; rear springs -20 % 24/24 vehicle, RL and RR named every time (the body response
+//! to wheel motion 2-4 Hz); RL damper -30 % 24/24 (RL named in 24), -20 % 22/24 (20), -10 %
+//! 1/24. `FAR=0.05` repeats it at a 5 % false-alarm rate (healthy 57/60; damper -20 % 23/24,
+//! -10 % 4/24); `FLEET_DEBUG=1` prints the summary of every record not classed normal.
 
 use std::collections::BTreeMap;
 
@@ -37,13 +38,13 @@ fn record(v: &VehicleParams, road: RoadClass, kmh: f64, seed: u64) -> vibmode_co
         .recording
 }
 
-/// (label, vehicle, road, speeds km/h, corner that must be named).
+/// (label, vehicle, road, speeds km/h, corners that must all be named).
 type Scenario = (
     String,
     VehicleParams,
     RoadClass,
     Vec<f64>,
-    Option<&'static str>,
+    &'static [&'static str],
 );
 
 fn with(bus: &VehicleParams, cc: CornerCondition) -> VehicleParams {
@@ -120,35 +121,35 @@ fn issue_scenarios_over_three_baselines() {
                 bus.clone(),
                 RoadClass::B,
                 (0..20).map(|i| 20.0 + i as f64).collect(),
-                None,
+                &[],
             ),
             (
                 "road D".into(),
                 bus.clone(),
                 RoadClass::D,
                 vec![30.0; 8],
-                None,
+                &[],
             ),
             (
                 "RL damper 50 %".into(),
                 rl_damper(0.5),
                 RoadClass::B,
                 vec![30.0; 8],
-                Some("RL"),
+                &["RL"],
             ),
             (
                 "FL tyre -30 %".into(),
                 fl_tyre.clone(),
                 RoadClass::B,
                 vec![30.0; 8],
-                Some("FL"),
+                &["FL"],
             ),
             (
                 "rear springs -20 %".into(),
                 rear_springs.clone(),
                 RoadClass::B,
                 vec![30.0; 8],
-                None,
+                &["RL", "RR"],
             ),
         ];
         for loss in [0.1, 0.2, 0.3] {
@@ -157,10 +158,10 @@ fn issue_scenarios_over_three_baselines() {
                 rl_damper(1.0 - loss),
                 RoadClass::B,
                 vec![30.0; 8],
-                Some("RL"),
+                &["RL"],
             ));
         }
-        for (k, (label, v, road, speeds, corner)) in scen.iter().enumerate() {
+        for (k, (label, v, road, speeds, corners)) in scen.iter().enumerate() {
             for (j, kmh) in speeds.iter().enumerate() {
                 let rec = record(v, *road, *kmh, base * 100_000 + k as u64 * 100 + j as u64);
                 let c = check_recording(
@@ -186,12 +187,13 @@ fn issue_scenarios_over_three_baselines() {
                     );
                 }
                 *confusion.entry((label.clone(), cls)).or_default() += 1;
-                if let Some(corner) = corner {
-                    if matches!(cls, Classification::Vehicle | Classification::Both)
-                        && c.assessment.summary.contains(&format!("{corner}:"))
-                    {
-                        *named.entry(label.clone()).or_default() += 1;
-                    }
+                if !corners.is_empty()
+                    && matches!(cls, Classification::Vehicle | Classification::Both)
+                    && corners
+                        .iter()
+                        .all(|corner| c.assessment.summary.contains(&format!("{corner}:")))
+                {
+                    *named.entry(label.clone()).or_default() += 1;
                 }
             }
         }
@@ -221,9 +223,17 @@ fn issue_scenarios_over_three_baselines() {
         named.get("FL tyre -30 %").copied().unwrap_or(0) >= 21,
         "{table}"
     );
-    // The sweep: a 30 % loss is caught (measured 23 of 24 at 1 %, 24 at 5 %), 20 % in part
-    // (9 and 12 of 24), 10 % at the false-alarm rate.
-    assert!(flagged("RL damper -30 %") >= 20, "{table}");
-    assert!(flagged("RL damper -10 %") <= 3, "{table}");
-    // Rear springs 20 % softer are not detected (2 of 24, 3 at 5 %): docs/fleet.md.
+    // Rear springs 20 % softer (issue: vehicle): measured 24 of 24 at 1 % and at 5 %, both rear
+    // corners named every time by the body response to wheel motion 2-4 Hz (-15 to -21 %).
+    assert!(flagged("rear springs -20 %") >= 21, "{table}");
+    assert!(
+        named.get("rear springs -20 %").copied().unwrap_or(0) >= 21,
+        "{table}"
+    );
+    // The sweep: a 30 % loss is caught (measured 24 of 24 at 1 % and 5 %), 20 % in most records
+    // (22 and 23 of 24), 10 % hardly (1 of 24 at 1 %, 4 at 5 %).
+    assert!(flagged("RL damper -30 %") >= 21, "{table}");
+    assert!(flagged("RL damper -20 %") >= 19, "{table}");
+    let ten_pct_bound = if cfg.false_alarm_rate <= 0.01 { 3 } else { 6 };
+    assert!(flagged("RL damper -10 %") <= ten_pct_bound, "{table}");
 }
