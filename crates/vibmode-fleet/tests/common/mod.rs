@@ -4,13 +4,17 @@
 use vibmode_fleet::FleetConfig;
 
 /// A faster analysis than the default (AR sweep to order 16) so several seeds run in seconds.
-/// `FAR=0.05 cargo test ...` repeats a run at another false-alarm rate (docs/fleet.md).
+/// `FAR=0.05 cargo test ...` repeats a run at another false-alarm rate (docs/fleet.md);
+/// `NO_BODY=1` leaves out the body response to wheel motion (to measure what it adds).
 pub fn config() -> FleetConfig {
     let mut c = FleetConfig::default();
     c.analysis.sweep.model = vibmode_analysis::SweepModel::Ar;
     c.analysis.sweep.order_max = 16;
     if let Some(v) = std::env::var("FAR").ok().and_then(|v| v.parse().ok()) {
         c.false_alarm_rate = v;
+    }
+    if std::env::var("NO_BODY").is_ok() {
+        c.body_response_bands_hz.clear();
     }
     c
 }
