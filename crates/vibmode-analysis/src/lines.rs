@@ -12,7 +12,9 @@
 use serde::{Deserialize, Serialize};
 use vibmode_core::{InvariantMode, LineParams, ModeClass};
 use vibmode_signal::Preprocessed;
-use vibmode_spectra::{line_candidates, narrowband_moments, LineCandidate};
+use vibmode_spectra::{
+    line_candidates, narrowband_moments, swept_line_candidates, LineCandidate, SweptCandidate,
+};
 
 /// A cluster the damping rule calls periodic is structural when its narrow-band kurtosis is at
 /// least this. Gaussian noise has 3, but in a 10 s record a 0.5 Hz band holds only ~5 DFT bins
@@ -47,6 +49,60 @@ pub struct LineTrack {
     /// moments pooled over those records (lowest over the pool's channels; 1.5 for a sine of
     /// steady amplitude, 3 for noise).
     pub kurtosis: f64,
+    /// Where the line swept within a record (its frequency moved by at least
+    /// `sweep_min_range_hz`, e.g. a driveline order while braking): the ridge in each record
+    /// (all records, in order; `None` where it did not sweep). A record holds a steady
+    /// frequency (`record_hz`) or a sweep, not both. `frequency_hz`, `frequency_range_hz` and
+    /// `kurtosis` are those of the steady records when there are any, else of the sweeps (a
+    /// track of sweeps alone never classes a cluster). Empty in files written before swept
+    /// lines.
+    #[serde(default)]
+    pub record_sweep: Vec<Option<LineSweep>>,
+}
+
+impl LineTrack {
+    /// True when the line was found steady in at least one record (only such tracks class
+    /// clusters: a sweep passes through a structural mode's band without being it).
+    pub fn has_steady_record(&self) -> bool {
+        self.record_hz.iter().any(Option::is_some)
+    }
+}
+
+/// A line whose frequency moved within one record: the ridge of the short-time spectra it
+/// followed, as an order-tracking plot or a spectrogram shows it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LineSweep {
+    /// Frequency at the first slice of the ridge, Hz.
+    pub start_hz: f64,
+    /// Frequency at the last slice, Hz.
+    pub end_hz: f64,
+    /// Lowest and highest frequency of the ridge, Hz.
+    pub range_hz: (f64, f64),
+    /// Mean frequency over the ridge's slices, Hz.
+    pub mean_hz: f64,
+    /// Kurtosis of the signal demodulated along the ridge (1.5 sine, 3 noise; lowest over the
+    /// pool's channels that saw the ridge).
+    pub kurtosis: f64,
+    /// Centre of each slice, s from the start of the record.
+    pub time_s: Vec<f64>,
+    /// Ridge frequency in each slice, Hz.
+    pub freq_hz: Vec<f64>,
+}
+
+impl LineSweep {
+    fn from_candidate(c: &SweptCandidate) -> Self {
+        let f = &c.ridge.freq_hz;
+        let (lo, hi) = c.ridge.span_hz();
+        LineSweep {
+            start_hz: f.first().copied().unwrap_or(f64::NAN),
+            end_hz: f.last().copied().unwrap_or(f64::NAN),
+            range_hz: (lo, hi),
+            mean_hz: f.iter().sum::<f64>() / f.len().max(1) as f64,
+            kurtosis: c.kurtosis,
+            time_s: c.ridge.time_s.clone(),
+            freq_hz: f.clone(),
+        }
+    }
 }
 
 /// The signals of the analysis, for the line evidence.
@@ -58,6 +114,8 @@ pub(crate) struct LineStage<'a> {
     /// Periodic candidates below the cutoff per record and channel, computed once (a channel is
     /// in its own pool, its role's and the multichannel one); empty for records not used.
     candidates: Vec<Vec<Vec<LineCandidate>>>,
+    /// Swept lines (periodic ridges below the cutoff) per record and channel, likewise.
+    swept: Vec<Vec<Vec<SweptCandidate>>>,
 }
 
 impl<'a> LineStage<'a> {
@@ -84,11 +142,32 @@ impl<'a> LineStage<'a> {
                     .collect()
             })
             .collect();
+        let swept = pre
+            .iter()
+            .zip(&used)
+            .map(|(p, &u)| {
+                if !(u && enabled) {
+                    return Vec::new();
+                }
+                p.recording
+                    .channels
+                    .iter()
+                    .map(|ch| {
+                        swept_line_candidates(&ch.samples, p.band.fs_hz, params)
+                            .unwrap_or_default()
+                            .into_iter()
+                            .filter(|c| c.periodic && c.ridge.span_hz().1 < p.band.cutoff_hz)
+                            .collect()
+                    })
+                    .collect()
+            })
+            .collect();
         LineStage {
             pre,
             used,
             params,
             candidates,
+            swept,
         }
     }
 
@@ -137,7 +216,7 @@ impl<'a> LineStage<'a> {
         let per_record = self.record_lines(channels);
         let n_used = self.used.iter().filter(|&&u| u).count().max(1);
         // A track must also look periodic with its records pooled (see `pooled_kurtosis`).
-        track(&per_record, self.params, n_used)
+        let steady: Vec<LineTrack> = track(&per_record, self.params, n_used)
             .into_iter()
             .filter_map(|mut t| {
                 // Pooled over the track's own records: testing a steady track in every record
@@ -149,6 +228,53 @@ impl<'a> LineStage<'a> {
                 let k = self.pooled_kurtosis(&at, channels)?;
                 t.kurtosis = k;
                 (k < self.params.max_kurtosis).then_some(t)
+            })
+            .collect();
+        attach_sweeps(steady, &self.record_sweeps(channels), self.params, n_used)
+    }
+
+    /// Swept lines of each record, merged over the `channels`: ridges of two channels are one
+    /// line when their frequencies differ by at most `half_width_hz` (median over the slices of
+    /// the shorter); the ridge found in more slices is kept, with the lower kurtosis of the two.
+    fn record_sweeps(&self, channels: &[usize]) -> Vec<Vec<LineSweep>> {
+        let hw = self.params.half_width_hz;
+        self.swept
+            .iter()
+            .map(|per_channel| {
+                let mut all: Vec<&SweptCandidate> = channels
+                    .iter()
+                    .filter_map(|&c| per_channel.get(c))
+                    .flatten()
+                    .collect();
+                all.sort_by(|a, b| {
+                    b.ridge
+                        .n_found
+                        .cmp(&a.ridge.n_found)
+                        .then(a.kurtosis.total_cmp(&b.kurtosis))
+                });
+                let mut kept: Vec<(&SweptCandidate, f64)> = Vec::new();
+                for c in all {
+                    let same = kept.iter_mut().find(|(k, _)| {
+                        let mut d: Vec<f64> = c
+                            .ridge
+                            .time_s
+                            .iter()
+                            .zip(&c.ridge.freq_hz)
+                            .filter_map(|(t, f)| k.ridge.freq_at(*t).map(|g| (g - f).abs()))
+                            .collect();
+                        median(&mut d).is_some_and(|m| m <= hw)
+                    });
+                    match same {
+                        Some((_, k)) => *k = k.min(c.kurtosis),
+                        None => kept.push((c, c.kurtosis)),
+                    }
+                }
+                kept.into_iter()
+                    .map(|(c, k)| LineSweep {
+                        kurtosis: k,
+                        ..LineSweep::from_candidate(c)
+                    })
+                    .collect()
             })
             .collect()
     }
@@ -206,7 +332,7 @@ impl<'a> LineStage<'a> {
             let Some(k) = k else { continue };
             // A tracked line at the cluster's frequency (the kurtosis at the cluster's mean
             // frequency can miss the line's peak by a few bins).
-            let on_track = tracks.iter().any(|t| {
+            let on_track = tracks.iter().filter(|t| t.has_steady_record()).any(|t| {
                 t.frequency_range_hz.0 - 0.5 * hw <= m.frequency_hz
                     && m.frequency_hz <= t.frequency_range_hz.1 + 0.5 * hw
             });
@@ -403,11 +529,78 @@ pub(crate) fn track(
                 record_hz: t.hz,
                 record_share: share,
                 kurtosis: median(&mut t.kurtosis)?,
+                record_sweep: Vec::new(),
             })
         })
         .collect();
     out.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
     out
+}
+
+/// Adds the swept lines of each record (`sweeps[r]`) to the steady `tracks`: a sweep joins the
+/// track, free in its record, whose steady frequency in the nearest earlier record is within
+/// `track_rel_tol` of the sweep's start, or in the nearest later record within it of the sweep's
+/// end (the smallest relative distance first): braking sweeps a driveline order from its
+/// frequency before to its frequency after. A sweep that joins no track is a track of its own
+/// (`record_hz` all `None`), whatever its record share: a manoeuvre happens once.
+pub(crate) fn attach_sweeps(
+    mut tracks: Vec<LineTrack>,
+    sweeps: &[Vec<LineSweep>],
+    p: &LineParams,
+    n_used: usize,
+) -> Vec<LineTrack> {
+    let n = sweeps.len();
+    for t in &mut tracks {
+        t.record_sweep = vec![None; n];
+    }
+    let n_steady = tracks.len();
+    for (r, list) in sweeps.iter().enumerate() {
+        for s in list {
+            let mut best: Option<(usize, f64)> = None;
+            for (j, t) in tracks.iter().enumerate().take(n_steady) {
+                if t.record_hz.get(r).is_some_and(Option::is_some)
+                    || t.record_sweep.get(r).is_some_and(Option::is_some)
+                {
+                    continue;
+                }
+                let before = t.record_hz[..r.min(t.record_hz.len())]
+                    .iter()
+                    .rev()
+                    .flatten()
+                    .next()
+                    .map(|f| (s.start_hz - f).abs() / f);
+                let after = t
+                    .record_hz
+                    .get(r + 1..)
+                    .and_then(|v| v.iter().flatten().next())
+                    .map(|f| (s.end_hz - f).abs() / f);
+                let d = [before, after]
+                    .into_iter()
+                    .flatten()
+                    .fold(f64::INFINITY, f64::min);
+                if d <= p.track_rel_tol && best.map_or(true, |(_, b)| d < b) {
+                    best = Some((j, d));
+                }
+            }
+            match best {
+                Some((j, _)) => tracks[j].record_sweep[r] = Some(s.clone()),
+                None => {
+                    let mut record_sweep = vec![None; n];
+                    record_sweep[r] = Some(s.clone());
+                    tracks.push(LineTrack {
+                        frequency_hz: s.mean_hz,
+                        frequency_range_hz: s.range_hz,
+                        record_hz: vec![None; n],
+                        record_share: 1.0 / n_used.max(1) as f64,
+                        kurtosis: s.kurtosis,
+                        record_sweep,
+                    });
+                }
+            }
+        }
+    }
+    tracks.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+    tracks
 }
 
 #[cfg(test)]
@@ -479,5 +672,48 @@ mod tests {
         assert_eq!(t.len(), 1);
         assert_eq!(t[0].record_hz, vec![Some(7.0), Some(7.1), None, Some(7.05)]);
         assert!((t[0].record_share - 0.75).abs() < 1e-12);
+    }
+
+    fn sweep(start: f64, end: f64) -> LineSweep {
+        LineSweep {
+            start_hz: start,
+            end_hz: end,
+            range_hz: (start.min(end), start.max(end)),
+            mean_hz: 0.5 * (start + end),
+            kurtosis: 1.6,
+            time_s: vec![1.0, 9.0],
+            freq_hz: vec![start, end],
+        }
+    }
+
+    #[test]
+    fn a_braking_sweep_joins_the_track_it_leaves_and_a_lone_sweep_is_its_own_track() {
+        let p = LineParams::default();
+        // 7 Hz driveline line, braked to 5.2 Hz in record 1; 11 Hz steady; a sweep 2->3 Hz
+        // that continues nothing.
+        let recs = vec![
+            Some(vec![line(7.0, 20.0), line(11.0, 20.0)]),
+            Some(vec![line(11.0, 20.0)]),
+            Some(vec![line(5.2, 20.0), line(11.05, 20.0)]),
+        ];
+        let steady = track(&recs, &p, 3);
+        assert_eq!(steady.len(), 3, "{steady:?}"); // 7, 11 and (new) 5.2
+        let sweeps = vec![vec![], vec![sweep(7.0, 5.3), sweep(2.0, 3.0)], vec![]];
+        let t = attach_sweeps(steady, &sweeps, &p, 3);
+        assert_eq!(t.len(), 4, "{t:?}");
+        // The lone sweep: its own track of sweeps at 2.5 Hz, first by frequency.
+        assert!((t[0].frequency_hz - 2.5).abs() < 1e-12);
+        assert!(!t[0].has_steady_record());
+        assert_eq!(t[0].record_sweep[1].as_ref().map(|s| s.end_hz), Some(3.0));
+        // The braking sweep on the 7 Hz track (it starts there), not on the 5.2 Hz one (its
+        // end is 1.9 % away: within tolerance, but farther).
+        let seven = t.iter().find(|x| x.frequency_hz == 7.0).unwrap();
+        let five = t.iter().find(|x| x.frequency_hz == 5.2).unwrap();
+        assert_eq!(seven.record_sweep[1].as_ref().map(|s| s.end_hz), Some(5.3));
+        assert!(five.record_sweep.iter().all(Option::is_none), "{t:?}");
+        assert_eq!(seven.record_hz, vec![Some(7.0), None, None]);
+        // The 11 Hz track is steady in record 1: no sweep there.
+        let eleven = t.iter().find(|x| x.frequency_hz == 11.0).unwrap();
+        assert!(eleven.record_sweep.iter().all(Option::is_none));
     }
 }
