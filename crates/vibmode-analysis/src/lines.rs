@@ -66,6 +66,27 @@ impl LineTrack {
     pub fn has_steady_record(&self) -> bool {
         self.record_hz.iter().any(Option::is_some)
     }
+
+    /// Frequency, range and kurtosis from the sweeps (a track without a steady record): the
+    /// median of their mean frequencies, their lowest and highest frequency, the median of
+    /// their kurtosis.
+    fn summarise_sweeps(&mut self) {
+        let sweeps: Vec<&LineSweep> = self.record_sweep.iter().flatten().collect();
+        let mut mean: Vec<f64> = sweeps.iter().map(|s| s.mean_hz).collect();
+        let mut k: Vec<f64> = sweeps.iter().map(|s| s.kurtosis).collect();
+        self.frequency_hz = median(&mut mean).unwrap_or(f64::NAN);
+        self.kurtosis = median(&mut k).unwrap_or(f64::NAN);
+        self.frequency_range_hz = (
+            sweeps
+                .iter()
+                .map(|s| s.range_hz.0)
+                .fold(f64::INFINITY, f64::min),
+            sweeps
+                .iter()
+                .map(|s| s.range_hz.1)
+                .fold(f64::NEG_INFINITY, f64::max),
+        );
+    }
 }
 
 /// A line whose frequency moved within one record: the ridge of the short-time spectra it
@@ -215,22 +236,37 @@ impl<'a> LineStage<'a> {
         }
         let per_record = self.record_lines(channels);
         let n_used = self.used.iter().filter(|&&u| u).count().max(1);
-        // A track must also look periodic with its records pooled (see `pooled_kurtosis`).
-        let steady: Vec<LineTrack> = track(&per_record, self.params, n_used)
+        // A track must also look periodic with its records pooled (see `pooled_kurtosis`); a
+        // track of sweeps alone was tested along its ridges.
+        let sweeps = self.record_sweeps(channels);
+        track(&per_record, &sweeps, self.params, n_used)
             .into_iter()
             .filter_map(|mut t| {
+                if !t.has_steady_record() {
+                    return Some(t);
+                }
                 // Pooled over the track's own records: testing a steady track in every record
                 // lost 13 of 70 true lines on the demo (a line steady in some records sits
                 // elsewhere in the others). A random mode that looked periodic in a few records
                 // can pass here; its cluster is still classed by its own kurtosis over all
                 // records (CLEARLY_GAUSSIAN_KURTOSIS).
                 let at = t.record_hz.clone();
-                let k = self.pooled_kurtosis(&at, channels)?;
-                t.kurtosis = k;
-                (k < self.params.max_kurtosis).then_some(t)
+                let k = self.pooled_kurtosis(&at, channels);
+                match k {
+                    Some(k) if k < self.params.max_kurtosis => {
+                        t.kurtosis = k;
+                        Some(t)
+                    }
+                    // Its steady records fail; its sweeps stand.
+                    _ if t.record_sweep.iter().any(Option::is_some) => {
+                        t.record_hz.iter_mut().for_each(|f| *f = None);
+                        t.summarise_sweeps();
+                        Some(t)
+                    }
+                    _ => None,
+                }
             })
-            .collect();
-        attach_sweeps(steady, &self.record_sweeps(channels), self.params, n_used)
+            .collect()
     }
 
     /// Swept lines of each record, merged over the `channels`: ridges of two channels are one
@@ -362,6 +398,9 @@ struct Building {
     last_hz: f64,
     hz: Vec<Option<f64>>,
     kurtosis: Vec<f64>,
+    sweep: Vec<Option<LineSweep>>,
+    /// Holds a sweep in the record being placed: no steady line joins it there.
+    busy: bool,
 }
 
 /// Engine orders of one record are matched to the tracks together when, scaled by one common
@@ -382,7 +421,7 @@ fn match_scaled(
 ) -> Vec<(usize, usize, f64)> {
     let mut pairs: Vec<(usize, usize, f64)> = Vec::new();
     for (i, l) in lines.iter().enumerate() {
-        for (j, t) in tracks.iter().enumerate() {
+        for (j, t) in tracks.iter().enumerate().filter(|(_, t)| !t.busy) {
             let d = (l.frequency_hz / scale - t.last_hz).abs() / t.last_hz;
             if d <= tol {
                 pairs.push((i, j, d));
@@ -433,7 +472,11 @@ fn assign(lines: &[LineCandidate], tracks: &[Building], g: f64, tol: f64) -> Ass
     let by_factor = pairs.len();
     let mut pending: Vec<(usize, usize, f64)> = Vec::new();
     for (i, l) in lines.iter().enumerate().filter(|(i, _)| !used_l[*i]) {
-        for (j, t) in tracks.iter().enumerate().filter(|(j, _)| !used_t[*j]) {
+        for (j, t) in tracks
+            .iter()
+            .enumerate()
+            .filter(|(j, t)| !used_t[*j] && !t.busy)
+        {
             let d = (l.frequency_hz / g - t.last_hz).abs() / t.last_hz;
             if d <= tol {
                 pending.push((i, j, d));
@@ -464,8 +507,16 @@ fn assign(lines: &[LineCandidate], tracks: &[Building], g: f64, tol: f64) -> Ass
 /// the same division; ties go to the factor that placed more lines itself, then to the smaller
 /// total distance. A line not placed starts a new track. Tracks found
 /// in fewer than `min_record_share` of the `n_used` records are dropped.
+///
+/// Swept lines (`sweeps[r]`, empty or shorter for none) are placed first in their record: a
+/// sweep joins the track whose latest frequency is nearest its start (within `track_rel_tol`),
+/// or starts a track; the track then continues from the sweep's end (braking takes a driveline
+/// order from 7 to 5.1 Hz, and the next record's steady line at 5.1 Hz is the same line). A
+/// track holding a sweep in a record takes no steady line there, and is kept whatever its record
+/// share (a manoeuvre happens once).
 pub(crate) fn track(
     per_record: &[Option<Vec<LineCandidate>>],
+    sweeps: &[Vec<LineSweep>],
     p: &LineParams,
     n_used: usize,
 ) -> Vec<LineTrack> {
@@ -473,11 +524,42 @@ pub(crate) fn track(
     let mut tracks: Vec<Building> = Vec::new();
     for (r, lines) in per_record.iter().enumerate() {
         let Some(lines) = lines else { continue };
+        for t in &mut tracks {
+            t.busy = false;
+        }
+        for s in sweeps.get(r).map_or(&[][..], Vec::as_slice) {
+            let best = tracks
+                .iter()
+                .enumerate()
+                .filter(|(_, t)| !t.busy)
+                .map(|(j, t)| (j, (s.start_hz - t.last_hz).abs() / t.last_hz))
+                .filter(|(_, d)| *d <= p.track_rel_tol)
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            match best {
+                Some((j, _)) => {
+                    let t = &mut tracks[j];
+                    t.sweep[r] = Some(s.clone());
+                    t.last_hz = s.end_hz;
+                    t.busy = true;
+                }
+                None => {
+                    let mut sweep = vec![None; n];
+                    sweep[r] = Some(s.clone());
+                    tracks.push(Building {
+                        last_hz: s.end_hz,
+                        hz: vec![None; n],
+                        kurtosis: Vec::new(),
+                        sweep,
+                        busy: true,
+                    });
+                }
+            }
+        }
         // The common factor: every ratio line / track is a candidate; the most lines placed
         // wins, then the most placed by the factor itself, then the smallest total distance.
         let mut scales = vec![1.0];
         for l in lines {
-            for t in &tracks {
+            for t in tracks.iter().filter(|t| !t.busy) {
                 let g = l.frequency_hz / t.last_hz;
                 if (g - 1.0).abs() <= ENGINE_SPEED_CHANGE_MAX {
                     scales.push(g);
@@ -509,6 +591,8 @@ pub(crate) fn track(
                     last_hz: l.frequency_hz,
                     hz,
                     kurtosis: vec![l.kurtosis],
+                    sweep: vec![None; n],
+                    busy: false,
                 });
             }
         }
@@ -516,91 +600,35 @@ pub(crate) fn track(
     let mut out: Vec<LineTrack> = tracks
         .into_iter()
         .filter_map(|mut t| {
+            let n_sweeps = t.sweep.iter().flatten().count();
             let mut f: Vec<f64> = t.hz.iter().flatten().copied().collect();
-            let share = f.len() as f64 / n_used as f64;
-            if share + 1e-12 < p.min_record_share {
+            let share = (f.len() + n_sweeps) as f64 / n_used as f64;
+            if n_sweeps == 0 && share + 1e-12 < p.min_record_share {
                 return None;
             }
-            let lo = f.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = f.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            Some(LineTrack {
-                frequency_hz: median(&mut f)?,
-                frequency_range_hz: (lo, hi),
+            let mut track = LineTrack {
+                frequency_hz: 0.0,
+                frequency_range_hz: (0.0, 0.0),
                 record_hz: t.hz,
                 record_share: share,
-                kurtosis: median(&mut t.kurtosis)?,
-                record_sweep: Vec::new(),
-            })
+                kurtosis: 0.0,
+                record_sweep: t.sweep,
+            };
+            if f.is_empty() {
+                track.summarise_sweeps();
+            } else {
+                track.frequency_range_hz = (
+                    f.iter().copied().fold(f64::INFINITY, f64::min),
+                    f.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                );
+                track.frequency_hz = median(&mut f)?;
+                track.kurtosis = median(&mut t.kurtosis)?;
+            }
+            Some(track)
         })
         .collect();
     out.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
     out
-}
-
-/// Adds the swept lines of each record (`sweeps[r]`) to the steady `tracks`: a sweep joins the
-/// track, free in its record, whose steady frequency in the nearest earlier record is within
-/// `track_rel_tol` of the sweep's start, or in the nearest later record within it of the sweep's
-/// end (the smallest relative distance first): braking sweeps a driveline order from its
-/// frequency before to its frequency after. A sweep that joins no track is a track of its own
-/// (`record_hz` all `None`), whatever its record share: a manoeuvre happens once.
-pub(crate) fn attach_sweeps(
-    mut tracks: Vec<LineTrack>,
-    sweeps: &[Vec<LineSweep>],
-    p: &LineParams,
-    n_used: usize,
-) -> Vec<LineTrack> {
-    let n = sweeps.len();
-    for t in &mut tracks {
-        t.record_sweep = vec![None; n];
-    }
-    let n_steady = tracks.len();
-    for (r, list) in sweeps.iter().enumerate() {
-        for s in list {
-            let mut best: Option<(usize, f64)> = None;
-            for (j, t) in tracks.iter().enumerate().take(n_steady) {
-                if t.record_hz.get(r).is_some_and(Option::is_some)
-                    || t.record_sweep.get(r).is_some_and(Option::is_some)
-                {
-                    continue;
-                }
-                let before = t.record_hz[..r.min(t.record_hz.len())]
-                    .iter()
-                    .rev()
-                    .flatten()
-                    .next()
-                    .map(|f| (s.start_hz - f).abs() / f);
-                let after = t
-                    .record_hz
-                    .get(r + 1..)
-                    .and_then(|v| v.iter().flatten().next())
-                    .map(|f| (s.end_hz - f).abs() / f);
-                let d = [before, after]
-                    .into_iter()
-                    .flatten()
-                    .fold(f64::INFINITY, f64::min);
-                if d <= p.track_rel_tol && best.map_or(true, |(_, b)| d < b) {
-                    best = Some((j, d));
-                }
-            }
-            match best {
-                Some((j, _)) => tracks[j].record_sweep[r] = Some(s.clone()),
-                None => {
-                    let mut record_sweep = vec![None; n];
-                    record_sweep[r] = Some(s.clone());
-                    tracks.push(LineTrack {
-                        frequency_hz: s.mean_hz,
-                        frequency_range_hz: s.range_hz,
-                        record_hz: vec![None; n],
-                        record_share: 1.0 / n_used.max(1) as f64,
-                        kurtosis: s.kurtosis,
-                        record_sweep,
-                    });
-                }
-            }
-        }
-    }
-    tracks.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
-    tracks
 }
 
 #[cfg(test)]
@@ -626,7 +654,7 @@ mod tests {
             None,
             Some(vec![line(10.9, 20.0), line(11.89, 15.0)]),
         ];
-        let t = track(&recs, &p, 3);
+        let t = track(&recs, &[], &p, 3);
         assert_eq!(t.len(), 2, "{t:?}");
         assert_eq!(
             t[0].record_hz,
@@ -650,7 +678,7 @@ mod tests {
             Some(vec![line(11.43, 20.0), line(12.32, 15.0)]),
             Some(vec![line(10.55, 20.0), line(11.37, 15.0)]),
         ];
-        let t = track(&recs, &p, 2);
+        let t = track(&recs, &[], &p, 2);
         assert_eq!(t.len(), 2, "{t:?}");
         assert_eq!(t[0].record_hz, vec![Some(11.43), Some(10.55)]);
         assert_eq!(t[1].record_hz, vec![Some(12.32), Some(11.37)]);
@@ -668,7 +696,7 @@ mod tests {
             Some(vec![line(5.2, 20.0)]), // braking: 27 % lower
             Some(vec![line(7.05, 20.0)]),
         ];
-        let t = track(&recs, &p, 4);
+        let t = track(&recs, &[], &p, 4);
         assert_eq!(t.len(), 1);
         assert_eq!(t[0].record_hz, vec![Some(7.0), Some(7.1), None, Some(7.05)]);
         assert!((t[0].record_share - 0.75).abs() < 1e-12);
@@ -687,33 +715,49 @@ mod tests {
     }
 
     #[test]
-    fn a_braking_sweep_joins_the_track_it_leaves_and_a_lone_sweep_is_its_own_track() {
-        let p = LineParams::default();
-        // 7 Hz driveline line, braked to 5.2 Hz in record 1; 11 Hz steady; a sweep 2->3 Hz
-        // that continues nothing.
+    fn a_braking_sweep_carries_its_track_to_the_next_record_and_a_lone_sweep_is_its_own_track() {
+        let p = LineParams {
+            min_record_share: 0.5,
+            ..LineParams::default()
+        };
+        // 7 Hz driveline line braked to 5.2 Hz in record 1 and steady there in records 2 and 3
+        // (alone, 5.2 Hz would be 27 % from the track); 11 Hz steady; a sweep 2 -> 3 Hz in
+        // record 1 that continues nothing.
         let recs = vec![
             Some(vec![line(7.0, 20.0), line(11.0, 20.0)]),
             Some(vec![line(11.0, 20.0)]),
             Some(vec![line(5.2, 20.0), line(11.05, 20.0)]),
+            Some(vec![line(5.25, 20.0), line(11.0, 20.0)]),
         ];
-        let steady = track(&recs, &p, 3);
-        assert_eq!(steady.len(), 3, "{steady:?}"); // 7, 11 and (new) 5.2
-        let sweeps = vec![vec![], vec![sweep(7.0, 5.3), sweep(2.0, 3.0)], vec![]];
-        let t = attach_sweeps(steady, &sweeps, &p, 3);
-        assert_eq!(t.len(), 4, "{t:?}");
-        // The lone sweep: its own track of sweeps at 2.5 Hz, first by frequency.
-        assert!((t[0].frequency_hz - 2.5).abs() < 1e-12);
+        let sweeps = vec![vec![], vec![sweep(7.02, 5.21), sweep(2.0, 3.0)]];
+        let t = track(&recs, &sweeps, &p, 4);
+        assert_eq!(t.len(), 3, "{t:?}");
+        // The lone sweep: its own track at 2.5 Hz (kept at a record share of 0.25).
+        assert!((t[0].frequency_hz - 2.5).abs() < 1e-12, "{t:?}");
         assert!(!t[0].has_steady_record());
+        assert_eq!(t[0].frequency_range_hz, (2.0, 3.0));
         assert_eq!(t[0].record_sweep[1].as_ref().map(|s| s.end_hz), Some(3.0));
-        // The braking sweep on the 7 Hz track (it starts there), not on the 5.2 Hz one (its
-        // end is 1.9 % away: within tolerance, but farther).
-        let seven = t.iter().find(|x| x.frequency_hz == 7.0).unwrap();
-        let five = t.iter().find(|x| x.frequency_hz == 5.2).unwrap();
-        assert_eq!(seven.record_sweep[1].as_ref().map(|s| s.end_hz), Some(5.3));
-        assert!(five.record_sweep.iter().all(Option::is_none), "{t:?}");
-        assert_eq!(seven.record_hz, vec![Some(7.0), None, None]);
-        // The 11 Hz track is steady in record 1: no sweep there.
-        let eleven = t.iter().find(|x| x.frequency_hz == 11.0).unwrap();
-        assert!(eleven.record_sweep.iter().all(Option::is_none));
+        // The driveline line: 7.0, the sweep, then 5.2 and 5.25 on the same track.
+        assert_eq!(t[1].record_hz, vec![Some(7.0), None, Some(5.2), Some(5.25)]);
+        assert_eq!(
+            t[1].record_sweep[1].as_ref().map(|s| s.start_hz),
+            Some(7.02)
+        );
+        assert!((t[1].record_share - 1.0).abs() < 1e-12);
+        // The 11 Hz line is steady in every record: no sweep on it.
+        assert_eq!(t[2].record_hz[1], Some(11.0));
+        assert!(t[2].record_sweep.iter().all(Option::is_none));
+        // Without the sweeps, 5.2 Hz starts a track of its own and 7 Hz is alone in record 0.
+        let t = track(&recs, &[], &p, 4);
+        assert!(t.iter().all(|x| x.record_hz[0] != Some(7.0)), "{t:?}");
+    }
+
+    #[test]
+    fn a_track_written_before_swept_lines_reads_with_none() {
+        let old = r#"{"frequency_hz":7.0,"frequency_range_hz":[6.9,7.1],
+            "record_hz":[7.0,null],"record_share":0.5,"kurtosis":1.6}"#;
+        let t: LineTrack = serde_json::from_str(old).expect("an old track reads");
+        assert!(t.record_sweep.is_empty());
+        assert!(t.has_steady_record());
     }
 }

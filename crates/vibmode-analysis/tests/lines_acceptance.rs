@@ -150,8 +150,10 @@ fn lines_are_found_per_record_over_five_seeds() {
         assert!(ratio((c.correct, c.entries)) >= 0.95, "{msg}");
         assert!(c.wrongly_periodic.is_empty(), "{msg}");
     }
-    // Swept lines on: the steady figures unchanged, the wide sweeps found.
+    // Swept lines on: the steady recall not lower (a braking sweep carries its track to the
+    // steady line after it: 61 -> 68 of 70 measured), the wide sweeps found.
     assert!(after.steady.0 >= before.steady.0, "{msg}");
-    assert!(ratio(after.wide) >= 0.8, "{msg}");
+    assert!(ratio(after.steady) >= 0.95, "{msg}");
+    assert!(ratio(after.wide) >= 0.9, "{msg}");
     assert!(after.swept.0 > before.swept.0, "{msg}");
 }
