@@ -1198,3 +1198,46 @@ pub fn write_analysis_report(
         figures: files,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use vibmode_analysis::{LineSweep, LineTrack};
+
+    #[test]
+    fn a_swept_entry_shows_start_and_end_and_is_listed() {
+        let sweep = LineSweep {
+            start_hz: 7.04,
+            end_hz: 5.19,
+            range_hz: (5.19, 7.05),
+            mean_hz: 5.9,
+            kurtosis: 1.53,
+            time_s: vec![0.96, 1.28, 9.28],
+            freq_hz: vec![7.04, 6.9, 5.19],
+        };
+        let t = LineTrack {
+            frequency_hz: 7.0,
+            frequency_range_hz: (7.0, 7.0),
+            record_hz: vec![Some(7.0), None, None],
+            record_share: 2.0 / 3.0,
+            kurtosis: 1.6,
+            record_sweep: vec![None, Some(sweep), None],
+        };
+        let entries: Vec<String> = (0..3).map(|r| record_entry(&t, r)).collect();
+        assert_eq!(entries, vec!["7.00", "7.04>5.19", "-"]);
+        let s = sweep_sentences(std::slice::from_ref(&t));
+        assert_eq!(
+            s,
+            vec![
+                "record 2: 7.04 -> 5.19 Hz from 1.0 to 9.3 s (range 5.19-7.05 Hz, kurtosis along the ridge 1.53)"
+            ]
+        );
+        // A track read from an older results.json (no sweeps) shows its steady entries only.
+        let old = LineTrack {
+            record_sweep: Vec::new(),
+            ..t
+        };
+        assert_eq!(record_entry(&old, 1), "-");
+        assert!(sweep_sentences(&[old]).is_empty());
+    }
+}
