@@ -201,6 +201,12 @@ impl AnalysisConfig {
                     ..base.sweep
                 },
                 spectra: SpectrumParams { nperseg: 256 },
+                // The same 1.92 s slices every 0.32 s at four times the rate.
+                lines: LineParams {
+                    stft_nperseg: 4 * base.lines.stft_nperseg,
+                    stft_noverlap: 4 * base.lines.stft_noverlap,
+                    ..base.lines.clone()
+                },
                 report: ReportParams {
                     model_psd_orders: vec![10, 20],
                 },

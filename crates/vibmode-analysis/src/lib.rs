@@ -38,7 +38,7 @@ pub mod stream;
 pub use config::{AnalysisConfig, ChannelRole, Preset, ReportParams};
 pub use first_record::{first_record_spectra, FirstRecordSpectra, ModelPsd};
 pub use identify::{Identifier, PoleOut, SignalFits, SweepIdentifier};
-pub use lines::LineTrack;
+pub use lines::{LineSweep, LineTrack};
 pub use multichannel::{ShapedPole, SsiAnalysis, MATCH_MAC_MIN};
 pub use pipeline::{
     analyze, analyze_prepared, analyze_with, check_records, cluster_params_for, preprocess_records,

@@ -12,7 +12,9 @@
 use serde::{Deserialize, Serialize};
 use vibmode_core::{InvariantMode, LineParams, ModeClass};
 use vibmode_signal::Preprocessed;
-use vibmode_spectra::{line_candidates, narrowband_moments, LineCandidate};
+use vibmode_spectra::{
+    line_candidates, narrowband_moments, swept_line_candidates, LineCandidate, SweptCandidate,
+};
 
 /// A cluster the damping rule calls periodic is structural when its narrow-band kurtosis is at
 /// least this. Gaussian noise has 3, but in a 10 s record a 0.5 Hz band holds only ~5 DFT bins
@@ -47,6 +49,81 @@ pub struct LineTrack {
     /// moments pooled over those records (lowest over the pool's channels; 1.5 for a sine of
     /// steady amplitude, 3 for noise).
     pub kurtosis: f64,
+    /// Where the line swept within a record (its frequency moved by at least
+    /// `sweep_min_range_hz`, e.g. a driveline order while braking): the ridge in each record
+    /// (all records, in order; `None` where it did not sweep). A record holds a steady
+    /// frequency (`record_hz`) or a sweep, not both. `frequency_hz`, `frequency_range_hz` and
+    /// `kurtosis` are those of the steady records when there are any, else of the sweeps (a
+    /// track of sweeps alone never classes a cluster). Empty in files written before swept
+    /// lines.
+    #[serde(default)]
+    pub record_sweep: Vec<Option<LineSweep>>,
+}
+
+impl LineTrack {
+    /// True when the line was found steady in at least one record (only such tracks class
+    /// clusters: a sweep passes through a structural mode's band without being it).
+    pub fn has_steady_record(&self) -> bool {
+        self.record_hz.iter().any(Option::is_some)
+    }
+
+    /// Frequency, range and kurtosis from the sweeps (a track without a steady record): the
+    /// median of their mean frequencies, their lowest and highest frequency, the median of
+    /// their kurtosis.
+    fn summarise_sweeps(&mut self) {
+        let sweeps: Vec<&LineSweep> = self.record_sweep.iter().flatten().collect();
+        let mut mean: Vec<f64> = sweeps.iter().map(|s| s.mean_hz).collect();
+        let mut k: Vec<f64> = sweeps.iter().map(|s| s.kurtosis).collect();
+        self.frequency_hz = median(&mut mean).unwrap_or(f64::NAN);
+        self.kurtosis = median(&mut k).unwrap_or(f64::NAN);
+        self.frequency_range_hz = (
+            sweeps
+                .iter()
+                .map(|s| s.range_hz.0)
+                .fold(f64::INFINITY, f64::min),
+            sweeps
+                .iter()
+                .map(|s| s.range_hz.1)
+                .fold(f64::NEG_INFINITY, f64::max),
+        );
+    }
+}
+
+/// A line whose frequency moved within one record: the ridge of the short-time spectra it
+/// followed, as an order-tracking plot or a spectrogram shows it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LineSweep {
+    /// Frequency at the first slice of the ridge, Hz.
+    pub start_hz: f64,
+    /// Frequency at the last slice, Hz.
+    pub end_hz: f64,
+    /// Lowest and highest frequency of the ridge, Hz.
+    pub range_hz: (f64, f64),
+    /// Mean frequency over the ridge's slices, Hz.
+    pub mean_hz: f64,
+    /// Kurtosis of the signal demodulated along the ridge (1.5 sine, 3 noise; lowest over the
+    /// pool's channels that saw the ridge).
+    pub kurtosis: f64,
+    /// Centre of each slice, s from the start of the record.
+    pub time_s: Vec<f64>,
+    /// Ridge frequency in each slice, Hz.
+    pub freq_hz: Vec<f64>,
+}
+
+impl LineSweep {
+    fn from_candidate(c: &SweptCandidate) -> Self {
+        let f = &c.ridge.freq_hz;
+        let (lo, hi) = c.ridge.span_hz();
+        LineSweep {
+            start_hz: f.first().copied().unwrap_or(f64::NAN),
+            end_hz: f.last().copied().unwrap_or(f64::NAN),
+            range_hz: (lo, hi),
+            mean_hz: f.iter().sum::<f64>() / f.len().max(1) as f64,
+            kurtosis: c.kurtosis,
+            time_s: c.ridge.time_s.clone(),
+            freq_hz: f.clone(),
+        }
+    }
 }
 
 /// The signals of the analysis, for the line evidence.
@@ -58,6 +135,8 @@ pub(crate) struct LineStage<'a> {
     /// Periodic candidates below the cutoff per record and channel, computed once (a channel is
     /// in its own pool, its role's and the multichannel one); empty for records not used.
     candidates: Vec<Vec<Vec<LineCandidate>>>,
+    /// Swept lines (periodic ridges below the cutoff) per record and channel, likewise.
+    swept: Vec<Vec<Vec<SweptCandidate>>>,
 }
 
 impl<'a> LineStage<'a> {
@@ -84,11 +163,32 @@ impl<'a> LineStage<'a> {
                     .collect()
             })
             .collect();
+        let swept = pre
+            .iter()
+            .zip(&used)
+            .map(|(p, &u)| {
+                if !(u && enabled) {
+                    return Vec::new();
+                }
+                p.recording
+                    .channels
+                    .iter()
+                    .map(|ch| {
+                        swept_line_candidates(&ch.samples, p.band.fs_hz, params)
+                            .unwrap_or_default()
+                            .into_iter()
+                            .filter(|c| c.periodic && c.ridge.span_hz().1 < p.band.cutoff_hz)
+                            .collect()
+                    })
+                    .collect()
+            })
+            .collect();
         LineStage {
             pre,
             used,
             params,
             candidates,
+            swept,
         }
     }
 
@@ -136,19 +236,81 @@ impl<'a> LineStage<'a> {
         }
         let per_record = self.record_lines(channels);
         let n_used = self.used.iter().filter(|&&u| u).count().max(1);
-        // A track must also look periodic with its records pooled (see `pooled_kurtosis`).
-        track(&per_record, self.params, n_used)
+        // A track must also look periodic with its records pooled (see `pooled_kurtosis`); a
+        // track of sweeps alone was tested along its ridges.
+        let sweeps = self.record_sweeps(channels);
+        track(&per_record, &sweeps, self.params, n_used)
             .into_iter()
             .filter_map(|mut t| {
+                if !t.has_steady_record() {
+                    return Some(t);
+                }
                 // Pooled over the track's own records: testing a steady track in every record
                 // lost 13 of 70 true lines on the demo (a line steady in some records sits
                 // elsewhere in the others). A random mode that looked periodic in a few records
                 // can pass here; its cluster is still classed by its own kurtosis over all
                 // records (CLEARLY_GAUSSIAN_KURTOSIS).
                 let at = t.record_hz.clone();
-                let k = self.pooled_kurtosis(&at, channels)?;
-                t.kurtosis = k;
-                (k < self.params.max_kurtosis).then_some(t)
+                let k = self.pooled_kurtosis(&at, channels);
+                match k {
+                    Some(k) if k < self.params.max_kurtosis => {
+                        t.kurtosis = k;
+                        Some(t)
+                    }
+                    // Its steady records fail; its sweeps stand.
+                    _ if t.record_sweep.iter().any(Option::is_some) => {
+                        t.record_hz.iter_mut().for_each(|f| *f = None);
+                        t.summarise_sweeps();
+                        Some(t)
+                    }
+                    _ => None,
+                }
+            })
+            .collect()
+    }
+
+    /// Swept lines of each record, merged over the `channels`: ridges of two channels are one
+    /// line when their frequencies differ by at most `half_width_hz` (median over the slices of
+    /// the shorter); the ridge found in more slices is kept, with the lower kurtosis of the two.
+    fn record_sweeps(&self, channels: &[usize]) -> Vec<Vec<LineSweep>> {
+        let hw = self.params.half_width_hz;
+        self.swept
+            .iter()
+            .map(|per_channel| {
+                let mut all: Vec<&SweptCandidate> = channels
+                    .iter()
+                    .filter_map(|&c| per_channel.get(c))
+                    .flatten()
+                    .collect();
+                all.sort_by(|a, b| {
+                    b.ridge
+                        .n_found
+                        .cmp(&a.ridge.n_found)
+                        .then(a.kurtosis.total_cmp(&b.kurtosis))
+                });
+                let mut kept: Vec<(&SweptCandidate, f64)> = Vec::new();
+                for c in all {
+                    let same = kept.iter_mut().find(|(k, _)| {
+                        let mut d: Vec<f64> = c
+                            .ridge
+                            .time_s
+                            .iter()
+                            .zip(&c.ridge.freq_hz)
+                            .filter_map(|(t, f)| k.ridge.freq_at(*t).map(|g| (g - f).abs()))
+                            .collect();
+                        median(&mut d).is_some_and(|m| m <= hw)
+                    });
+                    match same {
+                        Some((_, k)) => *k = k.min(c.kurtosis),
+                        None => kept.push((c, c.kurtosis)),
+                    }
+                }
+                kept.into_iter()
+                    .map(|(c, k)| LineSweep {
+                        kurtosis: k,
+                        ..LineSweep::from_candidate(c)
+                    })
+                    .collect()
             })
             .collect()
     }
@@ -206,7 +368,7 @@ impl<'a> LineStage<'a> {
             let Some(k) = k else { continue };
             // A tracked line at the cluster's frequency (the kurtosis at the cluster's mean
             // frequency can miss the line's peak by a few bins).
-            let on_track = tracks.iter().any(|t| {
+            let on_track = tracks.iter().filter(|t| t.has_steady_record()).any(|t| {
                 t.frequency_range_hz.0 - 0.5 * hw <= m.frequency_hz
                     && m.frequency_hz <= t.frequency_range_hz.1 + 0.5 * hw
             });
@@ -236,6 +398,9 @@ struct Building {
     last_hz: f64,
     hz: Vec<Option<f64>>,
     kurtosis: Vec<f64>,
+    sweep: Vec<Option<LineSweep>>,
+    /// Holds a sweep in the record being placed: no steady line joins it there.
+    busy: bool,
 }
 
 /// Engine orders of one record are matched to the tracks together when, scaled by one common
@@ -256,7 +421,7 @@ fn match_scaled(
 ) -> Vec<(usize, usize, f64)> {
     let mut pairs: Vec<(usize, usize, f64)> = Vec::new();
     for (i, l) in lines.iter().enumerate() {
-        for (j, t) in tracks.iter().enumerate() {
+        for (j, t) in tracks.iter().enumerate().filter(|(_, t)| !t.busy) {
             let d = (l.frequency_hz / scale - t.last_hz).abs() / t.last_hz;
             if d <= tol {
                 pairs.push((i, j, d));
@@ -307,7 +472,11 @@ fn assign(lines: &[LineCandidate], tracks: &[Building], g: f64, tol: f64) -> Ass
     let by_factor = pairs.len();
     let mut pending: Vec<(usize, usize, f64)> = Vec::new();
     for (i, l) in lines.iter().enumerate().filter(|(i, _)| !used_l[*i]) {
-        for (j, t) in tracks.iter().enumerate().filter(|(j, _)| !used_t[*j]) {
+        for (j, t) in tracks
+            .iter()
+            .enumerate()
+            .filter(|(j, t)| !used_t[*j] && !t.busy)
+        {
             let d = (l.frequency_hz / g - t.last_hz).abs() / t.last_hz;
             if d <= tol {
                 pending.push((i, j, d));
@@ -338,8 +507,16 @@ fn assign(lines: &[LineCandidate], tracks: &[Building], g: f64, tol: f64) -> Ass
 /// the same division; ties go to the factor that placed more lines itself, then to the smaller
 /// total distance. A line not placed starts a new track. Tracks found
 /// in fewer than `min_record_share` of the `n_used` records are dropped.
+///
+/// Swept lines (`sweeps[r]`, empty or shorter for none) are placed first in their record: a
+/// sweep joins the track whose latest frequency is nearest its start (within `track_rel_tol`),
+/// or starts a track; the track then continues from the sweep's end (braking takes a driveline
+/// order from 7 to 5.1 Hz, and the next record's steady line at 5.1 Hz is the same line). A
+/// track holding a sweep in a record takes no steady line there, and is kept whatever its record
+/// share (a manoeuvre happens once).
 pub(crate) fn track(
     per_record: &[Option<Vec<LineCandidate>>],
+    sweeps: &[Vec<LineSweep>],
     p: &LineParams,
     n_used: usize,
 ) -> Vec<LineTrack> {
@@ -347,11 +524,42 @@ pub(crate) fn track(
     let mut tracks: Vec<Building> = Vec::new();
     for (r, lines) in per_record.iter().enumerate() {
         let Some(lines) = lines else { continue };
+        for t in &mut tracks {
+            t.busy = false;
+        }
+        for s in sweeps.get(r).map_or(&[][..], Vec::as_slice) {
+            let best = tracks
+                .iter()
+                .enumerate()
+                .filter(|(_, t)| !t.busy)
+                .map(|(j, t)| (j, (s.start_hz - t.last_hz).abs() / t.last_hz))
+                .filter(|(_, d)| *d <= p.track_rel_tol)
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            match best {
+                Some((j, _)) => {
+                    let t = &mut tracks[j];
+                    t.sweep[r] = Some(s.clone());
+                    t.last_hz = s.end_hz;
+                    t.busy = true;
+                }
+                None => {
+                    let mut sweep = vec![None; n];
+                    sweep[r] = Some(s.clone());
+                    tracks.push(Building {
+                        last_hz: s.end_hz,
+                        hz: vec![None; n],
+                        kurtosis: Vec::new(),
+                        sweep,
+                        busy: true,
+                    });
+                }
+            }
+        }
         // The common factor: every ratio line / track is a candidate; the most lines placed
         // wins, then the most placed by the factor itself, then the smallest total distance.
         let mut scales = vec![1.0];
         for l in lines {
-            for t in &tracks {
+            for t in tracks.iter().filter(|t| !t.busy) {
                 let g = l.frequency_hz / t.last_hz;
                 if (g - 1.0).abs() <= ENGINE_SPEED_CHANGE_MAX {
                     scales.push(g);
@@ -383,6 +591,8 @@ pub(crate) fn track(
                     last_hz: l.frequency_hz,
                     hz,
                     kurtosis: vec![l.kurtosis],
+                    sweep: vec![None; n],
+                    busy: false,
                 });
             }
         }
@@ -390,20 +600,31 @@ pub(crate) fn track(
     let mut out: Vec<LineTrack> = tracks
         .into_iter()
         .filter_map(|mut t| {
+            let n_sweeps = t.sweep.iter().flatten().count();
             let mut f: Vec<f64> = t.hz.iter().flatten().copied().collect();
-            let share = f.len() as f64 / n_used as f64;
-            if share + 1e-12 < p.min_record_share {
+            let share = (f.len() + n_sweeps) as f64 / n_used as f64;
+            if n_sweeps == 0 && share + 1e-12 < p.min_record_share {
                 return None;
             }
-            let lo = f.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = f.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            Some(LineTrack {
-                frequency_hz: median(&mut f)?,
-                frequency_range_hz: (lo, hi),
+            let mut track = LineTrack {
+                frequency_hz: 0.0,
+                frequency_range_hz: (0.0, 0.0),
                 record_hz: t.hz,
                 record_share: share,
-                kurtosis: median(&mut t.kurtosis)?,
-            })
+                kurtosis: 0.0,
+                record_sweep: t.sweep,
+            };
+            if f.is_empty() {
+                track.summarise_sweeps();
+            } else {
+                track.frequency_range_hz = (
+                    f.iter().copied().fold(f64::INFINITY, f64::min),
+                    f.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                );
+                track.frequency_hz = median(&mut f)?;
+                track.kurtosis = median(&mut t.kurtosis)?;
+            }
+            Some(track)
         })
         .collect();
     out.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
@@ -433,7 +654,7 @@ mod tests {
             None,
             Some(vec![line(10.9, 20.0), line(11.89, 15.0)]),
         ];
-        let t = track(&recs, &p, 3);
+        let t = track(&recs, &[], &p, 3);
         assert_eq!(t.len(), 2, "{t:?}");
         assert_eq!(
             t[0].record_hz,
@@ -457,7 +678,7 @@ mod tests {
             Some(vec![line(11.43, 20.0), line(12.32, 15.0)]),
             Some(vec![line(10.55, 20.0), line(11.37, 15.0)]),
         ];
-        let t = track(&recs, &p, 2);
+        let t = track(&recs, &[], &p, 2);
         assert_eq!(t.len(), 2, "{t:?}");
         assert_eq!(t[0].record_hz, vec![Some(11.43), Some(10.55)]);
         assert_eq!(t[1].record_hz, vec![Some(12.32), Some(11.37)]);
@@ -475,9 +696,68 @@ mod tests {
             Some(vec![line(5.2, 20.0)]), // braking: 27 % lower
             Some(vec![line(7.05, 20.0)]),
         ];
-        let t = track(&recs, &p, 4);
+        let t = track(&recs, &[], &p, 4);
         assert_eq!(t.len(), 1);
         assert_eq!(t[0].record_hz, vec![Some(7.0), Some(7.1), None, Some(7.05)]);
         assert!((t[0].record_share - 0.75).abs() < 1e-12);
+    }
+
+    fn sweep(start: f64, end: f64) -> LineSweep {
+        LineSweep {
+            start_hz: start,
+            end_hz: end,
+            range_hz: (start.min(end), start.max(end)),
+            mean_hz: 0.5 * (start + end),
+            kurtosis: 1.6,
+            time_s: vec![1.0, 9.0],
+            freq_hz: vec![start, end],
+        }
+    }
+
+    #[test]
+    fn a_braking_sweep_carries_its_track_to_the_next_record_and_a_lone_sweep_is_its_own_track() {
+        let p = LineParams {
+            min_record_share: 0.5,
+            ..LineParams::default()
+        };
+        // 7 Hz driveline line braked to 5.2 Hz in record 1 and steady there in records 2 and 3
+        // (alone, 5.2 Hz would be 27 % from the track); 11 Hz steady; a sweep 2 -> 3 Hz in
+        // record 1 that continues nothing.
+        let recs = vec![
+            Some(vec![line(7.0, 20.0), line(11.0, 20.0)]),
+            Some(vec![line(11.0, 20.0)]),
+            Some(vec![line(5.2, 20.0), line(11.05, 20.0)]),
+            Some(vec![line(5.25, 20.0), line(11.0, 20.0)]),
+        ];
+        let sweeps = vec![vec![], vec![sweep(7.02, 5.21), sweep(2.0, 3.0)]];
+        let t = track(&recs, &sweeps, &p, 4);
+        assert_eq!(t.len(), 3, "{t:?}");
+        // The lone sweep: its own track at 2.5 Hz (kept at a record share of 0.25).
+        assert!((t[0].frequency_hz - 2.5).abs() < 1e-12, "{t:?}");
+        assert!(!t[0].has_steady_record());
+        assert_eq!(t[0].frequency_range_hz, (2.0, 3.0));
+        assert_eq!(t[0].record_sweep[1].as_ref().map(|s| s.end_hz), Some(3.0));
+        // The driveline line: 7.0, the sweep, then 5.2 and 5.25 on the same track.
+        assert_eq!(t[1].record_hz, vec![Some(7.0), None, Some(5.2), Some(5.25)]);
+        assert_eq!(
+            t[1].record_sweep[1].as_ref().map(|s| s.start_hz),
+            Some(7.02)
+        );
+        assert!((t[1].record_share - 1.0).abs() < 1e-12);
+        // The 11 Hz line is steady in every record: no sweep on it.
+        assert_eq!(t[2].record_hz[1], Some(11.0));
+        assert!(t[2].record_sweep.iter().all(Option::is_none));
+        // Without the sweeps, 5.2 Hz starts a track of its own and 7 Hz is alone in record 0.
+        let t = track(&recs, &[], &p, 4);
+        assert!(t.iter().all(|x| x.record_hz[0] != Some(7.0)), "{t:?}");
+    }
+
+    #[test]
+    fn a_track_written_before_swept_lines_reads_with_none() {
+        let old = r#"{"frequency_hz":7.0,"frequency_range_hz":[6.9,7.1],
+            "record_hz":[7.0,null],"record_share":0.5,"kurtosis":1.6}"#;
+        let t: LineTrack = serde_json::from_str(old).expect("an old track reads");
+        assert!(t.record_sweep.is_empty());
+        assert!(t.has_steady_record());
     }
 }

@@ -793,6 +793,27 @@ pub struct LineParams {
     /// A track is reported when it is found in at least this share of the records used
     /// (default 0.3: in the demo a body-roll peak looked periodic in 2 of 8 records).
     pub min_record_share: f64,
+    /// Swept lines (a line whose frequency moves within a record): segment length of the
+    /// short-time spectra, samples at the analysis rate (scipy's `nperseg`; default 96, 1.92 s
+    /// at 50 Hz, resolution 0.52 Hz: long enough for a 7 Hz line to stand 8 dB above the body's
+    /// response, short enough that braking at 1.3 Hz/s smears it over a few bins; 64 found 5
+    /// of the demo's 10 sweeps).
+    /// Longer than the record: no swept lines.
+    pub stft_nperseg: usize,
+    /// Overlap of successive short-time segments, samples (scipy's `noverlap`; default 48: a
+    /// slice every 0.32 s at 50 Hz). Must be below `stft_nperseg`.
+    pub stft_noverlap: usize,
+    /// A peak of a short-time spectrum is followed when it rises this far above the slice's
+    /// median within +-max(1 Hz, 4 fs/stft_nperseg), dB (default 6: a 1.92 s slice gains 7 dB
+    /// less on a line than the 10 s periodogram; 8 dB found 9 of the demo's 10 sweeps, 6 dB all).
+    pub stft_min_prominence_db: f64,
+    /// Largest rate of change of a ridge's frequency followed from slice to slice, Hz/s
+    /// (default 2.5; braking at 1.5 m/s^2 from 30 km/h sweeps a 7 Hz line at up to 1.3 Hz/s).
+    pub sweep_rate_max_hz_per_s: f64,
+    /// A ridge whose frequency (per slice, median of three) spans at least this much within the
+    /// record is tested as a swept line, Hz (default 0.5; a lightly damped mode does not move,
+    /// and narrower ridges are left to the steady test). 0 = no swept lines.
+    pub sweep_min_range_hz: f64,
 }
 
 impl Default for LineParams {
@@ -803,6 +824,11 @@ impl Default for LineParams {
             min_prominence_db: 10.0,
             track_rel_tol: 0.05,
             min_record_share: 0.3,
+            stft_nperseg: 96,
+            stft_noverlap: 80,
+            stft_min_prominence_db: 6.0,
+            sweep_rate_max_hz_per_s: 2.5,
+            sweep_min_range_hz: 0.5,
         }
     }
 }
@@ -853,6 +879,54 @@ impl LineParams {
                 self.min_record_share,
                 "must be in [0, 1]",
                 0.3,
+            ));
+        }
+        let d = LineParams::default();
+        if !(4..=1 << 20).contains(&self.stft_nperseg) {
+            return Err(bad(
+                "stft_nperseg",
+                self.stft_nperseg as f64,
+                "must be 4 to 1048576 samples",
+                d.stft_nperseg as f64,
+            ));
+        }
+        if self.stft_noverlap >= self.stft_nperseg {
+            return Err(bad(
+                "stft_noverlap",
+                self.stft_noverlap as f64,
+                "must be below stft_nperseg",
+                d.stft_noverlap as f64,
+            ));
+        }
+        if !(self.stft_min_prominence_db.is_finite()
+            && (0.0..=100.0).contains(&self.stft_min_prominence_db))
+        {
+            return Err(bad(
+                "stft_min_prominence_db",
+                self.stft_min_prominence_db,
+                "must be in [0, 100] dB",
+                d.stft_min_prominence_db,
+            ));
+        }
+        if !(self.sweep_rate_max_hz_per_s.is_finite()
+            && self.sweep_rate_max_hz_per_s > 0.0
+            && self.sweep_rate_max_hz_per_s <= 1000.0)
+        {
+            return Err(bad(
+                "sweep_rate_max_hz_per_s",
+                self.sweep_rate_max_hz_per_s,
+                "must be > 0 and at most 1000 Hz/s",
+                d.sweep_rate_max_hz_per_s,
+            ));
+        }
+        if !(self.sweep_min_range_hz.is_finite()
+            && (0.0..=100.0).contains(&self.sweep_min_range_hz))
+        {
+            return Err(bad(
+                "sweep_min_range_hz",
+                self.sweep_min_range_hz,
+                "must be in [0, 100] Hz (0 = no swept lines)",
+                d.sweep_min_range_hz,
             ));
         }
         Ok(())

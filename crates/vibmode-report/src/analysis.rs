@@ -289,8 +289,48 @@ fn matches_text(
     s
 }
 
+/// A track's entry in record `r`: its steady frequency (`7.00`), its sweep from start to end
+/// (`7.04>5.19`), or `-` where it was not found.
+fn record_entry(t: &vibmode_analysis::LineTrack, r: usize) -> String {
+    if let Some(f) = t.record_hz.get(r).copied().flatten() {
+        return format!("{f:.2}");
+    }
+    match t.record_sweep.get(r).and_then(Option::as_ref) {
+        Some(s) => format!("{:.2}>{:.2}", s.start_hz, s.end_hz),
+        None => "-".to_string(),
+    }
+}
+
+/// The swept entries of `lines`, one sentence each: record (1-based), start, end, range,
+/// kurtosis along the ridge and the time the ridge spans.
+fn sweep_sentences(lines: &[vibmode_analysis::LineTrack]) -> Vec<String> {
+    let mut out = Vec::new();
+    for t in lines {
+        for (r, s) in t.record_sweep.iter().enumerate() {
+            let Some(s) = s else { continue };
+            let (t0, t1) = (
+                s.time_s.first().copied().unwrap_or(0.0),
+                s.time_s.last().copied().unwrap_or(0.0),
+            );
+            out.push(format!(
+                "record {}: {:.2} -> {:.2} Hz from {:.1} to {:.1} s (range {:.2}-{:.2} Hz, kurtosis along the ridge {:.2})",
+                r + 1,
+                s.start_hz,
+                s.end_hz,
+                t0,
+                t1,
+                s.range_hz.0,
+                s.range_hz.1,
+                s.kurtosis
+            ));
+        }
+    }
+    out
+}
+
 /// The periodic lines of a pool, one per row with its frequency in each record (`-` where it was
-/// not found), or a sentence saying none was found.
+/// not found, `start>end` where it swept within the record), then the swept entries one per
+/// line; or a sentence saying none was found.
 pub fn lines_text(
     r: &AnalysisResults,
     lines: &[vibmode_analysis::LineTrack],
@@ -303,7 +343,7 @@ pub fn lines_text(
     if lines.is_empty() {
         let _ = writeln!(
             s,
-            "{indent}No periodic lines (no prominent peak with a narrow-band kurtosis below {} in {:.0} % of the records).",
+            "{indent}No periodic lines (no prominent peak with a narrow-band kurtosis below {} in {:.0} % of the records, no swept ridge).",
             r.config.lines.max_kurtosis,
             100.0 * r.config.lines.min_record_share
         );
@@ -311,13 +351,11 @@ pub fn lines_text(
     }
     let _ = writeln!(
         s,
-        "{indent}Periodic lines (engine/gear orders: narrow-band kurtosis near 1.5), frequency per record, Hz:"
+        "{indent}Periodic lines (engine/gear orders: narrow-band kurtosis near 1.5), frequency per record, Hz (a>b: swept from a to b within the record):"
     );
     for t in lines {
-        let per: Vec<String> = t
-            .record_hz
-            .iter()
-            .map(|f| f.map_or("-".to_string(), |f| format!("{f:.2}")))
+        let per: Vec<String> = (0..t.record_hz.len().max(t.record_sweep.len()))
+            .map(|i| record_entry(t, i))
             .collect();
         let _ = writeln!(
             s,
@@ -329,6 +367,16 @@ pub fn lines_text(
             t.kurtosis,
             per.join(" ")
         );
+    }
+    let sweeps = sweep_sentences(lines);
+    if !sweeps.is_empty() {
+        let _ = writeln!(
+            s,
+            "{indent}Swept lines (a ridge of the short-time spectra, periodic along it):"
+        );
+        for l in sweeps {
+            let _ = writeln!(s, "{indent}  {l}");
+        }
     }
     s
 }
@@ -822,7 +870,7 @@ fn lines_table(html: &mut HtmlReport, r: &AnalysisResults, lines: &[vibmode_anal
         return;
     }
     html.paragraph(
-        "Periodic lines (engine/gear orders), tracked over the records: a prominent peak whose narrow-band signal has the kurtosis of a sine (1.5) rather than of a randomly excited mode (3). Frequency in each record, Hz (- = not found there or a stop).",
+        "Periodic lines (engine/gear orders), tracked over the records: a prominent peak whose narrow-band signal has the kurtosis of a sine (1.5) rather than of a randomly excited mode (3). Frequency in each record, Hz (- = not found there or a stop; a>b = swept from a to b Hz within the record: a ridge of the short-time spectra along which the signal has the kurtosis of a sine).",
     );
     let mut headers: Vec<String> = vec![
         "frequency [Hz]".into(),
@@ -843,16 +891,19 @@ fn lines_table(html: &mut HtmlReport, r: &AnalysisResults, lines: &[vibmode_anal
                 format!("{:.0} %", 100.0 * t.record_share),
                 format!("{:.2}", t.kurtosis),
             ];
-            row.extend(
-                t.record_hz
-                    .iter()
-                    .map(|f| f.map_or("-".to_string(), |f| format!("{f:.2}"))),
-            );
+            row.extend((0..r.records.len()).map(|i| record_entry(t, i)));
             row
         })
         .collect();
     let h: Vec<&str> = headers.iter().map(String::as_str).collect();
     html.table(&h, &rows);
+    let sweeps = sweep_sentences(lines);
+    if !sweeps.is_empty() {
+        html.paragraph(&format!(
+            "Swept lines (a ridge of the short-time spectra, periodic along it; the frequency per slice is in results.json): {}.",
+            sweeps.join("; ")
+        ));
+    }
 }
 
 fn modes_tables(html: &mut HtmlReport, r: &AnalysisResults) {
@@ -1146,4 +1197,47 @@ pub fn write_analysis_report(
         modes_csv: modes_csv_path,
         figures: files,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use vibmode_analysis::{LineSweep, LineTrack};
+
+    #[test]
+    fn a_swept_entry_shows_start_and_end_and_is_listed() {
+        let sweep = LineSweep {
+            start_hz: 7.04,
+            end_hz: 5.19,
+            range_hz: (5.19, 7.05),
+            mean_hz: 5.9,
+            kurtosis: 1.53,
+            time_s: vec![0.96, 1.28, 9.28],
+            freq_hz: vec![7.04, 6.9, 5.19],
+        };
+        let t = LineTrack {
+            frequency_hz: 7.0,
+            frequency_range_hz: (7.0, 7.0),
+            record_hz: vec![Some(7.0), None, None],
+            record_share: 2.0 / 3.0,
+            kurtosis: 1.6,
+            record_sweep: vec![None, Some(sweep), None],
+        };
+        let entries: Vec<String> = (0..3).map(|r| record_entry(&t, r)).collect();
+        assert_eq!(entries, vec!["7.00", "7.04>5.19", "-"]);
+        let s = sweep_sentences(std::slice::from_ref(&t));
+        assert_eq!(
+            s,
+            vec![
+                "record 2: 7.04 -> 5.19 Hz from 1.0 to 9.3 s (range 5.19-7.05 Hz, kurtosis along the ridge 1.53)"
+            ]
+        );
+        // A track read from an older results.json (no sweeps) shows its steady entries only.
+        let old = LineTrack {
+            record_sweep: Vec::new(),
+            ..t
+        };
+        assert_eq!(record_entry(&old, 1), "-");
+        assert!(sweep_sentences(&[old]).is_empty());
+    }
 }

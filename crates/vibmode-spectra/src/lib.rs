@@ -56,11 +56,15 @@ mod window;
 
 pub use error::SpectraError;
 pub use integrate::{band_rms, peak, rms};
-pub use lines::{line_candidates, narrowband_kurtosis, narrowband_moments, LineCandidate};
+pub use lines::{
+    line_candidates, narrowband_kurtosis, narrowband_moments, ridges, swept_line_candidates,
+    tracked_kurtosis, LineCandidate, Ridge, SweptCandidate, RIDGE_MAX_GAP, RIDGE_MIN_SLICE_SHARE,
+    SWEEP_KURTOSIS_GAIN_MIN, SWEEP_ROUGHNESS_MAX_SHARE,
+};
 pub use num_complex::Complex64;
 pub use params::{Average, Detrend, PeriodogramParams, Scaling, ShortRecord, WelchParams, Window};
 pub use vibmode_core::LineParams;
-pub use welch::{Coherence, CrossSpectrum, Spectrum, WelchPlan};
+pub use welch::{Coherence, CrossSpectrum, Spectrogram, Spectrum, WelchPlan};
 pub use window::{window_values, WindowSpec};
 
 use welch::{check_fs, check_pair_samples, check_samples};

@@ -8,7 +8,8 @@
 //! it stays inside the band.
 
 use crate::error::SpectraError;
-use crate::welch::{check_fs, check_samples};
+use crate::welch::{check_fs, check_samples, median_in_place};
+use crate::{Spectrogram, WelchParams, WelchPlan};
 use realfft::RealFftPlanner;
 use serde::{Deserialize, Serialize};
 use vibmode_core::LineParams;
@@ -212,5 +213,365 @@ pub fn line_candidates(
         })
         .collect();
     out.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+    Ok(out)
+}
+
+/// A ridge of the short-time spectra: a prominent peak followed from slice to slice.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Ridge {
+    /// Centre of each slice the ridge spans, s from the first sample (gaps filled).
+    pub time_s: Vec<f64>,
+    /// Ridge frequency in each of those slices, Hz (peaks interpolated parabolically in the log
+    /// spectrum, gaps filled linearly, then a running median of three).
+    pub freq_hz: Vec<f64>,
+    /// Slices in which a peak was found (the rest of the span are filled gaps).
+    pub n_found: usize,
+}
+
+impl Ridge {
+    /// Highest minus lowest frequency of the ridge, Hz.
+    pub fn range_hz(&self) -> f64 {
+        let lo = self.freq_hz.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = self
+            .freq_hz
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max);
+        if hi >= lo {
+            hi - lo
+        } else {
+            0.0
+        }
+    }
+
+    /// Lowest and highest frequency of the ridge, Hz.
+    pub fn span_hz(&self) -> (f64, f64) {
+        let lo = self.freq_hz.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = self
+            .freq_hz
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max);
+        (lo, hi)
+    }
+
+    /// Median absolute second difference of the ridge frequency from slice to slice, Hz: near
+    /// 0 for a line whose frequency changes smoothly (a chirp has exactly 0), about the peak's
+    /// jitter for a ridge that follows the random peak of a mode.
+    pub fn roughness_hz(&self) -> f64 {
+        let mut d2: Vec<f64> = self
+            .freq_hz
+            .windows(3)
+            .map(|w| (w[0] - 2.0 * w[1] + w[2]).abs())
+            .collect();
+        if d2.is_empty() {
+            return 0.0;
+        }
+        median_in_place(&mut d2)
+    }
+
+    /// Ridge frequency at time `t_s` (linear between slice centres, held before the first and
+    /// after the last), Hz; `None` for an empty ridge.
+    pub fn freq_at(&self, t_s: f64) -> Option<f64> {
+        let (first, last) = (self.time_s.first()?, self.time_s.last()?);
+        if t_s <= *first {
+            return self.freq_hz.first().copied();
+        }
+        if t_s >= *last {
+            return self.freq_hz.last().copied();
+        }
+        let k = self.time_s.partition_point(|&t| t <= t_s).max(1);
+        let (t0, t1) = (self.time_s[k - 1], self.time_s[k]);
+        let (f0, f1) = (self.freq_hz[k - 1], self.freq_hz[k]);
+        let a = if t1 > t0 { (t_s - t0) / (t1 - t0) } else { 0.0 };
+        Some(f0 + a * (f1 - f0))
+    }
+}
+
+/// A ridge that may be a swept line, with the kurtosis of the signal demodulated along it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SweptCandidate {
+    /// The ridge.
+    pub ridge: Ridge,
+    /// Kurtosis of the signal demodulated along the ridge and band-limited to
+    /// `+- half_width_hz` (see [`tracked_kurtosis`]; 1.5 sine, 3 Gaussian).
+    pub kurtosis: f64,
+    /// The same kurtosis with the demodulation held at the ridge's median frequency: a line
+    /// that really sweeps leaves a fixed band most of the time (high), a ridge that follows
+    /// the random peak of a mode gains little by being followed.
+    pub fixed_kurtosis: f64,
+    /// True when `kurtosis < max_kurtosis`, `fixed_kurtosis - kurtosis` is at least
+    /// [`SWEEP_KURTOSIS_GAIN_MIN`] and the ridge is smooth (its [`Ridge::roughness_hz`] at most
+    /// [`SWEEP_ROUGHNESS_MAX_SHARE`] of its range).
+    pub periodic: bool,
+}
+
+/// A swept line's kurtosis along its ridge must be this much below the kurtosis at the ridge's
+/// median frequency. Measured on the realistic demo (5 seeds): the braking and acceleration
+/// sweeps gained 1 or more; ridges on the 9 Hz bending and the 1.3 Hz body modes, whose peaks
+/// jitter within their bandwidth, gained less than 0.3 (docs/analysis.md).
+pub const SWEEP_KURTOSIS_GAIN_MIN: f64 = 0.5;
+
+/// A swept line's ridge changes smoothly: its roughness (median absolute second difference from
+/// slice to slice) is at most this share of its range. A chirp has 0; the demo's braking and
+/// acceleration sweeps had 0.008-0.02; ridges on the 1.3 Hz body modes and the 9-10 Hz bending
+/// and wheel-hop modes, whose peaks jitter within their bandwidth, 0.035-0.16.
+pub const SWEEP_ROUGHNESS_MAX_SHARE: f64 = 0.03;
+
+/// A ridge may skip this many slices (a line crossing another peak, a fade of the modulation).
+pub const RIDGE_MAX_GAP: usize = 2;
+/// A ridge must be found in at least this share of a record's slices.
+pub const RIDGE_MIN_SLICE_SHARE: f64 = 0.5;
+
+/// Ridges of the short-time spectra `spec`: in every slice the peaks rising `stft_min_prominence_db`
+/// above the slice's median within +-max(1 Hz, 4 fs/nperseg), linked from slice to slice when the
+/// frequency changes by at most `sweep_rate_max_hz_per_s` times the time step plus a quarter of
+/// the slice resolution `fs/nperseg` (the nearest pairs first; gaps of up to [`RIDGE_MAX_GAP`]
+/// slices). Ridges found in fewer than [`RIDGE_MIN_SLICE_SHARE`] of the slices are dropped.
+/// Only peaks between `2 half_width_hz` and `fs/2 - half_width_hz` are followed. Sorted by mean
+/// frequency.
+pub fn ridges(spec: &Spectrogram, p: &LineParams) -> Vec<Ridge> {
+    let n_slices = spec.psd.len();
+    if n_slices == 0 || spec.freq_hz.len() < 8 || spec.nfft == 0 {
+        return Vec::new();
+    }
+    let df = spec.freq_hz[1] - spec.freq_hz[0];
+    let fs_hz = df * spec.nfft as f64;
+    let resolution_hz = fs_hz / spec.nperseg.max(1) as f64;
+    let reach = ((1.0f64.max(4.0 * resolution_hz) / df).round() as usize).max(3);
+    let k_lo = ((2.0 * p.half_width_hz / df).ceil() as usize).max(2);
+    let k_hi = (((fs_hz / 2.0 - p.half_width_hz) / df).floor() as usize)
+        .min(spec.freq_hz.len().saturating_sub(3));
+    let dt = if n_slices > 1 {
+        spec.time_s[1] - spec.time_s[0]
+    } else {
+        1.0
+    };
+    // Peaks of each slice: (frequency, power).
+    let peaks: Vec<Vec<f64>> = spec
+        .psd
+        .iter()
+        .map(|row| {
+            let pw: Vec<f64> = row.iter().map(|v| v.max(1e-300)).collect();
+            let mut out = Vec::new();
+            for k in k_lo..=k_hi {
+                if !(pw[k - 2..=k + 2].iter().all(|&v| v <= pw[k])) {
+                    continue;
+                }
+                let lo = k.saturating_sub(reach);
+                let hi = (k + reach).min(pw.len() - 1);
+                let mut near: Vec<f64> = pw[lo..=hi].to_vec();
+                near.sort_by(f64::total_cmp);
+                let median = near[near.len() / 2];
+                if 10.0 * (pw[k] / median).log10() < p.stft_min_prominence_db {
+                    continue;
+                }
+                let (a, b, c) = (pw[k - 1].ln(), pw[k].ln(), pw[k + 1].ln());
+                let den = a - 2.0 * b + c;
+                let delta = if den.abs() > 0.0 {
+                    0.5 * (a - c) / den
+                } else {
+                    0.0
+                };
+                out.push((k as f64 + delta.clamp(-0.5, 0.5)) * df);
+            }
+            out
+        })
+        .collect();
+    // Link: (slice, frequency) lists.
+    let mut building: Vec<Vec<(usize, f64)>> = Vec::new();
+    for (s, fs) in peaks.iter().enumerate() {
+        let mut pairs: Vec<(usize, usize, f64)> = Vec::new();
+        for (i, &f) in fs.iter().enumerate() {
+            for (j, r) in building.iter().enumerate() {
+                let Some(&(ls, lf)) = r.last() else { continue };
+                let gap = s - ls;
+                if gap == 0 || gap > RIDGE_MAX_GAP + 1 {
+                    continue;
+                }
+                let d = (f - lf).abs();
+                if d <= p.sweep_rate_max_hz_per_s * dt * gap as f64 + 0.25 * resolution_hz {
+                    pairs.push((i, j, d));
+                }
+            }
+        }
+        pairs.sort_by(|a, b| a.2.total_cmp(&b.2));
+        let (mut used_p, mut used_r) = (vec![false; fs.len()], vec![false; building.len()]);
+        for (i, j, _) in pairs {
+            if !used_p[i] && !used_r[j] {
+                used_p[i] = true;
+                used_r[j] = true;
+                building[j].push((s, fs[i]));
+            }
+        }
+        for (i, &f) in fs.iter().enumerate() {
+            if !used_p[i] {
+                building.push(vec![(s, f)]);
+            }
+        }
+    }
+    let mut out: Vec<Ridge> = building
+        .into_iter()
+        .filter(|r| r.len() as f64 >= RIDGE_MIN_SLICE_SHARE * n_slices as f64 && r.len() >= 3)
+        .map(|r| {
+            let (s0, s1) = (r[0].0, r[r.len() - 1].0);
+            // Fill the gaps linearly.
+            let mut f: Vec<f64> = Vec::with_capacity(s1 - s0 + 1);
+            for w in r.windows(2) {
+                let ((sa, fa), (sb, fb)) = (w[0], w[1]);
+                for s in sa..sb {
+                    f.push(fa + (fb - fa) * (s - sa) as f64 / (sb - sa) as f64);
+                }
+            }
+            f.push(r[r.len() - 1].1);
+            let smooth: Vec<f64> = (0..f.len())
+                .map(|i| {
+                    if i == 0 || i + 1 == f.len() {
+                        f[i]
+                    } else {
+                        let mut w = [f[i - 1], f[i], f[i + 1]];
+                        w.sort_by(f64::total_cmp);
+                        w[1]
+                    }
+                })
+                .collect();
+            Ridge {
+                time_s: spec.time_s[s0..=s1].to_vec(),
+                freq_hz: smooth,
+                n_found: r.len(),
+            }
+        })
+        .collect();
+    let mean = |r: &Ridge| r.freq_hz.iter().sum::<f64>() / r.freq_hz.len().max(1) as f64;
+    out.sort_by(|a, b| mean(a).total_cmp(&mean(b)));
+    out
+}
+
+/// Kurtosis of `x` (sampled at `fs_hz`, Hz) demodulated along `ridge` and band-limited to
+/// `+- half_width_hz`: the complex envelope `z = lowpass(x exp(-i phi))`, `phi` the integral of
+/// the ridge frequency, gives `1.5 E|z|^4 / E|z|^2^2` over the ridge's span (its first slice
+/// centre minus half a segment `half_segment_s` to its last plus half a segment). On the scale of
+/// [`narrowband_kurtosis`]: a sine followed by the ridge has 1.5, Gaussian noise 3. `NaN` when
+/// the span holds no power.
+/// Errors: fs_hz not positive/finite, empty `x`, NaN/Inf sample.
+pub fn tracked_kurtosis(
+    x: &[f64],
+    fs_hz: f64,
+    ridge: &Ridge,
+    half_width_hz: f64,
+    half_segment_s: f64,
+) -> Result<f64, SpectraError> {
+    check_fs(fs_hz)?;
+    check_samples(x, "x")?;
+    let n = x.len();
+    let (Some(&t0), Some(&t1)) = (ridge.time_s.first(), ridge.time_s.last()) else {
+        return Ok(f64::NAN);
+    };
+    let mean = x.iter().sum::<f64>() / n as f64;
+    let dt = 1.0 / fs_hz;
+    let mut phase = 0.0f64;
+    let mut re = Vec::with_capacity(n);
+    let mut im = Vec::with_capacity(n);
+    for (i, v) in x.iter().enumerate() {
+        let f = ridge.freq_at(i as f64 * dt).unwrap_or(0.0);
+        re.push((v - mean) * phase.cos());
+        im.push(-(v - mean) * phase.sin());
+        phase = (phase + 2.0 * std::f64::consts::PI * f * dt) % (2.0 * std::f64::consts::PI);
+    }
+    let mut planner = RealFftPlanner::<f64>::new();
+    lowpass(&mut planner, &mut re, fs_hz, half_width_hz);
+    lowpass(&mut planner, &mut im, fs_hz, half_width_hz);
+    let lo = (((t0 - half_segment_s) * fs_hz).floor().max(0.0)) as usize;
+    let hi = ((((t1 + half_segment_s) * fs_hz).ceil()) as usize).min(n);
+    let (mut m2, mut m4, mut k) = (0.0, 0.0, 0usize);
+    for i in lo..hi {
+        let a = re[i] * re[i] + im[i] * im[i];
+        m2 += a;
+        m4 += a * a;
+        k += 1;
+    }
+    if k == 0 || m2 <= 0.0 {
+        return Ok(f64::NAN);
+    }
+    let (m2, m4) = (m2 / k as f64, m4 / k as f64);
+    Ok(1.5 * m4 / (m2 * m2))
+}
+
+/// Ideal DFT low-pass of `y` to `cut_hz` (DC kept), in place.
+fn lowpass(planner: &mut RealFftPlanner<f64>, y: &mut [f64], fs_hz: f64, cut_hz: f64) {
+    let n = y.len();
+    let fwd = planner.plan_fft_forward(n);
+    let inv = planner.plan_fft_inverse(n);
+    let mut spec = fwd.make_output_vec();
+    if fwd.process(y, &mut spec).is_err() {
+        return;
+    }
+    let df = fs_hz / n as f64;
+    let last = spec.len() - 1;
+    for (k, c) in spec.iter_mut().enumerate() {
+        if k as f64 * df > cut_hz {
+            *c = num_complex::Complex64::new(0.0, 0.0);
+        }
+        if k == last && n % 2 == 0 {
+            c.im = 0.0;
+        }
+        if k == 0 {
+            c.im = 0.0;
+        }
+    }
+    if inv.process(&mut spec, y).is_err() {
+        return;
+    }
+    let s = 1.0 / n as f64;
+    y.iter_mut().for_each(|v| *v *= s);
+}
+
+/// Ridges of `x` (sampled at `fs_hz`, Hz) that span at least `sweep_min_range_hz`, each with
+/// its [`tracked_kurtosis`]: the candidates for lines whose frequency moves within the record.
+/// The short-time spectra are Hann-windowed periodograms of `stft_nperseg` samples overlapping
+/// by `stft_noverlap`, zero-padded 4x ([`WelchPlan::spectrogram`]); ridges as [`ridges`].
+/// A record shorter than `stft_nperseg`, or `sweep_min_range_hz = 0`, gives none.
+/// Errors: fs_hz not positive/finite, empty `x`, NaN/Inf sample.
+pub fn swept_line_candidates(
+    x: &[f64],
+    fs_hz: f64,
+    p: &LineParams,
+) -> Result<Vec<SweptCandidate>, SpectraError> {
+    check_fs(fs_hz)?;
+    check_samples(x, "x")?;
+    if p.sweep_min_range_hz <= 0.0 || x.len() < p.stft_nperseg || p.stft_nperseg < 4 {
+        return Ok(Vec::new());
+    }
+    let wp = WelchParams {
+        nperseg: Some(p.stft_nperseg),
+        noverlap: Some(p.stft_noverlap.min(p.stft_nperseg - 1)),
+        nfft: Some(4 * p.stft_nperseg),
+        ..WelchParams::default()
+    };
+    let mut plan = WelchPlan::new(x.len(), fs_hz, &wp)?;
+    let spec = plan.spectrogram(x)?;
+    let half_segment_s = p.stft_nperseg as f64 / fs_hz / 2.0;
+    let mut out = Vec::new();
+    for ridge in ridges(&spec, p) {
+        if ridge.range_hz() < p.sweep_min_range_hz {
+            continue;
+        }
+        let kurtosis = tracked_kurtosis(x, fs_hz, &ridge, p.half_width_hz, half_segment_s)?;
+        let mut f = ridge.freq_hz.clone();
+        let fixed = Ridge {
+            time_s: ridge.time_s.clone(),
+            freq_hz: vec![median_in_place(&mut f); ridge.time_s.len()],
+            n_found: ridge.n_found,
+        };
+        let fixed_kurtosis = tracked_kurtosis(x, fs_hz, &fixed, p.half_width_hz, half_segment_s)?;
+        out.push(SweptCandidate {
+            periodic: kurtosis < p.max_kurtosis
+                && fixed_kurtosis - kurtosis >= SWEEP_KURTOSIS_GAIN_MIN
+                && ridge.roughness_hz() <= SWEEP_ROUGHNESS_MAX_SHARE * ridge.range_hz(),
+            ridge,
+            kurtosis,
+            fixed_kurtosis,
+        });
+    }
     Ok(out)
 }

@@ -68,6 +68,28 @@ pub struct Coherence {
     pub notes: Vec<String>,
 }
 
+/// Short-time spectra of a real signal (scipy.signal.spectrogram with `mode="psd"`): the
+/// periodogram of each segment of a [`WelchPlan`], not averaged.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Spectrogram {
+    /// Frequencies of the bins, Hz (`k * fs_hz / nfft`, `k = 0 ..= nfft / 2`).
+    pub freq_hz: Vec<f64>,
+    /// Centre of each segment, s from the first sample (`(start + nperseg / 2) / fs_hz`, as
+    /// scipy).
+    pub time_s: Vec<f64>,
+    /// One one-sided spectrum per segment (`psd[segment][bin]`), scaled and doubled as
+    /// [`Spectrum::psd`].
+    pub psd: Vec<Vec<f64>>,
+    /// Segment length, samples.
+    pub nperseg: usize,
+    /// Overlap, samples.
+    pub noverlap: usize,
+    /// FFT length, samples.
+    pub nfft: usize,
+    /// Human-readable notes on deviations from the request.
+    pub notes: Vec<String>,
+}
+
 /// Resolved segment sizes of a plan, samples.
 struct Sizes {
     nperseg: usize,
@@ -128,7 +150,7 @@ fn median_bias(k: usize) -> f64 {
 
 /// Median of `v` (mean of the two middle values for an even count), reordering `v`.
 /// `v` must be non-empty and NaN-free (guaranteed: inputs are checked to be finite).
-fn median_in_place(v: &mut [f64]) -> f64 {
+pub(crate) fn median_in_place(v: &mut [f64]) -> f64 {
     let n = v.len();
     if n == 0 {
         return 0.0;
@@ -160,6 +182,7 @@ fn median_in_place(v: &mut [f64]) -> f64 {
 /// ```
 pub struct WelchPlan {
     n_samples: usize,
+    fs_hz: f64,
     nperseg: usize,
     noverlap: usize,
     nfft: usize,
@@ -342,6 +365,7 @@ impl WelchPlan {
         let scratch = fft.make_scratch_vec();
         WelchPlan {
             n_samples,
+            fs_hz,
             nperseg,
             noverlap,
             nfft,
@@ -446,6 +470,38 @@ impl WelchPlan {
             noverlap: self.noverlap,
             nfft: self.nfft,
             n_segments: k,
+            notes: self.notes.clone(),
+        })
+    }
+
+    /// Short-time spectra of `x`: the scaled one-sided periodogram of every segment of the plan
+    /// (scipy.signal.spectrogram with `mode="psd"` and this plan's window, nperseg, noverlap,
+    /// nfft, detrend and scaling; the mean over the segments is [`WelchPlan::welch`] with the
+    /// mean average).
+    /// Errors: empty or non-finite `x`, or `x.len()` differing from the plan's record length.
+    pub fn spectrogram(&mut self, x: &[f64]) -> Result<Spectrogram, SpectraError> {
+        self.check_input(x, "x")?;
+        let step = self.nperseg - self.noverlap;
+        let mut psd = Vec::with_capacity(self.n_segments);
+        let mut time_s = Vec::with_capacity(self.n_segments);
+        for s in 0..self.n_segments {
+            self.transform_segment(x, s, false);
+            let mut p: Vec<f64> = self
+                .spec_x
+                .iter()
+                .map(|c| c.norm_sqr() * self.scale)
+                .collect();
+            self.double_one_sided(&mut p);
+            psd.push(p);
+            time_s.push((s * step) as f64 / self.fs_hz + self.nperseg as f64 / 2.0 / self.fs_hz);
+        }
+        Ok(Spectrogram {
+            freq_hz: self.freq_hz.clone(),
+            time_s,
+            psd,
+            nperseg: self.nperseg,
+            noverlap: self.noverlap,
+            nfft: self.nfft,
             notes: self.notes.clone(),
         })
     }
