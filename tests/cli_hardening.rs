@@ -395,11 +395,14 @@ fn kill_9_leaves_the_old_or_the_new_output_never_a_mix() {
         .into_iter()
         .map(|(p, n)| (out.join(p.file_name().unwrap()), n))
         .collect();
-    // The visible files (a killed write leaves its hidden temporary file beside them).
+    // The output files (a killed write leaves its temporary `<name>.partial` beside them).
     let visible = |dir: &Path| -> Vec<(PathBuf, u64)> {
         listing(dir)
             .into_iter()
-            .filter(|(p, _)| !p.file_name().unwrap().to_string_lossy().starts_with('.'))
+            .filter(|(p, _)| {
+                let n = p.file_name().unwrap().to_string_lossy().into_owned();
+                !n.starts_with('.') && !n.ends_with(".partial")
+            })
             .collect()
     };
     for delay_ms in [0u64, 10, 30, 60, 100, 200, 350, 600] {
