@@ -143,46 +143,35 @@ impl<'a> LineStage<'a> {
     /// The stage over the pre-processed records; `used[r]` is false for stops.
     pub fn new(pre: &'a [Preprocessed], used: Vec<bool>, params: &'a LineParams) -> Self {
         let enabled = params.max_kurtosis > 0.0;
-        let candidates = pre
-            .iter()
-            .zip(&used)
-            .map(|(p, &u)| {
-                if !(u && enabled) {
-                    return Vec::new();
-                }
-                p.recording
-                    .channels
-                    .iter()
-                    .map(|ch| {
+        // Per record used, per channel: the steady and the swept periodic candidates.
+        let per_record = |p: &Preprocessed, u: bool| {
+            if !(u && enabled) {
+                return (Vec::new(), Vec::new());
+            }
+            p.recording
+                .channels
+                .iter()
+                .map(|ch| {
+                    let steady: Vec<LineCandidate> =
                         line_candidates(&ch.samples, p.band.fs_hz, params)
                             .unwrap_or_default()
                             .into_iter()
                             .filter(|l| l.periodic && l.frequency_hz < p.band.cutoff_hz)
-                            .collect()
-                    })
-                    .collect()
-            })
-            .collect();
-        let swept = pre
+                            .collect();
+                    let swept = swept_line_candidates(&ch.samples, p.band.fs_hz, params)
+                        .unwrap_or_default()
+                        .into_iter()
+                        .filter(|c| c.periodic && c.ridge.span_hz().1 < p.band.cutoff_hz)
+                        .collect();
+                    (steady, swept)
+                })
+                .unzip()
+        };
+        let (candidates, swept) = pre
             .iter()
             .zip(&used)
-            .map(|(p, &u)| {
-                if !(u && enabled) {
-                    return Vec::new();
-                }
-                p.recording
-                    .channels
-                    .iter()
-                    .map(|ch| {
-                        swept_line_candidates(&ch.samples, p.band.fs_hz, params)
-                            .unwrap_or_default()
-                            .into_iter()
-                            .filter(|c| c.periodic && c.ridge.span_hz().1 < p.band.cutoff_hz)
-                            .collect()
-                    })
-                    .collect()
-            })
-            .collect();
+            .map(|(p, &u)| per_record(p, u))
+            .unzip();
         LineStage {
             pre,
             used,

@@ -3,8 +3,8 @@
 //! 20-40 km/h), 8 on a class D road, 8 with the rear-left damper at 50 %, 8 with the front-left
 //! tyre 30 % softer, 8 with the rear springs 20 % softer, 8 with 15 % more load, and a sweep of
 //! rear-left damper losses (10, 20, 30, 50 %). Prints the confusion table; the assertions are
-//! what was measured (docs/fleet.md states it against the targets). Measured (`cargo test --release -p
-//! vibmode-fleet --test acceptance -- --nocapture`): healthy 59/60 normal; road D 23/24 road;
+//! what was measured (docs/fleet.md states it against the targets). Measured (`cargo
+//! test --release -p vibmode-fleet --test acceptance -- --nocapture`): healthy 59/60 normal; road D 23/24 road;
 //! RL damper at 50 % 24/24 vehicle, RL named every time; FL tyre -30 % 24/24 vehicle, FL named
 //! in 23; rear springs -20 % 24/24 vehicle, a rear corner named every time (the body response
 //! to wheel motion 2-4 Hz against the other axle); loaded +15 % 22/24 normal; RL damper -30 %
@@ -16,28 +16,12 @@ use std::collections::BTreeMap;
 
 mod common;
 
-use common::config;
+use common::{config, record};
 use vibmode_fleet::{
     build_baseline, check_recording, ingest_recording, recording_hash, Classification, Condition,
     IngestLabels, Store,
 };
-use vibmode_vehicle::{simulate, Corner, CornerCondition, RoadClass, SimParams, VehicleParams};
-
-fn record(v: &VehicleParams, road: RoadClass, kmh: f64, seed: u64) -> vibmode_core::Recording {
-    let p = SimParams {
-        road,
-        speed_kmh: kmh,
-        fs_hz: 200.0,
-        records: 1,
-        seed,
-        ..SimParams::default()
-    };
-    simulate(v, &p)
-        .expect("simulate")
-        .records
-        .remove(0)
-        .recording
-}
+use vibmode_vehicle::{Corner, CornerCondition, RoadClass, VehicleParams};
 
 /// (label, vehicle, road, speeds km/h, corners that must all be named).
 type Scenario = (

@@ -8,26 +8,10 @@
 
 mod common;
 
-use common::config;
+use common::{config, record};
 use vibmode_fleet::body::{body_response, fit_body_model};
 use vibmode_fleet::compute_features;
-use vibmode_vehicle::{simulate, RoadClass, SimParams, VehicleParams};
-
-fn record(v: &VehicleParams, road: RoadClass, kmh: f64, seed: u64) -> vibmode_core::Recording {
-    let p = SimParams {
-        road,
-        speed_kmh: kmh,
-        fs_hz: 200.0,
-        records: 1,
-        seed,
-        ..SimParams::default()
-    };
-    simulate(v, &p)
-        .expect("simulate")
-        .records
-        .remove(0)
-        .recording
-}
+use vibmode_vehicle::{RoadClass, VehicleParams};
 
 const BANDS: [[f64; 2]; 7] = [
     [0.7, 1.0],

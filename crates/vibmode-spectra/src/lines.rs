@@ -129,6 +129,46 @@ fn band_moments(
     }
 }
 
+/// Local maxima of `pw` (above their two neighbours on each side) in bins `k_lo..=k_hi`
+/// standing at least `min_db` above the median of the bins within `reach`: `(bin, dB above the
+/// median)`, by increasing bin.
+fn prominent_peaks(
+    pw: &[f64],
+    k_lo: usize,
+    k_hi: usize,
+    reach: usize,
+    min_db: f64,
+) -> Vec<(usize, f64)> {
+    let mut peaks = Vec::new();
+    for k in k_lo.max(2)..=k_hi.min(pw.len().saturating_sub(3)) {
+        if !(pw[k - 2..=k + 2].iter().all(|&v| v <= pw[k])) {
+            continue;
+        }
+        let lo = k.saturating_sub(reach);
+        let hi = (k + reach).min(pw.len() - 1);
+        let mut near: Vec<f64> = pw[lo..=hi].to_vec();
+        near.sort_by(f64::total_cmp);
+        let prominence_db = 10.0 * (pw[k] / near[near.len() / 2]).log10();
+        if prominence_db >= min_db {
+            peaks.push((k, prominence_db));
+        }
+    }
+    peaks
+}
+
+/// The fractional bin of the peak at bin `k` (`0 < k < len - 1`): the vertex of the parabola
+/// through the log powers of bins `k - 1, k, k + 1`, within half a bin of `k`.
+fn peak_bin(pw: &[f64], k: usize) -> f64 {
+    let (a, b, c) = (pw[k - 1].ln(), pw[k].ln(), pw[k + 1].ln());
+    let den = a - 2.0 * b + c;
+    let delta = if den.abs() > 0.0 {
+        0.5 * (a - c) / den
+    } else {
+        0.0
+    };
+    k as f64 + delta.clamp(-0.5, 0.5)
+}
+
 /// Every prominent peak of the periodogram of `x` (sampled at `fs_hz`, Hz) between
 /// `2 half_width_hz` and `fs_hz / 2 - half_width_hz`, with its narrow-band kurtosis.
 ///
@@ -166,21 +206,7 @@ pub fn line_candidates(
     let k_hi = ((fs_hz / 2.0 - p.half_width_hz) / df).floor() as usize;
     let k_hi = k_hi.min(pw.len().saturating_sub(3));
     let reach = ((1.0 / df).round() as usize).max(3);
-    let mut peaks: Vec<(usize, f64)> = Vec::new();
-    for k in k_lo..=k_hi {
-        if k < 2 || !(pw[k - 2..=k + 2].iter().all(|&v| v <= pw[k])) {
-            continue;
-        }
-        let lo = k.saturating_sub(reach);
-        let hi = (k + reach).min(pw.len() - 1);
-        let mut near: Vec<f64> = pw[lo..=hi].to_vec();
-        near.sort_by(f64::total_cmp);
-        let median = near[near.len() / 2];
-        let prominence_db = 10.0 * (pw[k] / median).log10();
-        if prominence_db >= p.min_prominence_db {
-            peaks.push((k, prominence_db));
-        }
-    }
+    let mut peaks = prominent_peaks(&pw, k_lo, k_hi, reach, p.min_prominence_db);
     // Strongest first; drop peaks within half_width_hz of a stronger one.
     peaks.sort_by(|a, b| pw[b.0].total_cmp(&pw[a.0]));
     let mut kept: Vec<(usize, f64)> = Vec::new();
@@ -195,14 +221,7 @@ pub fn line_candidates(
     let mut out: Vec<LineCandidate> = kept
         .into_iter()
         .map(|(k, prominence_db)| {
-            let (a, b, c) = (pw[k - 1].ln(), pw[k].ln(), pw[k + 1].ln());
-            let den = a - 2.0 * b + c;
-            let delta = if den.abs() > 0.0 {
-                0.5 * (a - c) / den
-            } else {
-                0.0
-            };
-            let frequency_hz = (k as f64 + delta.clamp(-0.5, 0.5)) * df;
+            let frequency_hz = peak_bin(&pw, k) * df;
             let kurtosis = band_kurtosis(&mut planner, x, fs_hz, frequency_hz, p.half_width_hz);
             LineCandidate {
                 frequency_hz,
@@ -353,29 +372,10 @@ pub fn ridges(spec: &Spectrogram, p: &LineParams) -> Vec<Ridge> {
         .iter()
         .map(|row| {
             let pw: Vec<f64> = row.iter().map(|v| v.max(1e-300)).collect();
-            let mut out = Vec::new();
-            for k in k_lo..=k_hi {
-                if !(pw[k - 2..=k + 2].iter().all(|&v| v <= pw[k])) {
-                    continue;
-                }
-                let lo = k.saturating_sub(reach);
-                let hi = (k + reach).min(pw.len() - 1);
-                let mut near: Vec<f64> = pw[lo..=hi].to_vec();
-                near.sort_by(f64::total_cmp);
-                let median = near[near.len() / 2];
-                if 10.0 * (pw[k] / median).log10() < p.stft_min_prominence_db {
-                    continue;
-                }
-                let (a, b, c) = (pw[k - 1].ln(), pw[k].ln(), pw[k + 1].ln());
-                let den = a - 2.0 * b + c;
-                let delta = if den.abs() > 0.0 {
-                    0.5 * (a - c) / den
-                } else {
-                    0.0
-                };
-                out.push((k as f64 + delta.clamp(-0.5, 0.5)) * df);
-            }
-            out
+            prominent_peaks(&pw, k_lo, k_hi, reach, p.stft_min_prominence_db)
+                .into_iter()
+                .map(|(k, _)| peak_bin(&pw, k) * df)
+                .collect()
         })
         .collect();
     // Link: (slice, frequency) lists.

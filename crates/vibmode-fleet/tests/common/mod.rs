@@ -2,6 +2,24 @@
 #![allow(dead_code)]
 
 use vibmode_fleet::FleetConfig;
+use vibmode_vehicle::{simulate, RoadClass, SimParams, VehicleParams};
+
+/// One simulated 10.24 s record at 200 Hz of `v` on `road` at `kmh`.
+pub fn record(v: &VehicleParams, road: RoadClass, kmh: f64, seed: u64) -> vibmode_core::Recording {
+    let p = SimParams {
+        road,
+        speed_kmh: kmh,
+        fs_hz: 200.0,
+        records: 1,
+        seed,
+        ..SimParams::default()
+    };
+    simulate(v, &p)
+        .expect("simulate")
+        .records
+        .remove(0)
+        .recording
+}
 
 /// A faster analysis than the default (AR sweep to order 16) so several seeds run in seconds.
 /// `FAR=0.05 cargo test ...` repeats a run at another false-alarm rate (docs/fleet.md);
