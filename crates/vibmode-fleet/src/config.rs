@@ -24,6 +24,12 @@ pub struct FleetConfig {
     pub floor_level: f64,
     /// Floor of the spread of ln(transmissibility) (default 0.10).
     pub floor_transmissibility: f64,
+    /// Bands of `bands_hz` starting below this frequency, Hz, give no transmissibility feature
+    /// (default 2: at 0.5-2 Hz the body modes' response to the front and rear wheels' inputs,
+    /// which the wheelbase delays by a speed-dependent time, made healthy records' sprung over
+    /// unsprung ratio scatter by 30-40 % and caused every false alarm of the acceptance; the
+    /// body response to wheel motion covers the body instead).
+    pub transmissibility_min_hz: f64,
     /// Floor of the spread of ln(mode frequency) (default 0.05).
     pub floor_frequency: f64,
     /// Floor of the spread of ln(damping ratio) (default 0.35).
@@ -76,6 +82,7 @@ impl Default for FleetConfig {
             min_nominal: 5,
             floor_level: 0.15,
             floor_transmissibility: 0.10,
+            transmissibility_min_hz: 2.0,
             floor_frequency: 0.05,
             floor_damping: 0.35,
             mode_group_tol: 0.08,

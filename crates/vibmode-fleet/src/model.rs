@@ -81,7 +81,7 @@ fn ratio_key(kind: Kind, name: &str, band: &[f64; 2]) -> String {
 /// Where a feature comes from, and its name in tables.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FeatureMeta {
-    /// Unique key, e.g. `trans:RL:8-12Hz`, `mode:RL_unsprung:1:damping`.
+    /// Unique key, e.g. `transrel:RL:8-12Hz`, `mode:RL_unsprung:1:damping`.
     pub key: String,
     /// Excitation or vehicle.
     pub group: Group,
@@ -358,6 +358,49 @@ fn body_features(
     out
 }
 
+/// Transmissibility per corner and band (bands starting at or above
+/// `transmissibility_min_hz`): ln(sprung / unsprung band RMS) minus its mean over the other
+/// corners that have the band, so that what moves every corner alike (the load, whose extra
+/// mass lowers every corner's damping per mass; the speed; the road's spectrum) cancels and a
+/// corner's own damper, spring or tyre stays. With a single corner the absolute value is kept.
+fn transmissibility_features(rf: &RecordFeatures, cfg: &FleetConfig) -> Vec<(FeatureMeta, f64)> {
+    let mut out = Vec::new();
+    for (k, b) in rf.bands_hz.iter().enumerate() {
+        if b[0] < cfg.transmissibility_min_hz {
+            continue;
+        }
+        let logs: Vec<(&crate::features::CornerTransmissibility, f64)> = rf
+            .transmissibility
+            .iter()
+            .filter_map(|t| {
+                let v = t.values.get(k).copied().flatten()?;
+                (v.is_finite() && v > 0.0).then(|| (t, v.ln()))
+            })
+            .collect();
+        let total: f64 = logs.iter().map(|(_, v)| v).sum();
+        for (t, v) in &logs {
+            let (value, against) = if logs.len() > 1 {
+                let others = (total - v) / (logs.len() - 1) as f64;
+                (v - others, " vs the other corners")
+            } else {
+                (*v, "")
+            };
+            out.push((
+                FeatureMeta {
+                    key: format!("transrel:{}:{}", t.corner, band_key(b)),
+                    group: Group::Vehicle,
+                    kind: Kind::Transmissibility,
+                    corner: Some(t.corner),
+                    channel: t.sprung.clone(),
+                    label: format!("transmissibility {}{against}", band_label(b)),
+                },
+                value,
+            ));
+        }
+    }
+    out
+}
+
 /// Scalar features of a record, as ln(value), given the model set's modes and nominal body
 /// response.
 pub fn scalar_features(
@@ -390,23 +433,7 @@ pub fn scalar_features(
             ));
         }
     }
-    for t in &rf.transmissibility {
-        for (b, v) in rf.bands_hz.iter().zip(&t.values) {
-            if let Some(v) = v {
-                out.push((
-                    FeatureMeta {
-                        key: format!("trans:{}:{}", t.corner, band_key(b)),
-                        group: Group::Vehicle,
-                        kind: Kind::Transmissibility,
-                        corner: Some(t.corner),
-                        channel: t.sprung.clone(),
-                        label: format!("transmissibility {}", band_label(b)),
-                    },
-                    v.ln(),
-                ));
-            }
-        }
-    }
+    out.extend(transmissibility_features(rf, cfg));
     // Unsprung level ratios at and above wheel hop: left over right wheel of each axle, front
     // over rear wheel of each side. Both wheels of a pair roll on the same road class at the same
     // speed (on one side, on the same track), so the road level and its spectrum cancel.
@@ -981,6 +1008,50 @@ mod tests {
             .collect();
         let names: Vec<String> = (0..6).map(|i| format!("n{i}")).collect();
         build_model_set("bus", &names, &recs, &FleetConfig::default()).expect("model set")
+    }
+
+    /// Transmissibility of three corners relative to the other two, by hand: every corner
+    /// scaled alike (a load) leaves the features unchanged; RL halved gives RL ln(0.5) and the
+    /// others -ln(0.5)/2; the band below `transmissibility_min_hz` gives no feature.
+    #[test]
+    fn transmissibility_relative_to_the_other_corners_by_hand() {
+        let cfg = FleetConfig::default();
+        let rec = |fl: f64, fr: f64, rl: f64| {
+            let mut r = record(1.0, 1.0);
+            r.bands_hz = vec![[0.5, 2.0], [2.0, 5.0]];
+            r.transmissibility = [(Corner::FL, fl), (Corner::FR, fr), (Corner::RL, rl)]
+                .into_iter()
+                .map(|(corner, v)| CornerTransmissibility {
+                    corner,
+                    sprung: format!("{corner}_sprung"),
+                    unsprung: format!("{corner}_unsprung"),
+                    values: vec![Some(1.0), Some(v)],
+                })
+                .collect();
+            transmissibility_features(&r, &cfg)
+        };
+        let base = rec(0.2, 0.3, 0.4);
+        assert_eq!(base.len(), 3, "one band of three corners: {base:?}");
+        let want_rl = 0.4f64.ln() - 0.5 * (0.2f64.ln() + 0.3f64.ln());
+        let rl = base.iter().find(|(m, _)| m.corner == Some(Corner::RL));
+        let (meta, v) = rl.expect("RL");
+        assert!((v - want_rl).abs() < 1e-12, "{v} {want_rl}");
+        assert_eq!(meta.label, "transmissibility 2-5 Hz vs the other corners");
+        for ((_, a), (_, b)) in base.iter().zip(&rec(0.2 * 0.8, 0.3 * 0.8, 0.4 * 0.8)) {
+            assert!(
+                (a - b).abs() < 1e-12,
+                "a common factor must cancel: {a} {b}"
+            );
+        }
+        let halved = rec(0.2, 0.3, 0.2);
+        for ((m, a), (_, b)) in base.iter().zip(&halved) {
+            let want = if m.corner == Some(Corner::RL) {
+                0.5f64.ln()
+            } else {
+                -0.5 * 0.5f64.ln()
+            };
+            assert!((b - a - want).abs() < 1e-12, "{m:?}: {a} -> {b}");
+        }
     }
 
     #[test]

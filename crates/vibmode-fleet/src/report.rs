@@ -232,7 +232,7 @@ fn trend_figure(html: &mut HtmlReport, set: &ModelSet, records: &[RecordEntry]) 
             let unit = match f.meta.kind {
                 crate::model::Kind::ModeFrequency => "Hz",
                 crate::model::Kind::ModeDamping => "damping ratio",
-                crate::model::Kind::Transmissibility => "sprung / unsprung RMS",
+                crate::model::Kind::Transmissibility => "sprung / unsprung RMS vs other corners",
                 crate::model::Kind::Level => "m/s^2",
                 crate::model::Kind::SideRatio => "left / right unsprung RMS",
                 crate::model::Kind::TrackRatio => "front / rear unsprung RMS",

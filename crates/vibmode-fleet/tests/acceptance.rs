@@ -1,15 +1,18 @@
 //! Issue 12's acceptance scenarios on the simulator, over three baseline seeds: a baseline of 8
 //! healthy records (class B road, 25-35 km/h), then 20 further healthy records (new seeds,
 //! 20-40 km/h), 8 on a class D road, 8 with the rear-left damper at 50 %, 8 with the front-left
-//! tyre 30 % softer, 8 with the rear springs 20 % softer, 8 with 15 % more load, and a sweep of
-//! rear-left damper losses (10, 20, 30, 50 %). Prints the confusion table; the assertions are
-//! what was measured (docs/fleet.md states it against the issue's targets). Measured (`cargo
-//! test --release -p vibmode-fleet --test acceptance -- --nocapture`): healthy 59/60 normal; road D 23/24 road;
-//! RL damper at 50 % 24/24 vehicle, RL named every time; FL tyre -30 % 24/24 vehicle, FL named
-//! in 23; rear springs -20 % 24/24 vehicle, a rear corner named every time (the body response
-//! to wheel motion 2-4 Hz against the other axle); loaded +15 % 22/24 normal; RL damper -30 %
-//! 24/24 (RL named in 24), -20 % 17/24 (17), -10 % 1/24. `FAR=0.05` repeats it at a 5 %
-//! false-alarm rate (healthy 57/60; loaded 18/24 normal; damper -20 % 23/24, -10 % 2/24);
+//! tyre 30 % softer, 8 with the rear springs 20 % softer, 8 with 15 % and 8 with 30 % more load
+//! (`VehicleParams::with_passenger_load`), and a sweep of rear-left damper losses (10, 20, 30,
+//! 50 %). Prints the confusion table; the assertions are what was measured (docs/fleet.md states
+//! it against the issue's targets). Measured (`cargo test --release -p vibmode-fleet --test
+//! acceptance -- --nocapture`): healthy 60/60 normal; road D 24/24 road; RL damper at 50 %
+//! 24/24 vehicle, RL named every time; FL tyre -30 % 24/24 vehicle, FL named in 24; rear springs
+//! -20 % 24/24 vehicle, a rear corner named every time; loaded +15 % 23/24 normal, +30 % 24/24;
+//! RL damper -30 % 24/24 (RL named in 24), -20 % 17/24, -10 % 3/24. `FAR=0.05` repeats it at a
+//! 5 % false-alarm rate (healthy 59/60; road D 23/24 road and 1 both; loaded +15 % 22/24 normal,
+//! +30 % 23/24; damper -20 % 21/24, -10 % 6/24). `LOAD_SPREAD=20` gives the baseline and the
+//! healthy records 0-20 % passenger load (1 %: loads 24/24 and 24/24 normal, but rear springs
+//! 18/24 and damper -30 % 20/24: 8 records of mixed loads are a wider baseline);
 //! `FLEET_DEBUG=1` prints the summary of every record not classed normal.
 
 use std::collections::BTreeMap;
@@ -38,6 +41,15 @@ fn with(bus: &VehicleParams, cc: CornerCondition) -> VehicleParams {
     v
 }
 
+/// The spread of passenger loads over the baseline and healthy records (fraction of the body
+/// mass; `LOAD_SPREAD` in percent, default 0: the issue's baseline is 8 records of one bus).
+fn load_spread() -> f64 {
+    std::env::var("LOAD_SPREAD")
+        .ok()
+        .and_then(|v| v.parse::<f64>().ok())
+        .map_or(0.0, |p| p / 100.0)
+}
+
 #[test]
 fn issue_scenarios_over_three_baselines() {
     let bus = VehicleParams::city_bus();
@@ -59,14 +71,9 @@ fn issue_scenarios_over_three_baselines() {
         },
     );
     // Another load (a normal operating condition): 15 % more sprung mass and inertia (about 23
-    // passengers), with the air springs' pressure raised by the level control so that their
-    // rate grows with the load (ride frequencies kept, as air suspensions are designed to).
-    let mut loaded = bus.clone();
-    loaded.body.mass_kg *= 1.15;
-    loaded.body.pitch_inertia_kgm2 *= 1.15;
-    loaded.body.roll_inertia_kgm2 *= 1.15;
-    loaded.front.spring_stiffness_n_per_m *= 1.15;
-    loaded.rear.spring_stiffness_n_per_m *= 1.15;
+    // passengers), the air springs' rate following (`with_passenger_load`).
+    let loaded = bus.with_passenger_load(0.15);
+    let heavy = bus.with_passenger_load(0.30);
     let mut rear_springs = bus.clone();
     rear_springs.rear.spring_stiffness_n_per_m *= 0.8;
     // (scenario, classification) -> count; (scenario) -> records naming the expected corner.
@@ -82,7 +89,14 @@ fn issue_scenarios_over_three_baselines() {
         };
         for i in 0..8u64 {
             let kmh = 25.0 + 10.0 * i as f64 / 7.0;
-            let rec = record(&bus, RoadClass::B, kmh, base * 1000 + i);
+            // Passenger loads of 0 to LOAD_SPREAD % (default 0: one load).
+            let load = load_spread() * ((i * 3) % 8) as f64 / 7.0;
+            let rec = record(
+                &bus.with_passenger_load(load),
+                RoadClass::B,
+                kmh,
+                base * 1000 + i,
+            );
             ingest_recording(
                 &mut store,
                 &labels,
@@ -120,6 +134,13 @@ fn issue_scenarios_over_three_baselines() {
             (
                 "loaded +15 %".into(),
                 loaded.clone(),
+                RoadClass::B,
+                (0..8).map(|i| 22.0 + 2.0 * i as f64).collect(),
+                &[],
+            ),
+            (
+                "loaded +30 %".into(),
+                heavy.clone(),
                 RoadClass::B,
                 (0..8).map(|i| 22.0 + 2.0 * i as f64).collect(),
                 &[],
@@ -164,6 +185,12 @@ fn issue_scenarios_over_three_baselines() {
         }
         for (k, (label, v, road, speeds, corners)) in scen.iter().enumerate() {
             for (j, kmh) in speeds.iter().enumerate() {
+                // The healthy records carry the baseline's spread of loads.
+                let v = if label.starts_with("healthy") {
+                    &v.with_passenger_load(load_spread() * ((j * 7) % 20) as f64 / 19.0)
+                } else {
+                    v
+                };
                 let rec = record(v, *road, *kmh, base * 100_000 + k as u64 * 100 + j as u64);
                 let c = check_recording(
                     &mut store,
@@ -232,16 +259,19 @@ fn issue_scenarios_over_three_baselines() {
         "{table}"
     );
     // The sweep: a 30 % loss is caught (measured 24 of 24 at 1 % and 5 %), 20 % in most records
-    // (22 and 23 of 24), 10 % hardly (1 of 24 at 1 %, 4 at 5 %).
+    // (17 and 21 of 24), 10 % hardly (3 of 24 at 1 %, 6 at 5 %).
     assert!(flagged("RL damper -30 %") >= 21, "{table}");
     assert!(flagged("RL damper -20 %") >= 15, "{table}");
-    // Another load (15 % heavier, air springs following): a normal condition, measured 22 of 24
-    // normal at 1 % and 18 of 24 at 5 % (docs/fleet.md: not yet met at 5 %).
-    let load_bound = if cfg.false_alarm_rate <= 0.01 { 3 } else { 7 };
+    // Another load (15 % or 30 % heavier, air springs following): a normal condition, measured
+    // 23 and 24 of 24 normal at 1 %, 22 and 23 at 5 %.
     assert!(
-        24 - count("loaded +15 %", Classification::Normal) <= load_bound,
+        24 - count("loaded +15 %", Classification::Normal) <= 3,
         "{table}"
     );
-    let ten_pct_bound = if cfg.false_alarm_rate <= 0.01 { 3 } else { 6 };
+    assert!(
+        24 - count("loaded +30 %", Classification::Normal) <= 3,
+        "{table}"
+    );
+    let ten_pct_bound = if cfg.false_alarm_rate <= 0.01 { 5 } else { 8 };
     assert!(flagged("RL damper -10 %") <= ten_pct_bound, "{table}");
 }

@@ -192,3 +192,49 @@ fn iso8608_class_values() {
     assert!((RoadClass::A.displacement_psd_m3(0.05) - 64e-6).abs() < 1e-15);
     assert_eq!(RoadClass::B.displacement_psd_m3(0.0), 0.0);
 }
+
+/// A passenger load scales the sprung mass, its inertias and the air springs by the same factor
+/// (by hand), so heave and pitch keep their frequencies within the tyres' share (the tyres are
+/// not stiffened), roll loses the anti-roll bars' share (they are not stiffened either), and their damping ratios, `c / (2 m omega)`, fall by
+/// about `1 - 1/1.15` = 13 % (the dampers are not stronger): checked on the full-car model's
+/// modes.
+#[test]
+fn passenger_load_scales_the_body_and_the_air_springs() {
+    use vibmode_vehicle::{FullCar, ModeLabel};
+    let bus = VehicleParams::city_bus();
+    let loaded = bus.with_passenger_load(0.15);
+    assert_eq!(loaded.body.mass_kg, bus.body.mass_kg * 1.15);
+    assert_eq!(
+        loaded.body.pitch_inertia_kgm2,
+        bus.body.pitch_inertia_kgm2 * 1.15
+    );
+    assert_eq!(
+        loaded.body.roll_inertia_kgm2,
+        bus.body.roll_inertia_kgm2 * 1.15
+    );
+    assert_eq!(
+        loaded.rear.spring_stiffness_n_per_m,
+        bus.rear.spring_stiffness_n_per_m * 1.15
+    );
+    assert_eq!(loaded.front.damper_n_s_per_m, bus.front.damper_n_s_per_m);
+    assert_eq!(loaded.front.unsprung_mass_kg, bus.front.unsprung_mass_kg);
+    assert_eq!(bus.with_passenger_load(0.0), bus);
+    assert_eq!(bus.with_passenger_load(f64::NAN), bus);
+    let modes = |v: &VehicleParams| FullCar::new(v).and_then(|c| c.modes()).expect("modes");
+    let (m0, m1) = (modes(&bus), modes(&loaded));
+    // Heave and pitch stay within the tyres' share; roll drops by part of 1 - 1/sqrt(1.15) =
+    // 6.7 %, the anti-roll bars' share of the roll stiffness.
+    for (label, lo, hi) in [
+        (ModeLabel::BodyHeave, -0.015, 0.0),
+        (ModeLabel::BodyPitch, -0.015, 0.0),
+        (ModeLabel::BodyRoll, -0.067, -0.02),
+    ] {
+        let a = m0.iter().find(|m| m.label == label).expect("nominal mode");
+        let b = m1.iter().find(|m| m.label == label).expect("loaded mode");
+        let df = b.frequency_hz / a.frequency_hz - 1.0;
+        let dz = b.damping_ratio / a.damping_ratio - 1.0;
+        eprintln!("{label:?}: frequency {df:+.4}, damping {dz:+.4}");
+        assert!((lo..hi).contains(&df), "{label:?}: frequency {df:+.4}");
+        assert!((-0.16..-0.10).contains(&dz), "{label:?}: damping {dz:+.4}");
+    }
+}
