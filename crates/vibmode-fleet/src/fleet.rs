@@ -117,10 +117,10 @@ pub fn ingest_recording(
     })
 }
 
-/// The file as the user named it (not only its base name: `run1/record_01.wav` and
-/// `run2/record_01.wav` must stay apart in the tables and the JSON).
 fn file_name(path: &Path) -> String {
-    path.display().to_string()
+    path.file_name()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_else(|| path.display().to_string())
 }
 
 fn hash_file(path: &Path) -> Result<String> {
