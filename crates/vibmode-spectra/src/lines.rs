@@ -250,12 +250,7 @@ pub struct Ridge {
 impl Ridge {
     /// Highest minus lowest frequency of the ridge, Hz.
     pub fn range_hz(&self) -> f64 {
-        let lo = self.freq_hz.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = self
-            .freq_hz
-            .iter()
-            .copied()
-            .fold(f64::NEG_INFINITY, f64::max);
+        let (lo, hi) = self.span_hz();
         if hi >= lo {
             hi - lo
         } else {
