@@ -123,14 +123,14 @@ fn check_channels(channels: &[&[f64]]) -> Result<usize, SsiError> {
 /// at a time, without recomputing a product.
 #[derive(Clone, Debug)]
 pub struct SsiCorrelations {
-    fs_hz: f64,
-    order_max: usize,
-    block_rows: usize,
-    skip: usize,
-    sums: Vec<Vec<DMatrix<f64>>>,
-    counts: Vec<Vec<usize>>,
-    n_samples: Vec<usize>,
-    max_abs: f64,
+    pub(crate) fs_hz: f64,
+    pub(crate) order_max: usize,
+    pub(crate) block_rows: usize,
+    pub(crate) skip: usize,
+    pub(crate) sums: Vec<Vec<DMatrix<f64>>>,
+    pub(crate) counts: Vec<Vec<usize>>,
+    pub(crate) n_samples: Vec<usize>,
+    pub(crate) max_abs: f64,
 }
 
 impl SsiCorrelations {
@@ -151,29 +151,8 @@ impl SsiCorrelations {
         let i = params.block_rows;
         let skip = params.first_lag - 1;
         let max_lag = 2 * i - 1 + skip;
-        let refs: Vec<usize> = match &params.reference_channels {
-            Some(refs) => {
-                if let Some(&index) = refs.iter().find(|&&r| r >= l.max(1)) {
-                    return Err(SsiError::ReferenceChannel {
-                        index,
-                        n_channels: l,
-                        last: l.saturating_sub(1),
-                    });
-                }
-                refs.clone()
-            }
-            None => (0..l).collect(),
-        };
-        let mut out = SsiCorrelations {
-            fs_hz,
-            order_max: params.order_max,
-            block_rows: i,
-            skip,
-            sums: Vec::with_capacity(segments.len()),
-            counts: Vec::with_capacity(segments.len()),
-            n_samples: Vec::with_capacity(segments.len()),
-            max_abs: 0.0,
-        };
+        let refs = reference_indices(params, l)?;
+        let mut out = SsiCorrelations::empty(fs_hz, params);
         for seg in segments {
             if seg.len() != l {
                 return Err(SsiError::LengthMismatch {
@@ -191,32 +170,79 @@ impl SsiCorrelations {
                     min_samples: max_lag + 1,
                 });
             }
-            let demeaned: Vec<Vec<f64>> = seg
-                .iter()
-                .map(|ch| {
-                    let m = ch.iter().sum::<f64>() / n as f64;
-                    ch.iter().map(|v| v - m).collect()
-                })
-                .collect();
+            let demeaned = demeaned(seg, n);
             out.max_abs = demeaned
                 .iter()
                 .flatten()
                 .fold(out.max_abs, |m, v| m.max(v.abs()));
-            let mut sums = vec![DMatrix::zeros(l, refs.len()); max_lag];
-            for (k, sum) in (1..=max_lag).zip(sums.iter_mut()) {
-                for a in 0..l {
-                    for (b, &rb) in refs.iter().enumerate() {
-                        let ya = &demeaned[a][k..];
-                        let yb = &demeaned[rb][..n - k];
-                        sum[(a, b)] += ya.iter().zip(yb).map(|(x, y)| x * y).sum::<f64>();
-                    }
-                }
-            }
+            let (sums, counts) = lag_sums(&demeaned, &refs, max_lag, 0..n);
             out.sums.push(sums);
-            out.counts.push((1..=max_lag).map(|k| n - k).collect());
+            out.counts.push(counts);
             out.n_samples.push(n);
         }
         Ok(out)
+    }
+
+    /// The correlation sums of one record (`channels`, equal lengths, finite, means removed
+    /// over the whole record) cut into `n_blocks` blocks of consecutive time: block `b` holds,
+    /// at every lag `k`, the products `y[t+k] y_ref[t]^T` of the `t` in
+    /// `[b N / n_blocks, (b + 1) N / n_blocks)` (and `t < N - k`). Every product of the record
+    /// is in exactly one block, so [`SsiCorrelations::plan`] is the plan of the whole record
+    /// ([`SsiCov::new`]); the blocks' scatter gives [`SsiCorrelations::perturbation`] and
+    /// [`SsiCorrelations::jackknife`]. Needs `n_blocks >= 2` and at least
+    /// `first_lag + 2 block_rows - 1` samples per block (`SsiError::BlocksTooShort`).
+    pub fn blocks(
+        channels: &[&[f64]],
+        fs_hz: f64,
+        params: &SsiParams,
+        n_blocks: usize,
+    ) -> Result<SsiCorrelations, SsiError> {
+        params.validate()?;
+        if !(fs_hz.is_finite() && fs_hz > 0.0) {
+            return Err(SsiError::InvalidSampleRate { fs_hz });
+        }
+        let mut out = SsiCorrelations::empty(fs_hz, params);
+        let n = check_channels(channels)?;
+        let l = channels.len();
+        let refs = reference_indices(params, l)?;
+        let max_lag = 2 * params.block_rows - 1 + (params.first_lag - 1);
+        if n_blocks < 2 {
+            return Err(SsiError::TooFewBlocks { n_blocks });
+        }
+        let block_len = n / n_blocks;
+        if block_len <= max_lag {
+            return Err(SsiError::BlocksTooShort {
+                n_samples: n,
+                n_blocks,
+                block_len,
+                min_block_len: max_lag + 1,
+                max_blocks: n / (max_lag + 1),
+            });
+        }
+        let demeaned = demeaned(channels, n);
+        out.max_abs = demeaned.iter().flatten().fold(0.0, |m, v| m.max(v.abs()));
+        for b in 0..n_blocks {
+            let (t0, t1) = (b * n / n_blocks, (b + 1) * n / n_blocks);
+            let (sums, counts) = lag_sums(&demeaned, &refs, max_lag, t0..t1);
+            out.sums.push(sums);
+            out.counts.push(counts);
+            out.n_samples.push(t1 - t0);
+        }
+        Ok(out)
+    }
+
+    /// No segment yet.
+    fn empty(fs_hz: f64, params: &SsiParams) -> SsiCorrelations {
+        SsiCorrelations {
+            fs_hz,
+            order_max: params.order_max,
+            block_rows: params.block_rows,
+            skip: params.first_lag - 1,
+            sums: Vec::new(),
+            counts: Vec::new(),
+            n_samples: Vec::new(),
+            max_abs: 0.0,
+        }
     }
 
     /// Number of segments.
@@ -279,6 +305,62 @@ impl SsiCorrelations {
         cov.n_samples = used().map(|s| self.n_samples[s]).sum();
         Ok(cov)
     }
+}
+
+/// Each channel minus its mean over its `n` samples.
+fn demeaned(channels: &[&[f64]], n: usize) -> Vec<Vec<f64>> {
+    channels
+        .iter()
+        .map(|ch| {
+            let m = ch.iter().sum::<f64>() / n as f64;
+            ch.iter().map(|v| v - m).collect()
+        })
+        .collect()
+}
+
+/// The reference channels' indices of `params` for `l` channels (all by default).
+fn reference_indices(params: &SsiParams, l: usize) -> Result<Vec<usize>, SsiError> {
+    match &params.reference_channels {
+        Some(refs) => {
+            if let Some(&index) = refs.iter().find(|&&r| r >= l.max(1)) {
+                return Err(SsiError::ReferenceChannel {
+                    index,
+                    n_channels: l,
+                    last: l.saturating_sub(1),
+                });
+            }
+            Ok(refs.clone())
+        }
+        None => Ok((0..l).collect()),
+    }
+}
+
+/// For the lags `k = 1..=max_lag`: `sum_{t in ts, t < N - k} y[t+k] y[refs][t]^T` and the number
+/// of products (`N` the channels' length).
+fn lag_sums(
+    y: &[Vec<f64>],
+    refs: &[usize],
+    max_lag: usize,
+    ts: std::ops::Range<usize>,
+) -> (Vec<DMatrix<f64>>, Vec<usize>) {
+    let n = y.first().map_or(0, Vec::len);
+    let mut sums = vec![DMatrix::zeros(y.len(), refs.len()); max_lag];
+    let mut counts = vec![0; max_lag];
+    for (k, (sum, count)) in (1..=max_lag).zip(sums.iter_mut().zip(counts.iter_mut())) {
+        let t1 = ts.end.min(n.saturating_sub(k));
+        if t1 <= ts.start {
+            continue;
+        }
+        *count = t1 - ts.start;
+        for (a, ya) in y.iter().enumerate() {
+            for (b, &rb) in refs.iter().enumerate() {
+                let fut = &ya[ts.start + k..t1 + k];
+                let past = &y[rb][ts.start..t1];
+                sum[(a, b)] += fut.iter().zip(past).map(|(x, v)| x * v).sum::<f64>();
+            }
+        }
+    }
+    (sums, counts)
 }
 
 /// The jackknife standard deviation of an estimate from its leave-one-out values `theta`

@@ -52,6 +52,26 @@ pub enum SsiError {
         /// Groups asked for.
         groups: usize,
     },
+    /// A perturbation-based uncertainty needs the scatter of at least two blocks.
+    #[error("{n_blocks} data block(s) give no scatter to propagate; cut the data into at least 2 blocks (20 to 50 is usual)")]
+    TooFewBlocks {
+        /// Blocks (or segments) given.
+        n_blocks: usize,
+    },
+    /// Blocks of one record too short for the lags of the block Toeplitz matrix.
+    #[error("{n_samples} samples cut into {n_blocks} blocks give {block_len} samples per block, fewer than the {min_block_len} the lags need; use at most {max_blocks} blocks or lower block_rows")]
+    BlocksTooShort {
+        /// Samples per channel of the record.
+        n_samples: usize,
+        /// Blocks asked for.
+        n_blocks: usize,
+        /// Samples per block.
+        block_len: usize,
+        /// Samples a block needs (`first_lag + 2 block_rows - 1`).
+        min_block_len: usize,
+        /// Most blocks the record allows.
+        max_blocks: usize,
+    },
     /// Too few samples for the lags of the block Toeplitz matrix.
     #[error("{n_samples} samples per channel are too few for block_rows = {block_rows} (lags up to {max_lag}); pass at least {min_samples} samples or lower block_rows")]
     TooFewSamples {

@@ -8,7 +8,8 @@
 //! ([`SsiCov::poles_at`]). [`ssi_cov`] does both for the orders of an [`SsiParams`];
 //! [`stabilisation`] labels each mode against the previous order ([`Stability`]); [`mac`] and
 //! [`mpc`] compare and grade mode shapes; [`identify_record`] runs all of it on one record
-//! and clusters the poles over the orders (`vibmode ssi`). The definitions are in `docs/ssi.md`.
+//! and clusters the poles over the orders (`vibmode ssi`); [`SsiCov::perturbation`] gives each
+//! pole's first-order standard deviations from blocks of the record (Döhler-style). The definitions are in `docs/ssi.md`.
 //!
 //! ## Panics
 //!
@@ -18,12 +19,14 @@
 mod cov;
 mod eig;
 mod error;
+mod perturb;
 mod record;
 mod shape;
 mod stability;
 
 pub use cov::{jackknife_std, ssi_cov, SsiCorrelations, SsiCov, SsiMode, SsiOrder, SsiResult};
 pub use error::SsiError;
+pub use perturb::{PoleStd, SsiPerturbation};
 pub use record::{identify_record, RecordSsi, RecordSsiOptions};
 pub use shape::{mac, mpc};
 pub use stability::{stabilisation, Stability};

@@ -366,3 +366,43 @@ fn one_record_pipeline_with_no_identifiable_order() {
         "{m}"
     );
 }
+
+#[test]
+fn perturbation_blocks_too_short_or_too_few() {
+    // 5 block rows: lags up to 9, so a block needs 10 samples; 95 samples allow 9 blocks.
+    let (a, b) = (noise(95, 1), noise(95, 2));
+    let (e, m) = msg(SsiCov::perturbation(&[&a, &b], 50.0, &params(5), 10));
+    assert_eq!(
+        e,
+        SsiError::BlocksTooShort {
+            n_samples: 95,
+            n_blocks: 10,
+            block_len: 9,
+            min_block_len: 10,
+            max_blocks: 9
+        }
+    );
+    assert!(
+        m.contains("10 blocks") && m.contains("at most 9 blocks") && !m.contains('\n'),
+        "{m}"
+    );
+    assert!(SsiCov::perturbation(&[&a, &b], 50.0, &params(5), 9).is_ok());
+    let (e, m) = msg(SsiCov::perturbation(&[&a, &b], 50.0, &params(5), 1));
+    assert_eq!(e, SsiError::TooFewBlocks { n_blocks: 1 });
+    assert!(m.contains("at least 2 blocks"), "{m}");
+    // Non-finite data is named as for SsiCov::new.
+    let mut c = a.clone();
+    c[40] = f64::NAN;
+    let (e, _) = msg(SsiCov::perturbation(&[&c, &b], 50.0, &params(5), 4));
+    assert!(
+        matches!(
+            e,
+            SsiError::NonFinite {
+                channel: 0,
+                index: 40,
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+}
