@@ -44,6 +44,12 @@ pub struct SsiArgs {
     /// back to the channels' units.
     #[arg(long)]
     pub no_normalise: bool,
+    /// Standard deviations of each mode's frequency and damping by first-order propagation
+    /// (Döhler-style): the record cut into this many blocks of time, whose scatter is carried
+    /// through the identification (20 to 50 are usual; each block needs 2 x block rows
+    /// samples). Off by default.
+    #[arg(long)]
+    pub uncertainty_blocks: Option<usize>,
 }
 
 #[derive(Serialize)]
@@ -111,6 +117,7 @@ pub fn run(a: &SsiArgs) -> Result<()> {
     let options = RecordSsiOptions {
         normalise: !a.no_normalise,
         valid_max_hz: band.map(|b| b.valid_max_hz()),
+        uncertainty_blocks: a.uncertainty_blocks,
         ..RecordSsiOptions::default()
     };
     let found = vibmode_ssi::identify_record(&chans, rec.fs_hz, &p, &options)?;
@@ -165,6 +172,15 @@ fn summary(out: &SsiOutput) -> String {
         );
         if let Some((med, _)) = m.shape_mac {
             let _ = write!(s, ", shape MAC {med:.2}");
+        }
+        if let Some(u) = &m.uncertainty {
+            let _ = write!(
+                s,
+                ", sd {:.4} Hz / damping {:.4} (first order, {} blocks)",
+                u.frequency_std_hz,
+                u.damping_std,
+                out.found.uncertainty_blocks.unwrap_or(0)
+            );
         }
         s.push('\n');
         if let Some(shape) = &m.shape {

@@ -298,6 +298,55 @@ fn ssi_identifies_a_simulated_record_and_reports_errors() {
         "{out}"
     );
     assert_eq!(v["channels"].as_array().map(Vec::len), Some(7));
+    // First-order standard deviations from 20 blocks: in the table and the JSON (the bending
+    // mode's, from 60 s, between 0.001 and 0.5 Hz); one pole_std row per identified order.
+    let u = vibmode(&[
+        "ssi",
+        wav,
+        "--resample-to",
+        "50",
+        "--block-rows",
+        "30",
+        "--uncertainty-blocks",
+        "20",
+        "--json",
+        "-",
+    ]);
+    assert!(u.status.success(), "{}", String::from_utf8_lossy(&u.stderr));
+    let uv: serde_json::Value = serde_json::from_slice(&u.stdout).unwrap();
+    assert_eq!(uv["uncertainty_blocks"], 20);
+    assert_eq!(
+        uv["pole_std"].as_array().map(Vec::len),
+        uv["result"]["orders"].as_array().map(Vec::len)
+    );
+    let bending = uv["modes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| {
+            m["class"] == "structural" && (m["frequency_hz"].as_f64().unwrap() - 9.0).abs() < 0.2
+        })
+        .expect("bending mode");
+    assert_eq!(bending["uncertainty"]["method"], "first-order");
+    let sd = bending["uncertainty"]["frequency_std_hz"].as_f64().unwrap();
+    assert!(sd > 0.001 && sd < 0.5, "{sd}");
+    fails_with(
+        &["ssi", wav, "--uncertainty-blocks", "1"],
+        &["1 data block", "at least 2 blocks"],
+    );
+    fails_with(
+        &[
+            "ssi",
+            wav,
+            "--resample-to",
+            "50",
+            "--block-rows",
+            "30",
+            "--uncertainty-blocks",
+            "100",
+        ],
+        &["100 blocks", "at most 50 blocks"],
+    );
     // A later first lag: reported, and in the JSON's parameters.
     let later = vibmode(&[
         "ssi",

@@ -29,9 +29,11 @@ fn ssi_defaults() -> PyResult<String> {
 
 /// SSI-cov of `data` (`n_channels x n_samples`, C-contiguous) sampled at `fs` Hz. `ssi` and
 /// `stability` are JSON objects of the keys to change from the defaults (unknown keys are an
-/// error). Returns the JSON of `vibmode_ssi::RecordSsi`.
+/// error). `uncertainty_blocks`: first-order standard deviations from that many blocks.
+/// Returns the JSON of `vibmode_ssi::RecordSsi`.
 #[pyfunction]
-#[pyo3(signature = (data, fs, ssi, stability, normalise, valid_max_hz))]
+#[pyo3(signature = (data, fs, ssi, stability, normalise, valid_max_hz, uncertainty_blocks=None))]
+#[allow(clippy::too_many_arguments)]
 fn ssi_cov(
     py: Python<'_>,
     data: PyReadonlyArray2<'_, f64>,
@@ -40,6 +42,7 @@ fn ssi_cov(
     stability: &str,
     normalise: bool,
     valid_max_hz: Option<f64>,
+    uncertainty_blocks: Option<usize>,
 ) -> PyResult<String> {
     check_fs(fs)?;
     let params: SsiParams = serde_json::from_str(ssi).map_err(value_err)?;
@@ -52,6 +55,7 @@ fn ssi_cov(
         normalise,
         valid_max_hz,
         stability,
+        uncertainty_blocks,
         ..RecordSsiOptions::default()
     };
     let found = py

@@ -87,6 +87,36 @@ def test_against_pyoma2_reference():
         assert compared > 20, (case, compared)
 
 
+def test_uncertainty_against_pyoma2_dohler():
+    """First-order standard deviations (uncertainty_blocks=20) against pyOMA2 1.4.3's closed-form
+    Döhler propagation of the same block scatter (tools/reference/ssi_uncertainty.py): orders
+    2..12, br = 10, to 1e-4 relative (normalise=False: the reference is of the unscaled data;
+    scaling the channels weights the SVD's truncation and moves poles and deviations)."""
+    ref = json.loads((REF / "ssi_uncertainty.json").read_text())
+    inp = json.loads((REF / "ssi_input.json").read_text())
+    data = np.asarray(inp["channels"], dtype=float)
+    res = vibmode.ssi_cov(
+        data, ref["fs_hz"], block_rows=ref["block_rows"], orders=range(2, 13, 2),
+        uncertainty_blocks=ref["n_blocks"], normalise=False, as_frame=False,
+    )
+    compared = 0
+    for o in ref["orders"]:
+        rows = np.flatnonzero(res.poles["order"] == o["order"])
+        ours = sorted(rows, key=lambda i: res.poles["frequency_hz"][i])
+        assert len(ours) == len(o["modes"]), o["order"]
+        for i, m in zip(ours, o["modes"]):
+            assert abs(res.poles["frequency_sd_hz"][i] / m["frequency_std_hz"] - 1) < 1e-4
+            assert abs(res.poles["damping_sd"][i] / m["damping_std"] - 1) < 1e-4
+            compared += 1
+    assert compared == sum(len(o["modes"]) for o in ref["orders"]) > 15
+    structural = [k for k, c in enumerate(res.modes["class"]) if c == "structural"]
+    assert structural and all(np.isfinite(res.modes["frequency_sd_hz"][k]) for k in structural)
+    with pytest.raises(ValueError, match="uncertainty_blocks"):
+        vibmode.ssi_cov(data, ref["fs_hz"], uncertainty_blocks=1)
+    with pytest.raises(ValueError, match="at most"):
+        vibmode.ssi_cov(data, ref["fs_hz"], uncertainty_blocks=1000)
+
+
 @pytest.mark.parametrize("seed", range(6))
 def test_true_modes_recovered(seed):
     """The clusters over the default orders (2..60) hold every true mode: within 1.5 % in

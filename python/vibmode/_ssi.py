@@ -22,6 +22,11 @@ def _shape(entries: List[List[float]]) -> np.ndarray:
     return a[:, 0] + 1j * a[:, 1]
 
 
+def _num(v: Any) -> float:
+    """A JSON number, or NaN for null / missing (serde writes NaN as null)."""
+    return float("nan") if v is None else float(v)
+
+
 def _orders(orders: Any) -> Dict[str, int]:
     """order_min, order_max, order_step from a range or an evenly spaced sequence."""
     if isinstance(orders, range):
@@ -51,14 +56,19 @@ class SsiResult:
     poles : table (DataFrame with pandas, else a dict of arrays), one row per identified mode
         of every order: ``order``, ``frequency_hz`` (Hz), ``damping_ratio``, ``mpc`` (modal
         phase collinearity, 0-1), ``stability`` (``new``, ``frequency``, ``frequency_damping``
-        or ``stable`` against the previous order: the stabilisation diagram).
+        or ``stable`` against the previous order: the stabilisation diagram); with
+        ``uncertainty_blocks`` also ``frequency_sd_hz`` and ``damping_sd``, the first-order
+        standard deviations of the estimate (NaN where not computable).
     pole_shapes : complex ndarray (n_poles, n_channels), the mode shape of each row of
         ``poles``, in the channels' units, largest entry 1.
     modes : table, the poles clustered over the orders: ``frequency_hz``, ``frequency_std_hz``,
         ``damping_ratio``, ``order_share`` (share of the orders with a pole in the cluster),
         ``min_order``, ``n_poles``, ``class`` (``structural`` when in at least half the
         orders), ``mac_median``, ``mac_min`` (between the poles' shapes and the mean shape);
-        structural modes first.
+        structural modes first. ``frequency_std_hz`` is the spread of the poles over the
+        orders; with ``uncertainty_blocks``, ``frequency_sd_hz`` and ``damping_sd`` are the
+        standard deviations of the estimate (median over the mode's orders; NaN for
+        non-structural clusters).
     shapes : complex ndarray (n_modes, n_channels), the mean shape of each row of ``modes``.
     channels : list of channel names.
     singular_values : ndarray, of the block Toeplitz matrix, largest first.
@@ -74,43 +84,53 @@ class SsiResult:
         self.stability_params: Dict[str, Any] = d["stability_params"]
         self.singular_values = np.asarray(d["result"]["singular_values"], dtype=np.float64)
         rows, shapes = [], []
-        for o, labels in zip(d["result"]["orders"], d["stability"]):
-            for m, label in zip(o["modes"], labels):
-                rows.append(
-                    {
-                        "order": o["order"],
-                        "frequency_hz": m["frequency_hz"],
-                        "damping_ratio": m["damping_ratio"],
-                        "mpc": m["mpc"],
-                        "stability": label,
-                    }
-                )
+        pole_std = d.get("pole_std")
+        sd_cols = ["frequency_sd_hz", "damping_sd"] if pole_std is not None else []
+        for k, (o, labels) in enumerate(zip(d["result"]["orders"], d["stability"])):
+            for j, (m, label) in enumerate(zip(o["modes"], labels)):
+                row = {
+                    "order": o["order"],
+                    "frequency_hz": m["frequency_hz"],
+                    "damping_ratio": m["damping_ratio"],
+                    "mpc": m["mpc"],
+                    "stability": label,
+                }
+                if pole_std is not None:
+                    sd = pole_std[k][j]
+                    row["frequency_sd_hz"] = _num(sd[0])
+                    row["damping_sd"] = _num(sd[1])
+                rows.append(row)
                 shapes.append(_shape(m["shape"]))
         n = len(channels)
-        self.poles = columns(rows, ["order", "frequency_hz", "damping_ratio", "mpc", "stability"], as_frame)
+        self.poles = columns(
+            rows, ["order", "frequency_hz", "damping_ratio", "mpc", "stability"] + sd_cols, as_frame
+        )
         self.pole_shapes = np.array(shapes).reshape(len(shapes), n)
         mrows, mshapes = [], []
         for m in d["modes"]:
             mac = m.get("shape_mac") or [None, None]
-            mrows.append(
-                {
-                    "frequency_hz": m["frequency_hz"],
-                    "frequency_std_hz": m["frequency_std_hz"],
-                    "damping_ratio": m["damping_ratio"],
-                    "order_share": m["order_share"],
-                    "min_order": m["min_order"],
-                    "n_poles": m["n_poles"],
-                    "class": m["class"],
-                    "mac_median": mac[0],
-                    "mac_min": mac[1],
-                }
-            )
+            unc = m.get("uncertainty") or {}
+            mrow = {
+                "frequency_hz": m["frequency_hz"],
+                "frequency_std_hz": m["frequency_std_hz"],
+                "damping_ratio": m["damping_ratio"],
+                "order_share": m["order_share"],
+                "min_order": m["min_order"],
+                "n_poles": m["n_poles"],
+                "class": m["class"],
+                "mac_median": mac[0],
+                "mac_min": mac[1],
+            }
+            if pole_std is not None:
+                mrow["frequency_sd_hz"] = _num(unc.get("frequency_std_hz"))
+                mrow["damping_sd"] = _num(unc.get("damping_std"))
+            mrows.append(mrow)
             s = m.get("shape")
             mshapes.append(_shape(s) if s else np.full(n, np.nan + 0j))
         self.modes = columns(
             mrows,
             ["frequency_hz", "frequency_std_hz", "damping_ratio", "order_share", "min_order",
-             "n_poles", "class", "mac_median", "mac_min"],
+             "n_poles", "class", "mac_median", "mac_min"] + sd_cols,
             as_frame,
         )
         self.shapes = np.array(mshapes).reshape(len(mshapes), n)
@@ -144,6 +164,7 @@ def ssi_cov(
     freq_tol_rel: Optional[float] = None,
     damping_tol_rel: Optional[float] = None,
     mac_min: Optional[float] = None,
+    uncertainty_blocks: Optional[int] = None,
     as_frame: Optional[bool] = None,
 ) -> SsiResult:
     """Covariance-driven SSI of one multichannel record, as ``vibmode ssi``: output
@@ -159,6 +180,10 @@ def ssi_cov(
     indices for reference-based SSI-cov. ``normalise``: divide each channel by its RMS first
     (shapes are scaled back to the channels' units). ``valid_max_hz``: poles at or above it
     are not clustered (the top of the valid band after an anti-alias filter; default Nyquist).
+    ``uncertainty_blocks``: cut the record into that many blocks of time and give every pole
+    (and structural mode) the first-order standard deviations of its frequency and damping
+    from the blocks' scatter (Döhler & Mevel 2013, as pyOMA2's ``calc_unc=True, nb=...``;
+    20 to 50 are usual; default off).
     The defaults of every parameter are those of the CLI and the analysis' ``[ssi]`` TOML
     section (``vibmode.ssi_cov.defaults``)."""
     names: Optional[List[str]] = None
@@ -208,8 +233,9 @@ def ssi_cov(
         if v is not None:
             stability[key] = float(v)
     vmax = None if valid_max_hz is None else float(valid_max_hz)
+    blocks = None if uncertainty_blocks is None else _order("uncertainty_blocks", uncertainty_blocks, 2)
     d = json.loads(
-        _native.ssi_cov(arr, fs, json.dumps(ssi), json.dumps(stability), bool(normalise), vmax)
+        _native.ssi_cov(arr, fs, json.dumps(ssi), json.dumps(stability), bool(normalise), vmax, blocks)
     )
     return SsiResult(d, names, as_frame)
 

@@ -226,6 +226,7 @@ impl SsiStage<'_> {
                     damping_std: vibmode_ssi::jackknife_std(&zs),
                     replicates: fs.len(),
                     of: groups,
+                    method: vibmode_core::UncertaintyMethod::Jackknife,
                 });
             }
         }

@@ -33,7 +33,7 @@ pub use error::{ParamError, RecordingError};
 pub use limits::{num, Num};
 pub use modes::{
     FitSummary, InvariantMode, ModeClass, ModeMatch, ModeUncertainty, ModelCoefficients,
-    PoleObservation, ReferenceMode, SupportFailure,
+    PoleObservation, ReferenceMode, SupportFailure, UncertaintyMethod,
 };
 pub use params::{
     BandLimit, ClusterParams, IdentMethod, LineParams, PoleFilterParams, PreprocessParams, Robust,

@@ -150,20 +150,39 @@ pub struct InvariantMode {
     pub uncertainty: Option<ModeUncertainty>,
 }
 
-/// Standard deviations of an identified mode's frequency and damping ratio from a
-/// leave-one-record-out jackknife: the identification repeated without each record in turn,
-/// the mode's median frequency and damping over its orders taken each time, and
-/// `sqrt((m - 1) / m * sum (theta_s - mean)^2)` over the `m` repetitions that found it.
+/// Standard deviations of an identified mode's frequency and damping ratio (of the estimate,
+/// not the spread of its poles), by one of two methods ([`UncertaintyMethod`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ModeUncertainty {
     /// Standard deviation of the frequency, Hz.
     pub frequency_std_hz: f64,
     /// Standard deviation of the damping ratio.
     pub damping_std: f64,
-    /// Repetitions (records left out) in which the mode was found.
+    /// Estimates behind the standard deviations: jackknife repetitions (groups of records
+    /// left out) that found the mode; first-order: the model orders whose pole near the mode
+    /// had a finite standard deviation (the median over them is given).
     pub replicates: usize,
-    /// Repetitions tried (the records used).
+    /// Jackknife: repetitions tried (groups of records); first-order: the mode's orders tried.
     pub of: usize,
+    /// How the standard deviations were obtained (default, when absent from JSON: jackknife).
+    #[serde(default)]
+    pub method: UncertaintyMethod,
+}
+
+/// How a [`ModeUncertainty`] was obtained.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+#[non_exhaustive]
+pub enum UncertaintyMethod {
+    /// A delete-a-group jackknife over records: the identification repeated without each group
+    /// of records, the mode's median frequency and damping over its orders taken each time, and
+    /// `sqrt((m - 1) / m * sum (theta_s - mean)^2)` over the `m` repetitions that found it.
+    #[default]
+    Jackknife,
+    /// First-order propagation of the block Toeplitz matrix's scatter over blocks of one
+    /// record to each pole (Döhler & Mevel 2013; `vibmode_ssi::SsiPerturbation`); the median
+    /// over the mode's orders.
+    FirstOrder,
 }
 
 impl InvariantMode {

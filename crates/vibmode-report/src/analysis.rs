@@ -431,11 +431,15 @@ fn csv_cell(text: &str) -> String {
     }
 }
 
-/// The jackknife standard deviations of a mode, e.g. "jackknife sd 0.012 Hz, damping 0.010".
+/// The standard deviations of a mode, e.g. "jackknife sd 0.012 Hz, damping 0.010".
 fn uncertainty_text(m: &InvariantMode) -> Option<String> {
     m.uncertainty.as_ref().map(|u| {
+        let how = match u.method {
+            vibmode_core::UncertaintyMethod::FirstOrder => "first-order",
+            _ => "jackknife",
+        };
         format!(
-            "jackknife sd {:.3} Hz, damping {:.3}",
+            "{how} sd {:.3} Hz, damping {:.3}",
             u.frequency_std_hz, u.damping_std
         )
     })

@@ -4,10 +4,11 @@
 
 use serde::{Deserialize, Serialize};
 use vibmode_core::{
-    ClusterParams, InvariantMode, ModeClass, PoleObservation, SsiParams, StabilityParams,
+    ClusterParams, InvariantMode, ModeClass, ModeUncertainty, PoleObservation, SsiParams,
+    StabilityParams, UncertaintyMethod,
 };
 
-use crate::cov::{SsiCov, SsiResult};
+use crate::cov::{SsiCorrelations, SsiCov, SsiResult};
 use crate::error::SsiError;
 use crate::stability::{stabilisation, Stability};
 
@@ -29,8 +30,18 @@ pub struct RecordSsi {
     /// as `result.orders[o].modes[m]`).
     pub stability: Vec<Vec<Stability>>,
     /// The poles below the valid band's top clustered over the orders (mean shape, spreads):
-    /// structural modes first, then the rest, each group by increasing frequency.
+    /// structural modes first, then the rest, each group by increasing frequency. With
+    /// [`RecordSsiOptions::uncertainty_blocks`], each structural mode's `uncertainty` is the
+    /// median over its orders of the first-order standard deviations of its pole.
     pub modes: Vec<InvariantMode>,
+    /// With [`RecordSsiOptions::uncertainty_blocks`]: the first-order standard deviations
+    /// `[frequency Hz, damping]` of every pole (same nesting as `result.orders[o].modes[m]`;
+    /// NaN where a perturbed plan lost the pole).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pole_std: Option<Vec<Vec<[f64; 2]>>>,
+    /// The blocks of [`RecordSsiOptions::uncertainty_blocks`], when used.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uncertainty_blocks: Option<usize>,
 }
 
 /// Options of [`identify_record`] beyond the SSI parameters.
@@ -46,6 +57,11 @@ pub struct RecordSsiOptions {
     pub stability: StabilityParams,
     /// Clustering of the poles over the orders (its `freq_max_hz` is set from `valid_max_hz`).
     pub cluster: ClusterParams,
+    /// Cut the record into this many blocks of time and give every pole the first-order
+    /// standard deviations of its frequency and damping from the blocks' scatter
+    /// ([`crate::SsiPerturbation`]; default none). 20 to 50 are usual; each block needs
+    /// `first_lag + 2 block_rows - 1` samples. Costs two SVDs of the Toeplitz matrix per block.
+    pub uncertainty_blocks: Option<usize>,
 }
 
 impl Default for RecordSsiOptions {
@@ -55,6 +71,7 @@ impl Default for RecordSsiOptions {
             valid_max_hz: None,
             stability: StabilityParams::default(),
             cluster: ClusterParams::default(),
+            uncertainty_blocks: None,
         }
     }
 }
@@ -102,7 +119,16 @@ pub fn identify_record(
         .map(|(c, s)| c.iter().map(|v| v / s).collect())
         .collect();
     let chans: Vec<&[f64]> = scaled.iter().map(Vec::as_slice).collect();
-    let plan = SsiCov::new(&chans, fs_hz, params)?;
+    let perturbation = match options.uncertainty_blocks {
+        Some(blocks) => {
+            Some(SsiCorrelations::blocks(&chans, fs_hz, params, blocks)?.perturbation()?)
+        }
+        None => None,
+    };
+    let plan = match &perturbation {
+        Some(p) => p.plan().clone(),
+        None => SsiCov::new(&chans, fs_hz, params)?,
+    };
     let orders: Vec<usize> = params
         .orders()
         .into_iter()
@@ -117,6 +143,20 @@ pub fn identify_record(
         });
     }
     let mut result = plan.sweep(&orders)?;
+    let pole_std = match &perturbation {
+        Some(p) => Some(
+            orders
+                .iter()
+                .map(|&o| {
+                    Ok(p.poles_at(o)?
+                        .iter()
+                        .map(|s| [s.frequency_std_hz, s.damping_std])
+                        .collect())
+                })
+                .collect::<Result<Vec<Vec<[f64; 2]>>, SsiError>>()?,
+        ),
+        None => None,
+    };
     for o in &mut result.orders {
         for m in &mut o.modes {
             m.shape = vibmode_modal::shapes::rescaled(&m.shape, &scales);
@@ -150,6 +190,14 @@ pub fn identify_record(
     };
     let mut modes = vibmode_modal::find_invariant_modes(&obs, 1, &orders, &cluster)?;
     modes.sort_by_key(|m| m.class != ModeClass::Structural);
+    if let Some(std) = &pole_std {
+        for m in modes
+            .iter_mut()
+            .filter(|m| m.class == ModeClass::Structural)
+        {
+            m.uncertainty = mode_std(m, &result, std);
+        }
+    }
     Ok(RecordSsi {
         fs_hz,
         n_samples: channels.first().map_or(0, |c| c.len()),
@@ -158,5 +206,42 @@ pub fn identify_record(
         result,
         stability,
         modes,
+        pole_std,
+        uncertainty_blocks: options.uncertainty_blocks,
+    })
+}
+
+/// The median first-order standard deviations of a structural mode's poles: at each order the
+/// pole nearest the mode's frequency, when within `max(3 std, 1 %)` of it and with a finite
+/// standard deviation.
+fn mode_std(
+    m: &InvariantMode,
+    result: &SsiResult,
+    std: &[Vec<[f64; 2]>],
+) -> Option<ModeUncertainty> {
+    let radius = (3.0 * m.frequency_std_hz).max(0.01 * m.frequency_hz);
+    let (f, z): (Vec<f64>, Vec<f64>) = result
+        .orders
+        .iter()
+        .zip(std)
+        .filter_map(|(o, s)| {
+            let (j, pole) = o.modes.iter().enumerate().min_by(|a, b| {
+                (a.1.frequency_hz - m.frequency_hz)
+                    .abs()
+                    .total_cmp(&(b.1.frequency_hz - m.frequency_hz).abs())
+            })?;
+            let v = s.get(j)?;
+            ((pole.frequency_hz - m.frequency_hz).abs() <= radius
+                && v[0].is_finite()
+                && v[1].is_finite())
+            .then_some((v[0], v[1]))
+        })
+        .unzip();
+    (!f.is_empty()).then(|| ModeUncertainty {
+        frequency_std_hz: vibmode_modal::stats::median(&f),
+        damping_std: vibmode_modal::stats::median(&z),
+        replicates: f.len(),
+        of: result.orders.len(),
+        method: UncertaintyMethod::FirstOrder,
     })
 }
