@@ -129,6 +129,10 @@ def analyze_record(
     with local_copy(url, so) as path:
         res = vibmode.analyze(path, fs=fs_hz, as_frames=False, **analysis)
         feats = vibmode.fleet.features(path, fs=fs_hz, settings=settings) if with_features else None
+    if feats is not None:
+        # Stored under the record as the user named it (as `vibmode fleet ingest` does), not
+        # under the temporary copy of a remote file.
+        feats["file"] = url
     table = modes_table(name, res)
     target = out.rstrip("/") + "/modes/" + os.path.splitext(name)[0] + ".parquet"
     ofs, opath = _fs(target, so)

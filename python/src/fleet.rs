@@ -208,10 +208,7 @@ fn fleet_features(
             })?;
             let sha256 = sha256_hex(&bytes);
             let rec = vibmode_signal::read_path(&path, &opts)?;
-            let file = path
-                .file_name()
-                .map(|s| s.to_string_lossy().to_string())
-                .unwrap_or_else(|| path.display().to_string());
+            let file = vibmode_fleet::record_file_name(&path);
             let features = compute_features(&file, &rec, &cfg)?;
             Ok::<_, FleetError>(FeaturesOut {
                 file,

@@ -80,7 +80,9 @@ def test_two_workers_equal_single_process(tmp_path):
     by_workers = stored_features(tmp_path / "dask.db")
     assert len(by_ingest) == 4 and by_workers == by_ingest
     default = vibmode.fleet.features(files[0])["features"]
-    assert default != by_ingest[files[0].name]
+    # Records are stored under the path as given (run1/record_01.wav and run2/record_01.wav
+    # stay apart), by the workers as by `ingest`.
+    assert default != by_ingest[str(files[0])]
 
 
 def test_cli_single_process(tmp_path):
@@ -106,7 +108,8 @@ def test_store_settings_reach_features(tmp_path):
     assert len(d["bands_hz"]) == 5 and d != s
     # Features with the store's settings are what ingest stores; with the defaults they differ.
     vibmode.fleet.ingest(db, "bus-1", path)
-    stored = stored_features(db)["record_01.wav"]
+    stored = stored_features(db)[str(path)]
+    assert vibmode.fleet.features(path)["file"] == str(path)
     with_settings = vibmode.fleet.features(path, settings=s)
     assert with_settings["features"] == stored
     assert vibmode.fleet.features(path, settings=d)["features"] == vibmode.fleet.features(path)["features"]

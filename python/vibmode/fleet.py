@@ -93,7 +93,10 @@ def features(
 ) -> Dict[str, Any]:
     """What the store keeps of one file (band levels, transmissibility, modes), computed without
     a store: the expensive part of :func:`ingest`, to run on many workers (e.g. Dask). Returns a
-    JSON-ready dict ``{'file', 'sha256', 'metadata', 'features'}`` for :func:`store_features`.
+    JSON-ready dict ``{'file', 'sha256', 'metadata', 'features'}`` for :func:`store_features`;
+    ``file`` is ``path`` as given (as :func:`ingest` names records: ``run1/record_01.wav`` and
+    ``run2/record_01.wav`` stay apart). A worker that reads a temporary copy of a remote file
+    sets ``file`` back to the file's URL before storing.
 
     ``settings``: the store's settings, :func:`settings` ``(db)`` (read once, passed to every
     worker); None computes with the default settings, which differ from a store initialised

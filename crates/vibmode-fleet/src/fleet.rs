@@ -117,10 +117,15 @@ pub fn ingest_recording(
     })
 }
 
+/// The name a record file is stored and reported under: the path as the user gave it, not
+/// its base name, so that `run1/record_01.wav` and `run2/record_01.wav` stay apart in the
+/// tables and the JSON. The CLI and the Python workers (`vibmode.fleet.features`) both use it.
+pub fn record_file_name(path: &Path) -> String {
+    path.display().to_string()
+}
+
 fn file_name(path: &Path) -> String {
-    path.file_name()
-        .map(|s| s.to_string_lossy().to_string())
-        .unwrap_or_else(|| path.display().to_string())
+    record_file_name(path)
 }
 
 fn hash_file(path: &Path) -> Result<String> {

@@ -26,7 +26,8 @@ pub use features::{
 };
 pub use fleet::{
     build_baseline, check_file, check_recording, check_vehicle_id, ingest_file, ingest_recording,
-    recording_hash, require_baseline, sha256_hex, Checked, IngestLabels, Ingested,
+    record_file_name, recording_hash, require_baseline, sha256_hex, Checked, IngestLabels,
+    Ingested,
 };
 pub use model::{
     assess, build_model_set, Assessment, Classification, Evidence, FeatureMeta, FeatureStat, Group,
