@@ -64,15 +64,20 @@ fn ref_orders(v: &Value) -> Vec<(usize, Vec<RefMode>)> {
         .collect()
 }
 
-fn identify(reference: &Value, refs: Option<Vec<usize>>) -> (vibmode_ssi::SsiResult, f64) {
+/// The record of `ssi_input.json`: its rate, Hz, and its channels.
+fn input() -> (f64, Vec<Vec<f64>>) {
     let input = load("ssi_input.json");
-    let fs = f(&input["fs_hz"]);
-    let channels: Vec<Vec<f64>> = input["channels"]
+    let channels = input["channels"]
         .as_array()
         .unwrap()
         .iter()
         .map(|c| c.as_array().unwrap().iter().map(f).collect())
         .collect();
+    (f(&input["fs_hz"]), channels)
+}
+
+fn identify(reference: &Value, refs: Option<Vec<usize>>) -> (vibmode_ssi::SsiResult, f64) {
+    let (fs, channels) = input();
     let ch: Vec<&[f64]> = channels.iter().map(Vec::as_slice).collect();
     let params = SsiParams {
         block_rows: reference["block_rows"].as_u64().unwrap() as usize,
@@ -187,14 +192,7 @@ fn pyoma2_own_estimator_agrees_on_the_physical_modes() {
 #[test]
 fn perturbation_std_agrees_with_pyoma2_dohler() {
     let reference = load("ssi_uncertainty.json");
-    let input = load("ssi_input.json");
-    let fs = f(&input["fs_hz"]);
-    let channels: Vec<Vec<f64>> = input["channels"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|c| c.as_array().unwrap().iter().map(f).collect())
-        .collect();
+    let (fs, channels) = input();
     let ch: Vec<&[f64]> = channels.iter().map(Vec::as_slice).collect();
     let params = SsiParams {
         block_rows: reference["block_rows"].as_u64().unwrap() as usize,
