@@ -10,7 +10,7 @@ import numpy as np
 
 from . import _native
 from ._io import Recording
-from ._models import _order
+from ._models import _num, _order
 from ._spectral import _check_fs, _real_input
 from ._tables import columns
 
@@ -20,11 +20,6 @@ _DEFAULTS = json.loads(_native.ssi_defaults())
 def _shape(entries: List[List[float]]) -> np.ndarray:
     a = np.asarray(entries, dtype=np.float64).reshape(-1, 2)
     return a[:, 0] + 1j * a[:, 1]
-
-
-def _num(v: Any) -> float:
-    """A JSON number, or NaN for null / missing (serde writes NaN as null)."""
-    return float("nan") if v is None else float(v)
 
 
 def _orders(orders: Any) -> Dict[str, int]:

@@ -274,21 +274,31 @@ impl SsiCorrelations {
             .collect()
     }
 
-    /// The plan from the correlations of every segment `s` but those with `left_out(s)`.
-    fn plan_without(&self, left_out: impl Fn(usize) -> bool) -> Result<SsiCov, SsiError> {
-        let used = || (0..self.sums.len()).filter(|&s| !left_out(s));
+    /// Per lag `1..=max_lag`: the sum of the products of every segment `s` but those with
+    /// `left_out(s)`, and their number.
+    pub(crate) fn totals(&self, left_out: impl Fn(usize) -> bool) -> Vec<(DMatrix<f64>, usize)> {
         let max_lag = self.sums.first().map_or(0, Vec::len);
-        let r: Vec<DMatrix<f64>> = (0..max_lag)
+        (0..max_lag)
             .map(|k| {
                 let (rows, cols) = self.sums[0][k].shape();
                 let mut total = DMatrix::zeros(rows, cols);
                 let mut count = 0usize;
-                for s in used() {
+                for s in (0..self.sums.len()).filter(|&s| !left_out(s)) {
                     total += &self.sums[s][k];
                     count += self.counts[s][k];
                 }
-                total / count.max(1) as f64
+                (total, count)
             })
+            .collect()
+    }
+
+    /// The plan from the correlations of every segment `s` but those with `left_out(s)`.
+    fn plan_without(&self, left_out: impl Fn(usize) -> bool) -> Result<SsiCov, SsiError> {
+        let used = || (0..self.sums.len()).filter(|&s| !left_out(s));
+        let r: Vec<DMatrix<f64>> = self
+            .totals(&left_out)
+            .into_iter()
+            .map(|(total, count)| total / count.max(1) as f64)
             .collect();
         if let Some(k) = r.iter().position(|m| m.iter().any(|v| !v.is_finite())) {
             return Err(SsiError::Overflow {

@@ -58,19 +58,8 @@ impl SsiCorrelations {
             return Err(SsiError::TooFewBlocks { n_blocks: m });
         }
         let plan = self.plan()?;
-        let max_lag = self.sums.first().map_or(0, Vec::len);
-        let totals: Vec<(DMatrix<f64>, usize)> = (0..max_lag)
-            .map(|k| {
-                let (rows, cols) = self.sums[0][k].shape();
-                let mut total = DMatrix::zeros(rows, cols);
-                let mut count = 0usize;
-                for s in 0..m {
-                    total += &self.sums[s][k];
-                    count += self.counts[s][k];
-                }
-                (total, count)
-            })
-            .collect();
+        let totals = self.totals(|_| false);
+        let max_lag = totals.len();
         let r_bar: Vec<DMatrix<f64>> = totals[self.skip..]
             .iter()
             .map(|(t, c)| t / (*c).max(1) as f64)

@@ -125,9 +125,13 @@ pub fn identify_record(
         }
         None => None,
     };
+    let own_plan;
     let plan = match &perturbation {
-        Some(p) => p.plan().clone(),
-        None => SsiCov::new(&chans, fs_hz, params)?,
+        Some(p) => p.plan(),
+        None => {
+            own_plan = SsiCov::new(&chans, fs_hz, params)?;
+            &own_plan
+        }
     };
     let orders: Vec<usize> = params
         .orders()
