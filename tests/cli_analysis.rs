@@ -263,16 +263,9 @@ fn ssi_identifies_a_simulated_record_and_reports_errors() {
     let wav = dir.join("record_01.wav");
     let wav = wav.to_str().unwrap();
     let plot = d.path().join("stab.svg");
-    let o = vibmode(&[
-        "ssi",
-        wav,
-        "--resample-to",
-        "50",
-        "--block-rows",
-        "30",
-        "--plot",
-        plot.to_str().unwrap(),
-    ]);
+    // The record at 50 Hz with 30 block rows, as every successful call below.
+    let base = ["ssi", wav, "--resample-to", "50", "--block-rows", "30"];
+    let o = vibmode(&[&base[..], &["--plot", plot.to_str().unwrap()]].concat());
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(out.contains("SSI-cov of 7 channels"), "{out}");
@@ -280,16 +273,7 @@ fn ssi_identifies_a_simulated_record_and_reports_errors() {
     assert!(out.contains("shape: FL_unsprung"), "{out}");
     assert!(plot.is_file());
     // The bending mode (9.0 Hz, damping 0.03) is among the modes that stay over the orders.
-    let j = vibmode(&[
-        "ssi",
-        wav,
-        "--resample-to",
-        "50",
-        "--block-rows",
-        "30",
-        "--json",
-        "-",
-    ]);
+    let j = vibmode(&[&base[..], &["--json", "-"]].concat());
     let v: serde_json::Value = serde_json::from_slice(&j.stdout).unwrap();
     let modes = v["modes"].as_array().unwrap();
     assert!(
@@ -300,18 +284,7 @@ fn ssi_identifies_a_simulated_record_and_reports_errors() {
     assert_eq!(v["channels"].as_array().map(Vec::len), Some(7));
     // First-order standard deviations from 20 blocks: in the table and the JSON (the bending
     // mode's, from 60 s, between 0.001 and 0.5 Hz); one pole_std row per identified order.
-    let u = vibmode(&[
-        "ssi",
-        wav,
-        "--resample-to",
-        "50",
-        "--block-rows",
-        "30",
-        "--uncertainty-blocks",
-        "20",
-        "--json",
-        "-",
-    ]);
+    let u = vibmode(&[&base[..], &["--uncertainty-blocks", "20", "--json", "-"]].concat());
     assert!(u.status.success(), "{}", String::from_utf8_lossy(&u.stderr));
     let uv: serde_json::Value = serde_json::from_slice(&u.stdout).unwrap();
     assert_eq!(uv["uncertainty_blocks"], 20);
@@ -335,29 +308,11 @@ fn ssi_identifies_a_simulated_record_and_reports_errors() {
         &["1 data block", "at least 2 blocks"],
     );
     fails_with(
-        &[
-            "ssi",
-            wav,
-            "--resample-to",
-            "50",
-            "--block-rows",
-            "30",
-            "--uncertainty-blocks",
-            "100",
-        ],
+        &[&base[..], &["--uncertainty-blocks", "100"]].concat(),
         &["100 blocks", "at most 50 blocks"],
     );
     // A later first lag: reported, and in the JSON's parameters.
-    let later = vibmode(&[
-        "ssi",
-        wav,
-        "--resample-to",
-        "50",
-        "--block-rows",
-        "30",
-        "--first-lag",
-        "37",
-    ]);
+    let later = vibmode(&[&base[..], &["--first-lag", "37"]].concat());
     let text = String::from_utf8_lossy(&later.stdout);
     assert!(text.contains("(lags 37..95)"), "{text}");
     assert_eq!(v["params"]["first_lag"], 1);
