@@ -232,7 +232,8 @@ pub struct SimParams {
     pub warmup_s: Option<f64>,
     /// Relative standard deviation of a slow random speed variation on top of the manoeuvres
     /// (default 0): the speed is `v(t) (1 + u(t))` with `u` a Gauss-Markov process of
-    /// correlation time `speed_wander_correlation_s`.
+    /// correlation time `speed_wander_correlation_s`, smoothed by a first-order lag of 1 s so
+    /// that the acceleration it implies is bounded (the misaligned sensors see it).
     pub speed_wander_rel_std: f64,
     /// Correlation time of the speed variation, s (default 5).
     pub speed_wander_correlation_s: f64,
@@ -954,17 +955,27 @@ fn add_line_forces(f: &mut [f64], lines: &mut LineBank, t: f64, speed_ratio: f64
 fn add_speed_wander(speed: &mut [f64], sim: &SimParams, dt: f64) {
     let mut rng = ChaCha8Rng::seed_from_u64(sim.seed);
     rng.set_stream(4);
-    if let Some(mut u) = OrnsteinUhlenbeck::new(
-        sim.speed_wander_rel_std,
-        sim.speed_wander_correlation_s,
-        dt,
-        &mut rng,
-    ) {
+    // A Gauss-Markov process low-passed once more (time constant SPEED_SMOOTHING_S), so that
+    // the speed has a derivative: the longitudinal acceleration stays bounded and does not grow
+    // with the sampling rate. The driving process' standard deviation is raised so that the
+    // smoothed one keeps `speed_wander_rel_std`.
+    let tau = sim.speed_wander_correlation_s;
+    let gain = ((tau + SPEED_SMOOTHING_S) / tau).sqrt();
+    if let Some(mut u) = OrnsteinUhlenbeck::new(sim.speed_wander_rel_std * gain, tau, dt, &mut rng)
+    {
+        let alpha = 1.0 - (-dt / SPEED_SMOOTHING_S).exp();
+        // Start at a draw of the smoothed process' stationary distribution.
+        let mut w = u.next(&mut rng) / gain;
         for v in speed.iter_mut() {
-            *v *= (1.0 + u.next(&mut rng)).max(0.5);
+            w += alpha * (u.next(&mut rng) - w);
+            *v *= (1.0 + w).max(0.5);
         }
     }
 }
+
+/// Time constant of the smoothing of the speed wander, s: a driver changes speed with a
+/// bounded acceleration (at 40 km/h and 3 %, about 0.07 m/s^2 rms).
+const SPEED_SMOOTHING_S: f64 = 1.0;
 
 /// Each sensor's tilt angles (about the lateral axis, about the longitudinal axis), deg.
 fn misalignment_angles(n: usize, max_deg: f64, rng: &mut ChaCha8Rng) -> Vec<[f64; 2]> {
