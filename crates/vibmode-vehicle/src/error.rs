@@ -43,6 +43,15 @@ pub enum VehicleError {
         /// Comma-separated list of valid values.
         valid: &'static str,
     },
+    /// Records cannot be used to fit the model's suspension (a missing sensor, too short a
+    /// record, a fit that gives a non-physical value).
+    #[error("cannot fit the suspension to the records: {problem}; {fix}")]
+    BodyFit {
+        /// What is wrong, with the offending value.
+        problem: String,
+        /// How to fix it.
+        fix: &'static str,
+    },
     /// A numerical routine failed (singular matrix, eigenvalue iteration did not converge).
     #[error("numerical failure: {0}; check that masses and stiffnesses are physically plausible")]
     Numerical(String),

@@ -39,6 +39,7 @@ pub mod model;
 pub mod params;
 pub mod road;
 pub mod sim;
+pub mod update;
 
 pub use error::{Result, VehicleError};
 pub use lines::LineTruth;

@@ -1,0 +1,685 @@
+//! Model updating: the full-car model's suspension and body inertias fitted to measured records
+//! from the body's equations of motion, which carry no road input.
+//!
+//! The road enters the full-car model only through the tyres. The three body rows of
+//! `M q'' + C q' + K q = f` (heave, pitch, roll) therefore hold with the measured motions alone:
+//! the body coordinates come from the sprung sensors (`z + x theta + y phi` at each sensor, least
+//! squares over three or more sensors), the wheel coordinates from the unsprung sensors. With the
+//! sprung mass fixed at the vehicle file's value, the rows are linear in the pitch and roll
+//! inertias, the four suspension springs and dampers and the anti-roll bars present in the file:
+//! an ordinary least-squares problem whose normal equations are summed record by record.
+//!
+//! The rows are differentiated twice, so that they hold for the measured accelerations and their
+//! first and second derivatives (`M a'' + C a' + K a = 0`): nothing is integrated. The
+//! derivatives are taken in the frequency domain under a band-pass with cosine tapers (30 % of
+//! each edge frequency) around the body modes; `edge_s` at each record end is dropped. The band
+//! keeps out the body bending modes (three sprung sensors cannot tell them from pitch) and the
+//! slow manoeuvres (braking, turns), which put moments on the body.
+//!
+//! The updated model keeps the vehicle file's masses, geometry, tyres and bending mode; its
+//! eigenvalues give the body modes of the vehicle that was measured. Units: SI throughout
+//! (N/m, N s/m, N m/rad, kg m^2), accelerations in any consistent unit (the fit is scale-free).
+use crate::error::{Result, VehicleError};
+use crate::model::{FullCar, ModeInfo, ModeLabel};
+use crate::params::{CornerCondition, VehicleParams};
+use nalgebra::{DMatrix, DVector};
+use realfft::RealFftPlanner;
+use serde::{Deserialize, Serialize};
+use vibmode_core::{Corner, Direction, Recording, Role};
+
+/// Settings of the body-equation fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BodyFitParams {
+    /// Band of the fitted equations, Hz. `None` (default): from the vehicle file's body modes,
+    /// `[0.45 f_min, 1.6 f_max]` over heave, pitch and roll (0.46-2.1 Hz on the demo bus).
+    pub band_hz: Option<[f64; 2]>,
+    /// Samples dropped at each end of a record, s (default 1.0; the band-pass rings there).
+    pub edge_s: f64,
+}
+
+impl Default for BodyFitParams {
+    fn default() -> Self {
+        BodyFitParams {
+            band_hz: None,
+            edge_s: 1.0,
+        }
+    }
+}
+
+impl BodyFitParams {
+    /// Checks the values (finite, positive, an increasing band).
+    pub fn validate(&self) -> Result<()> {
+        if !(self.edge_s.is_finite() && self.edge_s >= 0.0) {
+            return Err(crate::error::invalid(
+                "edge_s",
+                self.edge_s,
+                "must be a duration >= 0 s, e.g. 0.5",
+            ));
+        }
+        if let Some([lo, hi]) = self.band_hz {
+            if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi > lo) {
+                return Err(crate::error::invalid(
+                    "band_hz",
+                    format!("[{lo}, {hi}]"),
+                    "must be two frequencies 0 < low < high in Hz, e.g. [0.5, 2.0]",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Unknowns (per unit sprung mass): pitch inertia, roll inertia, springs FL..RR, dampers FL..RR,
+/// then the anti-roll bars of the axles that have one.
+const N_BASE: usize = 10;
+
+/// Where the fit takes each body and wheel coordinate from.
+#[derive(Debug, Clone)]
+struct Layout {
+    /// Channel index of the unsprung sensor at FL, FR, RL, RR.
+    wheels: [usize; 4],
+    /// Channel indices of the sprung sensors.
+    sprung: Vec<usize>,
+    /// Body coordinates [z, theta, phi] = `body` * (sprung samples): rows of the pseudo-inverse.
+    body: DMatrix<f64>,
+}
+
+/// Accumulates the body equations of many records and solves for the suspension.
+///
+/// ```no_run
+/// # fn demo(records: &[vibmode_core::Recording]) -> vibmode_vehicle::Result<()> {
+/// use vibmode_vehicle::{update::{BodyFit, BodyFitParams}, VehicleParams};
+/// let mut fit = BodyFit::new(&VehicleParams::city_bus_flexible(), BodyFitParams::default())?;
+/// for r in records {
+///     fit.add_record(r)?;
+/// }
+/// let updated = fit.solve()?;
+/// for m in &updated.modes {
+///     println!("{} {:.3} Hz", m.label, m.frequency_hz);
+/// }
+/// # Ok(()) }
+/// ```
+#[derive(Debug, Clone)]
+pub struct BodyFit {
+    vehicle: VehicleParams,
+    params: BodyFitParams,
+    band_hz: [f64; 2],
+    /// Anti-roll bars fitted: front, rear.
+    bars: [bool; 2],
+    /// Row weights of pitch and roll (1 / radius of gyration, 1/m).
+    row_weight: [f64; 2],
+    ata: DMatrix<f64>,
+    atb: DVector<f64>,
+    btb: f64,
+    equations: usize,
+    records: usize,
+}
+
+/// The updated model and how well the equations fitted.
+#[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
+pub struct BodyFitResult {
+    /// The vehicle file with the fitted springs, dampers (per corner, as `corner_condition`
+    /// factors on the axle means), anti-roll bars and pitch and roll inertias.
+    pub vehicle: VehicleParams,
+    /// The updated model's modes (the body modes are the fitted ones; wheel modes keep the
+    /// file's tyres and unsprung masses).
+    pub modes: Vec<ModeInfo>,
+    /// The vehicle file's own modes, for comparison.
+    pub nominal_modes: Vec<ModeInfo>,
+    /// Records that entered the fit.
+    pub records: usize,
+    /// Equations (time instants x 3 body rows).
+    pub equations: usize,
+    /// Band of the equations, Hz.
+    pub band_hz: [f64; 2],
+    /// Share of the equations' variance the fit explains (1 = exact), dimensionless.
+    pub explained: f64,
+}
+
+impl BodyFitResult {
+    /// The updated model's mode with this label, if any.
+    pub fn mode(&self, label: ModeLabel) -> Option<&ModeInfo> {
+        self.modes.iter().find(|m| m.label == label)
+    }
+
+    /// The vehicle file's mode with this label, if any.
+    pub fn nominal_mode(&self, label: ModeLabel) -> Option<&ModeInfo> {
+        self.nominal_modes.iter().find(|m| m.label == label)
+    }
+}
+
+fn fit_error(problem: String, fix: &'static str) -> VehicleError {
+    VehicleError::BodyFit { problem, fix }
+}
+
+impl BodyFit {
+    /// A fit of `vehicle`'s suspension (validated) with `params` (validated).
+    pub fn new(vehicle: &VehicleParams, params: BodyFitParams) -> Result<Self> {
+        params.validate()?;
+        let car = FullCar::new(vehicle)?;
+        let band_hz = match params.band_hz {
+            Some(b) => b,
+            None => {
+                let body: Vec<f64> = car
+                    .modes()?
+                    .iter()
+                    .filter(|m| {
+                        matches!(
+                            m.label,
+                            ModeLabel::BodyHeave | ModeLabel::BodyPitch | ModeLabel::BodyRoll
+                        )
+                    })
+                    .map(|m| m.frequency_hz)
+                    .collect();
+                if body.is_empty() {
+                    return Err(fit_error(
+                        "the vehicle model has no body heave, pitch or roll mode".into(),
+                        "check the vehicle file's masses and springs, or give the band",
+                    ));
+                }
+                let lo = body.iter().cloned().fold(f64::INFINITY, f64::min);
+                let hi = body.iter().cloned().fold(0.0, f64::max);
+                [0.45 * lo, 1.6 * hi]
+            }
+        };
+        let bars = [
+            vehicle.front.anti_roll_stiffness_nm_per_rad > 0.0,
+            vehicle.rear.anti_roll_stiffness_nm_per_rad > 0.0,
+        ];
+        let n = N_BASE + bars.iter().filter(|&&b| b).count();
+        let m = vehicle.body.mass_kg;
+        Ok(BodyFit {
+            vehicle: vehicle.clone(),
+            params,
+            band_hz,
+            bars,
+            row_weight: [
+                (m / vehicle.body.pitch_inertia_kgm2).sqrt(),
+                (m / vehicle.body.roll_inertia_kgm2).sqrt(),
+            ],
+            ata: DMatrix::zeros(n, n),
+            atb: DVector::zeros(n),
+            btb: 0.0,
+            equations: 0,
+            records: 0,
+        })
+    }
+
+    /// The band of the equations, Hz.
+    pub fn band_hz(&self) -> [f64; 2] {
+        self.band_hz
+    }
+
+    /// Records added so far.
+    pub fn records(&self) -> usize {
+        self.records
+    }
+
+    /// Which channel measures what: four unsprung sensors (one per corner) and three or more
+    /// sprung sensors at known body positions. Channels are placed by their placement (role and
+    /// corner) or, failing that, by the vehicle file's sensor of the same name; horizontal
+    /// channels are left out.
+    fn layout(&self, rec: &Recording) -> Result<Layout> {
+        let spec = self.vehicle.effective_sensors();
+        let mut wheels: [Option<usize>; 4] = [None; 4];
+        let mut sprung: Vec<(usize, f64, f64)> = Vec::new();
+        for (i, ch) in rec.channels.iter().enumerate() {
+            if matches!(ch.placement.direction, Some(Direction::X | Direction::Y)) {
+                continue;
+            }
+            let named = spec.iter().find(|s| s.name.eq_ignore_ascii_case(&ch.name));
+            let (role, corner) = match ch.placement.role {
+                Role::Sprung => (Role::Sprung, ch.placement.corner),
+                Role::Unsprung => (Role::Unsprung, ch.placement.corner),
+                Role::Other => match named {
+                    Some(s) => (s.kind.role(), s.corner),
+                    None => continue,
+                },
+            };
+            match role {
+                Role::Unsprung => {
+                    let Some(c) = corner.or(named.and_then(|s| s.corner)) else {
+                        continue;
+                    };
+                    let slot = &mut wheels[c.index()];
+                    if let Some(j) = *slot {
+                        return Err(fit_error(
+                            format!(
+                                "two unsprung channels at {c}: {} and {}",
+                                rec.channels[j].name, ch.name
+                            ),
+                            "give each wheel one unsprung channel",
+                        ));
+                    }
+                    *slot = Some(i);
+                }
+                Role::Sprung => {
+                    let pos = match corner {
+                        Some(c) => Some(self.vehicle.corner_position_m(c)),
+                        None => named.and_then(|s| match (s.corner, s.x_m, s.y_m) {
+                            (Some(c), _, _) => Some(self.vehicle.corner_position_m(c)),
+                            (None, Some(x), Some(y)) => Some((x, y)),
+                            _ => None,
+                        }),
+                    };
+                    if let Some((x, y)) = pos {
+                        sprung.push((i, x, y));
+                    }
+                }
+                Role::Other => {}
+            }
+        }
+        let missing: Vec<String> = Corner::ALL
+            .iter()
+            .filter(|c| wheels[c.index()].is_none())
+            .map(|c| c.to_string())
+            .collect();
+        if !missing.is_empty() {
+            return Err(fit_error(
+                format!("no unsprung channel at {}", missing.join(", ")),
+                "give each wheel's channel the role unsprung and its corner",
+            ));
+        }
+        let wheels = wheels.map(|w| w.unwrap_or(0));
+        if sprung.len() < 3 {
+            return Err(fit_error(
+                format!(
+                    "{} sprung channel(s) at known positions, 3 needed",
+                    sprung.len()
+                ),
+                "give three or more body channels the role sprung and a corner (or x_m, y_m in the vehicle file)",
+            ));
+        }
+        let p = DMatrix::from_fn(sprung.len(), 3, |r, c| {
+            let (_, x, y) = sprung[r];
+            [1.0, x, y][c]
+        });
+        let ptp = p.transpose() * &p;
+        // Collinear sensors leave pitch or roll unobserved.
+        let eig = ptp.clone().symmetric_eigen().eigenvalues;
+        let (emin, emax) = eig
+            .iter()
+            .fold((f64::INFINITY, 0.0_f64), |(a, b), &v| (a.min(v), b.max(v)));
+        let inv = if emin > 1e-6 * emax {
+            ptp.try_inverse()
+        } else {
+            None
+        };
+        let Some(inv) = inv else {
+            return Err(fit_error(
+                "the sprung channels lie on one line, so pitch or roll is not observed".into(),
+                "use three or more sprung sensors not on one line",
+            ));
+        };
+        Ok(Layout {
+            wheels,
+            sprung: sprung.iter().map(|s| s.0).collect(),
+            body: inv * p.transpose(),
+        })
+    }
+
+    /// Adds one record's equations. The channels need placements (or the vehicle file's sensor
+    /// names): four unsprung at FL, FR, RL, RR and three or more sprung at known positions.
+    pub fn add_record(&mut self, rec: &Recording) -> Result<()> {
+        let fs = rec.fs_hz;
+        if !(fs.is_finite() && fs > 0.0) {
+            return Err(fit_error(
+                format!("sampling rate {fs} Hz"),
+                "give a positive, finite rate",
+            ));
+        }
+        if self.band_hz[1] * 1.3 >= 0.5 * fs {
+            return Err(fit_error(
+                format!(
+                    "the band's upper edge {:.2} Hz (tapered to {:.2} Hz) is above the Nyquist frequency {:.2} Hz",
+                    self.band_hz[1],
+                    1.3 * self.band_hz[1],
+                    0.5 * fs
+                ),
+                "sample faster or lower the band",
+            ));
+        }
+        let layout = self.layout(rec)?;
+        let len = rec.channels.first().map_or(0, |c| c.samples.len());
+        let edge = (self.params.edge_s * fs).round() as usize;
+        // At least one period of the lowest band frequency between the edges.
+        let need = 2 * edge + (fs / self.band_hz[0]).ceil() as usize;
+        if len < need {
+            return Err(fit_error(
+                format!(
+                    "a record of {len} samples ({:.2} s) is shorter than {need} samples ({:.2} s): two edges of {} s and one period of {:.2} Hz",
+                    len as f64 / fs,
+                    need as f64 / fs,
+                    self.params.edge_s,
+                    self.band_hz[0]
+                ),
+                "use longer records",
+            ));
+        }
+        for ch in &rec.channels {
+            if ch.samples.len() != len {
+                return Err(fit_error(
+                    format!(
+                        "channel {} has {} samples, the first channel {len}",
+                        ch.name,
+                        ch.samples.len()
+                    ),
+                    "give channels of equal length",
+                ));
+            }
+            if let Some(k) = ch.samples.iter().position(|v| !v.is_finite()) {
+                return Err(fit_error(
+                    format!("channel {} sample {k} is {}", ch.name, ch.samples[k]),
+                    "remove or repair non-finite samples",
+                ));
+            }
+        }
+        // a, a', a'' of every used channel, band-limited.
+        let mut der: Vec<Option<[Vec<f64>; 3]>> = vec![None; rec.channels.len()];
+        let mut deriv = Derivatives::new(len, fs, self.band_hz);
+        for &i in layout.wheels.iter().chain(&layout.sprung) {
+            der[i] = Some(deriv.apply(&rec.channels[i].samples));
+        }
+        let get = |i: usize| der[i].as_ref();
+        // Body coordinates' derivatives.
+        let mut body: [[Vec<f64>; 3]; 3] = Default::default();
+        for (b, out) in body.iter_mut().enumerate() {
+            for (k, o) in out.iter_mut().enumerate() {
+                *o = vec![0.0; len];
+                for (j, &ci) in layout.sprung.iter().enumerate() {
+                    let w = layout.body[(b, j)];
+                    if let Some(d) = get(ci) {
+                        o.iter_mut().zip(&d[k]).for_each(|(y, x)| *y += w * x);
+                    }
+                }
+            }
+        }
+        let wheel: Vec<&[Vec<f64>; 3]> = layout.wheels.iter().filter_map(|&i| get(i)).collect();
+        let pos: Vec<(f64, f64)> = Corner::ALL
+            .iter()
+            .map(|&c| self.vehicle.corner_position_m(c))
+            .collect();
+        let tracks = [
+            self.vehicle.geometry.track_front_m,
+            self.vehicle.geometry.track_rear_m,
+        ];
+        // Equations at about 25 times the band's upper edge.
+        let step = ((fs / (25.0 * self.band_hz[1])).floor() as usize).max(1);
+        let n = self.ata.nrows();
+        let mut x = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        let mut y = [0.0; 3];
+        for t in (edge..len - edge).step_by(step) {
+            x.iter_mut()
+                .for_each(|r| r.iter_mut().for_each(|v| *v = 0.0));
+            // Suspension deflection g_c (k-th derivative) = z + x theta + y phi - w.
+            for (ci, &(cx, cy)) in pos.iter().enumerate() {
+                let g = |k: usize| {
+                    body[0][k][t] + cx * body[1][k][t] + cy * body[2][k][t] - wheel[ci][k][t]
+                };
+                let (g0, g1) = (g(0), g(1));
+                for (row, lever) in [(0, 1.0), (1, cx), (2, cy)] {
+                    x[row][2 + ci] = lever * g0;
+                    x[row][6 + ci] = lever * g1;
+                }
+            }
+            x[1][0] = body[1][2][t];
+            x[2][1] = body[2][2][t];
+            let mut col = N_BASE;
+            for (a, (l, r)) in [(0usize, (0usize, 1usize)), (1, (2, 3))] {
+                if self.bars[a] {
+                    x[2][col] = body[2][0][t] - (wheel[l][0][t] - wheel[r][0][t]) / tracks[a];
+                    col += 1;
+                }
+            }
+            y[0] = -body[0][2][t];
+            // Pitch and roll rows in force units (moment / radius of gyration).
+            for (row, w) in [(1, self.row_weight[0]), (2, self.row_weight[1])] {
+                x[row].iter_mut().for_each(|v| *v *= w);
+            }
+            for (xr, &yr) in x.iter().zip(&y) {
+                for (u, &xu) in xr.iter().enumerate() {
+                    if xu == 0.0 {
+                        continue;
+                    }
+                    self.atb[u] += xu * yr;
+                    for (v, &xv) in xr.iter().enumerate() {
+                        self.ata[(u, v)] += xu * xv;
+                    }
+                }
+                self.btb += yr * yr;
+            }
+            self.equations += 3;
+        }
+        self.records += 1;
+        Ok(())
+    }
+
+    /// Solves the accumulated equations and builds the updated model.
+    pub fn solve(&self) -> Result<BodyFitResult> {
+        if self.records == 0 {
+            return Err(fit_error(
+                "no record was added".into(),
+                "add at least one record",
+            ));
+        }
+        let Some(ch) = self.ata.clone().cholesky() else {
+            return Err(fit_error(
+                "the equations do not determine the suspension (singular normal matrix)".into(),
+                "check that the records contain body motion in the band and that the channels' corners are right",
+            ));
+        };
+        let th = ch.solve(&self.atb);
+        let rss = self.btb - 2.0 * th.dot(&self.atb) + (&self.ata * &th).dot(&th);
+        let explained = if self.btb > 0.0 {
+            1.0 - rss / self.btb
+        } else {
+            0.0
+        };
+        let m = self.vehicle.body.mass_kg;
+        let mut v = self.vehicle.clone();
+        let positive = |what: String, value: f64, unit: &str| -> Result<f64> {
+            if value.is_finite() && value > 0.0 {
+                Ok(value)
+            } else {
+                Err(fit_error(
+                    format!("the fit gave {what} = {value:.4e} {unit}, not positive"),
+                    "check the channels' roles and corners and that the records contain body motion in the band",
+                ))
+            }
+        };
+        v.body.pitch_inertia_kgm2 = positive("the pitch inertia".into(), th[0] * m, "kg m^2")?;
+        v.body.roll_inertia_kgm2 = positive("the roll inertia".into(), th[1] * m, "kg m^2")?;
+        let mut k = [0.0; 4];
+        let mut c = [0.0; 4];
+        for corner in Corner::ALL {
+            let i = corner.index();
+            k[i] = positive(format!("the {corner} spring"), th[2 + i] * m, "N/m")?;
+            c[i] = positive(format!("the {corner} damper"), th[6 + i] * m, "N s/m")?;
+        }
+        let mut col = N_BASE;
+        for (a, name) in [(0usize, "front"), (1, "rear")] {
+            if self.bars[a] {
+                let bar = positive(format!("the {name} anti-roll bar"), th[col] * m, "N m/rad")?;
+                if a == 0 {
+                    v.front.anti_roll_stiffness_nm_per_rad = bar;
+                } else {
+                    v.rear.anti_roll_stiffness_nm_per_rad = bar;
+                }
+                col += 1;
+            }
+        }
+        // Axle means, and each corner as factors on them (the file's tyre factors kept).
+        let tyre_factor = |corner: Corner| {
+            self.vehicle
+                .corner_condition
+                .iter()
+                .filter(|cc| cc.corner == corner)
+                .map(|cc| cc.tyre_stiffness_factor)
+                .product::<f64>()
+        };
+        let (kf, kr) = (0.5 * (k[0] + k[1]), 0.5 * (k[2] + k[3]));
+        let (cf, cr) = (0.5 * (c[0] + c[1]), 0.5 * (c[2] + c[3]));
+        v.front.spring_stiffness_n_per_m = kf;
+        v.rear.spring_stiffness_n_per_m = kr;
+        v.front.damper_n_s_per_m = cf;
+        v.rear.damper_n_s_per_m = cr;
+        v.corner_condition = Corner::ALL
+            .iter()
+            .map(|&corner| {
+                let i = corner.index();
+                let (ka, ca) = if corner.is_front() {
+                    (kf, cf)
+                } else {
+                    (kr, cr)
+                };
+                CornerCondition {
+                    corner,
+                    damper_factor: c[i] / ca,
+                    spring_factor: k[i] / ka,
+                    tyre_stiffness_factor: tyre_factor(corner),
+                }
+            })
+            .collect();
+        let modes = FullCar::new(&v)?.modes()?;
+        let nominal_modes = FullCar::new(&self.vehicle)?.modes()?;
+        Ok(BodyFitResult {
+            vehicle: v,
+            modes,
+            nominal_modes,
+            records: self.records,
+            equations: self.equations,
+            band_hz: self.band_hz,
+            explained,
+        })
+    }
+}
+
+/// The band-limited signal and its first two time derivatives, by FFT of the zero-padded record
+/// (twice its length, mean removed) under a band-pass with cosine tapers of 30 % of each edge.
+struct Derivatives {
+    len: usize,
+    fs_hz: f64,
+    band_hz: [f64; 2],
+    planner: RealFftPlanner<f64>,
+}
+
+impl Derivatives {
+    fn new(len: usize, fs_hz: f64, band_hz: [f64; 2]) -> Self {
+        Derivatives {
+            len,
+            fs_hz,
+            band_hz,
+            planner: RealFftPlanner::new(),
+        }
+    }
+
+    /// The band-pass gain at `f` Hz.
+    fn gain(&self, f: f64) -> f64 {
+        let [lo, hi] = self.band_hz;
+        let w = 0.3;
+        if f <= lo * (1.0 - w) || f >= hi * (1.0 + w) {
+            0.0
+        } else if f < lo * (1.0 + w) {
+            let u = (f - lo * (1.0 - w)) / (2.0 * w * lo);
+            0.5 - 0.5 * (std::f64::consts::PI * u).cos()
+        } else if f > hi * (1.0 - w) {
+            let u = (hi * (1.0 + w) - f) / (2.0 * w * hi);
+            0.5 - 0.5 * (std::f64::consts::PI * u).cos()
+        } else {
+            1.0
+        }
+    }
+
+    fn apply(&mut self, x: &[f64]) -> [Vec<f64>; 3] {
+        let m = 2 * self.len;
+        let fwd = self.planner.plan_fft_forward(m);
+        let inv = self.planner.plan_fft_inverse(m);
+        let mean = x.iter().sum::<f64>() / x.len().max(1) as f64;
+        let mut buf = fwd.make_input_vec();
+        buf.iter_mut().zip(x).for_each(|(b, v)| *b = v - mean);
+        let mut spec = fwd.make_output_vec();
+        // Lengths match by construction (plans of `m`).
+        if fwd.process(&mut buf, &mut spec).is_err() {
+            return [
+                vec![0.0; self.len],
+                vec![0.0; self.len],
+                vec![0.0; self.len],
+            ];
+        }
+        let df = self.fs_hz / m as f64;
+        let mut out: [Vec<f64>; 3] = Default::default();
+        for (k, o) in out.iter_mut().enumerate() {
+            let mut s = spec.clone();
+            for (i, v) in s.iter_mut().enumerate() {
+                let f = i as f64 * df;
+                let iw = num_complex::Complex64::new(0.0, 2.0 * std::f64::consts::PI * f);
+                let h = match k {
+                    0 => num_complex::Complex64::new(1.0, 0.0),
+                    1 => iw,
+                    _ => iw * iw,
+                };
+                *v *= h * (self.gain(f) / m as f64);
+            }
+            // The Nyquist and DC bins are real after the band-pass (gain 0 there).
+            s[0].im = 0.0;
+            if let Some(last) = s.last_mut() {
+                last.im = 0.0;
+            }
+            let mut y = inv.make_output_vec();
+            if inv.process(&mut s, &mut y).is_err() {
+                *o = vec![0.0; self.len];
+                continue;
+            }
+            y.truncate(self.len);
+            *o = y;
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// By hand: x = sin(2 pi f t) at f = 1 Hz inside the flat part of the band has
+    /// x' = 2 pi cos(2 pi f t) and x'' = -(2 pi)^2 sin(2 pi f t); away from the record ends the
+    /// frequency-domain derivatives match to 1e-3 of their amplitude, for several rates.
+    #[test]
+    fn derivatives_of_a_sine() {
+        for fs in [50.0, 100.0, 333.0] {
+            let n = (30.0 * fs) as usize;
+            let w = 2.0 * std::f64::consts::PI;
+            let x: Vec<f64> = (0..n).map(|i| (w * i as f64 / fs).sin()).collect();
+            let mut d = Derivatives::new(n, fs, [0.5, 2.0]);
+            let [a, v, acc] = d.apply(&x);
+            let edge = (5.0 * fs) as usize;
+            for i in edge..n - edge {
+                let t = i as f64 / fs;
+                assert!((a[i] - (w * t).sin()).abs() < 1e-3, "fs {fs} t {t}: x");
+                assert!(
+                    (v[i] - w * (w * t).cos()).abs() < 1e-3 * w,
+                    "fs {fs} t {t}: x'"
+                );
+                assert!(
+                    (acc[i] + w * w * (w * t).sin()).abs() < 1e-3 * w * w,
+                    "fs {fs} t {t}: x''"
+                );
+            }
+        }
+    }
+
+    /// Outside the band the output is zero (a 5 Hz sine through the 0.5-2 Hz band).
+    #[test]
+    fn out_of_band_is_removed() {
+        let fs = 100.0;
+        let n = 3000;
+        let x: Vec<f64> = (0..n)
+            .map(|i| (2.0 * std::f64::consts::PI * 5.0 * i as f64 / fs).sin())
+            .collect();
+        let [a, _, _] = Derivatives::new(n, fs, [0.5, 2.0]).apply(&x);
+        let worst = a[500..2500].iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        assert!(worst < 1e-3, "{worst}");
+    }
+}
