@@ -170,7 +170,14 @@ pub fn run(a: &AnalyzeArgs) -> Result<()> {
             None => StreamRecords::cut(&display_name(path), stream, record_length_s),
         })
     });
-    let (mut results, first) = run_stream_analysis(&mut source, &cfg, &reference, a.quiet)?;
+    // With --vehicle, every record also feeds the fit of the vehicle's suspension.
+    let mut update = ModelUpdate::new(a.vehicle.as_deref(), &cfg)?;
+    let mut tee = FeedUpdate {
+        source: &mut source,
+        update: &mut update,
+    };
+    let (mut results, first) = run_stream_analysis(&mut tee, &cfg, &reference, a.quiet)?;
+    let update = update.finish();
     if let Some([plan]) = plans.as_deref() {
         if let Some(g) = &plan.gps {
             results.drive_speed_trace = g.speed_trace.clone();
@@ -188,10 +195,144 @@ pub fn run(a: &AnalyzeArgs) -> Result<()> {
         std::fs::write(&path, text + "\n")
             .with_context(|| format!("writing {}", path.display()))?;
     }
+    let update_text = update.write(out.path(), &a.output)?;
     out.commit()?;
     print_modes(&results, None)?;
+    if let Some(t) = update_text {
+        crate::output::print_stdout(&t)?;
+    }
     eprintln!("report: {}", a.output.join("index.html").display());
     Ok(())
+}
+
+/// The fit of the vehicle file's suspension to the records (`vibmode_vehicle::update`).
+pub struct ModelUpdate {
+    cfg: AnalysisConfig,
+    state: UpdateState,
+}
+
+/// A record source that also feeds each record to the model update.
+pub struct FeedUpdate<'a> {
+    source: &'a mut dyn vibmode_analysis::RecordSource,
+    update: &'a mut ModelUpdate,
+}
+
+/// Where the model update stands.
+pub enum UpdateState {
+    /// No vehicle file: nothing to update.
+    Off,
+    /// Records are being added.
+    Fitting(
+        vibmode_vehicle::VehicleParams,
+        Box<vibmode_vehicle::update::BodyFit>,
+    ),
+    /// A record could not be used (the reason), so the update was stopped.
+    Skipped(String),
+}
+
+impl UpdateState {
+    /// A fit of `v`'s suspension with the default settings.
+    pub fn start(v: vibmode_vehicle::VehicleParams) -> Result<Self> {
+        let fit = vibmode_vehicle::update::BodyFit::new(
+            &v,
+            vibmode_vehicle::update::BodyFitParams::default(),
+        )?;
+        Ok(UpdateState::Fitting(v, Box::new(fit)))
+    }
+}
+
+impl ModelUpdate {
+    /// With a vehicle file, a fit of its suspension; without, nothing.
+    pub fn new(vehicle: Option<&Path>, cfg: &AnalysisConfig) -> Result<Self> {
+        let state = match vehicle {
+            Some(p) => UpdateState::start(vibmode_vehicle::VehicleParams::from_path(p)?)?,
+            None => UpdateState::Off,
+        };
+        Ok(ModelUpdate {
+            cfg: cfg.clone(),
+            state,
+        })
+    }
+
+    /// Adds one record (its channels placed as the analysis places them).
+    pub fn add(&mut self, r: &RecordInput) {
+        if let UpdateState::Fitting(_, fit) = &mut self.state {
+            let mut rec = r.recording.clone();
+            for ch in rec.channels.iter_mut() {
+                ch.placement = self.cfg.placement_of(ch);
+            }
+            if let Err(e) = fit.add_record(&rec) {
+                self.state = UpdateState::Skipped(format!("{}: {e}", r.name));
+            }
+        }
+    }
+
+    /// Solves the fit.
+    pub fn finish(&mut self) -> UpdateOutcome {
+        let state = std::mem::replace(&mut self.state, UpdateState::Off);
+        match state {
+            UpdateState::Off => UpdateOutcome::Off,
+            UpdateState::Skipped(why) => UpdateOutcome::Skipped(why),
+            UpdateState::Fitting(v, fit) => match fit.solve() {
+                Ok(r) => UpdateOutcome::Done(v, Box::new(r)),
+                Err(e) => UpdateOutcome::Skipped(e.to_string()),
+            },
+        }
+    }
+}
+
+impl vibmode_analysis::RecordSource for FeedUpdate<'_> {
+    fn next_record(&mut self) -> Option<Result<RecordInput, vibmode_analysis::AnalysisError>> {
+        let r = self.source.next_record();
+        if let Some(Ok(rec)) = &r {
+            self.update.add(rec);
+        }
+        r
+    }
+
+    fn meta(&self) -> Option<vibmode_core::RecordMeta> {
+        self.source.meta()
+    }
+}
+
+/// The model update's result.
+pub enum UpdateOutcome {
+    /// No vehicle file.
+    Off,
+    /// Not possible, and why.
+    Skipped(String),
+    /// The vehicle file and the fit.
+    Done(
+        vibmode_vehicle::VehicleParams,
+        Box<vibmode_vehicle::update::BodyFitResult>,
+    ),
+}
+
+impl UpdateOutcome {
+    /// Writes `model_update.json` and `updated_vehicle.toml` into `dir` and returns the text for
+    /// the terminal (a one-line reason when the update was not possible).
+    /// `shown` is the folder's final path, for the message.
+    pub fn write(&self, dir: &Path, shown: &Path) -> Result<Option<String>> {
+        match self {
+            UpdateOutcome::Off => Ok(None),
+            UpdateOutcome::Skipped(why) => Ok(Some(format!("Full-car model not updated: {why}\n"))),
+            UpdateOutcome::Done(file, r) => {
+                let json = dir.join("model_update.json");
+                std::fs::write(&json, serde_json::to_string_pretty(r.as_ref())? + "\n")
+                    .with_context(|| format!("writing {}", json.display()))?;
+                let toml_path = dir.join("updated_vehicle.toml");
+                let mut v = r.vehicle.clone();
+                v.name = format!("{} (updated from the records)", file.name);
+                std::fs::write(&toml_path, v.to_toml_string()?)
+                    .with_context(|| format!("writing {}", toml_path.display()))?;
+                Ok(Some(format!(
+                    "{}  the updated vehicle file: {}\n",
+                    r.summary_text(file),
+                    shown.join("updated_vehicle.toml").display()
+                )))
+            }
+        }
+    }
 }
 
 /// An analysis in which every fit failed has nothing to report: an error, with the first
@@ -392,6 +533,12 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
         .collect();
     let reference = reference_modes(&sim.truth.modes);
     let results = run_analysis(&records, &cfg, &reference, a.quiet)?;
+    let mut update = ModelUpdate {
+        cfg: cfg.clone(),
+        state: UpdateState::start(vehicle.clone())?,
+    };
+    records.iter().for_each(|r| update.add(r));
+    let update_text = update.finish().write(out.path(), &a.output)?;
     let lines: Vec<String> = sim
         .truth
         .disturbance_lines_hz
@@ -440,6 +587,9 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
     }
     truth.sort_by(|x, y| x.1.total_cmp(&y.1));
     print_modes(&results, Some(&truth))?;
+    if let Some(t) = update_text {
+        crate::output::print_stdout(&t)?;
+    }
     eprintln!("report: {}", a.output.join("index.html").display());
     Ok(())
 }

@@ -148,6 +148,73 @@ impl BodyFitResult {
     pub fn nominal_mode(&self, label: ModeLabel) -> Option<&ModeInfo> {
         self.nominal_modes.iter().find(|m| m.label == label)
     }
+
+    /// A plain-text summary: the body modes of the file and of the updated model, then the
+    /// fitted parameters beside the file's.
+    pub fn summary_text(&self, file: &VehicleParams) -> String {
+        let mut s = format!(
+            "Full-car model updated from the body's equations ({} records, {} equations in {:.2}-{:.2} Hz, {:.1} % of their variance explained):\n",
+            self.records,
+            self.equations,
+            self.band_hz[0],
+            self.band_hz[1],
+            100.0 * self.explained
+        );
+        s.push_str(&format!(
+            "  {:<12} {:>9} {:>11} {:>8} {:>13} {:>16}\n",
+            "mode", "file Hz", "updated Hz", "change", "file damping", "updated damping"
+        ));
+        for label in [
+            ModeLabel::BodyPitch,
+            ModeLabel::BodyHeave,
+            ModeLabel::BodyRoll,
+        ] {
+            if let (Some(n), Some(u)) = (self.nominal_mode(label), self.mode(label)) {
+                s.push_str(&format!(
+                    "  {:<12} {:>9.3} {:>11.3} {:>7.1}% {:>13.3} {:>16.3}\n",
+                    label.to_string(),
+                    n.frequency_hz,
+                    u.frequency_hz,
+                    100.0 * (u.frequency_hz / n.frequency_hz - 1.0),
+                    n.damping_ratio,
+                    u.damping_ratio
+                ));
+            }
+        }
+        let per = |v: &VehicleParams, f: fn(&crate::params::Axle) -> f64, scale: f64| {
+            Corner::ALL
+                .iter()
+                .map(|&c| format!("{:.1}", f(&v.axle(c)) / scale))
+                .collect::<Vec<_>>()
+                .join("/")
+        };
+        s.push_str(&format!(
+            "  springs FL/FR/RL/RR, kN/m: file {}, fitted {}\n",
+            per(file, |a| a.spring_stiffness_n_per_m, 1e3),
+            per(&self.vehicle, |a| a.spring_stiffness_n_per_m, 1e3)
+        ));
+        s.push_str(&format!(
+            "  dampers FL/FR/RL/RR, kN s/m: file {}, fitted {}\n",
+            per(file, |a| a.damper_n_s_per_m, 1e3),
+            per(&self.vehicle, |a| a.damper_n_s_per_m, 1e3)
+        ));
+        s.push_str(&format!(
+            "  pitch / roll inertia, kg m^2: file {:.0} / {:.0}, fitted {:.0} / {:.0}\n",
+            file.body.pitch_inertia_kgm2,
+            file.body.roll_inertia_kgm2,
+            self.vehicle.body.pitch_inertia_kgm2,
+            self.vehicle.body.roll_inertia_kgm2
+        ));
+        s.push_str(&format!(
+            "  anti-roll bars front / rear, kN m/rad: file {:.0} / {:.0}, fitted {:.0} / {:.0}\n",
+            file.front.anti_roll_stiffness_nm_per_rad / 1e3,
+            file.rear.anti_roll_stiffness_nm_per_rad / 1e3,
+            self.vehicle.front.anti_roll_stiffness_nm_per_rad / 1e3,
+            self.vehicle.rear.anti_roll_stiffness_nm_per_rad / 1e3
+        ));
+        s.push_str("  (sprung mass, unsprung masses, tyres and bending are the file's)\n");
+        s
+    }
 }
 
 fn fit_error(problem: String, fix: &'static str) -> VehicleError {
