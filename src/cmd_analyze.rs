@@ -223,8 +223,10 @@ pub enum UpdateState {
     Off,
     /// Records are being added.
     Fitting(
-        vibmode_vehicle::VehicleParams,
-        Box<vibmode_vehicle::update::BodyFit>,
+        Box<(
+            vibmode_vehicle::VehicleParams,
+            vibmode_vehicle::update::BodyFit,
+        )>,
     ),
     /// A record could not be used (the reason), so the update was stopped.
     Skipped(String),
@@ -237,7 +239,7 @@ impl UpdateState {
             &v,
             vibmode_vehicle::update::BodyFitParams::default(),
         )?;
-        Ok(UpdateState::Fitting(v, Box::new(fit)))
+        Ok(UpdateState::Fitting(Box::new((v, fit))))
     }
 }
 
@@ -256,7 +258,8 @@ impl ModelUpdate {
 
     /// Adds one record (its channels placed as the analysis places them).
     pub fn add(&mut self, r: &RecordInput) {
-        if let UpdateState::Fitting(_, fit) = &mut self.state {
+        if let UpdateState::Fitting(b) = &mut self.state {
+            let fit = &mut b.1;
             let mut rec = r.recording.clone();
             for ch in rec.channels.iter_mut() {
                 ch.placement = self.cfg.placement_of(ch);
@@ -273,8 +276,8 @@ impl ModelUpdate {
         match state {
             UpdateState::Off => UpdateOutcome::Off,
             UpdateState::Skipped(why) => UpdateOutcome::Skipped(why),
-            UpdateState::Fitting(v, fit) => match fit.solve() {
-                Ok(r) => UpdateOutcome::Done(v, Box::new(r)),
+            UpdateState::Fitting(b) => match b.1.solve() {
+                Ok(r) => UpdateOutcome::Done(Box::new((b.0, r))),
                 Err(e) => UpdateOutcome::Skipped(e.to_string()),
             },
         }
@@ -303,8 +306,10 @@ pub enum UpdateOutcome {
     Skipped(String),
     /// The vehicle file and the fit.
     Done(
-        vibmode_vehicle::VehicleParams,
-        Box<vibmode_vehicle::update::BodyFitResult>,
+        Box<(
+            vibmode_vehicle::VehicleParams,
+            vibmode_vehicle::update::BodyFitResult,
+        )>,
     ),
 }
 
@@ -316,9 +321,10 @@ impl UpdateOutcome {
         match self {
             UpdateOutcome::Off => Ok(None),
             UpdateOutcome::Skipped(why) => Ok(Some(format!("Full-car model not updated: {why}\n"))),
-            UpdateOutcome::Done(file, r) => {
+            UpdateOutcome::Done(b) => {
+                let (file, r) = (&b.0, &b.1);
                 let json = dir.join("model_update.json");
-                std::fs::write(&json, serde_json::to_string_pretty(r.as_ref())? + "\n")
+                std::fs::write(&json, serde_json::to_string_pretty(r)? + "\n")
                     .with_context(|| format!("writing {}", json.display()))?;
                 let toml_path = dir.join("updated_vehicle.toml");
                 let mut v = r.vehicle.clone();
