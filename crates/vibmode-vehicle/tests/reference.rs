@@ -1,7 +1,10 @@
 //! Against tools/reference/vehicle.py (numpy 2.1.3 / scipy 1.14.1): modes and PSD to 1e-6
-//! relative, bump response (scipy.signal.lsim) to 2e-3 of the channel peak.
+//! relative, bump response (scipy.signal.lsim) to 2e-3 of the channel peak; and the body-equation
+//! fit against tools/reference/body_fit.py to 1e-6.
 use serde_json::Value;
-use vibmode_vehicle::{FullCar, LateralCoherence, RoadClass, RoadInput, VehicleParams};
+use vibmode_vehicle::{
+    Corner, FullCar, LateralCoherence, ModeLabel, RoadClass, RoadInput, VehicleParams,
+};
 
 const REF: &str = include_str!(concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -92,4 +95,125 @@ fn modes_psd_and_bump_match_scipy() {
     assert!(worst_mode < 1e-6, "modes rel err {worst_mode}");
     assert!(worst_psd < 1e-6, "psd rel err {worst_psd}");
     eprintln!("worst relative error: modes {worst_mode:.2e}, psd {worst_psd:.2e}, bump {worst_bump:.2e} of peak");
+}
+
+const BODY_FIT: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../tools/reference/data/body_fit.json"
+));
+const BODY_FIT_INPUT: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../tools/reference/data/body_fit_input.json"
+));
+
+/// The body-equation fit against tools/reference/body_fit.py (numpy FFT derivatives, lstsq,
+/// scipy eigenvalues) on records of a changed rigid bus that script simulated: parameters and
+/// body modes equal to 1e-6; both within 1 % of the changed bus (its simulation's truth).
+#[test]
+fn body_fit_matches_numpy() {
+    use vibmode_core::{Channel, Recording};
+    use vibmode_vehicle::update::{BodyFit, BodyFitParams};
+    let r: Value = serde_json::from_str(BODY_FIT).unwrap();
+    let input: Value = serde_json::from_str(BODY_FIT_INPUT).unwrap();
+    let file = VehicleParams::from_path(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/city_bus.toml"
+    ))
+    .unwrap();
+    let fs = input["fs_hz"].as_f64().unwrap();
+    let names: Vec<&str> = input["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    let mut fit = BodyFit::new(&file, BodyFitParams::default()).unwrap();
+    for rec in input["records"].as_array().unwrap() {
+        let channels = rec
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(&names)
+            .map(|(v, n)| Channel::new(*n, "m/s^2", vec_f(v)))
+            .collect();
+        fit.add_record(&Recording {
+            fs_hz: fs,
+            channels,
+            time_axis: None,
+        })
+        .unwrap();
+    }
+    let res = fit.solve().unwrap();
+    let rel = |a: f64, b: f64| (a / b - 1.0).abs();
+    let want = &r["fit"];
+    assert_eq!(res.equations as u64, want["equations"].as_u64().unwrap());
+    let band = vec_f(&want["band_hz"]);
+    assert!(rel(res.band_hz[0], band[0]) < 1e-12 && rel(res.band_hz[1], band[1]) < 1e-12);
+    let v = &res.vehicle;
+    let got_params = [
+        (
+            "springs",
+            Corner::ALL
+                .map(|c| v.axle(c).spring_stiffness_n_per_m)
+                .to_vec(),
+        ),
+        (
+            "dampers",
+            Corner::ALL.map(|c| v.axle(c).damper_n_s_per_m).to_vec(),
+        ),
+        (
+            "bars",
+            vec![
+                v.front.anti_roll_stiffness_nm_per_rad,
+                v.rear.anti_roll_stiffness_nm_per_rad,
+            ],
+        ),
+        (
+            "inertia",
+            vec![v.body.pitch_inertia_kgm2, v.body.roll_inertia_kgm2],
+        ),
+    ];
+    for (key, got) in &got_params {
+        let numpy = vec_f(&want["params"][key]);
+        let truth = vec_f(&r["truth"]["params"][key]);
+        for ((g, n), t) in got.iter().zip(&numpy).zip(&truth) {
+            assert!(rel(*g, *n) < 1e-6, "{key}: {g} against numpy's {n}");
+            assert!(rel(*g, *t) < 0.01, "{key}: {g} against the truth {t}");
+        }
+    }
+    let mut body: Vec<(f64, f64)> = res
+        .modes
+        .iter()
+        .filter(|m| {
+            matches!(
+                m.label,
+                ModeLabel::BodyHeave | ModeLabel::BodyPitch | ModeLabel::BodyRoll
+            )
+        })
+        .map(|m| (m.frequency_hz, m.damping_ratio))
+        .collect();
+    body.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (nf, nz) = (
+        vec_f(&want["body_frequency_hz"]),
+        vec_f(&want["body_damping_ratio"]),
+    );
+    let tf = vec_f(&r["truth"]["body_frequency_hz"]);
+    assert_eq!(body.len(), 3);
+    for (i, (f, z)) in body.iter().enumerate() {
+        assert!(
+            rel(*f, nf[i]) < 1e-6,
+            "mode {i}: {f} Hz against numpy's {}",
+            nf[i]
+        );
+        assert!(
+            rel(*z, nz[i]) < 1e-6,
+            "mode {i}: damping {z} against numpy's {}",
+            nz[i]
+        );
+        assert!(
+            rel(*f, tf[i]) < 0.01,
+            "mode {i}: {f} Hz against the truth {}",
+            tf[i]
+        );
+    }
 }
