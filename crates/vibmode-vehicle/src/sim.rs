@@ -974,7 +974,7 @@ fn add_speed_wander(speed: &mut [f64], sim: &SimParams, dt: f64) {
 }
 
 /// Time constant of the smoothing of the speed wander, s: a driver changes speed with a
-/// bounded acceleration (at 40 km/h and 3 %, about 0.07 m/s^2 rms).
+/// bounded acceleration (at 40 km/h and 3 %, about 0.15 m/s^2 rms: v0 sigma sqrt(tau_s / tau) / tau_s).
 const SPEED_SMOOTHING_S: f64 = 1.0;
 
 /// Each sensor's tilt angles (about the lateral axis, about the longitudinal axis), deg.
