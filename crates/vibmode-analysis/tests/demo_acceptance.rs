@@ -6,7 +6,7 @@ mod common;
 
 use vibmode_analysis::{analyze, AnalysisConfig, Role};
 use vibmode_modal::{ModeClass, ReferenceMode};
-use vibmode_vehicle::{simulate, ModeLabel, SimParams, VehicleParams};
+use vibmode_vehicle::{simulate, SimParams, VehicleParams};
 
 #[test]
 fn demo_data_gives_the_true_modes_and_lines() {
@@ -26,12 +26,7 @@ fn demo_data_gives_the_true_modes_and_lines() {
         .truth
         .modes
         .iter()
-        .filter(|m| {
-            matches!(
-                m.label,
-                ModeLabel::BodyHeave | ModeLabel::BodyPitch | ModeLabel::BodyRoll
-            )
-        })
+        .filter(|m| m.label.is_body_rigid())
         .map(|m| m.frequency_hz)
         .collect();
     let hop: Vec<f64> = sim

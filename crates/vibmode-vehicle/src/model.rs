@@ -43,6 +43,16 @@ pub enum ModeLabel {
     BodyBending,
 }
 
+impl ModeLabel {
+    /// Body heave, pitch or roll: a rigid-body mode of the sprung mass on its suspension.
+    pub fn is_body_rigid(self) -> bool {
+        matches!(
+            self,
+            ModeLabel::BodyHeave | ModeLabel::BodyPitch | ModeLabel::BodyRoll
+        )
+    }
+}
+
 impl fmt::Display for ModeLabel {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {

@@ -232,12 +232,7 @@ impl BodyFit {
                 let body: Vec<f64> = car
                     .modes()?
                     .iter()
-                    .filter(|m| {
-                        matches!(
-                            m.label,
-                            ModeLabel::BodyHeave | ModeLabel::BodyPitch | ModeLabel::BodyRoll
-                        )
-                    })
+                    .filter(|m| m.label.is_body_rigid())
                     .map(|m| m.frequency_hz)
                     .collect();
                 if body.is_empty() {

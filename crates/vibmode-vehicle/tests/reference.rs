@@ -2,9 +2,7 @@
 //! relative, bump response (scipy.signal.lsim) to 2e-3 of the channel peak; and the body-equation
 //! fit against tools/reference/body_fit.py to 1e-6.
 use serde_json::Value;
-use vibmode_vehicle::{
-    Corner, FullCar, LateralCoherence, ModeLabel, RoadClass, RoadInput, VehicleParams,
-};
+use vibmode_vehicle::{Corner, FullCar, LateralCoherence, RoadClass, RoadInput, VehicleParams};
 
 const REF: &str = include_str!(concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -184,12 +182,7 @@ fn body_fit_matches_numpy() {
     let mut body: Vec<(f64, f64)> = res
         .modes
         .iter()
-        .filter(|m| {
-            matches!(
-                m.label,
-                ModeLabel::BodyHeave | ModeLabel::BodyPitch | ModeLabel::BodyRoll
-            )
-        })
+        .filter(|m| m.label.is_body_rigid())
         .map(|m| (m.frequency_hz, m.damping_ratio))
         .collect();
     body.sort_by(|a, b| a.0.total_cmp(&b.0));
