@@ -175,7 +175,41 @@ fn analyze(
     let results = py
         .detach(|| vibmode_analysis::analyze(&records, &cfg, &reference, &|_, _| {}))
         .map_err(analysis_err)?;
-    serde_json::to_string(&results).map_err(json_err)
+    let mut value = serde_json::to_value(&results).map_err(json_err)?;
+    // With a vehicle, its suspension fitted to the records (vibmode_vehicle::update), as the
+    // command line does: the result, or why it was not possible.
+    if let (Some(k), Some(v)) = (vehicle_kind, vehicle) {
+        let params = vehicle_of(k, v)?;
+        let update = py.detach(|| model_update(&params, &records, &cfg));
+        if let serde_json::Value::Object(map) = &mut value {
+            map.insert("model_update".into(), update);
+        }
+    }
+    serde_json::to_string(&value).map_err(json_err)
+}
+
+/// The body-equation fit of `vehicle` over `records` (channels placed as the analysis places
+/// them): `BodyFitResult` as JSON, or `{"not_updated": reason}`.
+fn model_update(
+    vehicle: &VehicleParams,
+    records: &[RecordInput],
+    cfg: &AnalysisConfig,
+) -> serde_json::Value {
+    use vibmode_vehicle::update::{BodyFit, BodyFitParams};
+    let run = || -> Result<serde_json::Value, String> {
+        let mut fit = BodyFit::new(vehicle, BodyFitParams::default()).map_err(|e| e.to_string())?;
+        for r in records {
+            let mut rec = r.recording.clone();
+            for ch in rec.channels.iter_mut() {
+                ch.placement = cfg.placement_of(ch);
+            }
+            fit.add_record(&rec)
+                .map_err(|e| format!("{}: {e}", r.name))?;
+        }
+        let res = fit.solve().map_err(|e| e.to_string())?;
+        serde_json::to_value(&res).map_err(|e| e.to_string())
+    };
+    run().unwrap_or_else(|why| serde_json::json!({ "not_updated": why }))
 }
 
 /// Simulates in-service records of a vehicle: `(records, truth_json)`, each record in the

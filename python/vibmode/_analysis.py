@@ -126,7 +126,9 @@ def analyze(
     (default) or 'paper'; keyword ``settings`` are merged over both, as sections
     (``sweep={'order_max': 12}``) or the flat keys (``order_max=12``, ``cutoff_hz=20``).
     ``vehicle``: full-car parameters (shipped name, TOML file/text or dict) whose modes are
-    matched. ``channels``: names or indices to analyse.
+    matched and whose suspension is fitted to the records' body equations: ``model_update`` in
+    the result holds the updated vehicle, its modes and the file's (docs/model_update.md), or
+    ``not_updated`` with the reason. ``channels``: names or indices to analyse.
 
     Returns the structure of ``results.json`` as a dict; with pandas installed (and
     ``as_frames`` not False) every table (list of flat records: poles, fits, invariant modes,
