@@ -259,12 +259,8 @@ impl ModelUpdate {
     /// Adds one record (its channels placed as the analysis places them).
     pub fn add(&mut self, r: &RecordInput) {
         if let UpdateState::Fitting(b) = &mut self.state {
-            let fit = &mut b.1;
-            let mut rec = r.recording.clone();
-            for ch in rec.channels.iter_mut() {
-                ch.placement = self.cfg.placement_of(ch);
-            }
-            if let Err(e) = fit.add_record(&rec) {
+            let cfg = &self.cfg;
+            if let Err(e) = b.1.add_record_placed(&r.recording, |c| cfg.placement_of(c)) {
                 self.state = UpdateState::Skipped(format!("{}: {e}", r.name));
             }
         }

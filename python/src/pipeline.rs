@@ -199,11 +199,7 @@ fn model_update(
     let run = || -> Result<serde_json::Value, String> {
         let mut fit = BodyFit::new(vehicle, BodyFitParams::default()).map_err(|e| e.to_string())?;
         for r in records {
-            let mut rec = r.recording.clone();
-            for ch in rec.channels.iter_mut() {
-                ch.placement = cfg.placement_of(ch);
-            }
-            fit.add_record(&rec)
+            fit.add_record_placed(&r.recording, |c| cfg.placement_of(c))
                 .map_err(|e| format!("{}: {e}", r.name))?;
         }
         let res = fit.solve().map_err(|e| e.to_string())?;

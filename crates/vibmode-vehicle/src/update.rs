@@ -25,7 +25,7 @@ use crate::params::{CornerCondition, VehicleParams};
 use nalgebra::{DMatrix, DVector};
 use realfft::RealFftPlanner;
 use serde::{Deserialize, Serialize};
-use vibmode_core::{Corner, Direction, Recording, Role};
+use vibmode_core::{Channel, Corner, Direction, Placement, Recording, Role};
 
 /// Settings of the body-equation fit.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -109,6 +109,8 @@ pub struct BodyFit {
     bars: [bool; 2],
     /// Row weights of pitch and roll (1 / radius of gyration, 1/m).
     row_weight: [f64; 2],
+    /// The vehicle file's own modes.
+    nominal_modes: Vec<ModeInfo>,
     ata: DMatrix<f64>,
     atb: DVector<f64>,
     btb: f64,
@@ -225,12 +227,11 @@ impl BodyFit {
     /// A fit of `vehicle`'s suspension (validated) with `params` (validated).
     pub fn new(vehicle: &VehicleParams, params: BodyFitParams) -> Result<Self> {
         params.validate()?;
-        let car = FullCar::new(vehicle)?;
+        let nominal_modes = FullCar::new(vehicle)?.modes()?;
         let band_hz = match params.band_hz {
             Some(b) => b,
             None => {
-                let body: Vec<f64> = car
-                    .modes()?
+                let body: Vec<f64> = nominal_modes
                     .iter()
                     .filter(|m| m.label.is_body_rigid())
                     .map(|m| m.frequency_hz)
@@ -261,6 +262,7 @@ impl BodyFit {
                 (m / vehicle.body.pitch_inertia_kgm2).sqrt(),
                 (m / vehicle.body.roll_inertia_kgm2).sqrt(),
             ],
+            nominal_modes,
             ata: DMatrix::zeros(n, n),
             atb: DVector::zeros(n),
             btb: 0.0,
@@ -283,18 +285,19 @@ impl BodyFit {
     /// sprung sensors at known body positions. Channels are placed by their placement (role and
     /// corner) or, failing that, by the vehicle file's sensor of the same name; horizontal
     /// channels are left out.
-    fn layout(&self, rec: &Recording) -> Result<Layout> {
+    fn layout(&self, rec: &Recording, placement: &dyn Fn(&Channel) -> Placement) -> Result<Layout> {
         let spec = self.vehicle.effective_sensors();
         let mut wheels: [Option<usize>; 4] = [None; 4];
         let mut sprung: Vec<(usize, f64, f64)> = Vec::new();
         for (i, ch) in rec.channels.iter().enumerate() {
-            if matches!(ch.placement.direction, Some(Direction::X | Direction::Y)) {
+            let pl = placement(ch);
+            if matches!(pl.direction, Some(Direction::X | Direction::Y)) {
                 continue;
             }
             let named = spec.iter().find(|s| s.name.eq_ignore_ascii_case(&ch.name));
-            let (role, corner) = match ch.placement.role {
-                Role::Sprung => (Role::Sprung, ch.placement.corner),
-                Role::Unsprung => (Role::Unsprung, ch.placement.corner),
+            let (role, corner) = match pl.role {
+                Role::Sprung => (Role::Sprung, pl.corner),
+                Role::Unsprung => (Role::Unsprung, pl.corner),
                 Role::Other => match named {
                     Some(s) => (s.kind.role(), s.corner),
                     None => continue,
@@ -385,6 +388,16 @@ impl BodyFit {
     /// Adds one record's equations. The channels need placements (or the vehicle file's sensor
     /// names): four unsprung at FL, FR, RL, RR and three or more sprung at known positions.
     pub fn add_record(&mut self, rec: &Recording) -> Result<()> {
+        self.add_record_placed(rec, |c| c.placement)
+    }
+
+    /// As [`BodyFit::add_record`], with each channel's placement given by `placement` instead
+    /// of its own (e.g. an analysis config's roles and corners).
+    pub fn add_record_placed(
+        &mut self,
+        rec: &Recording,
+        placement: impl Fn(&Channel) -> Placement,
+    ) -> Result<()> {
         let fs = rec.fs_hz;
         if !(fs.is_finite() && fs > 0.0) {
             return Err(fit_error(
@@ -403,7 +416,7 @@ impl BodyFit {
                 "sample faster or lower the band",
             ));
         }
-        let layout = self.layout(rec)?;
+        let layout = self.layout(rec, &placement)?;
         let len = rec.channels.first().map_or(0, |c| c.samples.len());
         let edge = (self.params.edge_s * fs).round() as usize;
         // At least one period of the lowest band frequency between the edges.
@@ -438,27 +451,36 @@ impl BodyFit {
                 ));
             }
         }
-        // a, a', a'' of every used channel, band-limited.
-        let mut der: Vec<Option<[Vec<f64>; 3]>> = vec![None; rec.channels.len()];
+        // Equations at about 25 times the band's upper edge, away from the record ends.
+        let step = ((fs / (25.0 * self.band_hz[1])).floor() as usize).max(1);
+        let instants: Vec<usize> = (edge..len - edge).step_by(step).collect();
+        // a, a', a'' of the used channels, band-limited, at those instants.
         let mut deriv = Derivatives::new(len, fs, self.band_hz);
-        for &i in layout.wheels.iter().chain(&layout.sprung) {
-            der[i] = Some(deriv.apply(&rec.channels[i].samples));
-        }
-        let get = |i: usize| der[i].as_ref();
+        let mut of = |i: usize| deriv.apply(&rec.channels[i].samples, &instants);
+        let wheel: Vec<[Vec<f64>; 3]> = layout
+            .wheels
+            .iter()
+            .map(|&i| of(i))
+            .collect::<Result<_>>()?;
+        let sprung: Vec<[Vec<f64>; 3]> = layout
+            .sprung
+            .iter()
+            .map(|&i| of(i))
+            .collect::<Result<_>>()?;
         // Body coordinates' derivatives.
-        let mut body: [[Vec<f64>; 3]; 3] = Default::default();
-        for (b, out) in body.iter_mut().enumerate() {
-            for (k, o) in out.iter_mut().enumerate() {
-                *o = vec![0.0; len];
-                for (j, &ci) in layout.sprung.iter().enumerate() {
-                    let w = layout.body[(b, j)];
-                    if let Some(d) = get(ci) {
-                        o.iter_mut().zip(&d[k]).for_each(|(y, x)| *y += w * x);
-                    }
-                }
-            }
-        }
-        let wheel: Vec<&[Vec<f64>; 3]> = layout.wheels.iter().filter_map(|&i| get(i)).collect();
+        let body: [[Vec<f64>; 3]; 3] = std::array::from_fn(|b| {
+            std::array::from_fn(|k| {
+                (0..instants.len())
+                    .map(|t| {
+                        sprung
+                            .iter()
+                            .enumerate()
+                            .map(|(j, d)| layout.body[(b, j)] * d[k][t])
+                            .sum()
+                    })
+                    .collect()
+            })
+        });
         let pos: Vec<(f64, f64)> = Corner::ALL
             .iter()
             .map(|&c| self.vehicle.corner_position_m(c))
@@ -467,12 +489,10 @@ impl BodyFit {
             self.vehicle.geometry.track_front_m,
             self.vehicle.geometry.track_rear_m,
         ];
-        // Equations at about 25 times the band's upper edge.
-        let step = ((fs / (25.0 * self.band_hz[1])).floor() as usize).max(1);
         let n = self.ata.nrows();
         let mut x = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
         let mut y = [0.0; 3];
-        for t in (edge..len - edge).step_by(step) {
+        for t in 0..instants.len() {
             x.iter_mut()
                 .for_each(|r| r.iter_mut().for_each(|v| *v = 0.0));
             // Suspension deflection g_c (k-th derivative) = z + x theta + y phi - w.
@@ -605,7 +625,7 @@ impl BodyFit {
             })
             .collect();
         let modes = FullCar::new(&v)?.modes()?;
-        let nominal_modes = FullCar::new(&self.vehicle)?.modes()?;
+        let nominal_modes = self.nominal_modes.clone();
         Ok(BodyFitResult {
             vehicle: v,
             modes,
@@ -654,7 +674,8 @@ impl Derivatives {
         }
     }
 
-    fn apply(&mut self, x: &[f64]) -> [Vec<f64>; 3] {
+    /// The three signals at the samples `keep`.
+    fn apply(&mut self, x: &[f64], keep: &[usize]) -> Result<[Vec<f64>; 3]> {
         let m = 2 * self.len;
         let fwd = self.planner.plan_fft_forward(m);
         let inv = self.planner.plan_fft_inverse(m);
@@ -662,14 +683,9 @@ impl Derivatives {
         let mut buf = fwd.make_input_vec();
         buf.iter_mut().zip(x).for_each(|(b, v)| *b = v - mean);
         let mut spec = fwd.make_output_vec();
-        // Lengths match by construction (plans of `m`).
-        if fwd.process(&mut buf, &mut spec).is_err() {
-            return [
-                vec![0.0; self.len],
-                vec![0.0; self.len],
-                vec![0.0; self.len],
-            ];
-        }
+        // Lengths match by construction (plans of `m`); a failure is a bug, not bad input.
+        let fft_failed = |e: realfft::FftError| VehicleError::Numerical(format!("FFT: {e}"));
+        fwd.process(&mut buf, &mut spec).map_err(fft_failed)?;
         let df = self.fs_hz / m as f64;
         let mut out: [Vec<f64>; 3] = Default::default();
         for (k, o) in out.iter_mut().enumerate() {
@@ -690,14 +706,10 @@ impl Derivatives {
                 last.im = 0.0;
             }
             let mut y = inv.make_output_vec();
-            if inv.process(&mut s, &mut y).is_err() {
-                *o = vec![0.0; self.len];
-                continue;
-            }
-            y.truncate(self.len);
-            *o = y;
+            inv.process(&mut s, &mut y).map_err(fft_failed)?;
+            *o = keep.iter().map(|&t| y[t]).collect();
         }
-        out
+        Ok(out)
     }
 }
 
@@ -715,7 +727,8 @@ mod tests {
             let w = 2.0 * std::f64::consts::PI;
             let x: Vec<f64> = (0..n).map(|i| (w * i as f64 / fs).sin()).collect();
             let mut d = Derivatives::new(n, fs, [0.5, 2.0]);
-            let [a, v, acc] = d.apply(&x);
+            let keep: Vec<usize> = (0..n).collect();
+            let [a, v, acc] = d.apply(&x, &keep).unwrap();
             let edge = (5.0 * fs) as usize;
             for i in edge..n - edge {
                 let t = i as f64 / fs;
@@ -740,7 +753,10 @@ mod tests {
         let x: Vec<f64> = (0..n)
             .map(|i| (2.0 * std::f64::consts::PI * 5.0 * i as f64 / fs).sin())
             .collect();
-        let [a, _, _] = Derivatives::new(n, fs, [0.5, 2.0]).apply(&x);
+        let keep: Vec<usize> = (0..n).collect();
+        let [a, _, _] = Derivatives::new(n, fs, [0.5, 2.0])
+            .apply(&x, &keep)
+            .unwrap();
         let worst = a[500..2500].iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         assert!(worst < 1e-3, "{worst}");
     }
