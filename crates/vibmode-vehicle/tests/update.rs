@@ -1,6 +1,7 @@
 //! The body-equation fit (`update::BodyFit`): the measured vehicle's body modes recovered from
 //! the demo's records when the vehicle file is not the vehicle that was measured; its errors.
 use vibmode_core::{Channel, Recording};
+use vibmode_modal::shapes::mac;
 use vibmode_vehicle::update::{BodyFit, BodyFitParams};
 use vibmode_vehicle::*;
 
@@ -29,18 +30,6 @@ fn changed(mut v: VehicleParams) -> VehicleParams {
         tyre_stiffness_factor: 1.0,
     });
     v
-}
-
-fn mac(a: &[[f64; 2]], b: &[[f64; 2]]) -> f64 {
-    let (mut re, mut im, mut aa, mut bb) = (0.0, 0.0, 0.0, 0.0);
-    for (x, y) in a.iter().zip(b) {
-        // a^H b
-        re += x[0] * y[0] + x[1] * y[1];
-        im += x[0] * y[1] - x[1] * y[0];
-        aa += x[0] * x[0] + x[1] * x[1];
-        bb += y[0] * y[0] + y[1] * y[1];
-    }
-    (re * re + im * im) / (aa * bb)
 }
 
 /// The demo's 8 records (lines, noise, misalignment, speed wander, braking and a turn) of the
