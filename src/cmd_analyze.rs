@@ -184,7 +184,13 @@ pub fn run(a: &AnalyzeArgs) -> Result<()> {
         }
     }
     check_some_fit(&results)?;
-    write_report(out.path(), std::slice::from_ref(&first), &results, None)?;
+    write_report(
+        out.path(),
+        std::slice::from_ref(&first),
+        &results,
+        None,
+        &update.sections(),
+    )?;
     if let Some(plans) = &plans {
         let path = out.path().join("segments.json");
         let text = if plans.len() == 1 {
@@ -233,12 +239,9 @@ pub enum UpdateState {
 }
 
 impl UpdateState {
-    /// A fit of `v`'s suspension with the default settings.
-    pub fn start(v: vibmode_vehicle::VehicleParams) -> Result<Self> {
-        let fit = vibmode_vehicle::update::BodyFit::new(
-            &v,
-            vibmode_vehicle::update::BodyFitParams::default(),
-        )?;
+    /// A fit of `v`'s suspension with the analysis' `[model_update]` settings.
+    pub fn start(v: vibmode_vehicle::VehicleParams, cfg: &AnalysisConfig) -> Result<Self> {
+        let fit = vibmode_vehicle::update::BodyFit::new(&v, cfg.model_update.clone())?;
         Ok(UpdateState::Fitting(Box::new((v, fit))))
     }
 }
@@ -247,7 +250,7 @@ impl ModelUpdate {
     /// With a vehicle file, a fit of its suspension; without, nothing.
     pub fn new(vehicle: Option<&Path>, cfg: &AnalysisConfig) -> Result<Self> {
         let state = match vehicle {
-            Some(p) => UpdateState::start(vibmode_vehicle::VehicleParams::from_path(p)?)?,
+            Some(p) => UpdateState::start(vibmode_vehicle::VehicleParams::from_path(p)?, cfg)?,
             None => UpdateState::Off,
         };
         Ok(ModelUpdate {
@@ -310,6 +313,16 @@ pub enum UpdateOutcome {
 }
 
 impl UpdateOutcome {
+    /// The report's section on the model update (none without a vehicle file).
+    pub fn sections(&self) -> Vec<vibmode_report::ReportSection> {
+        use vibmode_report::ReportSection;
+        match self {
+            UpdateOutcome::Off => Vec::new(),
+            UpdateOutcome::Skipped(why) => vec![ReportSection::model_update_skipped(why)],
+            UpdateOutcome::Done(b) => vec![ReportSection::model_update(&b.0, &b.1)],
+        }
+    }
+
     /// Writes `model_update.json` and `updated_vehicle.toml` into `dir` and returns the text for
     /// the terminal (a one-line reason when the update was not possible).
     /// `shown` is the folder's final path, for the message.
@@ -468,8 +481,9 @@ pub fn write_report(
     records: &[RecordInput],
     r: &AnalysisResults,
     intro: Option<&str>,
+    extra: &[vibmode_report::ReportSection],
 ) -> Result<()> {
-    vibmode_report::write_analysis_report(dir, records, r, intro)
+    vibmode_report::write_analysis_report(dir, records, r, intro, extra)
         .with_context(|| format!("writing the report in {}", dir.display()))?;
     Ok(())
 }
@@ -537,10 +551,11 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
     let results = run_analysis(&records, &cfg, &reference, a.quiet)?;
     let mut update = ModelUpdate {
         cfg: cfg.clone(),
-        state: UpdateState::start(vehicle.clone())?,
+        state: UpdateState::start(vehicle.clone(), &cfg)?,
     };
     records.iter().for_each(|r| update.add(r));
-    let update_text = update.finish().write(out.path(), &a.output)?;
+    let update = update.finish();
+    let update_text = update.write(out.path(), &a.output)?;
     let lines: Vec<String> = sim
         .truth
         .disturbance_lines_hz
@@ -562,7 +577,13 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
             .collect::<Vec<_>>()
             .join(", "),
     );
-    write_report(out.path(), &records, &results, Some(&intro))?;
+    write_report(
+        out.path(),
+        &records,
+        &results,
+        Some(&intro),
+        &update.sections(),
+    )?;
     out.commit()?;
     let mut truth: Vec<TruthRow> = sim
         .truth

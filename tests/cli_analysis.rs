@@ -405,6 +405,41 @@ fn analyze_with_a_vehicle_updates_the_model() {
         serde_json::from_str(&std::fs::read_to_string(out.join("model_update.json")).unwrap())
             .unwrap();
     assert_eq!(j["records"], 4);
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(
+        html.contains("<h2>Full-car model updated from the records</h2>"),
+        "report section"
+    );
+    // The fit's band from the analysis config's [model_update]; a bad band is a one-line error.
+    let cfg = d.path().join("band.toml");
+    std::fs::write(&cfg, "[model_update]\nband_hz = [0.5, 2.0]\nedge_s = 0.5\n").unwrap();
+    let out3 = d.path().join("report3");
+    let mut args: Vec<&str> = vec!["analyze", "-q", "--method", "ssi-cov", "--vehicle", file];
+    args.extend(wavs.iter().map(String::as_str));
+    args.extend([
+        "--config",
+        cfg.to_str().unwrap(),
+        "-o",
+        out3.to_str().unwrap(),
+    ]);
+    let o = vibmode(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out3.join("model_update.json")).unwrap())
+            .unwrap();
+    assert_eq!(j["band_hz"], serde_json::json!([0.5, 2.0]));
+    std::fs::write(&cfg, "[model_update]\nband_hz = [2.0, 0.5]\n").unwrap();
+    let out4 = d.path().join("report4");
+    args.pop();
+    args.push(out4.to_str().unwrap());
+    let o = vibmode(&args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("band_hz = [2, 0.5]") && err.lines().count() == 1,
+        "{err}"
+    );
+    assert!(!out4.exists());
     // A wheel's channel left out: the analysis runs, the update says why it did not.
     let out2 = d.path().join("report2");
     let mut args: Vec<&str> = vec!["analyze", "-q", "--method", "ssi-cov", "--vehicle", file];
@@ -429,4 +464,10 @@ fn analyze_with_a_vehicle_updates_the_model() {
         "{text}"
     );
     assert!(!out2.join("updated_vehicle.toml").exists());
+    let html = std::fs::read_to_string(out2.join("index.html")).unwrap();
+    assert!(
+        html.contains("<h2>Full-car model not updated</h2>")
+            && html.contains("no unsprung channel at RL"),
+        "report section"
+    );
 }

@@ -89,6 +89,27 @@ fn demo_report_renders_in_headless_chromium() {
         !html.contains("(unit)") && !html.contains(" at none"),
         "placeholders"
     );
+    // The model update is a section of the page, after the modes: the body modes of the file and
+    // of the updated model, then the fitted parameters.
+    let update = html
+        .split("<h2>Full-car model updated from the records</h2>")
+        .nth(1)
+        .expect("model update section");
+    assert!(
+        html.find("<h2>Full-car model updated").unwrap_or(0)
+            > html.find("Invariant modes").unwrap_or(usize::MAX),
+        "the model update comes after the modes"
+    );
+    for row in [
+        "body pitch",
+        "body heave",
+        "body roll",
+        "spring RL",
+        "damper FR",
+        "pitch inertia",
+    ] {
+        assert!(update.contains(&format!("<td>{row}</td>")), "row {row}");
+    }
     let csv = std::fs::read_to_string(out.join("modes.csv")).expect("modes.csv");
     assert!(csv.starts_with("pool,channels,frequency_hz,"), "{csv}");
     assert!(csv.lines().count() > 2, "{csv}");
@@ -153,6 +174,10 @@ fn demo_report_renders_in_headless_chromium() {
     assert!(
         dom.contains("Invariant modes"),
         "mode table missing from the rendered page"
+    );
+    assert!(
+        dom.contains("Full-car model updated from the records") && dom.contains("updated [Hz]"),
+        "model update missing from the rendered page"
     );
 }
 

@@ -195,9 +195,9 @@ fn model_update(
     records: &[RecordInput],
     cfg: &AnalysisConfig,
 ) -> serde_json::Value {
-    use vibmode_vehicle::update::{BodyFit, BodyFitParams};
+    use vibmode_vehicle::update::BodyFit;
     let run = || -> Result<serde_json::Value, String> {
-        let mut fit = BodyFit::new(vehicle, BodyFitParams::default()).map_err(|e| e.to_string())?;
+        let mut fit = BodyFit::new(vehicle, cfg.model_update.clone()).map_err(|e| e.to_string())?;
         for r in records {
             fit.add_record_placed(&r.recording, |c| cfg.placement_of(c))
                 .map_err(|e| format!("{}: {e}", r.name))?;

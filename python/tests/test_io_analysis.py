@@ -168,6 +168,12 @@ def test_analyze_with_vehicle_updates_the_model():
     r = vibmode.analyze(s.records[:1], vehicle="city_bus", order_max=8,
                         channels=["FR_sprung", "RL_sprung", "RR_sprung"], as_frames=False)
     assert "no unsprung channel at FL, FR, RL, RR" in r["model_update"]["not_updated"]
+    # The fit's band is the config's [model_update] section, here as a keyword.
+    r = vibmode.analyze(s.records[:1], vehicle="city_bus", order_max=8,
+                        model_update={"band_hz": [0.5, 2.0]}, as_frames=False)
+    assert r["model_update"]["band_hz"] == [0.5, 2.0]
+    with pytest.raises(ValueError, match=r"band_hz = \[2, 0.5\]"):
+        vibmode.analyze(s.records[:1], vehicle="city_bus", model_update={"band_hz": [2.0, 0.5]})
 
 
 def test_fleet_store(tmp_path):

@@ -5,8 +5,8 @@ use std::path::Path;
 
 use crate::AnalysisError;
 use vibmode_core::{
-    ClusterParams, Corner, IdentMethod, LineParams, PoleFilterParams, PreprocessParams, Role,
-    SpectrumParams, SsiParams, StopParams, SweepParams,
+    BodyFitParams, ClusterParams, Corner, IdentMethod, LineParams, PoleFilterParams,
+    PreprocessParams, Role, SpectrumParams, SsiParams, StopParams, SweepParams,
 };
 
 /// Named sets of defaults.
@@ -110,6 +110,9 @@ pub struct AnalysisConfig {
     pub lines: LineParams,
     /// What the report draws.
     pub report: ReportParams,
+    /// The model update with a vehicle file (`analyze --vehicle`): band and record edges of the
+    /// fit of the suspension to the records.
+    pub model_update: BodyFitParams,
 }
 
 impl Default for AnalysisConfig {
@@ -188,6 +191,7 @@ impl AnalysisConfig {
                 ..SsiParams::default()
             },
             report: ReportParams::default(),
+            model_update: BodyFitParams::default(),
         };
         match p {
             Preset::Vibmode => base,
@@ -285,6 +289,7 @@ impl AnalysisConfig {
         self.cluster.validate()?;
         self.lines.validate()?;
         self.ssi.validate()?;
+        self.model_update.validate()?;
         Ok(())
     }
 

@@ -932,3 +932,52 @@ impl LineParams {
         Ok(())
     }
 }
+
+/// Settings of the model update: the fit of a vehicle file's suspension to the records from the
+/// full-car model's body equations (`vibmode_vehicle::update`, `[model_update]` in the analysis
+/// TOML).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BodyFitParams {
+    /// Band of the fitted equations, Hz. `None` (default): from the vehicle file's body modes,
+    /// `[0.45 f_min, 1.6 f_max]` over heave, pitch and roll (0.46-2.1 Hz on the demo bus). A
+    /// band from 0 Hz lets the manoeuvres' body moments in; one above ~2 Hz lets in the body's
+    /// bending, which three sprung sensors cannot see (docs/model_update.md).
+    pub band_hz: Option<[f64; 2]>,
+    /// Samples dropped at each end of a record, s (default 1.0; the band-pass rings there).
+    pub edge_s: f64,
+}
+
+impl Default for BodyFitParams {
+    fn default() -> Self {
+        BodyFitParams {
+            band_hz: None,
+            edge_s: 1.0,
+        }
+    }
+}
+
+impl BodyFitParams {
+    /// Checks the values (finite, positive, an increasing band).
+    pub fn validate(&self) -> Result<(), ParamError> {
+        if !(self.edge_s.is_finite() && self.edge_s >= 0.0) {
+            return Err(bad(
+                "edge_s",
+                crate::Num(self.edge_s),
+                "must be a duration >= 0 s",
+                1.0,
+            ));
+        }
+        if let Some([lo, hi]) = self.band_hz {
+            if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi > lo) {
+                return Err(bad(
+                    "band_hz",
+                    format!("[{lo}, {hi}]"),
+                    "must be two frequencies 0 < low < high in Hz",
+                    "[0.5, 2.0]",
+                ));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1149,12 +1149,14 @@ fn shape_figures(
 }
 
 /// Writes `DIR/index.html`, `DIR/results.json`, `DIR/modes.csv` and `DIR/figures/*.svg|png` for
-/// the analysis `r` of `records`; `intro` is a first paragraph (e.g. what was simulated).
+/// the analysis `r` of `records`; `intro` is a first paragraph (e.g. what was simulated), `extra`
+/// are sections after the modes' tables (e.g. the model update).
 pub fn write_analysis_report(
     dir: &Path,
     records: &[RecordInput],
     r: &AnalysisResults,
     intro: Option<&str>,
+    extra: &[crate::ReportSection],
 ) -> Result<ReportFiles, ReportError> {
     let figdir = dir.join("figures");
     std::fs::create_dir_all(&figdir).map_err(|e| ReportError::Write {
@@ -1191,6 +1193,9 @@ pub fn write_analysis_report(
     } = w;
     modes_tables(&mut html, r);
     html.paragraph("The same modes, per role and per channel, are in modes.csv beside this page; every number of the analysis is in results.json.");
+    for section in extra {
+        section.render(&mut html);
+    }
     html.heading(2, "Settings");
     html.preformatted(&toml::to_string(&r.config).unwrap_or_default());
     let html_path = dir.join("index.html");

@@ -67,6 +67,7 @@ mod html;
 mod model;
 pub mod panels;
 mod render;
+pub mod sections;
 pub mod shape_figures;
 pub mod signal_figures;
 pub mod spectrum_figures;
@@ -79,6 +80,7 @@ pub use model::{Figure, Marker, Panel, Rgb, Scale, Series, SeriesStyle, PALETTE}
 pub use render::{
     MAX_POINTS_PER_SERIES, MAX_SIDE_PX, MIN_CELL_HEIGHT_PX, MIN_CELL_WIDTH_PX, MIN_SIDE_PX,
 };
+pub use sections::{ReportSection, ReportTable};
 pub use signal_figures::antialias_figure;
 pub use spectrum_figures::{model_spectra_figure, psd_figure, Curve, ModelSpectrumPanel};
 

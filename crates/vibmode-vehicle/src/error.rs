@@ -52,6 +52,9 @@ pub enum VehicleError {
         /// How to fix it.
         fix: &'static str,
     },
+    /// A settings struct from `vibmode-core` holds a value out of range.
+    #[error(transparent)]
+    Param(#[from] vibmode_core::ParamError),
     /// A numerical routine failed (singular matrix, eigenvalue iteration did not converge).
     #[error("numerical failure: {0}; check that masses and stiffnesses are physically plausible")]
     Numerical(String),

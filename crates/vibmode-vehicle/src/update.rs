@@ -24,51 +24,10 @@ use crate::model::{FullCar, ModeInfo, ModeLabel};
 use crate::params::{CornerCondition, VehicleParams};
 use nalgebra::{DMatrix, DVector};
 use realfft::RealFftPlanner;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 use vibmode_core::{Channel, Corner, Direction, Placement, Recording, Role};
 
-/// Settings of the body-equation fit.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct BodyFitParams {
-    /// Band of the fitted equations, Hz. `None` (default): from the vehicle file's body modes,
-    /// `[0.45 f_min, 1.6 f_max]` over heave, pitch and roll (0.46-2.1 Hz on the demo bus).
-    pub band_hz: Option<[f64; 2]>,
-    /// Samples dropped at each end of a record, s (default 1.0; the band-pass rings there).
-    pub edge_s: f64,
-}
-
-impl Default for BodyFitParams {
-    fn default() -> Self {
-        BodyFitParams {
-            band_hz: None,
-            edge_s: 1.0,
-        }
-    }
-}
-
-impl BodyFitParams {
-    /// Checks the values (finite, positive, an increasing band).
-    pub fn validate(&self) -> Result<()> {
-        if !(self.edge_s.is_finite() && self.edge_s >= 0.0) {
-            return Err(crate::error::invalid(
-                "edge_s",
-                self.edge_s,
-                "must be a duration >= 0 s, e.g. 0.5",
-            ));
-        }
-        if let Some([lo, hi]) = self.band_hz {
-            if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi > lo) {
-                return Err(crate::error::invalid(
-                    "band_hz",
-                    format!("[{lo}, {hi}]"),
-                    "must be two frequencies 0 < low < high in Hz, e.g. [0.5, 2.0]",
-                ));
-            }
-        }
-        Ok(())
-    }
-}
+pub use vibmode_core::BodyFitParams;
 
 /// Unknowns (per unit sprung mass): pitch inertia, roll inertia, springs FL..RR, dampers FL..RR,
 /// then the anti-roll bars of the axles that have one.
@@ -118,6 +77,20 @@ pub struct BodyFit {
     records: usize,
 }
 
+/// One fitted parameter beside the vehicle file's value.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct ParameterChange {
+    /// What it is, e.g. "spring RL" or "pitch inertia".
+    pub name: String,
+    /// Unit of both values, e.g. "kN/m".
+    pub unit: &'static str,
+    /// The vehicle file's value.
+    pub file: f64,
+    /// The fitted value.
+    pub fitted: f64,
+}
+
 /// The updated model and how well the equations fitted.
 #[derive(Debug, Clone, Serialize)]
 #[non_exhaustive]
@@ -151,6 +124,75 @@ impl BodyFitResult {
         self.nominal_modes.iter().find(|m| m.label == label)
     }
 
+    /// The body modes (pitch, heave, roll, in that order) of the vehicle file and of the updated
+    /// model, as `(file, updated)` pairs; a mode missing from either model is left out.
+    pub fn body_mode_pairs(&self) -> Vec<(&ModeInfo, &ModeInfo)> {
+        [
+            ModeLabel::BodyPitch,
+            ModeLabel::BodyHeave,
+            ModeLabel::BodyRoll,
+        ]
+        .into_iter()
+        .filter_map(|l| Some((self.nominal_mode(l)?, self.mode(l)?)))
+        .collect()
+    }
+
+    /// Every fitted parameter beside the vehicle file's value: the springs and dampers per
+    /// corner, the pitch and roll inertias and the anti-roll bars.
+    pub fn parameter_changes(&self, file: &VehicleParams) -> Vec<ParameterChange> {
+        let mut out = Vec::new();
+        let mut push = |name: String, unit: &'static str, a: f64, b: f64| {
+            out.push(ParameterChange {
+                name,
+                unit,
+                file: a,
+                fitted: b,
+            })
+        };
+        for c in Corner::ALL {
+            push(
+                format!("spring {c}"),
+                "kN/m",
+                file.axle(c).spring_stiffness_n_per_m / 1e3,
+                self.vehicle.axle(c).spring_stiffness_n_per_m / 1e3,
+            );
+        }
+        for c in Corner::ALL {
+            push(
+                format!("damper {c}"),
+                "kN s/m",
+                file.axle(c).damper_n_s_per_m / 1e3,
+                self.vehicle.axle(c).damper_n_s_per_m / 1e3,
+            );
+        }
+        push(
+            "pitch inertia".into(),
+            "kg m^2",
+            file.body.pitch_inertia_kgm2,
+            self.vehicle.body.pitch_inertia_kgm2,
+        );
+        push(
+            "roll inertia".into(),
+            "kg m^2",
+            file.body.roll_inertia_kgm2,
+            self.vehicle.body.roll_inertia_kgm2,
+        );
+        for (name, a, b) in [
+            ("anti-roll bar front", &file.front, &self.vehicle.front),
+            ("anti-roll bar rear", &file.rear, &self.vehicle.rear),
+        ] {
+            if a.anti_roll_stiffness_nm_per_rad > 0.0 {
+                push(
+                    name.into(),
+                    "kN m/rad",
+                    a.anti_roll_stiffness_nm_per_rad / 1e3,
+                    b.anti_roll_stiffness_nm_per_rad / 1e3,
+                );
+            }
+        }
+        out
+    }
+
     /// A plain-text summary: the body modes of the file and of the updated model, then the
     /// fitted parameters beside the file's.
     pub fn summary_text(&self, file: &VehicleParams) -> String {
@@ -166,22 +208,16 @@ impl BodyFitResult {
             "  {:<12} {:>9} {:>11} {:>8} {:>13} {:>16}\n",
             "mode", "file Hz", "updated Hz", "change", "file damping", "updated damping"
         ));
-        for label in [
-            ModeLabel::BodyPitch,
-            ModeLabel::BodyHeave,
-            ModeLabel::BodyRoll,
-        ] {
-            if let (Some(n), Some(u)) = (self.nominal_mode(label), self.mode(label)) {
-                s.push_str(&format!(
-                    "  {:<12} {:>9.3} {:>11.3} {:>7.1}% {:>13.3} {:>16.3}\n",
-                    label.to_string(),
-                    n.frequency_hz,
-                    u.frequency_hz,
-                    100.0 * (u.frequency_hz / n.frequency_hz - 1.0),
-                    n.damping_ratio,
-                    u.damping_ratio
-                ));
-            }
+        for (n, u) in self.body_mode_pairs() {
+            s.push_str(&format!(
+                "  {:<12} {:>9.3} {:>11.3} {:>7.1}% {:>13.3} {:>16.3}\n",
+                n.label.to_string(),
+                n.frequency_hz,
+                u.frequency_hz,
+                100.0 * (u.frequency_hz / n.frequency_hz - 1.0),
+                n.damping_ratio,
+                u.damping_ratio
+            ));
         }
         let per = |v: &VehicleParams, f: fn(&crate::params::Axle) -> f64, scale: f64| {
             Corner::ALL
@@ -226,7 +262,7 @@ fn fit_error(problem: String, fix: &'static str) -> VehicleError {
 impl BodyFit {
     /// A fit of `vehicle`'s suspension (validated) with `params` (validated).
     pub fn new(vehicle: &VehicleParams, params: BodyFitParams) -> Result<Self> {
-        params.validate()?;
+        params.validate().map_err(VehicleError::Param)?;
         let nominal_modes = FullCar::new(vehicle)?.modes()?;
         let band_hz = match params.band_hz {
             Some(b) => b,
