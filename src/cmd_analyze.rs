@@ -263,7 +263,9 @@ impl ModelUpdate {
     pub fn add(&mut self, r: &RecordInput) {
         if let UpdateState::Fitting(b) = &mut self.state {
             let cfg = &self.cfg;
-            if let Err(e) = b.1.add_record_placed(&r.recording, |c| cfg.placement_of(c)) {
+            if let Err(e) =
+                b.1.add_record_placed(&r.recording, |c| cfg.placement_for_update(c))
+            {
                 self.state = UpdateState::Skipped(format!("{}: {e}", r.name));
             }
         }

@@ -470,4 +470,13 @@ fn analyze_with_a_vehicle_updates_the_model() {
             && html.contains("no unsprung channel at RL"),
         "report section"
     );
+    // A channel given the role other on the command line is left out of the fit too.
+    let out5 = d.path().join("report5");
+    let mut args: Vec<&str> = vec!["analyze", "-q", "--method", "ssi-cov", "--vehicle", file];
+    args.extend(wavs.iter().map(String::as_str));
+    args.extend(["--role", "RL_unsprung=other", "-o", out5.to_str().unwrap()]);
+    let o = vibmode(&args);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(text.contains("no unsprung channel at RL"), "{text}");
 }

@@ -199,7 +199,7 @@ fn model_update(
     let run = || -> Result<serde_json::Value, String> {
         let mut fit = BodyFit::new(vehicle, cfg.model_update.clone()).map_err(|e| e.to_string())?;
         for r in records {
-            fit.add_record_placed(&r.recording, |c| cfg.placement_of(c))
+            fit.add_record_placed(&r.recording, |c| cfg.placement_for_update(c))
                 .map_err(|e| format!("{}: {e}", r.name))?;
         }
         let res = fit.solve().map_err(|e| e.to_string())?;

@@ -309,6 +309,19 @@ impl AnalysisConfig {
         vibmode_core::Placement::guess_from_name(&channel.name)
     }
 
+    /// Placement of a channel for the model update (`vibmode_vehicle::update`): `None` when the
+    /// `channels` table (or `--role`) marks it `other`, which leaves it out even where the
+    /// vehicle file names a sensor like it; else [`AnalysisConfig::placement_of`].
+    pub fn placement_for_update(
+        &self,
+        channel: &vibmode_core::Channel,
+    ) -> Option<vibmode_core::Placement> {
+        match self.channels.iter().find(|c| c.name == channel.name) {
+            Some(c) if c.role == Role::Other => None,
+            _ => Some(self.placement_of(channel)),
+        }
+    }
+
     /// Role of a channel by name: from `channels`, else guessed from its name.
     pub fn role_of(&self, name: &str) -> Role {
         self.channels

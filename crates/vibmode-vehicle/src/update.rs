@@ -320,13 +320,19 @@ impl BodyFit {
     /// Which channel measures what: four unsprung sensors (one per corner) and three or more
     /// sprung sensors at known body positions. Channels are placed by their placement (role and
     /// corner) or, failing that, by the vehicle file's sensor of the same name; horizontal
-    /// channels are left out.
-    fn layout(&self, rec: &Recording, placement: &dyn Fn(&Channel) -> Placement) -> Result<Layout> {
+    /// channels, and those whose placement is `None`, are left out.
+    fn layout(
+        &self,
+        rec: &Recording,
+        placement: &dyn Fn(&Channel) -> Option<Placement>,
+    ) -> Result<Layout> {
         let spec = self.vehicle.effective_sensors();
         let mut wheels: [Option<usize>; 4] = [None; 4];
         let mut sprung: Vec<(usize, f64, f64)> = Vec::new();
         for (i, ch) in rec.channels.iter().enumerate() {
-            let pl = placement(ch);
+            let Some(pl) = placement(ch) else {
+                continue;
+            };
             if matches!(pl.direction, Some(Direction::X | Direction::Y)) {
                 continue;
             }
@@ -424,15 +430,16 @@ impl BodyFit {
     /// Adds one record's equations. The channels need placements (or the vehicle file's sensor
     /// names): four unsprung at FL, FR, RL, RR and three or more sprung at known positions.
     pub fn add_record(&mut self, rec: &Recording) -> Result<()> {
-        self.add_record_placed(rec, |c| c.placement)
+        self.add_record_placed(rec, |c| Some(c.placement))
     }
 
     /// As [`BodyFit::add_record`], with each channel's placement given by `placement` instead
-    /// of its own (e.g. an analysis config's roles and corners).
+    /// of its own (e.g. an analysis config's roles and corners); a channel placed `None` is left
+    /// out, even when the vehicle file names a sensor like it.
     pub fn add_record_placed(
         &mut self,
         rec: &Recording,
-        placement: impl Fn(&Channel) -> Placement,
+        placement: impl Fn(&Channel) -> Option<Placement>,
     ) -> Result<()> {
         let fs = rec.fs_hz;
         if !(fs.is_finite() && fs > 0.0) {
