@@ -405,6 +405,10 @@ fn analyze_with_a_vehicle_updates_the_model() {
         serde_json::from_str(&std::fs::read_to_string(out.join("model_update.json")).unwrap())
             .unwrap();
     assert_eq!(j["records"], 4);
+    // results.json holds it too, as Python's analyze returns it.
+    let rj: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    assert_eq!(rj["model_update"], j);
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
     assert!(
         html.contains("<h2>Full-car model updated from the records</h2>"),
@@ -464,6 +468,10 @@ fn analyze_with_a_vehicle_updates_the_model() {
         "{text}"
     );
     assert!(!out2.join("updated_vehicle.toml").exists());
+    let rj: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out2.join("results.json")).unwrap()).unwrap();
+    let why = rj["model_update"]["not_updated"].as_str().unwrap_or("");
+    assert!(why.contains("no unsprung channel at RL"), "{rj}");
     let html = std::fs::read_to_string(out2.join("index.html")).unwrap();
     assert!(
         html.contains("<h2>Full-car model not updated</h2>")

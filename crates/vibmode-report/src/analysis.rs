@@ -1164,10 +1164,17 @@ pub fn write_analysis_report(
         message: e.to_string(),
     })?;
     let results_json = dir.join("results.json");
-    let json = serde_json::to_string_pretty(r).map_err(|e| ReportError::Write {
+    let json_err = |e: serde_json::Error| ReportError::Write {
         path: results_json.clone(),
         message: e.to_string(),
-    })?;
+    };
+    let mut value = serde_json::to_value(r).map_err(json_err)?;
+    if let serde_json::Value::Object(map) = &mut value {
+        for (key, v) in extra.iter().filter_map(|s| s.json.as_ref()) {
+            map.insert(key.clone(), v.clone());
+        }
+    }
+    let json = serde_json::to_string_pretty(&value).map_err(json_err)?;
     write_text(&results_json, &(json + "\n"))?;
     let modes_csv_path = dir.join("modes.csv");
     write_text(&modes_csv_path, &modes_csv(r))?;

@@ -30,11 +30,14 @@ pub struct ReportSection {
     pub paragraphs: Vec<String>,
     /// Tables after the paragraphs.
     pub tables: Vec<ReportTable>,
+    /// The section's numbers, added to `results.json` under this key (e.g. `model_update`).
+    pub json: Option<(String, serde_json::Value)>,
 }
 
 impl ReportSection {
     /// The model update: the body modes of the vehicle file and of the updated model, then the
-    /// fitted parameters beside the file's.
+    /// fitted parameters beside the file's; `results.json` gets the whole result as
+    /// `model_update` (as Python's `analyze` returns it).
     pub fn model_update(file: &VehicleParams, r: &BodyFitResult) -> ReportSection {
         let intro = format!(
             "The vehicle file's suspension and body inertias were fitted to the records from the full-car model's three body equations, which carry no road input: {} records, {} equations in {:.2}-{:.2} Hz, {:.1} % of their variance explained. The sprung mass, unsprung masses, tyres and bending are the file's. These body modes do not depend on the road's wheelbase delay, which biases output-only heave and pitch (docs/model_update.md); the updated vehicle file is updated_vehicle.toml beside this page, every number is in model_update.json.",
@@ -97,10 +100,14 @@ impl ReportSection {
             title: "Full-car model updated from the records".into(),
             paragraphs: vec![intro],
             tables: vec![modes, params],
+            json: serde_json::to_value(r)
+                .ok()
+                .map(|v| ("model_update".to_string(), v)),
         }
     }
 
-    /// The model update could not be made: the reason, so that its absence is not silent.
+    /// The model update could not be made: the reason, so that its absence is not silent
+    /// (`results.json`: `model_update: {"not_updated": reason}`).
     pub fn model_update_skipped(why: &str) -> ReportSection {
         ReportSection {
             title: "Full-car model not updated".into(),
@@ -108,6 +115,10 @@ impl ReportSection {
                 "The vehicle file's suspension was not fitted to the records: {why}. The modes above are matched to the vehicle file's model as it is."
             )],
             tables: Vec::new(),
+            json: Some((
+                "model_update".into(),
+                serde_json::json!({ "not_updated": why }),
+            )),
         }
     }
 
