@@ -189,7 +189,7 @@ pub fn run(a: &AnalyzeArgs) -> Result<()> {
         std::slice::from_ref(&first),
         &results,
         None,
-        &update.sections(),
+        &update.sections(&results),
     )?;
     if let Some(plans) = &plans {
         let path = out.path().join("segments.json");
@@ -315,13 +315,18 @@ pub enum UpdateOutcome {
 }
 
 impl UpdateOutcome {
-    /// The report's section on the model update (none without a vehicle file).
-    pub fn sections(&self) -> Vec<vibmode_report::ReportSection> {
+    /// The report's section on the model update (none without a vehicle file), with the
+    /// analysis' SSI-cov modes in its figure.
+    pub fn sections(&self, results: &AnalysisResults) -> Vec<vibmode_report::ReportSection> {
         use vibmode_report::ReportSection;
+        let identified = results
+            .ssi
+            .as_ref()
+            .map_or(&[][..], |s| &s.invariant_modes[..]);
         match self {
             UpdateOutcome::Off => Vec::new(),
             UpdateOutcome::Skipped(why) => vec![ReportSection::model_update_skipped(why)],
-            UpdateOutcome::Done(b) => vec![ReportSection::model_update(&b.0, &b.1)],
+            UpdateOutcome::Done(b) => vec![ReportSection::model_update(&b.0, &b.1, identified)],
         }
     }
 
@@ -584,7 +589,7 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
         &records,
         &results,
         Some(&intro),
-        &update.sections(),
+        &update.sections(&results),
     )?;
     out.commit()?;
     let mut truth: Vec<TruthRow> = sim

@@ -44,6 +44,7 @@ fn demo_report_renders_in_headless_chromium() {
         "fig06_frequency_damping",
         "fig07_mode_shapes",
         "fig08_mac_matrix",
+        "fig09_body_modes",
     ];
     for name in expected {
         for ext in ["svg", "png"] {

@@ -1195,14 +1195,24 @@ pub fn write_analysis_report(
         files: Vec::new(),
     };
     add_figures(&mut w, first, r, &spectra)?;
+    modes_tables(&mut w.html, r);
+    w.html.paragraph("The same modes, per role and per channel, are in modes.csv beside this page; every number of the analysis is in results.json.");
+    for section in extra {
+        w.html.heading(2, &section.title);
+        for p in &section.paragraphs {
+            w.html.paragraph(p);
+        }
+        for t in &section.tables {
+            let headers: Vec<&str> = t.headers.iter().map(String::as_str).collect();
+            w.html.table(&headers, &t.rows);
+        }
+        for f in &section.figures {
+            w.add(&f.file, &f.title, &f.figure, &f.caption)?;
+        }
+    }
     let FigureWriter {
         mut html, files, ..
     } = w;
-    modes_tables(&mut html, r);
-    html.paragraph("The same modes, per role and per channel, are in modes.csv beside this page; every number of the analysis is in results.json.");
-    for section in extra {
-        section.render(&mut html);
-    }
     html.heading(2, "Settings");
     html.preformatted(&toml::to_string(&r.config).unwrap_or_default());
     let html_path = dir.join("index.html");

@@ -1,6 +1,8 @@
 //! Sections of the analysis report beyond the analysis itself, as plain data: a title, paragraphs
 //! and tables. The model update (`analyze --vehicle`) is one.
 
+use crate::{Figure, Marker, Panel, Rgb, Scale, Series, SeriesStyle};
+use vibmode_core::{InvariantMode, ModeClass};
 use vibmode_vehicle::{update::BodyFitResult, VehicleParams};
 
 /// A parameter's value: whole numbers from 1000 on, else one decimal.
@@ -21,7 +23,20 @@ pub struct ReportTable {
     pub rows: Vec<Vec<String>>,
 }
 
-/// A section of the report: a heading, paragraphs, then tables.
+/// A figure of a [`ReportSection`], numbered with the report's others.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SectionFigure {
+    /// File name stem (`figNN_<file>.svg|png`).
+    pub file: String,
+    /// Heading, after "Figure n: ".
+    pub title: String,
+    /// The figure.
+    pub figure: Figure,
+    /// Caption.
+    pub caption: String,
+}
+
+/// A section of the report: a heading, paragraphs, tables, then figures.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ReportSection {
     /// The heading.
@@ -30,15 +45,22 @@ pub struct ReportSection {
     pub paragraphs: Vec<String>,
     /// Tables after the paragraphs.
     pub tables: Vec<ReportTable>,
+    /// Figures after the tables.
+    pub figures: Vec<SectionFigure>,
     /// The section's numbers, added to `results.json` under this key (e.g. `model_update`).
     pub json: Option<(String, serde_json::Value)>,
 }
 
 impl ReportSection {
     /// The model update: the body modes of the vehicle file and of the updated model, then the
-    /// fitted parameters beside the file's; `results.json` gets the whole result as
-    /// `model_update` (as Python's `analyze` returns it).
-    pub fn model_update(file: &VehicleParams, r: &BodyFitResult) -> ReportSection {
+    /// fitted parameters beside the file's, and a figure of the body modes with the
+    /// `identified` structural modes (e.g. the SSI-cov clusters) in the same band; `results.json`
+    /// gets the whole result as `model_update` (as Python's `analyze` returns it).
+    pub fn model_update(
+        file: &VehicleParams,
+        r: &BodyFitResult,
+        identified: &[InvariantMode],
+    ) -> ReportSection {
         let intro = format!(
             "The vehicle file's suspension and body inertias were fitted to the records from the full-car model's three body equations, which carry no road input: {} records, {} equations in {:.2}-{:.2} Hz, {:.1} % of their variance explained. The sprung mass, unsprung masses, tyres and bending are the file's. These body modes do not depend on the road's wheelbase delay, which biases output-only heave and pitch (docs/model_update.md); the updated vehicle file is updated_vehicle.toml beside this page, every number is in model_update.json.",
             r.records,
@@ -100,6 +122,7 @@ impl ReportSection {
             title: "Full-car model updated from the records".into(),
             paragraphs: vec![intro],
             tables: vec![modes, params],
+            figures: vec![body_modes_figure(r, identified)],
             json: serde_json::to_value(r)
                 .ok()
                 .map(|v| ("model_update".to_string(), v)),
@@ -115,22 +138,84 @@ impl ReportSection {
                 "The vehicle file's suspension was not fitted to the records: {why}. The modes above are matched to the vehicle file's model as it is."
             )],
             tables: Vec::new(),
+            figures: Vec::new(),
             json: Some((
                 "model_update".into(),
                 serde_json::json!({ "not_updated": why }),
             )),
         }
     }
+}
 
-    /// Adds the section to `html`.
-    pub(crate) fn render(&self, html: &mut crate::HtmlReport) {
-        html.heading(2, &self.title);
-        for p in &self.paragraphs {
-            html.paragraph(p);
-        }
-        for t in &self.tables {
-            let headers: Vec<&str> = t.headers.iter().map(String::as_str).collect();
-            html.table(&headers, &t.rows);
-        }
+/// Frequency against damping ratio around the body modes: the vehicle file's model (red
+/// diamonds), the updated model (green squares) and the identified structural modes (blue
+/// circles) in the same band.
+fn body_modes_figure(r: &BodyFitResult, identified: &[InvariantMode]) -> SectionFigure {
+    let pairs = r.body_mode_pairs();
+    let (lo, hi) = pairs
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), (n, u)| {
+            (
+                lo.min(n.frequency_hz).min(u.frequency_hz),
+                hi.max(n.frequency_hz).max(u.frequency_hz),
+            )
+        });
+    let (x0, x1) = if lo.is_finite() && hi > 0.0 {
+        (0.7 * lo, 1.3 * hi)
+    } else {
+        (r.band_hz[0], r.band_hz[1])
+    };
+    let points = |f: Vec<(f64, f64)>, label: &str, marker: Marker, color: Rgb, size: u32| {
+        let (x, y): (Vec<f64>, Vec<f64>) = f.into_iter().unzip();
+        Series::points(x, y, marker)
+            .with_label(label)
+            .with_color(color)
+            .with_style(SeriesStyle::Points { size, marker })
+    };
+    let ident: Vec<(f64, f64)> = identified
+        .iter()
+        .filter(|m| m.class == ModeClass::Structural)
+        .filter(|m| (x0..=x1).contains(&m.frequency_hz) && m.damping_ratio > 0.0)
+        .map(|m| (m.frequency_hz, m.damping_ratio))
+        .collect();
+    let n_ident = ident.len();
+    let mut panel = Panel::new("Body modes", "Frequency [Hz]", "Damping ratio [-]")
+        .with_scales(Scale::Linear, Scale::Log)
+        .with_series(points(
+            pairs
+                .iter()
+                .map(|(n, _)| (n.frequency_hz, n.damping_ratio))
+                .collect(),
+            "vehicle file's model",
+            Marker::Diamond,
+            Rgb::RED,
+            7,
+        ))
+        .with_series(points(
+            pairs
+                .iter()
+                .map(|(_, u)| (u.frequency_hz, u.damping_ratio))
+                .collect(),
+            "updated model",
+            Marker::Square,
+            Rgb::GREEN,
+            6,
+        ))
+        .with_series(points(
+            ident,
+            "identified structural modes",
+            Marker::Circle,
+            Rgb::BLUE,
+            5,
+        ));
+    panel.x_range = Some((x0, x1));
+    panel.y_range = Some((0.01, 3.0));
+    SectionFigure {
+        file: "body_modes".into(),
+        title: "body modes of the file, the updated model and the records".into(),
+        figure: Figure::single(panel),
+        caption: format!(
+            "Body pitch, heave and roll of the vehicle file's model (red diamonds) and of the model updated from the records (green squares), with the {n_ident} identified structural mode(s) between {x0:.2} and {x1:.2} Hz (blue circles). Output-only heave and pitch carry the road's wheelbase delay (docs/ssi.md); the updated model's do not."
+        ),
     }
 }
