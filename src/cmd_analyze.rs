@@ -24,7 +24,9 @@ pub struct AnalyzeArgs {
     /// Preset for the defaults: vibmode (50 Hz analysis rate, p = 2..30) or paper (200 Hz, p = 2..60).
     #[arg(long)]
     pub preset: Option<String>,
-    /// Full-car parameter file: its modes are drawn and matched to the invariant modes.
+    /// Full-car parameter file: its modes are drawn and matched to the invariant modes, and its
+    /// suspension is fitted to the records (the model update: the measured bus's body modes,
+    /// model_update.json, updated_vehicle.toml; settings in the config's `[model_update]`).
     #[arg(long)]
     pub vehicle: Option<PathBuf>,
     /// Channels to analyse, by name or 0-based index (default: all).
