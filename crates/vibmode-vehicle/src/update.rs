@@ -149,21 +149,19 @@ impl BodyFitResult {
                 fitted: b,
             })
         };
-        for c in Corner::ALL {
-            push(
-                format!("spring {c}"),
-                "kN/m",
-                file.axle(c).spring_stiffness_n_per_m / 1e3,
-                self.vehicle.axle(c).spring_stiffness_n_per_m / 1e3,
-            );
-        }
-        for c in Corner::ALL {
-            push(
-                format!("damper {c}"),
-                "kN s/m",
-                file.axle(c).damper_n_s_per_m / 1e3,
-                self.vehicle.axle(c).damper_n_s_per_m / 1e3,
-            );
+        let per_corner: [(&str, &'static str, fn(&crate::params::Axle) -> f64); 2] = [
+            ("spring", "kN/m", |a| a.spring_stiffness_n_per_m),
+            ("damper", "kN s/m", |a| a.damper_n_s_per_m),
+        ];
+        for (what, unit, get) in per_corner {
+            for c in Corner::ALL {
+                push(
+                    format!("{what} {c}"),
+                    unit,
+                    get(&file.axle(c)) / 1e3,
+                    get(&self.vehicle.axle(c)) / 1e3,
+                );
+            }
         }
         push(
             "pitch inertia".into(),
