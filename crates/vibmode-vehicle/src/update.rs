@@ -149,7 +149,8 @@ impl BodyFitResult {
                 fitted: b,
             })
         };
-        let per_corner: [(&str, &'static str, fn(&crate::params::Axle) -> f64); 2] = [
+        type Get = fn(&crate::params::Axle) -> f64;
+        let per_corner: [(&str, &'static str, Get); 2] = [
             ("spring", "kN/m", |a| a.spring_stiffness_n_per_m),
             ("damper", "kN s/m", |a| a.damper_n_s_per_m),
         ];
