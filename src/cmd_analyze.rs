@@ -76,8 +76,8 @@ fn apply_placements(cfg: &mut AnalysisConfig, roles: &[String], corners: &[Strin
             None => {
                 cfg.channels.push(ChannelRole {
                     name: name.to_string(),
-                    role: Role::guess_from_name(name),
-                    corner: Corner::guess_from_name(name),
+                    role: None,
+                    corner: None,
                 });
                 cfg.channels.len() - 1
             }
@@ -86,7 +86,7 @@ fn apply_placements(cfg: &mut AnalysisConfig, roles: &[String], corners: &[Strin
     }
     for r in roles {
         let (name, value) = split_assignment("--role", r)?;
-        entry(cfg, name).role = value.parse::<Role>()?;
+        entry(cfg, name).role = Some(value.parse::<Role>()?);
     }
     for c in corners {
         let (name, value) = split_assignment("--corner", c)?;

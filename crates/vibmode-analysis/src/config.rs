@@ -47,8 +47,11 @@ impl std::str::FromStr for Preset {
 pub struct ChannelRole {
     /// Channel name as in the input files.
     pub name: String,
-    /// sprung, unsprung or other.
-    pub role: Role,
+    /// sprung, unsprung or other; `None` (key left out, or `--corner` alone): the role the
+    /// record source gave, else one guessed from the name. An explicit `other` also keeps the
+    /// channel out of the model update.
+    #[serde(default)]
+    pub role: Option<Role>,
     /// Corner (FL, FR, RL, RR) if any.
     #[serde(default)]
     pub corner: Option<Corner>,
@@ -296,17 +299,19 @@ impl AnalysisConfig {
     /// Placement of a channel: the `channels` table first, else the placement the record source
     /// gave it, else one guessed from its name.
     pub fn placement_of(&self, channel: &vibmode_core::Channel) -> vibmode_core::Placement {
-        if let Some(c) = self.channels.iter().find(|c| c.name == channel.name) {
-            return vibmode_core::Placement {
-                role: c.role,
-                corner: c.corner.or(channel.placement.corner),
+        let own = if channel.placement != vibmode_core::Placement::default() {
+            channel.placement
+        } else {
+            vibmode_core::Placement::guess_from_name(&channel.name)
+        };
+        match self.channels.iter().find(|c| c.name == channel.name) {
+            Some(c) => vibmode_core::Placement {
+                role: c.role.unwrap_or(own.role),
+                corner: c.corner.or(own.corner),
                 direction: channel.placement.direction,
-            };
+            },
+            None => own,
         }
-        if channel.placement != vibmode_core::Placement::default() {
-            return channel.placement;
-        }
-        vibmode_core::Placement::guess_from_name(&channel.name)
     }
 
     /// Placement of a channel for the model update (`vibmode_vehicle::update`): `None` when the
@@ -317,17 +322,9 @@ impl AnalysisConfig {
         channel: &vibmode_core::Channel,
     ) -> Option<vibmode_core::Placement> {
         match self.channels.iter().find(|c| c.name == channel.name) {
-            Some(c) if c.role == Role::Other => None,
+            Some(c) if c.role == Some(Role::Other) => None,
             _ => Some(self.placement_of(channel)),
         }
-    }
-
-    /// Role of a channel by name: from `channels`, else guessed from its name.
-    pub fn role_of(&self, name: &str) -> Role {
-        self.channels
-            .iter()
-            .find(|c| c.name == name)
-            .map_or_else(|| Role::guess_from_name(name), |c| c.role)
     }
 }
 
@@ -383,5 +380,38 @@ mod tests {
         // `vibmode sweep` and `analyze` read the same struct: one definition.
         assert_eq!(AnalysisConfig::default().sweep, SweepParams::default());
         assert_eq!(AnalysisConfig::default().cluster, ClusterParams::default());
+    }
+
+    /// The `[[channels]]` table over the record's own placements: a corner alone keeps the
+    /// source's role (or the name's guess); an explicit role wins; an explicit `other` keeps
+    /// the channel out of the model update, a guessed one does not.
+    #[test]
+    fn channel_table_roles_and_corners() {
+        use vibmode_core::{Channel, Placement};
+        let c = AnalysisConfig::from_toml_str(
+            "[[channels]]\nname = \"acc3\"\ncorner = \"RL\"\n\n[[channels]]\nname = \"acc4\"\nrole = \"other\"\n\n[[channels]]\nname = \"FR_sprung\"\nrole = \"unsprung\"\n",
+        )
+        .unwrap();
+        let wheel = Placement {
+            role: Role::Unsprung,
+            corner: Some(Corner::FL),
+            direction: None,
+        };
+        let acc3 = Channel::new("acc3", "m/s^2", vec![0.0]).with_placement(wheel);
+        let p = c.placement_of(&acc3);
+        assert_eq!((p.role, p.corner), (Role::Unsprung, Some(Corner::RL)));
+        assert_eq!(c.placement_for_update(&acc3), Some(p));
+        // No placement from the source and no hint in the name: other, but only guessed.
+        let bare = Channel::new("acc3", "m/s^2", vec![0.0]);
+        let p = c.placement_of(&bare);
+        assert_eq!((p.role, p.corner), (Role::Other, Some(Corner::RL)));
+        assert!(c.placement_for_update(&bare).is_some());
+        let acc4 = Channel::new("acc4", "m/s^2", vec![0.0]).with_placement(wheel);
+        assert_eq!(c.placement_of(&acc4).role, Role::Other);
+        assert_eq!(c.placement_for_update(&acc4), None);
+        // The name's corner stays when the table gives only the role.
+        let fr = Channel::new("FR_sprung", "m/s^2", vec![0.0]);
+        let p = c.placement_of(&fr);
+        assert_eq!((p.role, p.corner), (Role::Unsprung, Some(Corner::FR)));
     }
 }
