@@ -251,8 +251,19 @@ impl UpdateState {
 impl ModelUpdate {
     /// With a vehicle file, a fit of its suspension; without, nothing.
     pub fn new(vehicle: Option<&Path>, cfg: &AnalysisConfig) -> Result<Self> {
+        let v = vehicle
+            .map(vibmode_vehicle::VehicleParams::from_path)
+            .transpose()?;
+        Self::for_vehicle(v, cfg)
+    }
+
+    /// As [`ModelUpdate::new`], with the vehicle's parameters already read.
+    pub fn for_vehicle(
+        vehicle: Option<vibmode_vehicle::VehicleParams>,
+        cfg: &AnalysisConfig,
+    ) -> Result<Self> {
         let state = match vehicle {
-            Some(p) => UpdateState::start(vibmode_vehicle::VehicleParams::from_path(p)?, cfg)?,
+            Some(v) => UpdateState::start(v, cfg)?,
             None => UpdateState::Off,
         };
         Ok(ModelUpdate {
@@ -558,10 +569,7 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
         .collect();
     let reference = reference_modes(&sim.truth.modes);
     let results = run_analysis(&records, &cfg, &reference, a.quiet)?;
-    let mut update = ModelUpdate {
-        cfg: cfg.clone(),
-        state: UpdateState::start(vehicle.clone(), &cfg)?,
-    };
+    let mut update = ModelUpdate::for_vehicle(Some(vehicle.clone()), &cfg)?;
     records.iter().for_each(|r| update.add(r));
     let update = update.finish();
     let update_text = update.write(out.path(), &a.output)?;

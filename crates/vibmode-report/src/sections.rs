@@ -62,7 +62,7 @@ impl ReportSection {
         identified: &[InvariantMode],
     ) -> ReportSection {
         let intro = format!(
-            "The vehicle file's suspension and body inertias were fitted to the records from the full-car model's three body equations, which carry no road input: {} records, {} equations in {:.2}-{:.2} Hz, {:.1} % of their variance explained. The sprung mass, unsprung masses, tyres and bending are the file's. These body modes do not depend on the road's wheelbase delay, which biases output-only heave and pitch (docs/model_update.md); the updated vehicle file is updated_vehicle.toml beside this page, every number is in model_update.json.",
+            "The vehicle file's suspension and body inertias were fitted to the records from the full-car model's three body equations, which carry no road input: {} records, {} equations in {:.2}-{:.2} Hz, {:.1} % of their variance explained. The sprung mass, unsprung masses, tyres and bending are the file's. These body modes do not depend on the road's wheelbase delay, which biases output-only heave and pitch (docs/model_update.md); the updated vehicle file is updated_vehicle.toml beside this page, every number is in model_update.json and, under model_update, in results.json.",
             r.records,
             r.equations,
             r.band_hz[0],
