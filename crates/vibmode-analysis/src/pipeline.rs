@@ -491,7 +491,15 @@ fn role_modes(
         let matches = if reference.is_empty() {
             Vec::new()
         } else {
-            vibmode_modal::match_reference(&invariant, reference, MATCH_MAX_FREQ_DIFF_REL)
+            // One to one, the closest frequencies first: a single-channel pool cannot tell
+            // heave from pitch, so one body cluster must not be reported as both.
+            vibmode_modal::match_reference_shapes(
+                &invariant,
+                reference,
+                &names,
+                MATCH_MAX_FREQ_DIFF_REL,
+                crate::multichannel::MATCH_MAC_MIN,
+            )
         };
         roles.push(RoleAnalysis {
             role,
@@ -504,6 +512,6 @@ fn role_modes(
     Ok(roles)
 }
 
-/// A physical-model mode is matched to the nearest structural mode within this relative
+/// A physical-model mode is matched to a structural mode within this relative
 /// frequency difference (25 %: body modes of a bus sit 15-25 % apart, wheel hop near 10 Hz).
 pub const MATCH_MAX_FREQ_DIFF_REL: f64 = 0.25;

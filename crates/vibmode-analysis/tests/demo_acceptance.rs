@@ -1,6 +1,7 @@
 //! Acceptance on the project's own simulator, with the default settings (the demo's data):
 //! the periodic lines are found within 0.05 Hz and classed as disturbances, the wheel-hop modes
-//! within 5 %, the body modes within 10 %, and no structural mode is classed as a disturbance.
+//! within 5 %, the body modes within 10 %, no structural mode is classed as a disturbance, and
+//! the model's modes are matched one to one.
 
 mod common;
 
@@ -101,6 +102,23 @@ fn demo_data_gives_the_true_modes_and_lines() {
             "wheel-hop mode {f} Hz not within 5 % of {hop:?}"
         );
     }
+    // The model's modes are matched one to one, each to its nearest free structural mode: the
+    // sprung pool's body cluster is one body mode, not heave, pitch and roll at once.
+    for r in &res.roles {
+        let mut used = std::collections::HashSet::new();
+        for m in &r.matches {
+            let Some(k) = m.invariant else { continue };
+            assert!(used.insert(k), "{}: mode {k} matched twice", r.role);
+            assert_eq!(r.invariant_modes[k].class, ModeClass::Structural);
+            assert!(m.freq_diff_rel.abs() <= 0.25, "{m:?}");
+        }
+        assert_eq!(r.matches.len(), reference.len());
+    }
+    let sprung_matched = sprung.matches.iter().filter(|m| m.invariant.is_some());
+    assert!(
+        sprung_matched.count() >= 1,
+        "no model mode matched on the sprung channels"
+    );
     // Every structural mode on either role is near a true mode (no spurious structural modes).
     let all_true: Vec<f64> = sim.truth.modes.iter().map(|m| m.frequency_hz).collect();
     for r in &res.roles {

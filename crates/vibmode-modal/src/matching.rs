@@ -58,7 +58,8 @@ pub fn match_reference(
 /// channels of the identified shapes, by name); candidates are accepted by decreasing MAC (then
 /// increasing frequency difference), each reference and each identified mode at most once.
 /// References or modes without a shape fall back to frequency only, after the shape matches,
-/// and only onto modes still free. The output has one entry per reference mode, in input order,
+/// and only onto modes still free, the pairs closest in relative frequency first (so with no
+/// shapes at all, e.g. single-channel ARMA modes, this is a one-to-one nearest-frequency match). The output has one entry per reference mode, in input order,
 /// with the MAC of the match. Never panics.
 pub fn match_reference_shapes(
     modes: &[InvariantMode],
@@ -100,23 +101,23 @@ pub fn match_reference_shapes(
             taken[k] = true;
         }
     }
-    // Frequency only, for what has no shape.
+    // Frequency only, for what has no shape: the closest free pairs first (relative difference),
+    // so a reference earlier in the list cannot take a mode that is nearer to a later one.
+    let mut by_freq: Vec<(usize, usize, f64)> = Vec::new();
     for (i, r) in reference.iter().enumerate() {
         if of_ref[i].is_some() {
             continue;
         }
-        let free_nearest = modes
-            .iter()
-            .enumerate()
-            .filter(|(k, m)| {
-                !taken[*k] && ok(r, m) && (ref_shapes[i].is_none() || m.shape.is_none())
-            })
-            .min_by(|a, b| {
-                let da = (a.1.frequency_hz - r.frequency_hz).abs();
-                let db = (b.1.frequency_hz - r.frequency_hz).abs();
-                da.total_cmp(&db)
-            });
-        if let Some((k, _)) = free_nearest {
+        for (k, m) in modes.iter().enumerate() {
+            if !taken[k] && ok(r, m) && (ref_shapes[i].is_none() || m.shape.is_none()) {
+                let d = (m.frequency_hz - r.frequency_hz).abs() / r.frequency_hz;
+                by_freq.push((i, k, d));
+            }
+        }
+    }
+    by_freq.sort_by(|a, b| a.2.total_cmp(&b.2));
+    for (i, k, _) in by_freq {
+        if of_ref[i].is_none() && !taken[k] {
             of_ref[i] = Some((k, None));
             taken[k] = true;
         }
@@ -196,5 +197,36 @@ mod tests {
         // both identified modes are taken: the third reference stays unmatched
         assert_eq!(m[2].invariant, None);
         assert!(m[2].freq_diff_rel.is_finite());
+    }
+
+    #[test]
+    fn without_shapes_the_closest_pairs_are_matched_first_one_to_one() {
+        // One identified body mode at 1.236 Hz and one wheel-hop mode at 9.255 Hz, no shapes
+        // (single-channel ARMA pools): heave (5.4 % away) takes the body mode before pitch
+        // (20 %) or roll (7.2 %) can, though pitch comes first in the list; of the wheel modes,
+        // the front tramp (0.1 %) takes 9.255 Hz.
+        let m = |f: f64| InvariantMode {
+            shape: None,
+            ..mode(f, vec![])
+        };
+        let modes = vec![m(1.236), m(9.255)];
+        let reference: Vec<ReferenceMode> = [
+            (1.030, "pitch"),
+            (1.173, "heave"),
+            (1.332, "roll"),
+            (8.672, "front bounce"),
+            (9.243, "front tramp"),
+            (9.873, "rear tramp"),
+        ]
+        .iter()
+        .map(|&(f, l)| ReferenceMode::new(f, 0.2, l))
+        .collect();
+        let got = match_reference_shapes(&modes, &reference, &[], 0.25, 0.5);
+        let taken: Vec<Option<usize>> = got.iter().map(|g| g.invariant).collect();
+        assert_eq!(taken, [None, Some(0), None, None, Some(1), None]);
+        // the unmatched still carry the difference to the nearest structural mode
+        assert!((got[0].freq_diff_rel - (1.236 / 1.030 - 1.0)).abs() < 1e-12);
+        assert!((got[5].freq_diff_rel - (9.255 / 9.873 - 1.0)).abs() < 1e-12);
+        assert!(got.iter().all(|g| g.mac.is_none()));
     }
 }

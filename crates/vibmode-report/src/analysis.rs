@@ -278,9 +278,35 @@ fn matches_text(
                 );
             }
             None => {
+                // The nearest structural mode, and where it went: matching is one to one.
+                let tol = vibmode_analysis::pipeline::MATCH_MAX_FREQ_DIFF_REL;
+                let why = if m.freq_diff_rel.is_finite() && m.freq_diff_rel.abs() > tol {
+                    format!(" (none within {:.0} %)", 100.0 * tol)
+                } else if m.freq_diff_rel.is_finite() {
+                    let near = m.reference.frequency_hz * (1.0 + m.freq_diff_rel);
+                    let owner = matches
+                        .iter()
+                        .filter_map(|o| {
+                            let inv = modes.get(o.invariant?)?;
+                            ((inv.frequency_hz - near).abs() <= 1e-9 * near.max(1.0))
+                                .then_some(o.reference.label.as_str())
+                        })
+                        .next();
+                    match owner {
+                        Some(label) => format!(
+                            " (nearest {near:.3} Hz, {:+.1} %, is {label}'s)",
+                            100.0 * m.freq_diff_rel
+                        ),
+                        None => {
+                            format!(" (nearest {near:.3} Hz, {:+.1} %)", 100.0 * m.freq_diff_rel)
+                        }
+                    }
+                } else {
+                    String::new()
+                };
                 let _ = writeln!(
                     s,
-                    "{indent}  {:<20} {:>7.3} Hz -> not found",
+                    "{indent}  {:<20} {:>7.3} Hz -> not found{why}",
                     m.reference.label, m.reference.frequency_hz
                 );
             }
