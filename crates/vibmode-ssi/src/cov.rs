@@ -183,6 +183,69 @@ impl SsiCorrelations {
         Ok(out)
     }
 
+    /// As [`SsiCorrelations::new`], but segment `s`'s Toeplitz matrix starts at its own lag
+    /// `first_lags[s]` (`params.first_lag` is not used): the segments' correlations are summed
+    /// lag by lag from each one's first lag, `R_s(first_lags[s] + k)` for `k = 0..2i-1`. For
+    /// white noise through one system the correlations beyond any lag share the observability
+    /// matrix, so records whose excitation is correlated over different delays (a vehicle's
+    /// wheelbase at different speeds) can be pooled, each beyond its own delay. Each segment
+    /// needs more than `first_lags[s] + 2i - 2` samples; `first_lags` needs one entry (at
+    /// least 1) per segment.
+    pub fn with_first_lags(
+        segments: &[Vec<&[f64]>],
+        fs_hz: f64,
+        params: &SsiParams,
+        first_lags: &[usize],
+    ) -> Result<SsiCorrelations, SsiError> {
+        params.validate()?;
+        if !(fs_hz.is_finite() && fs_hz > 0.0) {
+            return Err(SsiError::InvalidSampleRate { fs_hz });
+        }
+        if first_lags.len() != segments.len() || first_lags.contains(&0) {
+            return Err(SsiError::FirstLags {
+                n_lags: first_lags.len(),
+                n_segments: segments.len(),
+            });
+        }
+        let first = segments.first().ok_or(SsiError::NoChannels)?;
+        let l = first.len();
+        let i = params.block_rows;
+        let refs = reference_indices(params, l)?;
+        let mut out = SsiCorrelations::empty(fs_hz, params);
+        out.skip = 0;
+        for (seg, &first_lag) in segments.iter().zip(first_lags) {
+            if seg.len() != l {
+                return Err(SsiError::LengthMismatch {
+                    channel: seg.len().min(l),
+                    found: seg.len(),
+                    expected: l,
+                });
+            }
+            let n = check_channels(seg)?;
+            let max_lag = 2 * i - 2 + first_lag;
+            if n <= max_lag {
+                return Err(SsiError::TooFewSamples {
+                    n_samples: n,
+                    block_rows: i,
+                    max_lag,
+                    min_samples: max_lag + 1,
+                });
+            }
+            let demeaned = demeaned(seg, n);
+            out.max_abs = demeaned
+                .iter()
+                .flatten()
+                .fold(out.max_abs, |m, v| m.max(v.abs()));
+            let (mut sums, mut counts) = lag_sums(&demeaned, &refs, max_lag, 0..n);
+            sums.drain(..first_lag - 1);
+            counts.drain(..first_lag - 1);
+            out.sums.push(sums);
+            out.counts.push(counts);
+            out.n_samples.push(n);
+        }
+        Ok(out)
+    }
+
     /// The correlation sums of one record (`channels`, equal lengths, finite, means removed
     /// over the whole record) cut into `n_blocks` blocks of consecutive time: block `b` holds,
     /// at every lag `k`, the products `y[t+k] y_ref[t]^T` of the `t` in

@@ -72,6 +72,14 @@ pub enum SsiError {
         /// Most blocks the record allows.
         max_blocks: usize,
     },
+    /// Per-segment first lags that are not one positive lag per segment.
+    #[error("{n_lags} first lags for {n_segments} segments; give one first lag (at least 1 sample) per segment")]
+    FirstLags {
+        /// First lags given.
+        n_lags: usize,
+        /// Segments given.
+        n_segments: usize,
+    },
     /// Too few samples for the lags of the block Toeplitz matrix.
     #[error("{n_samples} samples per channel are too few for block_rows = {block_rows} (lags up to {max_lag}); pass at least {min_samples} samples or lower block_rows")]
     TooFewSamples {
