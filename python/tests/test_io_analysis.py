@@ -145,6 +145,22 @@ def test_analyze_with_vehicle_matches_modes(sim):
     assert len(r["reference_modes"]) > 0
 
 
+def test_analyze_reports_the_body_band_ssi(sim):
+    # SSI-cov of the body band, each record beyond its own front-to-rear wheel delay: the
+    # delays are measured from the wheel channels (5.9 m at 30 km/h: 0.71 s).
+    r = vibmode.analyze(sim.records[:2], order_max=8, as_frames=False)
+    b = r["body_ssi"]
+    assert len(b["delay_pairs"]) == 2
+    assert len(b["delays"]) == 2
+    for d in b["delays"]:
+        if d["delay_s"] is not None:
+            assert abs(d["delay_s"] - 5.9 / (30 / 3.6)) < 0.03, d
+    # the [body_ssi] section as a keyword; switched off, the result says so
+    r = vibmode.analyze(sim.records[:2], order_max=8, body_ssi={"enabled": False}, as_frames=False)
+    assert "body_ssi" not in r
+    assert "enabled = false" in r["body_ssi_not_run"]
+
+
 def test_analyze_with_vehicle_updates_the_model():
     # A bus whose springs are 25 % softer than its file says: the model update's body heave and
     # pitch are the changed bus's (within 3 %), where the file's are not.

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use crate::AnalysisError;
 use vibmode_core::{
-    BodyFitParams, ClusterParams, Corner, IdentMethod, LineParams, PoleFilterParams,
+    BodyFitParams, BodySsiParams, ClusterParams, Corner, IdentMethod, LineParams, PoleFilterParams,
     PreprocessParams, Role, SpectrumParams, SsiParams, StopParams, SweepParams,
 };
 
@@ -116,6 +116,9 @@ pub struct AnalysisConfig {
     /// The model update with a vehicle file (`analyze --vehicle`): band and record edges of the
     /// fit of the suspension to the records.
     pub model_update: BodyFitParams,
+    /// Body modes by SSI-cov at a low rate, each record beyond its own front-to-rear wheel
+    /// delay (`[body_ssi]`).
+    pub body_ssi: BodySsiParams,
 }
 
 impl Default for AnalysisConfig {
@@ -195,6 +198,7 @@ impl AnalysisConfig {
             },
             report: ReportParams::default(),
             model_update: BodyFitParams::default(),
+            body_ssi: BodySsiParams::default(),
         };
         match p {
             Preset::Vibmode => base,
@@ -293,6 +297,7 @@ impl AnalysisConfig {
         self.lines.validate()?;
         self.ssi.validate()?;
         self.model_update.validate()?;
+        self.body_ssi.validate()?;
         Ok(())
     }
 

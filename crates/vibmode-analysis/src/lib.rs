@@ -23,6 +23,7 @@
 //! assert!(AnalysisConfig::from_toml_str("no_such_key = 1\n").is_err());
 //! ```
 
+pub mod body;
 mod config;
 pub mod first_record;
 pub mod identify;
@@ -35,6 +36,7 @@ pub mod stops;
 pub mod store;
 pub mod stream;
 
+pub use body::{BodySsi, RecordDelay};
 pub use config::{AnalysisConfig, ChannelRole, Preset, ReportParams};
 pub use first_record::{first_record_spectra, FirstRecordSpectra, ModelPsd};
 pub use identify::{Identifier, PoleOut, SignalFits, SweepIdentifier};

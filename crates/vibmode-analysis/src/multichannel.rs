@@ -74,6 +74,8 @@ pub(crate) struct SsiStage<'a> {
     pub params: &'a SsiParams,
     pub cluster: &'a ClusterParams,
     pub drop_band_edge: bool,
+    /// Each record's own first lag (pooled records only): records with `None` are left out.
+    pub first_lags: Option<&'a [Option<usize>]>,
 }
 
 impl SsiStage<'_> {
@@ -118,13 +120,15 @@ impl SsiStage<'_> {
     /// The correlations of the records used (each channel divided by its scale), kept per
     /// record for the jackknife, and the first record's band; `None` when no record is used.
     fn pooled(&self, scales: &[f64]) -> Result<Option<Pooled>, String> {
-        let used: Vec<&Preprocessed> = self
+        let lag_of = |r: usize| self.first_lags.map(|l| l.get(r).copied().flatten());
+        let (used, lags): (Vec<&Preprocessed>, Vec<Option<usize>>) = self
             .pre
             .iter()
             .enumerate()
             .filter(|(r, _)| self.active.get(*r).copied().flatten().is_some())
-            .map(|(_, p)| p)
-            .collect();
+            .filter(|(r, _)| lag_of(*r) != Some(None))
+            .map(|(r, p)| (p, lag_of(r).flatten()))
+            .unzip();
         let Some(first) = used.first() else {
             return Ok(None);
         };
@@ -143,8 +147,13 @@ impl SsiStage<'_> {
             .iter()
             .map(|rec| rec.iter().map(Vec::as_slice).collect())
             .collect();
-        let correlations = SsiCorrelations::new(&segments, first.band.fs_hz, self.params)
-            .map_err(|e| e.to_string())?;
+        let correlations = if self.first_lags.is_some() {
+            let lags: Vec<usize> = lags.into_iter().flatten().collect();
+            SsiCorrelations::with_first_lags(&segments, first.band.fs_hz, self.params, &lags)
+        } else {
+            SsiCorrelations::new(&segments, first.band.fs_hz, self.params)
+        }
+        .map_err(|e| e.to_string())?;
         Ok(Some(Pooled {
             correlations,
             band: first.band,
@@ -283,10 +292,11 @@ impl SsiStage<'_> {
     }
 
     /// Identifies, clusters, classes (with the pool's own line tracks and `other_tracks`, those
-    /// of the role pools) and matches to `reference`.
+    /// of the role pools; `own_tracks` when they are known already) and matches to `reference`.
     pub fn run(
         &self,
         lines: &LineStage<'_>,
+        own_tracks: Option<&[LineTrack]>,
         other_tracks: &[LineTrack],
         reference: &[ReferenceMode],
     ) -> Result<SsiAnalysis, AnalysisError> {
@@ -355,7 +365,10 @@ impl SsiStage<'_> {
             vibmode_modal::find_invariant_modes(&obs, n_records, &orders, self.cluster)?
         };
         let all: Vec<usize> = (0..channels.len()).collect();
-        let tracks = lines.tracks(&all);
+        let tracks = match own_tracks {
+            Some(t) => t.to_vec(),
+            None => lines.tracks(&all),
+        };
         // The lines of the role pools count too: a line seen clearly on the sprung channels may
         // be lost among the wheels' response when all channels are merged.
         let mut known: Vec<LineTrack> = tracks.clone();

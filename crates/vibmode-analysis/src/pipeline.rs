@@ -231,12 +231,34 @@ pub fn analyze_prepared(
             params: &cfg.ssi,
             cluster: &cluster,
             drop_band_edge: cfg.poles.drop_band_edge,
+            first_lags: None,
         };
         let role_tracks: Vec<crate::LineTrack> =
             roles.iter().flat_map(|r| r.lines.iter().cloned()).collect();
-        Some(stage.run(&lines, &role_tracks, reference)?)
+        Some(stage.run(&lines, None, &role_tracks, reference)?)
     } else {
         None
+    };
+    let (body_ssi, body_ssi_not_run) = match &ssi {
+        Some(main) if cfg.body_ssi.enabled => {
+            let role_tracks: Vec<crate::LineTrack> =
+                roles.iter().flat_map(|r| r.lines.iter().cloned()).collect();
+            let stage = crate::body::BodyStage {
+                pre: &pre,
+                active: &active,
+                cfg,
+                cluster: &cluster,
+            };
+            match stage.run(&lines, &main.lines, &role_tracks, reference)? {
+                Ok(b) => (Some(b), None),
+                Err(why) => (None, Some(why)),
+            }
+        }
+        Some(_) => (
+            None,
+            Some("switched off ([body_ssi] enabled = false)".to_string()),
+        ),
+        None => (None, None),
     };
     let fits = channels.iter().flat_map(|c| c.fits.iter());
     let n_fits = fits.clone().count();
@@ -274,6 +296,8 @@ pub fn analyze_prepared(
         reference_modes: reference.to_vec(),
         n_stationary: stationary.iter().filter(|&&s| s).count(),
         ssi,
+        body_ssi,
+        body_ssi_not_run,
         n_fits,
         n_not_converged,
         n_failed,

@@ -124,6 +124,13 @@ pub struct AnalysisResults {
     /// Multichannel (SSI-cov) results, when that method ran.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ssi: Option<SsiAnalysis>,
+    /// Body modes by SSI-cov at a low rate, each record beyond its own wheelbase delay, when
+    /// that ran (`[body_ssi]`, docs/ssi.md).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body_ssi: Option<crate::BodySsi>,
+    /// Why the body-band SSI-cov did not run, when SSI-cov ran but it did not.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body_ssi_not_run: Option<String>,
     /// Physical model modes used for matching (empty without a vehicle model).
     pub reference_modes: Vec<ReferenceMode>,
     /// Number of records marked `stationary` (stops), left out of the mode statistics; the

@@ -36,9 +36,9 @@ pub use modes::{
     PoleObservation, ReferenceMode, SupportFailure, UncertaintyMethod,
 };
 pub use params::{
-    BandLimit, BodyFitParams, ClusterParams, IdentMethod, LineParams, PoleFilterParams,
-    PreprocessParams, Robust, SpectrumParams, StopParams, SweepModel, SweepParams,
-    DEFAULT_HUBER_FACTOR, EDGE_SHARE, EMPTY_BAND_MAX_CUTOFF_SHARE,
+    BandLimit, BodyFitParams, BodySsiParams, ClusterParams, IdentMethod, LineParams,
+    PoleFilterParams, PreprocessParams, Robust, SpectrumParams, StopParams, SweepModel,
+    SweepParams, DEFAULT_HUBER_FACTOR, EDGE_SHARE, EMPTY_BAND_MAX_CUTOFF_SHARE,
 };
 pub use placement::{Corner, Direction, Placement, Role};
 pub use record_meta::RecordMeta;

@@ -981,3 +981,111 @@ impl BodyFitParams {
         Ok(())
     }
 }
+
+/// Settings of the body-band SSI-cov (`[body_ssi]` in the analysis TOML): all channels
+/// resampled to a low rate that keeps only the body band, and each record's Toeplitz matrix
+/// begun beyond that record's own front-to-rear wheel delay, so that the road's delayed
+/// excitation does not bias body heave and pitch (docs/ssi.md, "Body modes beyond each
+/// record's wheelbase delay"). The delay is measured in each record as the peak of the
+/// cross-correlation of a front and a rear wheel channel on the same side.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BodySsiParams {
+    /// Run it when the method runs SSI-cov and the records have wheel channels at a front and a
+    /// rear corner of one side (default true).
+    pub enabled: bool,
+    /// Rate the records are resampled to, Hz (default 10: the band up to 4 Hz).
+    pub fs_hz: f64,
+    /// Block rows of each record's Toeplitz matrix (default 5: lags over 0.9 s at 10 Hz).
+    pub block_rows: usize,
+    /// Lowest identified order (default 10; heave and pitch merge at lower orders).
+    pub order_min: usize,
+    /// Highest identified order (default 18).
+    pub order_max: usize,
+    /// Lags skipped beyond each record's measured delay, s (default 0.2).
+    pub margin_s: f64,
+    /// Longest front-to-rear delay searched, s (default 3.0: a 6 m wheelbase down to 7 km/h).
+    pub max_delay_s: f64,
+    /// Lowest peak of the normalised front/rear cross-correlation that counts as a measured
+    /// delay (default 0.2); records below it are left out, with the reason.
+    pub min_delay_correlation: f64,
+}
+
+impl Default for BodySsiParams {
+    fn default() -> Self {
+        BodySsiParams {
+            enabled: true,
+            fs_hz: 10.0,
+            block_rows: 5,
+            order_min: 10,
+            order_max: 18,
+            margin_s: 0.2,
+            max_delay_s: 3.0,
+            min_delay_correlation: 0.2,
+        }
+    }
+}
+
+impl BodySsiParams {
+    /// Checks the values.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        let d = BodySsiParams::default();
+        positive("fs_hz", self.fs_hz, d.fs_hz)?;
+        positive("max_delay_s", self.max_delay_s, d.max_delay_s)?;
+        if self.block_rows < 2 {
+            return Err(bad(
+                "block_rows",
+                self.block_rows,
+                "must be >= 2",
+                d.block_rows,
+            ));
+        }
+        if self.order_min < 2 || self.order_max < self.order_min {
+            return Err(bad(
+                "order_min",
+                format!("{} (order_max {})", self.order_min, self.order_max),
+                "must be >= 2 and at most order_max",
+                format!("{} (order_max {})", d.order_min, d.order_max),
+            ));
+        }
+        if !(self.margin_s.is_finite() && self.margin_s >= 0.0) {
+            return Err(bad(
+                "margin_s",
+                crate::Num(self.margin_s),
+                "must be a duration >= 0 s",
+                d.margin_s,
+            ));
+        }
+        if !(self.min_delay_correlation.is_finite()
+            && (0.0..1.0).contains(&self.min_delay_correlation))
+        {
+            return Err(bad(
+                "min_delay_correlation",
+                crate::Num(self.min_delay_correlation),
+                "must be in [0, 1)",
+                d.min_delay_correlation,
+            ));
+        }
+        Ok(())
+    }
+
+    /// The SSI-cov settings of the pooled identification (orders step 2, records pooled).
+    pub fn ssi_params(&self) -> crate::SsiParams {
+        crate::SsiParams {
+            block_rows: self.block_rows,
+            order_min: self.order_min,
+            order_max: self.order_max,
+            order_step: 2,
+            reference_channels: None,
+            pool_records: true,
+            first_lag: 1,
+        }
+    }
+
+    /// The first lag (samples at `fs_hz`) of a record whose front-to-rear delay is `delay_s`:
+    /// `1 + ceil(delay_s fs_hz) + round(margin_s fs_hz)`.
+    pub fn first_lag(&self, delay_s: f64) -> usize {
+        1 + (delay_s * self.fs_hz).ceil().max(0.0) as usize
+            + (self.margin_s * self.fs_hz).round() as usize
+    }
+}

@@ -389,7 +389,9 @@ fn records_with_different_delays_pooled_each_beyond_its_own() {
             .map(|s| s.iter().map(Vec::as_slice).collect())
             .collect();
         let own = SsiCorrelations::with_first_lags(&views, 10.0, &p, &lags).unwrap();
-        let modes = own.plan().unwrap().sweep(&[4]).unwrap().orders[0].modes.clone();
+        let modes = own.plan().unwrap().sweep(&[4]).unwrap().orders[0]
+            .modes
+            .clone();
         assert_eq!(modes.len(), 2, "seed {seed}");
         for (&(f, z), m) in truth.iter().zip(&modes) {
             assert!(
@@ -403,7 +405,9 @@ fn records_with_different_delays_pooled_each_beyond_its_own() {
         }
         let ones = vec![1; views.len()];
         let lag1 = SsiCorrelations::with_first_lags(&views, 10.0, &p, &ones).unwrap();
-        let m1 = lag1.plan().unwrap().sweep(&[4]).unwrap().orders[0].modes.clone();
+        let m1 = lag1.plan().unwrap().sweep(&[4]).unwrap().orders[0]
+            .modes
+            .clone();
         biased_pitch += (m1[0].frequency_hz / 1.03 - 1.0).abs() / 5.0;
     }
     assert!(biased_pitch > 0.04, "lag 1 pitch error {biased_pitch}");
@@ -427,7 +431,10 @@ fn equal_first_lags_are_the_common_first_lag() {
             first_lag,
             ..SsiParams::default()
         };
-        let a = SsiCorrelations::new(&views, 10.0, &p).unwrap().plan().unwrap();
+        let a = SsiCorrelations::new(&views, 10.0, &p)
+            .unwrap()
+            .plan()
+            .unwrap();
         let lags = vec![first_lag; views.len()];
         let b = SsiCorrelations::with_first_lags(&views, 10.0, &p, &lags)
             .unwrap()

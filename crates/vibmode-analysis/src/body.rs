@@ -1,0 +1,319 @@
+//! Stage 3c, body modes by SSI-cov beyond each record's wheelbase delay.
+//!
+//! A vehicle's rear wheels run over the road its front wheels met `wheelbase / speed` earlier,
+//! so its excitation is correlated with itself at that delay, and SSI-cov from lag 1 merges
+//! body heave and pitch (docs/ssi.md). Here every record's delay is measured (the peak of the
+//! cross-correlation of a front and a rear wheel channel on the same side), the records are
+//! resampled to a low rate that keeps the body band only, and each record's Toeplitz matrix
+//! begins beyond its own delay: there the correlations are free decays of the modes. Records
+//! driven at different speeds then excite heave and pitch in different proportions, and the
+//! pooled correlations separate them; this needs hours of driving, not minutes.
+
+use serde::{Deserialize, Serialize};
+use vibmode_core::{BodySsiParams, ClusterParams, Corner, Direction, PreprocessParams, Role};
+use vibmode_signal::Preprocessed;
+
+use crate::lines::{LineStage, LineTrack};
+use crate::multichannel::{SsiAnalysis, SsiStage};
+use crate::{AnalysisConfig, AnalysisError};
+
+/// One record's front-to-rear delay.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RecordDelay {
+    /// The measured delay, s (`None` when the record is left out).
+    pub delay_s: Option<f64>,
+    /// Peak of the normalised front/rear cross-correlation (mean over the pairs).
+    pub correlation: f64,
+    /// First lag of the record's Toeplitz matrix, samples at the body rate.
+    pub first_lag: Option<usize>,
+    /// Why the record is left out, when it is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub left_out: Option<String>,
+}
+
+/// What the body-band SSI-cov found.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BodySsi {
+    /// Rate the records were resampled to, Hz.
+    pub fs_hz: f64,
+    /// The front/rear wheel channels whose cross-correlation gave the delays.
+    pub delay_pairs: Vec<[String; 2]>,
+    /// Per record (all records, in order; stationary ones left out).
+    pub delays: Vec<RecordDelay>,
+    /// Records used.
+    pub n_records: usize,
+    /// Their total duration, s.
+    pub duration_s: f64,
+    /// The identification, clusters and matches (every pole has record 0: one pooled
+    /// identification).
+    pub analysis: SsiAnalysis,
+}
+
+/// The pairs of vertical wheel channels (front, rear) on the same side, by index.
+pub fn delay_pairs(pre: &Preprocessed, cfg: &AnalysisConfig) -> Vec<(usize, usize)> {
+    let chans = &pre.recording.channels;
+    let find = |corner: Corner| {
+        chans.iter().position(|c| {
+            let p = cfg.placement_of(c);
+            p.role == Role::Unsprung
+                && p.corner == Some(corner)
+                && matches!(p.direction, None | Some(Direction::Z))
+        })
+    };
+    [(Corner::FL, Corner::RL), (Corner::FR, Corner::RR)]
+        .into_iter()
+        .filter_map(|(f, r)| Some((find(f)?, find(r)?)))
+        .collect()
+}
+
+/// The lag (s) at which `rear` best repeats `front` within `(0, max_delay_s]`, by the
+/// phase-transform generalised cross-correlation (GCC-PHAT) in `band_hz`: each pair's
+/// cross-spectrum (one Hann-windowed segment of the whole record, zero-padded to twice its
+/// length) divided by its magnitude, so that the wheels' resonance and the engine lines do not
+/// dominate, then `c(tau) = mean over bins and pairs of cos(phase + 2 pi f tau)` on a grid of
+/// `1 / (4 fs_hz)`; `c` is 1 for an exact copy and near 0 for unrelated signals. Returns the
+/// delay and `c` there; `None` when a channel is constant, too short or not finite.
+pub fn front_rear_delay(
+    pairs: &[(&[f64], &[f64])],
+    fs_hz: f64,
+    max_delay_s: f64,
+    band_hz: [f64; 2],
+) -> Option<(f64, f64)> {
+    let n = pairs.first()?.0.len();
+    if n < 16 || max_delay_s.is_nan() || max_delay_s <= 0.0 {
+        return None;
+    }
+    let wp = vibmode_spectra::WelchParams {
+        nperseg: Some(n),
+        noverlap: Some(0),
+        nfft: Some((2 * n).next_power_of_two()),
+        ..Default::default()
+    };
+    let mut bins: Vec<(f64, f64)> = Vec::new(); // (frequency Hz, phase)
+    for (f, r) in pairs {
+        if f.len() != n || r.len() != n {
+            return None;
+        }
+        let s = vibmode_spectra::csd(f, r, fs_hz, &wp).ok()?;
+        let mut any = false;
+        for (fr, c) in s.freq_hz.iter().zip(&s.csd) {
+            if *fr >= band_hz[0] && *fr <= band_hz[1] && c.norm() > 0.0 && c.norm().is_finite() {
+                bins.push((*fr, c.arg()));
+                any = true;
+            }
+        }
+        if !any {
+            return None;
+        }
+    }
+    // csd = conj(F) R: a rear that is the front `tau` later has the phase -2 pi f tau.
+    let step = 1.0 / (4.0 * fs_hz);
+    let n_tau = (max_delay_s / step).floor() as usize;
+    let c = |tau: f64| {
+        bins.iter()
+            .map(|(f, ph)| (ph + 2.0 * std::f64::consts::PI * f * tau).cos())
+            .sum::<f64>()
+            / bins.len() as f64
+    };
+    let (k, best) = (1..=n_tau)
+        .map(|k| (k, c(k as f64 * step)))
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    Some((k as f64 * step, best))
+}
+
+/// Lower edge of the band of the delay's cross-correlation, Hz: below it the body's own
+/// motion, common to front and rear, dominates the wheels' channels.
+pub const DELAY_BAND_LOW_HZ: f64 = 2.0;
+
+pub(crate) struct BodyStage<'a> {
+    pub pre: &'a [Preprocessed],
+    pub active: &'a [Option<usize>],
+    pub cfg: &'a AnalysisConfig,
+    pub cluster: &'a ClusterParams,
+}
+
+impl BodyStage<'_> {
+    /// Runs the stage; `Err(reason)` when it cannot (no wheel pair, no record with a delay,
+    /// too short records), which the analysis reports instead of the modes.
+    pub fn run(
+        &self,
+        lines: &LineStage<'_>,
+        tracks: &[LineTrack],
+        other_tracks: &[LineTrack],
+        reference: &[vibmode_core::ReferenceMode],
+    ) -> Result<Result<BodySsi, String>, AnalysisError> {
+        let p: &BodySsiParams = &self.cfg.body_ssi;
+        let Some(first) = self.pre.first() else {
+            return Ok(Err("no records".into()));
+        };
+        let pairs = delay_pairs(first, self.cfg);
+        if pairs.is_empty() {
+            return Ok(Err("no wheel channels at a front and a rear corner of one side (FL and RL, or FR and RR) to measure the wheelbase delay; give them the role unsprung and their corners".into()));
+        }
+        let names = |i: usize| first.recording.channels[i].name.clone();
+        let delay_pairs: Vec<[String; 2]> =
+            pairs.iter().map(|&(f, r)| [names(f), names(r)]).collect();
+        let body_pre = PreprocessParams {
+            cutoff_hz: 0.4 * p.fs_hz,
+            analysis_fs_hz: p.fs_hz,
+        };
+        let i = p.block_rows;
+        let mut delays = Vec::with_capacity(self.pre.len());
+        let mut low = Vec::with_capacity(self.pre.len());
+        let mut lags = Vec::with_capacity(self.pre.len());
+        for (r, pr) in self.pre.iter().enumerate() {
+            let left = |why: String, corr: f64| RecordDelay {
+                delay_s: None,
+                correlation: corr,
+                first_lag: None,
+                left_out: Some(why),
+            };
+            let resampled = vibmode_signal::preprocess(&pr.recording, &body_pre);
+            let (d, l) = if self.active.get(r).copied().flatten().is_none() {
+                (left("stationary".into(), f64::NAN), None)
+            } else {
+                let fs = pr.band.fs_hz;
+                let sig: Vec<(&[f64], &[f64])> = pairs
+                    .iter()
+                    .map(|&(f, b)| {
+                        (
+                            pr.recording.channels[f].samples.as_slice(),
+                            pr.recording.channels[b].samples.as_slice(),
+                        )
+                    })
+                    .collect();
+                let band = [DELAY_BAND_LOW_HZ, pr.band.valid_max_hz()];
+                match front_rear_delay(&sig, fs, p.max_delay_s, band) {
+                    None => (
+                        left("a wheel channel is constant or too short".into(), f64::NAN),
+                        None,
+                    ),
+                    Some((_, corr)) if corr < p.min_delay_correlation => (
+                        left(
+                            format!(
+                                "front/rear correlation {corr:.2} below min_delay_correlation {}",
+                                p.min_delay_correlation
+                            ),
+                            corr,
+                        ),
+                        None,
+                    ),
+                    Some((delay, corr)) => {
+                        let lag = p.first_lag(delay);
+                        let n = resampled.as_ref().map_or(0, |x| x.recording.len());
+                        if n <= lag + 2 * i - 2 {
+                            (
+                                left(
+                                    format!(
+                                        "{n} samples at {} Hz, too few for the lags {lag}..{} beyond its delay of {delay:.2} s",
+                                        p.fs_hz,
+                                        lag + 2 * i - 2
+                                    ),
+                                    corr,
+                                ),
+                                None,
+                            )
+                        } else {
+                            (
+                                RecordDelay {
+                                    delay_s: Some(delay),
+                                    correlation: corr,
+                                    first_lag: Some(lag),
+                                    left_out: None,
+                                },
+                                Some(lag),
+                            )
+                        }
+                    }
+                }
+            };
+            let res = match resampled {
+                Ok(x) => x,
+                Err(e) => return Ok(Err(format!("resampling to {} Hz: {e}", p.fs_hz))),
+            };
+            delays.push(d);
+            lags.push(l);
+            low.push(res);
+        }
+        let n_records = lags.iter().flatten().count();
+        if n_records == 0 {
+            let why = delays
+                .iter()
+                .find_map(|d| d.left_out.clone())
+                .unwrap_or_default();
+            return Ok(Err(format!(
+                "no record with a measured wheelbase delay (e.g. {why})"
+            )));
+        }
+        let duration_s = low
+            .iter()
+            .zip(&lags)
+            .filter(|(_, l)| l.is_some())
+            .map(|(x, _)| x.recording.len() as f64 / p.fs_hz)
+            .sum();
+        let ssi = p.ssi_params();
+        let cluster = crate::pipeline::cluster_params_for(
+            &ClusterParams {
+                freq_max_hz: None,
+                ..self.cluster.clone()
+            },
+            &low[0].band,
+        );
+        let stage = SsiStage {
+            pre: &low,
+            active: self.active,
+            n_active: n_records,
+            params: &ssi,
+            cluster: &cluster,
+            drop_band_edge: true,
+            first_lags: Some(&lags),
+        };
+        // Only the model's modes in the body band are matched (the wheels' lie above it).
+        let f_max = low[0].band.valid_max_hz();
+        let in_band: Vec<vibmode_core::ReferenceMode> = reference
+            .iter()
+            .filter(|m| m.frequency_hz < f_max)
+            .cloned()
+            .collect();
+        let analysis = stage.run(lines, Some(tracks), other_tracks, &in_band)?;
+        Ok(Ok(BodySsi {
+            fs_hz: p.fs_hz,
+            delay_pairs,
+            delays,
+            n_records,
+            duration_s,
+            analysis,
+        }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_delay_of_a_copied_signal() {
+        // rear = front 37 samples later (0.74 s at 50 Hz), plus a second pair 36 later
+        let mut x = 0.3f64;
+        let noise: Vec<f64> = (0..3000)
+            .map(|_| {
+                x = (x * 3.9 * (1.0 - x)).clamp(1e-6, 1.0 - 1e-6);
+                x - 0.5
+            })
+            .collect();
+        let front = &noise[100..2100];
+        let rear = &noise[63..2063];
+        let rear2 = &noise[64..2064];
+        let band = [2.0, 20.0];
+        let (d, c) = front_rear_delay(&[(front, rear)], 50.0, 3.0, band).unwrap();
+        assert!((d - 0.74).abs() < 1e-9, "{d}");
+        assert!(c > 0.6, "{c}");
+        let (d, _) = front_rear_delay(&[(front, rear), (front, rear2)], 50.0, 3.0, band).unwrap();
+        assert!((0.72..=0.74).contains(&d), "between the two: {d}");
+        // unrelated signals: a low peak
+        let other = &noise[900..2900];
+        let (_, c0) = front_rear_delay(&[(front, other)], 50.0, 3.0, band).unwrap();
+        assert!(c0 < 0.3, "{c0}");
+        assert!(front_rear_delay(&[(&[1.0; 2000], rear)], 50.0, 3.0, band).is_none());
+    }
+}
