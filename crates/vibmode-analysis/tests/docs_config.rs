@@ -25,5 +25,7 @@ fn documented_settings_are_the_defaults() {
     assert_eq!(cfg.cluster, d.cluster);
     assert_eq!(cfg.lines, d.lines);
     assert_eq!(cfg.report, d.report);
+    assert_eq!(cfg.model_update, d.model_update);
+    assert_eq!(cfg.body_ssi, d.body_ssi);
     assert_eq!(cfg.channels.len(), 1);
 }

@@ -766,6 +766,51 @@ mod tests {
         .to_string();
         assert!(e.contains("cutoff_hz = 30") && e.contains("25"), "{e}");
     }
+
+    #[test]
+    fn body_ssi_first_lag_and_checks() {
+        let p = BodySsiParams::default();
+        // 0.71 s at 10 Hz: ceil(7.1) = 8 lags of delay, 2 of margin, from lag 1
+        assert_eq!(p.first_lag(0.71), 11);
+        assert_eq!(p.first_lag(0.7), 10);
+        assert_eq!(
+            BodySsiParams {
+                margin_s: 0.0,
+                ..p.clone()
+            }
+            .first_lag(0.0),
+            1
+        );
+        let s = p.ssi_params();
+        assert!(s.pool_records && s.first_lag == 1 && s.orders() == [10, 12, 14, 16, 18]);
+        assert!(p.validate().is_ok());
+        for bad in [
+            BodySsiParams {
+                fs_hz: 0.0,
+                ..p.clone()
+            },
+            BodySsiParams {
+                block_rows: 1,
+                ..p.clone()
+            },
+            BodySsiParams {
+                order_min: 20,
+                ..p.clone()
+            },
+            BodySsiParams {
+                margin_s: f64::NAN,
+                ..p.clone()
+            },
+            BodySsiParams {
+                min_delay_correlation: 1.0,
+                ..p.clone()
+            },
+        ] {
+            assert!(bad.validate().is_err(), "{bad:?}");
+        }
+        let e = BodySsiParams { order_min: 20, ..p }.validate().unwrap_err();
+        assert!(e.to_string().contains("order_min"), "{e}");
+    }
 }
 
 /// Detection of periodic lines (engine / gear orders) from evidence that does not depend on a
