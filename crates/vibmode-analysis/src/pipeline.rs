@@ -223,6 +223,8 @@ pub fn analyze_prepared(
         &mut store,
     )?;
     let roles = role_modes(&channels, &store, &support, &lines, reference)?;
+    let role_tracks: Vec<crate::LineTrack> =
+        roles.iter().flat_map(|r| r.lines.iter().cloned()).collect();
     let ssi = if cfg.method.runs_ssi() {
         let stage = SsiStage {
             pre: &pre,
@@ -233,16 +235,12 @@ pub fn analyze_prepared(
             drop_band_edge: cfg.poles.drop_band_edge,
             first_lags: None,
         };
-        let role_tracks: Vec<crate::LineTrack> =
-            roles.iter().flat_map(|r| r.lines.iter().cloned()).collect();
         Some(stage.run(&lines, None, &role_tracks, reference)?)
     } else {
         None
     };
     let (body_ssi, body_ssi_not_run) = match &ssi {
         Some(main) if cfg.body_ssi.enabled => {
-            let role_tracks: Vec<crate::LineTrack> =
-                roles.iter().flat_map(|r| r.lines.iter().cloned()).collect();
             let stage = crate::body::BodyStage {
                 pre: &pre,
                 active: &active,

@@ -154,31 +154,7 @@ impl SsiCorrelations {
         let refs = reference_indices(params, l)?;
         let mut out = SsiCorrelations::empty(fs_hz, params);
         for seg in segments {
-            if seg.len() != l {
-                return Err(SsiError::LengthMismatch {
-                    channel: seg.len().min(l),
-                    found: seg.len(),
-                    expected: l,
-                });
-            }
-            let n = check_channels(seg)?;
-            if n <= max_lag {
-                return Err(SsiError::TooFewSamples {
-                    n_samples: n,
-                    block_rows: i,
-                    max_lag,
-                    min_samples: max_lag + 1,
-                });
-            }
-            let demeaned = demeaned(seg, n);
-            out.max_abs = demeaned
-                .iter()
-                .flatten()
-                .fold(out.max_abs, |m, v| m.max(v.abs()));
-            let (sums, counts) = lag_sums(&demeaned, &refs, max_lag, 0..n);
-            out.sums.push(sums);
-            out.counts.push(counts);
-            out.n_samples.push(n);
+            out.push_segment(seg, l, &refs, i, max_lag, 0)?;
         }
         Ok(out)
     }
@@ -214,36 +190,50 @@ impl SsiCorrelations {
         let mut out = SsiCorrelations::empty(fs_hz, params);
         out.skip = 0;
         for (seg, &first_lag) in segments.iter().zip(first_lags) {
-            if seg.len() != l {
-                return Err(SsiError::LengthMismatch {
-                    channel: seg.len().min(l),
-                    found: seg.len(),
-                    expected: l,
-                });
-            }
-            let n = check_channels(seg)?;
-            let max_lag = 2 * i - 2 + first_lag;
-            if n <= max_lag {
-                return Err(SsiError::TooFewSamples {
-                    n_samples: n,
-                    block_rows: i,
-                    max_lag,
-                    min_samples: max_lag + 1,
-                });
-            }
-            let demeaned = demeaned(seg, n);
-            out.max_abs = demeaned
-                .iter()
-                .flatten()
-                .fold(out.max_abs, |m, v| m.max(v.abs()));
-            let (mut sums, mut counts) = lag_sums(&demeaned, &refs, max_lag, 0..n);
-            sums.drain(..first_lag - 1);
-            counts.drain(..first_lag - 1);
-            out.sums.push(sums);
-            out.counts.push(counts);
-            out.n_samples.push(n);
+            out.push_segment(seg, l, &refs, i, 2 * i - 2 + first_lag, first_lag - 1)?;
         }
         Ok(out)
+    }
+
+    /// Adds one segment (`l` channels, more than `max_lag` samples each): its means removed,
+    /// its lag sums for the lags `1 + dropped..=max_lag` (the first `dropped` lags not kept).
+    fn push_segment(
+        &mut self,
+        seg: &[&[f64]],
+        l: usize,
+        refs: &[usize],
+        block_rows: usize,
+        max_lag: usize,
+        dropped: usize,
+    ) -> Result<(), SsiError> {
+        if seg.len() != l {
+            return Err(SsiError::LengthMismatch {
+                channel: seg.len().min(l),
+                found: seg.len(),
+                expected: l,
+            });
+        }
+        let n = check_channels(seg)?;
+        if n <= max_lag {
+            return Err(SsiError::TooFewSamples {
+                n_samples: n,
+                block_rows,
+                max_lag,
+                min_samples: max_lag + 1,
+            });
+        }
+        let demeaned = demeaned(seg, n);
+        self.max_abs = demeaned
+            .iter()
+            .flatten()
+            .fold(self.max_abs, |m, v| m.max(v.abs()));
+        let (mut sums, mut counts) = lag_sums(&demeaned, refs, max_lag, 0..n);
+        sums.drain(..dropped);
+        counts.drain(..dropped);
+        self.sums.push(sums);
+        self.counts.push(counts);
+        self.n_samples.push(n);
+        Ok(())
     }
 
     /// The correlation sums of one record (`channels`, equal lengths, finite, means removed
