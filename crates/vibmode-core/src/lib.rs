@@ -30,7 +30,7 @@ pub mod recording;
 pub mod ssi;
 
 pub use error::{ParamError, RecordingError};
-pub use limits::{num, Num};
+pub use limits::{cap_message, num, quoted, Num, Quoted};
 pub use modes::{
     FitSummary, InvariantMode, ModeClass, ModeMatch, ModeUncertainty, ModelCoefficients,
     PoleObservation, ReferenceMode, SupportFailure, UncertaintyMethod,

@@ -66,6 +66,53 @@ pub fn num(v: &f64) -> Num {
     Num(*v)
 }
 
+/// Most characters of user input quoted in a message ([`Quoted`]).
+pub const QUOTE_CHARS_MAX: usize = 60;
+/// Most bytes of the one-line error the command line prints (the whole line).
+pub const MESSAGE_BYTES_MAX: usize = 400;
+
+/// User input (a cell, a name, an id, a path) for messages: at most [`QUOTE_CHARS_MAX`]
+/// characters, every control character, escape sequence or replacement character shown as `?`,
+/// and `...` where it was cut. A 2 MB cell or a terminal escape sequence never reaches the
+/// terminal through an error.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Quoted<'a>(pub &'a str);
+
+impl fmt::Display for Quoted<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mut chars = self.0.chars();
+        for c in chars.by_ref().take(QUOTE_CHARS_MAX) {
+            let shown = if c.is_control() || c == char::REPLACEMENT_CHARACTER {
+                '?'
+            } else {
+                c
+            };
+            write!(f, "{shown}")?;
+        }
+        if chars.next().is_some() {
+            f.write_str("...")?;
+        }
+        Ok(())
+    }
+}
+
+/// `Quoted(s)`, for `#[error(...)]` attributes that see fields by reference.
+pub fn quoted(s: &str) -> Quoted<'_> {
+    Quoted(s)
+}
+
+/// A message cut to at most `max_bytes` bytes on a character boundary, `...` marking the cut.
+pub fn cap_message(msg: &str, max_bytes: usize) -> String {
+    if msg.len() <= max_bytes {
+        return msg.to_string();
+    }
+    let mut end = max_bytes.saturating_sub(3);
+    while end > 0 && !msg.is_char_boundary(end) {
+        end -= 1;
+    }
+    format!("{}...", &msg[..end])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -83,5 +130,22 @@ mod tests {
         assert_eq!(Num(0.0033333333333333335).to_string(), "0.00333333");
         assert_eq!(Num(3.2837746232756027e-200).to_string(), "3.28377e-200");
         assert_eq!(Num(-1.0000001).to_string(), "-1.0000001");
+    }
+
+    #[test]
+    fn quoted_is_short_and_printable() {
+        assert_eq!(Quoted("bus-017").to_string(), "bus-017");
+        assert_eq!(Quoted("a\u{1b}[31mb\n").to_string(), "a?[31mb?");
+        let long = "x".repeat(10_000);
+        assert_eq!(Quoted(&long).to_string(), format!("{}...", "x".repeat(60)));
+        assert_eq!(Quoted("\u{fffd}\u{fffd}").to_string(), "??");
+    }
+
+    #[test]
+    fn cap_message_keeps_char_boundaries() {
+        assert_eq!(cap_message("short", 400), "short");
+        let m = "é".repeat(300); // 600 bytes
+        let c = cap_message(&m, 400);
+        assert!(c.len() <= 400 && c.ends_with("..."));
     }
 }
