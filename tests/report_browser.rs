@@ -19,6 +19,18 @@ fn chromium() -> Option<String> {
         .map(|s| s.to_string())
 }
 
+/// Says "skipped: <why>" when `what` (`shared`: the shared data folder, `chromium`: a headless
+/// browser) is absent here; fails instead where CI requires it (`VIBMODE_REQUIRE=shared,chromium`,
+/// set by `.ci/run` when the resource is present).
+fn skipped(what: &str, why: &str) {
+    let required = std::env::var("VIBMODE_REQUIRE").unwrap_or_default();
+    assert!(
+        !required.split(',').any(|r| r.trim() == what),
+        "{why}, but VIBMODE_REQUIRE={required} requires it here"
+    );
+    eprintln!("skipped: {why}");
+}
+
 #[test]
 fn demo_report_renders_in_headless_chromium() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -116,7 +128,10 @@ fn demo_report_renders_in_headless_chromium() {
     assert!(csv.lines().count() > 2, "{csv}");
 
     let Some(browser) = chromium() else {
-        eprintln!("SKIP browser part: no chromium installed (apt-get install chromium)");
+        skipped(
+            "chromium",
+            "browser part: no chromium installed (apt-get install chromium)",
+        );
         return;
     };
     let profile = dir.path().join("profile");

@@ -36,6 +36,18 @@ fn recording(dir: &Path, name: &str, fs: f64, n: usize, start_time: Option<&str>
     p
 }
 
+/// Says "skipped: <why>" when `what` (`shared`: the shared data folder, `chromium`: a headless
+/// browser) is absent here; fails instead where CI requires it (`VIBMODE_REQUIRE=shared,chromium`,
+/// set by `.ci/run` when the resource is present).
+fn skipped(what: &str, why: &str) {
+    let required = std::env::var("VIBMODE_REQUIRE").unwrap_or_default();
+    assert!(
+        !required.split(',').any(|r| r.trim() == what),
+        "{why}, but VIBMODE_REQUIRE={required} requires it here"
+    );
+    eprintln!("skipped: {why}");
+}
+
 #[test]
 fn gps_cuts_lie_in_steady_cruising_for_every_track_format_over_seeds() {
     let dir = tempfile::tempdir().unwrap();
@@ -388,7 +400,7 @@ fn bratislava_bus_stop_is_skipped() {
     let p = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/data/real/bratislava_transit/L35_1915_Borska_Zaluhy.csv");
     if !p.exists() {
-        eprintln!("skipped: {} not present", p.display());
+        skipped("shared", &format!("{} not present", p.display()));
         return;
     }
     let opts = ReadOptions {

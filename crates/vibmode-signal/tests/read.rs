@@ -42,6 +42,18 @@ fn random_recording(seed: u64, n: usize, nch: usize, fs: f64) -> Recording {
     Recording::new(fs, chans).unwrap()
 }
 
+/// Says "skipped: <why>" when `what` (`shared`: the shared data folder, `chromium`: a headless
+/// browser) is absent here; fails instead where CI requires it (`VIBMODE_REQUIRE=shared,chromium`,
+/// set by `.ci/run` when the resource is present).
+fn skipped(what: &str, why: &str) {
+    let required = std::env::var("VIBMODE_REQUIRE").unwrap_or_default();
+    assert!(
+        !required.split(',').any(|r| r.trim() == what),
+        "{why}, but VIBMODE_REQUIRE={required} requires it here"
+    );
+    eprintln!("skipped: {why}");
+}
+
 #[test]
 fn comma_csv_with_time_column_and_units() {
     let d = tempfile::tempdir().unwrap();
@@ -515,7 +527,7 @@ fn real_dir(sub: &str) -> Option<PathBuf> {
     if p.is_dir() {
         Some(p)
     } else {
-        eprintln!("skipping: {} not present", p.display());
+        skipped("shared", &format!("{} not present", p.display()));
         None
     }
 }
