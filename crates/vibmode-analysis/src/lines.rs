@@ -378,9 +378,9 @@ impl<'a> LineStage<'a> {
     }
 }
 
-/// Median (`vibmode_modal::stats::median`), `None` for no value.
+/// Median (`vibmode_core::stats::median_in_place`), `None` for no value.
 fn median(v: &mut [f64]) -> Option<f64> {
-    (!v.is_empty()).then(|| vibmode_modal::stats::median(v))
+    (!v.is_empty()).then(|| vibmode_core::stats::median_in_place(v))
 }
 
 struct Building {

@@ -28,6 +28,7 @@ pub mod placement;
 pub mod record_meta;
 pub mod recording;
 pub mod ssi;
+pub mod stats;
 
 pub use error::{ParamError, RecordingError};
 pub use limits::{cap_message, num, quoted, Num, Quoted};

@@ -9,16 +9,7 @@ pub const MAD_TO_SIGMA: f64 = 1.482_602_218_505_602;
 /// there is no finite value.
 pub fn median(values: &[f64]) -> Option<f64> {
     let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    Some(if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    })
+    (!v.is_empty()).then(|| vibmode_core::stats::median_in_place(&mut v))
 }
 
 /// Median absolute deviation from the median (unscaled); `None` when there is no finite value.

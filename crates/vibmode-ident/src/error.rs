@@ -3,6 +3,7 @@
 /// Everything that can go wrong in identification. Every message is one line naming the offending
 /// value and how to fix it.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum IdentError {
     /// The input signal has no samples.
     #[error("input signal is empty; pass at least {min_len} samples")]

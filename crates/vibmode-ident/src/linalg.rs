@@ -288,20 +288,12 @@ pub(crate) fn spd_inverse_diag(h: &DMatrix<f64>) -> Option<Vec<f64>> {
     }
 }
 
-/// Median of a slice (copied; NaN-free input assumed).
+/// Median of a slice (`vibmode_core::stats::median`), 0 for an empty slice.
 pub(crate) fn median(v: &[f64]) -> f64 {
     if v.is_empty() {
-        return 0.0;
-    }
-    let mut w = v.to_vec();
-    let mid = w.len() / 2;
-    let (_, m, _) = w.select_nth_unstable_by(mid, |a, b| a.total_cmp(b));
-    let m = *m;
-    if w.len() % 2 == 1 {
-        m
+        0.0
     } else {
-        let lower = w[..mid].iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        0.5 * (lower + m)
+        vibmode_core::stats::median(v)
     }
 }
 

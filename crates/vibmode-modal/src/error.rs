@@ -3,6 +3,7 @@
 /// Everything that can go wrong in `vibmode-modal`. Every message is one line naming the offending
 /// value and how to fix it.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum ModalError {
     /// A clustering parameter out of its range (see [`vibmode_core::ClusterParams::validate`]).
     #[error(transparent)]

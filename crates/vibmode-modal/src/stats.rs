@@ -15,12 +15,7 @@ pub fn percentile_sorted(sorted: &[f64], q: f64) -> f64 {
     sorted[lo] + (sorted[hi] - sorted[lo]) * frac
 }
 
-/// Median of an arbitrary slice of finite values (copies and sorts). NaN for an empty slice.
-pub fn median(values: &[f64]) -> f64 {
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    percentile_sorted(&v, 0.5)
-}
+pub use vibmode_core::stats::median;
 
 /// Mean and sample standard deviation (n - 1 denominator; 0 when n = 1). NaN for an empty slice.
 pub fn mean_std(values: &[f64]) -> (f64, f64) {

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 /// Every error returned by `vibmode-report`. Messages are one line, name the offending value and
 /// say how to fix it.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum ReportError {
     /// Figure size outside the supported range (pixels).
     #[error("figure size {width_px}x{height_px} px is out of range; use width_px and height_px between {min_px} and {max_px}")]

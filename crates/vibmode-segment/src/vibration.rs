@@ -50,18 +50,7 @@ fn is_longitudinal_or_lateral(name: &str) -> bool {
         || n.starts_with("lat")
 }
 
-fn median(v: &mut [f64]) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        (v[n / 2 - 1] + v[n / 2]) / 2.0
-    }
-}
+use vibmode_core::stats::median_in_place as median;
 
 /// Segments the recording read from `stream` by its vibration (see the module documentation);
 /// also returns the state of every window.

@@ -148,23 +148,7 @@ fn median_bias(k: usize) -> f64 {
         .sum::<f64>()
 }
 
-/// Median of `v` (mean of the two middle values for an even count), reordering `v`.
-/// `v` must be non-empty and NaN-free (guaranteed: inputs are checked to be finite).
-pub(crate) fn median_in_place(v: &mut [f64]) -> f64 {
-    let n = v.len();
-    if n == 0 {
-        return 0.0;
-    }
-    let mid = n / 2;
-    let (lo, m, _) = v.select_nth_unstable_by(mid, f64::total_cmp);
-    let upper = *m;
-    if n % 2 == 1 {
-        upper
-    } else {
-        let lower = lo.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        (lower + upper) / 2.0
-    }
-}
+pub(crate) use vibmode_core::stats::median_in_place;
 
 /// A reusable Welch computation for records of one length: resolves the parameters
 /// once (clamping, defaults), and keeps the FFT plan, the window and all scratch buffers,

@@ -4,6 +4,7 @@
 ///
 /// Every message is one line that names the offending value and says how to fix it.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum VehicleError {
     /// The TOML text could not be parsed (syntax error, unknown key, missing key, wrong type).
     #[error(

@@ -1,0 +1,68 @@
+//! The one median every layer uses (spectra, identification, clustering, lines, segmentation,
+//! fleet): mean of the two middle values for an even count, NaN for no value.
+//!
+//! Values are ordered by [`f64::total_cmp`]; callers pass NaN-free values (every input is checked
+//! to be finite where it is read) or filter them first.
+
+/// Median of `v`, reordering `v` in place (O(n): `select_nth_unstable`). NaN when `v` is empty.
+pub fn median_in_place(v: &mut [f64]) -> f64 {
+    let n = v.len();
+    if n == 0 {
+        return f64::NAN;
+    }
+    let mid = n / 2;
+    let (lower, m, _) = v.select_nth_unstable_by(mid, f64::total_cmp);
+    let upper = *m;
+    if n % 2 == 1 {
+        upper
+    } else {
+        let below = lower.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        (below + upper) / 2.0
+    }
+}
+
+/// Median of `values` (copied). NaN when `values` is empty.
+pub fn median(values: &[f64]) -> f64 {
+    median_in_place(&mut values.to_vec())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn by_hand() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
+        assert_eq!(median(&[-1.0]), -1.0);
+        assert_eq!(median(&[5.0, 5.0, 1.0, 9.0]), 5.0);
+        assert!(median(&[]).is_nan());
+    }
+
+    /// Against the definition (sort, take the middle) on seeded random inputs of every length
+    /// up to 64, with ties.
+    #[test]
+    fn equals_the_sorted_middle_over_seeds() {
+        let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
+        for n in 1..=64usize {
+            for _ in 0..20 {
+                let v: Vec<f64> = (0..n)
+                    .map(|_| {
+                        state = state
+                            .wrapping_mul(6_364_136_223_846_793_005)
+                            .wrapping_add(1_442_695_040_888_963_407);
+                        ((state >> 33) % 17) as f64 - 8.0
+                    })
+                    .collect();
+                let mut s = v.clone();
+                s.sort_by(f64::total_cmp);
+                let want = if n % 2 == 1 {
+                    s[n / 2]
+                } else {
+                    (s[n / 2 - 1] + s[n / 2]) / 2.0
+                };
+                assert_eq!(median(&v), want, "{v:?}");
+            }
+        }
+    }
+}
