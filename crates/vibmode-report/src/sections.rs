@@ -69,6 +69,14 @@ impl ReportSection {
             r.band_hz[1],
             100.0 * r.explained
         );
+        let intro = if r.absent.is_empty() {
+            intro
+        } else {
+            format!(
+                "{intro} The records put the {} at 0 (held there by the bounded fit, every parameter >= 0): the measured vehicle has none, and the updated vehicle file has none.",
+                r.absent.join(" and the ")
+            )
+        };
         let modes = ReportTable {
             headers: [
                 "mode",

@@ -36,6 +36,7 @@ pub mod drive;
 pub mod error;
 pub mod lines;
 pub mod model;
+pub mod nnls;
 pub mod params;
 pub mod road;
 pub mod sim;

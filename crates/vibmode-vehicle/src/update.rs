@@ -111,6 +111,10 @@ pub struct BodyFitResult {
     pub band_hz: [f64; 2],
     /// Share of the equations' variance the fit explains (1 = exact), dimensionless.
     pub explained: f64,
+    /// Parameters of the vehicle file the records put at 0 (the bounded fit held them there):
+    /// an anti-roll bar the measured bus does not have, e.g. "front anti-roll bar". The updated
+    /// vehicle has them at 0.
+    pub absent: Vec<String>,
 }
 
 impl BodyFitResult {
@@ -594,7 +598,21 @@ impl BodyFit {
                 "check that the records contain body motion in the band and that the channels' corners are right",
             ));
         };
-        let th = ch.solve(&self.atb);
+        // Every unknown is >= 0 (inertias, springs, dampers, bars): the unconstrained solution
+        // when it is feasible, else non-negative least squares, which holds at 0 what the
+        // records pull below it (an anti-roll bar the bus does not have).
+        let mut th = ch.solve(&self.atb);
+        let mut at_zero = vec![false; th.len()];
+        if th.iter().any(|&v| v < 0.0) {
+            let Some(sol) = crate::nnls::nnls_normal(&self.ata, &self.atb) else {
+                return Err(fit_error(
+                    "the bounded fit did not converge".into(),
+                    "check that the records contain body motion in the band",
+                ));
+            };
+            th = sol.x;
+            at_zero = sol.at_bound;
+        }
         let rss = self.btb - 2.0 * th.dot(&self.atb) + (&self.ata * &th).dot(&th);
         let explained = if self.btb > 0.0 {
             1.0 - rss / self.btb
@@ -608,11 +626,12 @@ impl BodyFit {
                 Ok(value)
             } else {
                 Err(fit_error(
-                    format!("the fit gave {what} = {value:.4e} {unit}, not positive"),
+                    format!("the fit put {what} at its bound {value:.4e} {unit}: the records do not support a positive value"),
                     "check the channels' roles and corners and that the records contain body motion in the band",
                 ))
             }
         };
+        let mut absent = Vec::new();
         v.body.pitch_inertia_kgm2 = positive("the pitch inertia".into(), th[0] * m, "kg m^2")?;
         v.body.roll_inertia_kgm2 = positive("the roll inertia".into(), th[1] * m, "kg m^2")?;
         let mut k = [0.0; 4];
@@ -625,7 +644,12 @@ impl BodyFit {
         let mut col = N_BASE;
         for (a, name) in [(0usize, "front"), (1, "rear")] {
             if self.bars[a] {
-                let bar = positive(format!("the {name} anti-roll bar"), th[col] * m, "N m/rad")?;
+                // A bar held at 0 is one the measured bus does not have.
+                let bar = th[col] * m;
+                if at_zero[col] || bar <= 0.0 {
+                    absent.push(format!("{name} anti-roll bar"));
+                }
+                let bar = bar.max(0.0);
                 if a == 0 {
                     v.front.anti_roll_stiffness_nm_per_rad = bar;
                 } else {
@@ -676,6 +700,7 @@ impl BodyFit {
             equations: self.equations,
             band_hz: self.band_hz,
             explained,
+            absent,
         })
     }
 }
