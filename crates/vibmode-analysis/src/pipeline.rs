@@ -196,11 +196,17 @@ pub fn analyze_prepared(
         return Err(AnalysisError::NoRecords);
     }
     check_lengths_named(facts.iter().map(|f| f.name.as_str()), &pre, cfg)?;
-    let outs = identify_all(&pre, cfg, identifier, progress)?;
+    // The spectra first, then the stops from them, then the identification of the records that
+    // are used (and of the first record, whose models the report draws): a stop's sweep would be
+    // thrown away.
+    let mut outs = spectra_all(&pre, cfg)?;
     let n_ch = pre.first().map_or(0, |p| p.recording.n_channels());
     let activity_rms = record_activity(&outs, facts.len(), n_ch, cfg);
     let activity_ratio = activity_ratios(&activity_rms, n_ch);
     let stationary = detect_stops(&activity_ratio, &cfg.stops);
+    if cfg.method.runs_arma() {
+        identify_used(&pre, &mut outs, &stationary, cfg, identifier, progress);
+    }
     let active = renumber_active(&stationary);
     let n_active = active.iter().flatten().count();
     let cluster = cluster_params_for(&cfg.cluster, &pre[0].band);
@@ -305,20 +311,17 @@ pub fn analyze_prepared(
     })
 }
 
-/// Stage 3 (with the Welch spectrum each signal needs for the stops), every (record, channel)
-/// in parallel; each record's own band (rate, cutoff) is used for its signals.
-fn identify_all(
+/// The Welch spectrum of every (record, channel) in parallel, each record at its own band
+/// (rate, cutoff): what the stops, the lines and the channel spectra need. `outs[r * n_ch + c]`
+/// is record `r`, channel `c`.
+fn spectra_all(
     pre: &[Preprocessed],
     cfg: &AnalysisConfig,
-    identifier: &dyn Identifier,
-    progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Vec<SignalOut>, AnalysisError> {
     let n_ch = pre.first().map_or(0, |p| p.recording.n_channels());
     let tasks: Vec<(usize, usize)> = (0..pre.len())
         .flat_map(|r| (0..n_ch).map(move |c| (r, c)))
         .collect();
-    let total = tasks.len();
-    let done = AtomicUsize::new(0);
     tasks
         .par_iter()
         .map(|&(r, c)| {
@@ -330,26 +333,44 @@ fn identify_all(
                 ..WelchParams::default()
             };
             let w = vibmode_spectra::welch(y, p.band.fs_hz, &wp)?;
-            let keep = if r == 0 {
-                cfg.report.model_psd_orders.as_slice()
-            } else {
-                &[]
-            };
-            let fits = if cfg.method.runs_arma() {
-                identifier.identify(y, &p.band, r, keep)
-            } else {
-                SignalFits::default()
-            };
-            progress(done.fetch_add(1, Ordering::SeqCst) + 1, total);
             Ok(SignalOut {
                 record: r,
                 channel: c,
                 welch_freq: w.freq_hz,
                 welch: w.psd,
-                fits,
+                fits: SignalFits::default(),
             })
         })
         .collect()
+}
+
+/// Stage 3: the identification of every channel of the records used for the modes (not the
+/// stops) and of the first record (the report draws its models), in parallel.
+fn identify_used(
+    pre: &[Preprocessed],
+    outs: &mut [SignalOut],
+    stationary: &[bool],
+    cfg: &AnalysisConfig,
+    identifier: &dyn Identifier,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) {
+    let used: Vec<&mut SignalOut> = outs
+        .iter_mut()
+        .filter(|o| o.record == 0 || !stationary[o.record])
+        .collect();
+    let total = used.len();
+    let done = AtomicUsize::new(0);
+    used.into_par_iter().for_each(|o| {
+        let p = &pre[o.record];
+        let y = &p.recording.channels[o.channel].samples;
+        let keep = if o.record == 0 {
+            cfg.report.model_psd_orders.as_slice()
+        } else {
+            &[]
+        };
+        o.fits = identifier.identify(y, &p.band, o.record, keep);
+        progress(done.fetch_add(1, Ordering::SeqCst) + 1, total);
+    });
 }
 
 /// Activity per record and channel: band RMS of the Welch PSD.
@@ -363,8 +384,8 @@ fn record_activity(
         .map(|r| {
             (0..n_ch)
                 .map(|c| {
-                    outs.iter()
-                        .find(|o| o.record == r && o.channel == c)
+                    outs.get(r * n_ch + c)
+                        .filter(|o| o.record == r && o.channel == c)
                         .map_or(f64::NAN, |o| {
                             band_rms(
                                 &o.welch_freq,

@@ -95,8 +95,18 @@ fn stop_records_are_excluded_and_modes_still_found() {
         assert_eq!(r.activity_rms.len(), 7);
     }
     assert_eq!(res.n_stationary, 2);
-    // Poles of the stop records are kept for the figures.
-    assert!(res.channels[0].poles.iter().any(|p| p.record == 2));
+    // The stops are decided before the sweep, which runs only on the other records (and on the
+    // first, for the report's model spectra): no pole or fit of a stop record.
+    let stops: Vec<usize> = (0..res.records.len())
+        .filter(|&i| res.records[i].stationary)
+        .collect();
+    assert!(!stops.contains(&0));
+    for ch in &res.channels {
+        assert!(ch.poles.iter().all(|p| !stops.contains(&p.record)));
+        assert!(ch.fits.iter().all(|f| !stops.contains(&f.record)));
+        assert!(ch.poles.iter().any(|p| p.record == 1));
+    }
+    assert_eq!(res.n_fits, 6 * 7 * cfg.orders().len());
 
     let sprung = res
         .roles
