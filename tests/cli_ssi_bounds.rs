@@ -38,7 +38,8 @@ fn bus_record(dir: &Path) -> PathBuf {
 fn csv(path: &Path, n: usize) {
     let mut text = String::from("time_s,a,b\n");
     for i in 0..n {
-        let noise = |k: usize| ((k.wrapping_mul(2654435761) % 1_000_003) as f64 / 1_000_003.0) - 0.5;
+        let noise =
+            |k: usize| ((k.wrapping_mul(2654435761) % 1_000_003) as f64 / 1_000_003.0) - 0.5;
         let t = i as f64 / 50.0;
         let a = (2.0 * std::f64::consts::PI * 3.0 * t).sin() + noise(i);
         text.push_str(&format!("{t},{a},{}\n", noise(i + 77)));
@@ -59,7 +60,11 @@ fn huge_first_lag_and_block_rows_are_refused_in_one_line() {
     // Reported wrapped numbers.
     fails_with(
         &["ssi", r, "--block-rows", "18446744073709551615"],
-        &["block_rows = 18446744073709551615", "at most 1024", "--block-rows"],
+        &[
+            "block_rows = 18446744073709551615",
+            "at most 1024",
+            "--block-rows",
+        ],
     );
     // Within the bound, beyond the record: the samples it would need are named.
     fails_with(
@@ -69,7 +74,11 @@ fn huge_first_lag_and_block_rows_are_refused_in_one_line() {
     // One past what clap's integer holds: the value and the allowed range.
     fails_with(
         &["ssi", r, "--first-lag", "18446744073709551616"],
-        &["--first-lag", "18446744073709551616", "0 to 18446744073709551615"],
+        &[
+            "--first-lag",
+            "18446744073709551616",
+            "0 to 18446744073709551615",
+        ],
     );
 }
 
@@ -81,7 +90,11 @@ fn block_rows_are_bounded_by_the_record_and_the_matrix_size() {
     // Ran past 30 s: 7000 rows of Toeplitz matrix for 2048 samples.
     fails_with(
         &["ssi", r, "--block-rows", "1000"],
-        &["block_rows = 1000 with 7 channels", "1024 rows", "block_rows = 146"],
+        &[
+            "block_rows = 1000 with 7 channels",
+            "1024 rows",
+            "block_rows = 146",
+        ],
     );
     fails_with(
         &["ssi", r, "--block-rows", "147"],
@@ -115,7 +128,16 @@ fn block_rows_are_bounded_by_the_record_and_the_matrix_size() {
         &["reference channel 7", "--references"],
     );
     // A bound that leaves the usual run alone.
-    let o = ok(&["ssi", r, "--block-rows", "10", "--orders", "2:20:2", "--json", "-"]);
+    let o = ok(&[
+        "ssi",
+        r,
+        "--block-rows",
+        "10",
+        "--orders",
+        "2:20:2",
+        "--json",
+        "-",
+    ]);
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["params"]["block_rows"], 10);
     assert_eq!(v["result"]["orders"].as_array().map(Vec::len), Some(10));
@@ -135,11 +157,19 @@ fn a_channel_given_twice_is_refused() {
         &["ssi", s(&f), "-c", "b", "-c", "1"],
         &["channel 'b' (index 1) is selected twice"],
     );
-    fails_with(
-        &["psd", s(&f), "-c", "a", "-c", "A"],
-        &["selected twice"],
-    );
-    ok(&["ssi", s(&f), "-c", "1", "-c", "0", "--block-rows", "8", "--orders", "2:8:2"]);
+    fails_with(&["psd", s(&f), "-c", "a", "-c", "A"], &["selected twice"]);
+    ok(&[
+        "ssi",
+        s(&f),
+        "-c",
+        "1",
+        "-c",
+        "0",
+        "--block-rows",
+        "8",
+        "--orders",
+        "2:8:2",
+    ]);
 }
 
 #[test]
@@ -196,7 +226,10 @@ fn clap_errors_are_one_line_naming_the_value_and_the_fix() {
     for (args, needles) in [
         (
             vec!["simulate", bus, "-o", o, "--seed", "-1"],
-            vec!["invalid value for --seed: '-1'", "0 to 18446744073709551615"],
+            vec![
+                "invalid value for --seed: '-1'",
+                "0 to 18446744073709551615",
+            ],
         ),
         (
             vec!["simulate", bus, "-o", o, "--records", "-1"],
@@ -204,7 +237,11 @@ fn clap_errors_are_one_line_naming_the_value_and_the_fix() {
         ),
         (
             vec!["simulate", bus, "-o", o, "--seed", "99999999999999999999"],
-            vec!["'99999999999999999999'", "too large", "0 to 18446744073709551615"],
+            vec![
+                "'99999999999999999999'",
+                "too large",
+                "0 to 18446744073709551615",
+            ],
         ),
         (
             vec!["analyze", s(&f), "-o", o, "--vehicle", "-bus"],
