@@ -152,6 +152,21 @@ fn lag_span(block_rows: usize, first_lag: usize) -> Result<(usize, usize), SsiEr
     Ok((max_lag, min_samples))
 }
 
+/// The fewest samples a record (or segment) needs for `block_rows` block rows from `first_lag`:
+/// `first_lag - 1 + 2 (2 block_rows - 1)` ([`SSI_SAMPLES_PER_LAG_MIN`]); `None` when the
+/// arithmetic overflows (no record is that long) or `block_rows` or `first_lag` is 0.
+///
+/// ```
+/// assert_eq!(vibmode_ssi::samples_needed(20, 1), Some(78));
+/// assert_eq!(vibmode_ssi::samples_needed(20, usize::MAX), None);
+/// ```
+pub fn samples_needed(block_rows: usize, first_lag: usize) -> Option<usize> {
+    if block_rows == 0 {
+        return None;
+    }
+    lag_span(block_rows, first_lag).ok().map(|(_, n)| n)
+}
+
 /// The output correlations of several segments (records) kept apart: per segment the
 /// unnormalised sums `sum_t y_s[t+k] y_s,ref[t]^T` and their product counts `N_s - k`, for the
 /// `2i - 1` lags of the Toeplitz matrix (`first_lag..=first_lag + 2i - 2`; the lags before the
