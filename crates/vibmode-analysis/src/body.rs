@@ -201,7 +201,7 @@ impl BodyStage<'_> {
                     Some((delay, corr)) => {
                         let lag = p.first_lag(delay);
                         let n = resampled.as_ref().map_or(0, |x| x.recording.len());
-                        if vibmode_ssi::samples_needed(i, lag).is_none_or(|needed| n < needed) {
+                        if !vibmode_ssi::samples_needed(i, lag).is_some_and(|needed| n >= needed) {
                             (
                                 left(
                                     format!(
