@@ -18,19 +18,24 @@ use vibmode_ssi::{RecordSsi, RecordSsiOptions};
 pub struct SsiArgs {
     #[command(flatten)]
     pub input: InputArgs,
-    /// Block rows of the Toeplitz matrix of output correlations (lags 1..2i-1; default 20).
+    /// Block rows i of the Toeplitz matrix of output correlations (lags 1..2i-1; default 20).
+    /// At most 1024 / channels, and the record needs 2 (2i - 1) samples beyond the first lag
+    /// (docs/ssi.md, "Bounds").
     #[arg(long)]
     pub block_rows: Option<usize>,
-    /// First correlation lag of the Toeplitz matrix, samples (default 1). Vehicles: beyond the
-    /// front-to-rear wheel delay, `1 + wheelbase / speed * fs`, the road's own correlation
-    /// no longer biases the body modes (docs/ssi.md).
+    /// First correlation lag of the Toeplitz matrix, samples (default 1; at most 2^30 and
+    /// below the record's length). Vehicles: beyond the front-to-rear wheel delay,
+    /// `1 + wheelbase / speed * fs`, the road's own correlation no longer biases the body modes
+    /// (docs/ssi.md).
     #[arg(long)]
     pub first_lag: Option<usize>,
-    /// Model orders (state dimensions): `2:60:2` (default), `2:40`, or a list `10,20,30`.
+    /// Model orders (state dimensions), 1 to 1024: a range `2:60:2` (default; the stop on the
+    /// step's grid), `2:40`, or a list `10,20,35` (identified as listed). Orders above what
+    /// the block rows and channels allow are left out.
     #[arg(long)]
     pub orders: Option<String>,
-    /// Reference channels (0-based indices among the selected channels), comma-separated:
-    /// reference-based SSI-cov.
+    /// Reference channels (0-based indices among the selected channels, each once),
+    /// comma-separated: reference-based SSI-cov.
     #[arg(long)]
     pub references: Option<String>,
     /// Write JSON results to this path (`-` for standard output).
@@ -61,12 +66,19 @@ struct SsiOutput {
     found: RecordSsi,
 }
 
-fn params(a: &SsiArgs) -> Result<SsiParams> {
+/// The SSI parameters and the orders to identify (`--orders` as given, or the default range).
+fn params(a: &SsiArgs) -> Result<(SsiParams, Vec<usize>)> {
     let d = SsiParams::default();
     let orders = match &a.orders {
         Some(o) => parse_orders(o)?,
         None => d.orders(),
     };
+    if orders.windows(2).any(|w| w[0] >= w[1]) {
+        anyhow::bail!(
+            "invalid --orders: {} (list the orders increasing, each once, e.g. 10,20,35)",
+            vibmode_core::quoted(a.orders.as_deref().unwrap_or_default())
+        );
+    }
     let (lo, hi) = (
         orders.iter().copied().min().unwrap_or(d.order_min),
         orders.iter().copied().max().unwrap_or(d.order_max),
@@ -87,7 +99,8 @@ fn params(a: &SsiArgs) -> Result<SsiParams> {
                 .map(|x| {
                     x.trim().parse::<usize>().map_err(|_| {
                         anyhow::anyhow!(
-                            "invalid --references '{s}'; give 0-based channel indices like 0,2"
+                            "invalid --references: {} (give 0-based channel indices like 0,2)",
+                            vibmode_core::quoted(s)
                         )
                     })
                 })
@@ -105,19 +118,20 @@ fn params(a: &SsiArgs) -> Result<SsiParams> {
         ..d
     };
     p.validate()?;
-    Ok(p)
+    Ok((p, orders))
 }
 
 /// Runs `vibmode ssi`.
 pub fn run(a: &SsiArgs) -> Result<()> {
     crate::output::check_outputs(&a.input.input, &[], &[a.plot.as_deref()], a.json.as_deref())?;
+    let (p, orders) = params(a)?;
     let (rec, band) = a.input.load_with_band()?;
-    let p = params(a)?;
     let chans: Vec<&[f64]> = rec.channels.iter().map(|c| c.samples.as_slice()).collect();
     let options = RecordSsiOptions {
         normalise: !a.no_normalise,
         valid_max_hz: band.map(|b| b.valid_max_hz()),
         uncertainty_blocks: a.uncertainty_blocks,
+        orders: Some(orders),
         ..RecordSsiOptions::default()
     };
     let found = vibmode_ssi::identify_record(&chans, rec.fs_hz, &p, &options)?;

@@ -16,8 +16,9 @@ use vibmode_report::panels as figures;
 pub struct SweepArgs {
     #[command(flatten)]
     pub input: InputArgs,
-    /// Model orders: `2:60` (inclusive range), `2:60:2` (with step) or a list `4,8,16`
-    /// (default: the analysis sweep's, 2:30).
+    /// Model orders: `2:60` (inclusive range), `2:60:2` (with step; the stop on the step's
+    /// grid) or a list `4,8,16` (the orders listed); orders 1 to 1024 (default: the analysis
+    /// sweep's, 2:30).
     #[arg(long)]
     pub orders: Option<String>,
     /// Model structure: arma (ARMA(p,p)) or ar.
@@ -44,34 +45,52 @@ pub struct SweepArgs {
     pub plot: Option<PathBuf>,
 }
 
-/// Parses `2:60`, `2:60:2` or `4,8,16`.
+/// Highest model order (and most orders) `--orders` takes, for every command.
+pub const ORDERS_MAX: usize = vibmode_core::limits::SSI_ORDER_MAX;
+
+/// Parses `--orders`: a range `2:60` (inclusive), a stepped range `2:60:2` (the stop on the
+/// step's grid: `2:35:2` is refused, not cut to 34) or a list `10,20,35` (the orders listed).
+/// Every order from 1 to [`ORDERS_MAX`], at most [`ORDERS_MAX`] of them.
 pub fn parse_orders(s: &str) -> Result<Vec<usize>> {
+    let q = vibmode_core::quoted(s);
     let bad = || {
-        anyhow::anyhow!("invalid --orders '{s}'; use a range like 2:60, a stepped range 2:60:2, or a list 4,8,16")
+        anyhow::anyhow!(
+            "invalid --orders: {q} (give a range 2:60, a stepped range 2:60:2 or a list 4,8,16 of orders from 1 to {ORDERS_MAX})"
+        )
     };
-    let v: Vec<usize> = if s.contains(':') {
-        let parts: Vec<usize> = s
-            .split(':')
-            .map(|p| p.trim().parse::<usize>().map_err(|_| bad()))
-            .collect::<Result<_>>()?;
+    let order = |p: &str| {
+        p.trim()
+            .parse::<usize>()
+            .ok()
+            .filter(|v| (1..=ORDERS_MAX).contains(v))
+            .ok_or_else(bad)
+    };
+    if s.contains(':') {
+        let parts: Vec<&str> = s.split(':').collect();
         let (lo, hi, step) = match parts.as_slice() {
-            [lo, hi] => (*lo, *hi, 1),
-            [lo, hi, st] => (*lo, *hi, *st),
+            [lo, hi] => (order(lo)?, order(hi)?, 1),
+            [lo, hi, st] => (order(lo)?, order(hi)?, order(st)?),
             _ => return Err(bad()),
         };
-        if step == 0 || hi < lo {
-            return Err(bad());
+        if hi < lo {
+            bail!("invalid --orders: {q} (the stop {hi} is below the start {lo}; give start:stop or start:stop:step with start <= stop)");
         }
-        (lo..=hi).step_by(step).collect()
-    } else {
-        s.split(',')
-            .map(|p| p.trim().parse::<usize>().map_err(|_| bad()))
-            .collect::<Result<_>>()?
-    };
-    if v.is_empty() || v.contains(&0) {
-        bail!("--orders '{s}' must list orders >= 1");
+        let off = (hi - lo) % step;
+        if off != 0 {
+            let below = hi - off;
+            let above = below + step;
+            bail!("invalid --orders: {q} (the stop {hi} is not on the step-{step} grid from {lo}; give {lo}:{below}:{step} or {lo}:{above}:{step}, or list the orders with commas)");
+        }
+        return Ok((lo..=hi).step_by(step).collect());
     }
-    Ok(v)
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() > ORDERS_MAX {
+        bail!(
+            "invalid --orders: {q} ({} orders; give at most {ORDERS_MAX})",
+            parts.len()
+        );
+    }
+    parts.into_iter().map(order).collect()
 }
 
 /// One pole pair of the sweep.

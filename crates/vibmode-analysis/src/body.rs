@@ -201,13 +201,13 @@ impl BodyStage<'_> {
                     Some((delay, corr)) => {
                         let lag = p.first_lag(delay);
                         let n = resampled.as_ref().map_or(0, |x| x.recording.len());
-                        if n <= lag + 2 * i - 2 {
+                        if !vibmode_ssi::samples_needed(i, lag).is_some_and(|needed| n >= needed) {
                             (
                                 left(
                                     format!(
                                         "{n} samples at {} Hz, too few for the lags {lag}..{} beyond its delay of {delay:.2} s",
                                         p.fs_hz,
-                                        lag + 2 * i - 2
+                                        lag.saturating_add(2 * i - 2)
                                     ),
                                     corr,
                                 ),

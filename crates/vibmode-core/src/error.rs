@@ -1,14 +1,14 @@
 //! Errors of the core types. Messages name the offending value and the fix, never a
 //! command-line flag: the front end (CLI, Python) adds its own hints.
 
-use crate::limits::{num, FS_HZ_MAX, FS_HZ_MIN, SAMPLE_ABS_MAX, SAMPLE_PEAK_MIN};
+use crate::limits::{num, quoted, FS_HZ_MAX, FS_HZ_MIN, SAMPLE_ABS_MAX, SAMPLE_PEAK_MIN};
 
 /// A recording that breaks its invariants, or a channel that cannot be found.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum RecordingError {
     /// A NaN or infinite sample.
-    #[error("channel '{channel}' sample {index} is {}; clean the data first (remove or interpolate the bad samples)", num(.value))]
+    #[error("channel '{}' sample {index} is {}; clean the data first (remove or interpolate the bad samples)", quoted(.channel), num(.value))]
     NonFinite {
         /// Channel name.
         channel: String,
@@ -18,7 +18,7 @@ pub enum RecordingError {
         value: f64,
     },
     /// A sampling rate that is not a positive finite number.
-    #[error("sampling rate {} Hz ({what}) must be a positive finite number", num(.fs_hz))]
+    #[error("sampling rate {} Hz ({}) must be a positive finite number", num(.fs_hz), quoted(.what))]
     InvalidSampleRate {
         /// Where the rate came from.
         what: String,
@@ -26,7 +26,7 @@ pub enum RecordingError {
         fs_hz: f64,
     },
     /// A sampling rate outside [`FS_HZ_MIN`, `FS_HZ_MAX`].
-    #[error("sampling rate {} Hz ({what}) is outside {} to {} Hz; check its unit (a time column in ms read as s, say)", num(.fs_hz), num(&FS_HZ_MIN), num(&FS_HZ_MAX))]
+    #[error("sampling rate {} Hz ({}) is outside {} to {} Hz; check its unit (a time column in ms read as s, say)", num(.fs_hz), quoted(.what), num(&FS_HZ_MIN), num(&FS_HZ_MAX))]
     SampleRateOutOfRange {
         /// Where the rate came from.
         what: String,
@@ -34,7 +34,7 @@ pub enum RecordingError {
         fs_hz: f64,
     },
     /// A sample whose magnitude exceeds [`SAMPLE_ABS_MAX`]: its powers would overflow.
-    #[error("channel '{channel}' sample {index} is {}, beyond the largest magnitude vibmode accepts ({}); rescale the data (another unit) or remove the bad samples", num(.value), num(&SAMPLE_ABS_MAX))]
+    #[error("channel '{}' sample {index} is {}, beyond the largest magnitude vibmode accepts ({}); rescale the data (another unit) or remove the bad samples", quoted(.channel), num(.value), num(&SAMPLE_ABS_MAX))]
     SampleTooLarge {
         /// Channel name.
         channel: String,
@@ -44,7 +44,7 @@ pub enum RecordingError {
         value: f64,
     },
     /// A channel whose largest magnitude is below [`SAMPLE_PEAK_MIN`] but not zero.
-    #[error("channel '{channel}' peaks at {}, below the smallest magnitude vibmode accepts ({}); rescale the data (another unit)", num(.peak), num(&SAMPLE_PEAK_MIN))]
+    #[error("channel '{}' peaks at {}, below the smallest magnitude vibmode accepts ({}); rescale the data (another unit)", quoted(.channel), num(.peak), num(&SAMPLE_PEAK_MIN))]
     SamplesTooSmall {
         /// Channel name.
         channel: String,
@@ -52,7 +52,7 @@ pub enum RecordingError {
         peak: f64,
     },
     /// More channels than [`CHANNELS_MAX`].
-    #[error("{what} has {count} channels; vibmode reads at most {max}: select the columns you need or split the file")]
+    #[error("{} has {count} channels; vibmode reads at most {max}: select the columns you need or split the file", quoted(.what))]
     TooManyChannels {
         /// Where.
         what: String,
@@ -62,7 +62,7 @@ pub enum RecordingError {
         max: usize,
     },
     /// A channel name not present in the recording.
-    #[error("no channel named '{name}'; available: {available}{hint}")]
+    #[error("no channel named '{}'; available: {}{hint}", quoted(.name), quoted(.available))]
     UnknownChannel {
         /// The requested name.
         name: String,
@@ -74,7 +74,8 @@ pub enum RecordingError {
     },
     /// A channel index out of range.
     #[error(
-        "channel index {index} is out of range: there are {count} channels (0-based: {available})"
+        "channel index {index} is out of range: there are {count} channels (0-based: {})",
+        quoted(.available)
     )]
     ChannelIndex {
         /// The requested 0-based index.
@@ -87,8 +88,16 @@ pub enum RecordingError {
     /// An empty channel selector string.
     #[error("empty channel selector; give a channel name or a 0-based index")]
     EmptySelector,
+    /// A channel selected twice (by name or index): it would be analysed twice.
+    #[error("channel '{}' (index {index}) is selected twice; select each channel once", quoted(.name))]
+    DuplicateChannel {
+        /// The channel's name.
+        name: String,
+        /// Its 0-based index.
+        index: usize,
+    },
     /// Channels of different lengths in one recording.
-    #[error("channel '{channel}' has {found} samples but '{first}' has {expected}; all channels must have the same length")]
+    #[error("channel '{}' has {found} samples but '{}' has {expected}; all channels must have the same length", quoted(.channel), quoted(.first))]
     LengthMismatch {
         /// Offending channel.
         channel: String,
@@ -130,7 +139,7 @@ pub enum ParamError {
         suggestion: String,
     },
     /// A name that is not one of the valid ones (a preset, a model, a corner...).
-    #[error("unknown {what} '{value}'; valid: {valid}")]
+    #[error("unknown {what} '{}'; valid: {valid}", quoted(.value))]
     UnknownName {
         /// What was being named.
         what: &'static str,

@@ -24,6 +24,23 @@ pub const SAMPLES_OUT_MAX: u64 = 1 << 30;
 /// Largest configuration or vehicle file read, bytes (1 MiB).
 pub const CONFIG_BYTES_MAX: u64 = 1 << 20;
 
+/// Most rows of the SSI-cov block Toeplitz matrix, `block_rows x channels`: its SVD, the bulk
+/// of an identification, takes about a second at this size (7 s at twice it).
+pub const SSI_TOEPLITZ_ROWS_MAX: usize = 1024;
+/// Highest model order (state dimension) SSI-cov identifies: at most the Toeplitz matrix's rows.
+pub const SSI_ORDER_MAX: usize = SSI_TOEPLITZ_ROWS_MAX;
+/// Largest first correlation lag of SSI-cov, samples (2^30: 12 days at 1 kHz, beyond any record
+/// held in memory).
+pub const SSI_FIRST_LAG_MAX: usize = 1 << 30;
+/// Samples an SSI-cov record (or segment) needs per lag of its Toeplitz matrix beyond the lags
+/// skipped: at least `first_lag - 1 + 2 (2 block_rows - 1)`, so that even the largest lag's
+/// correlation averages as many products as the matrix has lags.
+pub const SSI_SAMPLES_PER_LAG_MIN: usize = 2;
+/// Most SVD work of one SSI-cov identification with uncertainty blocks,
+/// `(2 blocks + 1) x rows^2 x columns` of the Toeplitz matrix: eight SVDs at the largest
+/// matrix, thousands at the usual ones.
+pub const SSI_SVD_WORK_MAX: u64 = 8 << 30;
+
 /// A number for messages: plain below 1e9 and above 1e-4 in magnitude, otherwise in exponent
 /// form, never 300 digits.
 #[derive(Clone, Copy, Debug, PartialEq)]

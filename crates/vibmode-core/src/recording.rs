@@ -188,7 +188,7 @@ impl Recording {
             .filter(|c| !lower.is_empty() && c.to_lowercase().starts_with(&lower))
             .collect();
         match hits.as_slice() {
-            [one] => format!("; did you mean '{one}'?"),
+            [one] => format!("; did you mean '{}'?", crate::limits::quoted(one)),
             _ => String::new(),
         }
     }
@@ -226,6 +226,7 @@ impl Recording {
             return Ok(self.clone());
         }
         let mut channels = Vec::with_capacity(sel.len());
+        let mut picked: Vec<usize> = Vec::with_capacity(sel.len());
         for s in sel {
             let i = match s {
                 ChannelSelector::Index(i) => {
@@ -253,6 +254,13 @@ impl Recording {
                         })?
                 }
             };
+            if picked.contains(&i) {
+                return Err(RecordingError::DuplicateChannel {
+                    name: self.channels[i].name.clone(),
+                    index: i,
+                });
+            }
+            picked.push(i);
             channels.push(self.channels[i].clone());
         }
         Ok(Recording {
@@ -417,5 +425,46 @@ impl Recording {
             start,
             end,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 28: `-c 0 -c 0` analysed the same channel twice without a word.
+    #[test]
+    fn a_channel_selected_twice_is_refused() {
+        let rec = Recording::new(
+            50.0,
+            vec![
+                Channel::new("z", "m/s^2", vec![0.0; 4]),
+                Channel::new("y\u{1b}[31m", "m/s^2", vec![0.0; 4]),
+            ],
+        )
+        .unwrap();
+        for sel in [
+            vec![ChannelSelector::Index(0), ChannelSelector::Index(0)],
+            vec![ChannelSelector::Index(0), ChannelSelector::Name("z".into())],
+            vec![ChannelSelector::Name("Z".into()), ChannelSelector::Index(0)],
+        ] {
+            let e = rec.select(&sel).unwrap_err();
+            assert_eq!(
+                e,
+                RecordingError::DuplicateChannel {
+                    name: "z".into(),
+                    index: 0
+                }
+            );
+            assert!(e.to_string().contains("'z' (index 0) is selected twice"));
+        }
+        let e = rec
+            .select(&[ChannelSelector::Index(1), ChannelSelector::Index(1)])
+            .unwrap_err()
+            .to_string();
+        assert!(!e.contains('\u{1b}') && e.contains("'y?[31m'"), "{e}");
+        assert!(rec
+            .select(&[ChannelSelector::Index(1), ChannelSelector::Index(0)])
+            .is_ok());
     }
 }

@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::ParamError;
+use crate::limits::{SSI_FIRST_LAG_MAX, SSI_ORDER_MAX, SSI_TOEPLITZ_ROWS_MAX};
 
 /// SSI-cov: the block Toeplitz matrix and the model orders identified from it.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -64,9 +65,12 @@ impl SsiParams {
             .collect()
     }
 
-    /// Checks ranges: `block_rows >= 1`, `order_min >= 2`, `order_step >= 1`,
-    /// `order_max >= order_min`, and `reference_channels` (when given) not empty and without
-    /// repeated indices. Whether the indices exist is checked against the data.
+    /// Checks ranges: `1 <= block_rows <= 1024` ([`SSI_TOEPLITZ_ROWS_MAX`]; with the channels,
+    /// `block_rows x channels <= 1024` is checked against the data), `order_min >= 2`,
+    /// `order_step >= 1`, `order_min <= order_max <= 1024` ([`SSI_ORDER_MAX`]),
+    /// `1 <= first_lag <= 2^30` ([`SSI_FIRST_LAG_MAX`]), and `reference_channels` (when given)
+    /// not empty and without repeated indices. Whether the indices exist, and whether the
+    /// record is long enough, is checked against the data.
     pub fn validate(&self) -> Result<(), ParamError> {
         let d = SsiParams::default();
         if self.block_rows < 1 {
@@ -75,6 +79,22 @@ impl SsiParams {
                 self.block_rows,
                 "must be >= 1",
                 d.block_rows,
+            ));
+        }
+        if self.block_rows > SSI_TOEPLITZ_ROWS_MAX {
+            return Err(ParamError::out_of_range(
+                "block_rows",
+                self.block_rows,
+                "is too large: block_rows x channels must be at most 1024 (the Toeplitz matrix's rows)",
+                d.block_rows,
+            ));
+        }
+        if self.first_lag > SSI_FIRST_LAG_MAX {
+            return Err(ParamError::out_of_range(
+                "first_lag",
+                self.first_lag,
+                "must be at most 2^30 = 1073741824 samples (and below the record's length)",
+                d.first_lag,
             ));
         }
         if self.order_min < 2 {
@@ -107,6 +127,14 @@ impl SsiParams {
                 self.order_max,
                 "must be >= order_min",
                 self.order_min.max(d.order_max),
+            ));
+        }
+        if self.order_max > SSI_ORDER_MAX {
+            return Err(ParamError::out_of_range(
+                "order_max",
+                self.order_max,
+                "must be at most 1024 (an order is at most block_rows x channels)",
+                d.order_max,
             ));
         }
         if let Some(refs) = &self.reference_channels {
@@ -209,6 +237,15 @@ mod tests {
         assert!(p.validate().is_ok());
         assert_eq!(p.orders(), vec![3, 6, 9]);
         assert!(StabilityParams::default().validate().is_ok());
+        // The largest values accepted.
+        let p = SsiParams {
+            block_rows: SSI_TOEPLITZ_ROWS_MAX,
+            order_max: SSI_ORDER_MAX,
+            first_lag: SSI_FIRST_LAG_MAX,
+            ..SsiParams::default()
+        };
+        assert!(p.validate().is_ok());
+        assert_eq!(SSI_FIRST_LAG_MAX, 1_073_741_824);
     }
 
     #[test]
@@ -242,6 +279,34 @@ mod tests {
                     ..Default::default()
                 },
                 "order_max = 4",
+            ),
+            (
+                SsiParams {
+                    block_rows: usize::MAX,
+                    ..Default::default()
+                },
+                "block_rows = 18446744073709551615 is too large",
+            ),
+            (
+                SsiParams {
+                    block_rows: SSI_TOEPLITZ_ROWS_MAX + 1,
+                    ..Default::default()
+                },
+                "at most 1024",
+            ),
+            (
+                SsiParams {
+                    first_lag: usize::MAX,
+                    ..Default::default()
+                },
+                "first_lag = 18446744073709551615 must be at most 2^30 = 1073741824",
+            ),
+            (
+                SsiParams {
+                    order_max: SSI_ORDER_MAX + 1,
+                    ..Default::default()
+                },
+                "order_max = 1025 must be at most 1024",
             ),
         ];
         for (p, text) in cases {

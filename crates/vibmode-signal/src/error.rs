@@ -10,7 +10,7 @@ pub enum SignalError {
     #[error(transparent)]
     Recording(#[from] vibmode_core::RecordingError),
     /// The file could not be opened, read or written.
-    #[error("cannot {action} {path}: {message}; check the path and permissions")]
+    #[error("cannot {action} {path_q}: {message}; check the path and permissions", path_q = vibmode_core::quoted(.path))]
     Io {
         /// "read" or "write".
         action: &'static str,
@@ -20,14 +20,14 @@ pub enum SignalError {
         message: String,
     },
     /// The file has no content at all.
-    #[error("{path} is empty; expected numeric rows (optionally after one header row)")]
+    #[error("{path_q} is empty; expected numeric rows (optionally after one header row)", path_q = vibmode_core::quoted(.path))]
     EmptyFile {
         /// The file.
         path: String,
     },
     /// Bytes that are not text (NUL or other control characters) where delimited text was
     /// expected.
-    #[error("{path} is not a text file (line {line} has control bytes); give a CSV/text export, a .wav, or raw samples with a .json sidecar")]
+    #[error("{path_q} is not a text file (line {line} has control bytes); give a CSV/text export, a .wav, or raw samples with a .json sidecar", path_q = vibmode_core::quoted(.path))]
     NotText {
         /// The file.
         path: String,
@@ -35,7 +35,7 @@ pub enum SignalError {
         line: usize,
     },
     /// Excel's `sep=X` directive names a separator vibmode does not read.
-    #[error("{path}: the separator directive on line {line} names '{sep}'; vibmode reads comma, semicolon, tab or whitespace separators")]
+    #[error("{path_q}: the separator directive on line {line} names '{sep_q}'; vibmode reads comma, semicolon, tab or whitespace separators", path_q = vibmode_core::quoted(.path), sep_q = vibmode_core::quoted(.sep))]
     UnsupportedSeparator {
         /// The file.
         path: String,
@@ -45,13 +45,13 @@ pub enum SignalError {
         sep: String,
     },
     /// A header row but no data rows.
-    #[error("{path} has a header row but no data rows; check that the file was fully exported")]
+    #[error("{path_q} has a header row but no data rows; check that the file was fully exported", path_q = vibmode_core::quoted(.path))]
     NoDataRows {
         /// The file.
         path: String,
     },
     /// A data row whose number of cells differs from the header (or first row).
-    #[error("line {line} of {path} has {found} columns but {expected} were expected (from line {reference_line}); fix or delete that row")]
+    #[error("line {line} of {path_q} has {found} columns but {expected} were expected (from line {reference_line}); fix or delete that row", path_q = vibmode_core::quoted(.path))]
     RaggedRow {
         /// The file.
         path: String,
@@ -65,7 +65,7 @@ pub enum SignalError {
         reference_line: usize,
     },
     /// A cell that is not a number.
-    #[error("line {line}, column {column} ('{column_name}') of {path}: '{text}' is not a number; fix the cell or delete the row")]
+    #[error("line {line}, column {column} ('{column_name_q}') of {path_q}: '{text_q}' is not a number; fix the cell or delete the row", path_q = vibmode_core::quoted(.path), column_name_q = vibmode_core::quoted(.column_name), text_q = vibmode_core::quoted(.text))]
     NotNumeric {
         /// The file.
         path: String,
@@ -79,13 +79,13 @@ pub enum SignalError {
         text: String,
     },
     /// No time column and no `fs_hz` given.
-    #[error("no time column in {path}; give its sampling rate (fs_hz)")]
+    #[error("no time column in {path_q}; give its sampling rate (fs_hz)", path_q = vibmode_core::quoted(.path))]
     NoSampleRate {
         /// The file.
         path: String,
     },
     /// The rate given by the user and the one found in the file disagree by more than 1 %.
-    #[error("{path}: the sampling rate from {source_name} is {} Hz but {} Hz was given (more than 1% apart); give no rate or fix the file", vibmode_core::num(.file_fs_hz), vibmode_core::num(.given_fs_hz))]
+    #[error("{path_q}: the sampling rate from {source_name_q} is {} Hz but {} Hz was given (more than 1% apart); give no rate or fix the file", vibmode_core::num(.file_fs_hz), vibmode_core::num(.given_fs_hz), path_q = vibmode_core::quoted(.path), source_name_q = vibmode_core::quoted(.source_name))]
     SampleRateMismatch {
         /// The file.
         path: String,
@@ -97,7 +97,7 @@ pub enum SignalError {
         given_fs_hz: f64,
     },
     /// The time column is not uniform enough.
-    #[error("time column '{column}' of {path} is not uniform: jitter {jitter_rel:.3e} of the mean step exceeds {max_jitter_rel:.3e}; allow a non-uniform time column (allow_nonuniform) to interpolate onto a uniform grid at {mean_fs_hz:.6} Hz")]
+    #[error("time column '{column_q}' of {path_q} is not uniform: jitter {jitter_rel:.3e} of the mean step exceeds {max_jitter_rel:.3e}; allow a non-uniform time column (allow_nonuniform) to interpolate onto a uniform grid at {mean_fs_hz:.6} Hz", path_q = vibmode_core::quoted(.path), column_q = vibmode_core::quoted(.column))]
     NonUniformTime {
         /// The file.
         path: String,
@@ -111,7 +111,7 @@ pub enum SignalError {
         mean_fs_hz: f64,
     },
     /// The time column does not strictly increase.
-    #[error("time column '{column}' of {path} does not increase at line {line} ({} then {}); sort the rows or remove duplicates", vibmode_core::num(.previous), vibmode_core::num(.value))]
+    #[error("time column '{column_q}' of {path_q} does not increase at line {line} ({} then {}); sort the rows or remove duplicates", vibmode_core::num(.previous), vibmode_core::num(.value), path_q = vibmode_core::quoted(.path), column_q = vibmode_core::quoted(.column))]
     TimeNotIncreasing {
         /// The file.
         path: String,
@@ -125,13 +125,13 @@ pub enum SignalError {
         value: f64,
     },
     /// The file has no data channel (e.g. only a time column).
-    #[error("{path} has no data channels (only a time column?); check the file")]
+    #[error("{path_q} has no data channels (only a time column?); check the file", path_q = vibmode_core::quoted(.path))]
     NoChannels {
         /// The file.
         path: String,
     },
     /// A missing or malformed JSON sidecar of a raw binary file.
-    #[error("sidecar {path}: {reason}")]
+    #[error("sidecar {path_q}: {reason}", path_q = vibmode_core::quoted(.path))]
     Sidecar {
         /// The sidecar file (or the expected names).
         path: String,
@@ -139,7 +139,7 @@ pub enum SignalError {
         reason: String,
     },
     /// A binary (raw) file whose size does not fit the sidecar.
-    #[error("{path} has {bytes} bytes, not a multiple of {frame_bytes} (= {channels} channels x {dtype_bytes} bytes); check dtype and channels in the sidecar")]
+    #[error("{path_q} has {bytes} bytes, not a multiple of {frame_bytes} (= {channels} channels x {dtype_bytes} bytes); check dtype and channels in the sidecar", path_q = vibmode_core::quoted(.path))]
     RawSize {
         /// The file.
         path: String,
@@ -154,7 +154,7 @@ pub enum SignalError {
     },
     /// A raw file that ends inside a frame: cut off mid-write, or a sidecar whose `dtype` or
     /// `channels` do not fit the data (found by the stream reader before any sample is used).
-    #[error("{path} has {bytes} bytes, not a whole number of {frame_bytes}-byte frames ({channels} channels x {dtype_bytes} bytes): it was cut off mid-write or the sidecar's dtype/channels are wrong; check the sidecar, or keep the whole frames by cutting the file to {whole_bytes} bytes (truncate -s {whole_bytes})")]
+    #[error("{path_q} has {bytes} bytes, not a whole number of {frame_bytes}-byte frames ({channels} channels x {dtype_bytes} bytes): it was cut off mid-write or the sidecar's dtype/channels are wrong; check the sidecar, or keep the whole frames by cutting the file to {whole_bytes} bytes (truncate -s {whole_bytes})", path_q = vibmode_core::quoted(.path))]
     PartialFrame {
         /// The file.
         path: String,
@@ -170,7 +170,7 @@ pub enum SignalError {
         whole_bytes: u64,
     },
     /// A WAV file that cannot be used.
-    #[error("WAV {path}: {reason}")]
+    #[error("WAV {path_q}: {reason}", path_q = vibmode_core::quoted(.path))]
     Wav {
         /// The file.
         path: String,
@@ -178,7 +178,7 @@ pub enum SignalError {
         reason: String,
     },
     /// A file extension or format name that is not known.
-    #[error("unknown format '{given}'; valid formats: delimited (.csv/.txt/.tsv/.dat), wav (.wav), raw (.f32/.f64/.bin/.raw + .json sidecar)")]
+    #[error("unknown format '{given_q}'; valid formats: delimited (.csv/.txt/.tsv/.dat), wav (.wav), raw (.f32/.f64/.bin/.raw + .json sidecar)", given_q = vibmode_core::quoted(.given))]
     UnknownFormat {
         /// The name or extension given.
         given: String,

@@ -3,6 +3,7 @@
 use nalgebra::{DMatrix, SVD};
 use num_complex::Complex64;
 use serde::{Deserialize, Serialize};
+use vibmode_core::limits::{SSI_SAMPLES_PER_LAG_MIN, SSI_TOEPLITZ_ROWS_MAX};
 use vibmode_core::SsiParams;
 
 use crate::eig::complex_eigenpairs;
@@ -116,9 +117,60 @@ fn check_channels(channels: &[&[f64]]) -> Result<usize, SsiError> {
     Ok(n)
 }
 
+/// The rows of the block Toeplitz matrix, `block_rows x channels`, checked against
+/// [`SSI_TOEPLITZ_ROWS_MAX`] (the SVD's cost grows with their cube).
+fn check_matrix_size(block_rows: usize, n_channels: usize) -> Result<usize, SsiError> {
+    block_rows
+        .checked_mul(n_channels)
+        .filter(|&rows| rows <= SSI_TOEPLITZ_ROWS_MAX)
+        .ok_or(SsiError::MatrixTooLarge {
+            block_rows,
+            n_channels,
+            max_rows: SSI_TOEPLITZ_ROWS_MAX,
+            max_block_rows: SSI_TOEPLITZ_ROWS_MAX / n_channels.max(1),
+        })
+}
+
+/// The lags of the Toeplitz matrix from `first_lag` (`first_lag..=max_lag`,
+/// `max_lag = first_lag + 2 block_rows - 2`) and the samples a record needs for them,
+/// `first_lag - 1 + SSI_SAMPLES_PER_LAG_MIN (2 block_rows - 1)`, in checked arithmetic.
+fn lag_span(block_rows: usize, first_lag: usize) -> Result<(usize, usize), SsiError> {
+    let too_large = SsiError::LagsTooLarge {
+        block_rows,
+        first_lag,
+    };
+    let n_lags = block_rows
+        .checked_mul(2)
+        .and_then(|v| v.checked_sub(1))
+        .ok_or(too_large.clone())?;
+    let skipped = first_lag.checked_sub(1).ok_or(too_large.clone())?;
+    let max_lag = skipped.checked_add(n_lags).ok_or(too_large.clone())?;
+    let min_samples = n_lags
+        .checked_mul(SSI_SAMPLES_PER_LAG_MIN)
+        .and_then(|v| v.checked_add(skipped))
+        .ok_or(too_large)?;
+    Ok((max_lag, min_samples))
+}
+
+/// The fewest samples a record (or segment) needs for `block_rows` block rows from `first_lag`:
+/// `first_lag - 1 + 2 (2 block_rows - 1)` ([`SSI_SAMPLES_PER_LAG_MIN`]); `None` when the
+/// arithmetic overflows (no record is that long) or `block_rows` or `first_lag` is 0.
+///
+/// ```
+/// assert_eq!(vibmode_ssi::samples_needed(20, 1), Some(78));
+/// assert_eq!(vibmode_ssi::samples_needed(20, usize::MAX), None);
+/// ```
+pub fn samples_needed(block_rows: usize, first_lag: usize) -> Option<usize> {
+    if block_rows == 0 {
+        return None;
+    }
+    lag_span(block_rows, first_lag).ok().map(|(_, n)| n)
+}
+
 /// The output correlations of several segments (records) kept apart: per segment the
 /// unnormalised sums `sum_t y_s[t+k] y_s,ref[t]^T` and their product counts `N_s - k`, for the
-/// lags `1..=first_lag + 2i - 2`. Computed once; [`SsiCorrelations::plan`] identifies from all
+/// `2i - 1` lags of the Toeplitz matrix (`first_lag..=first_lag + 2i - 2`; the lags before the
+/// first are not computed). Computed once; [`SsiCorrelations::plan`] identifies from all
 /// segments ([`SsiCov::from_segments`]), [`SsiCorrelations::jackknife`] from all but one group
 /// at a time, without recomputing a product.
 #[derive(Clone, Debug)]
@@ -126,7 +178,8 @@ pub struct SsiCorrelations {
     pub(crate) fs_hz: f64,
     pub(crate) order_max: usize,
     pub(crate) block_rows: usize,
-    pub(crate) skip: usize,
+    /// The lag of `sums[s][0]` (of the first segment's, when each has its own), for messages.
+    pub(crate) first_lag: usize,
     pub(crate) sums: Vec<Vec<DMatrix<f64>>>,
     pub(crate) counts: Vec<Vec<usize>>,
     pub(crate) n_samples: Vec<usize>,
@@ -135,8 +188,10 @@ pub struct SsiCorrelations {
 
 impl SsiCorrelations {
     /// The correlation sums of `segments` (each the same channels, finite, with at least
-    /// `first_lag + 2 block_rows - 1` samples; each segment's means removed) sampled at `fs_hz`,
-    /// for `params`' block rows, first lag and references.
+    /// `first_lag - 1 + 2 (2 block_rows - 1)` samples, [`SSI_SAMPLES_PER_LAG_MIN`]; each
+    /// segment's means removed) sampled at `fs_hz`, for `params`' block rows, first lag and
+    /// references. The Toeplitz matrix may have at most [`SSI_TOEPLITZ_ROWS_MAX`] rows
+    /// (`block_rows x channels`).
     pub fn new(
         segments: &[Vec<&[f64]>],
         fs_hz: f64,
@@ -148,13 +203,11 @@ impl SsiCorrelations {
         }
         let first = segments.first().ok_or(SsiError::NoChannels)?;
         let l = first.len();
-        let i = params.block_rows;
-        let skip = params.first_lag - 1;
-        let max_lag = 2 * i - 1 + skip;
+        check_matrix_size(params.block_rows, l)?;
         let refs = reference_indices(params, l)?;
         let mut out = SsiCorrelations::empty(fs_hz, params);
         for seg in segments {
-            out.push_segment(seg, l, &refs, i, max_lag, 0)?;
+            out.push_segment(seg, l, &refs, params.block_rows, params.first_lag)?;
         }
         Ok(out)
     }
@@ -165,7 +218,7 @@ impl SsiCorrelations {
     /// white noise through one system the correlations beyond any lag share the observability
     /// matrix, so records whose excitation is correlated over different delays (a vehicle's
     /// wheelbase at different speeds) can be pooled, each beyond its own delay. Each segment
-    /// needs more than `first_lags[s] + 2i - 2` samples; `first_lags` needs one entry (at
+    /// needs at least `first_lags[s] - 1 + 2 (2i - 1)` samples; `first_lags` needs one entry (at
     /// least 1) per segment.
     pub fn with_first_lags(
         segments: &[Vec<&[f64]>],
@@ -183,28 +236,36 @@ impl SsiCorrelations {
                 n_segments: segments.len(),
             });
         }
+        if let Some(&first_lag) = first_lags
+            .iter()
+            .find(|&&f| f > vibmode_core::limits::SSI_FIRST_LAG_MAX)
+        {
+            return Err(SsiError::LagsTooLarge {
+                block_rows: params.block_rows,
+                first_lag,
+            });
+        }
         let first = segments.first().ok_or(SsiError::NoChannels)?;
         let l = first.len();
-        let i = params.block_rows;
+        check_matrix_size(params.block_rows, l)?;
         let refs = reference_indices(params, l)?;
         let mut out = SsiCorrelations::empty(fs_hz, params);
-        out.skip = 0;
+        out.first_lag = first_lags.first().copied().unwrap_or(1);
         for (seg, &first_lag) in segments.iter().zip(first_lags) {
-            out.push_segment(seg, l, &refs, i, 2 * i - 2 + first_lag, first_lag - 1)?;
+            out.push_segment(seg, l, &refs, params.block_rows, first_lag)?;
         }
         Ok(out)
     }
 
-    /// Adds one segment (`l` channels, more than `max_lag` samples each): its means removed,
-    /// its lag sums for the lags `1 + dropped..=max_lag` (the first `dropped` lags not kept).
+    /// Adds one segment (`l` channels, samples enough for the lags, [`lag_span`]): its means
+    /// removed, its lag sums for the lags `first_lag..=first_lag + 2 block_rows - 2`.
     fn push_segment(
         &mut self,
         seg: &[&[f64]],
         l: usize,
         refs: &[usize],
         block_rows: usize,
-        max_lag: usize,
-        dropped: usize,
+        first_lag: usize,
     ) -> Result<(), SsiError> {
         if seg.len() != l {
             return Err(SsiError::LengthMismatch {
@@ -214,12 +275,14 @@ impl SsiCorrelations {
             });
         }
         let n = check_channels(seg)?;
-        if n <= max_lag {
+        let (max_lag, min_samples) = lag_span(block_rows, first_lag)?;
+        if n < min_samples {
             return Err(SsiError::TooFewSamples {
                 n_samples: n,
                 block_rows,
+                first_lag,
                 max_lag,
-                min_samples: max_lag + 1,
+                min_samples,
             });
         }
         let demeaned = demeaned(seg, n);
@@ -227,9 +290,7 @@ impl SsiCorrelations {
             .iter()
             .flatten()
             .fold(self.max_abs, |m, v| m.max(v.abs()));
-        let (mut sums, mut counts) = lag_sums(&demeaned, refs, max_lag, 0..n);
-        sums.drain(..dropped);
-        counts.drain(..dropped);
+        let (sums, counts) = lag_sums(&demeaned, refs, first_lag..=max_lag, 0..n);
         self.sums.push(sums);
         self.counts.push(counts);
         self.n_samples.push(n);
@@ -242,8 +303,10 @@ impl SsiCorrelations {
     /// `[b N / n_blocks, (b + 1) N / n_blocks)` (and `t < N - k`). Every product of the record
     /// is in exactly one block, so [`SsiCorrelations::plan`] is the plan of the whole record
     /// ([`SsiCov::new`]); the blocks' scatter gives [`SsiCorrelations::perturbation`] and
-    /// [`SsiCorrelations::jackknife`]. Needs `n_blocks >= 2` and at least
-    /// `first_lag + 2 block_rows - 1` samples per block (`SsiError::BlocksTooShort`).
+    /// [`SsiCorrelations::jackknife`]. Needs `n_blocks >= 2`, the record's samples as for
+    /// [`SsiCorrelations::new`], at least `first_lag + 2 block_rows - 1` samples per block
+    /// (`SsiError::BlocksTooShort`), and the uncertainty's SVDs within
+    /// [`vibmode_core::limits::SSI_SVD_WORK_MAX`] (`SsiError::TooManyBlocks`).
     pub fn blocks(
         channels: &[&[f64]],
         fs_hz: f64,
@@ -257,10 +320,33 @@ impl SsiCorrelations {
         let mut out = SsiCorrelations::empty(fs_hz, params);
         let n = check_channels(channels)?;
         let l = channels.len();
+        let rows = check_matrix_size(params.block_rows, l)?;
         let refs = reference_indices(params, l)?;
-        let max_lag = 2 * params.block_rows - 1 + (params.first_lag - 1);
+        let (max_lag, min_samples) = lag_span(params.block_rows, params.first_lag)?;
+        if n < min_samples {
+            return Err(SsiError::TooFewSamples {
+                n_samples: n,
+                block_rows: params.block_rows,
+                first_lag: params.first_lag,
+                max_lag,
+                min_samples,
+            });
+        }
         if n_blocks < 2 {
             return Err(SsiError::TooFewBlocks { n_blocks });
+        }
+        // One SVD of the whole record's matrix and two per block.
+        let cols = params.block_rows * refs.len();
+        let svd_work = (rows as u64) * (rows as u64) * (cols as u64);
+        let max_blocks =
+            (vibmode_core::limits::SSI_SVD_WORK_MAX / svd_work.max(1)).saturating_sub(1) / 2;
+        if n_blocks as u64 > max_blocks {
+            return Err(SsiError::TooManyBlocks {
+                n_blocks,
+                rows,
+                cols,
+                max_blocks: usize::try_from(max_blocks).unwrap_or(usize::MAX),
+            });
         }
         let block_len = n / n_blocks;
         if block_len <= max_lag {
@@ -276,7 +362,7 @@ impl SsiCorrelations {
         out.max_abs = demeaned.iter().flatten().fold(0.0, |m, v| m.max(v.abs()));
         for b in 0..n_blocks {
             let (t0, t1) = (b * n / n_blocks, (b + 1) * n / n_blocks);
-            let (sums, counts) = lag_sums(&demeaned, &refs, max_lag, t0..t1);
+            let (sums, counts) = lag_sums(&demeaned, &refs, params.first_lag..=max_lag, t0..t1);
             out.sums.push(sums);
             out.counts.push(counts);
             out.n_samples.push(t1 - t0);
@@ -290,7 +376,7 @@ impl SsiCorrelations {
             fs_hz,
             order_max: params.order_max,
             block_rows: params.block_rows,
-            skip: params.first_lag - 1,
+            first_lag: params.first_lag,
             sums: Vec::new(),
             counts: Vec::new(),
             n_samples: Vec::new(),
@@ -327,7 +413,7 @@ impl SsiCorrelations {
             .collect()
     }
 
-    /// Per lag `1..=max_lag`: the sum of the products of every segment `s` but those with
+    /// Per lag of the Toeplitz matrix (`first_lag..`): the sum of the products of every segment `s` but those with
     /// `left_out(s)`, and their number.
     pub(crate) fn totals(&self, left_out: impl Fn(usize) -> bool) -> Vec<(DMatrix<f64>, usize)> {
         let max_lag = self.sums.first().map_or(0, Vec::len);
@@ -355,16 +441,11 @@ impl SsiCorrelations {
             .collect();
         if let Some(k) = r.iter().position(|m| m.iter().any(|v| !v.is_finite())) {
             return Err(SsiError::Overflow {
-                lag: k + 1,
+                lag: self.first_lag.saturating_add(k),
                 max_abs: self.max_abs,
             });
         }
-        let mut cov = SsiCov::from_correlations(
-            &r[self.skip..],
-            self.fs_hz,
-            self.block_rows,
-            self.order_max,
-        )?;
+        let mut cov = SsiCov::from_correlations(&r, self.fs_hz, self.block_rows, self.order_max)?;
         cov.n_samples = used().map(|s| self.n_samples[s]).sum();
         Ok(cov)
     }
@@ -398,18 +479,19 @@ fn reference_indices(params: &SsiParams, l: usize) -> Result<Vec<usize>, SsiErro
     }
 }
 
-/// For the lags `k = 1..=max_lag`: `sum_{t in ts, t < N - k} y[t+k] y[refs][t]^T` and the number
-/// of products (`N` the channels' length).
+/// For the lags `k` of `lags`: `sum_{t in ts, t < N - k} y[t+k] y[refs][t]^T` and the number
+/// of products (`N` the channels' length; `lags` within `1..N`, checked by the callers).
 fn lag_sums(
     y: &[Vec<f64>],
     refs: &[usize],
-    max_lag: usize,
+    lags: std::ops::RangeInclusive<usize>,
     ts: std::ops::Range<usize>,
 ) -> (Vec<DMatrix<f64>>, Vec<usize>) {
     let n = y.first().map_or(0, Vec::len);
-    let mut sums = vec![DMatrix::zeros(y.len(), refs.len()); max_lag];
-    let mut counts = vec![0; max_lag];
-    for (k, (sum, count)) in (1..=max_lag).zip(sums.iter_mut().zip(counts.iter_mut())) {
+    let n_lags = lags.clone().count();
+    let mut sums = vec![DMatrix::zeros(y.len(), refs.len()); n_lags];
+    let mut counts = vec![0; n_lags];
+    for (k, (sum, count)) in lags.zip(sums.iter_mut().zip(counts.iter_mut())) {
         let t1 = ts.end.min(n.saturating_sub(k));
         if t1 <= ts.start {
             continue;

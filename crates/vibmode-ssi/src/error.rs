@@ -80,17 +80,65 @@ pub enum SsiError {
         /// Segments given.
         n_segments: usize,
     },
-    /// Too few samples for the lags of the block Toeplitz matrix.
-    #[error("{n_samples} samples per channel are too few for block_rows = {block_rows} (lags up to {max_lag}); pass at least {min_samples} samples or lower block_rows")]
+    /// Too few samples for the lags of the block Toeplitz matrix: a record (or segment) needs
+    /// `first_lag - 1 + 2 (2 block_rows - 1)` samples
+    /// ([`vibmode_core::limits::SSI_SAMPLES_PER_LAG_MIN`]), so that its largest lag's
+    /// correlation still averages as many products as the matrix has lags.
+    #[error("{n_samples} samples per channel are too few for block_rows = {block_rows} from first_lag = {first_lag} (lags {first_lag}..={max_lag}); pass at least {min_samples} samples, or lower block_rows or first_lag")]
     TooFewSamples {
         /// Samples per channel.
         n_samples: usize,
         /// Block rows asked for.
         block_rows: usize,
+        /// First lag of the Toeplitz matrix.
+        first_lag: usize,
         /// Largest lag of the Toeplitz matrix, `first_lag + 2 * block_rows - 2`.
         max_lag: usize,
-        /// Smallest number of samples accepted, `max_lag + 1`.
+        /// Smallest number of samples accepted, `first_lag - 1 + 2 (2 block_rows - 1)`.
         min_samples: usize,
+    },
+    /// A block Toeplitz matrix with more than
+    /// [`vibmode_core::limits::SSI_TOEPLITZ_ROWS_MAX`] rows (`block_rows x channels`).
+    #[error("block_rows = {block_rows} with {n_channels} channels makes a Toeplitz matrix of more than {max_rows} rows (block_rows x channels), too large to decompose; use at most block_rows = {max_block_rows} or fewer channels")]
+    MatrixTooLarge {
+        /// Block rows asked for.
+        block_rows: usize,
+        /// Number of channels.
+        n_channels: usize,
+        /// Most rows accepted.
+        max_rows: usize,
+        /// Most block rows for these channels.
+        max_block_rows: usize,
+    },
+    /// Lags whose arithmetic overflows (a first lag far beyond any record).
+    #[error("first_lag = {first_lag} with block_rows = {block_rows} puts the Toeplitz matrix's lags beyond any record (at most 2^30 samples); lower first_lag")]
+    LagsTooLarge {
+        /// Block rows asked for.
+        block_rows: usize,
+        /// First lag asked for.
+        first_lag: usize,
+    },
+    /// More uncertainty blocks than [`vibmode_core::limits::SSI_SVD_WORK_MAX`] allows for the
+    /// size of the Toeplitz matrix (two SVDs per block).
+    #[error("{n_blocks} uncertainty blocks need {n_blocks} x 2 SVDs of a {rows} x {cols} Toeplitz matrix, too much work; use at most {max_blocks} blocks or lower block_rows")]
+    TooManyBlocks {
+        /// Blocks asked for.
+        n_blocks: usize,
+        /// Rows of the Toeplitz matrix.
+        rows: usize,
+        /// Columns of the Toeplitz matrix.
+        cols: usize,
+        /// Most blocks allowed at this size.
+        max_blocks: usize,
+    },
+    /// A list of model orders that is empty, not increasing, or holds an order outside
+    /// `1..=`[`vibmode_core::limits::SSI_ORDER_MAX`].
+    #[error("model orders {orders} must be increasing orders from 1 to {max}, e.g. 2, 4, 6")]
+    OrderList {
+        /// The list given (its start, at most 60 characters).
+        orders: String,
+        /// Highest order accepted.
+        max: usize,
     },
     /// A reference channel index that is not a channel of the data.
     #[error("reference channel {index} does not exist: there are {n_channels} channels (0-based indices 0..={last}); list existing channels in reference_channels")]

@@ -24,7 +24,9 @@ mod record;
 mod shape;
 mod stability;
 
-pub use cov::{jackknife_std, ssi_cov, SsiCorrelations, SsiCov, SsiMode, SsiOrder, SsiResult};
+pub use cov::{
+    jackknife_std, samples_needed, ssi_cov, SsiCorrelations, SsiCov, SsiMode, SsiOrder, SsiResult,
+};
 pub use error::SsiError;
 pub use perturb::{PoleStd, SsiPerturbation};
 pub use record::{identify_record, RecordSsi, RecordSsiOptions};

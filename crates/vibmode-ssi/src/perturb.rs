@@ -60,16 +60,13 @@ impl SsiCorrelations {
         let plan = self.plan()?;
         let totals = self.totals(|_| false);
         let max_lag = totals.len();
-        let r_bar: Vec<DMatrix<f64>> = totals[self.skip..]
-            .iter()
-            .map(|(t, c)| t / (*c).max(1) as f64)
-            .collect();
+        let r_bar: Vec<DMatrix<f64>> = totals.iter().map(|(t, c)| t / (*c).max(1) as f64).collect();
         let norm = |r: &[DMatrix<f64>]| r.iter().map(|x| x.norm_squared()).sum::<f64>().sqrt();
         let r_norm = norm(&r_bar);
         let scale = (m as f64 / (m as f64 - 1.0)).sqrt();
         let mut moved = Vec::with_capacity(m);
         for s in 0..m {
-            let d: Vec<DMatrix<f64>> = (self.skip..max_lag)
+            let d: Vec<DMatrix<f64>> = (0..max_lag)
                 .zip(&r_bar)
                 .map(|(k, rb)| {
                     let (total, count) = &totals[k];
@@ -201,7 +198,7 @@ mod tests {
             fs_hz: 20.0,
             order_max: 2,
             block_rows: i,
-            skip: 0,
+            first_lag: 1,
             counts: vec![vec![count; 2 * i - 1]; m],
             n_samples: vec![count; m],
             sums: blocks,

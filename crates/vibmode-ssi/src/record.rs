@@ -62,6 +62,11 @@ pub struct RecordSsiOptions {
     /// ([`crate::SsiPerturbation`]; default none). 20 to 50 are usual; each block needs
     /// `first_lag + 2 block_rows - 1` samples. Costs two SVDs of the Toeplitz matrix per block.
     pub uncertainty_blocks: Option<usize>,
+    /// The model orders to identify, increasing, from 1 to
+    /// [`vibmode_core::limits::SSI_ORDER_MAX`] (default none: `params.orders()`, the range
+    /// `order_min..=order_max` by `order_step`). A list such as `[10, 20, 35]` is identified as
+    /// listed.
+    pub orders: Option<Vec<usize>>,
 }
 
 impl Default for RecordSsiOptions {
@@ -72,7 +77,21 @@ impl Default for RecordSsiOptions {
             stability: StabilityParams::default(),
             cluster: ClusterParams::default(),
             uncertainty_blocks: None,
+            orders: None,
         }
+    }
+}
+
+/// The orders of `list`, checked: not empty, increasing, each in `1..=SSI_ORDER_MAX`.
+fn checked_orders(list: &[usize]) -> Result<Vec<usize>, SsiError> {
+    let max = vibmode_core::limits::SSI_ORDER_MAX;
+    let increasing = list.windows(2).all(|w| w[0] < w[1]);
+    match (list.first(), list.last()) {
+        (Some(&lo), Some(&hi)) if increasing && lo >= 1 && hi <= max => Ok(list.to_vec()),
+        _ => Err(SsiError::OrderList {
+            orders: vibmode_core::quoted(&format!("{list:?}")).to_string(),
+            max,
+        }),
     }
 }
 
@@ -99,8 +118,10 @@ fn rms_scales(channels: &[&[f64]]) -> Vec<f64> {
 /// (`vibmode_modal::find_invariant_modes` with one record: a structural mode must recur in
 /// `min_order_share` of the orders).
 ///
-/// Errors: those of [`SsiCov::new`] (channels, samples, parameters), no order of `params`
-/// identifiable ([`SsiError::NoOrder`]), a clustering parameter out of range.
+/// Errors: those of [`SsiCov::new`] (channels, samples, parameters), an order list that is not
+/// increasing orders from 1 to [`vibmode_core::limits::SSI_ORDER_MAX`] ([`SsiError::OrderList`]),
+/// no order of `params` identifiable ([`SsiError::NoOrder`]), a clustering parameter out of
+/// range.
 pub fn identify_record(
     channels: &[&[f64]],
     fs_hz: f64,
@@ -108,6 +129,10 @@ pub fn identify_record(
     options: &RecordSsiOptions,
 ) -> Result<RecordSsi, SsiError> {
     params.validate()?;
+    let wanted = match &options.orders {
+        Some(list) => checked_orders(list)?,
+        None => params.orders(),
+    };
     let scales = if options.normalise {
         rms_scales(channels)
     } else {
@@ -133,14 +158,14 @@ pub fn identify_record(
             &own_plan
         }
     };
-    let orders: Vec<usize> = params
-        .orders()
-        .into_iter()
+    let orders: Vec<usize> = wanted
+        .iter()
+        .copied()
         .filter(|&o| o <= plan.max_order())
         .collect();
     if orders.is_empty() {
         return Err(SsiError::NoOrder {
-            order_min: params.order_min,
+            order_min: wanted.first().copied().unwrap_or(params.order_min),
             n_channels: channels.len(),
             block_rows: params.block_rows,
             max_order: plan.max_order(),

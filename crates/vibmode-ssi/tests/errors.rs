@@ -116,25 +116,27 @@ fn invalid_sample_rate() {
 
 #[test]
 fn too_few_samples_for_the_block_rows() {
-    let a = noise(39, 1);
+    // 20 block rows: 39 lags, each averaged over at least 39 products: 78 samples.
+    let a = noise(77, 1);
     let (e, m) = msg(ssi_cov(&[&a], 50.0, &params(20)));
     assert_eq!(
         e,
         SsiError::TooFewSamples {
-            n_samples: 39,
+            n_samples: 77,
             block_rows: 20,
+            first_lag: 1,
             max_lag: 39,
-            min_samples: 40
+            min_samples: 78
         }
     );
     assert!(
-        m.contains("39 samples") && m.contains("block_rows = 20") && m.contains("at least 40"),
+        m.contains("77 samples") && m.contains("block_rows = 20") && m.contains("at least 78"),
         "{m}"
     );
-    // Exactly 2 i samples is accepted.
-    let a = noise(40, 1);
+    // Exactly 2 (2 i - 1) samples is accepted.
+    let a = noise(78, 1);
     assert!(SsiCov::new(&[&a], 50.0, &params(20)).is_ok());
-    // A later first lag needs as many more samples: lags 11..=49 need 50.
+    // A later first lag needs as many more samples: lags 11..=49 need 88.
     let p = SsiParams {
         first_lag: 11,
         ..params(20)
@@ -143,17 +145,18 @@ fn too_few_samples_for_the_block_rows() {
     assert_eq!(
         e,
         SsiError::TooFewSamples {
-            n_samples: 40,
+            n_samples: 78,
             block_rows: 20,
+            first_lag: 11,
             max_lag: 49,
-            min_samples: 50
+            min_samples: 88
         }
     );
     assert!(
-        m.contains("lags up to 49") && m.contains("at least 50"),
+        m.contains("lags 11..=49") && m.contains("at least 88"),
         "{m}"
     );
-    assert!(SsiCov::new(&[&noise(50, 1)], 50.0, &p).is_ok());
+    assert!(SsiCov::new(&[&noise(88, 1)], 50.0, &p).is_ok());
     let (_, m) = msg(ssi_cov(
         &[&a],
         50.0,
@@ -405,4 +408,175 @@ fn perturbation_blocks_too_short_or_too_few() {
         ),
         "{e:?}"
     );
+}
+
+/// Issue 28: `--first-lag 18446744073709551615` panicked (a range start out of range) and a huge
+/// `block_rows` wrapped around; the library refuses both, naming the value, on every entry point.
+#[test]
+fn huge_first_lag_and_block_rows_are_refused_not_wrapped() {
+    let (a, b) = (noise(2048, 1), noise(2048, 2));
+    for (p, needle) in [
+        (
+            SsiParams {
+                first_lag: usize::MAX,
+                ..params(20)
+            },
+            "first_lag = 18446744073709551615",
+        ),
+        (
+            SsiParams {
+                block_rows: usize::MAX,
+                ..params(20)
+            },
+            "block_rows = 18446744073709551615",
+        ),
+        (
+            SsiParams {
+                block_rows: usize::MAX / 2 + 1,
+                ..params(20)
+            },
+            "block_rows = 9223372036854775808",
+        ),
+    ] {
+        let (e, m) = msg(ssi_cov(&[&a, &b], 50.0, &p));
+        assert!(matches!(e, SsiError::Param(_)), "{e:?}");
+        assert!(m.contains(needle), "{m}");
+        let segs = [vec![a.as_slice(), b.as_slice()]];
+        let (_, m) = msg(vibmode_ssi::SsiCorrelations::new(&segs, 50.0, &p));
+        assert!(m.contains(needle), "{m}");
+        let (_, m) = msg(SsiCov::perturbation(&[&a, &b], 50.0, &p, 4));
+        assert!(m.contains(needle), "{m}");
+    }
+    // Per-segment first lags are checked as well.
+    let segs = [vec![a.as_slice(), b.as_slice()]];
+    let (e, m) = msg(vibmode_ssi::SsiCorrelations::with_first_lags(
+        &segs,
+        50.0,
+        &params(20),
+        &[usize::MAX],
+    ));
+    assert!(matches!(e, SsiError::LagsTooLarge { .. }), "{e:?}");
+    assert!(m.contains("first_lag = 18446744073709551615"), "{m}");
+    // A first lag within the bound but beyond the record: too few samples, named.
+    let p = SsiParams {
+        first_lag: 1 << 30,
+        ..params(20)
+    };
+    let (e, m) = msg(ssi_cov(&[&a, &b], 50.0, &p));
+    assert!(
+        matches!(
+            e,
+            SsiError::TooFewSamples {
+                n_samples: 2048,
+                first_lag: 1073741824,
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    assert!(m.contains("at least 1073741901"), "{m}");
+}
+
+/// Issue 28: 1000 block rows on a 2048-sample record ran for minutes (a 1000 x 1000 SVD from
+/// correlations of a few products each). The record's length bounds the block rows, and the
+/// Toeplitz matrix's size is bounded whatever the length.
+#[test]
+fn block_rows_are_bounded_by_the_record_and_the_matrix_size() {
+    let a = noise(2048, 1);
+    let (e, m) = msg(ssi_cov(&[&a], 50.0, &params(1000)));
+    assert_eq!(
+        e,
+        SsiError::TooFewSamples {
+            n_samples: 2048,
+            block_rows: 1000,
+            first_lag: 1,
+            max_lag: 1999,
+            min_samples: 3998
+        }
+    );
+    assert!(m.contains("block_rows = 1000") && m.contains("3998"), "{m}");
+    // The largest block rows this record allows: 2 (2 i - 1) <= 2048.
+    let one = [vec![a.as_slice()]];
+    assert!(vibmode_ssi::SsiCorrelations::new(&one, 50.0, &params(512)).is_ok());
+    assert!(matches!(
+        vibmode_ssi::SsiCorrelations::new(&one, 50.0, &params(513)).unwrap_err(),
+        SsiError::TooFewSamples { .. }
+    ));
+    // 600 block rows of 2 channels: 1200 rows, above the 1024 the SVD is allowed, however long
+    // the record.
+    let (c, d) = (noise(5000, 3), noise(5000, 4));
+    let (e, m) = msg(SsiCov::new(&[&c, &d], 50.0, &params(600)));
+    assert_eq!(
+        e,
+        SsiError::MatrixTooLarge {
+            block_rows: 600,
+            n_channels: 2,
+            max_rows: 1024,
+            max_block_rows: 512
+        }
+    );
+    assert!(
+        m.contains("block_rows = 600 with 2 channels") && m.contains("block_rows = 512"),
+        "{m}"
+    );
+    let (e, _) = msg(SsiCov::perturbation(&[&c, &d], 50.0, &params(600), 2));
+    assert!(matches!(e, SsiError::MatrixTooLarge { .. }), "{e:?}");
+}
+
+/// Uncertainty blocks cost two SVDs each: their number is bounded by the matrix size.
+#[test]
+fn uncertainty_blocks_are_bounded_by_the_svd_work() {
+    let (a, b) = (noise(40_000, 1), noise(40_000, 2));
+    // 256 block rows of 2 channels: a 512 x 512 matrix, 2^27 work per SVD: at most 31 blocks.
+    let p = SsiParams {
+        block_rows: 256,
+        ..params(256)
+    };
+    let (e, m) = msg(SsiCov::perturbation(&[&a, &b], 50.0, &p, 40));
+    assert_eq!(
+        e,
+        SsiError::TooManyBlocks {
+            n_blocks: 40,
+            rows: 512,
+            cols: 512,
+            max_blocks: 31
+        }
+    );
+    assert!(m.contains("at most 31 blocks"), "{m}");
+}
+
+/// Issue 28: an order list is identified as listed (`10, 20, 35` once ran 10, 20, 30), and a
+/// list that is not increasing orders within the bound is refused.
+#[test]
+fn order_lists_are_taken_as_listed() {
+    let y: Vec<Vec<f64>> = (0..4).map(|c| noise(4000, c)).collect();
+    let chans: Vec<&[f64]> = y.iter().map(Vec::as_slice).collect();
+    let p = SsiParams {
+        block_rows: 12,
+        ..SsiParams::default()
+    };
+    let options = vibmode_ssi::RecordSsiOptions {
+        orders: Some(vec![10, 20, 35]),
+        ..Default::default()
+    };
+    let r = vibmode_ssi::identify_record(&chans, 50.0, &p, &options).unwrap();
+    let got: Vec<usize> = r.result.orders.iter().map(|o| o.order).collect();
+    assert_eq!(got, vec![10, 20, 35]);
+    for bad in [vec![], vec![0, 2], vec![4, 2], vec![2, 2], vec![2, 5000]] {
+        let options = vibmode_ssi::RecordSsiOptions {
+            orders: Some(bad.clone()),
+            ..Default::default()
+        };
+        let (e, m) = msg(vibmode_ssi::identify_record(&chans, 50.0, &p, &options));
+        assert!(matches!(e, SsiError::OrderList { .. }), "{bad:?}: {e:?}");
+        assert!(m.contains("increasing orders from 1 to 1024"), "{m}");
+    }
+    // A list of 10^5 orders is quoted in at most 60 characters.
+    let long: Vec<usize> = (1..100_000).rev().collect();
+    let options = vibmode_ssi::RecordSsiOptions {
+        orders: Some(long),
+        ..Default::default()
+    };
+    let (_, m) = msg(vibmode_ssi::identify_record(&chans, 50.0, &p, &options));
+    assert!(m.len() < 200, "{m}");
 }
