@@ -106,6 +106,9 @@ pub fn plan(
             bail!("give either --gps TRACK or --by-vibration, not both");
         }
         let track = vibmode_segment::read_track(track_path)?;
+        if let Some(note) = track.dropped_note() {
+            eprintln!("GPS track {}: {note}", track_path.display());
+        }
         let mut s = open(path, opts, sel)?;
         let n = frames(&mut s)?;
         let s = open(path, opts, sel)?;
@@ -152,9 +155,11 @@ pub fn summary(seg: &Segmentation) -> String {
         .gps
         .as_ref()
         .map(|g| {
+            let dropped: usize = g.dropped_fixes.values().sum();
+            let incomplete: usize = g.incomplete_sentences.values().sum();
             format!(
-                "; GPS: {} fixes, {} unparseable sentences skipped",
-                g.n_fixes, g.n_bad_sentences
+                "; GPS: {} fixes, {} unparseable and {} incomplete sentences skipped, {} invalid fixes dropped",
+                g.n_fixes, g.n_bad_sentences, incomplete, dropped
             )
         })
         .unwrap_or_default();

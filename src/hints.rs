@@ -3,6 +3,7 @@
 
 use vibmode_analysis::AnalysisError;
 use vibmode_core::RecordingError;
+use vibmode_segment::SegmentError;
 use vibmode_signal::SignalError;
 
 /// The flag that fixes `e`, if the error is one a flag fixes.
@@ -24,8 +25,24 @@ pub fn hint(e: &anyhow::Error) -> Option<&'static str> {
         if let Some(r) = cause.downcast_ref::<RecordingError>() {
             return recording_hint(r);
         }
+        if let Some(s) = cause.downcast_ref::<SegmentError>() {
+            return segment_hint(s);
+        }
     }
     None
+}
+
+fn segment_hint(e: &SegmentError) -> Option<&'static str> {
+    match e {
+        SegmentError::InvalidParam { name, .. } => Some(match *name {
+            "record_length_s" => "--record-length-s SECONDS",
+            "gps_offset_s" => "--gps-offset-s SECONDS",
+            _ => "set it in the --segment-config file",
+        }),
+        SegmentError::NoOverlap { .. } => Some("--gps-offset-s SECONDS"),
+        SegmentError::Signal(s) => signal_hint(s),
+        _ => None,
+    }
 }
 
 fn signal_hint(e: &SignalError) -> Option<&'static str> {

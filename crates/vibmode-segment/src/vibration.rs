@@ -71,8 +71,38 @@ pub fn by_vibration(
     p: &SegmentParams,
 ) -> Result<(Segmentation, Vec<VibrationWindow>), SegmentError> {
     p.validate(record_length_s)?;
+    if p.window_s > record_length_s {
+        return Err(SegmentError::InvalidParam {
+            name: "window_s",
+            value: p.window_s,
+            rule: format!(
+                "at most the record length ({} s; window_s defaults to 1): give a longer record length or a shorter window_s",
+                vibmode_core::Num(record_length_s)
+            ),
+        });
+    }
     let info = stream.info().clone();
     let nch = info.n_channels();
+    let check_cells = |n_windows: f64| {
+        if n_windows * nch as f64 > crate::VIBRATION_CELLS_MAX {
+            Err(SegmentError::InvalidParam {
+                name: "window_s",
+                value: p.window_s,
+                rule: format!(
+                    "long enough for at most {} windows x channels ({} channels here), e.g. 1",
+                    crate::VIBRATION_CELLS_MAX,
+                    nch
+                ),
+            })
+        } else {
+            Ok(())
+        }
+    };
+    if let Some(n) = info.n_frames {
+        let duration_s = check_length(&info, n, record_length_s)?;
+        p.check_work(record_length_s, info.fs_hz, duration_s, false)?;
+        check_cells(duration_s / p.window_s)?;
+    }
     // Road-induced body and axle motion lies below ~8 Hz; an idling engine's lines lie above
     // (Bratislava bus: 0.5-8 Hz RMS falls to 0.15-0.4 of the median at a stop, 8-40 Hz does not).
     let factor = (info.fs_hz / 20.0).floor().max(1.0);
@@ -125,6 +155,7 @@ pub fn by_vibration(
             d.extend_from_slice(&c);
         }
         consume(&mut pending, &mut stats);
+        check_cells(stats.len() as f64)?;
     }
     if let Some(f) = fir.as_mut() {
         for (d, c) in pending.iter_mut().zip(f.finish()) {
@@ -134,6 +165,7 @@ pub fn by_vibration(
     }
     let n_frames = stream.position();
     let duration_s = check_length(&info, n_frames, record_length_s)?;
+    p.check_work(record_length_s, info.fs_hz, duration_s, false)?;
     let start_unix = recording_start(&info)?;
     let window_s = win_n as f64 / fs_d;
     let nw = stats.len();
@@ -188,16 +220,20 @@ pub fn by_vibration(
             }
         })
         .collect();
-    // Guard windows next to stops and manoeuvres.
-    let guard = (p.guard_s / window_s).ceil() as usize;
-    let bad: Vec<bool> = windows.iter().map(|w| w.skip.is_some()).collect();
+    // Guard windows next to stops and manoeuvres (a prefix count of the bad windows: one pass
+    // whatever guard_s is).
+    let guard = (p.guard_s / window_s).ceil().min(nw as f64) as usize;
+    let mut n_bad = vec![0usize; nw + 1];
     for w in 0..nw {
-        if bad[w] {
+        n_bad[w + 1] = n_bad[w] + usize::from(windows[w].skip.is_some());
+    }
+    for w in 0..nw {
+        if windows[w].skip.is_some() {
             continue;
         }
         let lo = w.saturating_sub(guard);
         let hi = (w + guard + 1).min(nw);
-        if (lo..hi).any(|k| bad[k]) {
+        if n_bad[hi] > n_bad[lo] {
             windows[w].skip = Some(SkipReason::Transition);
         }
     }
