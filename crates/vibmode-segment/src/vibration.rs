@@ -71,6 +71,8 @@ pub fn by_vibration(
     p: &SegmentParams,
 ) -> Result<(Segmentation, Vec<VibrationWindow>), SegmentError> {
     p.validate(record_length_s)?;
+    // The record length against the rate first (no duration yet), then the window against it.
+    p.check_work(record_length_s, stream.info().fs_hz, 0.0, false)?;
     if p.window_s > record_length_s {
         return Err(SegmentError::InvalidParam {
             name: "window_s",
@@ -89,7 +91,7 @@ pub fn by_vibration(
                 name: "window_s",
                 value: p.window_s,
                 rule: format!(
-                    "long enough for at most {} windows x channels ({} channels here), e.g. 1",
+                    "long enough for at most {} windows x channels ({} channels here; a window is at least 2 samples at about 20 Hz), e.g. 1",
                     crate::VIBRATION_CELLS_MAX,
                     nch
                 ),
@@ -101,7 +103,6 @@ pub fn by_vibration(
     if let Some(n) = info.n_frames {
         let duration_s = check_length(&info, n, record_length_s)?;
         p.check_work(record_length_s, info.fs_hz, duration_s, false)?;
-        check_cells(duration_s / p.window_s)?;
     }
     // Road-induced body and axle motion lies below ~8 Hz; an idling engine's lines lie above
     // (Bratislava bus: 0.5-8 Hz RMS falls to 0.15-0.4 of the median at a stop, 8-40 Hz does not).
@@ -122,6 +123,10 @@ pub fn by_vibration(
     };
     let fs_d = fir.as_ref().map_or(info.fs_hz, FirDecimator::fs_out_hz);
     let win_n = ((p.window_s * fs_d).round() as usize).max(2);
+    if let Some(n) = info.n_frames {
+        // Windows of win_n decimated samples.
+        check_cells(n as f64 / info.fs_hz * fs_d / win_n as f64)?;
+    }
     let mut pending: Vec<Vec<f64>> = vec![Vec::new(); nch];
     // Per window: per channel (mean, rms about the mean).
     let mut stats: Vec<Vec<(f64, f64)>> = Vec::new();
