@@ -422,4 +422,34 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn cruising_fixes_follow_the_cruise_speed_and_gga_carries_every_fix() {
+        for cruise in [1.0, 30.0, 120.0, 500.0] {
+            let mut p = DriveParams::new(900.0, 4);
+            p.cruise_kmh = cruise;
+            let d = simulate_drive(&p);
+            let v: Vec<f64> = d
+                .fixes
+                .iter()
+                .filter(|f| {
+                    d.phases_in(f.t_s - 0.5, f.t_s + 0.5)
+                        .iter()
+                        .all(|k| k.0 == PhaseKind::Cruise)
+                })
+                .map(|f| f.speed_kmh)
+                .collect();
+            assert!(v.len() > 100, "{cruise}: {} cruising fixes", v.len());
+            let mean = v.iter().sum::<f64>() / v.len() as f64;
+            assert!(
+                mean > 0.6 * cruise && mean < 1.4 * cruise + 0.3,
+                "cruise {cruise}: mean {mean}"
+            );
+            assert!(d.fixes.iter().all(|f| f.speed_kmh <= 1.45 * cruise + 0.3));
+        }
+        let d = simulate_drive(&DriveParams::new(30.0, 1));
+        let gga = d.to_nmea_gga();
+        assert_eq!(gga.lines().count(), d.fixes.len());
+        assert!(gga.lines().all(|l| l.starts_with("$GPGGA,")));
+    }
 }
