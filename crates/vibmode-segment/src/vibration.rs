@@ -228,18 +228,19 @@ pub fn by_vibration(
     // Guard windows next to stops and manoeuvres (a prefix count of the bad windows: one pass
     // whatever guard_s is).
     let guard = (p.guard_s / window_s).ceil().min(nw as f64) as usize;
-    let mut n_bad = vec![0usize; nw + 1];
-    for w in 0..nw {
-        n_bad[w + 1] = n_bad[w] + usize::from(windows[w].skip.is_some());
+    let mut n_bad = Vec::with_capacity(nw + 1);
+    n_bad.push(0usize);
+    for win in &windows {
+        n_bad.push(n_bad[n_bad.len() - 1] + usize::from(win.skip.is_some()));
     }
-    for w in 0..nw {
-        if windows[w].skip.is_some() {
+    for (w, win) in windows.iter_mut().enumerate() {
+        if win.skip.is_some() {
             continue;
         }
         let lo = w.saturating_sub(guard);
         let hi = (w + guard + 1).min(nw);
         if n_bad[hi] > n_bad[lo] {
-            windows[w].skip = Some(SkipReason::Transition);
+            win.skip = Some(SkipReason::Transition);
         }
     }
     let mut seg = empty_segmentation(
