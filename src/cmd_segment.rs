@@ -157,10 +157,17 @@ pub fn summary(seg: &Segmentation) -> String {
         .map(|g| {
             let dropped: usize = g.dropped_fixes.values().sum();
             let incomplete: usize = g.incomplete_sentences.values().sum();
-            format!(
-                "; GPS: {} fixes, {} unparseable and {} incomplete sentences skipped, {} invalid fixes dropped",
-                g.n_fixes, g.n_bad_sentences, incomplete, dropped
-            )
+            let mut t = format!(
+                "; GPS: {} fixes, {} unparseable sentences skipped",
+                g.n_fixes, g.n_bad_sentences
+            );
+            if incomplete > 0 {
+                t += &format!(", {incomplete} sentences without a fix skipped");
+            }
+            if dropped > 0 {
+                t += &format!(", {dropped} invalid fixes dropped");
+            }
+            t
         })
         .unwrap_or_default();
     format!(
