@@ -115,6 +115,20 @@ pub(crate) fn reasons(counts: &BTreeMap<String, usize>) -> String {
         .join(", ")
 }
 
+/// A library's message for ours: control characters shown as `?`, at most 160 characters
+/// (it may carry pieces of the input).
+fn short(msg: &str) -> String {
+    let mut out: String = msg
+        .chars()
+        .take(160)
+        .map(|c| if c.is_control() { '?' } else { c })
+        .collect();
+    if msg.chars().nth(160).is_some() {
+        out.push_str("...");
+    }
+    out
+}
+
 /// Why a fix is invalid, or `None` when it passes (see the module documentation).
 pub fn fix_problem(f: &GpsFix) -> Option<&'static str> {
     if !f.t_s.is_finite() {
@@ -321,14 +335,20 @@ fn raw_track(p: &str, format: TrackFormat, fixes: Vec<GpsFix>, absolute: bool) -
 }
 
 fn read_gpx(text: &str, p: &str) -> Result<Raw, SegmentError> {
-    let g = gpx::read(text.as_bytes()).map_err(|e| {
-        track_err(
+    let g = gpx::read(text.as_bytes()).map_err(|e| match e {
+        // The GPX reader refuses a coordinate out of range for the whole file (such a file is
+        // not valid GPX); the value is named, short.
+        gpx::errors::GpxError::LonLatOutOfBoundsError(name, range, v) => track_err(
             p,
             format!(
-                "{}; check that it is a valid GPX file",
-                quoted(&e.to_string())
+                "{name} {} is outside {range} degrees, which makes the file invalid GPX; fix or delete that point",
+                Num(v)
             ),
-        )
+        ),
+        e => track_err(
+            p,
+            format!("{}; check that it is a valid GPX file", short(&e.to_string())),
+        ),
     })?;
     let mut points: Vec<&gpx::Waypoint> = g
         .tracks
@@ -491,7 +511,7 @@ fn read_csv(text: &str, p: &str) -> Result<Raw, SegmentError> {
                 p,
                 format!(
                     "{}; expected a header row like time,lat,lon,speed",
-                    quoted(&e.to_string())
+                    short(&e.to_string())
                 ),
             )
         })?
@@ -554,7 +574,7 @@ fn read_csv(text: &str, p: &str) -> Result<Raw, SegmentError> {
                 p,
                 format!(
                     "line {line}: {}; check the CSV quoting",
-                    quoted(&e.to_string())
+                    short(&e.to_string())
                 ),
             )
         })?;

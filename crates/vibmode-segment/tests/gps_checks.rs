@@ -544,3 +544,25 @@ fn messages_quote_at_most_a_short_printable_piece_of_the_input() {
         assert!(e.len() < 400 && !e.chars().any(char::is_control), "{e:?}");
     }
 }
+
+/// GPX alone checked coordinate ranges (its reader refuses such a file as a whole); the
+/// message now names the value in a short number (1e300 gave 300 digits) and stays one line.
+#[test]
+fn a_gpx_coordinate_out_of_range_is_refused_naming_the_value() {
+    let dir = tempfile::tempdir().unwrap();
+    let gpx = simulate_drive(&DriveParams::new(30.0, 1)).to_gpx();
+    for (attr, v) in [("lat", "95"), ("lat", "1e300"), ("lon", "-400")] {
+        let mut lines: Vec<String> = gpx.lines().map(str::to_string).collect();
+        let l = &mut lines[10];
+        let a = l.find(&format!("{attr}=\"")).unwrap() + attr.len() + 2;
+        let b = a + l[a..].find('"').unwrap();
+        l.replace_range(a..b, v);
+        let e = read_track(&write(dir.path(), "c.gpx", &lines.join("\n")))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!(" {v} is outside")) && e.len() < 300 && !e.contains('\n'),
+            "{e}"
+        );
+    }
+}
