@@ -37,13 +37,19 @@ impl SegmentOptions {
         match &self.segment_config {
             None => Ok(SegmentParams::default()),
             Some(p) => {
-                let text = std::fs::read_to_string(p)
+                let text = vibmode_core::files::read_text_capped(p)
                     .with_context(|| format!("cannot read --segment-config {}", p.display()))?;
                 toml::from_str(&text).map_err(|e| {
+                    // The message without the echoed source line, quoted short; the line number.
+                    let line = e
+                        .span()
+                        .and_then(|r| text.get(..r.start))
+                        .map(|t| t.matches('\n').count() + 1);
                     anyhow::anyhow!(
-                        "--segment-config {}: {}",
+                        "--segment-config {}{}: {}",
                         p.display(),
-                        e.to_string().replace('\n', " ")
+                        line.map(|l| format!(" line {l}")).unwrap_or_default(),
+                        vibmode_core::quoted(&e.message().replace('\n', " "))
                     )
                 })
             }

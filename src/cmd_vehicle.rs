@@ -156,9 +156,11 @@ pub fn write_simulation(
     };
     let mut paths = Vec::new();
     for (i, r) in sim.records.iter().enumerate() {
-        let path = dir.join(format!("record_{:02}.{ext}", i + 1));
+        let name = format!("record_{:02}.{ext}", i + 1);
+        let path = dir.join(&name);
+        // Named without the hidden staging folder it is written in.
         vibmode_signal::write_path(&path, &r.recording)
-            .with_context(|| format!("writing {}", path.display()))?;
+            .with_context(|| format!("writing {name}"))?;
         paths.push(path);
     }
     write_json(&dir.join("truth.json").to_string_lossy(), &sim.truth)?;
@@ -205,7 +207,7 @@ pub fn run_simulate(a: &SimulateArgs) -> Result<()> {
             ),
         ] {
             let path = out.path().join(name);
-            std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
+            std::fs::write(&path, text).with_context(|| format!("writing {name}"))?;
         }
         eprintln!(
             "wrote a {:.0} s GPS track (track.gpx, track.nmea, track.csv) and its true phases (drive_truth.json)",

@@ -319,3 +319,35 @@ fn simulate_speed_and_rate() {
         s(&bad),
     ]);
 }
+
+/// The segmentation config: a 500 kB key or a terminal escape in it is not echoed; the unknown
+/// key is named (short) with its line.
+#[test]
+fn segment_config_errors_are_short() {
+    let d = tempfile::tempdir().unwrap();
+    let input = recording(d.path(), "r.f32", 100.0, 30.0);
+    let cfg = d.path().join("seg.toml");
+    let out = d.path().join("out");
+    for (text, needles) in [
+        (
+            "step_s = 1\nmin_sped_kmh = 20\n".to_string(),
+            vec!["line 2", "min_sped_kmh"],
+        ),
+        (format!("{} = 1\n", "k".repeat(500_000)), vec!["line 1"]),
+        ("\u{1b}[2J = 1\n".to_string(), vec!["line 1"]),
+    ] {
+        std::fs::write(&cfg, text).unwrap();
+        let e = fails_with(
+            &[
+                "segment",
+                s(&input),
+                "--segment-config",
+                s(&cfg),
+                "-o",
+                s(&out),
+            ],
+            &needles,
+        );
+        assert!(!e.contains('\u{1b}'), "{e:?}");
+    }
+}
