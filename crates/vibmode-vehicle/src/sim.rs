@@ -874,7 +874,7 @@ fn speed_profile(
             return Err(invalid(
                 "manoeuvres",
                 format!("speed {:.2} m/s at t = {:.2} s", speed[k], t1),
-                format!("brakes the vehicle below {floor:.2} m/s (0.5 m/s, or half the initial speed when slower); reduce the braking longitudinal_accel_m_s2 or raise speed_kmh"),
+                format!("brakes the vehicle below {} m/s (the floor: 0.5 m/s, or half the initial speed when slower); reduce the braking longitudinal_accel_m_s2 or raise speed_kmh", vibmode_core::Num(floor)),
             ));
         }
     }
