@@ -28,8 +28,8 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use vibmode_core::{quoted, Num};
 
-/// Highest speed accepted from a GPS track, km/h: above any ground vehicle (the maglev speed record is
-/// 603 km/h); a larger value is a broken fix or a speed in the wrong unit.
+/// Highest speed accepted from a GPS track, km/h: above any ground vehicle (the maglev speed
+/// record is 603 km/h); a larger value is a broken fix or a speed in the wrong unit.
 pub const GPS_SPEED_KMH_MAX: f64 = 1000.0;
 /// Largest magnitude of a GPS time, s (Unix time 1e11 s is the year 5138).
 pub const GPS_TIME_ABS_MAX_S: f64 = 1e11;
