@@ -37,13 +37,19 @@ impl SegmentOptions {
         match &self.segment_config {
             None => Ok(SegmentParams::default()),
             Some(p) => {
-                let text = std::fs::read_to_string(p)
+                let text = vibmode_core::files::read_text_capped(p)
                     .with_context(|| format!("cannot read --segment-config {}", p.display()))?;
                 toml::from_str(&text).map_err(|e| {
+                    // The message without the echoed source line, quoted short; the line number.
+                    let line = e
+                        .span()
+                        .and_then(|r| text.get(..r.start))
+                        .map(|t| t.matches('\n').count() + 1);
                     anyhow::anyhow!(
-                        "--segment-config {}: {}",
+                        "--segment-config {}{}: {}",
                         p.display(),
-                        e.to_string().replace('\n', " ")
+                        line.map(|l| format!(" line {l}")).unwrap_or_default(),
+                        vibmode_core::quoted(&e.message().replace('\n', " "))
                     )
                 })
             }
@@ -106,6 +112,9 @@ pub fn plan(
             bail!("give either --gps TRACK or --by-vibration, not both");
         }
         let track = vibmode_segment::read_track(track_path)?;
+        if let Some(note) = track.dropped_note() {
+            eprintln!("GPS track {}: {note}", track_path.display());
+        }
         let mut s = open(path, opts, sel)?;
         let n = frames(&mut s)?;
         let s = open(path, opts, sel)?;
@@ -152,10 +161,19 @@ pub fn summary(seg: &Segmentation) -> String {
         .gps
         .as_ref()
         .map(|g| {
-            format!(
+            let dropped: usize = g.dropped_fixes.values().sum();
+            let incomplete: usize = g.incomplete_sentences.values().sum();
+            let mut t = format!(
                 "; GPS: {} fixes, {} unparseable sentences skipped",
                 g.n_fixes, g.n_bad_sentences
-            )
+            );
+            if incomplete > 0 {
+                t += &format!(", {incomplete} sentences without a fix skipped");
+            }
+            if dropped > 0 {
+                t += &format!(", {dropped} invalid fixes dropped");
+            }
+            t
         })
         .unwrap_or_default();
     format!(

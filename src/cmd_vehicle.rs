@@ -81,7 +81,7 @@ pub struct SimulateArgs {
     /// ISO 8608 road class, A (very good) to H (very poor).
     #[arg(long, default_value = "B")]
     pub road: String,
-    /// Vehicle speed, km/h.
+    /// Vehicle speed, km/h (1 to 500; also the cruising speed of --gps-track).
     #[arg(long = "speed-kmh", default_value_t = 30.0)]
     pub speed_kmh: f64,
     /// Length of each record, s.
@@ -90,7 +90,7 @@ pub struct SimulateArgs {
     /// Number of records (successive segments of one drive).
     #[arg(long, default_value_t = 8)]
     pub records: usize,
-    /// Sampling rate, Hz.
+    /// Sampling rate, Hz (a whole number for --format wav).
     #[arg(long = "fs", default_value_t = 20000.0)]
     pub fs_hz: f64,
     /// Random seed: the same seed gives the same bytes.
@@ -105,9 +105,9 @@ pub struct SimulateArgs {
     /// Output folder: record_01.wav ... and truth.json.
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
-    /// Also write a GPS track of a city drive (stops, turns, speed changes) as long as all the
-    /// records together, starting at 2024-05-02T07:31:00Z: track.gpx, track.nmea, track.csv and
-    /// the true phases in drive_truth.json.
+    /// Also write a GPS track of a city drive (stops, turns, speed changes; cruising at about
+    /// --speed-kmh) as long as all the records together, starting at 2024-05-02T07:31:00Z:
+    /// track.gpx, track.nmea, track.csv and the true phases in drive_truth.json.
     #[arg(long = "gps-track")]
     pub gps_track: bool,
 }
@@ -137,6 +137,9 @@ pub fn sim_params(
         ..base
     };
     p.validate()?;
+    // At low speeds the in-service braking is softened so the vehicle keeps moving (from 11 km/h
+    // up it is unchanged).
+    let p = p.manoeuvres_fitted_to_speed();
     Ok(p)
 }
 
@@ -153,9 +156,11 @@ pub fn write_simulation(
     };
     let mut paths = Vec::new();
     for (i, r) in sim.records.iter().enumerate() {
-        let path = dir.join(format!("record_{:02}.{ext}", i + 1));
+        let name = format!("record_{:02}.{ext}", i + 1);
+        let path = dir.join(&name);
+        // Named without the hidden staging folder it is written in.
         vibmode_signal::write_path(&path, &r.recording)
-            .with_context(|| format!("writing {}", path.display()))?;
+            .with_context(|| format!("writing {name}"))?;
         paths.push(path);
     }
     write_json(&dir.join("truth.json").to_string_lossy(), &sim.truth)?;
@@ -166,6 +171,13 @@ pub fn write_simulation(
 pub fn run_simulate(a: &SimulateArgs) -> Result<()> {
     if a.records == 0 {
         bail!("--records 0: give at least one record");
+    }
+    if a.format == RecordFormat::Wav && a.fs_hz.is_finite() && a.fs_hz.fract() != 0.0 {
+        bail!(
+            "--fs {}: WAV stores a whole number of Hz; give a whole rate such as --fs {} or write --format csv or f32",
+            vibmode_core::Num(a.fs_hz),
+            vibmode_core::Num(a.fs_hz.round().max(1.0))
+        );
     }
     let vehicle = VehicleParams::from_path(&a.params)?;
     let p = sim_params(
@@ -181,9 +193,10 @@ pub fn run_simulate(a: &SimulateArgs) -> Result<()> {
     let sim = vibmode_vehicle::simulate(&vehicle, &p)?;
     let paths = write_simulation(out.path(), &sim, a.format)?;
     if a.gps_track {
-        let drive = vibmode_vehicle::drive::simulate_drive(
-            &vibmode_vehicle::drive::DriveParams::new(a.duration_s * a.records as f64, a.seed),
-        );
+        let drive = vibmode_vehicle::drive::simulate_drive(&vibmode_vehicle::drive::DriveParams {
+            cruise_kmh: a.speed_kmh,
+            ..vibmode_vehicle::drive::DriveParams::new(a.duration_s * a.records as f64, a.seed)
+        });
         for (name, text) in [
             ("track.gpx", drive.to_gpx()),
             ("track.nmea", drive.to_nmea()),
@@ -194,7 +207,7 @@ pub fn run_simulate(a: &SimulateArgs) -> Result<()> {
             ),
         ] {
             let path = out.path().join(name);
-            std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
+            std::fs::write(&path, text).with_context(|| format!("writing {name}"))?;
         }
         eprintln!(
             "wrote a {:.0} s GPS track (track.gpx, track.nmea, track.csv) and its true phases (drive_truth.json)",

@@ -6,6 +6,7 @@
 
 use vibmode_analysis::AnalysisError;
 use vibmode_core::{ParamError, RecordingError};
+use vibmode_segment::SegmentError;
 use vibmode_signal::SignalError;
 use vibmode_ssi::SsiError;
 
@@ -42,12 +43,18 @@ pub enum Hint {
     References,
     /// Uncertainty blocks out of range.
     UncertaintyBlocks,
+    /// A record length out of range.
+    RecordLength,
+    /// A GPS offset out of range, or a track that misses the recording.
+    GpsOffset,
+    /// Another segmentation setting out of range.
+    SegmentConfig,
 }
 
 impl Hint {
     /// Every hint (for the test that walks them against every command).
     #[cfg(test)]
-    pub const ALL: [Hint; 15] = [
+    pub const ALL: [Hint; 18] = [
         Hint::Fs,
         Hint::DropFs,
         Hint::ResampleNonuniform,
@@ -63,6 +70,9 @@ impl Hint {
         Hint::Orders,
         Hint::References,
         Hint::UncertaintyBlocks,
+        Hint::RecordLength,
+        Hint::GpsOffset,
+        Hint::SegmentConfig,
     ];
 
     /// The text appended to the message.
@@ -83,6 +93,9 @@ impl Hint {
             Hint::Orders => "--orders",
             Hint::References => "--references",
             Hint::UncertaintyBlocks => "--uncertainty-blocks N",
+            Hint::RecordLength => "--record-length-s SECONDS",
+            Hint::GpsOffset => "--gps-offset-s SECONDS",
+            Hint::SegmentConfig => "set it in the --segment-config file",
         }
     }
 }
@@ -135,8 +148,24 @@ fn key(e: &anyhow::Error) -> Option<Hint> {
         if let Some(p) = cause.downcast_ref::<ParamError>() {
             return param_hint(p);
         }
+        if let Some(s) = cause.downcast_ref::<SegmentError>() {
+            return segment_hint(s);
+        }
     }
     None
+}
+
+fn segment_hint(e: &SegmentError) -> Option<Hint> {
+    match e {
+        SegmentError::InvalidParam { name, .. } => Some(match *name {
+            "record_length_s" => Hint::RecordLength,
+            "gps_offset_s" => Hint::GpsOffset,
+            _ => Hint::SegmentConfig,
+        }),
+        SegmentError::NoOverlap { .. } => Some(Hint::GpsOffset),
+        SegmentError::Signal(s) => signal_hint(s),
+        _ => None,
+    }
 }
 
 fn signal_hint(e: &SignalError) -> Option<Hint> {

@@ -13,12 +13,28 @@
 //!   `;`. Time cells are seconds (Unix time when above 1e8) or RFC 3339 (`2024-05-02T07:31:00Z`).
 //!   Speed is m/s unless the header says km/h (`speed_kmh`, `speed (km/h)`) or knots (`kn`).
 //!
-//! Times must not go backwards ([`crate::SegmentError::TimeBackwards`]); repeated times keep the
-//! first fix.
+//! Every fix of every format passes one check ([`check_fixes`]): time finite and within
+//! +-[`GPS_TIME_ABS_MAX_S`], latitude finite and within +-90 degrees, longitude finite and within
+//! +-180 degrees, speed (when given) finite and within 0..=[`GPS_SPEED_KMH_MAX`] km/h. A fix that
+//! fails is dropped and counted by reason ([`GpsTrack::dropped`]); when more than
+//! [`DROPPED_FIXES_MAX_REL`] of the fixes fail, the file is refused
+//! ([`crate::SegmentError::TooManyBadFixes`]). A course that is not finite or outside 0..=360
+//! degrees is left out (the heading is then measured from the positions). Times must not go
+//! backwards ([`crate::SegmentError::TimeBackwards`]); repeated times keep the first fix.
 
 use crate::{parse_rfc3339, SegmentError};
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 use std::path::Path;
+use vibmode_core::{quoted, Num};
+
+/// Highest speed accepted from a GPS track, km/h: above any ground vehicle (the maglev speed
+/// record is 603 km/h); a larger value is a broken fix or a speed in the wrong unit.
+pub const GPS_SPEED_KMH_MAX: f64 = 1000.0;
+/// Largest magnitude of a GPS time, s (Unix time 1e11 s is the year 5138).
+pub const GPS_TIME_ABS_MAX_S: f64 = 1e11;
+/// Largest share of a track's fixes that may be dropped as invalid before the file is refused.
+pub const DROPPED_FIXES_MAX_REL: f64 = 0.5;
 
 /// One GPS fix.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -62,6 +78,101 @@ pub struct GpsTrack {
     pub n_bad_sentences: usize,
     /// NMEA sentences of other types.
     pub n_other_sentences: usize,
+    /// NMEA RMC/GGA sentences that parse but give no fix, by reason (e.g. "RMC without a date").
+    pub incomplete_sentences: BTreeMap<String, usize>,
+    /// Fixes read before the check of [`check_fixes`].
+    pub n_read: usize,
+    /// Fixes dropped by [`check_fixes`], by reason (e.g. "speed not finite").
+    pub dropped: BTreeMap<String, usize>,
+}
+
+impl GpsTrack {
+    /// Fixes dropped as invalid.
+    pub fn n_dropped(&self) -> usize {
+        self.dropped.values().sum()
+    }
+
+    /// `"dropped 3 of 600 fixes: 2 speed not finite, 1 latitude out of range"`, or `None` when
+    /// no fix was dropped.
+    pub fn dropped_note(&self) -> Option<String> {
+        let n = self.n_dropped();
+        (n > 0).then(|| {
+            format!(
+                "dropped {n} of {} fixes: {}",
+                self.n_read,
+                reasons(&self.dropped)
+            )
+        })
+    }
+}
+
+/// `"2 speed not finite, 1 latitude out of range"`.
+pub(crate) fn reasons(counts: &BTreeMap<String, usize>) -> String {
+    counts
+        .iter()
+        .map(|(k, v)| format!("{v} {k}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// A library's message for ours: control characters shown as `?`, at most 160 characters
+/// (it may carry pieces of the input).
+fn short(msg: &str) -> String {
+    let mut out: String = msg
+        .chars()
+        .take(160)
+        .map(|c| if c.is_control() { '?' } else { c })
+        .collect();
+    if msg.chars().nth(160).is_some() {
+        out.push_str("...");
+    }
+    out
+}
+
+/// Why a fix is invalid, or `None` when it passes (see the module documentation).
+pub fn fix_problem(f: &GpsFix) -> Option<&'static str> {
+    if !f.t_s.is_finite() {
+        Some("time not finite")
+    } else if f.t_s.abs() > GPS_TIME_ABS_MAX_S {
+        Some("time out of range")
+    } else if !f.lat_deg.is_finite() {
+        Some("latitude not finite")
+    } else if f.lat_deg.abs() > 90.0 {
+        Some("latitude out of range")
+    } else if !f.lon_deg.is_finite() {
+        Some("longitude not finite")
+    } else if f.lon_deg.abs() > 180.0 {
+        Some("longitude out of range")
+    } else {
+        match f.speed_kmh {
+            Some(v) if !v.is_finite() => Some("speed not finite"),
+            Some(v) if v < 0.0 => Some("speed negative"),
+            Some(v) if v > GPS_SPEED_KMH_MAX => Some("speed above the maximum"),
+            _ => None,
+        }
+    }
+}
+
+/// The one check of every format's fixes: drops invalid fixes (counted by reason in the
+/// returned map) and clears an invalid course; `keep` gets the indices kept.
+pub fn check_fixes(fixes: Vec<GpsFix>) -> (Vec<GpsFix>, Vec<usize>, BTreeMap<String, usize>) {
+    let mut dropped: BTreeMap<String, usize> = BTreeMap::new();
+    let mut kept = Vec::with_capacity(fixes.len());
+    let mut idx = Vec::with_capacity(fixes.len());
+    for (i, mut f) in fixes.into_iter().enumerate() {
+        if let Some(why) = fix_problem(&f) {
+            *dropped.entry(why.to_string()).or_insert(0) += 1;
+            continue;
+        }
+        if f.course_deg
+            .is_some_and(|c| !(c.is_finite() && (0.0..=360.0).contains(&c)))
+        {
+            f.course_deg = None;
+        }
+        kept.push(f);
+        idx.push(i);
+    }
+    (kept, idx, dropped)
 }
 
 fn track_err(path: &str, reason: String) -> SegmentError {
@@ -99,24 +210,79 @@ pub fn read_track(path: &Path) -> Result<GpsTrack, SegmentError> {
             _ => TrackFormat::Csv,
         },
     };
-    let mut track = match format {
+    let (raw, places) = match format {
         TrackFormat::Gpx => read_gpx(&text, &p)?,
         TrackFormat::Nmea => read_nmea(&text, &p)?,
         TrackFormat::Csv => read_csv(&text, &p)?,
     };
+    finish(raw, places, &p)
+}
+
+/// Reads a track from its text in a known format (as [`read_track`]; `path` names it in
+/// messages).
+pub fn parse_track(text: &str, format: TrackFormat, path: &str) -> Result<GpsTrack, SegmentError> {
+    let (raw, places) = match format {
+        TrackFormat::Gpx => read_gpx(text, path)?,
+        TrackFormat::Nmea => read_nmea(text, path)?,
+        TrackFormat::Csv => read_csv(text, path)?,
+    };
+    finish(raw, places, path)
+}
+
+/// Checks the fixes as read (`places` names each: line or point), their order and their count.
+fn finish(mut track: GpsTrack, places: Vec<String>, p: &str) -> Result<GpsTrack, SegmentError> {
+    let n_read = track.fixes.len();
+    let (fixes, idx, dropped) = check_fixes(std::mem::take(&mut track.fixes));
+    track.fixes = fixes;
+    track.n_read = n_read;
+    track.dropped = dropped;
+    let n_dropped = track.n_dropped();
     if track.fixes.is_empty() {
+        let mut detail = Vec::new();
+        if track.format == TrackFormat::Nmea {
+            detail.push(format!(
+                "{} unparseable and {} other sentences",
+                track.n_bad_sentences, track.n_other_sentences
+            ));
+            if !track.incomplete_sentences.is_empty() {
+                detail.push(reasons(&track.incomplete_sentences));
+            }
+        }
+        if n_dropped > 0 {
+            detail.push(format!(
+                "{n_dropped} fixes dropped: {}",
+                reasons(&track.dropped)
+            ));
+        }
         return Err(SegmentError::NoFixes {
-            path: p,
-            detail: if track.format == TrackFormat::Nmea {
-                format!(
-                    " ({} unparseable and {} other sentences)",
-                    track.n_bad_sentences, track.n_other_sentences
-                )
-            } else {
+            path: p.to_string(),
+            detail: if detail.is_empty() {
                 String::new()
+            } else {
+                format!(" ({})", detail.join("; "))
             },
         });
     }
+    if n_dropped as f64 > DROPPED_FIXES_MAX_REL * n_read as f64 {
+        return Err(SegmentError::TooManyBadFixes {
+            path: p.to_string(),
+            n_dropped,
+            n_read,
+            reasons: reasons(&track.dropped),
+        });
+    }
+    let absolute = track.absolute;
+    check_order(
+        p,
+        &track.fixes,
+        |i| {
+            idx.get(i)
+                .and_then(|&k| places.get(k))
+                .cloned()
+                .unwrap_or_default()
+        },
+        show_time(absolute),
+    )?;
     track.fixes.dedup_by(|b, a| b.t_s == a.t_s);
     Ok(track)
 }
@@ -144,16 +310,46 @@ fn check_order(
 fn show_time(absolute: bool) -> impl Fn(f64) -> String {
     move |t| {
         if absolute {
-            crate::format_rfc3339(t).unwrap_or_else(|| format!("{t} s"))
+            crate::format_rfc3339(t).unwrap_or_else(|| format!("{} s", Num(t)))
         } else {
-            format!("{t} s")
+            format!("{} s", Num(t))
         }
     }
 }
 
-fn read_gpx(text: &str, p: &str) -> Result<GpsTrack, SegmentError> {
-    let g = gpx::read(text.as_bytes())
-        .map_err(|e| track_err(p, format!("{e}; check that it is a valid GPX file")))?;
+/// A track as read, before [`finish`] checks it, with a place name per fix.
+type Raw = (GpsTrack, Vec<String>);
+
+fn raw_track(p: &str, format: TrackFormat, fixes: Vec<GpsFix>, absolute: bool) -> GpsTrack {
+    GpsTrack {
+        path: p.to_string(),
+        format,
+        fixes,
+        absolute,
+        n_bad_sentences: 0,
+        n_other_sentences: 0,
+        incomplete_sentences: BTreeMap::new(),
+        n_read: 0,
+        dropped: BTreeMap::new(),
+    }
+}
+
+fn read_gpx(text: &str, p: &str) -> Result<Raw, SegmentError> {
+    let g = gpx::read(text.as_bytes()).map_err(|e| match e {
+        // The GPX reader refuses a coordinate out of range for the whole file (such a file is
+        // not valid GPX); the value is named, short.
+        gpx::errors::GpxError::LonLatOutOfBoundsError(name, range, v) => track_err(
+            p,
+            format!(
+                "{name} {} is outside {range} degrees, which makes the file invalid GPX; fix or delete that point",
+                Num(v)
+            ),
+        ),
+        e => track_err(
+            p,
+            format!("{}; check that it is a valid GPX file", short(&e.to_string())),
+        ),
+    })?;
     let mut points: Vec<&gpx::Waypoint> = g
         .tracks
         .iter()
@@ -167,7 +363,8 @@ fn read_gpx(text: &str, p: &str) -> Result<GpsTrack, SegmentError> {
         points = g.waypoints.iter().collect();
     }
     let mut fixes = Vec::with_capacity(points.len());
-    for w in points {
+    let mut places = Vec::with_capacity(points.len());
+    for (k, w) in points.into_iter().enumerate() {
         let Some(t) = w.time else { continue };
         let t: time::OffsetDateTime = t.into();
         let pt = w.point();
@@ -178,23 +375,18 @@ fn read_gpx(text: &str, p: &str) -> Result<GpsTrack, SegmentError> {
             speed_kmh: w.speed.map(|v| v * 3.6),
             course_deg: None,
         });
+        places.push(format!("point {}", k + 1));
     }
-    check_order(p, &fixes, |i| format!("point {}", i + 1), show_time(true))?;
-    Ok(GpsTrack {
-        path: p.to_string(),
-        format: TrackFormat::Gpx,
-        fixes,
-        absolute: true,
-        n_bad_sentences: 0,
-        n_other_sentences: 0,
-    })
+    Ok((raw_track(p, TrackFormat::Gpx, fixes, true), places))
 }
 
-fn read_nmea(text: &str, p: &str) -> Result<GpsTrack, SegmentError> {
+fn read_nmea(text: &str, p: &str) -> Result<Raw, SegmentError> {
     use chrono::Timelike;
     let mut rmc: Vec<(GpsFix, usize)> = Vec::new();
     let mut gga: Vec<(f64, f64, f64, usize)> = Vec::new();
     let (mut bad, mut other) = (0usize, 0usize);
+    let mut incomplete: BTreeMap<String, usize> = BTreeMap::new();
+    let mut count = |why: &str| *incomplete.entry(why.to_string()).or_insert(0) += 1;
     for (k, line) in text.lines().enumerate() {
         let line = line.trim().trim_start_matches('\u{feff}');
         if line.is_empty() {
@@ -210,6 +402,15 @@ fn read_nmea(text: &str, p: &str) -> Result<GpsTrack, SegmentError> {
                     r.status_of_fix,
                     nmea::sentences::rmc::RmcStatusOfFix::Invalid
                 );
+                if !valid {
+                    count("RMC without a fix (status V)");
+                } else if r.fix_time.is_none() {
+                    count("RMC without a time");
+                } else if r.fix_date.is_none() {
+                    count("RMC without a date");
+                } else if r.lat.is_none() || r.lon.is_none() {
+                    count("RMC without a position");
+                }
                 if let (true, Some(tm), Some(date), Some(lat), Some(lon)) =
                     (valid, r.fix_time, r.fix_date, r.lat, r.lon)
                 {
@@ -231,6 +432,8 @@ fn read_nmea(text: &str, p: &str) -> Result<GpsTrack, SegmentError> {
                 if let (Some(tm), Some(lat), Some(lon)) = (g.fix_time, g.latitude, g.longitude) {
                     let t = tm.num_seconds_from_midnight() as f64 + tm.nanosecond() as f64 / 1e9;
                     gga.push((t, lat, lon, k + 1));
+                } else {
+                    count("GGA without a time or position");
                 }
             }
             Ok(_) => other += 1,
@@ -243,6 +446,7 @@ fn read_nmea(text: &str, p: &str) -> Result<GpsTrack, SegmentError> {
         }
     }
     let (fixes, lines, absolute) = if !rmc.is_empty() {
+        incomplete.remove("GGA without a time or position");
         other += gga.len();
         let lines: Vec<usize> = rmc.iter().map(|f| f.1).collect();
         (
@@ -272,20 +476,11 @@ fn read_nmea(text: &str, p: &str) -> Result<GpsTrack, SegmentError> {
         }
         (fixes, lines, false)
     };
-    check_order(
-        p,
-        &fixes,
-        |i| format!("line {}", lines.get(i).copied().unwrap_or(0)),
-        show_time(absolute),
-    )?;
-    Ok(GpsTrack {
-        path: p.to_string(),
-        format: TrackFormat::Nmea,
-        fixes,
-        absolute,
-        n_bad_sentences: bad,
-        n_other_sentences: other,
-    })
+    let mut track = raw_track(p, TrackFormat::Nmea, fixes, absolute);
+    track.n_bad_sentences = bad;
+    track.n_other_sentences = other;
+    track.incomplete_sentences = incomplete;
+    Ok((track, lines.iter().map(|l| format!("line {l}")).collect()))
 }
 
 fn find_col(header: &[String], names: &[&str]) -> Option<usize> {
@@ -300,7 +495,7 @@ fn find_col(header: &[String], names: &[&str]) -> Option<usize> {
     })
 }
 
-fn read_csv(text: &str, p: &str) -> Result<GpsTrack, SegmentError> {
+fn read_csv(text: &str, p: &str) -> Result<Raw, SegmentError> {
     let text = text.trim_start_matches('\u{feff}');
     let first_line = text.lines().next().unwrap_or("");
     let delim = if first_line.contains(';') { b';' } else { b',' };
@@ -314,7 +509,10 @@ fn read_csv(text: &str, p: &str) -> Result<GpsTrack, SegmentError> {
         .map_err(|e| {
             track_err(
                 p,
-                format!("{e}; expected a header row like time,lat,lon,speed"),
+                format!(
+                    "{}; expected a header row like time,lat,lon,speed",
+                    short(&e.to_string())
+                ),
             )
         })?
         .iter()
@@ -326,7 +524,7 @@ fn read_csv(text: &str, p: &str) -> Result<GpsTrack, SegmentError> {
                 p,
                 format!(
                     "no {what} column in the header [{}]; name the columns time, lat, lon and (optionally) speed",
-                    header.join(", ")
+                    quoted(&header.join(", "))
                 ),
             )
         })
@@ -371,25 +569,34 @@ fn read_csv(text: &str, p: &str) -> Result<GpsTrack, SegmentError> {
     let mut absolute = None;
     for (k, rec) in rdr.records().enumerate() {
         let line = k + 2;
-        let rec = rec.map_err(|e| track_err(p, format!("line {line}: {e}")))?;
+        let rec = rec.map_err(|e| {
+            track_err(
+                p,
+                format!(
+                    "line {line}: {}; check the CSV quoting",
+                    short(&e.to_string())
+                ),
+            )
+        })?;
         let cell = |i: usize| rec.get(i).unwrap_or("");
         if rec.iter().all(str::is_empty) {
             continue;
         }
+        // A number that is not finite (nan, inf) or out of range is checked with the other
+        // formats' fixes (dropped and counted); text that is no number at all is refused.
         let num = |i: usize, what: &str| -> Result<f64, SegmentError> {
-            cell(i)
-                .parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| {
-                    track_err(
-                        p,
-                        format!("line {line}: {what} '{}' is not a number; fix the cell or delete the row", cell(i)),
-                    )
-                })
+            cell(i).parse::<f64>().map_err(|_| {
+                track_err(
+                    p,
+                    format!(
+                        "line {line}: {what} '{}' is not a number; fix the cell or delete the row",
+                        quoted(cell(i))
+                    ),
+                )
+            })
         };
         let (t, abs) = match cell(tc).parse::<f64>() {
-            Ok(v) if v.is_finite() => (v, v > 1e8),
+            Ok(v) => (v, v > 1e8),
             _ => match parse_rfc3339(cell(tc)) {
                 Some(v) => (v, true),
                 None => {
@@ -397,13 +604,15 @@ fn read_csv(text: &str, p: &str) -> Result<GpsTrack, SegmentError> {
                         p,
                         format!(
                             "line {line}: time '{}' is neither seconds nor an RFC 3339 time such as 2024-05-02T07:31:00Z",
-                            cell(tc)
+                            quoted(cell(tc))
                         ),
                     ))
                 }
             },
         };
-        absolute.get_or_insert(abs);
+        if t.is_finite() {
+            absolute.get_or_insert(abs);
+        }
         let speed_kmh = match sc {
             Some(i) if !cell(i).is_empty() => Some(num(i, "speed")? * speed_factor),
             _ => None,
@@ -418,20 +627,10 @@ fn read_csv(text: &str, p: &str) -> Result<GpsTrack, SegmentError> {
         lines.push(line);
     }
     let absolute = absolute.unwrap_or(false);
-    check_order(
-        p,
-        &fixes,
-        |i| format!("line {}", lines.get(i).copied().unwrap_or(0)),
-        show_time(absolute),
-    )?;
-    Ok(GpsTrack {
-        path: p.to_string(),
-        format: TrackFormat::Csv,
-        fixes,
-        absolute,
-        n_bad_sentences: 0,
-        n_other_sentences: 0,
-    })
+    Ok((
+        raw_track(p, TrackFormat::Csv, fixes, absolute),
+        lines.iter().map(|l| format!("line {l}")).collect(),
+    ))
 }
 
 /// Great-circle distance between two fixes, m (haversine, mean Earth radius 6 371 008.8 m).

@@ -19,14 +19,18 @@ mod plan;
 mod vibration;
 mod write;
 
-pub use gps::{read_track, GpsFix, GpsTrack, TrackFormat};
+pub use gps::{
+    check_fixes, parse_track, read_track, GpsFix, GpsTrack, TrackFormat, DROPPED_FIXES_MAX_REL,
+    GPS_SPEED_KMH_MAX, GPS_TIME_ABS_MAX_S,
+};
 pub use plan::{by_gps, fixed_cuts, GpsAlignment};
 pub use vibration::{by_vibration, VibrationWindow};
 pub use write::{write_segments, Written};
 
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 use vibmode_analysis::RecordWindow;
-use vibmode_core::RecordMeta;
+use vibmode_core::{num, quoted, Num, RecordMeta};
 
 /// Settings of the segmentation; the defaults are the documented tolerances.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -77,8 +81,25 @@ impl Default for SegmentParams {
     }
 }
 
+/// Fewest samples in a record (`record_length_s * fs_hz`).
+pub const RECORD_SAMPLES_MIN: f64 = 16.0;
+/// Most records one segmentation may cut (`duration_s / record_length_s`).
+pub const RECORDS_MAX: f64 = 100_000.0;
+/// Most positions the GPS search visits (`duration_s / step_s`).
+pub const SEARCH_STEPS_MAX: f64 = 1_000_000.0;
+/// Most vibration windows times channels (`duration_s / window_s * channels`): 16 Mi, 256 MiB
+/// of window statistics.
+pub const VIBRATION_CELLS_MAX: f64 = 16_777_216.0;
+/// Largest magnitude of the GPS clock offset, s (11.6 days).
+pub const GPS_OFFSET_S_MAX: f64 = 1e6;
+
+fn invalid(name: &'static str, value: f64, rule: String) -> SegmentError {
+    SegmentError::InvalidParam { name, value, rule }
+}
+
 impl SegmentParams {
-    /// Checks every value (finite, in range).
+    /// Checks every value (finite, in range) and the record length; the bounds against the
+    /// recording are checked by [`SegmentParams::check_work`].
     pub fn validate(&self, record_length_s: f64) -> Result<(), SegmentError> {
         let checks: [(&'static str, f64, bool, &str); 11] = [
             (
@@ -90,8 +111,8 @@ impl SegmentParams {
             (
                 "min_speed_kmh",
                 self.min_speed_kmh,
-                self.min_speed_kmh >= 0.0,
-                ">= 0, e.g. 10",
+                (0.0..=GPS_SPEED_KMH_MAX).contains(&self.min_speed_kmh),
+                "0 to 1000, e.g. 10",
             ),
             (
                 "speed_tolerance_rel",
@@ -121,8 +142,8 @@ impl SegmentParams {
             (
                 "window_s",
                 self.window_s,
-                self.window_s > 0.0 && self.window_s <= record_length_s,
-                "> 0 and at most the record length, e.g. 1",
+                self.window_s > 0.0,
+                "> 0, e.g. 1",
             ),
             (
                 "stop_activity_ratio",
@@ -140,12 +161,52 @@ impl SegmentParams {
         ];
         for (name, value, ok, rule) in checks {
             if !(value.is_finite() && ok) {
-                return Err(SegmentError::InvalidParam {
-                    name,
-                    value,
-                    rule: rule.to_string(),
-                });
+                return Err(invalid(name, value, rule.to_string()));
             }
+        }
+        Ok(())
+    }
+
+    /// Bounds the work against the recording (`fs_hz`, `duration_s`), before it starts: a
+    /// record holds at least [`RECORD_SAMPLES_MIN`] samples and at most [`RECORDS_MAX`] records
+    /// fit; with `gps`, the search step is at least one sample and at most [`SEARCH_STEPS_MAX`]
+    /// steps fit. Errors name the setting given.
+    pub fn check_work(
+        &self,
+        record_length_s: f64,
+        fs_hz: f64,
+        duration_s: f64,
+        gps: bool,
+    ) -> Result<(), SegmentError> {
+        self.validate(record_length_s)?;
+        let min_len = (RECORD_SAMPLES_MIN / fs_hz).max(duration_s / RECORDS_MAX);
+        if record_length_s < min_len {
+            return Err(invalid(
+                "record_length_s",
+                record_length_s,
+                format!(
+                    "at least {} s here ({} samples at {} Hz, and at most {} records in {} s), e.g. 10.24",
+                    Num(min_len),
+                    RECORD_SAMPLES_MIN,
+                    Num(fs_hz),
+                    RECORDS_MAX,
+                    Num(duration_s)
+                ),
+            ));
+        }
+        let min_step = (1.0 / fs_hz).max(duration_s / SEARCH_STEPS_MAX);
+        if gps && self.step_s < min_step {
+            return Err(invalid(
+                "step_s",
+                self.step_s,
+                format!(
+                    "at least {} s here (one sample at {} Hz, and at most {} steps in {} s), e.g. 1",
+                    Num(min_step),
+                    Num(fs_hz),
+                    SEARCH_STEPS_MAX,
+                    Num(duration_s)
+                ),
+            ));
         }
         Ok(())
     }
@@ -217,6 +278,13 @@ pub struct GpsSummary {
     pub n_bad_sentences: usize,
     /// NMEA sentences of other types (GSV, VTG...), ignored.
     pub n_other_sentences: usize,
+    /// NMEA RMC/GGA sentences without a fix, by reason (e.g. "RMC without a date"), skipped.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub incomplete_sentences: BTreeMap<String, usize>,
+    /// Fixes dropped as invalid (time, latitude, longitude or speed not finite or out of
+    /// range), by reason; `n_fixes` counts the fixes kept.
+    #[serde(default)]
+    pub dropped_fixes: BTreeMap<String, usize>,
     /// How GPS times were mapped onto the recording.
     pub alignment: GpsAlignment,
     /// The part of the recording the track covers, s.
@@ -341,6 +409,18 @@ pub enum SegmentError {
         /// Counts of what was found.
         detail: String,
     },
+    /// More than [`DROPPED_FIXES_MAX_REL`] of the fixes invalid.
+    #[error("GPS track {path}: {n_dropped} of {n_read} fixes are invalid ({reasons}); fix the track (a speed in m/s, km/h or knots as the header says; latitude within +-90, longitude within +-180 degrees)")]
+    TooManyBadFixes {
+        /// The file.
+        path: String,
+        /// Fixes dropped.
+        n_dropped: usize,
+        /// Fixes read.
+        n_read: usize,
+        /// Counts by reason, in words.
+        reasons: String,
+    },
     /// Time going backwards in the track.
     #[error("GPS track {path}: time goes backwards at {at} ({previous} then {value}); sort the fixes by time or remove the repeated stretch")]
     TimeBackwards {
@@ -354,7 +434,7 @@ pub enum SegmentError {
         value: String,
     },
     /// A track that does not overlap the recording.
-    #[error("GPS track {path} covers {track_start_s:.1} to {track_end_s:.1} s of the recording's time axis but the recording runs from 0 to {duration_s:.1} s ({alignment}); they do not overlap: check the recording's start time, or give the offset between the two clocks (gps_offset_s)")]
+    #[error("GPS track {path} covers {} to {} s of the recording's time axis but the recording runs from 0 to {} s ({alignment}); they do not overlap: check the recording's start time, or give the offset between the two clocks (gps_offset_s)", num(track_start_s), num(track_end_s), num(duration_s))]
     NoOverlap {
         /// The track.
         path: String,
@@ -368,7 +448,7 @@ pub enum SegmentError {
         alignment: String,
     },
     /// A start time that cannot be parsed.
-    #[error("start time '{value}' of {path} is not an RFC 3339 time such as 2024-05-02T07:31:00Z; fix \"start_time\" in the sidecar")]
+    #[error("start time '{}' of {path} is neither an RFC 3339 time such as 2024-05-02T07:31:00Z nor seconds since 1970 (0 to 1e11); fix \"start_time\" in the sidecar", quoted(value))]
     StartTime {
         /// The file.
         path: String,
@@ -376,7 +456,7 @@ pub enum SegmentError {
         value: String,
     },
     /// A recording shorter than one record.
-    #[error("{path} lasts {duration_s:.2} s, shorter than one record ({record_length_s} s); give a longer recording or a shorter record length")]
+    #[error("{path} lasts {duration_s:.2} s, shorter than one record ({} s); give a longer recording or a shorter record length", num(record_length_s))]
     TooShort {
         /// The file.
         path: String,
@@ -386,7 +466,10 @@ pub enum SegmentError {
         record_length_s: f64,
     },
     /// A setting out of range.
-    #[error("segmentation setting {name} = {value} is invalid: it must be {rule}")]
+    #[error(
+        "segmentation setting {name} = {} is invalid: it must be {rule}",
+        num(value)
+    )]
     InvalidParam {
         /// Name.
         name: &'static str,

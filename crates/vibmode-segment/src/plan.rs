@@ -1,11 +1,12 @@
 //! Records cut by a GPS track, and consecutive records.
 
-use crate::gps::{bearing_deg, distance_m, GpsTrack};
+use crate::gps::{bearing_deg, distance_m, GpsTrack, GPS_TIME_ABS_MAX_S};
 use crate::{
     format_rfc3339, parse_rfc3339, push_skip, GpsSummary, SegmentError, SegmentParams,
-    SegmentRecord, Segmentation, SkipReason,
+    SegmentRecord, Segmentation, SkipReason, GPS_OFFSET_S_MAX,
 };
 use serde::{Deserialize, Serialize};
+use vibmode_core::Num;
 use vibmode_core::RecordMeta;
 use vibmode_signal::StreamInfo;
 
@@ -21,11 +22,18 @@ pub struct GpsAlignment {
     pub rule: String,
 }
 
-/// Unix seconds of the recording's start from its sidecar, if it has one.
+/// Unix seconds of the recording's start from its sidecar, if it has one: an RFC 3339 time or
+/// seconds since 1970 (0 to [`GPS_TIME_ABS_MAX_S`]).
 pub(crate) fn recording_start(info: &StreamInfo) -> Result<Option<f64>, SegmentError> {
     match &info.start_time {
         None => Ok(None),
         Some(s) => parse_rfc3339(s)
+            .or_else(|| {
+                s.trim()
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite() && (0.0..=GPS_TIME_ABS_MAX_S).contains(v))
+            })
             .map(Some)
             .ok_or_else(|| SegmentError::StartTime {
                 path: info.path.clone(),
@@ -104,6 +112,7 @@ pub fn fixed_cuts(
 ) -> Result<Segmentation, SegmentError> {
     p.validate(record_length_s)?;
     let duration_s = check_length(info, n_frames, record_length_s)?;
+    p.check_work(record_length_s, info.fs_hz, duration_s, false)?;
     let start_unix = recording_start(info)?;
     let mut seg = empty_segmentation(info, "fixed", duration_s, record_length_s, p, start_unix);
     let n = (duration_s / record_length_s + 1e-9).floor() as usize;
@@ -129,6 +138,34 @@ pub fn fixed_cuts(
 /// no course.
 const HEADING_BASELINE: usize = 3;
 
+/// Window of the speed derived from positions when the receiver gives none (GGA-only NMEA, CSV
+/// without a speed column), s: the distance between the first and the last fix within
+/// `SPEED_WINDOW_S / 2` before and after a fix, over their time difference, i.e. the centred
+/// moving average of the velocity over 8 s. Position noise of 2 m then moves the speed by about
+/// 1 km/h, and a standing vehicle reads about 1 km/h, not the 10 km/h of fix-to-fix steps.
+pub const SPEED_WINDOW_S: f64 = 8.0;
+
+/// Speed from positions (see [`SPEED_WINDOW_S`]) at fix `i`, km/h.
+fn derived_speed_kmh(f: &[crate::GpsFix], i: usize) -> f64 {
+    let t = f[i].t_s;
+    let a = f.partition_point(|q| q.t_s < t - SPEED_WINDOW_S / 2.0);
+    let b = f
+        .partition_point(|q| q.t_s <= t + SPEED_WINDOW_S / 2.0)
+        .saturating_sub(1);
+    // Fewer than two fixes in the window: the neighbours.
+    let (a, b) = if b > a {
+        (a, b)
+    } else {
+        (i.saturating_sub(1), (i + 1).min(f.len() - 1))
+    };
+    let dt = f[b].t_s - f[a].t_s;
+    if a < b && dt > 0.0 {
+        distance_m(&f[a], &f[b]) / dt * 3.6
+    } else {
+        0.0
+    }
+}
+
 /// A fix on the recording's axis with speed and heading.
 struct Point {
     t: f64,
@@ -143,15 +180,7 @@ fn points(track: &GpsTrack, base: f64, offset_s: f64) -> Vec<Point> {
     let n = f.len();
     (0..n)
         .map(|i| {
-            let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
-            let dt = f[b].t_s - f[a].t_s;
-            let dist = if a != b {
-                distance_m(&f[a], &f[b])
-            } else {
-                0.0
-            };
-            let derived = if dt > 0.0 { dist / dt * 3.6 } else { 0.0 };
-            let speed = f[i].speed_kmh.unwrap_or(derived);
+            let speed = f[i].speed_kmh.unwrap_or_else(|| derived_speed_kmh(f, i));
             // Bearings over a longer baseline (fixes 3 before to 3 after) so that position noise
             // (a few metres) does not pass for a turn.
             let (ha, hb) = (
@@ -246,14 +275,18 @@ pub fn by_gps(
     p: &SegmentParams,
 ) -> Result<Segmentation, SegmentError> {
     p.validate(record_length_s)?;
-    if !offset_s.is_finite() {
+    if !(offset_s.is_finite() && offset_s.abs() <= GPS_OFFSET_S_MAX) {
         return Err(SegmentError::InvalidParam {
             name: "gps_offset_s",
             value: offset_s,
-            rule: "a finite number of seconds".into(),
+            rule: format!(
+                "a number of seconds within +-{} (11.6 days), e.g. 3600",
+                Num(GPS_OFFSET_S_MAX)
+            ),
         });
     }
     let duration_s = check_length(info, n_frames, record_length_s)?;
+    p.check_work(record_length_s, info.fs_hz, duration_s, true)?;
     let start = recording_start(info)?;
     let first_t = track.fixes.first().map_or(0.0, |f| f.t_s);
     let (base, alignment) = match (start, track.absolute) {
@@ -263,7 +296,8 @@ pub fn by_gps(
                 recording_start: format_rfc3339(s),
                 offset_s,
                 rule: format!(
-                    "GPS time minus the recording's start time from its sidecar, plus {offset_s} s"
+                    "GPS time minus the recording's start time from its sidecar, plus {} s",
+                    Num(offset_s)
                 ),
             },
         ),
@@ -272,7 +306,10 @@ pub fn by_gps(
             GpsAlignment {
                 recording_start: None,
                 offset_s,
-                rule: format!("the recording starts at the track's first fix; GPS times shifted by {offset_s} s"),
+                rule: format!(
+                    "the recording starts at the track's first fix; GPS times shifted by {} s",
+                    Num(offset_s)
+                ),
             },
         ),
     };
@@ -308,6 +345,8 @@ pub fn by_gps(
         n_fixes: track.fixes.len(),
         n_bad_sentences: track.n_bad_sentences,
         n_other_sentences: track.n_other_sentences,
+        incomplete_sentences: track.incomplete_sentences.clone(),
+        dropped_fixes: track.dropped.clone(),
         alignment,
         covered_s: [t0.max(0.0), t1.min(duration_s)],
         speed_trace: {

@@ -60,8 +60,39 @@ pub fn by_vibration(
     p: &SegmentParams,
 ) -> Result<(Segmentation, Vec<VibrationWindow>), SegmentError> {
     p.validate(record_length_s)?;
+    // The record length against the rate first (no duration yet), then the window against it.
+    p.check_work(record_length_s, stream.info().fs_hz, 0.0, false)?;
+    if p.window_s > record_length_s {
+        return Err(SegmentError::InvalidParam {
+            name: "window_s",
+            value: p.window_s,
+            rule: format!(
+                "at most the record length ({} s; window_s defaults to 1): give a longer record length or a shorter window_s",
+                vibmode_core::Num(record_length_s)
+            ),
+        });
+    }
     let info = stream.info().clone();
     let nch = info.n_channels();
+    let check_cells = |n_windows: f64| {
+        if n_windows * nch as f64 > crate::VIBRATION_CELLS_MAX {
+            Err(SegmentError::InvalidParam {
+                name: "window_s",
+                value: p.window_s,
+                rule: format!(
+                    "long enough for at most {} windows x channels ({} channels here; a window is at least 2 samples at about 20 Hz), e.g. 1",
+                    crate::VIBRATION_CELLS_MAX,
+                    nch
+                ),
+            })
+        } else {
+            Ok(())
+        }
+    };
+    if let Some(n) = info.n_frames {
+        let duration_s = check_length(&info, n, record_length_s)?;
+        p.check_work(record_length_s, info.fs_hz, duration_s, false)?;
+    }
     // Road-induced body and axle motion lies below ~8 Hz; an idling engine's lines lie above
     // (Bratislava bus: 0.5-8 Hz RMS falls to 0.15-0.4 of the median at a stop, 8-40 Hz does not).
     let factor = (info.fs_hz / 20.0).floor().max(1.0);
@@ -81,6 +112,10 @@ pub fn by_vibration(
     };
     let fs_d = fir.as_ref().map_or(info.fs_hz, FirDecimator::fs_out_hz);
     let win_n = ((p.window_s * fs_d).round() as usize).max(2);
+    if let Some(n) = info.n_frames {
+        // Windows of win_n decimated samples.
+        check_cells(n as f64 / info.fs_hz * fs_d / win_n as f64)?;
+    }
     let mut pending: Vec<Vec<f64>> = vec![Vec::new(); nch];
     // Per window: per channel (mean, rms about the mean).
     let mut stats: Vec<Vec<(f64, f64)>> = Vec::new();
@@ -114,6 +149,7 @@ pub fn by_vibration(
             d.extend_from_slice(&c);
         }
         consume(&mut pending, &mut stats);
+        check_cells(stats.len() as f64)?;
     }
     if let Some(f) = fir.as_mut() {
         for (d, c) in pending.iter_mut().zip(f.finish()) {
@@ -123,6 +159,7 @@ pub fn by_vibration(
     }
     let n_frames = stream.position();
     let duration_s = check_length(&info, n_frames, record_length_s)?;
+    p.check_work(record_length_s, info.fs_hz, duration_s, false)?;
     let start_unix = recording_start(&info)?;
     let window_s = win_n as f64 / fs_d;
     let nw = stats.len();
@@ -177,17 +214,22 @@ pub fn by_vibration(
             }
         })
         .collect();
-    // Guard windows next to stops and manoeuvres.
-    let guard = (p.guard_s / window_s).ceil() as usize;
-    let bad: Vec<bool> = windows.iter().map(|w| w.skip.is_some()).collect();
-    for w in 0..nw {
-        if bad[w] {
+    // Guard windows next to stops and manoeuvres (a prefix count of the bad windows: one pass
+    // whatever guard_s is).
+    let guard = (p.guard_s / window_s).ceil().min(nw as f64) as usize;
+    let mut n_bad = Vec::with_capacity(nw + 1);
+    n_bad.push(0usize);
+    for win in &windows {
+        n_bad.push(n_bad[n_bad.len() - 1] + usize::from(win.skip.is_some()));
+    }
+    for (w, win) in windows.iter_mut().enumerate() {
+        if win.skip.is_some() {
             continue;
         }
         let lo = w.saturating_sub(guard);
         let hi = (w + guard + 1).min(nw);
-        if (lo..hi).any(|k| bad[k]) {
-            windows[w].skip = Some(SkipReason::Transition);
+        if n_bad[hi] > n_bad[lo] {
+            win.skip = Some(SkipReason::Transition);
         }
     }
     let mut seg = empty_segmentation(

@@ -49,7 +49,8 @@ pub struct StreamInfo {
     /// else 0).
     pub start_s: f64,
     /// The absolute start time written in the sidecar (`"start_time"`, RFC 3339, e.g.
-    /// `"2024-05-02T07:31:00Z"`), as written; `None` when there is none.
+    /// `"2024-05-02T07:31:00Z"`, or seconds since 1970), as written (a number as its decimal
+    /// text); `None` when there is none.
     pub start_time: Option<String>,
 }
 
@@ -169,11 +170,17 @@ fn stream(info: StreamInfo, inner: Inner) -> FrameStream {
     }
 }
 
-/// `"start_time"` of a JSON sidecar, if any.
+/// `"start_time"` of a JSON sidecar, if any: a string as written, a number (seconds since 1970)
+/// as its decimal text, anything else as its JSON text, so that the reader checks it and refuses
+/// what it cannot use instead of it being ignored.
 fn sidecar_start_time(sidecar: &Path) -> Option<String> {
     let text = std::fs::read_to_string(sidecar).ok()?;
     let v: serde_json::Value = serde_json::from_str(&text).ok()?;
-    v.get("start_time")?.as_str().map(str::to_string)
+    match v.get("start_time")? {
+        serde_json::Value::Null => None,
+        serde_json::Value::String(s) => Some(s.clone()),
+        other => Some(other.to_string()),
+    }
 }
 
 fn open_raw(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {

@@ -3,7 +3,8 @@
 //! checked against the truth.
 //!
 //! The vehicle's speed and heading are integrated every 0.1 s: braking at 1.2 m/s^2, pulling away
-//! at 1.0 m/s^2, turns of 90 degrees at 20 km/h over 8 s (slowing down and speeding up around
+//! at 1.0 m/s^2 (faster for a cruise speed above 54 km/h: reaching it takes at most 15 s and
+//! braking from it at most 12 s), turns of 90 degrees at 20 km/h over 8 s (slowing down and speeding up around
 //! them), cruising at the cruise speed times 0.85..1.15 (drawn per stretch) with a slow +-2 %
 //! wander. Positions on a flat Earth around (`lat0_deg`, `lon0_deg`). Fixes every
 //! `fix_interval_s` with `gps_noise_m` of position noise and 0.3 km/h of speed noise, as a
@@ -126,6 +127,11 @@ pub fn simulate_drive(p: &DriveParams) -> Drive {
     let mut samples: Vec<(f64, f64, f64, f64, f64)> = Vec::new(); // t, x, y, v, heading
     let mut phases: Vec<Phase> = Vec::new();
     let end = p.duration_s;
+    // Pulling away and braking rates, m/s^2.
+    let (a_up, a_down) = (
+        (p.cruise_kmh / 3.6 / 15.0).max(1.0),
+        (p.cruise_kmh / 3.6 / 12.0).max(1.2),
+    );
     let step =
         |s: &mut State, a: f64, turn_rate: f64, samples: &mut Vec<(f64, f64, f64, f64, f64)>| {
             s.v = (s.v + a * DT).max(0.0);
@@ -156,9 +162,9 @@ pub fn simulate_drive(p: &DriveParams) -> Drive {
     while s.t < end {
         // Reach the target speed.
         let t0 = s.t;
-        let a = if target > s.v { 1.0 } else { -1.2 };
+        let a = if target > s.v { a_up } else { -a_down };
         while (s.v - target).abs() > 0.05 && s.t < end {
-            let da = (target - s.v).clamp(-1.2 * DT, 1.0 * DT) / DT;
+            let da = (target - s.v).clamp(-a_down * DT, a_up * DT) / DT;
             step(&mut s, da, 0.0, &mut samples);
         }
         phase(
@@ -190,7 +196,7 @@ pub fn simulate_drive(p: &DriveParams) -> Drive {
         if what < 0.4 {
             let t0 = s.t;
             while s.v > 0.0 && s.t < end {
-                step(&mut s, -1.2, 0.0, &mut samples);
+                step(&mut s, -a_down, 0.0, &mut samples);
             }
             phase(&mut phases, t0, s.t, PhaseKind::Braking);
             let t0 = s.t;
@@ -205,7 +211,7 @@ pub fn simulate_drive(p: &DriveParams) -> Drive {
             if s.v > turn_v {
                 let t0 = s.t;
                 while s.v > turn_v && s.t < end {
-                    step(&mut s, -1.2, 0.0, &mut samples);
+                    step(&mut s, -a_down, 0.0, &mut samples);
                 }
                 phase(&mut phases, t0, s.t, PhaseKind::Braking);
             }
@@ -321,6 +327,22 @@ impl Drive {
         out
     }
 
+    /// The track as NMEA GGA sentences only (time of day and position, no date, speed or
+    /// course), as a receiver logging only GGA writes it.
+    pub fn to_nmea_gga(&self) -> String {
+        let mut out = String::new();
+        for f in &self.fixes {
+            let (_, _, _, h, mi, s) = civil(self.params.start_unix_s + f.t_s);
+            let body = format!(
+                "GPGGA,{h:02}{mi:02}{s:05.2},{},{},1,08,0.9,150.0,M,45.0,M,,",
+                nmea_coord(f.lat_deg, true),
+                nmea_coord(f.lon_deg, false),
+            );
+            out.push_str(&format!("${body}*{:02X}\n", nmea_checksum(&body)));
+        }
+        out
+    }
+
     /// The track as CSV: `time,lat,lon,speed_kmh` with RFC 3339 times.
     pub fn to_csv(&self) -> String {
         let mut out = String::from("time,lat,lon,speed_kmh\n");
@@ -399,5 +421,35 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn cruising_fixes_follow_the_cruise_speed_and_gga_carries_every_fix() {
+        for cruise in [1.0, 30.0, 120.0, 500.0] {
+            let mut p = DriveParams::new(900.0, 4);
+            p.cruise_kmh = cruise;
+            let d = simulate_drive(&p);
+            let v: Vec<f64> = d
+                .fixes
+                .iter()
+                .filter(|f| {
+                    d.phases_in(f.t_s - 0.5, f.t_s + 0.5)
+                        .iter()
+                        .all(|k| k.0 == PhaseKind::Cruise)
+                })
+                .map(|f| f.speed_kmh)
+                .collect();
+            assert!(v.len() > 100, "{cruise}: {} cruising fixes", v.len());
+            let mean = v.iter().sum::<f64>() / v.len() as f64;
+            assert!(
+                mean > 0.6 * cruise && mean < 1.4 * cruise + 0.3,
+                "cruise {cruise}: mean {mean}"
+            );
+            assert!(d.fixes.iter().all(|f| f.speed_kmh <= 1.45 * cruise + 0.3));
+        }
+        let d = simulate_drive(&DriveParams::new(30.0, 1));
+        let gga = d.to_nmea_gga();
+        assert_eq!(gga.lines().count(), d.fixes.len());
+        assert!(gga.lines().all(|l| l.starts_with("$GPGGA,")));
     }
 }

@@ -340,6 +340,29 @@ impl SimParams {
         }
     }
 
+    /// The manoeuvres with their longitudinal accelerations scaled down, all by one factor, so
+    /// that braking alone (a sin^2 pulse of peak `a` over `d` changes the speed by `a d / 2`)
+    /// leaves at least the lowest speed the simulation accepts (0.5 m/s, or half the initial
+    /// speed when slower) plus 10 % of `speed_kmh`. Unchanged when the speed is high enough:
+    /// the in-service preset's braking (-1.5 m/s^2 over 3 s, -2.25 m/s) is kept from 11 km/h
+    /// up. Lateral accelerations are kept.
+    pub fn manoeuvres_fitted_to_speed(mut self) -> Self {
+        let loss: f64 = self
+            .manoeuvres
+            .iter()
+            .map(|m| (-m.longitudinal_accel_m_s2 * m.duration_s / 2.0).max(0.0))
+            .sum();
+        let v0 = self.speed_kmh / 3.6;
+        let allowed = 0.9 * v0 - min_speed_m_s(v0);
+        if loss.is_finite() && allowed > 0.0 && loss > allowed {
+            let f = allowed / loss;
+            for m in &mut self.manoeuvres {
+                m.longitudinal_accel_m_s2 *= f;
+            }
+        }
+        self
+    }
+
     /// The road as seen by the wheels (for [`FullCar::acceleration_psd`]).
     pub fn road_input(&self) -> RoadInput {
         RoadInput {
@@ -826,6 +849,12 @@ fn default_warmup_s(modes: &[ModeInfo]) -> f64 {
     (5.0 * tmax).clamp(2.0, 30.0)
 }
 
+/// Lowest speed the manoeuvres may brake to, m/s: 0.5 m/s, or half the initial speed `v0` when
+/// that is slower (a vehicle simulated at 1 km/h).
+fn min_speed_m_s(v0: f64) -> f64 {
+    0.5f64.min(0.5 * v0)
+}
+
 /// Speed (m/s) at each of `nk` samples, integrating the manoeuvres' longitudinal acceleration
 /// `ax(t)` by the trapezoidal rule from `v0`; `time(k)` is the time of sample k.
 fn speed_profile(
@@ -836,15 +865,16 @@ fn speed_profile(
     ax: impl Fn(f64) -> f64,
 ) -> Result<Vec<f64>> {
     let mut speed = vec![v0; nk];
+    let floor = min_speed_m_s(v0);
     for k in 1..nk {
         let t0 = time(k - 1);
         let t1 = time(k);
         speed[k] = speed[k - 1] + 0.5 * (ax(t0) + ax(t1)) * dt;
-        if speed[k] < 0.5 {
+        if speed[k] < floor {
             return Err(invalid(
                 "manoeuvres",
                 format!("speed {:.2} m/s at t = {:.2} s", speed[k], t1),
-                "brakes the vehicle below 0.5 m/s; reduce the braking longitudinal_accel_m_s2 or raise speed_kmh",
+                format!("brakes the vehicle below {} m/s (the floor: 0.5 m/s, or half the initial speed when slower); reduce the braking longitudinal_accel_m_s2 or raise speed_kmh", vibmode_core::Num(floor)),
             ));
         }
     }

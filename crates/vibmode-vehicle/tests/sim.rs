@@ -537,3 +537,41 @@ fn a_simulated_record_carries_its_sensors_names_units_and_placements() {
         assert_eq!(ch.placement.direction, Some(vibmode_core::Direction::Z));
     }
 }
+
+/// Issue 28: `simulate --speed-kmh 1`, the documented minimum, was refused with the in-service
+/// preset (its braking, -2.25 m/s, stops a vehicle below 10 km/h, and the 0.5 m/s floor was
+/// above 1 km/h itself). Fitted to the speed, the braking leaves the vehicle moving; from
+/// 11 km/h up the preset is unchanged.
+#[test]
+fn in_service_preset_runs_from_the_minimum_speed() {
+    let car = VehicleParams::city_bus();
+    for speed in [1.0, 5.0, 10.0] {
+        let p = SimParams {
+            speed_kmh: speed,
+            records: 3,
+            duration_s: 10.24,
+            fs_hz: 200.0,
+            ..SimParams::in_service()
+        };
+        p.validate().unwrap();
+        let fitted = p.clone().manoeuvres_fitted_to_speed();
+        let sim = simulate(&car, &fitted).unwrap_or_else(|e| panic!("{speed} km/h: {e}"));
+        assert_eq!(sim.records.len(), 3);
+        for r in &sim.records {
+            assert!(r.mean_speed_kmh > 0.0 && r.mean_speed_kmh.is_finite());
+        }
+        // The braking is softened, not removed; the lateral acceleration is kept.
+        let (b0, b1) = (&p.manoeuvres[0], &fitted.manoeuvres[0]);
+        assert!(b1.longitudinal_accel_m_s2 < 0.0);
+        assert!(b1.longitudinal_accel_m_s2 > b0.longitudinal_accel_m_s2);
+        assert_eq!(
+            p.manoeuvres[2].lateral_accel_m_s2,
+            fitted.manoeuvres[2].lateral_accel_m_s2
+        );
+    }
+    let p = SimParams {
+        speed_kmh: 11.0,
+        ..SimParams::in_service()
+    };
+    assert_eq!(p.clone().manoeuvres_fitted_to_speed(), p);
+}
