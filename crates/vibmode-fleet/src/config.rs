@@ -114,6 +114,8 @@ pub const FALSE_ALARM_RATE_MIN: f64 = 1e-9;
 pub const MIN_NOMINAL_MAX: usize = 100_000;
 /// Most bands in `bands_hz` or `body_response_bands_hz`.
 pub const BANDS_MAX: usize = 64;
+/// Lowest band edge other than 0, Hz (a record must span 4 periods of the lowest: 4000 s).
+pub const BAND_EDGE_MIN_HZ: f64 = 1e-3;
 /// Largest spread floor, ln units (a factor e^10 = 22 000: beyond it no feature is ever scored).
 pub const FLOOR_MAX: f64 = 10.0;
 
@@ -151,6 +153,38 @@ impl FleetConfig {
         Self::from_toml_str(&text, &shown)
     }
 
+    /// The lowest sampling rate a record may have, Hz: twice the highest band edge
+    /// (`bands_hz`, `ratio_band_hz`, `body_band_hz`), so that every band lies below its Nyquist
+    /// frequency (40 Hz with the defaults).
+    pub fn min_fs_hz(&self) -> f64 {
+        2.0 * self
+            .bands_hz
+            .iter()
+            .chain([&self.ratio_band_hz, &self.body_band_hz])
+            .map(|b| b[1])
+            .fold(0.0, f64::max)
+    }
+
+    /// The lowest band edge of `bands_hz` above 0, Hz (none: `None`).
+    pub fn lowest_band_edge_hz(&self) -> Option<f64> {
+        self.bands_hz
+            .iter()
+            .map(|b| b[0])
+            .filter(|&f| f > 0.0)
+            .min_by(f64::total_cmp)
+    }
+
+    /// The shortest record the features may be computed from, s: 4 periods of the lowest band
+    /// edge of `bands_hz` and one Welch segment at the analysis rate (8 s with the defaults).
+    pub fn min_record_s(&self) -> f64 {
+        let by_band = self
+            .lowest_band_edge_hz()
+            .map_or(0.0, |f| crate::features::MIN_PERIODS / f);
+        let by_welch =
+            self.analysis.spectra.nperseg as f64 / self.analysis.preprocess.analysis_fs_hz;
+        by_band.max(by_welch)
+    }
+
     /// Checks every value; errors name the key and a valid value.
     pub fn validate(&self) -> Result<()> {
         self.analysis.validate()?;
@@ -180,7 +214,7 @@ impl FleetConfig {
         ]) {
             if !(b[0].is_finite()
                 && b[1].is_finite()
-                && 0.0 <= b[0]
+                && (b[0] == 0.0 || b[0] >= BAND_EDGE_MIN_HZ)
                 && b[0] < b[1]
                 && b[1] <= nyquist)
             {
@@ -188,7 +222,7 @@ impl FleetConfig {
                     key,
                     format!("[{}, {}]", Num(b[0]), Num(b[1])),
                     &format!(
-                        "must be increasing bands between 0 and the analysis Nyquist frequency {} Hz",
+                        "must be increasing bands from 0 (or {BAND_EDGE_MIN_HZ} Hz) to the analysis Nyquist frequency {} Hz",
                         Num(nyquist)
                     ),
                 ));

@@ -149,7 +149,7 @@ pub fn sensor_faults(rec: &Recording, acfg: &AnalysisConfig) -> Vec<SensorFault>
             fault,
             detail,
         };
-        if !(peak > vibmode_core::limits::SAMPLE_PEAK_MIN) {
+        if peak <= vibmode_core::limits::SAMPLE_PEAK_MIN {
             out.push(fault(FaultKind::Dead, "every sample is 0".into()));
             continue;
         }
@@ -194,42 +194,24 @@ pub fn check_sampling(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<
         record: name.to_string(),
         reason,
     };
-    let top = cfg
-        .bands_hz
-        .iter()
-        .chain([&cfg.ratio_band_hz, &cfg.body_band_hz])
-        .map(|b| b[1])
-        .fold(0.0, f64::max);
-    if rec.fs_hz < 2.0 * top {
+    let min_fs = cfg.min_fs_hz();
+    if rec.fs_hz.is_nan() || rec.fs_hz < min_fs {
         return Err(unfit(format!(
             "it is sampled at {} Hz, but the feature bands reach {} Hz, which needs at least {} Hz; record at a higher rate",
             Num(rec.fs_hz),
-            Num(top),
-            Num(2.0 * top)
+            Num(min_fs / 2.0),
+            Num(min_fs)
         )));
     }
-    let lowest = cfg
-        .bands_hz
-        .iter()
-        .map(|b| b[0])
-        .filter(|&f| f > 0.0)
-        .fold(f64::INFINITY, f64::min);
-    let by_band = if lowest.is_finite() {
-        MIN_PERIODS / lowest
-    } else {
-        0.0
-    };
-    let acfg = &cfg.analysis;
-    let by_welch = acfg.spectra.nperseg as f64 / acfg.preprocess.analysis_fs_hz;
-    let min_s = by_band.max(by_welch);
+    let min_s = cfg.min_record_s();
     let duration = rec.duration_s();
-    if !(duration >= min_s) {
+    if duration.is_nan() || duration < min_s {
         return Err(unfit(format!(
-            "it lasts {} s, but the features need at least {} s ({} periods of its lowest band edge, {} Hz); give longer records",
+            "it lasts {} s, but the features need at least {} s ({} periods of the lowest band edge, {} Hz, and one Welch segment); give longer records",
             Num(duration),
             Num(min_s),
             MIN_PERIODS,
-            Num(lowest)
+            Num(cfg.lowest_band_edge_hz().unwrap_or(0.0))
         )));
     }
     Ok(())
@@ -463,4 +445,75 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
         body_spectra: body,
         sensor_faults: Vec::new(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use vibmode_core::Channel;
+
+    /// A smooth, non-repeating signal (no two samples equal, one at each extreme).
+    fn wave(n: usize, scale: f64) -> Vec<f64> {
+        (0..n)
+            .map(|i| {
+                let t = i as f64 / 200.0;
+                scale * ((7.3 * t).sin() + 0.5 * (2.9 * t + 0.4).sin() + 0.01 * t)
+            })
+            .collect()
+    }
+
+    fn recording(fs: f64, channels: Vec<(&str, Vec<f64>)>) -> Recording {
+        Recording::new(
+            fs,
+            channels
+                .into_iter()
+                .map(|(n, s)| Channel::new(n, "m/s^2", s))
+                .collect(),
+        )
+        .expect("recording")
+    }
+
+    #[test]
+    fn dead_flat_and_clipped_channels_are_found_healthy_and_unplaced_ones_not() {
+        let n = 2048;
+        let clipped: Vec<f64> = wave(n, 1.0).iter().map(|x| x.clamp(-1.0, 1.0)).collect();
+        let rec = recording(
+            200.0,
+            vec![
+                ("FL_unsprung", wave(n, 3.0)),
+                ("FR_unsprung", vec![0.0; n]),
+                ("RL_unsprung", vec![9.81; n]),
+                ("RR_unsprung", clipped),
+                // Not a sensor of the features: a constant speed column is no fault.
+                ("speed", vec![40.0; n]),
+            ],
+        );
+        let f = sensor_faults(&rec, &FleetConfig::default().analysis);
+        let got: Vec<(&str, FaultKind)> = f.iter().map(|f| (f.channel.as_str(), f.fault)).collect();
+        assert_eq!(
+            got,
+            vec![
+                ("FR_unsprung", FaultKind::Dead),
+                ("RL_unsprung", FaultKind::Flat),
+                ("RR_unsprung", FaultKind::Clipped),
+            ],
+            "{f:?}"
+        );
+        assert!(f[1].to_string().contains("9.81"), "{}", f[1]);
+    }
+
+    #[test]
+    fn too_short_and_too_slowly_sampled_records_are_refused_with_the_minimum() {
+        let cfg = FleetConfig::default();
+        assert_eq!(cfg.min_fs_hz(), 40.0);
+        assert_eq!(cfg.min_record_s(), 8.0);
+        let short = recording(200.0, vec![("FL_unsprung", wave(300, 1.0))]);
+        let e = check_sampling("short.csv", &short, &cfg).expect_err("1.5 s");
+        assert!(e.to_string().contains("at least 8 s"), "{e}");
+        let slow = recording(20.0, vec![("FL_unsprung", wave(400, 1.0))]);
+        let e = check_sampling("slow.csv", &slow, &cfg).expect_err("20 Hz");
+        assert!(e.to_string().contains("at least 40 Hz"), "{e}");
+        let fine = recording(200.0, vec![("FL_unsprung", wave(1600, 1.0))]);
+        assert!(check_sampling("fine.csv", &fine, &cfg).is_ok());
+    }
 }

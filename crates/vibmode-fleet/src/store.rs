@@ -1040,4 +1040,65 @@ mod tests {
         ));
         assert_eq!(s.latest_model_set("bus-1").expect("none"), None);
     }
+
+    #[test]
+    fn nothing_a_later_command_cannot_read_is_stored() {
+        let d = tempfile::tempdir().expect("tempdir");
+        let (mut s, _) = Store::init(&d.path().join("f.db")).expect("init");
+        // Settings with a NaN (as an older vibmode stored them: null) make the store unreadable;
+        // while it holds no record, good settings replace them.
+        s.conn
+            .execute(
+                "INSERT INTO meta (key, value) VALUES ('fleet_config', '{\"transmissibility_min_hz\": null}')",
+                [],
+            )
+            .expect("bad settings");
+        assert!(s.config().is_err());
+        let good = FleetConfig {
+            false_alarm_rate: 0.02,
+            ..FleetConfig::default()
+        };
+        s.set_config(&good).expect("repaired");
+        assert_eq!(s.config().expect("readable"), good);
+        // Settings that fail validation are refused before anything is written.
+        let bad = FleetConfig {
+            transmissibility_min_hz: f64::NAN,
+            ..FleetConfig::default()
+        };
+        assert!(s.set_config(&bad).is_err());
+        assert_eq!(s.config().expect("unchanged"), good);
+        // A check with a NaN score is refused (it would be stored as null and never read).
+        let rec = NewRecord {
+            vehicle: "bus-1",
+            sha256: "abc",
+            file_name: "a.csv",
+            condition: Condition::Test,
+            road: None,
+            metadata: serde_json::json!({}),
+        };
+        let a = Assessment {
+            classification: Classification::Normal,
+            scores: crate::model::Scores {
+                vehicle_max_abs_z: f64::NAN,
+                excitation_max_abs_z: 0.0,
+                n_vehicle: 0,
+                n_excitation: 0,
+            },
+            evidence: Vec::new(),
+            summary: String::new(),
+            missing: Vec::new(),
+            sensor_faults: Vec::new(),
+        };
+        let f = features();
+        let e = s
+            .store_batch(&[BatchItem {
+                record: rec,
+                features: &f,
+                check: Some((1, &a)),
+            }])
+            .expect_err("NaN score");
+        assert!(matches!(e, FleetError::NotStorable { .. }), "{e}");
+        // All or nothing: the record was not stored either.
+        assert_eq!(s.find_record("bus-1", "abc").expect("find"), None);
+    }
 }
