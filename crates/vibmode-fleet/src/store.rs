@@ -753,7 +753,9 @@ impl Store {
                 reason: e.to_string(),
             })?;
         back.validate()?;
-        if self.config().ok().as_ref() == Some(cfg) {
+        // Compared as stored: serde_json may parse a float one unit in the last place off, so
+        // the same file again must compare what it reads back as.
+        if self.config().ok().as_ref() == Some(&back) {
             return Ok(());
         }
         let path = self.path.clone();
