@@ -781,6 +781,20 @@ pub fn build_model_set(
         let group = group_of(kind);
         let bonferroni = bonferroni_limit(cfg.false_alarm_rate, count(group));
         let loo_max_abs_z = loo_max.get(&kind).copied().unwrap_or(0.0);
+        // Never a NaN limit (stored as null, the model set unreadable, every check failing):
+        // refused with the setting that gave it.
+        if !(bonferroni.is_finite() && loo_max_abs_z.is_finite()) {
+            return Err(FleetError::Config {
+                key: "false_alarm_rate",
+                value: vibmode_core::Num(cfg.false_alarm_rate).to_string(),
+                fix: format!(
+                    "gives a control limit of {} (leave-one-out {}) for {} features; use e.g. 0.01",
+                    vibmode_core::Num(bonferroni),
+                    vibmode_core::Num(loo_max_abs_z),
+                    count(group)
+                ),
+            });
+        }
         limits.push(KindLimit {
             kind,
             group,
