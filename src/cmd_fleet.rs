@@ -5,7 +5,7 @@ use clap::{Args, Subcommand};
 use serde::Serialize;
 use std::path::PathBuf;
 use vibmode_fleet::{
-    build_baseline, check_file, ingest_file, require_baseline, Checked, Condition, FleetConfig,
+    build_baseline, check_files, ingest_files, require_baseline, Checked, Condition, FleetConfig,
     IngestLabels, Store,
 };
 
@@ -41,7 +41,8 @@ pub enum FleetCommand {
         #[arg(long)]
         vehicle: String,
     },
-    /// Classify records against the vehicle's latest model set: normal, road, vehicle, both.
+    /// Classify records against the vehicle's latest model set: normal, road, vehicle, both,
+    /// or sensor (a dead, stuck or clipped channel). All files or none are stored.
     #[command(allow_negative_numbers = true)]
     Check(CheckArgs),
     /// Per vehicle: records, baseline version, last classifications.
@@ -149,8 +150,11 @@ fn ingest(a: &IngestArgs) -> Result<()> {
         road: a.road.as_deref(),
     };
     let cfg = store.config()?;
-    for f in &a.files {
-        let r = ingest_file(&mut store, &labels, f, &a.read.options(), &cfg)?;
+    // All or nothing: every file is read and analysed before any is stored, so nothing is
+    // reported as stored unless all were.
+    let files: Vec<&std::path::Path> = a.files.iter().map(|f| f.as_path()).collect();
+    let done = ingest_files(&mut store, &labels, &files, &a.read.options(), &cfg)?;
+    for r in &done {
         if r.already_stored {
             eprintln!(
                 "{}: already stored for vehicle {} (record {}), nothing to do",
@@ -206,15 +210,21 @@ struct CheckJson<'a> {
 }
 
 fn check(a: &CheckArgs) -> Result<()> {
-    let inputs: Vec<&std::path::Path> = a.files.iter().map(|f| f.as_path()).collect();
+    // The store is an input too: JSON written over it would destroy it.
+    let inputs: Vec<&std::path::Path> = std::iter::once(a.db.as_path())
+        .chain(a.files.iter().map(|f| f.as_path()))
+        .collect();
     crate::output::check_json_dest(a.json.as_deref(), &inputs)?;
     let mut store = Store::open(&a.db)?;
     store.require_vehicle(&a.vehicle)?;
     let set = require_baseline(&store, &a.vehicle)?;
-    let mut out = Vec::new();
-    for f in &a.files {
-        out.push(check_file(&mut store, &set, f, &a.read.options())?);
-    }
+    // All or nothing: every file is read and scored before any record or check is stored.
+    let out = check_files(
+        &mut store,
+        &set,
+        &a.files.iter().map(|f| f.as_path()).collect::<Vec<_>>(),
+        &a.read.options(),
+    )?;
     let mut text = format!(
         "vehicle {} against model set version {}\nfile                            class     vehicle |z|  road score  evidence\n",
         a.vehicle, set.version

@@ -37,7 +37,7 @@ pub fn check_output(path: &Path, inputs: &[&Path]) -> Result<()> {
         .with_context(|| format!("cannot write {}", path.display()))?;
     if let Ok(o) = path.canonicalize() {
         for i in inputs {
-            if i.canonicalize().is_ok_and(|i| i == o) {
+            if i.canonicalize().is_ok_and(|i| i == o) || same_file(path, i) {
                 anyhow::bail!(
                     "the output {} is an input file; write to another file",
                     path.display()
@@ -46,6 +46,21 @@ pub fn check_output(path: &Path, inputs: &[&Path]) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Whether two existing paths are one file (the same device and inode: hard links too).
+#[cfg(unix)]
+fn same_file(a: &Path, b: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (std::fs::metadata(a), std::fs::metadata(b)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+#[cfg(not(unix))]
+fn same_file(_: &Path, _: &Path) -> bool {
+    false
 }
 
 /// [`check_output`] for an optional JSON destination (`-` is standard output).

@@ -256,7 +256,7 @@ fn init_config_sets_the_fleet_settings() {
             "--config",
             bad.to_str().unwrap(),
         ],
-        &["false_alarm_rate = 2", "(0, 0.5)"],
+        &["false_alarm_rate = 2", "[1e-9, 0.5)"],
     );
     assert!(!Path::new(db).exists());
     ok(&[

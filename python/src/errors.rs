@@ -55,7 +55,12 @@ pub fn fleet_err(e: vibmode_fleet::FleetError) -> PyErr {
     use vibmode_fleet::FleetError as F;
     match e {
         F::Signal(s) => signal_err(s),
-        F::Io { .. } | F::NoStore { .. } | F::NotAStore { .. } | F::Sql { .. } => os_err(e),
+        F::Io { .. }
+        | F::NoStore { .. }
+        | F::NotAStore { .. }
+        | F::NotAFile { .. }
+        | F::NoFolder { .. }
+        | F::Sql { .. } => os_err(e),
         other => value_err(other),
     }
 }

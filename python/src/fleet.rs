@@ -5,9 +5,9 @@
 use pyo3::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
-use vibmode_fleet::store::NewRecord;
+use vibmode_fleet::store::{BatchItem, NewRecord};
 use vibmode_fleet::{
-    build_baseline, check_file, ingest_file, require_baseline, Condition, FleetConfig,
+    build_baseline, check_files, ingest_files, require_baseline, Condition, FleetConfig,
     IngestLabels, Store,
 };
 use vibmode_fleet::{compute_features, sha256_hex, FleetError, Ingested, RecordFeatures};
@@ -105,10 +105,9 @@ fn fleet_ingest(
             };
             // The settings the store was initialised with (`fleet init --config`).
             let cfg = store.config()?;
-            files
-                .iter()
-                .map(|f| ingest_file(&mut store, &labels, f, &opts, &cfg))
-                .collect::<Result<Vec<_>, _>>()
+            // All or nothing, as `vibmode fleet ingest`.
+            let paths: Vec<&std::path::Path> = files.iter().map(|f| f.as_path()).collect();
+            ingest_files(&mut store, &labels, &paths, &opts, &cfg)
         })
         .map_err(fleet_err)?;
     serde_json::to_string(&out).map_err(json_err)
@@ -152,10 +151,9 @@ fn fleet_check(
             let mut store = Store::open(&db)?;
             store.require_vehicle(vehicle)?;
             let set = require_baseline(&store, vehicle)?;
-            let records = files
-                .iter()
-                .map(|f| check_file(&mut store, &set, f, &opts))
-                .collect::<Result<Vec<_>, _>>()?;
+            // All or nothing, as `vibmode fleet check`.
+            let paths: Vec<&std::path::Path> = files.iter().map(|f| f.as_path()).collect();
+            let records = check_files(&mut store, &set, &paths, &opts)?;
             Ok::<_, vibmode_fleet::FleetError>(CheckOut {
                 vehicle: vehicle.to_string(),
                 model_version: set.version,
@@ -244,35 +242,38 @@ fn fleet_store_features(
         .detach(|| {
             vibmode_fleet::check_vehicle_id(vehicle)?;
             let mut store = Store::open(&db)?;
-            let mut out = Vec::with_capacity(items.len());
-            for it in items {
-                if let Some(row) = store.find_record(vehicle, &it.sha256)? {
-                    out.push(Ingested {
-                        file: it.file,
-                        record_id: row.id,
-                        already_stored: true,
-                        notes: Vec::new(),
-                    });
-                    continue;
-                }
-                let id = store.insert_record(
-                    &NewRecord {
+            // All or nothing, in one transaction; content the vehicle already has (stored by
+            // another process meanwhile, too) is left alone.
+            let batch: Vec<BatchItem<'_>> = items
+                .iter()
+                .map(|it| BatchItem {
+                    record: NewRecord {
                         vehicle,
                         sha256: &it.sha256,
                         file_name: &it.file,
                         condition,
                         road,
-                        metadata: it.metadata,
+                        metadata: it.metadata.clone(),
                     },
-                    &it.features,
-                )?;
-                out.push(Ingested {
-                    file: it.file,
-                    record_id: id,
-                    already_stored: false,
-                    notes: it.features.notes,
-                });
-            }
+                    features: &it.features,
+                    check: None,
+                })
+                .collect();
+            let stored = store.store_batch(&batch)?;
+            let out: Vec<Ingested> = items
+                .iter()
+                .zip(stored)
+                .map(|(it, s)| Ingested {
+                    file: it.file.clone(),
+                    record_id: s.record_id,
+                    already_stored: !s.inserted,
+                    notes: if s.inserted {
+                        it.features.notes.clone()
+                    } else {
+                        Vec::new()
+                    },
+                })
+                .collect();
             Ok::<_, FleetError>(out)
         })
         .map_err(fleet_err)?;

@@ -54,7 +54,9 @@ def ingest(
     unit: Optional[str] = None,
 ) -> List[Dict[str, Any]]:
     """Stores the features of ``files`` for ``vehicle`` (``condition`` 'nominal' or 'test');
-    a file already stored is not stored twice. Returns one dict per file."""
+    a file already stored is not stored twice. All or nothing: every file is read and analysed
+    first, then all are stored in one transaction; an error stores none. Returns one dict per
+    file."""
     return json.loads(
         _native.fleet_ingest(os.fspath(db), vehicle, _paths(files), condition, road, fs, float(scale), unit)
     )
@@ -75,7 +77,9 @@ def check(
 ) -> Dict[str, Any]:
     """Classifies ``files`` against the vehicle's latest model set (``vibmode fleet check
     --json``): ``{'vehicle', 'model_version', 'records': [...]}``, each record with its
-    ``assessment`` (classification, scores, evidence)."""
+    ``assessment`` (classification: normal, road, vehicle, both, or sensor for a dead, stuck or
+    clipped channel listed in ``sensor_faults``; scores, evidence). All or nothing: an error in
+    any file stores no record and no check."""
     return json.loads(_native.fleet_check(os.fspath(db), vehicle, _paths(files), fs, float(scale), unit))
 
 

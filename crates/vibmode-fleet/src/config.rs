@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 use vibmode_analysis::AnalysisConfig;
+use vibmode_core::Num;
 
 use crate::error::{FleetError, Result};
 
@@ -106,13 +107,36 @@ fn bad(key: &'static str, value: impl ToString, fix: &str) -> FleetError {
     }
 }
 
+/// Smallest `false_alarm_rate`: below one false alarm in 10^9 records the limits only grow
+/// (|z| 6.1 for one feature), and the statistics of a few dozen nominal records say nothing there.
+pub const FALSE_ALARM_RATE_MIN: f64 = 1e-9;
+/// Most nominal records a baseline may ask for.
+pub const MIN_NOMINAL_MAX: usize = 100_000;
+/// Most bands in `bands_hz` or `body_response_bands_hz`.
+pub const BANDS_MAX: usize = 64;
+/// Lowest band edge other than 0, Hz (a record must span 4 periods of the lowest: 4000 s).
+pub const BAND_EDGE_MIN_HZ: f64 = 1e-3;
+/// Largest spread floor, ln units (a factor e^10 = 22 000: beyond it no feature is ever scored).
+pub const FLOOR_MAX: f64 = 10.0;
+
+/// The parser's message, short: serde's "expected one of `a`, `b`, ..." list of every key is
+/// dropped (docs/fleet.md lists them), and what remains is cut to 160 bytes.
+fn short_reason(message: &str) -> String {
+    let one_line = message.replace('\n', " ");
+    let trimmed = one_line.trim();
+    let head = trimmed
+        .split_once(", expected one of")
+        .map_or(trimmed, |(head, _)| head);
+    vibmode_core::cap_message(&vibmode_core::Quoted(head).to_string(), 160)
+}
+
 impl FleetConfig {
     /// Parses and validates TOML settings (every key optional: the defaults above; the
     /// per-record analysis under `[analysis]`, with the keys of docs/analysis.md).
     pub fn from_toml_str(text: &str, path: &str) -> Result<Self> {
         let cfg: FleetConfig = toml::from_str(text).map_err(|e| FleetError::ConfigFile {
             path: path.to_string(),
-            reason: e.message().replace('\n', " ").trim().to_string(),
+            reason: short_reason(e.message()),
         })?;
         cfg.validate()?;
         Ok(cfg)
@@ -129,6 +153,38 @@ impl FleetConfig {
         Self::from_toml_str(&text, &shown)
     }
 
+    /// The lowest sampling rate a record may have, Hz: twice the highest band edge
+    /// (`bands_hz`, `ratio_band_hz`, `body_band_hz`), so that every band lies below its Nyquist
+    /// frequency (40 Hz with the defaults).
+    pub fn min_fs_hz(&self) -> f64 {
+        2.0 * self
+            .bands_hz
+            .iter()
+            .chain([&self.ratio_band_hz, &self.body_band_hz])
+            .map(|b| b[1])
+            .fold(0.0, f64::max)
+    }
+
+    /// The lowest band edge of `bands_hz` above 0, Hz (none: `None`).
+    pub fn lowest_band_edge_hz(&self) -> Option<f64> {
+        self.bands_hz
+            .iter()
+            .map(|b| b[0])
+            .filter(|&f| f > 0.0)
+            .min_by(f64::total_cmp)
+    }
+
+    /// The shortest record the features may be computed from, s: 4 periods of the lowest band
+    /// edge of `bands_hz` and one Welch segment at the analysis rate (8 s with the defaults).
+    pub fn min_record_s(&self) -> f64 {
+        let by_band = self
+            .lowest_band_edge_hz()
+            .map_or(0.0, |f| crate::features::MIN_PERIODS / f);
+        let by_welch =
+            self.analysis.spectra.nperseg as f64 / self.analysis.preprocess.analysis_fs_hz;
+        by_band.max(by_welch)
+    }
+
     /// Checks every value; errors name the key and a valid value.
     pub fn validate(&self) -> Result<()> {
         self.analysis.validate()?;
@@ -140,20 +196,35 @@ impl FleetConfig {
                 "must list at least one band, e.g. [[2, 5]]",
             ));
         }
+        for (key, n) in [
+            ("bands_hz", self.bands_hz.len()),
+            ("body_response_bands_hz", self.body_response_bands_hz.len()),
+        ] {
+            if n > BANDS_MAX {
+                return Err(bad(
+                    key,
+                    format!("({n} bands)"),
+                    &format!("must list at most {BANDS_MAX} bands"),
+                ));
+            }
+        }
         for (key, b) in self.bands_hz.iter().map(|b| ("bands_hz", b)).chain([
             ("ratio_band_hz", &self.ratio_band_hz),
             ("body_band_hz", &self.body_band_hz),
         ]) {
             if !(b[0].is_finite()
                 && b[1].is_finite()
-                && 0.0 <= b[0]
+                && (b[0] == 0.0 || b[0] >= BAND_EDGE_MIN_HZ)
                 && b[0] < b[1]
                 && b[1] <= nyquist)
             {
                 return Err(bad(
                     key,
-                    format!("[{}, {}]", b[0], b[1]),
-                    &format!("must be increasing bands between 0 and the analysis Nyquist frequency {nyquist} Hz"),
+                    format!("[{}, {}]", Num(b[0]), Num(b[1])),
+                    &format!(
+                        "must be increasing bands from 0 (or {BAND_EDGE_MIN_HZ} Hz) to the analysis Nyquist frequency {} Hz",
+                        Num(nyquist)
+                    ),
                 ));
             }
         }
@@ -161,26 +232,38 @@ impl FleetConfig {
             if !(b[0] < b[1] && self.body_band_hz[0] <= b[0] && b[1] <= self.body_band_hz[1]) {
                 return Err(bad(
                     "body_response_bands_hz",
-                    format!("[{}, {}]", b[0], b[1]),
+                    format!("[{}, {}]", Num(b[0]), Num(b[1])),
                     &format!(
                         "must be increasing bands within body_band_hz [{}, {}], e.g. [2, 4]",
-                        self.body_band_hz[0], self.body_band_hz[1]
+                        Num(self.body_band_hz[0]),
+                        Num(self.body_band_hz[1])
                     ),
                 ));
             }
         }
-        if !(self.false_alarm_rate > 0.0 && self.false_alarm_rate < 0.5) {
+        if !(self.false_alarm_rate >= FALSE_ALARM_RATE_MIN && self.false_alarm_rate < 0.5) {
             return Err(bad(
                 "false_alarm_rate",
-                self.false_alarm_rate,
-                "must be in (0, 0.5), e.g. 0.01",
+                Num(self.false_alarm_rate),
+                &format!("must be in [{FALSE_ALARM_RATE_MIN:e}, 0.5), e.g. 0.01"),
             ));
         }
-        if self.min_nominal < 3 {
+        if !(3..=MIN_NOMINAL_MAX).contains(&self.min_nominal) {
             return Err(bad(
                 "min_nominal",
                 self.min_nominal,
-                "must be at least 3, e.g. 5",
+                &format!("must be from 3 to {MIN_NOMINAL_MAX}, e.g. 5"),
+            ));
+        }
+        let t = self.transmissibility_min_hz;
+        if !(t.is_finite() && (0.0..=nyquist).contains(&t)) {
+            return Err(bad(
+                "transmissibility_min_hz",
+                Num(t),
+                &format!(
+                    "must be from 0 to the analysis Nyquist frequency {} Hz, e.g. 2",
+                    Num(nyquist)
+                ),
             ));
         }
         for (key, v) in [
@@ -192,32 +275,32 @@ impl FleetConfig {
             ("floor_track_ratio", self.floor_track_ratio),
             ("floor_body_response", self.floor_body_response),
         ] {
-            if !(v.is_finite() && v > 0.0) {
+            if !(v.is_finite() && v > 0.0 && v <= FLOOR_MAX) {
                 return Err(bad(
                     key,
-                    v,
-                    "must be positive (a spread of a logarithm), e.g. 0.1",
+                    Num(v),
+                    &format!("must be in (0, {FLOOR_MAX}] (a spread of a logarithm), e.g. 0.1"),
                 ));
             }
         }
         if !(self.mode_group_tol > 0.0 && self.mode_group_tol < 1.0) {
             return Err(bad(
                 "mode_group_tol",
-                self.mode_group_tol,
+                Num(self.mode_group_tol),
                 "must be in (0, 1), e.g. 0.08",
             ));
         }
         if !(self.mode_match_tol > 0.0 && self.mode_match_tol < 1.0) {
             return Err(bad(
                 "mode_match_tol",
-                self.mode_match_tol,
+                Num(self.mode_match_tol),
                 "must be in (0, 1), e.g. 0.15",
             ));
         }
         if !(self.mode_min_share > 0.0 && self.mode_min_share <= 1.0) {
             return Err(bad(
                 "mode_min_share",
-                self.mode_min_share,
+                Num(self.mode_min_share),
                 "must be in (0, 1], e.g. 0.6",
             ));
         }

@@ -6,7 +6,7 @@
 #[non_exhaustive]
 pub enum FleetError {
     /// The database file cannot be opened or is not an SQLite database.
-    #[error("{path} is not a vibmode fleet store ({reason}); give the path of a store made by fleet init, or a new file name")]
+    #[error("{} is not a vibmode fleet store ({}); give the path of a store made by fleet init, or a new file name", vibmode_core::quoted(path), vibmode_core::cap_message(reason, 120))]
     NotAStore {
         /// The file.
         path: String,
@@ -14,7 +14,7 @@ pub enum FleetError {
         reason: String,
     },
     /// The store was written by a newer vibmode.
-    #[error("{path} has fleet schema version {found}, this vibmode reads up to version {supported}; use a newer vibmode")]
+    #[error("{} has fleet schema version {found}, this vibmode reads up to version {supported}; use a newer vibmode", vibmode_core::quoted(path))]
     NewerSchema {
         /// The file.
         path: String,
@@ -24,13 +24,73 @@ pub enum FleetError {
         supported: i64,
     },
     /// The store file does not exist (and was not to be created).
-    #[error("no fleet store at {path}; create it with fleet init first")]
+    #[error(
+        "no fleet store at {}; create it with fleet init first",
+        vibmode_core::quoted(path)
+    )]
     NoStore {
         /// The path.
         path: String,
     },
+    /// A store schema version that no vibmode writes (below 1; 0 is an empty file).
+    #[error("{}: store schema version {found} is not one vibmode knows (1..{supported}); the file was changed by another program: restore it from a backup or start a new store", vibmode_core::quoted(path))]
+    UnknownSchema {
+        /// The file.
+        path: String,
+        /// Its `user_version`.
+        found: i64,
+        /// The newest this build knows.
+        supported: i64,
+    },
+    /// The store path is a folder or a device, not a regular file.
+    #[error(
+        "{} is {what}, not a store file; give the path of a store file (e.g. fleet.db)",
+        vibmode_core::quoted(path)
+    )]
+    NotAFile {
+        /// The path.
+        path: String,
+        /// "a folder" or "not a regular file".
+        what: &'static str,
+    },
+    /// The folder the store would be in does not exist.
+    #[error("the folder {} (where the store {} would be) does not exist; create it first or give another path", vibmode_core::quoted(folder), vibmode_core::quoted(path))]
+    NoFolder {
+        /// The store path.
+        path: String,
+        /// Its folder.
+        folder: String,
+    },
+    /// Something to be stored that could not be read back (a number that is not finite).
+    #[error("{what} was not stored: it holds a value that is not a finite number ({}); nothing was written", vibmode_core::cap_message(reason, 120))]
+    NotStorable {
+        /// What.
+        what: String,
+        /// The check's message.
+        reason: String,
+    },
+    /// A record too short or too slowly sampled for the features.
+    #[error("'{}' cannot be scored: {reason}", vibmode_core::quoted(record))]
+    RecordUnfit {
+        /// The record (file name).
+        record: String,
+        /// What is wrong and the minimum.
+        reason: String,
+    },
+    /// A nominal record with a faulty sensor (it would spoil the baseline).
+    #[error("'{}' is to be nominal but {faults}; a nominal record needs every sensor working: fix the logger or leave the file out", vibmode_core::quoted(record))]
+    NominalSensorFault {
+        /// The record (file name).
+        record: String,
+        /// The faults, e.g. `channel FL_sprung is dead (every sample 0)`.
+        faults: String,
+    },
     /// An SQLite operation failed.
-    #[error("fleet store {path}: {operation} failed: {reason}")]
+    #[error(
+        "fleet store {}: {operation} failed: {}",
+        vibmode_core::quoted(path),
+        vibmode_core::cap_message(reason, 160)
+    )]
     Sql {
         /// The file.
         path: String,
@@ -40,7 +100,11 @@ pub enum FleetError {
         reason: String,
     },
     /// A vehicle identifier that the store does not know.
-    #[error("vehicle '{vehicle}' is not in the store (known: {known}); ingest its nominal records first")]
+    #[error(
+        "vehicle '{}' is not in the store (known: {}); ingest its nominal records first",
+        vibmode_core::quoted(vehicle),
+        vibmode_core::cap_message(known, 120)
+    )]
     UnknownVehicle {
         /// The identifier given.
         vehicle: String,
@@ -49,7 +113,8 @@ pub enum FleetError {
     },
     /// A vehicle identifier that is empty or not printable.
     #[error(
-        "vehicle id '{vehicle}' must be 1 to 64 printable characters without spaces, e.g. bus-017"
+        "vehicle id '{}' must be 1 to 64 printable characters without spaces, e.g. bus-017",
+        vibmode_core::quoted(vehicle)
     )]
     BadVehicleId {
         /// The identifier given.
@@ -62,7 +127,7 @@ pub enum FleetError {
         reason: String,
     },
     /// Too few nominal records for a baseline.
-    #[error("vehicle '{vehicle}' has {found} nominal record(s) with features; a baseline needs at least {needed}: ingest more nominal runs")]
+    #[error("vehicle '{}' has {found} nominal record(s) with features; a baseline needs at least {needed}: ingest more nominal runs", vibmode_core::quoted(vehicle))]
     TooFewNominal {
         /// The vehicle.
         vehicle: String,
@@ -72,7 +137,7 @@ pub enum FleetError {
         needed: usize,
     },
     /// A record whose channels differ from those of the baseline it is checked against.
-    #[error("'{record}' has channels {found}, but the baseline of vehicle '{vehicle}' was built from {baseline}; record the same sensors with the same names, or build a new baseline for the new layout")]
+    #[error("'{}' has channels {}, but the baseline of vehicle '{}' was built from {}; record the same sensors with the same names, or build a new baseline for the new layout", vibmode_core::quoted(record), vibmode_core::cap_message(found, 100), vibmode_core::quoted(vehicle), vibmode_core::cap_message(baseline, 100))]
     LayoutDiffers {
         /// The record (file) name.
         record: String,
@@ -84,13 +149,17 @@ pub enum FleetError {
         baseline: String,
     },
     /// A check without a baseline.
-    #[error("vehicle '{vehicle}' has no baseline yet; build one from its nominal records first (fleet baseline)")]
+    #[error("vehicle '{}' has no baseline yet; build one from its nominal records first (fleet baseline)", vibmode_core::quoted(vehicle))]
     NoBaseline {
         /// The vehicle.
         vehicle: String,
     },
     /// A record's features cannot be computed.
-    #[error("features of '{record}' cannot be computed: {reason}")]
+    #[error(
+        "features of '{}' cannot be computed: {}",
+        vibmode_core::quoted(record),
+        vibmode_core::cap_message(reason, 250)
+    )]
     Features {
         /// The record (file name).
         record: String,
@@ -98,13 +167,16 @@ pub enum FleetError {
         reason: String,
     },
     /// A condition label that is not nominal or test.
-    #[error("condition '{value}' is not one of nominal, test")]
+    #[error(
+        "condition '{}' is not one of nominal, test",
+        vibmode_core::quoted(value)
+    )]
     BadCondition {
         /// The text given.
         value: String,
     },
     /// Stored content that does not parse (edited or foreign rows).
-    #[error("fleet store {path}: {what} cannot be read ({reason}); the row was not written by this vibmode: restore the store or re-ingest the record")]
+    #[error("fleet store {}: {} cannot be read ({}); the row was not written by this vibmode: restore the store or re-ingest the record", vibmode_core::quoted(path), vibmode_core::cap_message(what, 80), vibmode_core::cap_message(reason, 100))]
     CorruptRow {
         /// The file.
         path: String,
@@ -114,7 +186,7 @@ pub enum FleetError {
         reason: String,
     },
     /// Reading a record file failed.
-    #[error("cannot read {path}: {reason}")]
+    #[error("cannot read {}: {reason}", vibmode_core::quoted(path))]
     Io {
         /// The file.
         path: String,
@@ -122,7 +194,10 @@ pub enum FleetError {
         reason: String,
     },
     /// A settings file that cannot be read or parsed.
-    #[error("fleet config {path}: {reason}; see docs/fleet.md for the keys")]
+    #[error(
+        "fleet config {}: {reason}; see docs/fleet.md for the keys",
+        vibmode_core::quoted(path)
+    )]
     ConfigFile {
         /// The file.
         path: String,
@@ -130,7 +205,7 @@ pub enum FleetError {
         reason: String,
     },
     /// New settings for a store that already holds records analysed with other settings.
-    #[error("{path} already holds {records} record(s) analysed with other settings; settings are fixed when the first record is stored: use a new store for new settings")]
+    #[error("{} already holds {records} record(s) analysed with other settings; settings are fixed when the first record is stored: use a new store for new settings", vibmode_core::quoted(path))]
     ConfigAfterRecords {
         /// The store.
         path: String,

@@ -11,6 +11,7 @@ use crate::body::{body_spectra, BodySpectra};
 
 use crate::config::FleetConfig;
 use crate::error::{FleetError, Result};
+use vibmode_core::Num;
 
 /// One identified mode of a channel.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -77,6 +78,143 @@ pub struct RecordFeatures {
     /// without both a sprung and an unsprung channel with a corner.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub body_spectra: Option<BodySpectra>,
+    /// Channels with a role whose sensor failed (dead, stuck or clipped); they give no feature,
+    /// and a check of the record is classed `sensor`. Empty in records stored before it existed.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sensor_faults: Vec<SensorFault>,
+}
+
+/// What is wrong with a sensor.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FaultKind {
+    /// Every sample is 0 (a dead logger channel, a broken cable).
+    Dead,
+    /// Every sample has one value other than 0 (a stuck sensor).
+    Flat,
+    /// More than [`CLIPPED_SHARE`] of the samples sit at the channel's largest or smallest
+    /// value (a saturated sensor or amplifier).
+    Clipped,
+}
+
+/// A channel whose sensor failed.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SensorFault {
+    /// The channel.
+    pub channel: String,
+    /// What is wrong.
+    pub fault: FaultKind,
+    /// In words, e.g. `every sample is 0`, `12.5 % of the samples at 9.81`.
+    pub detail: String,
+}
+
+impl std::fmt::Display for SensorFault {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let kind = match self.fault {
+            FaultKind::Dead => "dead",
+            FaultKind::Flat => "flat",
+            FaultKind::Clipped => "clipped",
+        };
+        write!(
+            f,
+            "channel {} is {kind} ({})",
+            vibmode_core::quoted(&self.channel),
+            self.detail
+        )
+    }
+}
+
+/// Share of the samples at one extreme of a channel above which it counts as clipped (a
+/// continuous signal reaches its extreme once or, quantised, a few times).
+pub const CLIPPED_SHARE: f64 = 0.01;
+/// Fewest samples at one extreme that count as clipped, however short the record.
+pub const CLIPPED_MIN_SAMPLES: usize = 10;
+/// Periods of the lowest band edge a record must span (4 periods of 0.5 Hz: 8 s).
+pub const MIN_PERIODS: f64 = 4.0;
+
+/// The sensor faults of the channels of `rec` that have a role (sprung or unsprung; other
+/// columns, such as a speed, are not sensors of the features).
+pub fn sensor_faults(rec: &Recording, acfg: &AnalysisConfig) -> Vec<SensorFault> {
+    let mut out = Vec::new();
+    for ch in &rec.channels {
+        if acfg.placement_of(ch).role == Role::Other || ch.samples.is_empty() {
+            continue;
+        }
+        let x = &ch.samples;
+        let max = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let min = x.iter().copied().fold(f64::INFINITY, f64::min);
+        let peak = max.abs().max(min.abs());
+        let fault = |fault, detail| SensorFault {
+            channel: ch.name.clone(),
+            fault,
+            detail,
+        };
+        if peak <= vibmode_core::limits::SAMPLE_PEAK_MIN {
+            out.push(fault(FaultKind::Dead, "every sample is 0".into()));
+            continue;
+        }
+        let range = max - min;
+        if range <= 1e-9 * peak {
+            out.push(fault(
+                FaultKind::Flat,
+                format!("every sample is {}", vibmode_core::Num(max)),
+            ));
+            continue;
+        }
+        let tol = 1e-9 * range;
+        let at_max = x.iter().filter(|&&v| v >= max - tol).count();
+        let at_min = x.iter().filter(|&&v| v <= min + tol).count();
+        let need = CLIPPED_MIN_SAMPLES.max((CLIPPED_SHARE * x.len() as f64).ceil() as usize);
+        let (n, value) = if at_max >= at_min {
+            (at_max, max)
+        } else {
+            (at_min, min)
+        };
+        if n >= need {
+            out.push(fault(
+                FaultKind::Clipped,
+                format!(
+                    "{:.1} % of the samples at {}",
+                    100.0 * n as f64 / x.len() as f64,
+                    vibmode_core::Num(value)
+                ),
+            ));
+        }
+    }
+    out
+}
+
+/// A record must be sampled fast enough for the highest band of the features and long enough
+/// for the lowest: its Nyquist frequency at least the highest band edge (`bands_hz`,
+/// `ratio_band_hz`, `body_band_hz`), its duration at least [`MIN_PERIODS`] periods of the
+/// lowest band edge of `bands_hz` and one Welch segment at the analysis rate. Else an error
+/// stating the minimum.
+pub fn check_sampling(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<()> {
+    let unfit = |reason: String| FleetError::RecordUnfit {
+        record: name.to_string(),
+        reason,
+    };
+    let min_fs = cfg.min_fs_hz();
+    if rec.fs_hz.is_nan() || rec.fs_hz < min_fs {
+        return Err(unfit(format!(
+            "it is sampled at {} Hz, but the feature bands reach {} Hz, which needs at least {} Hz; record at a higher rate",
+            Num(rec.fs_hz),
+            Num(min_fs / 2.0),
+            Num(min_fs)
+        )));
+    }
+    let min_s = cfg.min_record_s();
+    let duration = rec.duration_s();
+    if duration.is_nan() || duration < min_s {
+        return Err(unfit(format!(
+            "it lasts {} s, but the features need at least {} s ({} periods of the lowest band edge, {} Hz, and one Welch segment); give longer records",
+            Num(duration),
+            Num(min_s),
+            MIN_PERIODS,
+            Num(cfg.lowest_band_edge_hz().unwrap_or(0.0))
+        )));
+    }
+    Ok(())
 }
 
 fn finite(x: f64) -> Option<f64> {
@@ -85,10 +223,53 @@ fn finite(x: f64) -> Option<f64> {
 
 /// Computes the features of `rec` (a file's recording, named `name` in messages).
 ///
-/// Errors: the analysis fails (too short a record, bad settings), or no feature can be
-/// computed (no channel with a role: name channels like `FL_unsprung`, `RR_sprung`).
+/// The record's sampling is checked first ([`check_sampling`]); channels whose sensor failed
+/// ([`sensor_faults`]) are left out of the features and listed in
+/// [`RecordFeatures::sensor_faults`] (a record of only failed sensors has no feature at all).
+///
+/// Errors: too short or too slowly sampled a record, the analysis fails (bad settings), or no
+/// feature can be computed (no channel with a role: name channels like `FL_unsprung`,
+/// `RR_sprung`).
 pub fn compute_features(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordFeatures> {
     cfg.validate()?;
+    check_sampling(name, rec, cfg)?;
+    let faults = sensor_faults(rec, &cfg.analysis);
+    if faults.is_empty() {
+        return features_of(name, rec, cfg);
+    }
+    let mut healthy = rec.clone();
+    healthy
+        .channels
+        .retain(|c| !faults.iter().any(|f| f.channel == c.name));
+    let only_faults = |note: String| RecordFeatures {
+        analysis_fs_hz: cfg.analysis.preprocess.analysis_fs_hz,
+        duration_s: rec.duration_s(),
+        n_segments: 0,
+        bands_hz: cfg.bands_hz.clone(),
+        channels: Vec::new(),
+        transmissibility: Vec::new(),
+        notes: vec![note],
+        body_spectra: None,
+        sensor_faults: faults.clone(),
+    };
+    if healthy.channels.is_empty() {
+        return Ok(only_faults("no working sensor: no feature".into()));
+    }
+    // The working channels alone may give no feature (or the analysis fails on them): the
+    // record is still one with failed sensors, not an error.
+    let mut f = match features_of(name, &healthy, cfg) {
+        Ok(f) => f,
+        Err(e) => {
+            return Ok(only_faults(format!(
+                "the working sensors give no feature: {e}"
+            )))
+        }
+    };
+    f.sensor_faults = faults;
+    Ok(f)
+}
+
+fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordFeatures> {
     let acfg: &AnalysisConfig = &cfg.analysis;
     let records = cut_records(name, rec, acfg.record_length_s);
     let fail = |reason: String| FleetError::Features {
@@ -262,5 +443,77 @@ pub fn compute_features(name: &str, rec: &Recording, cfg: &FleetConfig) -> Resul
         transmissibility,
         notes,
         body_spectra: body,
+        sensor_faults: Vec::new(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use vibmode_core::Channel;
+
+    /// A smooth, non-repeating signal (no two samples equal, one at each extreme).
+    fn wave(n: usize, scale: f64) -> Vec<f64> {
+        (0..n)
+            .map(|i| {
+                let t = i as f64 / 200.0;
+                scale * ((7.3 * t).sin() + 0.5 * (2.9 * t + 0.4).sin() + 0.01 * t)
+            })
+            .collect()
+    }
+
+    fn recording(fs: f64, channels: Vec<(&str, Vec<f64>)>) -> Recording {
+        Recording::new(
+            fs,
+            channels
+                .into_iter()
+                .map(|(n, s)| Channel::new(n, "m/s^2", s))
+                .collect(),
+        )
+        .expect("recording")
+    }
+
+    #[test]
+    fn dead_flat_and_clipped_channels_are_found_healthy_and_unplaced_ones_not() {
+        let n = 2048;
+        let clipped: Vec<f64> = wave(n, 1.0).iter().map(|x| x.clamp(-1.0, 1.0)).collect();
+        let rec = recording(
+            200.0,
+            vec![
+                ("FL_unsprung", wave(n, 3.0)),
+                ("FR_unsprung", vec![0.0; n]),
+                ("RL_unsprung", vec![9.81; n]),
+                ("RR_unsprung", clipped),
+                // Not a sensor of the features: a constant speed column is no fault.
+                ("speed", vec![40.0; n]),
+            ],
+        );
+        let f = sensor_faults(&rec, &FleetConfig::default().analysis);
+        let got: Vec<(&str, FaultKind)> = f.iter().map(|f| (f.channel.as_str(), f.fault)).collect();
+        assert_eq!(
+            got,
+            vec![
+                ("FR_unsprung", FaultKind::Dead),
+                ("RL_unsprung", FaultKind::Flat),
+                ("RR_unsprung", FaultKind::Clipped),
+            ],
+            "{f:?}"
+        );
+        assert!(f[1].to_string().contains("9.81"), "{}", f[1]);
+    }
+
+    #[test]
+    fn too_short_and_too_slowly_sampled_records_are_refused_with_the_minimum() {
+        let cfg = FleetConfig::default();
+        assert_eq!(cfg.min_fs_hz(), 40.0);
+        assert_eq!(cfg.min_record_s(), 8.0);
+        let short = recording(200.0, vec![("FL_unsprung", wave(300, 1.0))]);
+        let e = check_sampling("short.csv", &short, &cfg).expect_err("1.5 s");
+        assert!(e.to_string().contains("at least 8 s"), "{e}");
+        let slow = recording(20.0, vec![("FL_unsprung", wave(400, 1.0))]);
+        let e = check_sampling("slow.csv", &slow, &cfg).expect_err("20 Hz");
+        assert!(e.to_string().contains("at least 40 Hz"), "{e}");
+        let fine = recording(200.0, vec![("FL_unsprung", wave(1600, 1.0))]);
+        assert!(check_sampling("fine.csv", &fine, &cfg).is_ok());
+    }
 }

@@ -9,9 +9,9 @@ use vibmode_signal::ReadOptions;
 
 use crate::config::FleetConfig;
 use crate::error::{FleetError, Result};
-use crate::features::compute_features;
+use crate::features::{compute_features, RecordFeatures};
 use crate::model::{assess, build_model_set, Assessment, ModelSet};
-use crate::store::{Condition, NewRecord, Store};
+use crate::store::{BatchItem, Condition, NewRecord, Store, Stored};
 
 /// SHA-256 of bytes, lower-case hex.
 pub fn sha256_hex(bytes: &[u8]) -> String {
@@ -74,6 +74,105 @@ pub struct IngestLabels<'a> {
     pub road: Option<&'a str>,
 }
 
+/// A record read and analysed (or found in the store), not yet stored.
+struct Prepared {
+    file: String,
+    sha256: String,
+    metadata: serde_json::Value,
+    features: RecordFeatures,
+    /// The vehicle already had this content when it was read.
+    known: bool,
+}
+
+fn metadata_of(rec: &Recording) -> serde_json::Value {
+    serde_json::json!({
+        "fs_hz": rec.fs_hz,
+        "n_samples": rec.len(),
+        "channels": rec.names(),
+    })
+}
+
+/// A nominal record must have every sensor working: it would spoil the baseline.
+fn check_nominal_sensors(condition: Condition, name: &str, f: &RecordFeatures) -> Result<()> {
+    if condition != Condition::Nominal || f.sensor_faults.is_empty() {
+        return Ok(());
+    }
+    let faults: Vec<String> = f.sensor_faults.iter().map(|x| x.to_string()).collect();
+    Err(FleetError::NominalSensorFault {
+        record: name.to_string(),
+        faults: vibmode_core::cap_message(&faults.join(", "), 160),
+    })
+}
+
+/// Features of a recording to be stored under `labels` (from the store when the vehicle
+/// already has its content).
+fn prepare_recording(
+    store: &Store,
+    labels: &IngestLabels<'_>,
+    name: &str,
+    sha256: &str,
+    rec: &Recording,
+    cfg: &FleetConfig,
+) -> Result<Prepared> {
+    if let Some(row) = store.find_record(labels.vehicle, sha256)? {
+        return Ok(Prepared {
+            file: name.to_string(),
+            sha256: sha256.to_string(),
+            metadata: metadata_of(rec),
+            features: store.features(row.id)?,
+            known: true,
+        });
+    }
+    let features = compute_features(name, rec, cfg)?;
+    check_nominal_sensors(labels.condition, name, &features)?;
+    Ok(Prepared {
+        file: name.to_string(),
+        sha256: sha256.to_string(),
+        metadata: metadata_of(rec),
+        features,
+        known: false,
+    })
+}
+
+/// Stores prepared records (with their checks) in one transaction.
+fn store_prepared(
+    store: &mut Store,
+    labels: &IngestLabels<'_>,
+    prepared: &[Prepared],
+    checks: &[Option<(i64, Assessment)>],
+) -> Result<Vec<Stored>> {
+    let items: Vec<BatchItem<'_>> = prepared
+        .iter()
+        .zip(checks)
+        .map(|(p, c)| BatchItem {
+            record: NewRecord {
+                vehicle: labels.vehicle,
+                sha256: &p.sha256,
+                file_name: &p.file,
+                condition: labels.condition,
+                road: labels.road,
+                metadata: p.metadata.clone(),
+            },
+            features: &p.features,
+            check: c.as_ref().map(|(v, a)| (*v, a)),
+        })
+        .collect();
+    store.store_batch(&items)
+}
+
+fn ingested(p: Prepared, s: Stored) -> Ingested {
+    Ingested {
+        file: p.file,
+        record_id: s.record_id,
+        already_stored: p.known || !s.inserted,
+        notes: if s.inserted {
+            p.features.notes
+        } else {
+            Vec::new()
+        },
+    }
+}
+
 /// Ingests a recording with a known content hash: a no-op if the vehicle already has it.
 pub fn ingest_recording(
     store: &mut Store,
@@ -84,37 +183,16 @@ pub fn ingest_recording(
     cfg: &FleetConfig,
 ) -> Result<Ingested> {
     check_vehicle_id(labels.vehicle)?;
-    if let Some(row) = store.find_record(labels.vehicle, sha256)? {
-        return Ok(Ingested {
-            file: name.to_string(),
-            record_id: row.id,
-            already_stored: true,
-            notes: Vec::new(),
-        });
-    }
-    let features = compute_features(name, rec, cfg)?;
-    let metadata = serde_json::json!({
-        "fs_hz": rec.fs_hz,
-        "n_samples": rec.len(),
-        "channels": rec.names(),
-    });
-    let id = store.insert_record(
-        &NewRecord {
-            vehicle: labels.vehicle,
-            sha256,
-            file_name: name,
-            condition: labels.condition,
-            road: labels.road,
-            metadata,
-        },
-        &features,
-    )?;
-    Ok(Ingested {
-        file: name.to_string(),
-        record_id: id,
-        already_stored: false,
-        notes: features.notes,
-    })
+    let p = prepare_recording(store, labels, name, sha256, rec, cfg)?;
+    let stored = store_prepared(store, labels, std::slice::from_ref(&p), &[None])?;
+    let s = stored
+        .first()
+        .copied()
+        .ok_or_else(|| FleetError::NotStorable {
+            what: format!("'{}'", vibmode_core::quoted(name)),
+            reason: "the store returned no row".into(),
+        })?;
+    Ok(ingested(p, s))
 }
 
 /// The name a record file is stored and reported under: the path as the user gave it, not
@@ -136,6 +214,80 @@ fn hash_file(path: &Path) -> Result<String> {
     Ok(sha256_hex(&bytes))
 }
 
+/// Reads and analyses every file (a file whose bytes the vehicle already has is not read
+/// again; the same bytes twice in `paths` are analysed once). `layout` checks each read
+/// recording first.
+fn prepare_files(
+    store: &Store,
+    labels: &IngestLabels<'_>,
+    paths: &[&Path],
+    opts: &ReadOptions,
+    cfg: &FleetConfig,
+    layout: &dyn Fn(&str, &Recording) -> Result<()>,
+) -> Result<Vec<Prepared>> {
+    let mut out: Vec<Prepared> = Vec::with_capacity(paths.len());
+    for path in paths {
+        let name = file_name(path);
+        let sha = hash_file(path)?;
+        if let Some(row) = store.find_record(labels.vehicle, &sha)? {
+            out.push(Prepared {
+                file: name,
+                sha256: sha,
+                metadata: serde_json::json!({}),
+                features: store.features(row.id)?,
+                known: true,
+            });
+            continue;
+        }
+        if let Some(same) = out.iter().find(|p| p.sha256 == sha) {
+            let features = same.features.clone();
+            out.push(Prepared {
+                file: name,
+                sha256: sha,
+                metadata: serde_json::json!({}),
+                features,
+                known: false,
+            });
+            continue;
+        }
+        let rec = vibmode_signal::read_path(path, opts)?;
+        layout(&name, &rec)?;
+        let features = compute_features(&name, &rec, cfg)?;
+        check_nominal_sensors(labels.condition, &name, &features)?;
+        out.push(Prepared {
+            file: name,
+            sha256: sha,
+            metadata: metadata_of(&rec),
+            features,
+            known: false,
+        });
+    }
+    Ok(out)
+}
+
+/// Ingests files, all or nothing: every file is read and analysed first, then all are stored
+/// in one transaction; any error (an unreadable file, a record too short, a nominal record
+/// with a failed sensor) leaves the store unchanged. A file whose bytes the vehicle already
+/// has (stored earlier, by another process meanwhile, or given twice) is a no-op
+/// (`already_stored`).
+pub fn ingest_files(
+    store: &mut Store,
+    labels: &IngestLabels<'_>,
+    paths: &[&Path],
+    opts: &ReadOptions,
+    cfg: &FleetConfig,
+) -> Result<Vec<Ingested>> {
+    check_vehicle_id(labels.vehicle)?;
+    let prepared = prepare_files(store, labels, paths, opts, cfg, &|_, _| Ok(()))?;
+    let checks = vec![None; prepared.len()];
+    let stored = store_prepared(store, labels, &prepared, &checks)?;
+    Ok(prepared
+        .into_iter()
+        .zip(stored)
+        .map(|(p, s)| ingested(p, s))
+        .collect())
+}
+
 /// Ingests a file (read with `opts`): a no-op when its bytes are already stored for the vehicle.
 pub fn ingest_file(
     store: &mut Store,
@@ -144,26 +296,36 @@ pub fn ingest_file(
     opts: &ReadOptions,
     cfg: &FleetConfig,
 ) -> Result<Ingested> {
-    check_vehicle_id(labels.vehicle)?;
-    let sha = hash_file(path)?;
-    if let Some(row) = store.find_record(labels.vehicle, &sha)? {
-        return Ok(Ingested {
-            file: file_name(path),
-            record_id: row.id,
-            already_stored: true,
-            notes: Vec::new(),
-        });
-    }
-    let rec = vibmode_signal::read_path(path, opts)?;
-    ingest_recording(store, labels, &file_name(path), &sha, &rec, cfg)
+    let mut out = ingest_files(store, labels, &[path], opts, cfg)?;
+    out.pop().ok_or_else(|| FleetError::NotStorable {
+        what: format!("'{}'", vibmode_core::quoted(&file_name(path))),
+        reason: "the store returned no row".into(),
+    })
 }
 
 /// Builds and stores the next model-set version of a vehicle from its nominal records.
+/// Nominal records with a failed sensor (stored by an older vibmode, or through the Python
+/// workers) are left out, with a note.
 pub fn build_baseline(store: &mut Store, vehicle: &str, cfg: &FleetConfig) -> Result<ModelSet> {
     let nominal = store.nominal_records(vehicle)?;
-    let names: Vec<String> = nominal.iter().map(|(r, _)| r.file_name.clone()).collect();
-    let feats: Vec<_> = nominal.into_iter().map(|(_, f)| f).collect();
+    let mut notes = Vec::new();
+    let mut names = Vec::new();
+    let mut feats = Vec::new();
+    for (r, f) in nominal {
+        if f.sensor_faults.is_empty() {
+            names.push(r.file_name);
+            feats.push(f);
+        } else {
+            let faults: Vec<String> = f.sensor_faults.iter().map(|x| x.to_string()).collect();
+            notes.push(format!(
+                "nominal record {} left out: {}",
+                vibmode_core::quoted(&r.file_name),
+                faults.join(", ")
+            ));
+        }
+    }
     let mut set = build_model_set(vehicle, &names, &feats, cfg)?;
+    set.notes.extend(notes);
     store.save_model_set(&mut set)?;
     Ok(set)
 }
@@ -191,6 +353,41 @@ pub fn require_baseline(store: &Store, vehicle: &str) -> Result<ModelSet> {
         })
 }
 
+fn test_labels(set: &ModelSet) -> IngestLabels<'_> {
+    IngestLabels {
+        vehicle: &set.vehicle,
+        condition: Condition::Test,
+        road: None,
+    }
+}
+
+/// Scores prepared records against `set` and stores them with their checks in one
+/// transaction.
+fn check_prepared(
+    store: &mut Store,
+    set: &ModelSet,
+    prepared: Vec<Prepared>,
+) -> Result<Vec<Checked>> {
+    let checks: Vec<Option<(i64, Assessment)>> = prepared
+        .iter()
+        .map(|p| Some((set.version, assess(set, &p.features))))
+        .collect();
+    let stored = store_prepared(store, &test_labels(set), &prepared, &checks)?;
+    Ok(prepared
+        .into_iter()
+        .zip(checks)
+        .zip(stored)
+        .filter_map(|((p, c), s)| {
+            c.map(|(v, assessment)| Checked {
+                file: p.file,
+                record_id: s.record_id,
+                model_version: v,
+                assessment,
+            })
+        })
+        .collect())
+}
+
 /// Checks a recording (stored as a test record unless already stored) against `set`.
 pub fn check_recording(
     store: &mut Store,
@@ -199,14 +396,14 @@ pub fn check_recording(
     sha256: &str,
     rec: &Recording,
 ) -> Result<Checked> {
-    let labels = IngestLabels {
-        vehicle: &set.vehicle,
-        condition: Condition::Test,
-        road: None,
-    };
+    check_vehicle_id(&set.vehicle)?;
     check_layout(set, name, rec)?;
-    let ing = ingest_recording(store, &labels, name, sha256, rec, &set.config)?;
-    finish_check(store, set, ing)
+    let p = prepare_recording(store, &test_labels(set), name, sha256, rec, &set.config)?;
+    let mut out = check_prepared(store, set, vec![p])?;
+    out.pop().ok_or_else(|| FleetError::NotStorable {
+        what: format!("the check of '{}'", vibmode_core::quoted(name)),
+        reason: "the store returned no row".into(),
+    })
 }
 
 /// A record must have the channels the baseline was built from (same names, any order); else
@@ -230,6 +427,21 @@ fn check_layout(set: &ModelSet, name: &str, rec: &Recording) -> Result<()> {
     })
 }
 
+/// Checks files against `set`, all or nothing: every file is read, analysed and scored first,
+/// then all (test records and checks) are stored in one transaction; any error leaves the
+/// store unchanged. A file the vehicle already has is scored from its stored features.
+pub fn check_files(
+    store: &mut Store,
+    set: &ModelSet,
+    paths: &[&Path],
+    opts: &ReadOptions,
+) -> Result<Vec<Checked>> {
+    check_vehicle_id(&set.vehicle)?;
+    let layout = |name: &str, rec: &Recording| check_layout(set, name, rec);
+    let prepared = prepare_files(store, &test_labels(set), paths, opts, &set.config, &layout)?;
+    check_prepared(store, set, prepared)
+}
+
 /// Checks a file against `set` (stored as a test record unless already stored).
 pub fn check_file(
     store: &mut Store,
@@ -237,37 +449,9 @@ pub fn check_file(
     path: &Path,
     opts: &ReadOptions,
 ) -> Result<Checked> {
-    let labels = IngestLabels {
-        vehicle: &set.vehicle,
-        condition: Condition::Test,
-        road: None,
-    };
-    check_vehicle_id(labels.vehicle)?;
-    let sha = hash_file(path)?;
-    let ing = match store.find_record(labels.vehicle, &sha)? {
-        Some(row) => Ingested {
-            file: file_name(path),
-            record_id: row.id,
-            already_stored: true,
-            notes: Vec::new(),
-        },
-        None => {
-            let rec = vibmode_signal::read_path(path, opts)?;
-            check_layout(set, &file_name(path), &rec)?;
-            ingest_recording(store, &labels, &file_name(path), &sha, &rec, &set.config)?
-        }
-    };
-    finish_check(store, set, ing)
-}
-
-fn finish_check(store: &mut Store, set: &ModelSet, ing: Ingested) -> Result<Checked> {
-    let features = store.features(ing.record_id)?;
-    let assessment = assess(set, &features);
-    store.save_check(ing.record_id, set.version, &assessment)?;
-    Ok(Checked {
-        file: ing.file,
-        record_id: ing.record_id,
-        model_version: set.version,
-        assessment,
+    let mut out = check_files(store, set, &[path], opts)?;
+    out.pop().ok_or_else(|| FleetError::NotStorable {
+        what: format!("the check of '{}'", vibmode_core::quoted(&file_name(path))),
+        reason: "the store returned no row".into(),
     })
 }

@@ -22,16 +22,17 @@ pub use body::{fit_body_model, BodyModel, BodySpectra};
 pub use config::FleetConfig;
 pub use error::{FleetError, Result};
 pub use features::{
-    compute_features, ChannelFeatures, CornerTransmissibility, ModeEstimate, RecordFeatures,
+    check_sampling, compute_features, sensor_faults, ChannelFeatures, CornerTransmissibility,
+    FaultKind, ModeEstimate, RecordFeatures, SensorFault,
 };
 pub use fleet::{
-    build_baseline, check_file, check_recording, check_vehicle_id, ingest_file, ingest_recording,
-    record_file_name, recording_hash, require_baseline, sha256_hex, Checked, IngestLabels,
-    Ingested,
+    build_baseline, check_file, check_files, check_recording, check_vehicle_id, ingest_file,
+    ingest_files, ingest_recording, record_file_name, recording_hash, require_baseline, sha256_hex,
+    Checked, IngestLabels, Ingested,
 };
 pub use model::{
     assess, build_model_set, Assessment, Classification, Evidence, FeatureMeta, FeatureStat, Group,
     Kind, KindLimit, ModeSlot, ModelSet, Scores, LOO_MARGIN,
 };
 pub use report::write_fleet_report;
-pub use store::{Condition, RecordRow, Store, VehicleStatus, SCHEMA_VERSION};
+pub use store::{BatchItem, Condition, RecordRow, Store, Stored, VehicleStatus, SCHEMA_VERSION};

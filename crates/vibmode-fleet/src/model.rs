@@ -205,6 +205,9 @@ pub enum Classification {
     Vehicle,
     /// Both outside.
     Both,
+    /// A sensor of the record failed (dead, stuck or clipped channel): its scores say nothing
+    /// about the vehicle or the road until the sensor is fixed.
+    Sensor,
 }
 
 impl Classification {
@@ -226,6 +229,7 @@ impl fmt::Display for Classification {
             Classification::Road => "road",
             Classification::Vehicle => "vehicle",
             Classification::Both => "both",
+            Classification::Sensor => "sensor",
         })
     }
 }
@@ -278,6 +282,10 @@ pub struct Assessment {
     pub summary: String,
     /// Features of the model set the record lacks (e.g. a mode not identified in it).
     pub missing: Vec<String>,
+    /// The record's failed sensors (the class is then `sensor`); empty in checks stored
+    /// before it existed.
+    #[serde(default)]
+    pub sensor_faults: Vec<crate::features::SensorFault>,
 }
 
 fn band_label(b: &[f64; 2]) -> String {
@@ -773,6 +781,20 @@ pub fn build_model_set(
         let group = group_of(kind);
         let bonferroni = bonferroni_limit(cfg.false_alarm_rate, count(group));
         let loo_max_abs_z = loo_max.get(&kind).copied().unwrap_or(0.0);
+        // Never a NaN limit (stored as null, the model set unreadable, every check failing):
+        // refused with the setting that gave it.
+        if !(bonferroni.is_finite() && loo_max_abs_z.is_finite()) {
+            return Err(FleetError::Config {
+                key: "false_alarm_rate",
+                value: vibmode_core::Num(cfg.false_alarm_rate).to_string(),
+                fix: format!(
+                    "gives a control limit of {} (leave-one-out {}) for {} features; use e.g. 0.01",
+                    vibmode_core::Num(bonferroni),
+                    vibmode_core::Num(loo_max_abs_z),
+                    count(group)
+                ),
+            });
+        }
         limits.push(KindLimit {
             kind,
             group,
@@ -817,9 +839,24 @@ fn score(f: &FeatureStat, x: f64, cfg: &FleetConfig) -> f64 {
 }
 
 /// Scores a record against the model set.
+///
+/// A record with a failed sensor is classed [`Classification::Sensor`] whatever its scores
+/// (which cover its working channels only); the summary names the channels first.
 pub fn assess(set: &ModelSet, rf: &RecordFeatures) -> Assessment {
     let values = scalar_features(rf, &set.slots, set.body.as_ref(), &set.config);
-    score_values(set, &values)
+    let mut a = score_values(set, &values);
+    if !rf.sensor_faults.is_empty() {
+        a.classification = Classification::Sensor;
+        let faults: Vec<String> = rf.sensor_faults.iter().map(|f| f.to_string()).collect();
+        let mut summary = format!("sensor: {}", faults.join(", "));
+        if !a.summary.is_empty() {
+            summary.push_str("; ");
+            summary.push_str(&a.summary);
+        }
+        a.summary = summary;
+        a.sensor_faults = rf.sensor_faults.clone();
+    }
+    a
 }
 
 fn score_values(set: &ModelSet, values: &[(FeatureMeta, f64)]) -> Assessment {
@@ -871,6 +908,7 @@ fn score_values(set: &ModelSet, values: &[(FeatureMeta, f64)]) -> Assessment {
         summary: summary(&evidence),
         evidence,
         missing,
+        sensor_faults: Vec::new(),
     }
 }
 
@@ -998,6 +1036,7 @@ mod tests {
             }],
             notes: Vec::new(),
             body_spectra: None,
+            sensor_faults: Vec::new(),
         }
     }
 
@@ -1170,6 +1209,7 @@ mod tests {
             transmissibility: Vec::new(),
             notes: Vec::new(),
             body_spectra: Some(s),
+            sensor_faults: Vec::new(),
         }
     }
 
@@ -1270,6 +1310,7 @@ mod tests {
             transmissibility: Vec::new(),
             notes: Vec::new(),
             body_spectra: None,
+            sensor_faults: Vec::new(),
         }
     }
 

@@ -29,7 +29,7 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
     let mut html = HtmlReport::new("vibmode fleet report");
     let vehicles = store.vehicles()?;
     html.paragraph(&format!(
-        "Store {}: {} vehicle(s). Each record is classified against its vehicle's nominal model set: normal, road (excitation outside the nominal range), vehicle (transmissibility or modes of a corner moved) or both (docs/fleet.md).",
+        "Store {}: {} vehicle(s). Each record is classified against its vehicle's nominal model set: normal, road (excitation outside the nominal range), vehicle (transmissibility or modes of a corner moved), both, or sensor (a dead, stuck or clipped channel: fix the sensor first) (docs/fleet.md).",
         store.path(),
         vehicles.len()
     ));
@@ -53,6 +53,7 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
                 count(Classification::Road),
                 count(Classification::Vehicle),
                 count(Classification::Both),
+                count(Classification::Sensor),
             ]
         })
         .collect();
@@ -67,6 +68,7 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
             "road",
             "vehicle",
             "both",
+            "sensor",
         ],
         &rows,
     );
@@ -102,12 +104,9 @@ fn vehicle_section(html: &mut HtmlReport, store: &Store, vehicle: &str) -> Resul
         .filter_map(|(row, _, a)| {
             let a = a.as_ref()?;
             (a.classification != Classification::Normal).then(|| {
-                let evidence: Vec<String> = a
-                    .evidence
-                    .iter()
-                    .filter(|e| e.flagged)
-                    .take(6)
-                    .map(|e| {
+                let sensors = a.sensor_faults.iter().map(|f| f.to_string());
+                let evidence: Vec<String> = sensors
+                    .chain(a.evidence.iter().filter(|e| e.flagged).take(6).map(|e| {
                         format!(
                             "{}{} {:+.0} % (z {:.1})",
                             e.meta.corner.map_or(String::new(), |c| format!("{c}: ")),
@@ -115,7 +114,7 @@ fn vehicle_section(html: &mut HtmlReport, store: &Store, vehicle: &str) -> Resul
                             e.change_pct,
                             e.z
                         )
-                    })
+                    }))
                     .collect();
                 vec![
                     row.file_name.clone(),

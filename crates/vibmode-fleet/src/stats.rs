@@ -88,9 +88,13 @@ pub fn normal_quantile(p: f64) -> f64 {
 /// Two-sided Bonferroni control limit on |z| for `n_features` scores so that a nominal record
 /// raises an alarm with probability at most `false_alarm_rate` (normal scores):
 /// `Phi^-1(1 - alpha / (2 m))`. `n_features = 0` counts as 1.
+///
+/// Computed as `-Phi^-1(alpha / (2 m))` (the normal is symmetric): `1 - alpha / (2 m)` rounds
+/// to 1 below alpha / (2 m) = 1.1e-16, where the quantile would be NaN; the lower tail stays
+/// finite for every positive rate.
 pub fn bonferroni_limit(false_alarm_rate: f64, n_features: usize) -> f64 {
     let m = n_features.max(1) as f64;
-    normal_quantile(1.0 - false_alarm_rate / (2.0 * m))
+    -normal_quantile(false_alarm_rate / (2.0 * m))
 }
 
 #[cfg(test)]
@@ -142,5 +146,18 @@ mod tests {
         // alpha 0.01 over 50 features: Phi^-1(1 - 1e-4) = 3.719.
         assert!((bonferroni_limit(0.01, 50) - 3.719_016_485).abs() < 1e-7);
         assert!((bonferroni_limit(0.05, 1) - 1.959_963_985).abs() < 1e-7);
+        // Tiny rates (1e-15 made 1 - alpha / 2m round to 1: a NaN limit) stay finite and
+        // grow: Phi^-1(1 - 5e-16) = 8.0269 (bisection of erfc).
+        assert!(
+            (bonferroni_limit(1e-15, 1) - 8.026_859).abs() < 1e-4,
+            "{}",
+            bonferroni_limit(1e-15, 1)
+        );
+        let mut last = 0.0;
+        for rate in [1e-9, 1e-15, 1e-100, 1e-300] {
+            let l = bonferroni_limit(rate, 1000);
+            assert!(l.is_finite() && l > last, "{rate}: {l}");
+            last = l;
+        }
     }
 }

@@ -3,7 +3,8 @@
 
 use std::path::Path;
 
-use rusqlite::{params, Connection, OpenFlags, OptionalExtension};
+use rusqlite::{params, Connection, OpenFlags, OptionalExtension, TransactionBehavior};
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 use crate::config::FleetConfig;
@@ -187,95 +188,203 @@ impl Store {
         }
     }
 
+    /// The store path must be a regular file (or, with `may_be_new`, a new name in an existing
+    /// folder): a folder, a device or a missing folder is named as such.
+    fn check_path(path: &Path, may_be_new: bool) -> Result<()> {
+        let p = path.display().to_string();
+        match std::fs::metadata(path) {
+            Ok(m) if m.is_dir() => Err(FleetError::NotAFile {
+                path: p,
+                what: "a folder",
+            }),
+            Ok(m) if !m.is_file() => Err(FleetError::NotAFile {
+                path: p,
+                what: "a special file (a device or a pipe)",
+            }),
+            Ok(_) => Ok(()),
+            Err(_) => {
+                let folder = vibmode_core::files::parent_dir(path);
+                if !folder.is_dir() {
+                    Err(FleetError::NoFolder {
+                        path: p,
+                        folder: folder.display().to_string(),
+                    })
+                } else if may_be_new {
+                    Ok(())
+                } else {
+                    Err(FleetError::NoStore { path: p })
+                }
+            }
+        }
+    }
+
     /// Creates a new store at `path`, or opens the store already there. Returns the store and
     /// whether it was created. A file that is not a fleet store is an error (it is not touched).
+    ///
+    /// Safe to run by several processes at once: the schema is created in an immediate
+    /// transaction that re-reads the schema version, so exactly one of them creates it and the
+    /// others find it.
     pub fn init(path: &Path) -> Result<(Store, bool)> {
-        if path.exists() {
-            return Ok((Store::open(path)?, false));
-        }
+        Store::check_path(path, true)?;
         let p = path.display().to_string();
-        let conn = Connection::open(path).map_err(|e| Store::not_a_store(&p, e))?;
+        let conn = Connection::open_with_flags(
+            path,
+            OpenFlags::SQLITE_OPEN_READ_WRITE
+                | OpenFlags::SQLITE_OPEN_CREATE
+                | OpenFlags::SQLITE_OPEN_NO_MUTEX,
+        )
+        .map_err(|e| Store::not_a_store(&p, e))?;
+        conn.busy_timeout(BUSY_TIMEOUT)
+            .map_err(|e| Store::not_a_store(&p, e))?;
         let mut store = Store { conn, path: p };
+        let created = store.create_schema()?;
+        store.check_schema()?;
         store.configure()?;
-        store.migrate(0)?;
-        Ok((store, true))
+        store.migrate()?;
+        Ok((store, created))
+    }
+
+    /// In one immediate transaction: an empty database (no table, `user_version` 0) gets the
+    /// first schema; anything else is left alone. Returns whether the schema was created.
+    fn create_schema(&mut self) -> Result<bool> {
+        let p = self.path.clone();
+        let err = |e: rusqlite::Error| Store::not_a_store(&p, e);
+        let tx = self
+            .conn
+            .transaction_with_behavior(TransactionBehavior::Immediate)
+            .map_err(err)?;
+        let version: i64 = tx
+            .query_row("PRAGMA user_version", [], |r| r.get(0))
+            .map_err(err)?;
+        let objects: i64 = tx
+            .query_row("SELECT COUNT(*) FROM sqlite_master", [], |r| r.get(0))
+            .map_err(err)?;
+        if version != 0 || objects != 0 {
+            return Ok(false);
+        }
+        Store::apply_migration(&tx, 0).map_err(|e| FleetError::Sql {
+            path: p.clone(),
+            operation: "creating the schema",
+            reason: e.to_string(),
+        })?;
+        tx.commit().map_err(err)?;
+        Ok(true)
+    }
+
+    /// Migration `i` (0-based) and its `user_version`, inside `tx`.
+    fn apply_migration(tx: &rusqlite::Transaction<'_>, i: usize) -> rusqlite::Result<()> {
+        if let Some(sql) = MIGRATIONS.get(i) {
+            tx.execute_batch(sql)?;
+            tx.execute_batch(&format!("PRAGMA user_version = {}", i + 1))?;
+        }
+        Ok(())
     }
 
     /// Opens an existing store, migrating an older schema. Errors: no file, a file that is not
-    /// a fleet store (corrupt, foreign SQLite), a newer schema.
+    /// a fleet store (corrupt, foreign SQLite), a newer or unknown schema.
     pub fn open(path: &Path) -> Result<Store> {
+        Store::check_path(path, false)?;
         let p = path.display().to_string();
-        if !path.is_file() {
-            return Err(FleetError::NoStore { path: p });
-        }
         let conn = Connection::open_with_flags(
             path,
             OpenFlags::SQLITE_OPEN_READ_WRITE | OpenFlags::SQLITE_OPEN_NO_MUTEX,
         )
         .map_err(|e| Store::not_a_store(&p, e))?;
-        let version: i64 = conn
-            .query_row("PRAGMA user_version", [], |r| r.get(0))
+        conn.busy_timeout(BUSY_TIMEOUT)
             .map_err(|e| Store::not_a_store(&p, e))?;
+        let mut store = Store { conn, path: p };
+        store.check_schema()?;
+        store.configure()?;
+        store.migrate()?;
+        Ok(store)
+    }
+
+    /// The schema version must be one this build reads, and the file a fleet store.
+    fn check_schema(&self) -> Result<()> {
+        let p = &self.path;
+        let version: i64 = self
+            .conn
+            .query_row("PRAGMA user_version", [], |r| r.get(0))
+            .map_err(|e| Store::not_a_store(p, e))?;
         if version > SCHEMA_VERSION {
             return Err(FleetError::NewerSchema {
-                path: p,
+                path: p.clone(),
+                found: version,
+                supported: SCHEMA_VERSION,
+            });
+        }
+        if version < 0 {
+            return Err(FleetError::UnknownSchema {
+                path: p.clone(),
                 found: version,
                 supported: SCHEMA_VERSION,
             });
         }
         if version == 0 {
-            return Err(Store::not_a_store(&p, "no fleet schema (user_version 0)"));
+            return Err(Store::not_a_store(p, "no fleet schema (user_version 0)"));
         }
-        let app: Option<String> = conn
+        let app: Option<String> = self
+            .conn
             .query_row("SELECT value FROM meta WHERE key = 'app'", [], |r| r.get(0))
             .optional()
-            .map_err(|e| Store::not_a_store(&p, e))?;
+            .map_err(|e| Store::not_a_store(p, e))?;
         if app.as_deref() != Some(APP_ID) {
             return Err(Store::not_a_store(
-                &p,
-                format!("meta app is {app:?}, not {APP_ID}"),
+                p,
+                format!(
+                    "meta app is '{}', not {APP_ID}",
+                    vibmode_core::quoted(app.as_deref().unwrap_or("none"))
+                ),
             ));
         }
-        let mut store = Store { conn, path: p };
-        store.configure()?;
-        store.migrate(version)?;
-        Ok(store)
+        Ok(())
     }
 
     fn configure(&mut self) -> Result<()> {
         let p = self.path.clone();
+        // Another process writing: wait for it (up to BUSY_TIMEOUT) instead of failing.
+        self.conn
+            .busy_timeout(BUSY_TIMEOUT)
+            .map_err(|e| Store::not_a_store(&p, e))?;
         self.conn
             .query_row("PRAGMA journal_mode=WAL", [], |r| r.get::<_, String>(0))
             .map_err(|e| Store::not_a_store(&p, e))?;
         self.conn
             .execute_batch("PRAGMA foreign_keys=ON;")
             .map_err(|e| Store::not_a_store(&p, e))?;
-        // Another process writing: wait for it (up to BUSY_TIMEOUT) instead of failing.
-        self.conn
-            .busy_timeout(BUSY_TIMEOUT)
-            .map_err(|e| Store::not_a_store(&p, e))?;
         Ok(())
     }
 
-    /// Applies the migrations after `from`, each in a transaction with its `user_version`.
-    fn migrate(&mut self, from: i64) -> Result<()> {
-        for (i, sql) in MIGRATIONS.iter().enumerate().skip(from.max(0) as usize) {
-            let path = self.path.clone();
-            let err = |e: rusqlite::Error| FleetError::Sql {
-                path: path.clone(),
-                operation: "schema migration",
-                reason: e.to_string(),
-            };
+    /// Applies the missing migrations, each in an immediate transaction that re-reads
+    /// `user_version` (another process may have applied it meanwhile).
+    fn migrate(&mut self) -> Result<()> {
+        let path = self.path.clone();
+        let err = |e: rusqlite::Error| FleetError::Sql {
+            path: path.clone(),
+            operation: "schema migration",
+            reason: e.to_string(),
+        };
+        let current: i64 = self
+            .conn
+            .query_row("PRAGMA user_version", [], |r| r.get(0))
+            .map_err(err)?;
+        if current >= SCHEMA_VERSION {
+            return Ok(());
+        }
+        loop {
             let tx = self
                 .conn
-                .transaction_with_behavior(rusqlite::TransactionBehavior::Immediate)
+                .transaction_with_behavior(TransactionBehavior::Immediate)
                 .map_err(err)?;
-            tx.execute_batch(sql).map_err(err)?;
-            tx.execute_batch(&format!("PRAGMA user_version = {}", i + 1))
+            let version: i64 = tx
+                .query_row("PRAGMA user_version", [], |r| r.get(0))
                 .map_err(err)?;
+            if !(1..SCHEMA_VERSION).contains(&version) {
+                return Ok(());
+            }
+            Store::apply_migration(&tx, version as usize).map_err(err)?;
             tx.commit().map_err(err)?;
         }
-        Ok(())
     }
 
     /// The schema version (`user_version`).
@@ -318,12 +427,20 @@ impl Store {
             Some(id) => Ok(id),
             None => {
                 let known = self.vehicles()?;
+                let mut shown: Vec<String> = known
+                    .iter()
+                    .take(5)
+                    .map(|v| vibmode_core::quoted(v).to_string())
+                    .collect();
+                if known.len() > 5 {
+                    shown.push(format!("and {} more", known.len() - 5));
+                }
                 Err(FleetError::UnknownVehicle {
                     vehicle: vehicle.to_string(),
                     known: if known.is_empty() {
                         "none".into()
                     } else {
-                        known.join(", ")
+                        shown.join(", ")
                     },
                 })
             }
@@ -357,55 +474,124 @@ impl Store {
     }
 
     /// Stores a record and its features in one transaction (creating the vehicle if new).
-    /// Returns the record id.
+    /// Returns the record id; a record whose content the vehicle already has (stored by another
+    /// process meanwhile, too) is left alone and its id returned.
     pub fn insert_record(&mut self, rec: &NewRecord<'_>, features: &RecordFeatures) -> Result<i64> {
-        let json = serde_json::to_string(features).map_err(|e| self.corrupt("features", e))?;
-        let meta = rec.metadata.to_string();
+        let out = self.store_batch(&[BatchItem {
+            record: rec.clone(),
+            features,
+            check: None,
+        }])?;
+        Ok(out.first().map_or(0, |o| o.record_id))
+    }
+
+    /// Stores records, their features and checks all in one immediate transaction: all of them
+    /// or (on any error) none. A record whose content the vehicle already has (stored earlier,
+    /// by another process meanwhile, or twice in `items`) is not stored again (`inserted`
+    /// false); its check is stored against the existing row. Everything is serialised and read
+    /// back before the transaction starts: a value that could not be read later (a non-finite
+    /// number) is an error and nothing is written.
+    pub fn store_batch(&mut self, items: &[BatchItem<'_>]) -> Result<Vec<Stored>> {
+        let mut prepared = Vec::with_capacity(items.len());
+        for it in items {
+            let features = to_json_checked(
+                it.features,
+                &format!(
+                    "the features of '{}'",
+                    vibmode_core::quoted(it.record.file_name)
+                ),
+            )?;
+            let check = match it.check {
+                Some((version, a)) => Some((
+                    version,
+                    a.classification.to_string(),
+                    to_json_checked(
+                        a,
+                        &format!(
+                            "the check of '{}'",
+                            vibmode_core::quoted(it.record.file_name)
+                        ),
+                    )?,
+                )),
+                None => None,
+            };
+            prepared.push((features, check));
+        }
         let now = now_utc();
         let path = self.path.clone();
         let err = |e: rusqlite::Error| FleetError::Sql {
             path: path.clone(),
-            operation: "storing a record",
+            operation: "storing records",
             reason: e.to_string(),
         };
         let tx = self
             .conn
-            .transaction_with_behavior(rusqlite::TransactionBehavior::Immediate)
+            .transaction_with_behavior(TransactionBehavior::Immediate)
             .map_err(err)?;
-        tx.execute(
-            "INSERT OR IGNORE INTO vehicles (name, created) VALUES (?1, ?2)",
-            params![rec.vehicle, now],
-        )
-        .map_err(err)?;
-        let vid: i64 = tx
-            .query_row(
-                "SELECT id FROM vehicles WHERE name = ?1",
-                [rec.vehicle],
-                |r| r.get(0),
+        let mut out = Vec::with_capacity(items.len());
+        for (it, (features, check)) in items.iter().zip(prepared) {
+            let rec = &it.record;
+            tx.execute(
+                "INSERT OR IGNORE INTO vehicles (name, created) VALUES (?1, ?2)",
+                params![rec.vehicle, now],
             )
             .map_err(err)?;
-        tx.execute(
-            "INSERT INTO records (vehicle_id, sha256, file_name, ingested, condition, road, metadata)
-             VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)",
-            params![
-                vid,
-                rec.sha256,
-                rec.file_name,
-                now,
-                rec.condition.as_str(),
-                rec.road,
-                meta
-            ],
-        )
-        .map_err(err)?;
-        let id = tx.last_insert_rowid();
-        tx.execute(
-            "INSERT INTO features (record_id, json) VALUES (?1, ?2)",
-            params![id, json],
-        )
-        .map_err(err)?;
+            let vid: i64 = tx
+                .query_row(
+                    "SELECT id FROM vehicles WHERE name = ?1",
+                    [rec.vehicle],
+                    |r| r.get(0),
+                )
+                .map_err(err)?;
+            let changed = tx
+                .execute(
+                    "INSERT INTO records
+                        (vehicle_id, sha256, file_name, ingested, condition, road, metadata)
+                     VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)
+                     ON CONFLICT (vehicle_id, sha256) DO NOTHING",
+                    params![
+                        vid,
+                        rec.sha256,
+                        rec.file_name,
+                        now,
+                        rec.condition.as_str(),
+                        rec.road,
+                        rec.metadata.to_string()
+                    ],
+                )
+                .map_err(err)?;
+            let inserted = changed == 1;
+            let id: i64 = if inserted {
+                let id = tx.last_insert_rowid();
+                tx.execute(
+                    "INSERT INTO features (record_id, json) VALUES (?1, ?2)",
+                    params![id, features],
+                )
+                .map_err(err)?;
+                id
+            } else {
+                tx.query_row(
+                    "SELECT id FROM records WHERE vehicle_id = ?1 AND sha256 = ?2",
+                    params![vid, rec.sha256],
+                    |r| r.get(0),
+                )
+                .map_err(err)?
+            };
+            if let Some((version, class, json)) = check {
+                tx.execute(
+                    "INSERT INTO checks (record_id, model_version, checked, classification, json)
+                     VALUES (?1, ?2, ?3, ?4, ?5)",
+                    params![id, version, now, class, json],
+                )
+                .map_err(err)?;
+            }
+            out.push(Stored {
+                record_id: id,
+                inserted,
+            });
+        }
         tx.commit().map_err(err)?;
-        Ok(id)
+        Ok(out)
     }
 
     /// The features of a record.
@@ -515,11 +701,10 @@ impl Store {
             )
             .map_err(err)?;
         set.version = last.unwrap_or(0) + 1;
-        let json = serde_json::to_string(set).map_err(|e| FleetError::CorruptRow {
-            path: path.clone(),
-            what: "model set".into(),
-            reason: e.to_string(),
-        })?;
+        let json = to_json_checked(
+            &*set,
+            &format!("the model set of '{}'", vibmode_core::quoted(&set.vehicle)),
+        )?;
         tx.execute(
             "INSERT INTO model_sets (vehicle_id, version, created, json) VALUES (?1, ?2, ?3, ?4)",
             params![vid, set.version, now_utc(), json],
@@ -555,9 +740,22 @@ impl Store {
     /// Stores the settings. Refused when the store already holds records and the settings
     /// differ (their features were computed with the old ones); the same settings again are
     /// a no-op.
+    ///
+    /// Settings stored by an older vibmode that can no longer be read are replaced while the
+    /// store holds no record.
     pub fn set_config(&mut self, cfg: &FleetConfig) -> Result<()> {
         cfg.validate()?;
-        if self.config()? == *cfg {
+        // Read back as a later command will: a setting that would not read is never stored.
+        let json = to_json_checked(cfg, "the settings")?;
+        let back: FleetConfig =
+            serde_json::from_str(&json).map_err(|e| FleetError::NotStorable {
+                what: "the settings".into(),
+                reason: e.to_string(),
+            })?;
+        back.validate()?;
+        // Compared as stored: serde_json may parse a float one unit in the last place off, so
+        // the same file again must compare what it reads back as.
+        if self.config().ok().as_ref() == Some(&back) {
             return Ok(());
         }
         let path = self.path.clone();
@@ -579,11 +777,6 @@ impl Store {
                 records,
             });
         }
-        let json = serde_json::to_string(cfg).map_err(|e| FleetError::CorruptRow {
-            path: path.clone(),
-            what: "settings".into(),
-            reason: e.to_string(),
-        })?;
         tx.execute(
             "INSERT INTO meta (key, value) VALUES ('fleet_config', ?1)
              ON CONFLICT(key) DO UPDATE SET value = excluded.value",
@@ -614,7 +807,7 @@ impl Store {
 
     /// Stores the outcome of a check.
     pub fn save_check(&mut self, record_id: i64, version: i64, a: &Assessment) -> Result<()> {
-        let json = serde_json::to_string(a).map_err(|e| self.corrupt("assessment", e))?;
+        let json = to_json_checked(a, "the check")?;
         let path = self.path.clone();
         let err = |e: rusqlite::Error| FleetError::Sql {
             path: path.clone(),
@@ -696,6 +889,38 @@ impl Store {
     }
 }
 
+/// One record of [`Store::store_batch`].
+#[derive(Clone, Debug)]
+pub struct BatchItem<'a> {
+    /// The record.
+    pub record: NewRecord<'a>,
+    /// Its features (stored when the record is new).
+    pub features: &'a RecordFeatures,
+    /// A check to store with it: the model-set version and the verdict.
+    pub check: Option<(i64, &'a Assessment)>,
+}
+
+/// Where [`Store::store_batch`] put a record.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Stored {
+    /// Its row id.
+    pub record_id: i64,
+    /// False when the vehicle already had the content (nothing was stored but the check).
+    pub inserted: bool,
+}
+
+/// JSON of `value`, read back as a later command will read it: a value that does not read back
+/// (a NaN or infinity, written as null) is refused before anything is stored.
+fn to_json_checked<T: Serialize + DeserializeOwned>(value: &T, what: &str) -> Result<String> {
+    let fail = |e: serde_json::Error| FleetError::NotStorable {
+        what: what.to_string(),
+        reason: e.to_string(),
+    };
+    let json = serde_json::to_string(value).map_err(fail)?;
+    serde_json::from_str::<T>(&json).map_err(fail)?;
+    Ok(json)
+}
+
 type RowResult = std::result::Result<RecordRow, String>;
 
 fn row_to_record(r: &rusqlite::Row<'_>) -> rusqlite::Result<RowResult> {
@@ -737,6 +962,7 @@ mod tests {
             transmissibility: Vec::new(),
             notes: Vec::new(),
             body_spectra: None,
+            sensor_faults: Vec::new(),
         }
     }
 
@@ -806,8 +1032,8 @@ mod tests {
         let id = s.insert_record(&rec, &features()).expect("insert");
         let found = s.find_record("bus-1", "abc").expect("find");
         assert_eq!(found.map(|r| r.id), Some(id));
-        // The unique constraint refuses a second row with the same hash.
-        assert!(s.insert_record(&rec, &features()).is_err());
+        // The same content again (another process, a second file) is the same row.
+        assert_eq!(s.insert_record(&rec, &features()).expect("again"), id);
         assert_eq!(s.nominal_records("bus-1").expect("nominal").len(), 1);
         assert_eq!(s.features(id).expect("features"), features());
         assert!(matches!(
@@ -815,5 +1041,66 @@ mod tests {
             Err(FleetError::UnknownVehicle { .. })
         ));
         assert_eq!(s.latest_model_set("bus-1").expect("none"), None);
+    }
+
+    #[test]
+    fn nothing_a_later_command_cannot_read_is_stored() {
+        let d = tempfile::tempdir().expect("tempdir");
+        let (mut s, _) = Store::init(&d.path().join("f.db")).expect("init");
+        // Settings with a NaN (as an older vibmode stored them: null) make the store unreadable;
+        // while it holds no record, good settings replace them.
+        s.conn
+            .execute(
+                "INSERT INTO meta (key, value) VALUES ('fleet_config', '{\"transmissibility_min_hz\": null}')",
+                [],
+            )
+            .expect("bad settings");
+        assert!(s.config().is_err());
+        let good = FleetConfig {
+            false_alarm_rate: 0.02,
+            ..FleetConfig::default()
+        };
+        s.set_config(&good).expect("repaired");
+        assert_eq!(s.config().expect("readable"), good);
+        // Settings that fail validation are refused before anything is written.
+        let bad = FleetConfig {
+            transmissibility_min_hz: f64::NAN,
+            ..FleetConfig::default()
+        };
+        assert!(s.set_config(&bad).is_err());
+        assert_eq!(s.config().expect("unchanged"), good);
+        // A check with a NaN score is refused (it would be stored as null and never read).
+        let rec = NewRecord {
+            vehicle: "bus-1",
+            sha256: "abc",
+            file_name: "a.csv",
+            condition: Condition::Test,
+            road: None,
+            metadata: serde_json::json!({}),
+        };
+        let a = Assessment {
+            classification: Classification::Normal,
+            scores: crate::model::Scores {
+                vehicle_max_abs_z: f64::NAN,
+                excitation_max_abs_z: 0.0,
+                n_vehicle: 0,
+                n_excitation: 0,
+            },
+            evidence: Vec::new(),
+            summary: String::new(),
+            missing: Vec::new(),
+            sensor_faults: Vec::new(),
+        };
+        let f = features();
+        let e = s
+            .store_batch(&[BatchItem {
+                record: rec,
+                features: &f,
+                check: Some((1, &a)),
+            }])
+            .expect_err("NaN score");
+        assert!(matches!(e, FleetError::NotStorable { .. }), "{e}");
+        // All or nothing: the record was not stored either.
+        assert_eq!(s.find_record("bus-1", "abc").expect("find"), None);
     }
 }
