@@ -173,6 +173,9 @@ fn migrate_legacy(value: &mut toml::Value) {
     }
 }
 
+/// Longest record cut from a long recording, s (one day).
+pub const RECORD_LENGTH_S_MAX: f64 = 86_400.0;
+
 impl AnalysisConfig {
     /// The defaults of a preset.
     pub fn preset(p: Preset) -> Self {
@@ -279,12 +282,15 @@ impl AnalysisConfig {
 
     /// Checks every section; errors name the key and a valid value.
     pub fn validate(&self) -> Result<(), AnalysisError> {
-        if !(self.record_length_s.is_finite() && self.record_length_s > 0.0) {
+        if !(self.record_length_s.is_finite()
+            && self.record_length_s > 0.0
+            && self.record_length_s <= RECORD_LENGTH_S_MAX)
+        {
             return Err(AnalysisError::Config {
                 key: Some("record_length_s"),
                 message: format!(
-                    "record_length_s = {} must be positive; use e.g. record_length_s = 10.24",
-                    self.record_length_s
+                    "record_length_s = {} must be in (0, {RECORD_LENGTH_S_MAX}] s; use e.g. record_length_s = 10.24",
+                    vibmode_core::Num(self.record_length_s)
                 ),
             });
         }

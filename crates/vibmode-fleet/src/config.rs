@@ -118,6 +118,9 @@ pub const BANDS_MAX: usize = 64;
 pub const BAND_EDGE_MIN_HZ: f64 = 1e-3;
 /// Largest spread floor, ln units (a factor e^10 = 22 000: beyond it no feature is ever scored).
 pub const FLOOR_MAX: f64 = 10.0;
+/// Smallest spread floor, ln units (a relative spread of 1e-6: scores stay finite, 1 / floor
+/// included).
+pub const FLOOR_MIN: f64 = 1e-6;
 
 /// The parser's message, short: serde's "expected one of `a`, `b`, ..." list of every key is
 /// dropped (docs/fleet.md lists them), and what remains is cut to 160 bytes.
@@ -275,11 +278,11 @@ impl FleetConfig {
             ("floor_track_ratio", self.floor_track_ratio),
             ("floor_body_response", self.floor_body_response),
         ] {
-            if !(v.is_finite() && v > 0.0 && v <= FLOOR_MAX) {
+            if !(v.is_finite() && (FLOOR_MIN..=FLOOR_MAX).contains(&v)) {
                 return Err(bad(
                     key,
                     Num(v),
-                    &format!("must be in (0, {FLOOR_MAX}] (a spread of a logarithm), e.g. 0.1"),
+                    &format!("must be in [{FLOOR_MIN:e}, {FLOOR_MAX}] (a spread of a logarithm), e.g. 0.1"),
                 ));
             }
         }
