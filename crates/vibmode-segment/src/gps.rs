@@ -540,7 +540,8 @@ const NOT_POSITION: [&str; 8] = [
 /// A CSV track's column for one quantity: the one whose name is exactly one of `exact`
 /// (`lat`); failing that, the one that has a word of `words_any` and none of [`NOT_POSITION`]
 /// (`Lat_GNSS`, `gps_lat`, `latitude_deg`). `Ok(None)` when no column matches; two candidates
-/// at the same level are refused, naming both.
+/// at the same level are refused, naming both (but of several exact time names the first is
+/// taken, as the reader always did).
 fn find_pattern_col(
     header: &[String],
     exact: &[&str],
@@ -565,6 +566,12 @@ fn find_pattern_col(
     let exact_cands: Vec<usize> = (0..header.len())
         .filter(|&i| exact.contains(&base_name(&header[i]).as_str()))
         .collect();
+    // Several exact time names (`time_s` and `utc`) take the first, as before patterns.
+    if what == "time" {
+        if let Some(&first) = exact_cands.first() {
+            return Ok(Some(first));
+        }
+    }
     if !exact_cands.is_empty() {
         return pick(exact_cands);
     }

@@ -246,6 +246,14 @@ fn gps_csv_columns_found_by_name_patterns() {
     std::fs::write(&rel, text).unwrap();
     let r = read_track(&rel).unwrap();
     assert!(!r.absolute);
+    // Two latitude words but only one exact name: the exact one is taken.
+    let exact = dir.path().join("exact.csv");
+    std::fs::write(
+        &exact,
+        "time,lat,lat_err,lon\n0,48.0,5.0,17.0\n1,48.0001,5.0,17.0\n",
+    )
+    .unwrap();
+    assert_eq!(read_track(&exact).unwrap().fixes[1].lat_deg, 48.0001);
     assert_eq!(r.fixes[60].t_s, 60.0);
     assert_eq!(r.fixes[60].lat_deg, 48.0 + 60.0 * 1e-4);
 }
