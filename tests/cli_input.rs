@@ -157,3 +157,56 @@ fn time_column_units_by_name_and_by_option() {
         &["time_unit", "fortnights", "ms"],
     );
 }
+
+/// A car dataset's GPS track `Timestamp,Lat_GNSS,Long_GNSS` (Unix ms, no speed column) is read
+/// by `segment --gps`: the speed comes from the positions and the records are cut where the car
+/// drives (the command refused the file before: "no latitude column").
+#[test]
+fn segment_reads_a_gps_csv_with_gnss_column_names() {
+    use vibmode_signal::{write_path, Channel, Recording};
+    let d = tempfile::tempdir().unwrap();
+    let fs = 100.0;
+    let n = 6_000;
+    let mut rng = Lcg(3);
+    let rec = Recording {
+        fs_hz: fs,
+        channels: vec![Channel::new(
+            "z".to_string(),
+            "m/s^2".to_string(),
+            (0..n).map(|_| rng.next()).collect(),
+        )],
+        time_axis: None,
+    };
+    let r = d.path().join("r.f32");
+    write_path(&r, &rec).unwrap();
+    let side = d.path().join("r.f32.json");
+    let text = std::fs::read_to_string(&side).unwrap();
+    let text = text.replacen('{', "{\n  \"start_time\": \"2024-05-02T07:31:00Z\",", 1);
+    std::fs::write(&side, text).unwrap();
+    // 10 m/s due north for 38 s, then standing.
+    let mut track = String::from("Timestamp,Lat_GNSS,Long_GNSS\n");
+    for i in 0..=60u64 {
+        let north = 10.0 * (i as f64).min(38.0);
+        let ms = (1_714_635_060 + i) * 1000;
+        track.push_str(&format!("{ms},{},17.0\n", 48.0 + north / 111_195.08));
+    }
+    let g = d.path().join("gnss.csv");
+    std::fs::write(&g, track).unwrap();
+    let out = d.path().join("segs");
+    ok(&[
+        "segment",
+        s(&r),
+        "--gps",
+        s(&g),
+        "--plan-only",
+        "-o",
+        s(&out),
+    ]);
+    let sj = json(&out.join("segments.json"));
+    let records = sj["records"].as_array().expect("records");
+    assert_eq!(records.len(), 3, "{sj}");
+    for rec in records {
+        let v = rec["mean_speed_kmh"].as_f64().expect("speed");
+        assert!((v - 36.0).abs() < 1.0, "{v}");
+    }
+}
