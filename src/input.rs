@@ -20,8 +20,8 @@ pub struct ReadArgs {
     /// Unit of the samples when the file does not say (e.g. m/s^2).
     #[arg(long)]
     pub unit: Option<String>,
-    /// Unit of a text file's time column when its name and header do not say (s, ms, us, ns,
-    /// min, h), e.g. ms for a `Timestamp` column in milliseconds.
+    /// Unit of a text file's time column (s, ms, us, ns, min, h), overriding what its name and
+    /// header say, e.g. ms for a `Timestamp` column in milliseconds.
     #[arg(long = "time-unit", value_name = "UNIT")]
     pub time_unit: Option<String>,
     /// Accept a non-uniform time column by interpolating onto a uniform grid at the mean rate.
