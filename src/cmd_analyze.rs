@@ -29,9 +29,8 @@ pub struct AnalyzeArgs {
     /// model_update.json, updated_vehicle.toml; settings in the config's `[model_update]`).
     #[arg(long)]
     pub vehicle: Option<PathBuf>,
-    /// Channels to analyse, by name or 0-based index (default: all).
-    #[arg(long = "channel", short = 'c')]
-    pub channels: Vec<String>,
+    #[command(flatten)]
+    pub channel: crate::input::ChannelArgs,
     #[command(flatten)]
     pub read: crate::input::ReadArgs,
     /// Output folder for index.html, results.json and figures/.
@@ -128,8 +127,8 @@ pub fn run(a: &AnalyzeArgs) -> Result<()> {
     if let Some(m) = &a.method {
         cfg.method = m.parse()?;
     }
-    let opts = a.read.options();
-    let sel = crate::input::selectors(&a.channels)?;
+    let opts = a.read.options()?;
+    let sel = a.channel.selectors()?;
     let reference = match &a.vehicle {
         Some(p) => vehicle_reference(p)?,
         None => Vec::new(),

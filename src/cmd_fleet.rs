@@ -153,7 +153,7 @@ fn ingest(a: &IngestArgs) -> Result<()> {
     // All or nothing: every file is read and analysed before any is stored, so nothing is
     // reported as stored unless all were.
     let files: Vec<&std::path::Path> = a.files.iter().map(|f| f.as_path()).collect();
-    let done = ingest_files(&mut store, &labels, &files, &a.read.options(), &cfg)?;
+    let done = ingest_files(&mut store, &labels, &files, &a.read.options()?, &cfg)?;
     for r in &done {
         if r.already_stored {
             eprintln!(
@@ -223,7 +223,7 @@ fn check(a: &CheckArgs) -> Result<()> {
         &mut store,
         &set,
         &a.files.iter().map(|f| f.as_path()).collect::<Vec<_>>(),
-        &a.read.options(),
+        &a.read.options()?,
     )?;
     let mut text = format!(
         "vehicle {} against model set version {}\nfile                            class     vehicle |z|  road score  evidence\n",

@@ -74,9 +74,8 @@ pub struct SegmentArgs {
     /// Record length in seconds (default: the analysis's `record_length_s`, 10.24).
     #[arg(long = "record-length-s")]
     pub record_length_s: Option<f64>,
-    /// Channels to keep, by name or 0-based index (default: all).
-    #[arg(long = "channel", short = 'c')]
-    pub channels: Vec<String>,
+    #[command(flatten)]
+    pub channel: crate::input::ChannelArgs,
     #[command(flatten)]
     pub read: crate::input::ReadArgs,
     /// Format of the record files: csv, wav, f32 or f64 (default: f32 for raw input, wav for
@@ -198,8 +197,8 @@ pub fn run(a: &SegmentArgs) -> Result<()> {
     let mut inputs = vec![a.input.clone()];
     inputs.extend(a.seg.gps.iter().cloned());
     let out = crate::output::StagedDir::begin(&a.output, &inputs)?;
-    let opts = a.read.options();
-    let sel = crate::input::selectors(&a.channels)?;
+    let opts = a.read.options()?;
+    let sel = a.channel.selectors()?;
     let record_length_s = a
         .record_length_s
         .unwrap_or(vibmode_analysis::AnalysisConfig::default().record_length_s);

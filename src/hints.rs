@@ -6,6 +6,7 @@
 
 use vibmode_analysis::AnalysisError;
 use vibmode_core::{ParamError, RecordingError};
+use vibmode_fleet::FleetError;
 use vibmode_segment::SegmentError;
 use vibmode_signal::SignalError;
 use vibmode_ssi::SsiError;
@@ -151,6 +152,13 @@ fn key(e: &anyhow::Error) -> Option<Hint> {
         if let Some(s) = cause.downcast_ref::<SegmentError>() {
             return segment_hint(s);
         }
+        if let Some(f) = cause.downcast_ref::<FleetError>() {
+            return match f {
+                FleetError::Signal(s) => signal_hint(s),
+                FleetError::Analysis(AnalysisError::Signal(s)) => signal_hint(s),
+                _ => None,
+            };
+        }
     }
     None
 }
@@ -264,8 +272,8 @@ mod tests {
     }
 
     /// Issue 29 item 5: every hint the binary gives names flags the command accepts. A hint a
-    /// command cannot act on is not given there (the `analyze` and `segment` commands read
-    /// files too, but have no `--resample-nonuniform`).
+    /// command cannot act on is not given there; the reading hints are given by every command
+    /// that reads recordings, since they all share the same input options.
     #[test]
     fn every_hint_names_a_flag_of_the_command_that_gives_it() {
         let commands = commands();
@@ -293,9 +301,36 @@ mod tests {
                 .map(|(_, c)| c.clone())
                 .unwrap_or_else(|| panic!("no command {name}"))
         };
-        assert!(for_command(Hint::ResampleNonuniform, &find("vibmode psd")).is_some());
-        assert!(for_command(Hint::ResampleNonuniform, &find("vibmode analyze")).is_none());
-        assert!(for_command(Hint::ResampleNonuniform, &find("vibmode segment")).is_none());
+        for reader in [
+            "vibmode psd",
+            "vibmode fit",
+            "vibmode sweep",
+            "vibmode ssi",
+            "vibmode resample",
+            "vibmode segment",
+            "vibmode analyze",
+            "vibmode fleet ingest",
+            "vibmode fleet check",
+        ] {
+            let cmd = find(reader);
+            for h in [
+                Hint::ResampleNonuniform,
+                Hint::Fs,
+                Hint::DropFs,
+                Hint::FsExample,
+            ] {
+                assert!(for_command(h, &cmd).is_some(), "{reader}: {h:?}");
+            }
+            for flag in ["scale", "unit", "time-unit"] {
+                assert!(accepts(&cmd, flag), "{reader} lacks --{flag}");
+            }
+        }
+        for selects in ["vibmode psd", "vibmode segment", "vibmode analyze"] {
+            assert!(
+                for_command(Hint::Channel, &find(selects)).is_some(),
+                "{selects}"
+            );
+        }
         assert!(for_command(Hint::Channel, &find("vibmode simulate")).is_none());
         assert!(for_command(Hint::BlockRows, &find("vibmode ssi")).is_some());
         assert!(for_command(Hint::BlockRows, &find("vibmode analyze")).is_none());
@@ -320,5 +355,9 @@ mod tests {
         assert_eq!(key(&e), Some(Hint::FirstLag));
         let e = anyhow::Error::from(ParamError::out_of_range("nperseg", 0, "must be >= 1", 1));
         assert_eq!(key(&e), None);
+        let e = anyhow::Error::from(FleetError::Signal(SignalError::NoSampleRate {
+            path: "a.csv".into(),
+        }));
+        assert_eq!(key(&e), Some(Hint::Fs));
     }
 }

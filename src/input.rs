@@ -5,8 +5,10 @@ use clap::Args;
 use std::path::PathBuf;
 use vibmode_signal::{ChannelSelector, ReadOptions, Recording, ResampleParams, ResampleRecording};
 
-/// How files are read: rate, WAV scale and unit where the file does not say (every command that
-/// reads recordings flattens this).
+/// How files are read: the options every command that reads recordings flattens (`psd`, `fit`,
+/// `sweep`, `ssi`, `resample`, `segment`, `analyze`, `fleet ingest`, `fleet check`). Each
+/// option has one name, one default and one help text, here; [`ReadArgs::options`] is the one
+/// mapping to the reader's [`ReadOptions`].
 #[derive(Args, Debug, Clone)]
 pub struct ReadArgs {
     /// Sampling rate in Hz, required when a file has no time column and no header rate.
@@ -18,17 +20,46 @@ pub struct ReadArgs {
     /// Unit of the samples when the file does not say (e.g. m/s^2).
     #[arg(long)]
     pub unit: Option<String>,
+    /// Unit of a text file's time column (s, ms, us, ns, min, h), overriding what its name and
+    /// header say, e.g. ms for a `Timestamp` column in milliseconds.
+    #[arg(long = "time-unit", value_name = "UNIT")]
+    pub time_unit: Option<String>,
+    /// Accept a non-uniform time column by interpolating onto a uniform grid at the mean rate.
+    #[arg(long)]
+    pub resample_nonuniform: bool,
 }
 
 impl ReadArgs {
-    /// The reader's options.
-    pub fn options(&self) -> ReadOptions {
-        ReadOptions {
+    /// The reader's options (the one place the flags map to [`ReadOptions`]).
+    pub fn options(&self) -> Result<ReadOptions> {
+        let time_scale_s = match &self.time_unit {
+            Some(u) => Some(vibmode_signal::time_unit_scale(u)?),
+            None => None,
+        };
+        Ok(ReadOptions {
             fs_hz: self.fs_hz,
             scale: self.scale,
             unit: self.unit.clone(),
+            allow_nonuniform: self.resample_nonuniform,
+            time_scale_s,
             ..ReadOptions::default()
-        }
+        })
+    }
+}
+
+/// `--channel`, for the commands that select channels.
+#[derive(Args, Debug, Clone, Default)]
+pub struct ChannelArgs {
+    /// Channel to use, by name or 0-based index; repeat for several (default: every channel but
+    /// the time column).
+    #[arg(long = "channel", short = 'c')]
+    pub channels: Vec<String>,
+}
+
+impl ChannelArgs {
+    /// The parsed selectors (empty: every channel).
+    pub fn selectors(&self) -> Result<Vec<ChannelSelector>> {
+        selectors(&self.channels)
     }
 }
 
@@ -45,14 +76,10 @@ pub fn selectors(channels: &[String]) -> Result<Vec<ChannelSelector>> {
 pub struct InputArgs {
     /// Input file: delimited text (.csv, .txt, .tsv), WAV (.wav), or raw f32/f64 with a JSON sidecar.
     pub input: PathBuf,
-    /// Channel to analyse, by name or 0-based index; repeat for several (default: all but time).
-    #[arg(long = "channel", short = 'c')]
-    pub channels: Vec<String>,
+    #[command(flatten)]
+    pub channel: ChannelArgs,
     #[command(flatten)]
     pub read: ReadArgs,
-    /// Accept a non-uniform time column by interpolating onto a uniform grid at the mean rate.
-    #[arg(long)]
-    pub resample_nonuniform: bool,
     /// Resample to this rate in Hz (ideal DFT anti-alias filter first) before analysis.
     #[arg(long = "resample-to")]
     pub resample_to_hz: Option<f64>,
@@ -97,24 +124,17 @@ impl InputArgs {
 
     /// Opens the file as a stream of blocks with the channels selected (for any length).
     pub fn open_stream(&self) -> Result<vibmode_signal::FrameStream> {
-        let mut s = vibmode_signal::open_stream(&self.input, &self.read_options())?;
-        s.select(&selectors(&self.channels)?)?;
+        let mut s = vibmode_signal::open_stream(&self.input, &self.read.options()?)?;
+        s.select(&self.channel.selectors()?)?;
         Ok(s)
-    }
-
-    fn read_options(&self) -> ReadOptions {
-        ReadOptions {
-            allow_nonuniform: self.resample_nonuniform,
-            ..self.read.options()
-        }
     }
 
     /// Reads the file and selects channels, without resampling.
     pub fn load_raw(&self) -> Result<Recording> {
-        let rec = vibmode_signal::read_path(&self.input, &self.read_options())?;
-        if self.channels.is_empty() {
+        let rec = vibmode_signal::read_path(&self.input, &self.read.options()?)?;
+        if self.channel.channels.is_empty() {
             return Ok(rec);
         }
-        Ok(rec.select(&selectors(&self.channels)?)?)
+        Ok(rec.select(&self.channel.selectors()?)?)
     }
 }

@@ -8,10 +8,18 @@
 //!   skipped and counted (`n_bad_sentences`); sentences of other types (GSV, VTG...) are ignored
 //!   and counted (`n_other_sentences`). RMC with status `V` (no fix) is skipped. Without any date
 //!   (GGA only) times are seconds of the day, rolled over at midnight.
-//! - **CSV**: a header row naming the columns `time` (or `t`, `time_s`, `timestamp`, `datetime`,
-//!   `utc`), `lat`/`latitude`, `lon`/`lng`/`longitude` and optionally `speed`; separator `,` or
-//!   `;`. Time cells are seconds (Unix time when above 1e8) or RFC 3339 (`2024-05-02T07:31:00Z`).
-//!   Speed is m/s unless the header says km/h (`speed_kmh`, `speed (km/h)`) or knots (`kn`).
+//! - **CSV**: a header row naming a time, a latitude, a longitude and optionally a speed
+//!   column; separator `,` or `;`. Columns are found by name (case-insensitive, a unit in
+//!   `(...)`/`[...]` removed): first an exact name (`time`, `t`, `time_s`, `time_ms`, `t_ms`,
+//!   `timestamp`, `timestamp_ms`, `datetime`, `utc`; `lat`, `latitude`; `lon`, `lng`, `long`,
+//!   `longitude`), else a name with such a word among its `_`/`-`/`.`/space-separated words
+//!   (`Lat_GNSS`, `gps_lat`, `Long_GNSS`, `GPS_Time`) and no motion word (`acc`, `vel`,
+//!   `speed`, ...: `Long_Acc` is no longitude). Two candidates at the same level are refused,
+//!   naming both. Time cells are seconds (Unix time when above 1e8), milliseconds when the
+//!   name ends in `_ms` or the unit is `ms`, Unix milliseconds when a number exceeds 1e11 (no
+//!   time in seconds does: [`GPS_TIME_ABS_MAX_S`]), or RFC 3339 (`2024-05-02T07:31:00Z`).
+//!   Speed is m/s unless the header says km/h (`speed_kmh`, `speed (km/h)`) or knots (`kn`);
+//!   without a speed column the speed comes from the positions, as for GGA-only NMEA.
 //!
 //! Every fix of every format passes one check ([`check_fixes`]): time finite and within
 //! +-[`GPS_TIME_ABS_MAX_S`], latitude finite and within +-90 degrees, longitude finite and within
@@ -483,16 +491,117 @@ fn read_nmea(text: &str, p: &str) -> Result<Raw, SegmentError> {
     Ok((track, lines.iter().map(|l| format!("line {l}")).collect()))
 }
 
-fn find_col(header: &[String], names: &[&str]) -> Option<usize> {
-    header.iter().position(|h| {
-        let base = h
-            .split(['(', '['])
-            .next()
-            .unwrap_or("")
+/// A header cell's name: without a unit in `(...)` or `[...]`, trimmed, lower case.
+fn base_name(h: &str) -> String {
+    h.split(['(', '['])
+        .next()
+        .unwrap_or("")
+        .trim()
+        .to_ascii_lowercase()
+}
+
+/// A header cell's unit in `(...)` or `[...]`, lower case (empty when none).
+fn header_unit(h: &str) -> String {
+    match h.find(['(', '[']) {
+        Some(i) => h[i + 1..]
+            .trim_end()
+            .trim_end_matches([')', ']'])
             .trim()
-            .to_ascii_lowercase();
-        names.contains(&base.as_str())
-    })
+            .to_ascii_lowercase(),
+        None => String::new(),
+    }
+}
+
+/// The words of a name: split at `_`, `-`, `.` and spaces (`Lat_GNSS` -> `lat`, `gnss`).
+fn words(name: &str) -> Vec<&str> {
+    name.split(['_', '-', '.', ' '])
+        .filter(|w| !w.is_empty())
+        .collect()
+}
+
+fn find_col(header: &[String], names: &[&str]) -> Option<usize> {
+    header
+        .iter()
+        .position(|h| names.contains(&base_name(h).as_str()))
+}
+
+/// Words that make a column a motion quantity rather than a position (`Long_Acc`, `lat_vel`).
+const NOT_POSITION: [&str; 8] = [
+    "acc",
+    "accel",
+    "acceleration",
+    "g",
+    "vel",
+    "velocity",
+    "speed",
+    "rate",
+];
+
+/// A CSV track's column for one quantity: the one whose name is exactly one of `exact`
+/// (`lat`); failing that, the one that has a word of `words_any` and none of [`NOT_POSITION`]
+/// (`Lat_GNSS`, `gps_lat`, `latitude_deg`). `Ok(None)` when no column matches; two candidates
+/// at the same level are refused, naming both (but of several exact time names the first is
+/// taken, as the reader always did).
+fn find_pattern_col(
+    header: &[String],
+    exact: &[&str],
+    words_any: &[&str],
+    what: &str,
+    p: &str,
+) -> Result<Option<usize>, SegmentError> {
+    let pick = |cands: Vec<usize>| -> Result<Option<usize>, SegmentError> {
+        match cands.as_slice() {
+            [] => Ok(None),
+            [i] => Ok(Some(*i)),
+            [a, b, ..] => Err(track_err(
+                p,
+                format!(
+                    "two {what} columns, '{}' and '{}'; keep one, or rename the other so that it does not read as {what}",
+                    quoted(&header[*a]),
+                    quoted(&header[*b])
+                ),
+            )),
+        }
+    };
+    let exact_cands: Vec<usize> = (0..header.len())
+        .filter(|&i| exact.contains(&base_name(&header[i]).as_str()))
+        .collect();
+    // Several exact time names (`time_s` and `utc`) take the first, as before patterns.
+    if what == "time" {
+        if let Some(&first) = exact_cands.first() {
+            return Ok(Some(first));
+        }
+    }
+    if !exact_cands.is_empty() {
+        return pick(exact_cands);
+    }
+    let pattern_cands: Vec<usize> = (0..header.len())
+        .filter(|&i| {
+            let b = base_name(&header[i]);
+            let w = words(&b);
+            w.iter().any(|x| words_any.contains(x)) && !w.iter().any(|x| NOT_POSITION.contains(x))
+        })
+        .collect();
+    pick(pattern_cands)
+}
+
+/// Seconds per unit of a CSV track's time column, when its name (`time_ms`) or header unit
+/// (`time (ms)`) says; `None` for seconds or RFC 3339 text as the cells say.
+fn time_col_scale(h: &str) -> Option<f64> {
+    let unit = header_unit(h);
+    let b = base_name(h);
+    let suffix = words(&b).last().map(|w| w.to_string()).unwrap_or_default();
+    let by = |u: &str| match u {
+        "ms" | "msec" => Some(1e-3),
+        "us" | "µs" => Some(1e-6),
+        "ns" => Some(1e-9),
+        _ => None,
+    };
+    if unit.is_empty() {
+        by(&suffix)
+    } else {
+        by(&unit)
+    }
 }
 
 fn read_csv(text: &str, p: &str) -> Result<Raw, SegmentError> {
@@ -529,20 +638,44 @@ fn read_csv(text: &str, p: &str) -> Result<Raw, SegmentError> {
             )
         })
     };
-    let tc = need(
+    let tc = find_pattern_col(
+        &header,
         &[
             "time",
             "t",
             "time_s",
+            "time_ms",
+            "t_s",
+            "t_ms",
             "timestamp",
+            "timestamp_s",
+            "timestamp_ms",
             "datetime",
             "utc",
             "date_time",
         ],
+        &["time", "timestamp", "datetime", "utc"],
         "time",
+        p,
     )?;
-    let la = need(&["lat", "latitude"], "latitude")?;
-    let lo = need(&["lon", "lng", "long", "longitude"], "longitude")?;
+    let tc = tc.map_or_else(|| need(&[], "time"), Ok)?;
+    let la = find_pattern_col(
+        &header,
+        &["lat", "latitude"],
+        &["lat", "latitude"],
+        "latitude",
+        p,
+    )?;
+    let la = la.map_or_else(|| need(&[], "latitude"), Ok)?;
+    let lo = find_pattern_col(
+        &header,
+        &["lon", "lng", "long", "longitude"],
+        &["lon", "lng", "long", "longitude"],
+        "longitude",
+        p,
+    )?;
+    let lo = lo.map_or_else(|| need(&[], "longitude"), Ok)?;
+    let time_scale = time_col_scale(&header[tc]);
     let sc = find_col(
         &header,
         &[
@@ -596,7 +729,13 @@ fn read_csv(text: &str, p: &str) -> Result<Raw, SegmentError> {
             })
         };
         let (t, abs) = match cell(tc).parse::<f64>() {
-            Ok(v) => (v, v > 1e8),
+            // Milliseconds by the column's name or unit; a number above 1e11 (no Unix time in
+            // seconds, GPS_TIME_ABS_MAX_S) is Unix time in milliseconds.
+            Ok(v) => match time_scale {
+                Some(k) => (v * k, v * k > 1e8),
+                None if v.abs() > GPS_TIME_ABS_MAX_S => (v * 1e-3, true),
+                None => (v, v > 1e8),
+            },
             _ => match parse_rfc3339(cell(tc)) {
                 Some(v) => (v, true),
                 None => {

@@ -167,6 +167,97 @@ fn a_hand_checkable_track_two_records_then_a_stop() {
     assert!(seg.records.is_empty(), "{:?}", seg.records);
 }
 
+/// Issue 29 item 5: a car dataset's `Timestamp,Lat_GNSS,Long_GNSS` track (Unix time in ms, no
+/// speed column: the speed comes from the positions) segments as the same track written as
+/// `time,lat,lon,speed` (Unix seconds, speed in m/s); two latitude columns are refused naming
+/// both; an acceleration column `Long_Acc` is not taken for the longitude.
+#[test]
+fn gps_csv_columns_found_by_name_patterns() {
+    let dir = tempfile::tempdir().unwrap();
+    // 10 m/s due north for 38 s, then standing; fixes every second from 2024-05-02T07:31:00Z.
+    let t0 = 1_714_635_060.0;
+    let mut plain = String::from("time,lat,lon,speed\n");
+    let mut car = String::from("Timestamp,Long_Acc,Lat_GNSS,Long_GNSS\n");
+    for i in 0..=60 {
+        let t = i as f64;
+        let north = 10.0 * t.min(38.0);
+        let v = if i <= 38 { 10.0 } else { 0.0 };
+        let lat = 48.0 + north / 111_195.08;
+        plain.push_str(&format!("{},{lat},17.0,{v}\n", t0 + t));
+        car.push_str(&format!("{},0.1,{lat},17.0\n", (t0 + t) as u64 * 1000));
+    }
+    let plain_p = dir.path().join("plain.csv");
+    let car_p = dir.path().join("car.csv");
+    std::fs::write(&plain_p, plain).unwrap();
+    std::fs::write(&car_p, &car).unwrap();
+    let rec = recording(
+        dir.path(),
+        "r.f32",
+        100.0,
+        6_000,
+        Some("2024-05-02T07:31:00Z"),
+    );
+    let info = open_stream(&rec, &ReadOptions::default())
+        .unwrap()
+        .info()
+        .clone();
+    let a = read_track(&plain_p).unwrap();
+    let b = read_track(&car_p).unwrap();
+    assert!(a.absolute && b.absolute);
+    assert_eq!(a.fixes.len(), b.fixes.len());
+    for (x, y) in a.fixes.iter().zip(&b.fixes) {
+        assert!((x.t_s - y.t_s).abs() < 1e-6, "{} {}", x.t_s, y.t_s);
+        assert_eq!((x.lat_deg, x.lon_deg), (y.lat_deg, y.lon_deg));
+        assert!(y.speed_kmh.is_none());
+    }
+    let p = SegmentParams::default();
+    let sa = by_gps(&info, 6_000, &a, 0.0, L, &p).unwrap();
+    let sb = by_gps(&info, 6_000, &b, 0.0, L, &p).unwrap();
+    let starts = |s: &vibmode_segment::Segmentation| -> Vec<f64> {
+        s.records.iter().map(|r| r.meta.start_s).collect()
+    };
+    assert_eq!(starts(&sa), [0.0, 10.24, 20.48]);
+    assert_eq!(starts(&sb), starts(&sa));
+    for (x, y) in sa.records.iter().zip(&sb.records) {
+        assert_eq!(x.n_frames, y.n_frames);
+        let (vx, vy) = (
+            x.meta.mean_speed_kmh.unwrap(),
+            y.meta.mean_speed_kmh.unwrap(),
+        );
+        assert!((vx - vy).abs() < 0.1, "{vx} {vy}");
+    }
+    // Two latitude candidates: one line naming both.
+    let two = dir.path().join("two.csv");
+    std::fs::write(&two, car.replace("Long_Acc", "lat_imu")).unwrap();
+    let e = read_track(&two).unwrap_err().to_string();
+    assert!(
+        e.contains("two latitude columns")
+            && e.contains("'lat_imu'")
+            && e.contains("'Lat_GNSS'")
+            && !e.contains('\n'),
+        "{e}"
+    );
+    // A time column in milliseconds by its name, relative times.
+    let rel = dir.path().join("rel.csv");
+    let mut text = String::from("time_ms,latitude_deg,lng\n");
+    for i in 0..=60 {
+        text.push_str(&format!("{},{},17.0\n", i * 1000, 48.0 + i as f64 * 1e-4));
+    }
+    std::fs::write(&rel, text).unwrap();
+    let r = read_track(&rel).unwrap();
+    assert!(!r.absolute);
+    // Two latitude words but only one exact name: the exact one is taken.
+    let exact = dir.path().join("exact.csv");
+    std::fs::write(
+        &exact,
+        "time,lat,lat_err,lon\n0,48.0,5.0,17.0\n1,48.0001,5.0,17.0\n",
+    )
+    .unwrap();
+    assert_eq!(read_track(&exact).unwrap().fixes[1].lat_deg, 48.0001);
+    assert_eq!(r.fixes[60].t_s, 60.0);
+    assert_eq!(r.fixes[60].lat_deg, 48.0 + 60.0 * 1e-4);
+}
+
 #[test]
 fn bad_tracks_one_line_errors_and_counted_nmea_sentences() {
     let dir = tempfile::tempdir().unwrap();

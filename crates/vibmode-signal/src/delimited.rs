@@ -278,26 +278,46 @@ pub fn split_name_unit(header: &str) -> (String, String) {
     (h.to_string(), String::new())
 }
 
-/// Seconds per unit if `name`/`unit` denote a time column.
-fn time_scale(name: &str, unit: &str) -> Option<f64> {
-    let n = name.trim().to_ascii_lowercase();
-    let implied = match n.as_str() {
-        "time" | "t" | "timestamp" | "zeit" => None,
-        "time_s" | "t_s" | "time_sec" => Some(1.0),
-        "time_ms" | "t_ms" => Some(1e-3),
-        "time_us" | "t_us" => Some(1e-6),
-        _ => return None,
-    };
-    let u = unit.trim().to_ascii_lowercase();
-    let from_unit = match u.as_str() {
-        "" => None,
+/// Seconds per unit of a time unit's name (`s`, `ms`, `us`/`µs`, `ns`, `min`, `h` and their
+/// spellings), case-insensitive; `None` for anything else.
+pub fn time_unit_seconds(unit: &str) -> Option<f64> {
+    match unit.trim().to_lowercase().as_str() {
         "s" | "sec" | "secs" | "second" | "seconds" => Some(1.0),
         "ms" | "msec" => Some(1e-3),
         "us" | "µs" | "μs" | "usec" => Some(1e-6),
         "ns" => Some(1e-9),
         "min" => Some(60.0),
         "h" | "hr" => Some(3600.0),
-        _ => return None,
+        _ => None,
+    }
+}
+
+/// Seconds per unit if `name`/`unit` denote a time column: a base name `time`, `t`,
+/// `timestamp` or `zeit`, optionally with a unit suffix `_s`, `_sec`, `_ms`, `_us` or `_ns`
+/// (`Time_ms`, `timestamp_ms`), case-insensitive. A unit in the header wins over the suffix; no
+/// unit at all means seconds.
+fn time_scale(name: &str, unit: &str) -> Option<f64> {
+    let n = name.trim().to_ascii_lowercase();
+    let is_base = |b: &str| matches!(b, "time" | "t" | "timestamp" | "zeit");
+    let implied = if is_base(&n) {
+        None
+    } else {
+        let (base, suffix) = n.rsplit_once('_')?;
+        if !is_base(base) {
+            return None;
+        }
+        match suffix {
+            "s" | "sec" => Some(1.0),
+            "ms" => Some(1e-3),
+            "us" => Some(1e-6),
+            "ns" => Some(1e-9),
+            _ => return None,
+        }
+    };
+    let from_unit = if unit.trim().is_empty() {
+        None
+    } else {
+        Some(time_unit_seconds(unit)?)
     };
     Some(from_unit.or(implied).unwrap_or(1.0))
 }
@@ -981,6 +1001,14 @@ mod tests {
         assert_eq!(time_scale("timestamp", ""), Some(1.0));
         assert_eq!(time_scale("Time", "furlongs"), None);
         assert_eq!(time_scale("x", "s"), None);
+        assert_eq!(time_scale("Time_ms", ""), Some(1e-3));
+        assert_eq!(time_scale("Timestamp_ms", ""), Some(1e-3));
+        assert_eq!(time_scale("time_ns", ""), Some(1e-9));
+        assert_eq!(time_scale("t_ms", "s"), Some(1.0));
+        assert_eq!(time_scale("speed_ms", ""), None);
+        assert_eq!(time_scale("time_xyz", ""), None);
+        assert_eq!(time_unit_seconds("MS"), Some(1e-3));
+        assert_eq!(time_unit_seconds("fortnight"), None);
     }
 
     #[test]

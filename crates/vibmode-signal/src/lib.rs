@@ -53,8 +53,8 @@ pub use delimited::{Block, ColumnInfo, DelimitedReader, Separator};
 pub use error::SignalError;
 pub use preprocess::{preprocess, Preprocessed};
 pub use read::{
-    read_delimited, read_delimited_bytes, read_path, sidecar_candidates, Format, ReadOptions,
-    Sidecar, WavSidecar,
+    read_delimited, read_delimited_bytes, read_path, sidecar_candidates, time_unit_scale, Format,
+    ReadOptions, Sidecar, WavSidecar,
 };
 pub use resample::ResampleRecording;
 pub use resample::{resample, ResampleMethod, ResampleParams, Resampler};

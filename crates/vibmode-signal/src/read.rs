@@ -98,6 +98,20 @@ pub struct ReadOptions {
     pub max_jitter_rel: f64,
     /// Unit given to channels whose file does not state one (e.g. `m/s^2`). Default `None`.
     pub unit: Option<String>,
+    /// Seconds per unit of a text file's time column, overriding what its name and header say
+    /// (`Some(1e-3)` for a `Timestamp` column in milliseconds; see [`time_unit_scale`]).
+    /// Default `None`: from the name and header.
+    pub time_scale_s: Option<f64>,
+}
+
+/// Seconds per unit of a time unit (`s`, `ms`, `us`, `ns`, `min`, `h`, case-insensitive), for
+/// [`ReadOptions::time_scale_s`].
+pub fn time_unit_scale(unit: &str) -> Result<f64> {
+    crate::delimited::time_unit_seconds(unit).ok_or_else(|| SignalError::InvalidParam {
+        name: "time_unit",
+        value: format!("'{}'", vibmode_core::quoted(unit)),
+        fix: "use s, ms, us, ns, min or h".into(),
+    })
 }
 
 impl Default for ReadOptions {
@@ -109,6 +123,7 @@ impl Default for ReadOptions {
             allow_nonuniform: false,
             max_jitter_rel: 0.01,
             unit: None,
+            time_scale_s: None,
         }
     }
 }
@@ -119,6 +134,15 @@ impl ReadOptions {
     pub fn check(&self) -> Result<()> {
         if let Some(fs) = self.fs_hz {
             check_fs(fs, "the given fs_hz")?;
+        }
+        if let Some(t) = self.time_scale_s {
+            if !(t.is_finite() && t > 0.0) {
+                return Err(SignalError::InvalidParam {
+                    name: "time_scale_s",
+                    value: t.to_string(),
+                    fix: "must be a finite number > 0, e.g. 0.001 for milliseconds".into(),
+                });
+            }
         }
         if !(self.max_jitter_rel.is_finite() && self.max_jitter_rel >= 0.0) {
             return Err(SignalError::InvalidParam {
@@ -283,7 +307,7 @@ fn finish_delimited(
     let mut channels = Vec::with_capacity(cols.len());
     for (i, (c, d)) in cols.iter().zip(data).enumerate() {
         if Some(i) == tcol {
-            let scale = c.time_scale_s.unwrap_or(1.0);
+            let scale = opts.time_scale_s.or(c.time_scale_s).unwrap_or(1.0);
             time = Some(d.into_iter().map(|v| v * scale).collect());
         } else {
             channels.push(Channel::new(c.name.clone(), c.unit.clone(), d));
