@@ -433,11 +433,12 @@ pub fn run_analysis(
     Ok(res)
 }
 
-/// The file name of `path` (the whole path if it has none).
+/// The name a record file is reported under: the path as the user gave it (relative stays
+/// relative), not its base name, so that `run1/record_01.wav` and `run2/record_01.wav` stay
+/// apart. The same rule as the fleet's ([`vibmode_fleet::record_file_name`]) and the Python
+/// package's.
 pub fn display_name(path: &Path) -> String {
-    path.file_name()
-        .map(|s| s.to_string_lossy().to_string())
-        .unwrap_or_else(|| path.display().to_string())
+    vibmode_fleet::record_file_name(path)
 }
 
 /// Runs the streamed analysis of `source` with a progress display on a terminal; returns the
