@@ -19,7 +19,12 @@ fn ok_in(dir: &Path, args: &[&str]) -> Output {
         .spawn()
         .expect("start vibmode");
     let o = wait_or_kill(child, args);
-    assert_eq!(o.status.code(), Some(0), "args {args:?}: {}", common::stderr(&o));
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "args {args:?}: {}",
+        common::stderr(&o)
+    );
     o
 }
 
@@ -58,12 +63,24 @@ fn fleet_check_names_records_by_the_path_given() {
     ok_in(dir, &["fleet", "init", "--db", "fleet.db"]);
     simulate(dir, "nominal", "3", "6", "10.24");
     let mut args = vec!["fleet", "ingest", "--db", "fleet.db", "--vehicle", "bus-1"];
-    let nominal: Vec<String> = (1..=6).map(|i| format!("nominal/record_{i:02}.csv")).collect();
+    let nominal: Vec<String> = (1..=6)
+        .map(|i| format!("nominal/record_{i:02}.csv"))
+        .collect();
     args.extend(nominal.iter().map(String::as_str));
     let o = ok_in(dir, &args);
     let err = common::stderr(&o);
     assert!(err.contains("nominal/record_01.csv: stored"), "{err}");
-    ok_in(dir, &["fleet", "baseline", "--db", "fleet.db", "--vehicle", "bus-1"]);
+    ok_in(
+        dir,
+        &[
+            "fleet",
+            "baseline",
+            "--db",
+            "fleet.db",
+            "--vehicle",
+            "bus-1",
+        ],
+    );
     // Two runs, one base name.
     simulate(dir, "a", "4", "1", "10.24");
     simulate(dir, "b", "5", "1", "10.24");
@@ -142,7 +159,10 @@ fn analyze_names_records_by_the_path_given() {
     assert_eq!(names[0], "a/record_01.csv");
     assert_eq!(names[1], "b/record_01.csv");
     assert_eq!(names[2], "long/record_01.csv [0.00-10.24 s]");
-    assert!(names[3..]
-        .iter()
-        .all(|n| n.starts_with("long/record_01.csv [")), "{names:?}");
+    assert!(
+        names[3..]
+            .iter()
+            .all(|n| n.starts_with("long/record_01.csv [")),
+        "{names:?}"
+    );
 }
