@@ -411,7 +411,7 @@ pub fn run_analysis(
         bail!("no records to analyse");
     }
     let n_ch = AtomicUsize::new(records[0].recording.channels.len());
-    let pb = crate::progress::records_bar(quiet, None, "records identified");
+    let pb = crate::progress::records_bar(quiet, None, "records identified", "records");
     let progress = sweeps_as_records(&pb, &n_ch);
     let res = analyze(records, cfg, reference, &progress)?;
     pb.finish_and_clear();
@@ -429,7 +429,12 @@ fn sweeps_as_records<'a>(
     move |done: usize, total: usize| {
         let n = n_ch.load(Ordering::SeqCst).max(1);
         if !started.swap(true, Ordering::SeqCst) {
-            crate::progress::set_phase(pb, Some(total.div_ceil(n) as u64), "records identified");
+            crate::progress::set_phase(
+                pb,
+                Some(total.div_ceil(n) as u64),
+                "records identified",
+                "records",
+            );
         }
         pb.set_position((done / n) as u64);
     }
@@ -453,7 +458,7 @@ pub fn run_stream_analysis(
 ) -> Result<(AnalysisResults, RecordInput)> {
     // Records are counted as they are read (and brought to the analysis rate), then as they
     // are identified; the number of channels is the first record's (all must have its layout).
-    let pb = crate::progress::records_bar(quiet, None, "records read");
+    let pb = crate::progress::records_bar(quiet, None, "records read", "records");
     let n_ch = AtomicUsize::new(0);
     let mut counted = CountChannels {
         source,

@@ -159,7 +159,8 @@ fn ingest(a: &IngestArgs) -> Result<()> {
     // All or nothing: every file is read and analysed before any is stored, so nothing is
     // reported as stored unless all were.
     let files: Vec<&std::path::Path> = a.files.iter().map(|f| f.as_path()).collect();
-    let pb = crate::progress::records_bar(a.quiet, Some(files.len() as u64), "files analysed");
+    let pb =
+        crate::progress::records_bar(a.quiet, Some(files.len() as u64), "files analysed", "files");
     let done = ingest_files_progress(&mut store, &labels, &files, &a.read.options(), &cfg, &|n| {
         pb.set_position(n as u64)
     });
@@ -230,7 +231,12 @@ fn check(a: &CheckArgs) -> Result<()> {
     store.require_vehicle(&a.vehicle)?;
     let set = require_baseline(&store, &a.vehicle)?;
     // All or nothing: every file is read and scored before any record or check is stored.
-    let pb = crate::progress::records_bar(a.quiet, Some(a.files.len() as u64), "files analysed");
+    let pb = crate::progress::records_bar(
+        a.quiet,
+        Some(a.files.len() as u64),
+        "files analysed",
+        "files",
+    );
     let out = check_files_progress(
         &mut store,
         &set,

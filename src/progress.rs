@@ -13,27 +13,31 @@ pub fn shown(quiet: bool) -> bool {
 
 /// A bar counting records: with a known total (`len`), a bar, `done/total`, the rate and the
 /// time left; without, a spinner, the count and the rate. `what` says what is counted (e.g.
-/// "files analysed"); the unit is records (files or records cut from them), never channels.
-pub fn records_bar(quiet: bool, len: Option<u64>, what: &str) -> ProgressBar {
+/// "records identified"), `unit` its unit in the rate ("records", "files"): records (files or
+/// records cut from them), never channels.
+pub fn records_bar(quiet: bool, len: Option<u64>, what: &str, unit: &'static str) -> ProgressBar {
     let target = if shown(quiet) {
         ProgressDrawTarget::stderr()
     } else {
         ProgressDrawTarget::hidden()
     };
     let pb = ProgressBar::with_draw_target(len, target);
-    set_phase(&pb, len, what);
+    set_phase(&pb, len, what, unit);
     pb
 }
 
 /// Starts a new phase on `pb`: a new total (or none), the count and the rate estimate from 0,
 /// and what is counted.
-pub fn set_phase(pb: &ProgressBar, len: Option<u64>, what: &str) {
+pub fn set_phase(pb: &ProgressBar, len: Option<u64>, what: &str, unit: &'static str) {
     let template = if len.is_some() {
         "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}  {rate}  {left}"
     } else {
         "{spinner} [{elapsed_precise}] {pos} {msg}  {rate}"
     };
     if let Ok(style) = ProgressStyle::with_template(template) {
+        let rate = move |s: &ProgressState, w: &mut dyn std::fmt::Write| {
+            let _ = write!(w, "{:.1} {unit}/s", s.per_sec());
+        };
         pb.set_style(style.with_key("rate", rate).with_key("left", left));
     }
     match len {
@@ -43,11 +47,6 @@ pub fn set_phase(pb: &ProgressBar, len: Option<u64>, what: &str) {
     pb.set_position(0);
     pb.reset_eta();
     pb.set_message(what.to_string());
-}
-
-/// Records per second, one decimal.
-fn rate(state: &ProgressState, w: &mut dyn std::fmt::Write) {
-    let _ = write!(w, "{:.1} records/s", state.per_sec());
 }
 
 /// The time left, once a record is done (before, there is no rate to tell it from).

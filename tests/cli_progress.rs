@@ -50,6 +50,7 @@ fn assert_no_bar(what: &str, err: &str) {
         "\r",
         "\x1b[",
         "records/s",
+        "files/s",
         "ETA",
         "\u{2588}",
         "\u{2591}",
@@ -146,7 +147,7 @@ fn bar_counts_files_on_a_terminal_and_not_with_q() {
     };
     assert!(quiet.contains("stored as nominal"), "{quiet}");
     assert!(
-        !quiet.contains("files analysed") && !quiet.contains("records/s"),
+        !quiet.contains("files analysed") && !quiet.contains("files/s"),
         "{quiet:?}"
     );
     // Other files (new content), without -q: the bar counts files with their rate.
@@ -156,7 +157,7 @@ fn bar_counts_files_on_a_terminal_and_not_with_q() {
     let shown = on_terminal(&args).unwrap_or_default();
     assert!(shown.contains("stored as nominal"), "{shown}");
     assert!(
-        shown.contains("/3 files analysed") && shown.contains("records/s"),
+        shown.contains("/3 files analysed") && shown.contains("files/s"),
         "{shown:?}"
     );
 }
