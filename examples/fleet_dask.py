@@ -8,7 +8,7 @@ per-record results written to Parquet, and optionally the fleet store fed.
     python examples/fleet_dask.py s3://bucket/fleet/ -o s3://bucket/results/ --scheduler tcp://host:8786
     python examples/fleet_dask.py RECORDS_DIR -o results/ --store fleet.db --vehicle bus-017
 
-Outputs (any fsspec URL): OUT/modes/<record>.parquet (one row per invariant mode of the record,
+Outputs (any fsspec URL): OUT/modes/<record>-<digest>.parquet (one row per invariant mode of the record,
 per channel and per role; written by the worker that analysed it), OUT/records.parquet (one row
 per record: rate, length, fits, modes, seconds) and, with --store and --condition test,
 OUT/checks.parquet (the store's classification of each record).
@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import hashlib
 import json
 import os
 import sys
@@ -64,11 +65,12 @@ def list_records(source: str, pattern: str = "*", storage_options: Optional[Dict
     so = storage_options or {}
     fs, root = _fs(source, so)
     if fs.isfile(root):
-        files = [root]
-    else:
-        files = sorted(f for f in fs.glob(root.rstrip("/") + "/" + pattern) if f.lower().endswith(EXTENSIONS))
+        return [source]
+    files = sorted(f for f in fs.glob(root.rstrip("/") + "/" + pattern) if f.lower().endswith(EXTENSIONS))
     if _is_local(fs):
-        return files
+        # Named as the user gave the folder (relative stays relative), as `vibmode analyze`
+        # and `vibmode fleet ingest` name records.
+        return [os.path.join(source, os.path.relpath(f, root)) for f in files]
     return [fs.unstrip_protocol(f) for f in files]
 
 
@@ -125,7 +127,10 @@ def analyze_record(
     vibmode.fleet.settings(db))."""
     so = storage_options or {}
     t0 = time.perf_counter()
-    name = os.path.basename(url.rstrip("/"))
+    # The record is named by its path or URL as listed (as `vibmode analyze` and `vibmode fleet
+    # ingest` name records: run1/record_01.wav and run2/record_01.wav stay apart), also when a
+    # remote file is analysed from a temporary copy.
+    name = url
     with local_copy(url, so) as path:
         res = vibmode.analyze(path, fs=fs_hz, as_frames=False, **analysis)
         feats = vibmode.fleet.features(path, fs=fs_hz, settings=settings) if with_features else None
@@ -134,7 +139,11 @@ def analyze_record(
         # under the temporary copy of a remote file.
         feats["file"] = url
     table = modes_table(name, res)
-    target = out.rstrip("/") + "/modes/" + os.path.splitext(name)[0] + ".parquet"
+    # One file per record: its base name and a digest of the full name, as records of two
+    # folders may share a base name.
+    digest = hashlib.sha256(name.encode("utf-8")).hexdigest()[:12]
+    stem = os.path.splitext(os.path.basename(name.rstrip("/")))[0]
+    target = out.rstrip("/") + "/modes/" + f"{stem}-{digest}.parquet"
     ofs, opath = _fs(target, so)
     ofs.makedirs(opath.rsplit("/", 1)[0], exist_ok=True)
     with ofs.open(opath, "wb") as f:

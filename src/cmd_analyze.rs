@@ -2,9 +2,8 @@
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use vibmode_analysis::{
     analyze, AnalysisConfig, AnalysisResults, ChainedRecords, Preset, RecordInput, StreamRecords,
 };
@@ -399,7 +398,8 @@ fn reference_modes(modes: &[vibmode_vehicle::ModeInfo]) -> Vec<ReferenceMode> {
     modes.iter().map(|m| m.to_reference()).collect()
 }
 
-/// Runs the analysis with a progress bar on a terminal.
+/// Runs the analysis with a progress bar on a terminal (records identified, per second, the
+/// time left).
 pub fn run_analysis(
     records: &[RecordInput],
     cfg: &AnalysisConfig,
@@ -409,34 +409,42 @@ pub fn run_analysis(
     if records.is_empty() {
         bail!("no records to analyse");
     }
-    let show = !quiet && std::io::stderr().is_terminal();
-    let pb = ProgressBar::with_draw_target(
-        None,
-        if show {
-            ProgressDrawTarget::stderr()
-        } else {
-            ProgressDrawTarget::hidden()
-        },
-    );
-    if let Ok(style) = ProgressStyle::with_template(
-        "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} record x channel sweeps {msg}",
-    ) {
-        pb.set_style(style);
-    }
-    let progress = |done: usize, total: usize| {
-        pb.set_length(total as u64);
-        pb.set_position(done as u64);
-    };
+    let n_ch = AtomicUsize::new(records[0].recording.channels.len());
+    let pb = crate::progress::records_bar(quiet, None, "records identified", "records");
+    let progress = sweeps_as_records(&pb, &n_ch);
     let res = analyze(records, cfg, reference, &progress)?;
     pb.finish_and_clear();
     Ok(res)
 }
 
-/// The file name of `path` (the whole path if it has none).
+/// The analysis' progress (`done` of `total` record x channel fits) shown as records: a record
+/// counts when all its `n_ch` channels are fitted (the total is the records fitted: stops are
+/// not). `n_ch` is read at the first call (a streamed source knows it once read).
+fn sweeps_as_records<'a>(
+    pb: &'a indicatif::ProgressBar,
+    n_ch: &'a AtomicUsize,
+) -> impl Fn(usize, usize) + Sync + 'a {
+    let started = AtomicBool::new(false);
+    move |done: usize, total: usize| {
+        let n = n_ch.load(Ordering::SeqCst).max(1);
+        if !started.swap(true, Ordering::SeqCst) {
+            crate::progress::set_phase(
+                pb,
+                Some(total.div_ceil(n) as u64),
+                "records identified",
+                "records",
+            );
+        }
+        pb.set_position((done / n) as u64);
+    }
+}
+
+/// The name a record file is reported under: the path as the user gave it (relative stays
+/// relative), not its base name, so that `run1/record_01.wav` and `run2/record_01.wav` stay
+/// apart. The same rule as the fleet's ([`vibmode_fleet::record_file_name`]) and the Python
+/// package's.
 pub fn display_name(path: &Path) -> String {
-    path.file_name()
-        .map(|s| s.to_string_lossy().to_string())
-        .unwrap_or_else(|| path.display().to_string())
+    vibmode_fleet::record_file_name(path)
 }
 
 /// Runs the streamed analysis of `source` with a progress display on a terminal; returns the
@@ -447,46 +455,56 @@ pub fn run_stream_analysis(
     reference: &[ReferenceMode],
     quiet: bool,
 ) -> Result<(AnalysisResults, RecordInput)> {
-    let show = !quiet && std::io::stderr().is_terminal();
-    let pb = ProgressBar::with_draw_target(
-        None,
-        if show {
-            ProgressDrawTarget::stderr()
-        } else {
-            ProgressDrawTarget::hidden()
-        },
-    );
-    if let Ok(style) =
-        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} {msg}")
-    {
-        pb.set_style(style);
-    }
-    pb.set_message("records read and resampled");
-    let on_record = |n: usize| {
-        pb.set_position(n as u64);
-        pb.tick();
+    // Records are counted as they are read (and brought to the analysis rate), then as they
+    // are identified; the number of channels is the first record's (all must have its layout).
+    let pb = crate::progress::records_bar(quiet, None, "records read", "records");
+    let n_ch = AtomicUsize::new(0);
+    let mut counted = CountChannels {
+        source,
+        n_ch: &n_ch,
     };
-    let progress = |done: usize, total: usize| {
-        if done == 1 {
-            pb.set_message("record x channel sweeps");
-        }
-        pb.set_length(total as u64);
-        pb.set_position(done as u64);
-    };
+    let on_record = |n: usize| pb.set_position(n as u64);
+    let sweeps = sweeps_as_records(&pb, &n_ch);
     let identifier = vibmode_analysis::SweepIdentifier {
         sweep: cfg.sweep.clone(),
         poles: cfg.poles.clone(),
     };
     let out = vibmode_analysis::analyze_source(
-        source,
+        &mut counted,
         cfg,
         &identifier,
         reference,
         &on_record,
-        &progress,
+        &sweeps,
     )?;
     pb.finish_and_clear();
     Ok(out)
+}
+
+/// A record source that notes the number of channels of the first record (for the progress in
+/// records).
+struct CountChannels<'a> {
+    source: &'a mut dyn vibmode_analysis::RecordSource,
+    n_ch: &'a AtomicUsize,
+}
+
+impl vibmode_analysis::RecordSource for CountChannels<'_> {
+    fn next_record(&mut self) -> Option<Result<RecordInput, vibmode_analysis::AnalysisError>> {
+        let r = self.source.next_record();
+        if let Some(Ok(rec)) = &r {
+            let _ = self.n_ch.compare_exchange(
+                0,
+                rec.recording.channels.len(),
+                Ordering::SeqCst,
+                Ordering::SeqCst,
+            );
+        }
+        r
+    }
+
+    fn meta(&self) -> Option<vibmode_core::RecordMeta> {
+        self.source.meta()
+    }
 }
 
 /// Prints the invariant-mode table per role; with `truth`, the true modes beside it.

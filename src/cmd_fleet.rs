@@ -5,8 +5,8 @@ use clap::{Args, Subcommand};
 use serde::Serialize;
 use std::path::PathBuf;
 use vibmode_fleet::{
-    build_baseline, check_files, ingest_files, require_baseline, Checked, Condition, FleetConfig,
-    IngestLabels, Store,
+    build_baseline, check_files_progress, ingest_files_progress, require_baseline, Checked,
+    Condition, FleetConfig, IngestLabels, Store,
 };
 
 /// Arguments of `vibmode fleet`.
@@ -83,6 +83,9 @@ pub struct IngestArgs {
     /// Record files.
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
+    /// No progress bar.
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
 }
 
 /// Arguments of `vibmode fleet check`.
@@ -102,6 +105,9 @@ pub struct CheckArgs {
     /// Record files.
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
+    /// No progress bar.
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
 }
 
 /// Runs `vibmode fleet ...`.
@@ -153,7 +159,18 @@ fn ingest(a: &IngestArgs) -> Result<()> {
     // All or nothing: every file is read and analysed before any is stored, so nothing is
     // reported as stored unless all were.
     let files: Vec<&std::path::Path> = a.files.iter().map(|f| f.as_path()).collect();
-    let done = ingest_files(&mut store, &labels, &files, &a.read.options()?, &cfg)?;
+    let pb =
+        crate::progress::records_bar(a.quiet, Some(files.len() as u64), "files analysed", "files");
+    let done = ingest_files_progress(
+        &mut store,
+        &labels,
+        &files,
+        &a.read.options()?,
+        &cfg,
+        &|n| pb.set_position(n as u64),
+    );
+    pb.finish_and_clear();
+    let done = done?;
     for r in &done {
         if r.already_stored {
             eprintln!(
@@ -219,12 +236,21 @@ fn check(a: &CheckArgs) -> Result<()> {
     store.require_vehicle(&a.vehicle)?;
     let set = require_baseline(&store, &a.vehicle)?;
     // All or nothing: every file is read and scored before any record or check is stored.
-    let out = check_files(
+    let pb = crate::progress::records_bar(
+        a.quiet,
+        Some(a.files.len() as u64),
+        "files analysed",
+        "files",
+    );
+    let out = check_files_progress(
         &mut store,
         &set,
         &a.files.iter().map(|f| f.as_path()).collect::<Vec<_>>(),
         &a.read.options()?,
-    )?;
+        &|n| pb.set_position(n as u64),
+    );
+    pb.finish_and_clear();
+    let out = out?;
     let mut text = format!(
         "vehicle {} against model set version {}\nfile                            class     vehicle |z|  road score  evidence\n",
         a.vehicle, set.version

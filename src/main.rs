@@ -16,6 +16,7 @@ mod cmd_vehicle;
 mod hints;
 mod input;
 mod output;
+mod progress;
 
 use clap::error::{ContextKind, ContextValue, ErrorKind};
 use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};

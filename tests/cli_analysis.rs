@@ -463,7 +463,7 @@ fn analyze_with_a_vehicle_updates_the_model() {
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(
-        text.contains("Full-car model not updated: record_01.wav")
+        text.contains(&format!("Full-car model not updated: {}", wavs[0]))
             && text.contains("no unsprung channel at RL"),
         "{text}"
     );

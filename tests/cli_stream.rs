@@ -113,7 +113,11 @@ fn streamed_analyze_cuts_records_and_reports_their_start() {
     let recs = json["records"].as_array().unwrap();
     assert_eq!(recs.len(), 3);
     assert_eq!(recs[1]["segment"]["start_s"], 10.24);
-    assert_eq!(recs[2]["name"], "drive.f32 [20.48-30.72 s]");
+    // Named by the path as given, with the record's time range.
+    assert_eq!(
+        recs[2]["name"].as_str().unwrap(),
+        format!("{} [20.48-30.72 s]", input.display())
+    );
     assert_eq!(recs[0]["n_samples"], 10240);
 }
 

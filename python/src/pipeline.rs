@@ -148,10 +148,8 @@ fn analyze(
                     select(rec, channels.as_deref())
                 })
                 .map_err(signal_err)?;
-            let name = path
-                .file_name()
-                .map(|s| s.to_string_lossy().to_string())
-                .unwrap_or_else(|| path.display().to_string());
+            // The path as given (as the CLI and vibmode.fleet name records), not its base name.
+            let name = vibmode_fleet::record_file_name(&path);
             records.extend(cut_records(&name, &rec, cfg.record_length_s));
         }
     }

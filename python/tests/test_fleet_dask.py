@@ -2,6 +2,7 @@
 
 import importlib.util
 import json
+import os
 import sqlite3
 import sys
 from pathlib import Path
@@ -59,15 +60,17 @@ def test_two_workers_equal_single_process(tmp_path):
 
     cols = [c for c in single.columns if c != "seconds"]
     pd.testing.assert_frame_equal(single[cols], dist[cols])
-    assert list(single["record"]) == [f"record_{i:02d}.wav" for i in range(1, 5)]
+    # Records are named by their path (the folder as given joined with the file), by the
+    # workers as in one process.
+    assert list(single["record"]) == [os.path.join(str(rec_dir), f"record_{i:02d}.wav") for i in range(1, 5)]
     a = pd.read_parquet(tmp_path / "single" / "modes").sort_values(["record", "pool_kind", "pool", "frequency_hz"]).reset_index(drop=True)
     b = pd.read_parquet(tmp_path / "dask" / "modes").sort_values(["record", "pool_kind", "pool", "frequency_hz"]).reset_index(drop=True)
     assert len(a) > 0 and set(a["record"]) == set(single["record"])
     pd.testing.assert_frame_equal(a, b)
     # The per-record table is the one-record analysis of each file.
     one = vibmode.analyze(str(rec_dir / "record_02.wav"), order_max=8, as_frames=False)
-    expect = fd.modes_table("record_02.wav", one)
-    got = a[a["record"] == "record_02.wav"].sort_values(["pool_kind", "pool", "frequency_hz"]).reset_index(drop=True)
+    expect = fd.modes_table(str(rec_dir / "record_02.wav"), one)
+    got = a[a["record"] == str(rec_dir / "record_02.wav")].sort_values(["pool_kind", "pool", "frequency_hz"]).reset_index(drop=True)
     expect = expect.sort_values(["pool_kind", "pool", "frequency_hz"]).reset_index(drop=True)
     pd.testing.assert_frame_equal(got, expect, check_dtype=False)
     # The two stores hold the same records.

@@ -118,7 +118,7 @@ def read(
         os.fspath(path), None if fs is None else _check_fs(fs), float(scale), unit,
         bool(allow_nonuniform), format, sel,
     )
-    rec = Recording(data, rate, names, units, json.loads(placements), name=os.path.basename(os.fspath(path)))
+    rec = Recording(data, rate, names, units, json.loads(placements), name=os.fspath(path))
     return rec.to_frame() if as_frame else rec
 
 

@@ -216,7 +216,7 @@ fn hash_file(path: &Path) -> Result<String> {
 
 /// Reads and analyses every file (a file whose bytes the vehicle already has is not read
 /// again; the same bytes twice in `paths` are analysed once). `layout` checks each read
-/// recording first.
+/// recording first. `progress(n)` is called after the first `n` files are done.
 fn prepare_files(
     store: &Store,
     labels: &IngestLabels<'_>,
@@ -224,9 +224,13 @@ fn prepare_files(
     opts: &ReadOptions,
     cfg: &FleetConfig,
     layout: &dyn Fn(&str, &Recording) -> Result<()>,
+    progress: &dyn Fn(usize),
 ) -> Result<Vec<Prepared>> {
     let mut out: Vec<Prepared> = Vec::with_capacity(paths.len());
     for path in paths {
+        if !out.is_empty() {
+            progress(out.len());
+        }
         let name = file_name(path);
         let sha = hash_file(path)?;
         if let Some(row) = store.find_record(labels.vehicle, &sha)? {
@@ -262,6 +266,7 @@ fn prepare_files(
             known: false,
         });
     }
+    progress(out.len());
     Ok(out)
 }
 
@@ -277,8 +282,21 @@ pub fn ingest_files(
     opts: &ReadOptions,
     cfg: &FleetConfig,
 ) -> Result<Vec<Ingested>> {
+    ingest_files_progress(store, labels, paths, opts, cfg, &|_| ())
+}
+
+/// As [`ingest_files`], calling `progress(n)` after the first `n` files are read and analysed
+/// (before anything is stored).
+pub fn ingest_files_progress(
+    store: &mut Store,
+    labels: &IngestLabels<'_>,
+    paths: &[&Path],
+    opts: &ReadOptions,
+    cfg: &FleetConfig,
+    progress: &dyn Fn(usize),
+) -> Result<Vec<Ingested>> {
     check_vehicle_id(labels.vehicle)?;
-    let prepared = prepare_files(store, labels, paths, opts, cfg, &|_, _| Ok(()))?;
+    let prepared = prepare_files(store, labels, paths, opts, cfg, &|_, _| Ok(()), progress)?;
     let checks = vec![None; prepared.len()];
     let stored = store_prepared(store, labels, &prepared, &checks)?;
     Ok(prepared
@@ -436,9 +454,29 @@ pub fn check_files(
     paths: &[&Path],
     opts: &ReadOptions,
 ) -> Result<Vec<Checked>> {
+    check_files_progress(store, set, paths, opts, &|_| ())
+}
+
+/// As [`check_files`], calling `progress(n)` after the first `n` files are read and analysed
+/// (they are scored and stored after the last).
+pub fn check_files_progress(
+    store: &mut Store,
+    set: &ModelSet,
+    paths: &[&Path],
+    opts: &ReadOptions,
+    progress: &dyn Fn(usize),
+) -> Result<Vec<Checked>> {
     check_vehicle_id(&set.vehicle)?;
     let layout = |name: &str, rec: &Recording| check_layout(set, name, rec);
-    let prepared = prepare_files(store, &test_labels(set), paths, opts, &set.config, &layout)?;
+    let prepared = prepare_files(
+        store,
+        &test_labels(set),
+        paths,
+        opts,
+        &set.config,
+        &layout,
+        progress,
+    )?;
     check_prepared(store, set, prepared)
 }
 

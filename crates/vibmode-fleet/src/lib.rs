@@ -26,9 +26,10 @@ pub use features::{
     FaultKind, ModeEstimate, RecordFeatures, SensorFault,
 };
 pub use fleet::{
-    build_baseline, check_file, check_files, check_recording, check_vehicle_id, ingest_file,
-    ingest_files, ingest_recording, record_file_name, recording_hash, require_baseline, sha256_hex,
-    Checked, IngestLabels, Ingested,
+    build_baseline, check_file, check_files, check_files_progress, check_recording,
+    check_vehicle_id, ingest_file, ingest_files, ingest_files_progress, ingest_recording,
+    record_file_name, recording_hash, require_baseline, sha256_hex, Checked, IngestLabels,
+    Ingested,
 };
 pub use model::{
     assess, build_model_set, Assessment, Classification, Evidence, FeatureMeta, FeatureStat, Group,

@@ -58,10 +58,8 @@ fn write_all(
     ext: &str,
     written: &mut Vec<PathBuf>,
 ) -> Result<PathBuf, SegmentError> {
-    let name = Path::new(&seg.source)
-        .file_name()
-        .map_or_else(|| seg.source.clone(), |s| s.to_string_lossy().to_string());
-    let mut src = StreamRecords::windows(&name, stream, seg.windows());
+    // The records are named by the source as given (as `vibmode analyze` names them).
+    let mut src = StreamRecords::windows(&seg.source, stream, seg.windows());
     let mut k = 0;
     while let Some(r) = src.next_record() {
         let r = r?;
