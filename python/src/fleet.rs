@@ -2,6 +2,7 @@
 //! status. Every call opens the store, does its work and closes it (SQLite: one writer at a
 //! time; see docs/scaling.md).
 
+use crate::signal::read_options;
 use pyo3::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -11,7 +12,6 @@ use vibmode_fleet::{
     IngestLabels, Store,
 };
 use vibmode_fleet::{compute_features, sha256_hex, FleetError, Ingested, RecordFeatures};
-use vibmode_signal::ReadOptions;
 
 use crate::errors::{fleet_err, json_err};
 
@@ -26,15 +26,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fleet_features, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_store_features, m)?)?;
     Ok(())
-}
-
-fn read_options(fs: Option<f64>, scale: f64, unit: Option<String>) -> ReadOptions {
-    ReadOptions {
-        fs_hz: fs,
-        scale,
-        unit,
-        ..ReadOptions::default()
-    }
 }
 
 /// Creates the store if needed, with the settings `config_toml` (TOML text of a
@@ -80,7 +71,7 @@ fn settings_from_json(json: Option<&str>) -> PyResult<FleetConfig> {
 
 /// Ingests files for a vehicle; JSON list of `Ingested`.
 #[pyfunction]
-#[pyo3(signature = (db, vehicle, files, condition="nominal", road=None, fs=None, scale=1.0, unit=None))]
+#[pyo3(signature = (db, vehicle, files, condition="nominal", road=None, fs=None, scale=1.0, unit=None, allow_nonuniform=false, time_unit=None))]
 #[allow(clippy::too_many_arguments)]
 fn fleet_ingest(
     py: Python<'_>,
@@ -92,9 +83,11 @@ fn fleet_ingest(
     fs: Option<f64>,
     scale: f64,
     unit: Option<String>,
+    allow_nonuniform: bool,
+    time_unit: Option<&str>,
 ) -> PyResult<String> {
     let condition: Condition = condition.parse().map_err(fleet_err)?;
-    let opts = read_options(fs, scale, unit);
+    let opts = read_options(fs, scale, unit, allow_nonuniform, time_unit)?;
     let out = py
         .detach(|| {
             let mut store = Store::open(&db)?;
@@ -135,7 +128,8 @@ struct CheckOut {
 
 /// Checks files against the vehicle's latest model set; JSON as `vibmode fleet check --json`.
 #[pyfunction]
-#[pyo3(signature = (db, vehicle, files, fs=None, scale=1.0, unit=None))]
+#[pyo3(signature = (db, vehicle, files, fs=None, scale=1.0, unit=None, allow_nonuniform=false, time_unit=None))]
+#[allow(clippy::too_many_arguments)]
 fn fleet_check(
     py: Python<'_>,
     db: PathBuf,
@@ -144,8 +138,10 @@ fn fleet_check(
     fs: Option<f64>,
     scale: f64,
     unit: Option<String>,
+    allow_nonuniform: bool,
+    time_unit: Option<&str>,
 ) -> PyResult<String> {
-    let opts = read_options(fs, scale, unit);
+    let opts = read_options(fs, scale, unit, allow_nonuniform, time_unit)?;
     let out = py
         .detach(|| {
             let mut store = Store::open(&db)?;
@@ -187,7 +183,8 @@ struct FeaturesOut {
 /// without touching a store, with the settings `settings_json` (from [`fleet_settings`]; `None`:
 /// the defaults); JSON for [`fleet_store_features`].
 #[pyfunction]
-#[pyo3(signature = (path, fs=None, scale=1.0, unit=None, settings_json=None))]
+#[pyo3(signature = (path, fs=None, scale=1.0, unit=None, settings_json=None, allow_nonuniform=false, time_unit=None))]
+#[allow(clippy::too_many_arguments)]
 fn fleet_features(
     py: Python<'_>,
     path: PathBuf,
@@ -195,9 +192,11 @@ fn fleet_features(
     scale: f64,
     unit: Option<String>,
     settings_json: Option<&str>,
+    allow_nonuniform: bool,
+    time_unit: Option<&str>,
 ) -> PyResult<String> {
     let cfg = settings_from_json(settings_json)?;
-    let opts = read_options(fs, scale, unit);
+    let opts = read_options(fs, scale, unit, allow_nonuniform, time_unit)?;
     let out = py
         .detach(|| {
             let bytes = std::fs::read(&path).map_err(|e| FleetError::Io {

@@ -8,7 +8,6 @@ use pyo3::types::{PyList, PyTuple};
 use std::path::PathBuf;
 use vibmode_analysis::{cut_records, AnalysisConfig, Preset, RecordInput};
 use vibmode_modal::ReferenceMode;
-use vibmode_signal::ReadOptions;
 use vibmode_vehicle::{FullCar, RoadClass, SimParams, VehicleParams};
 
 use crate::errors::{analysis_err, json_err, signal_err, value_err, vehicle_err};
@@ -107,7 +106,7 @@ fn fullcar_modes(py: Python<'_>, kind: &str, value: &str) -> PyResult<String> {
 /// `(name, data (channels, samples), fs_hz, names, units, placements_json)`.
 /// Files are cut into records of `record_length_s`. Returns results.json's text.
 #[pyfunction]
-#[pyo3(signature = (inputs, config_toml=None, preset=None, fs=None, scale=1.0, unit=None, channels=None, vehicle_kind=None, vehicle=None))]
+#[pyo3(signature = (inputs, config_toml=None, preset=None, fs=None, scale=1.0, unit=None, channels=None, vehicle_kind=None, vehicle=None, allow_nonuniform=false, time_unit=None))]
 #[allow(clippy::too_many_arguments)]
 fn analyze(
     py: Python<'_>,
@@ -120,14 +119,11 @@ fn analyze(
     channels: Option<Vec<String>>,
     vehicle_kind: Option<&str>,
     vehicle: Option<&str>,
+    allow_nonuniform: bool,
+    time_unit: Option<&str>,
 ) -> PyResult<String> {
     let cfg = config_of(config_toml, preset)?;
-    let opts = ReadOptions {
-        fs_hz: fs,
-        scale,
-        unit,
-        ..ReadOptions::default()
-    };
+    let opts = crate::signal::read_options(fs, scale, unit, allow_nonuniform, time_unit)?;
     let mut records: Vec<RecordInput> = Vec::new();
     for item in inputs.iter() {
         if let Ok(t) = item.cast::<PyTuple>() {

@@ -86,9 +86,33 @@ pub fn from_py(
     Recording::new(fs, channels).map_err(value_err)
 }
 
+/// The file-reading options every reading function takes, as the command line's shared input
+/// options (`--fs --scale --unit --time-unit --resample-nonuniform`): one mapping to
+/// [`ReadOptions`].
+pub fn read_options(
+    fs: Option<f64>,
+    scale: f64,
+    unit: Option<String>,
+    allow_nonuniform: bool,
+    time_unit: Option<&str>,
+) -> PyResult<ReadOptions> {
+    let time_scale_s = match time_unit {
+        Some(u) => Some(vibmode_signal::time_unit_scale(u).map_err(signal_err)?),
+        None => None,
+    };
+    Ok(ReadOptions {
+        fs_hz: fs,
+        scale,
+        unit,
+        allow_nonuniform,
+        time_scale_s,
+        ..ReadOptions::default()
+    })
+}
+
 /// Reads a recording (delimited text, WAV, raw + JSON sidecar).
 #[pyfunction]
-#[pyo3(signature = (path, fs=None, scale=1.0, unit=None, allow_nonuniform=false, format=None, channels=None))]
+#[pyo3(signature = (path, fs=None, scale=1.0, unit=None, allow_nonuniform=false, format=None, channels=None, time_unit=None))]
 #[allow(clippy::too_many_arguments)]
 fn read<'py>(
     py: Python<'py>,
@@ -99,18 +123,15 @@ fn read<'py>(
     allow_nonuniform: bool,
     format: Option<&str>,
     channels: Option<Vec<String>>,
+    time_unit: Option<&str>,
 ) -> PyResult<PyRecording<'py>> {
     let format = match format {
         Some(f) => Some(f.parse::<Format>().map_err(signal_err)?),
         None => None,
     };
     let opts = ReadOptions {
-        fs_hz: fs,
         format,
-        scale,
-        allow_nonuniform,
-        unit,
-        ..ReadOptions::default()
+        ..read_options(fs, scale, unit, allow_nonuniform, time_unit)?
     };
     let rec = py
         .detach(|| {

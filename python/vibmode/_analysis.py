@@ -111,6 +111,8 @@ def analyze(
     channels: Optional[Sequence[Union[str, int]]] = None,
     unit: Optional[str] = None,
     scale: float = 1.0,
+    allow_nonuniform: bool = False,
+    time_unit: Optional[str] = None,
     as_frames: Optional[bool] = None,
     **settings: Any,
 ) -> Dict[str, Any]:
@@ -146,6 +148,7 @@ def analyze(
     sel = None if channels is None else [str(c) for c in channels]
     text = _native.analyze(
         native_items, toml, preset, None if fs is None else _check_fs(fs), float(scale), unit, sel, vk, vv,
+        bool(allow_nonuniform), time_unit,
     )
     res = json.loads(text)
     use = has_pandas() if as_frames is None else bool(as_frames)

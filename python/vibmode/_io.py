@@ -101,13 +101,17 @@ def read(
     allow_nonuniform: bool = False,
     format: Optional[str] = None,
     as_frame: bool = False,
+    time_unit: Optional[str] = None,
 ):
     """Reads a recording: delimited text (separator, header, units, decimal commas and a time
     column detected), WAV (PCM or float) or raw f32/f64 with a JSON sidecar (docs/formats.md).
 
     ``fs``: sampling rate in Hz for files without a time column. ``channels``: names or 0-based
     indices to keep. ``scale``: multiplier of WAV integer samples (full scale = 1.0).
-    ``unit``: unit of channels whose file gives none.
+    ``unit``: unit of channels whose file gives none. ``allow_nonuniform``: resample a jittery
+    time column to its mean rate (the command line's ``--resample-nonuniform``). ``time_unit``:
+    the time column's unit (``s``, ``ms``, ``us``, ``ns``, ``min``, ``h``) when its name and header
+    do not say (``--time-unit``); :func:`analyze` and the fleet functions take the same options.
 
     Returns a :class:`Recording` (``data, fs, names = vibmode.read(path)`` unpacks it), or with
     ``as_frame=True`` a pandas DataFrame (index ``time_s``, ``attrs['fs']`` in Hz).
@@ -116,7 +120,7 @@ def read(
     sel = None if channels is None else [str(c) for c in channels]
     data, rate, names, units, placements = _native.read(
         os.fspath(path), None if fs is None else _check_fs(fs), float(scale), unit,
-        bool(allow_nonuniform), format, sel,
+        bool(allow_nonuniform), format, sel, time_unit,
     )
     rec = Recording(data, rate, names, units, json.loads(placements), name=os.fspath(path))
     return rec.to_frame() if as_frame else rec

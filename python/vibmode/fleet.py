@@ -52,13 +52,18 @@ def ingest(
     fs: Optional[float] = None,
     scale: float = 1.0,
     unit: Optional[str] = None,
+    allow_nonuniform: bool = False,
+    time_unit: Optional[str] = None,
 ) -> List[Dict[str, Any]]:
     """Stores the features of ``files`` for ``vehicle`` (``condition`` 'nominal' or 'test');
     a file already stored is not stored twice. All or nothing: every file is read and analysed
     first, then all are stored in one transaction; an error stores none. Returns one dict per
     file."""
     return json.loads(
-        _native.fleet_ingest(os.fspath(db), vehicle, _paths(files), condition, road, fs, float(scale), unit)
+        _native.fleet_ingest(
+            os.fspath(db), vehicle, _paths(files), condition, road, fs, float(scale), unit,
+            bool(allow_nonuniform), time_unit,
+        )
     )
 
 
@@ -74,13 +79,19 @@ def check(
     fs: Optional[float] = None,
     scale: float = 1.0,
     unit: Optional[str] = None,
+    allow_nonuniform: bool = False,
+    time_unit: Optional[str] = None,
 ) -> Dict[str, Any]:
     """Classifies ``files`` against the vehicle's latest model set (``vibmode fleet check
     --json``): ``{'vehicle', 'model_version', 'records': [...]}``, each record with its
     ``assessment`` (classification: normal, road, vehicle, both, or sensor for a dead, stuck or
     clipped channel listed in ``sensor_faults``; scores, evidence). All or nothing: an error in
     any file stores no record and no check."""
-    return json.loads(_native.fleet_check(os.fspath(db), vehicle, _paths(files), fs, float(scale), unit))
+    return json.loads(
+        _native.fleet_check(
+            os.fspath(db), vehicle, _paths(files), fs, float(scale), unit, bool(allow_nonuniform), time_unit
+        )
+    )
 
 
 def status(db: PathLike, last: int = 10) -> List[Dict[str, Any]]:
@@ -94,6 +105,8 @@ def features(
     scale: float = 1.0,
     unit: Optional[str] = None,
     settings: Optional[Dict[str, Any]] = None,
+    allow_nonuniform: bool = False,
+    time_unit: Optional[str] = None,
 ) -> Dict[str, Any]:
     """What the store keeps of one file (band levels, transmissibility, modes), computed without
     a store: the expensive part of :func:`ingest`, to run on many workers (e.g. Dask). Returns a
@@ -110,7 +123,9 @@ def features(
             f"settings of type {type(settings).__name__}: pass the dict vibmode.fleet.settings(db) returns, or None"
         )
     text = None if settings is None else json.dumps(settings)
-    return json.loads(_native.fleet_features(os.fspath(path), fs, float(scale), unit, text))
+    return json.loads(
+        _native.fleet_features(os.fspath(path), fs, float(scale), unit, text, bool(allow_nonuniform), time_unit)
+    )
 
 
 def store_features(
