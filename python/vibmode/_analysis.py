@@ -130,7 +130,8 @@ def analyze(
     ``vehicle``: full-car parameters (shipped name, TOML file/text or dict) whose modes are
     matched and whose suspension is fitted to the records' body equations: ``model_update`` in
     the result holds the updated vehicle, its modes and the file's (docs/model_update.md), or
-    ``not_updated`` with the reason. ``channels``: names or indices to analyse.
+    ``not_updated`` with the reason. ``channels``: names or indices to analyse. Files are read
+    with ``scale``, ``unit``, ``time_unit`` and ``allow_nonuniform`` as :func:`read` reads them.
 
     Returns the structure of ``results.json`` as a dict; with pandas installed (and
     ``as_frames`` not False) every table (list of flat records: poles, fits, invariant modes,
