@@ -5,41 +5,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{bin, fails_with, ok};
-
-/// Simulated bus records (CSV, 200 Hz) from `vibmode simulate` into `dir`.
-fn simulate(dir: &Path, road: &str, speed: &str, seed: &str, records: &str) -> Vec<String> {
-    let params = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/city_bus.toml");
-    ok(&[
-        "simulate",
-        params,
-        "--road",
-        road,
-        "--speed-kmh",
-        speed,
-        "--duration-s",
-        "10.24",
-        "--records",
-        records,
-        "--seed",
-        seed,
-        "--fs",
-        "200",
-        "--format",
-        "csv",
-        "-o",
-        dir.to_str().unwrap(),
-    ]);
-    let mut files: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|x| x == "csv"))
-        .map(|p| p.to_string_lossy().to_string())
-        .collect();
-    files.sort();
-    files
-}
+use common::{bin, fails_with, ok, simulate_csv};
 
 #[test]
 fn fleet_workflow_and_errors() {
@@ -48,7 +14,7 @@ fn fleet_workflow_and_errors() {
     let db = db.to_str().unwrap();
     let o = ok(&["fleet", "init", "--db", db]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("created"));
-    let nominal = simulate(&d.path().join("nominal"), "C", "40", "3", "6");
+    let nominal = simulate_csv(&d.path().join("nominal"), "C", "40", "3", "6");
     assert_eq!(nominal.len(), 6, "{nominal:?}");
     let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1"];
     args.extend(nominal.iter().map(String::as_str));
@@ -72,7 +38,7 @@ fn fleet_workflow_and_errors() {
     );
     let o = ok(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
     assert!(String::from_utf8_lossy(&o.stdout).contains("version 1"));
-    let test = simulate(&d.path().join("test"), "C", "40", "4", "1");
+    let test = simulate_csv(&d.path().join("test"), "C", "40", "4", "1");
     let o = ok(&[
         "fleet",
         "check",
@@ -178,7 +144,7 @@ fn fleet_workflow_and_errors() {
 #[test]
 fn concurrent_ingests_both_succeed() {
     let d = tempfile::tempdir().unwrap();
-    let files = simulate(&d.path().join("sim"), "B", "30", "3", "2");
+    let files = simulate_csv(&d.path().join("sim"), "B", "30", "3", "2");
     let db = d.path().join("fleet.db");
     let db = db.to_str().unwrap();
     ok(&["fleet", "init", "--db", db]);
@@ -205,7 +171,7 @@ fn concurrent_ingests_both_succeed() {
 #[test]
 fn killed_ingest_leaves_a_consistent_store() {
     let d = tempfile::tempdir().unwrap();
-    let files = simulate(&d.path().join("sim"), "B", "30", "4", "6");
+    let files = simulate_csv(&d.path().join("sim"), "B", "30", "4", "6");
     let db = d.path().join("fleet.db");
     let db = db.to_str().unwrap();
     ok(&["fleet", "init", "--db", db]);
@@ -267,7 +233,7 @@ fn init_config_sets_the_fleet_settings() {
         "--config",
         cfg.to_str().unwrap(),
     ]);
-    let files = simulate(&d.path().join("n"), "A", "30", "7", "3");
+    let files = simulate_csv(&d.path().join("n"), "A", "30", "7", "3");
     let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus1"];
     args.extend(files.iter().map(|s| s.as_str()));
     ok(&args);

@@ -8,41 +8,7 @@ mod common;
 use std::path::Path;
 use std::process::Stdio;
 
-use common::{bin, fails_with, ok, stderr, vibmode, wait_or_kill};
-
-/// Simulated bus records (CSV, 200 Hz, 10.24 s) from `vibmode simulate` into `dir`.
-fn simulate(dir: &Path, seed: &str, records: &str) -> Vec<String> {
-    let params = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/city_bus.toml");
-    ok(&[
-        "simulate",
-        params,
-        "--road",
-        "C",
-        "--speed-kmh",
-        "40",
-        "--duration-s",
-        "10.24",
-        "--records",
-        records,
-        "--seed",
-        seed,
-        "--fs",
-        "200",
-        "--format",
-        "csv",
-        "-o",
-        dir.to_str().unwrap(),
-    ]);
-    let mut files: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|x| x == "csv"))
-        .map(|p| p.to_string_lossy().to_string())
-        .collect();
-    files.sort();
-    files
-}
+use common::{bin, fails_with, ok, simulate_csv, stderr, vibmode, wait_or_kill};
 
 /// A CSV record's header and rows.
 fn read_csv(path: &str) -> (String, Vec<Vec<String>>) {
@@ -101,12 +67,12 @@ fn store_is_safe_checks_are_all_or_nothing_and_failed_sensors_are_named() {
     let db_path = d.path().join("fleet.db");
     let db = db_path.to_str().unwrap();
     ok(&["fleet", "init", "--db", db]);
-    let nominal = simulate(&d.path().join("nominal"), "3", "6");
+    let nominal = simulate_csv(&d.path().join("nominal"), "C", "40", "3", "6");
     let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1"];
     args.extend(nominal.iter().map(String::as_str));
     ok(&args);
     ok(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
-    let test = simulate(&d.path().join("test"), "4", "1");
+    let test = simulate_csv(&d.path().join("test"), "C", "40", "4", "1");
     let good = test[0].as_str();
     let before = std::fs::read(&db_path).unwrap();
 
@@ -425,7 +391,7 @@ fn bad_store_paths_and_input_are_short_one_line_messages() {
 #[test]
 fn concurrent_ingests_and_inits_both_succeed() {
     let d = tempfile::tempdir().unwrap();
-    let files = simulate(&d.path().join("rec"), "5", "4");
+    let files = simulate_csv(&d.path().join("rec"), "C", "40", "5", "4");
     let spawn = |args: &[&str]| {
         bin()
             .args(args)

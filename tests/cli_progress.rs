@@ -7,41 +7,7 @@ mod common;
 use std::path::Path;
 use std::process::Command;
 
-use common::ok;
-
-/// Simulated bus records (CSV, 200 Hz) into `dir`.
-fn simulate(dir: &Path, seed: &str, records: &str) -> Vec<String> {
-    let params = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/city_bus.toml");
-    ok(&[
-        "simulate",
-        params,
-        "--road",
-        "C",
-        "--speed-kmh",
-        "40",
-        "--duration-s",
-        "10.24",
-        "--records",
-        records,
-        "--seed",
-        seed,
-        "--fs",
-        "200",
-        "--format",
-        "csv",
-        "-o",
-        dir.to_str().unwrap(),
-    ]);
-    let mut files: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|x| x == "csv"))
-        .map(|p| p.to_string_lossy().to_string())
-        .collect();
-    files.sort();
-    files
-}
+use common::{ok, simulate_csv};
 
 /// Nothing a progress bar draws: no carriage return, no terminal escape, no bar or spinner
 /// characters, no rate, no time left.
@@ -72,7 +38,7 @@ fn no_bar_when_stderr_is_not_a_terminal_and_q_accepted() {
     let d = tempfile::tempdir().unwrap();
     let db = d.path().join("fleet.db");
     ok(&["fleet", "init", "--db", s(&db)]);
-    let nominal = simulate(&d.path().join("nominal"), "3", "6");
+    let nominal = simulate_csv(&d.path().join("nominal"), "C", "40", "3", "6");
     let mut args = vec!["fleet", "ingest", "--db", s(&db), "--vehicle", "bus-1"];
     args.extend(nominal.iter().map(String::as_str));
     // Piped stderr, no -q: the per-file lines only.
@@ -87,7 +53,7 @@ fn no_bar_when_stderr_is_not_a_terminal_and_q_accepted() {
         assert_no_bar("fleet ingest -q", &common::stderr(&ok(&with_q)));
     }
     ok(&["fleet", "baseline", "--db", s(&db), "--vehicle", "bus-1"]);
-    let test = simulate(&d.path().join("test"), "4", "2");
+    let test = simulate_csv(&d.path().join("test"), "C", "40", "4", "2");
     let check = |extra: &[&str]| {
         let mut a = vec!["fleet", "check", "--db", s(&db), "--vehicle", "bus-1"];
         a.extend(extra);
@@ -130,7 +96,7 @@ fn bar_counts_files_on_a_terminal_and_not_with_q() {
     let d = tempfile::tempdir().unwrap();
     let db = d.path().join("fleet.db");
     ok(&["fleet", "init", "--db", s(&db)]);
-    let files = simulate(&d.path().join("r"), "5", "3");
+    let files = simulate_csv(&d.path().join("r"), "C", "40", "5", "3");
     let mut args = vec![
         "fleet",
         "ingest",
@@ -151,7 +117,7 @@ fn bar_counts_files_on_a_terminal_and_not_with_q() {
         "{quiet:?}"
     );
     // Other files (new content), without -q: the bar counts files with their rate.
-    let files = simulate(&d.path().join("r2"), "6", "3");
+    let files = simulate_csv(&d.path().join("r2"), "C", "40", "6", "3");
     let mut args = vec!["fleet", "ingest", "--db", s(&db), "--vehicle", "bus-1"];
     args.extend(files.iter().map(String::as_str));
     let shown = on_terminal(&args).unwrap_or_default();

@@ -85,3 +85,43 @@ pub fn ok(args: &[&str]) -> Output {
     assert_eq!(o.status.code(), Some(0), "args {args:?}: {}", stderr(&o));
     o
 }
+
+/// Simulated bus records (CSV, 200 Hz, 10.24 s; road class, speed in km/h) from `vibmode simulate` into `dir`.
+pub fn simulate_csv(
+    dir: &std::path::Path,
+    road: &str,
+    speed: &str,
+    seed: &str,
+    records: &str,
+) -> Vec<String> {
+    let params = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/city_bus.toml");
+    ok(&[
+        "simulate",
+        params,
+        "--road",
+        road,
+        "--speed-kmh",
+        speed,
+        "--duration-s",
+        "10.24",
+        "--records",
+        records,
+        "--seed",
+        seed,
+        "--fs",
+        "200",
+        "--format",
+        "csv",
+        "-o",
+        dir.to_str().unwrap(),
+    ]);
+    let mut files: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "csv"))
+        .map(|p| p.to_string_lossy().to_string())
+        .collect();
+    files.sort();
+    files
+}
