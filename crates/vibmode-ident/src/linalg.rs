@@ -130,16 +130,20 @@ pub(crate) fn mirror_upper_block(h: &mut DMatrix<f64>, split: usize) {
     }
 }
 
+/// `c[1..=q]` reversed: `[c_q, ..., c_1]`, so that `sum_{k=1}^{m} c_k x[t-k]` is the dot product
+/// of its last `m` entries with `x[t-m..t]` (four accumulators in [`dot`], not one serial chain).
+fn reversed_tail(c: &[f64]) -> Vec<f64> {
+    c.iter().skip(1).rev().copied().collect()
+}
+
 /// `out[t] = x[t] / C(q)`: `out[t] = x[t] - sum_{k=1}^{q} c[k] out[t-k]`, zero initial conditions.
 pub(crate) fn filter_inv_c(x: &[f64], c: &[f64], out: &mut [f64]) {
     let q = c.len().saturating_sub(1);
-    for t in 0..x.len() {
-        let mut v = x[t];
+    let crev = reversed_tail(c);
+    for t in 0..x.len().min(out.len()) {
         let kmax = q.min(t);
-        for k in 1..=kmax {
-            v -= c[k] * out[t - k];
-        }
-        out[t] = v;
+        let (done, rest) = out.split_at_mut(t);
+        rest[0] = x[t] - dot(&crev[q - kmax..], &done[t - kmax..]);
     }
 }
 
@@ -149,33 +153,27 @@ pub(crate) fn filter_inv_c(x: &[f64], c: &[f64], out: &mut [f64]) {
 pub(crate) fn predict_errors(y: &[f64], a: &[f64], c: &[f64], eps: &mut [f64]) {
     let p = a.len().saturating_sub(1);
     let q = c.len().saturating_sub(1);
-    for e in eps.iter_mut().take(p.min(y.len())) {
+    let n = y.len().min(eps.len());
+    for e in eps.iter_mut().take(p.min(n)) {
         *e = 0.0;
     }
-    for t in p..y.len() {
-        let mut v = y[t];
-        for k in 1..=p {
-            v += a[k] * y[t - k];
-        }
-        for k in 1..=q.min(t) {
-            v -= c[k] * eps[t - k];
-        }
-        eps[t] = v;
+    let (arev, crev) = (reversed_tail(a), reversed_tail(c));
+    for t in p..n {
+        let kmax = q.min(t);
+        let (done, rest) = eps.split_at_mut(t);
+        rest[0] = y[t] + dot(&arev, &y[t - p..t]) - dot(&crev[q - kmax..], &done[t - kmax..]);
     }
 }
 
 /// Adjoint of `x -> x / C`: `u_t = v_t - sum_{k=1}^{q} c_k u_{t+k}` (run backwards).
 pub(crate) fn filter_inv_c_adjoint(v: &[f64], c: &[f64], out: &mut [f64]) {
     let q = c.len().saturating_sub(1);
-    let n = v.len();
+    let n = v.len().min(out.len());
+    let tail = c.get(1..).unwrap_or(&[]);
     for t in (0..n).rev() {
-        let mut s = v[t];
-        for k in 1..=q {
-            if t + k < n {
-                s -= c[k] * out[t + k];
-            }
-        }
-        out[t] = s;
+        let kmax = q.min(n - 1 - t);
+        let (head, later) = out.split_at_mut(t + 1);
+        head[t] = v[t] - dot(&tail[..kmax], &later[..kmax]);
     }
 }
 
