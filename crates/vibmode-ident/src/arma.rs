@@ -427,7 +427,7 @@ impl<'a> Search<'a> {
     /// The exact AR columns of the Jacobian into `self.cols`, and the rows `0..p` of the Gram
     /// (the AR block and the upper AR-MA block).
     fn exact_ar_block(&mut self, c: &[f64], h: &mut DMatrix<f64>) {
-        let (p, q) = (self.p, self.q);
+        let p = self.p;
         let n = self.ys.len();
         if p == 0 || n <= p {
             return;
@@ -447,24 +447,73 @@ impl<'a> Search<'a> {
         let mut g = vec![0.0; n - p];
         filter_inv_c(&delta, c, &mut g);
         self.cols.push(col);
-        for i in 1..p {
-            let prev = &self.cols[i - 1];
-            let y0 = self.ys[p - 1 - i];
+        // b[i]: the impulse's weight from column i to column i + 1.
+        let b: Vec<f64> = (0..p - 1).map(|i| self.ys[p - 2 - i]).collect();
+        for &bi in &b {
+            let prev = &self.cols[self.cols.len() - 1];
             let mut next = vec![0.0; n];
             next[1..].copy_from_slice(&prev[..n - 1]);
             for (nt, &gt) in next[p..].iter_mut().zip(&g) {
-                *nt += y0 * gt;
+                *nt += bi * gt;
             }
             self.cols.push(next);
         }
-        for i in 0..p {
-            for j in i..p {
-                let v = dot(&self.cols[i][p..], &self.cols[j][p..]);
-                h[(i, j)] = v;
-                h[(j, i)] = v;
+        self.ar_gram_blocks(&g, &b, h);
+    }
+
+    /// The AR block `G[i][j] = sum_{t>=p} col_i[t] col_j[t]` and the AR-MA block
+    /// `M[i][j] = sum_{t>=p} col_i[t] ef[t-j]` (stored negated) of the Gram, from their first
+    /// row and column by the shift recursion of the columns (columns vanish before `p`):
+    /// `G[i+1][j+1] = G[i][j] - col_i[n-1] col_j[n-1] + b_j D_i + b_i D_j + b_i b_j (g.g)` with
+    /// `D_i = sum_{t>=p} col_i[t-1] g[t-p]`, and
+    /// `M[i+1][j+1] = M[i][j] - col_i[n-1] ef[n-1-j] + b_i E_j` with
+    /// `E_j = sum_{t>=p} g[t-p] ef[t-1-j]`: O(N (p + q) + p (p + q)) instead of O(N p (p + q)).
+    fn ar_gram_blocks(&self, g: &[f64], b: &[f64], h: &mut DMatrix<f64>) {
+        let (p, q) = (self.p, self.q);
+        let n = self.ys.len();
+        let cols = &self.cols;
+        let last: Vec<f64> = cols.iter().map(|c| c[n - 1]).collect();
+        let d: Vec<f64> = cols[..p - 1]
+            .iter()
+            .map(|c| dot(&c[p - 1..n - 1], g))
+            .collect();
+        let gg = dot(g, g);
+        for j in 0..p {
+            h[(0, j)] = dot(&cols[0][p..], &cols[j][p..]);
+        }
+        for i in 0..p - 1 {
+            for j in i..p - 1 {
+                let v =
+                    h[(i, j)] - last[i] * last[j] + b[j] * d[i] + b[i] * d[j] + b[i] * b[j] * gg;
+                h[(i + 1, j + 1)] = v;
             }
-            for j in 1..=q {
-                h[(i, p + j - 1)] = -dot(&self.cols[i][p..n], &self.ef[p - j..n - j]);
+        }
+        for i in 0..p {
+            for j in 0..i {
+                h[(i, j)] = h[(j, i)];
+            }
+        }
+        if q == 0 {
+            return;
+        }
+        let ef = &self.ef;
+        // m[i][j - 1] = M[i][j] (MA lag j = 1..q).
+        let mut m = DMatrix::<f64>::zeros(p, q);
+        for j in 1..=q {
+            m[(0, j - 1)] = dot(&cols[0][p..n], &ef[p - j..n - j]);
+        }
+        for i in 1..p {
+            m[(i, 0)] = dot(&cols[i][p..n], &ef[p - 1..n - 1]);
+        }
+        let e: Vec<f64> = (1..q).map(|j| dot(g, &ef[p - 1 - j..n - 1 - j])).collect();
+        for i in 0..p - 1 {
+            for j in 1..q {
+                m[(i + 1, j)] = m[(i, j - 1)] - last[i] * ef[n - 1 - j] + b[i] * e[j - 1];
+            }
+        }
+        for i in 0..p {
+            for j in 0..q {
+                h[(i, p + j)] = -m[(i, j)];
             }
         }
     }
@@ -1093,10 +1142,10 @@ pub fn prediction_error_variance(y: &[f64], mean: f64, a: &[f64], c: &[f64]) -> 
 mod tests {
     use super::*;
 
-    /// The AR columns built by the shift recursion equal one filter pass per column (the
-    /// definition), on seeded random signals and minimum-phase C over many seeds and orders.
+    /// The AR columns and Gram blocks built by the shift recursions equal one filter pass per
+    /// column (the definition) and direct sums, on seeded random signals and minimum-phase C over many seeds and orders.
     #[test]
-    fn exact_ar_columns_match_one_pass_per_column() {
+    fn exact_ar_columns_and_gram_match_direct_sums() {
         let mut state = 0x9e37_79b9_7f4a_7c15_u64;
         let mut uniform = move || {
             state ^= state << 13;
@@ -1114,9 +1163,27 @@ mod tests {
                 .collect();
             let c = poly_from_roots(&roots);
             let mut s = Search::new(&y, p, q, None);
+            s.ef = (0..n).map(|_| uniform()).collect();
             let mut h = DMatrix::<f64>::zeros(p + q, p + q);
             s.exact_ar_block(&c, &mut h);
             assert_eq!(s.cols.len(), p);
+            // The Gram blocks by their recursion against direct sums over t >= p.
+            let close = |a: f64, b: f64, what: &str| {
+                assert!(
+                    (a - b).abs() <= 1e-11 * (1.0 + b.abs()),
+                    "case {case} {what}: {a} vs {b}"
+                );
+            };
+            for i in 0..p {
+                for j in 0..p {
+                    let direct: f64 = (p..n).map(|t| s.cols[i][t] * s.cols[j][t]).sum();
+                    close(h[(i, j)], direct, &format!("G[{i}][{j}]"));
+                }
+                for j in 1..=q {
+                    let direct: f64 = (p..n).map(|t| s.cols[i][t] * s.ef[t - j]).sum();
+                    close(h[(i, p + j - 1)], -direct, &format!("M[{i}][{j}]"));
+                }
+            }
             for i in 1..=p {
                 let z: Vec<f64> = (0..n)
                     .map(|t| if t >= p { y[t - i] } else { 0.0 })
