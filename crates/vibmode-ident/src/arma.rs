@@ -14,7 +14,7 @@ use crate::model::{information_criteria, ArmaModel, Estimator, StopReason};
 use crate::outliers::OutlierCleaning;
 use crate::params::{ArmaParams, Robust};
 use crate::prepare::{self, Prepared};
-use crate::roots::polynomial_roots;
+use crate::roots::{polynomial_roots, polynomial_roots_unpolished};
 use crate::IdentError;
 
 /// Largest N p (p + q) for which the AR columns of the Jacobian are filtered exactly
@@ -210,7 +210,8 @@ fn stabilise(c: &mut [f64]) {
             return;
         }
     }
-    if let Ok(roots) = polynomial_roots(c) {
+    // Unpolished roots: the reflected C is a trial point of the search, not a result.
+    if let Ok(roots) = polynomial_roots_unpolished(c) {
         let refl: Vec<Complex64> = roots
             .iter()
             .map(|&z| {

@@ -21,6 +21,17 @@ use crate::IdentError;
 /// Errors: empty input or zero leading coefficient, non-finite coefficients, or (very unlikely)
 /// non-convergence of the Schur iteration.
 pub fn polynomial_roots(coeffs: &[f64]) -> Result<Vec<Complex64>, IdentError> {
+    roots_impl(coeffs, true)
+}
+
+/// As [`polynomial_roots`] without the Newton polishing: the companion matrix's eigenvalues,
+/// accurate to about eps x each root's condition number. For uses where that suffices (the
+/// reflection of a trial step's C into the unit circle, which only moves a search point).
+pub(crate) fn polynomial_roots_unpolished(coeffs: &[f64]) -> Result<Vec<Complex64>, IdentError> {
+    roots_impl(coeffs, false)
+}
+
+fn roots_impl(coeffs: &[f64], polished: bool) -> Result<Vec<Complex64>, IdentError> {
     let lead = match coeffs.first() {
         Some(&v) => v,
         None => return Err(IdentError::ZeroLeading { value: 0.0 }),
@@ -57,8 +68,12 @@ pub fn polynomial_roots(coeffs: &[f64]) -> Result<Vec<Complex64>, IdentError> {
         let raw: Vec<Complex64> = eig.iter().map(|z| Complex64::new(z.re, z.im)).collect();
         // Polish on the caller's coefficients (dividing by the leading one would round them).
         let original = &coeffs[..end];
-        for i in 0..raw.len() {
-            roots.push(polish(original, raw[i], &raw, i));
+        if polished {
+            for i in 0..raw.len() {
+                roots.push(polish(original, raw[i], &raw, i));
+            }
+        } else {
+            roots.extend_from_slice(&raw);
         }
     }
     roots.extend(std::iter::repeat(Complex64::new(0.0, 0.0)).take(zeros_at_origin));
@@ -195,6 +210,27 @@ mod tests {
     fn sorted(mut r: Vec<Complex64>) -> Vec<Complex64> {
         r.sort_by(|a, b| a.re.total_cmp(&b.re).then(a.im.total_cmp(&b.im)));
         r
+    }
+
+    /// Unpolished roots are the same set as polished ones to eps x condition: by hand for
+    /// (z - 0.5)(z + 0.25)(z^2 - z + 0.5) (roots 0.5, -0.25, 0.5 +- 0.5i).
+    #[test]
+    fn unpolished_roots_by_hand() {
+        // (z^2 + 0.25 z - 0.125)(z^2 - z + 0.5) = z^4 - 0.75 z^3 + 0.125 z^2 + 0.25 z - 0.0625
+        let c = [1.0, -0.75, 0.125, 0.25, -0.0625];
+        let want = sorted(vec![
+            Complex64::new(-0.25, 0.0),
+            Complex64::new(0.5, -0.5),
+            Complex64::new(0.5, 0.0),
+            Complex64::new(0.5, 0.5),
+        ]);
+        for got in [polynomial_roots_unpolished(&c), polynomial_roots(&c)] {
+            let got = sorted(got.unwrap_or_default());
+            assert_eq!(got.len(), 4);
+            for (g, w) in got.iter().zip(&want) {
+                assert!((g - w).norm() < 1e-12, "{g} vs {w}");
+            }
+        }
     }
 
     #[test]
