@@ -12,6 +12,17 @@ pub enum SpectraError {
         /// The rejected sampling rate, Hz.
         fs_hz: f64,
     },
+    /// Slepian tapers that cannot be made: fewer than 2 samples, no taper, more tapers than
+    /// samples, or a time-half-bandwidth product outside (0, n/2).
+    #[error("multitaper settings n = {n}, nw = {}, k = {k} are invalid: need n >= 2, 0 < nw < n/2 and 1 <= k <= n (2 or more for the F-test); use e.g. nw = 4, k = 7", vibmode_core::num(.nw))]
+    InvalidTapers {
+        /// Record length, samples.
+        n: usize,
+        /// Time-half-bandwidth product.
+        nw: f64,
+        /// Number of tapers.
+        k: usize,
+    },
     /// An input signal has no samples.
     #[error("{name} is empty (0 samples); a spectrum needs at least one sample")]
     EmptyInput {

@@ -48,6 +48,7 @@
 #![warn(missing_docs)]
 
 mod error;
+mod harmonic;
 mod integrate;
 mod lines;
 mod params;
@@ -55,6 +56,7 @@ mod welch;
 mod window;
 
 pub use error::SpectraError;
+pub use harmonic::{dpss, f_test_p_value, f_test_peaks, harmonic_f_test, HarmonicF, HarmonicPlan};
 pub use integrate::{band_rms, peak, rms};
 pub use lines::{
     line_candidates, narrowband_kurtosis, narrowband_moments, ridges, swept_line_candidates,
