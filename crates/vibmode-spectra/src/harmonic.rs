@@ -364,7 +364,7 @@ pub fn f_test_peaks(h: &HarmonicF, alpha: f64, lo_hz: f64, hi_hz: f64) -> Vec<(f
             continue;
         }
         let p = h.p_value(j);
-        if !(p < alpha) {
+        if p.is_nan() || p >= alpha {
             continue;
         }
         let a = j.saturating_sub(reach);
