@@ -859,6 +859,25 @@ pub struct LineParams {
     /// record is tested as a swept line, Hz (default 0.5; a lightly damped mode does not move,
     /// and narrower ridges are left to the steady test). 0 = no swept lines.
     pub sweep_min_range_hz: f64,
+    /// Steady lines are found by Thomson's multitaper harmonic F-test in each record and
+    /// channel: a line where F peaks with `P(F > F_obs) < f_test_alpha` under F(2, 2K - 2), the
+    /// distribution of F without a line over a spectrum smooth within the tapers' band
+    /// (docs/analysis.md, "Lines"). Default 1e-4: the false-alarm probability per record,
+    /// channel and independent frequency (a 10.24 s record has 10.24 of them per Hz), so at most
+    /// 0.18 false detections per record over 0-25 Hz on one channel; a track needs detections in
+    /// `min_record_share` of the records. In (0, 0.1].
+    pub f_test_alpha: f64,
+    /// Time-half-bandwidth product `NW` of the F-test's Slepian tapers (default 4: a 10.24 s
+    /// record's tapers are concentrated in +-0.39 Hz). In [1, 20].
+    pub f_test_nw: f64,
+    /// Number of Slepian tapers `K` of the F-test (default 7 = 2 NW - 1, F with 2 and 12
+    /// degrees of freedom). In [2, 2 NW].
+    pub f_test_tapers: usize,
+    /// Lowest frequency of a line, steady or swept, Hz (default 3). Below it the F-test's null
+    /// fails on road vehicles: the body's modes (half-power half-width ~0.25 Hz at 1.2 Hz with
+    /// damping 0.2) are narrower than the tapers' +-0.39 Hz and braking and turning add
+    /// deterministic transients; busgen's nominal bus gave a steady "line" at 1.25 Hz.
+    pub min_frequency_hz: f64,
 }
 
 impl Default for LineParams {
@@ -874,6 +893,10 @@ impl Default for LineParams {
             stft_min_prominence_db: 6.0,
             sweep_rate_max_hz_per_s: 2.5,
             sweep_min_range_hz: 0.5,
+            f_test_alpha: 1e-4,
+            f_test_nw: 4.0,
+            f_test_tapers: 7,
+            min_frequency_hz: 3.0,
         }
     }
 }
@@ -972,6 +995,38 @@ impl LineParams {
                 self.sweep_min_range_hz,
                 "must be in [0, 100] Hz (0 = no swept lines)",
                 d.sweep_min_range_hz,
+            ));
+        }
+        if !(self.f_test_alpha.is_finite() && self.f_test_alpha > 0.0 && self.f_test_alpha <= 0.1) {
+            return Err(bad(
+                "f_test_alpha",
+                self.f_test_alpha,
+                "must be in (0, 0.1] (false-alarm probability per record, channel and frequency)",
+                d.f_test_alpha,
+            ));
+        }
+        if !(self.f_test_nw.is_finite() && (1.0..=20.0).contains(&self.f_test_nw)) {
+            return Err(bad(
+                "f_test_nw",
+                self.f_test_nw,
+                "must be in [1, 20]",
+                d.f_test_nw,
+            ));
+        }
+        if !(2..=(2.0 * self.f_test_nw).floor() as usize).contains(&self.f_test_tapers) {
+            return Err(bad(
+                "f_test_tapers",
+                self.f_test_tapers as f64,
+                "must be 2 to 2 f_test_nw (2 NW - 1 tapers are well concentrated)",
+                (2.0 * self.f_test_nw - 1.0).max(2.0).floor(),
+            ));
+        }
+        if !(self.min_frequency_hz.is_finite() && (0.0..=1e6).contains(&self.min_frequency_hz)) {
+            return Err(bad(
+                "min_frequency_hz",
+                self.min_frequency_hz,
+                "must be in [0, 1e6] Hz",
+                d.min_frequency_hz,
             ));
         }
         Ok(())

@@ -59,9 +59,9 @@ pub use error::SpectraError;
 pub use harmonic::{dpss, f_test_p_value, f_test_peaks, harmonic_f_test, HarmonicF, HarmonicPlan};
 pub use integrate::{band_rms, peak, rms};
 pub use lines::{
-    line_candidates, narrowband_kurtosis, narrowband_moments, ridges, swept_line_candidates,
-    tracked_kurtosis, LineCandidate, Ridge, SweptCandidate, RIDGE_MAX_GAP, RIDGE_MIN_SLICE_SHARE,
-    SWEEP_KURTOSIS_GAIN_MIN, SWEEP_ROUGHNESS_MAX_SHARE,
+    f_test_line_candidates, line_candidates, narrowband_kurtosis, narrowband_moments, ridges,
+    swept_line_candidates, tracked_kurtosis, LineCandidate, Ridge, SweptCandidate, RIDGE_MAX_GAP,
+    RIDGE_MIN_SLICE_SHARE, SWEEP_KURTOSIS_GAIN_MIN, SWEEP_ROUGHNESS_MAX_SHARE,
 };
 pub use num_complex::Complex64;
 pub use params::{Average, Detrend, PeriodogramParams, Scaling, ShortRecord, WelchParams, Window};

@@ -8,6 +8,7 @@
 //! it stays inside the band.
 
 use crate::error::SpectraError;
+use crate::harmonic::{f_test_peaks, HarmonicF};
 use crate::welch::{check_fs, check_samples, median_in_place};
 use crate::{Spectrogram, WelchParams, WelchPlan};
 use realfft::RealFftPlanner;
@@ -24,8 +25,17 @@ pub struct LineCandidate {
     pub kurtosis: f64,
     /// Height of the peak above the median periodogram within +-1 Hz, dB.
     pub prominence_db: f64,
-    /// True when `kurtosis < max_kurtosis`: a periodic line.
+    /// True when `kurtosis < max_kurtosis` ([`line_candidates`]) or the F-test's p-value is
+    /// below `f_test_alpha` ([`f_test_line_candidates`]): a periodic line.
     pub periodic: bool,
+    /// `P(F > F_obs)` of Thomson's harmonic F-test at `frequency_hz` without a line (F(2, 2K -
+    /// 2)); NaN for a candidate found by the periodogram and kurtosis alone.
+    #[serde(default = "nan")]
+    pub p_value: f64,
+}
+
+fn nan() -> f64 {
+    f64::NAN
 }
 
 /// Kurtosis `E[y^4] / E[y^2]^2` of `x` (sampled at `fs_hz`, Hz) ideally band-passed to
@@ -228,11 +238,51 @@ pub fn line_candidates(
                 kurtosis,
                 prominence_db,
                 periodic: kurtosis < p.max_kurtosis,
+                p_value: f64::NAN,
             }
         })
         .collect();
     out.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
     Ok(out)
+}
+
+/// The lines of `x` (sampled at `fs_hz`, Hz) from its harmonic F-test `h`
+/// ([`HarmonicPlan::f_test`] with `p.f_test_nw`, `p.f_test_tapers`): every local maximum of F
+/// over `+- W` with `P(F > F_obs) < p.f_test_alpha`, between `max(2 W, p.min_frequency_hz)` and
+/// `hi_hz - W`, each with the
+/// narrow-band kurtosis of its band (`p.half_width_hz`, for information) and as prominence the
+/// line's power over the residual of the tapers' fit, `10 log10(F / (K - 1))` dB. All are
+/// `periodic`. Sorted by frequency.
+pub fn f_test_line_candidates(
+    h: &HarmonicF,
+    x: &[f64],
+    fs_hz: f64,
+    hi_hz: f64,
+    p: &LineParams,
+) -> Vec<LineCandidate> {
+    let w = h.half_bandwidth_hz;
+    let mut planner = RealFftPlanner::<f64>::new();
+    let dof_num = h.dof / 2.0; // K - 1
+    let df = h.freq_hz.get(1).copied().unwrap_or(f64::NAN);
+    f_test_peaks(
+        h,
+        p.f_test_alpha,
+        (2.0 * w).max(p.min_frequency_hz),
+        hi_hz - w,
+    )
+    .into_iter()
+    .map(|(f, pv, _)| {
+        let j = (f / df).round() as usize;
+        let fstat = h.f_stat.get(j).copied().unwrap_or(f64::NAN);
+        LineCandidate {
+            frequency_hz: f,
+            kurtosis: band_kurtosis(&mut planner, x, fs_hz, f, p.half_width_hz),
+            prominence_db: 10.0 * (fstat / dof_num).log10(),
+            periodic: true,
+            p_value: pv,
+        }
+    })
+    .collect()
 }
 
 /// A ridge of the short-time spectra: a prominent peak followed from slice to slice.
