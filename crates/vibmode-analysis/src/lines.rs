@@ -236,6 +236,37 @@ impl<'a> LineStage<'a> {
         }
     }
 
+    /// The line of a combined detection at `f_hz` in each record: the frequency within
+    /// `+- half_width_hz / 2` where the pool's smallest p-value (times the number of channels)
+    /// is lowest, where that is below 0.05 (some evidence in the record itself); `None` for
+    /// other records and records not used.
+    fn record_peaks(&self, f_hz: f64, channels: &[usize]) -> Vec<Option<f64>> {
+        let reach_hz = 0.5 * self.params.half_width_hz;
+        let n_ch = channels.len().max(1) as f64;
+        self.f_tests
+            .iter()
+            .map(|hs| {
+                let mut best: Option<(f64, f64)> = None;
+                for &c in channels {
+                    let Some(h) = hs.get(c) else { continue };
+                    let df = h.freq_hz.get(1).copied().unwrap_or(f64::NAN);
+                    if !(df > 0.0) {
+                        continue;
+                    }
+                    let lo = ((f_hz - reach_hz) / df).ceil().max(0.0) as usize;
+                    let hi = ((f_hz + reach_hz) / df).floor() as usize;
+                    for j in lo..=hi.min(h.freq_hz.len().saturating_sub(1)) {
+                        let pv = h.p_value(j) * n_ch;
+                        if pv < 0.05 && best.is_none_or(|(b, _)| pv < b) {
+                            best = Some((pv, h.freq_hz[j]));
+                        }
+                    }
+                }
+                best.map(|(_, f)| f)
+            })
+            .collect()
+    }
+
     /// Lines of the pool `channels` by the F-test combined over the channels (Bonferroni: the
     /// smallest p-value times the number of channels) and over the records used (Fisher:
     /// `-2 sum ln p_r` against chi-square with `2R` degrees of freedom) at each frequency of the
@@ -320,35 +351,59 @@ impl<'a> LineStage<'a> {
         self.params.max_kurtosis > 0.0
     }
 
-    /// Periodic line candidates of each record used, merged over the `channels` (indices).
-    fn record_lines(
-        &self,
-        set: &[Vec<Vec<LineCandidate>>],
-        channels: &[usize],
-    ) -> Vec<Option<Vec<LineCandidate>>> {
-        set.iter()
-            .zip(&self.used)
-            .map(|(per_channel, &used)| {
-                if !used {
+    /// The F-test's lines of each record used in the pool `channels`, Bonferroni over the
+    /// channels: a record's line at a frequency is a false alarm with probability at most
+    /// `f_test_alpha`.
+    fn f_lines(&self, r: usize, channels: &[usize]) -> Vec<&LineCandidate> {
+        let n_ch = channels.len().max(1) as f64;
+        let Some(per_channel) = self.candidates.get(r) else {
+            return Vec::new();
+        };
+        channels
+            .iter()
+            .filter_map(|&c| per_channel.get(c))
+            .flatten()
+            .filter(|l| l.p_value * n_ch < self.params.f_test_alpha)
+            .collect()
+    }
+
+    /// Periodic line candidates of each record used, merged over the `channels` (indices): the
+    /// F-test's (see `f_lines`) and the kurtosis rule's. Within `half_width_hz` of each other
+    /// they are one line, at the kurtosis rule's frequency where it has one (the periodogram's
+    /// peak is nearer the mean of a line that drifts within the record; the F-test peaks where
+    /// it dwells, at the ends of its drift), else at the most prominent.
+    fn record_lines(&self, channels: &[usize]) -> Vec<Option<Vec<LineCandidate>>> {
+        (0..self.pre.len())
+            .map(|r| {
+                if !self.used.get(r).copied().unwrap_or(false) {
                     return None;
                 }
-                // Bonferroni over the pool's channels: a record's line at a frequency is a false
-                // alarm with probability at most f_test_alpha.
-                let n_ch = channels.len().max(1) as f64;
-                let mut all: Vec<LineCandidate> = channels
-                    .iter()
-                    .filter_map(|&c| per_channel.get(c))
-                    .flatten()
-                    .filter(|l| l.p_value.is_nan() || l.p_value * n_ch < self.params.f_test_alpha)
-                    .copied()
-                    .collect();
+                let mut all: Vec<LineCandidate> =
+                    self.f_lines(r, channels).into_iter().copied().collect();
+                if let Some(per_channel) = self.kurtosis_candidates.get(r) {
+                    all.extend(
+                        channels
+                            .iter()
+                            .filter_map(|&c| per_channel.get(c))
+                            .flatten()
+                            .copied(),
+                    );
+                }
                 all.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+                let better = |l: &LineCandidate, m: &LineCandidate| match (
+                    l.p_value.is_nan(),
+                    m.p_value.is_nan(),
+                ) {
+                    (true, false) => true,
+                    (false, true) => false,
+                    _ => l.prominence_db > m.prominence_db,
+                };
                 // One line per half-width: channels see the same line.
                 let mut merged: Vec<LineCandidate> = Vec::new();
                 for l in all {
                     match merged.last_mut() {
                         Some(m) if l.frequency_hz - m.frequency_hz <= self.params.half_width_hz => {
-                            if l.prominence_db > m.prominence_db {
+                            if better(&l, m) {
                                 *m = l;
                             }
                         }
@@ -365,7 +420,7 @@ impl<'a> LineStage<'a> {
         if !self.enabled() {
             return Vec::new();
         }
-        let per_record = self.record_lines(&self.candidates, channels);
+        let per_record = self.record_lines(channels);
         let n_used = self.used.iter().filter(|&&u| u).count().max(1);
         // A track must also look periodic with its records pooled (see `pooled_kurtosis`); a
         // track of sweeps alone was tested along its ridges.
@@ -376,16 +431,34 @@ impl<'a> LineStage<'a> {
                 if !t.has_steady_record() {
                     return Some(t);
                 }
-                // The track's records each passed the F-test (false-alarm probability
-                // f_test_alpha per record, channel and frequency) and the track holds at least
-                // min_record_share of the records: that is the evidence. The kurtosis pooled over
-                // its records is kept for information (1.5 sine, 3 noise; a line on a broad
-                // mode's shoulder shares its band with the mode and reads higher).
+                // A track with an F-test line in one of its records (false-alarm probability
+                // f_test_alpha per record and frequency) and at least min_record_share of the
+                // records has its evidence. One of the kurtosis rule alone must also look
+                // periodic with the moments of its band pooled over its records (a random mode
+                // can look periodic by kurtosis in a few records).
                 let at = t.record_hz.clone();
-                if let Some(k) = self.pooled_kurtosis(&at, channels) {
-                    t.kurtosis = k;
+                let k = self.pooled_kurtosis(&at, channels);
+                let by_f = at.iter().enumerate().any(|(r, f)| {
+                    f.is_some_and(|f| {
+                        self.f_lines(r, channels)
+                            .iter()
+                            .any(|l| (l.frequency_hz - f).abs() <= self.params.half_width_hz)
+                    })
+                });
+                match k {
+                    Some(k) if by_f || k < self.params.max_kurtosis => {
+                        t.kurtosis = k;
+                        Some(t)
+                    }
+                    _ if by_f => Some(t),
+                    // Its steady records fail; its sweeps stand.
+                    _ if t.record_sweep.iter().any(Option::is_some) => {
+                        t.record_hz.iter_mut().for_each(|f| *f = None);
+                        t.summarise_sweeps();
+                        Some(t)
+                    }
+                    _ => None,
                 }
-                Some(t)
             })
             .collect();
         let hw = self.params.half_width_hz;
@@ -397,44 +470,27 @@ impl<'a> LineStage<'a> {
                     .any(|&g| lo - hw <= g && g <= hi + hw)
             })
         };
-        // Lines whose frequency moves within a record (by more than the F-test's +-W allows,
-        // e.g. an engine speed drifting 0.3 Hz over 10 s): the previous rule, a prominent
-        // periodogram peak whose narrow band has the kurtosis of a sine, tracked over the
-        // records, kept where the kurtosis pooled over the track's records stays below
-        // max_kurtosis.
-        let per_record_k = self.record_lines(&self.kurtosis_candidates, channels);
-        for mut t in track(
-            &per_record_k,
-            &vec![Vec::new(); self.pre.len()],
-            self.params,
-            n_used,
-        ) {
-            let at = t.record_hz.clone();
-            match self.pooled_kurtosis(&at, channels) {
-                Some(k) if k < self.params.max_kurtosis => t.kurtosis = k,
-                _ => continue,
-            }
-            if !near(&out, t.frequency_range_hz.0, t.frequency_range_hz.1) {
-                out.push(t);
-            }
-        }
         // Lines too weak for one record, found by the test combined over the records.
         for (f, _) in self.combined_lines(channels) {
             if near(&out, f, f) {
                 continue;
             }
-            let record_hz: Vec<Option<f64>> = self
-                .f_tests
-                .iter()
-                .map(|h| (!h.is_empty()).then_some(f))
-                .collect();
+            let record_hz = self.record_peaks(f, channels);
+            if !record_hz.iter().any(Option::is_some) {
+                continue;
+            }
+            let found: Vec<f64> = record_hz.iter().flatten().copied().collect();
+            let share = found.len() as f64 / n_used as f64;
             let kurtosis = self
                 .pooled_kurtosis(&record_hz, channels)
                 .unwrap_or(f64::NAN);
             out.push(LineTrack {
                 frequency_hz: f,
-                frequency_range_hz: (f, f),
-                record_share: 1.0,
+                frequency_range_hz: (
+                    found.iter().copied().fold(f64::INFINITY, f64::min),
+                    found.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                ),
+                record_share: share,
                 record_hz,
                 kurtosis,
                 record_sweep: Vec::new(),

@@ -147,9 +147,14 @@ fn lines_are_found_per_record_over_five_seeds() {
     let ratio = |(a, b): (usize, usize)| a as f64 / b.max(1) as f64;
     for c in [&before, &after] {
         assert!(ratio(c.steady) >= 0.85, "{msg}");
-        assert!(ratio((c.correct, c.entries)) >= 0.95, "{msg}");
         assert!(c.wrongly_periodic.is_empty(), "{msg}");
     }
+    // Precision with the defaults. With swept lines off (not a default) the F-test's steady
+    // line at the end of a braking sweep (5.15 Hz after braking from 7 Hz; the record's mean
+    // is 5.9 Hz) counts as a wrong entry: 103/115 measured when the F-test came in (issue 30),
+    // against 99/99 with the kurtosis rule alone; required there: 0.85.
+    assert!(ratio((after.correct, after.entries)) >= 0.95, "{msg}");
+    assert!(ratio((before.correct, before.entries)) >= 0.85, "{msg}");
     // Swept lines on: the steady recall not lower (a braking sweep carries its track to the
     // steady line after it: 61 -> 68 of 70 measured), the wide sweeps found.
     assert!(after.steady.0 >= before.steady.0, "{msg}");
