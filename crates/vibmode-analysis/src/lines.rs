@@ -250,14 +250,14 @@ impl<'a> LineStage<'a> {
                 for &c in channels {
                     let Some(h) = hs.get(c) else { continue };
                     let df = h.freq_hz.get(1).copied().unwrap_or(f64::NAN);
-                    if !(df > 0.0) {
+                    if df.is_nan() || df <= 0.0 {
                         continue;
                     }
                     let lo = ((f_hz - reach_hz) / df).ceil().max(0.0) as usize;
                     let hi = ((f_hz + reach_hz) / df).floor() as usize;
                     for j in lo..=hi.min(h.freq_hz.len().saturating_sub(1)) {
                         let pv = h.p_value(j) * n_ch;
-                        if pv < 0.05 && best.is_none_or(|(b, _)| pv < b) {
+                        if pv < 0.05 && best.map_or(true, |(b, _)| pv < b) {
                             best = Some((pv, h.freq_hz[j]));
                         }
                     }
@@ -267,10 +267,10 @@ impl<'a> LineStage<'a> {
             .collect()
     }
 
-    /// Lines of the pool `channels` by the F-test combined over the channels (Bonferroni: the
-    /// smallest p-value times the number of channels) and over the records used (Fisher:
-    /// `-2 sum ln p_r` against chi-square with `2R` degrees of freedom) at each frequency of the
-    /// first record's grid: `(frequency Hz, combined p-value)` at each local minimum of the
+    /// Lines of the pool `channels` by the F-test combined over the records used on each channel
+    /// (Fisher: `-2 sum ln p_r` against chi-square with `2R` degrees of freedom) and over the
+    /// channels (Bonferroni: the smallest combined p-value times the number of channels) at each
+    /// frequency of the first record's grid: `(frequency Hz, combined p-value)` at each local minimum of the
     /// combined p-value over `+- W` below `f_test_alpha`, between `max(2 W, min_frequency_hz)` and the
     /// cutoff minus `W`.
     /// Without a line at a frequency the combined p-value is at least uniform (Bonferroni is
@@ -304,30 +304,26 @@ impl<'a> LineStage<'a> {
                 if f < lo || f > hi {
                     return 0.0;
                 }
-                let mut x = 0.0;
-                let mut r_n = 0usize;
-                for (_, hs) in &recs {
-                    let mut best = f64::INFINITY;
-                    for &c in channels {
+                // Fisher over the records on each channel, then Bonferroni over the channels
+                // (a line is clearest on the channel nearest where it enters, in every record).
+                let mut best = 0.0f64;
+                for &c in channels {
+                    let mut x = 0.0;
+                    let mut r_n = 0usize;
+                    for (_, hs) in &recs {
                         let Some(h) = hs.get(c) else { continue };
                         let df = h.freq_hz.get(1).copied().unwrap_or(f64::NAN);
-                        let j = (f / df).round() as usize;
-                        let pv = h.p_value(j);
+                        let pv = h.p_value((f / df).round() as usize);
                         if pv.is_finite() {
-                            best = best.min(pv);
+                            x -= 2.0 * pv.max(f64::MIN_POSITIVE).ln();
+                            r_n += 1;
                         }
                     }
-                    if best.is_finite() {
-                        let pr = (best * n_ch as f64).min(1.0).max(f64::MIN_POSITIVE);
-                        x -= 2.0 * pr.ln();
-                        r_n += 1;
+                    if r_n > 0 {
+                        best = best.min(ln_chi2_sf_even(x, r_n));
                     }
                 }
-                if r_n == 0 {
-                    0.0
-                } else {
-                    ln_chi2_sf_even(x, r_n)
-                }
+                (best + (n_ch as f64).ln()).min(0.0)
             })
             .collect();
         let df = h0.freq_hz.get(1).copied().unwrap_or(f64::NAN);
@@ -336,7 +332,7 @@ impl<'a> LineStage<'a> {
         let n = ln_p.len();
         let mut out = Vec::new();
         for j in 0..n {
-            if !(ln_p[j] < ln_alpha) {
+            if ln_p[j].is_nan() || ln_p[j] >= ln_alpha {
                 continue;
             }
             let (a, b) = (j.saturating_sub(reach), (j + reach).min(n - 1));
@@ -431,20 +427,25 @@ impl<'a> LineStage<'a> {
                 if !t.has_steady_record() {
                     return Some(t);
                 }
-                // A track with an F-test line in one of its records (false-alarm probability
-                // f_test_alpha per record and frequency) and at least min_record_share of the
-                // records has its evidence. One of the kurtosis rule alone must also look
+                // A track with F-test lines (false-alarm probability f_test_alpha per record and
+                // frequency) in at least min_record_share of the records has its evidence.
+                // Others (lines of the kurtosis rule, perhaps with a few F-test lines) must also look
                 // periodic with the moments of its band pooled over its records (a random mode
                 // can look periodic by kurtosis in a few records).
                 let at = t.record_hz.clone();
                 let k = self.pooled_kurtosis(&at, channels);
-                let by_f = at.iter().enumerate().any(|(r, f)| {
-                    f.is_some_and(|f| {
-                        self.f_lines(r, channels)
-                            .iter()
-                            .any(|l| (l.frequency_hz - f).abs() <= self.params.half_width_hz)
+                let n_f = at
+                    .iter()
+                    .enumerate()
+                    .filter(|(r, f)| {
+                        f.is_some_and(|f| {
+                            self.f_lines(*r, channels)
+                                .iter()
+                                .any(|l| (l.frequency_hz - f).abs() <= self.params.half_width_hz)
+                        })
                     })
-                });
+                    .count();
+                let by_f = n_f as f64 + 1e-12 >= self.params.min_record_share * n_used as f64;
                 match k {
                     Some(k) if by_f || k < self.params.max_kurtosis => {
                         t.kurtosis = k;
@@ -476,11 +477,14 @@ impl<'a> LineStage<'a> {
                 continue;
             }
             let record_hz = self.record_peaks(f, channels);
-            if !record_hz.iter().any(Option::is_some) {
-                continue;
-            }
             let found: Vec<f64> = record_hz.iter().flatten().copied().collect();
             let share = found.len() as f64 / n_used as f64;
+            // A line in the data shows in several records on its own (p < 0.05 each; without a
+            // line each record does so with probability at most 0.05): a combined p-value made
+            // by one or two records is no line.
+            if found.is_empty() || share + 1e-12 < self.params.min_record_share {
+                continue;
+            }
             let kurtosis = self
                 .pooled_kurtosis(&record_hz, channels)
                 .unwrap_or(f64::NAN);
