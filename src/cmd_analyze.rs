@@ -5,7 +5,8 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use vibmode_analysis::{
-    analyze, AnalysisConfig, AnalysisResults, ChainedRecords, Preset, RecordInput, StreamRecords,
+    analyze, AnalysisConfig, AnalysisResults, ChainedRecords, ConfigText, Preset, RecordInput,
+    StreamRecords,
 };
 use vibmode_modal::ReferenceMode;
 use vibmode_report::TruthRow;
@@ -95,24 +96,8 @@ fn apply_placements(cfg: &mut AnalysisConfig, roles: &[String], corners: &[Strin
 
 /// Reads the config: --config file (with its own preset key) or --preset, else defaults.
 fn load_config(config: Option<&Path>, preset: Option<&str>) -> Result<AnalysisConfig> {
-    let cfg = match (config, preset) {
-        (Some(path), None) => AnalysisConfig::from_path(path)?,
-        (Some(path), Some(p)) => {
-            let text = vibmode_core::files::read_text_capped(path)
-                .with_context(|| format!("cannot read config {}", path.display()))?;
-            let p: Preset = p.parse()?;
-            let name = match p {
-                Preset::Paper => "paper",
-                Preset::Vibmode => "vibmode",
-            };
-            AnalysisConfig::from_toml_str(&format!("preset = \"{name}\"\n{text}"))
-                .with_context(|| format!("config {}", path.display()))?
-        }
-        (None, Some(p)) => AnalysisConfig::preset(p.parse()?),
-        (None, None) => AnalysisConfig::default(),
-    };
-    cfg.validate()?;
-    Ok(cfg)
+    let preset = preset.map(str::parse::<Preset>).transpose()?;
+    Ok(AnalysisConfig::load(config.map(ConfigText::Path), preset)?)
 }
 
 /// Runs `vibmode analyze`.

@@ -6,7 +6,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyList, PyTuple};
 use std::path::PathBuf;
-use vibmode_analysis::{cut_records, AnalysisConfig, Preset, RecordInput};
+use vibmode_analysis::{cut_records, AnalysisConfig, ConfigText, Preset, RecordInput};
 use vibmode_modal::ReferenceMode;
 use vibmode_vehicle::{FullCar, RoadClass, SimParams, VehicleParams};
 
@@ -55,22 +55,11 @@ fn analysis_config(toml_text: Option<&str>, preset: Option<&str>) -> PyResult<St
 }
 
 fn config_of(toml_text: Option<&str>, preset: Option<&str>) -> PyResult<AnalysisConfig> {
-    let cfg = match (toml_text, preset) {
-        (Some(t), Some(p)) => {
-            let p: Preset = p.parse().map_err(analysis_err)?;
-            let name = match p {
-                Preset::Paper => "paper",
-                Preset::Vibmode => "vibmode",
-            };
-            AnalysisConfig::from_toml_str(&format!("preset = \"{name}\"\n{t}"))
-                .map_err(analysis_err)?
-        }
-        (Some(t), None) => AnalysisConfig::from_toml_str(t).map_err(analysis_err)?,
-        (None, Some(p)) => AnalysisConfig::preset(p.parse().map_err(analysis_err)?),
-        (None, None) => AnalysisConfig::default(),
-    };
-    cfg.validate().map_err(analysis_err)?;
-    Ok(cfg)
+    let preset = preset
+        .map(str::parse::<Preset>)
+        .transpose()
+        .map_err(analysis_err)?;
+    AnalysisConfig::load(toml_text.map(ConfigText::Text), preset).map_err(analysis_err)
 }
 
 /// Vehicle parameters from a file path, TOML text, or a shipped model's name.
