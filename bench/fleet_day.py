@@ -113,23 +113,24 @@ def run(fleet, seeds, n_workers, workdir):
 
 
 def drive_verdict(check):
-    """The day drive's verdict from its records: the most frequent class, and the corners named
-    first by the records classed vehicle or both."""
+    """The day drive's verdict: the store's per-drive decision when it gives one (`drives`), else
+    the most frequent class of the records; the corner named first (the first evidence's)."""
     classes = collections.Counter()
     corners = collections.Counter()
     for r in check.get("records", []):
-        a = r.get("assessment", {})
-        c = a.get("classification", "?")
+        c = r.get("classification", "?")
         classes[c] += 1
-        if c in ("vehicle", "both"):
-            ev = a.get("evidence") or []
-            text = json.dumps(ev[:1]).lower()
-            for k in CORNERS:
-                if f'"{k}' in text or f" {k}" in text or f"{k}:" in text:
-                    corners[k] += 1
-                    break
+        ev = r.get("evidence") or []
+        if c in ("vehicle", "both") and ev and isinstance(ev[0], dict) and ev[0].get("corner"):
+            corners[str(ev[0]["corner"]).lower()] += 1
     top = classes.most_common(1)[0][0] if classes else "?"
     corner = corners.most_common(1)[0][0] if corners else None
+    drives = check.get("drives") or []
+    if drives and isinstance(drives[0], dict) and drives[0].get("classification"):
+        top = drives[0]["classification"]
+        named = drives[0].get("corner")
+        if named:
+            corner = str(named).lower()
     return top, dict(classes), corner
 
 
