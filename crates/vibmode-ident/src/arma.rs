@@ -1197,11 +1197,11 @@ mod tests {
             s.add_huber_correction(&eps, r, &mut hc);
             let k = p + q;
             let mut want = DMatrix::<f64>::zeros(k, k);
-            for t in p..n {
-                if eps[t].abs() <= r {
+            for (t, e) in eps.iter().enumerate().skip(p) {
+                if e.abs() <= r {
                     continue;
                 }
-                let f = r / eps[t].abs() - 1.0;
+                let f = r / e.abs() - 1.0;
                 let psi: Vec<f64> = (0..k)
                     .map(|i| {
                         if i < p {
