@@ -337,7 +337,10 @@ impl UpdateOutcome {
         match self {
             UpdateOutcome::Off => Vec::new(),
             UpdateOutcome::Skipped(why) => vec![ReportSection::model_update_skipped(why)],
-            UpdateOutcome::Done(b) => vec![ReportSection::model_update(&b.0, &b.1, identified)],
+            UpdateOutcome::Done(b) => match unsupported(&b.1) {
+                Some(why) => vec![ReportSection::model_update_skipped(&why)],
+                None => vec![ReportSection::model_update(&b.0, &b.1, identified)],
+            },
         }
     }
 
@@ -353,6 +356,14 @@ impl UpdateOutcome {
                 let json = dir.join("model_update.json");
                 std::fs::write(&json, serde_json::to_string_pretty(r)? + "\n")
                     .with_context(|| format!("writing {}", json.display()))?;
+                // A fit the records do not support is not written as a vehicle file; its
+                // figures stay in model_update.json.
+                if let Some(why) = unsupported(r) {
+                    return Ok(Some(format!(
+                        "Full-car model not updated: {why} (the fit's figures: {})\n",
+                        shown.join("model_update.json").display()
+                    )));
+                }
                 let toml_path = dir.join("updated_vehicle.toml");
                 let mut v = r.vehicle.clone();
                 v.name = format!("{} (updated from the records)", file.name);
@@ -366,6 +377,17 @@ impl UpdateOutcome {
             }
         }
     }
+}
+
+/// Why the records do not support a model update's fit, as the one line the terminal and the
+/// report give; `None` when they do.
+fn unsupported(r: &vibmode_vehicle::update::BodyFitResult) -> Option<String> {
+    (!r.supported).then(|| {
+        format!(
+            "the records do not support the fit: {}",
+            r.not_supported.as_deref().unwrap_or("no reason recorded")
+        )
+    })
 }
 
 /// An analysis in which every fit failed has nothing to report: an error, with the first
