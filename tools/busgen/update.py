@@ -122,16 +122,28 @@ def score(folder: Path, front_bar: bool, out: Path) -> Dict:
     res = harness.analyze(folder, "--vehicle", vf, out=out / "out")
     mu = res.get("model_update") or {}
     row: Dict = {"bus": t["bus_seed"], "front_bar": front_bar}
-    if "not_updated" in mu or "vehicle" not in mu:
-        row["not_updated"] = mu.get("not_updated", "no model_update in results.json")
+    if "not_updated" in mu:
+        row["not_updated"] = mu["not_updated"]
+        # A fit the records do not support still leaves its figures in model_update.json.
+        full = out / "out" / "model_update.json"
+        if not full.is_file():
+            return row
+        mu = json.loads(full.read_text())
+    if "vehicle" not in mu:
+        row["not_updated"] = "no model_update in results.json"
         return row
     row["supported"] = mu.get("supported", True)
+    sd_hz = {m["label"].replace("_", " "): m["frequency_hz_sd"] for m in mu.get("mode_sd", [])}
+    row["param_sd"] = {p["name"]: p["sd"] / p["value"] for p in mu.get("parameters", [])
+                       if p.get("sd") is not None and p["value"] > 0}
     truth_modes = {m["label"]: m for m in t["modes"]}
     errs = {}
     for lab in BODY:
         got = [m for m in mu["modes"] if m["label"] == lab.replace(" ", "_")]
         if lab in truth_modes and got:
             errs[lab] = got[0]["frequency_hz"] / truth_modes[lab]["f_n_hz"] - 1.0
+            if lab in sd_hz:
+                row.setdefault("mode_sd", {})[lab] = sd_hz[lab] / got[0]["frequency_hz"]
     row["modes"] = errs
     tp, fp = true_params(t), fitted_params(mu)
     row["params"] = {k: fp[k] / tp[k] - 1.0 for k in tp}
@@ -141,21 +153,26 @@ def score(folder: Path, front_bar: bool, out: Path) -> Dict:
 
 def fmt_row(r: Dict) -> str:
     head = f"bus {r['bus']:>5} {'front bar' if r['front_bar'] else 'no bar   '}"
-    if "not_updated" in r:
+    if "modes" not in r:
         return f"{head}  NOT UPDATED: {r['not_updated'][:150]}"
+    sds = r.get("param_sd", {})
+    worst_sd = max(sds.items(), key=lambda kv: kv[1]) if sds else ("-", float("nan"))
+    sd_txt = (f"  sd: modes <= {100 * max(r['mode_sd'].values()):.1f}%"
+              if r.get("mode_sd") else "  sd: -")
     m = " ".join(f"{k.split()[1]} {100 * v:+6.2f}%" for k, v in r["modes"].items())
     worst = max(r["params"].items(), key=lambda kv: abs(kv[1]))
     sp = max(abs(v) for k, v in r["params"].items() if k.startswith("spring"))
     dp = max(abs(v) for k, v in r["params"].items() if k.startswith("damper"))
     return (f"{head}  {m}  springs <= {100 * sp:.1f}%  dampers <= {100 * dp:.1f}% "
             f"(worst {worst[0]} {100 * worst[1]:+.1f}%)  absent {r['absent'] or '-'}"
-            f"{'' if r.get('supported', True) else '  [reported: not supported]'}")
+            f"{sd_txt}, worst parameter sd {worst_sd[0]} {100 * worst_sd[1]:.1f}%"
+            f"{'' if r.get('supported', True) else '  [NOT UPDATED: ' + r.get('not_updated', '')[:90] + ']'}")
 
 
 def summarize(rows: List[Dict]) -> Dict[str, float]:
     """Rates over the rows: all three body modes within 3 %; every spring and damper within 10 %."""
     n = len(rows)
-    done = [r for r in rows if "modes" in r]
+    done = [r for r in rows if "modes" in r and r.get("supported", True)]
     modes_ok = sum(1 for r in done if len(r["modes"]) == 3
                    and all(abs(v) <= MODE_TOL for v in r["modes"].values()))
     params_ok = sum(1 for r in done if all(abs(v) <= PARAM_TOL for v in r["params"].values()))
@@ -183,12 +200,13 @@ def main(argv: Optional[List[str]] = None) -> int:
     ap.add_argument("--nominal", action="store_true", help="add busgen's nominal bus (seed 0)")
     ap.add_argument("--no-noise", action="store_true", help="simulate without sensor noise")
     ap.add_argument("--json", type=Path, help="write the rows and the summary here")
+    ap.add_argument("--work", type=Path, help="keep each run's vehicle file and output here")
     a = ap.parse_args(argv)
     try:
         seeds = harness.draw_bus_seeds(a.buses, "model update")
         if a.nominal and 0 not in seeds:
             seeds = [0] + seeds
-        rows = run(seeds, ["--no-noise"] if a.no_noise else [])
+        rows = run(seeds, ["--no-noise"] if a.no_noise else [], a.work)
     except harness.Skip as e:
         print(f"skipped: {e}")
         return 0
