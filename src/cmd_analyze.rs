@@ -367,7 +367,21 @@ impl UpdateOutcome {
                 let toml_path = dir.join("updated_vehicle.toml");
                 let mut v = r.vehicle.clone();
                 v.name = format!("{} (updated from the records)", file.name);
-                std::fs::write(&toml_path, v.to_toml_string()?)
+                // The fit's standard deviations as comments (jackknife over the records).
+                let mut head = format!(
+                    "# Fitted to {} records by vibmode's model update (docs/model_update.md).\n",
+                    r.records
+                );
+                for p in r.parameters.iter().filter(|p| p.sd.is_some()) {
+                    head.push_str(&format!(
+                        "# {}: {:.6e} {}, standard deviation {:.2e}\n",
+                        p.name,
+                        p.value,
+                        p.unit,
+                        p.sd.unwrap_or(f64::NAN)
+                    ));
+                }
+                std::fs::write(&toml_path, head + &v.to_toml_string()?)
                     .with_context(|| format!("writing {}", toml_path.display()))?;
                 Ok(Some(format!(
                     "{}  the updated vehicle file: {}\n",

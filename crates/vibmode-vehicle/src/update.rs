@@ -7,7 +7,11 @@
 //! squares over three or more sensors), the wheel coordinates from the unsprung sensors. With the
 //! sprung mass fixed at the vehicle file's value, the rows are linear in the pitch and roll
 //! inertias, the four suspension springs and dampers and the anti-roll bars present in the file:
-//! an ordinary least-squares problem whose normal equations are summed record by record.
+//! a least-squares problem whose normal equations are summed record by record, each record's
+//! with its sensors' noise share taken out (bias-compensated least squares: every regressor is a
+//! measured, noisy signal; the noise densities come from each channel's spectrum above the
+//! band), and whose parameters and body modes get jackknife standard deviations over the
+//! records (docs/model_update.md).
 //!
 //! The rows are differentiated twice, so that they hold for the measured accelerations and their
 //! first and second derivatives (`M a'' + C a' + K a = 0`): nothing is integrated. The
@@ -356,7 +360,23 @@ impl BodyFitResult {
                 sds.join(", ")
             ));
         }
-        s.push_str("  (sprung mass, unsprung masses, tyres and bending are the file's; each sensor's noise, from its spectrum above the band, taken out of the equations)\n");
+        let floorless: Vec<&str> = self
+            .noise_density
+            .iter()
+            .filter(|c| c.density_per_hz <= 0.0)
+            .map(|c| c.channel.as_str())
+            .collect();
+        s.push_str(&format!(
+            "  (sprung mass, unsprung masses, tyres and bending are the file's; the sensors' white noise, measured above the band, taken out of the equations{})\n",
+            if floorless.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    "; no flat noise floor on {}, so none taken out there",
+                    floorless.join(", ")
+                )
+            }
+        ));
         s
     }
 }
