@@ -14,7 +14,7 @@ use crate::model::{information_criteria, ArmaModel, Estimator, StopReason};
 use crate::outliers::OutlierCleaning;
 use crate::params::{ArmaParams, Robust};
 use crate::prepare::{self, Prepared};
-use crate::roots::{polynomial_roots, polynomial_roots_unpolished};
+use crate::roots::{aberth_roots, polynomial_roots, polynomial_roots_unpolished};
 use crate::IdentError;
 
 /// Largest N p (p + q) for which the AR columns of the Jacobian are filtered exactly
@@ -210,8 +210,12 @@ fn stabilise(c: &mut [f64]) {
             return;
         }
     }
-    // Unpolished roots: the reflected C is a trial point of the search, not a result.
-    if let Ok(roots) = polynomial_roots_unpolished(c) {
+    // Unpolished roots: the reflected C is a trial point of the search, not a result. Aberth's
+    // iteration (O(q^2) per sweep) first, the companion matrix if it does not settle.
+    let roots = aberth_roots(c)
+        .map(Ok)
+        .unwrap_or_else(|| polynomial_roots_unpolished(c));
+    if let Ok(roots) = roots {
         let refl: Vec<Complex64> = roots
             .iter()
             .map(|&z| {
