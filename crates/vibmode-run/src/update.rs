@@ -122,10 +122,15 @@ impl UpdateOutcome {
         match self {
             UpdateOutcome::Off => None,
             UpdateOutcome::Skipped(why) => Some(serde_json::json!({ "not_updated": why })),
-            UpdateOutcome::Done(b) => Some(
-                serde_json::to_value(&b.1)
-                    .unwrap_or_else(|e| serde_json::json!({ "not_updated": e.to_string() })),
-            ),
+            UpdateOutcome::Done(b) => {
+                let mut v = serde_json::to_value(&b.1)
+                    .unwrap_or_else(|e| serde_json::json!({ "not_updated": e.to_string() }));
+                // A fit the records do not support: its figures, and why it was not used.
+                if let (Some(why), Some(o)) = (unsupported(&b.1), v.as_object_mut()) {
+                    o.insert("not_updated".into(), why.into());
+                }
+                Some(v)
+            }
         }
     }
 
@@ -144,7 +149,10 @@ impl UpdateOutcome {
         match self {
             UpdateOutcome::Off => Vec::new(),
             UpdateOutcome::Skipped(why) => vec![ReportSection::model_update_skipped(why)],
-            UpdateOutcome::Done(b) => vec![ReportSection::model_update(&b.0, &b.1, identified)],
+            UpdateOutcome::Done(b) => match unsupported(&b.1) {
+                Some(why) => vec![ReportSection::model_update_skipped(&why)],
+                None => vec![ReportSection::model_update(&b.0, &b.1, identified)],
+            },
         }
     }
 
@@ -166,9 +174,27 @@ impl UpdateOutcome {
             message: e.to_string(),
         })?;
         write("model_update.json", json + "\n")?;
+        // A fit the records do not support is not written as a vehicle file; its figures stay
+        // in model_update.json.
+        if !r.supported {
+            return Ok(());
+        }
         let mut v = r.vehicle.clone();
         v.name = format!("{} (updated from the records)", file.name);
-        write("updated_vehicle.toml", v.to_toml_string()?)?;
+        // The fit's standard deviations as comments (jackknife over the records).
+        let mut head = format!(
+            "# Fitted to {} records by vibmode's model update (docs/model_update.md).\n",
+            r.records
+        );
+        for p in r.parameters.iter() {
+            if let Some(sd) = p.sd {
+                head.push_str(&format!(
+                    "# {}: {:.6e} {}, standard deviation {sd:.2e}\n",
+                    p.name, p.value, p.unit
+                ));
+            }
+        }
+        write("updated_vehicle.toml", head + &v.to_toml_string()?)?;
         Ok(())
     }
 
@@ -179,6 +205,11 @@ impl UpdateOutcome {
         match self {
             UpdateOutcome::Off => None,
             UpdateOutcome::Skipped(why) => Some(format!("Full-car model not updated: {why}\n")),
+            UpdateOutcome::Done(b) if !b.1.supported => Some(format!(
+                "Full-car model not updated: {} (the fit's figures: {})\n",
+                unsupported(&b.1).unwrap_or_default(),
+                shown.join("model_update.json").display()
+            )),
             UpdateOutcome::Done(b) => Some(format!(
                 "{}  the updated vehicle file: {}\n",
                 b.1.summary_text(&b.0),
@@ -186,4 +217,15 @@ impl UpdateOutcome {
             )),
         }
     }
+}
+
+/// Why the records do not support a model update's fit, as the one line the terminal and the
+/// report give; `None` when they do.
+fn unsupported(r: &BodyFitResult) -> Option<String> {
+    (!r.supported).then(|| {
+        format!(
+            "the records do not support the fit: {}",
+            r.not_supported.as_deref().unwrap_or("no reason recorded")
+        )
+    })
 }
