@@ -447,6 +447,22 @@ impl Store {
         }
     }
 
+    /// The vehicles other than `vehicle` that have a record with this content hash.
+    pub fn other_vehicles_with(&self, vehicle: &str, sha256: &str) -> Result<Vec<String>> {
+        let mut st = self
+            .conn
+            .prepare(
+                "SELECT DISTINCT v.name FROM records r JOIN vehicles v ON v.id = r.vehicle_id
+                 WHERE r.sha256 = ?1 AND v.name <> ?2 ORDER BY v.name",
+            )
+            .map_err(self.sql("looking up a record's vehicles"))?;
+        let rows = st
+            .query_map(params![sha256, vehicle], |r| r.get::<_, String>(0))
+            .map_err(self.sql("looking up a record's vehicles"))?;
+        rows.collect::<std::result::Result<Vec<_>, _>>()
+            .map_err(self.sql("looking up a record's vehicles"))
+    }
+
     /// The record of `vehicle` with this content hash, if stored.
     pub fn find_record(&self, vehicle: &str, sha256: &str) -> Result<Option<RecordRow>> {
         let Some(vid) = self.vehicle_id(vehicle)? else {
