@@ -377,16 +377,23 @@ fn transmissibility_features(rf: &RecordFeatures, cfg: &FleetConfig) -> Vec<(Fea
         if b[0] < cfg.transmissibility_min_hz {
             continue;
         }
-        let logs: Vec<(&crate::features::CornerTransmissibility, f64)> = rf
+        let logs: Vec<(&crate::features::CornerTransmissibility, &str, f64)> = rf
             .transmissibility
             .iter()
             .filter_map(|t| {
-                let v = t.values.get(k).copied().flatten()?;
-                (v.is_finite() && v > 0.0).then(|| (t, v.ln()))
+                // The cross-spectral (H1) value where the record has it, under its own key: a
+                // model set of band-RMS ratios does not score it, nor the reverse.
+                let (v, key) = if t.h1.is_empty() {
+                    (&t.values, "transrel")
+                } else {
+                    (&t.h1, "transh1")
+                };
+                let v = v.get(k).copied().flatten()?;
+                (v.is_finite() && v > 0.0).then(|| (t, key, v.ln()))
             })
             .collect();
-        let total: f64 = logs.iter().map(|(_, v)| v).sum();
-        for (t, v) in &logs {
+        let total: f64 = logs.iter().map(|(_, _, v)| v).sum();
+        for (t, key, v) in &logs {
             let (value, against) = if logs.len() > 1 {
                 let others = (total - v) / (logs.len() - 1) as f64;
                 (v - others, " vs the other corners")
@@ -395,7 +402,7 @@ fn transmissibility_features(rf: &RecordFeatures, cfg: &FleetConfig) -> Vec<(Fea
             };
             out.push((
                 FeatureMeta {
-                    key: format!("transrel:{}:{}", t.corner, band_key(b)),
+                    key: format!("{key}:{}:{}", t.corner, band_key(b)),
                     group: Group::Vehicle,
                     kind: Kind::Transmissibility,
                     corner: Some(t.corner),
@@ -1109,6 +1116,7 @@ mod tests {
                 sprung: "RL_sprung".into(),
                 unsprung: "RL_unsprung".into(),
                 values: vec![Some(trans)],
+                h1: Vec::new(),
             }],
             notes: Vec::new(),
             body_spectra: None,
@@ -1141,6 +1149,7 @@ mod tests {
                     sprung: format!("{corner}_sprung"),
                     unsprung: format!("{corner}_unsprung"),
                     values: vec![Some(1.0), Some(v)],
+                    h1: Vec::new(),
                 })
                 .collect();
             transmissibility_features(&r, &cfg)
