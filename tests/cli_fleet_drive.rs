@@ -66,6 +66,16 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
     assert_eq!(dr["false_alarm_rate"], 0.01);
     assert_eq!(dr["classification"], "normal", "{dr}");
     assert_eq!(n_test(db, "bus-1"), 4);
+    let drives = || {
+        vibmode_fleet::Store::open(std::path::Path::new(db))
+            .unwrap()
+            .drives("bus-1")
+            .unwrap()
+    };
+    assert_eq!(
+        drives(),
+        vec![("2026-11-25".to_string(), "normal".to_string(), 4)]
+    );
 
     // Without --drive: 3 or more records are the drive "all given records"; fewer, no drive.
     let mut args = vec![
@@ -95,6 +105,8 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
         &test[0],
     ]);
     assert_eq!(v["drives"].as_array().unwrap().len(), 0, "{v}");
+    assert_eq!(drives().len(), 2);
+    assert_eq!(drives()[1].0, "all given records");
 
     // Too few records for a named drive: refused before anything is read or stored.
     let more = simulate_csv(&d.path().join("more"), "B", "30", "31", "3");
@@ -177,4 +189,5 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
         ],
     );
     assert_eq!(n_test(db, "bus-1"), 4);
+    assert_eq!(drives().len(), 2, "no drive stored by a refused check");
 }

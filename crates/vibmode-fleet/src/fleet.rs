@@ -143,6 +143,17 @@ fn store_prepared(
     prepared: &[Prepared],
     checks: &[Option<(i64, Assessment)>],
 ) -> Result<Vec<Stored>> {
+    store_prepared_drive(store, labels, prepared, checks, None)
+}
+
+/// As [`store_prepared`], with a drive's verdict over the records in the same transaction.
+fn store_prepared_drive(
+    store: &mut Store,
+    labels: &IngestLabels<'_>,
+    prepared: &[Prepared],
+    checks: &[Option<(i64, Assessment)>],
+    drive: Option<&Drive>,
+) -> Result<Vec<Stored>> {
     let items: Vec<BatchItem<'_>> = prepared
         .iter()
         .zip(checks)
@@ -159,7 +170,7 @@ fn store_prepared(
             check: c.as_ref().map(|(v, a)| (*v, a)),
         })
         .collect();
-    store.store_batch(&items)
+    store.store_batch_with_drive(&items, drive)
 }
 
 fn ingested(p: Prepared, s: Stored) -> Ingested {
@@ -388,11 +399,21 @@ fn check_prepared(
     set: &ModelSet,
     prepared: Vec<Prepared>,
 ) -> Result<Vec<Checked>> {
+    check_prepared_drive(store, set, prepared, None)
+}
+
+/// As [`check_prepared`], storing a drive's verdict in the same transaction.
+fn check_prepared_drive(
+    store: &mut Store,
+    set: &ModelSet,
+    prepared: Vec<Prepared>,
+    drive: Option<&Drive>,
+) -> Result<Vec<Checked>> {
     let checks: Vec<Option<(i64, Assessment)>> = prepared
         .iter()
         .map(|p| Some((set.version, assess(set, &p.features))))
         .collect();
-    let stored = store_prepared(store, &test_labels(set), &prepared, &checks)?;
+    let stored = store_prepared_drive(store, &test_labels(set), &prepared, &checks, drive)?;
     Ok(prepared
         .into_iter()
         .zip(checks)
@@ -570,7 +591,8 @@ pub fn check_drive_files_progress(
             assessment,
         }
     });
-    Ok((check_prepared(store, set, prepared)?, drive))
+    let checked = check_prepared_drive(store, set, prepared, drive.as_ref())?;
+    Ok((checked, drive))
 }
 
 /// Checks a file against `set` (stored as a test record unless already stored).
