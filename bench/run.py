@@ -40,9 +40,48 @@ def median_time(fn, repeat, min_time=0.0):
     return statistics.median(times)
 
 
-def peers(data_dir, quick):
+def ssi_peer(data_dir, meta, quick):
+    res = {}
+    # SSI-cov: pyOMA2's functions (as its SSI class with method "cov" calls them) on the same
+    # 8 records x 7 channels x 512 samples, block rows 20, orders 0..60 step 2, hard criterion
+    # xi < 1 only (vibmode's filter). Skipped with a note when pyOMA2 is not installed.
+    try:
+        os.environ.setdefault("TQDM_DISABLE", "1")
+        import logging
+        from pyoma2.functions import ssi as pyssi
+        logging.disable(logging.CRITICAL)
+        m = meta["ssi"]
+        data = np.fromfile(os.path.join(data_dir, "ssi_8x7x512.f64"), dtype="<f8").reshape(
+            m["records"], m["channels"], m["samples"])
+        br, om, st, dt = m["block_rows"], m["order_max"], m["order_step"], 1.0 / m["fs_hz"]
+
+        def pyoma2_ssi():
+            n = 0
+            for y in data:
+                h, _ = pyssi.build_hank(y, y, br, "cov")
+                obs, a, c, _ = pyssi.SSI_fast(h, br, om, step=st)
+                fn, *_ = pyssi.SSI_poles(obs, a, c, om, dt, step=st, HC=True, xi_max=1.0)
+                n += int(np.sum(~np.isnan(fn)))
+            return n
+
+        case = "ssi_cov_8x7x512_br20_orders2-60"
+        res[case] = {"pyOMA2 1.4 SSI-cov (build_hank cov + SSI_fast + SSI_poles)": median_time(pyoma2_ssi, 1 if quick else 3),
+                     "_n_modes_pyoma2": pyoma2_ssi()}
+        import importlib.metadata
+        res.setdefault("_versions", {})["pyoma2"] = importlib.metadata.version("pyoma-2")
+    except ImportError as e:
+        print(f"note: SSI peer skipped, pyOMA2 is not importable ({e})", file=sys.stderr)
+    return res
+
+
+def peers(data_dir, quick, only=None):
     res = {}
     meta = json.load(open(os.path.join(data_dir, "meta.json")))
+    if only is not None:
+        # One case's peers only (SSI-cov is the one with a peer worth timing alone).
+        res = ssi_peer(data_dir, meta, quick) if "ssi_cov".startswith(only) or only.startswith("ssi_cov") else {}
+        res.setdefault("_versions", {}).update({"numpy": np.__version__, "scipy": scipy.__version__})
+        return res
     csv_path = os.path.join(data_dir, "seven_channels.csv")
     x = np.fromfile(os.path.join(data_dir, "welch.f64"), dtype="<f8")
     r = 3 if quick else 7
@@ -79,35 +118,7 @@ def peers(data_dir, quick):
     except ImportError:
         pass
     res["read_csv_7x204800"] = csv
-    # SSI-cov: pyOMA2's functions (as its SSI class with method "cov" calls them) on the same
-    # 8 records x 7 channels x 512 samples, block rows 20, orders 0..60 step 2, hard criterion
-    # xi < 1 only (vibmode's filter). Skipped with a note when pyOMA2 is not installed.
-    try:
-        os.environ.setdefault("TQDM_DISABLE", "1")
-        import logging
-        from pyoma2.functions import ssi as pyssi
-        logging.disable(logging.CRITICAL)
-        m = meta["ssi"]
-        data = np.fromfile(os.path.join(data_dir, "ssi_8x7x512.f64"), dtype="<f8").reshape(
-            m["records"], m["channels"], m["samples"])
-        br, om, st, dt = m["block_rows"], m["order_max"], m["order_step"], 1.0 / m["fs_hz"]
-
-        def pyoma2_ssi():
-            n = 0
-            for y in data:
-                h, _ = pyssi.build_hank(y, y, br, "cov")
-                obs, a, c, _ = pyssi.SSI_fast(h, br, om, step=st)
-                fn, *_ = pyssi.SSI_poles(obs, a, c, om, dt, step=st, HC=True, xi_max=1.0)
-                n += int(np.sum(~np.isnan(fn)))
-            return n
-
-        case = "ssi_cov_8x7x512_br20_orders2-60"
-        res[case] = {"pyOMA2 1.4 SSI-cov (build_hank cov + SSI_fast + SSI_poles)": median_time(pyoma2_ssi, 1 if quick else 3),
-                     "_n_modes_pyoma2": pyoma2_ssi()}
-        import importlib.metadata
-        res.setdefault("_versions", {})["pyoma2"] = importlib.metadata.version("pyoma-2")
-    except ImportError as e:
-        print(f"note: SSI peer skipped, pyOMA2 is not importable ({e})", file=sys.stderr)
+    res.update(ssi_peer(data_dir, meta, quick))
     # ARMA fits (statsmodels exact-likelihood ARIMA), same data as vibmode.
     try:
         import statsmodels
@@ -146,6 +157,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="fewer repetitions")
     ap.add_argument("--out", default=None, help="also write all figures to this JSON file")
+    ap.add_argument("--only", default=None,
+                    help="only the cases whose name starts with this (e.g. ssi_cov): other peers are not run")
     args = ap.parse_args()
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     subprocess.run(["cargo", "build", "--release", "-q", "-p", "vibmode-bench"], cwd=root, check=True)
@@ -155,10 +168,10 @@ def main():
         subprocess.run([exe, "gen", d], check=True)
         out = subprocess.run([exe, "run", d] + (["--quick"] if args.quick else []), check=True, capture_output=True, text=True)
         rust = json.loads(out.stdout)
-        py = peers(d, args.quick)
+        py = peers(d, args.quick, args.only)
     rows = []
     for case, rs in rust.items():
-        if case.startswith("_"):
+        if case.startswith("_") or (args.only and not case.startswith(args.only)):
             continue
         for impl_name, t in rs.items():
             if impl_name.startswith("_"):

@@ -3,12 +3,10 @@
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use vibmode_analysis::{
-    analyze, AnalysisConfig, AnalysisResults, ChainedRecords, Preset, RecordInput, StreamRecords,
-};
-use vibmode_modal::ReferenceMode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use vibmode_analysis::{AnalysisConfig, AnalysisResults, ConfigText, Preset, RecordInput};
 use vibmode_report::TruthRow;
+use vibmode_run::{Progress, Run, RunInput, RunOutput};
 
 /// Arguments of `vibmode analyze`.
 #[derive(Args, Debug)]
@@ -95,24 +93,8 @@ fn apply_placements(cfg: &mut AnalysisConfig, roles: &[String], corners: &[Strin
 
 /// Reads the config: --config file (with its own preset key) or --preset, else defaults.
 fn load_config(config: Option<&Path>, preset: Option<&str>) -> Result<AnalysisConfig> {
-    let cfg = match (config, preset) {
-        (Some(path), None) => AnalysisConfig::from_path(path)?,
-        (Some(path), Some(p)) => {
-            let text = vibmode_core::files::read_text_capped(path)
-                .with_context(|| format!("cannot read config {}", path.display()))?;
-            let p: Preset = p.parse()?;
-            let name = match p {
-                Preset::Paper => "paper",
-                Preset::Vibmode => "vibmode",
-            };
-            AnalysisConfig::from_toml_str(&format!("preset = \"{name}\"\n{text}"))
-                .with_context(|| format!("config {}", path.display()))?
-        }
-        (None, Some(p)) => AnalysisConfig::preset(p.parse()?),
-        (None, None) => AnalysisConfig::default(),
-    };
-    cfg.validate()?;
-    Ok(cfg)
+    let preset = preset.map(str::parse::<Preset>).transpose()?;
+    Ok(AnalysisConfig::load(config.map(ConfigText::Path), preset)?)
 }
 
 /// Runs `vibmode analyze`.
@@ -128,12 +110,6 @@ pub fn run(a: &AnalyzeArgs) -> Result<()> {
     }
     let opts = a.read.options()?;
     let sel = a.channel.selectors()?;
-    let reference = match &a.vehicle {
-        Some(p) => vehicle_reference(p)?,
-        None => Vec::new(),
-    };
-    // Each file is read as a stream and cut into records as it is read; each record is brought
-    // to the analysis rate as it arrives, so memory does not grow with the file.
     if let Some(l) = a.record_length_s {
         cfg.record_length_s = l;
         cfg.validate()?;
@@ -161,36 +137,29 @@ pub fn run(a: &AnalyzeArgs) -> Result<()> {
     } else {
         None
     };
-    let mut source = ChainedRecords::new(a.inputs.len(), |i| {
-        let path = &a.inputs[i];
-        let mut stream = vibmode_signal::open_stream(path, &opts)?;
-        stream.select(&sel)?;
-        Ok(match &plans {
-            Some(p) => StreamRecords::windows(&display_name(path), stream, p[i].windows()),
-            None => StreamRecords::cut(&display_name(path), stream, record_length_s),
-        })
-    });
-    // With --vehicle, every record also feeds the fit of the vehicle's suspension.
-    let mut update = ModelUpdate::new(a.vehicle.as_deref(), &cfg)?;
-    let mut tee = FeedUpdate {
-        source: &mut source,
-        update: &mut update,
-    };
-    let (mut results, first) = run_stream_analysis(&mut tee, &cfg, &reference, a.quiet)?;
-    let update = update.finish();
+    let mut run = Run::new(cfg);
+    if let Some(p) = &a.vehicle {
+        run = run.vehicle(vibmode_vehicle::VehicleParams::from_path(p)?)?;
+    }
     if let Some([plan]) = plans.as_deref() {
         if let Some(g) = &plan.gps {
-            results.drive_speed_trace = g.speed_trace.clone();
+            run = run.speed_trace(g.speed_trace.clone());
         }
     }
-    check_some_fit(&results)?;
-    write_report(
-        out.path(),
-        std::slice::from_ref(&first),
-        &results,
-        None,
-        &update.sections(&results),
-    )?;
+    // Each file is read as a stream and cut into records as it is read; each record is brought
+    // to the analysis rate as it arrives, so memory does not grow with the file.
+    let input = RunInput::Files {
+        paths: &a.inputs,
+        read: &opts,
+        channels: &sel,
+        windows: plans
+            .as_ref()
+            .map(|p| p.iter().map(|s| s.windows()).collect()),
+    };
+    let output = with_progress(a.quiet, true, |progress| run.run(input, progress))?;
+    output
+        .write(out.path(), None)
+        .with_context(|| format!("writing the report in {}", out.path().display()))?;
     if let Some(plans) = &plans {
         let path = out.path().join("segments.json");
         let text = if plans.len() == 1 {
@@ -201,328 +170,48 @@ pub fn run(a: &AnalyzeArgs) -> Result<()> {
         std::fs::write(&path, text + "\n")
             .with_context(|| format!("writing {}", path.display()))?;
     }
-    let update_text = update.write(out.path(), &a.output)?;
     out.commit()?;
-    print_modes(&results, None)?;
-    if let Some(t) = update_text {
+    print_modes(&output.results, None)?;
+    if let Some(t) = output.update.summary_text(&a.output) {
         crate::output::print_stdout(&t)?;
     }
     eprintln!("report: {}", a.output.join("index.html").display());
     Ok(())
 }
 
-/// The fit of the vehicle file's suspension to the records (`vibmode_vehicle::update`).
-pub struct ModelUpdate {
-    cfg: AnalysisConfig,
-    state: UpdateState,
-}
-
-/// A record source that also feeds each record to the model update.
-pub struct FeedUpdate<'a> {
-    source: &'a mut dyn vibmode_analysis::RecordSource,
-    update: &'a mut ModelUpdate,
-}
-
-/// Where the model update stands.
-pub enum UpdateState {
-    /// No vehicle file: nothing to update.
-    Off,
-    /// Records are being added.
-    Fitting(
-        Box<(
-            vibmode_vehicle::VehicleParams,
-            vibmode_vehicle::update::BodyFit,
-        )>,
-    ),
-    /// A record could not be used (the reason), so the update was stopped.
-    Skipped(String),
-}
-
-impl UpdateState {
-    /// A fit of `v`'s suspension with the analysis' `[model_update]` settings.
-    pub fn start(v: vibmode_vehicle::VehicleParams, cfg: &AnalysisConfig) -> Result<Self> {
-        let fit = vibmode_vehicle::update::BodyFit::new(&v, cfg.model_update.clone())?;
-        Ok(UpdateState::Fitting(Box::new((v, fit))))
-    }
-}
-
-impl ModelUpdate {
-    /// With a vehicle file, a fit of its suspension; without, nothing.
-    pub fn new(vehicle: Option<&Path>, cfg: &AnalysisConfig) -> Result<Self> {
-        let v = vehicle
-            .map(vibmode_vehicle::VehicleParams::from_path)
-            .transpose()?;
-        Self::for_vehicle(v, cfg)
-    }
-
-    /// As [`ModelUpdate::new`], with the vehicle's parameters already read.
-    pub fn for_vehicle(
-        vehicle: Option<vibmode_vehicle::VehicleParams>,
-        cfg: &AnalysisConfig,
-    ) -> Result<Self> {
-        let state = match vehicle {
-            Some(v) => UpdateState::start(v, cfg)?,
-            None => UpdateState::Off,
-        };
-        Ok(ModelUpdate {
-            cfg: cfg.clone(),
-            state,
-        })
-    }
-
-    /// Adds one record (its channels placed as the analysis places them).
-    pub fn add(&mut self, r: &RecordInput) {
-        if let UpdateState::Fitting(b) = &mut self.state {
-            let cfg = &self.cfg;
-            if let Err(e) =
-                b.1.add_record_placed(&r.recording, |c| cfg.placement_for_update(c))
-            {
-                self.state = UpdateState::Skipped(format!("{}: {e}", r.name));
-            }
-        }
-    }
-
-    /// Solves the fit.
-    pub fn finish(&mut self) -> UpdateOutcome {
-        let state = std::mem::replace(&mut self.state, UpdateState::Off);
-        match state {
-            UpdateState::Off => UpdateOutcome::Off,
-            UpdateState::Skipped(why) => UpdateOutcome::Skipped(why),
-            UpdateState::Fitting(b) => match b.1.solve() {
-                Ok(r) => UpdateOutcome::Done(Box::new((b.0, r))),
-                Err(e) => UpdateOutcome::Skipped(e.to_string()),
-            },
-        }
-    }
-}
-
-impl vibmode_analysis::RecordSource for FeedUpdate<'_> {
-    fn next_record(&mut self) -> Option<Result<RecordInput, vibmode_analysis::AnalysisError>> {
-        let r = self.source.next_record();
-        if let Some(Ok(rec)) = &r {
-            self.update.add(rec);
-        }
-        r
-    }
-
-    fn meta(&self) -> Option<vibmode_core::RecordMeta> {
-        self.source.meta()
-    }
-}
-
-/// The model update's result.
-pub enum UpdateOutcome {
-    /// No vehicle file.
-    Off,
-    /// Not possible, and why.
-    Skipped(String),
-    /// The vehicle file and the fit.
-    Done(
-        Box<(
-            vibmode_vehicle::VehicleParams,
-            vibmode_vehicle::update::BodyFitResult,
-        )>,
-    ),
-}
-
-impl UpdateOutcome {
-    /// The report's section on the model update (none without a vehicle file), with the
-    /// analysis' SSI-cov modes in its figure.
-    pub fn sections(&self, results: &AnalysisResults) -> Vec<vibmode_report::ReportSection> {
-        use vibmode_report::ReportSection;
-        let identified = results
-            .ssi
-            .as_ref()
-            .map_or(&[][..], |s| &s.invariant_modes[..]);
-        match self {
-            UpdateOutcome::Off => Vec::new(),
-            UpdateOutcome::Skipped(why) => vec![ReportSection::model_update_skipped(why)],
-            UpdateOutcome::Done(b) => vec![ReportSection::model_update(&b.0, &b.1, identified)],
-        }
-    }
-
-    /// Writes `model_update.json` and `updated_vehicle.toml` into `dir` and returns the text for
-    /// the terminal (a one-line reason when the update was not possible).
-    /// `shown` is the folder's final path, for the message.
-    pub fn write(&self, dir: &Path, shown: &Path) -> Result<Option<String>> {
-        match self {
-            UpdateOutcome::Off => Ok(None),
-            UpdateOutcome::Skipped(why) => Ok(Some(format!("Full-car model not updated: {why}\n"))),
-            UpdateOutcome::Done(b) => {
-                let (file, r) = (&b.0, &b.1);
-                let json = dir.join("model_update.json");
-                std::fs::write(&json, serde_json::to_string_pretty(r)? + "\n")
-                    .with_context(|| format!("writing {}", json.display()))?;
-                let toml_path = dir.join("updated_vehicle.toml");
-                let mut v = r.vehicle.clone();
-                v.name = format!("{} (updated from the records)", file.name);
-                std::fs::write(&toml_path, v.to_toml_string()?)
-                    .with_context(|| format!("writing {}", toml_path.display()))?;
-                Ok(Some(format!(
-                    "{}  the updated vehicle file: {}\n",
-                    r.summary_text(file),
-                    shown.join("updated_vehicle.toml").display()
-                )))
-            }
-        }
-    }
-}
-
-/// An analysis in which every fit failed has nothing to report: an error, with the first
-/// failure's reason (not an empty table and exit 0).
-fn check_some_fit(r: &AnalysisResults) -> Result<()> {
-    if r.n_fits > 0 && r.n_failed == r.n_fits {
-        let why = r
-            .channels
-            .iter()
-            .flat_map(|c| c.fits.iter())
-            .find_map(|f| f.error.clone())
-            .unwrap_or_else(|| "no reason recorded".into());
-        bail!(
-            "every one of the {} fits failed, so nothing was identified; the first failure: {why}",
-            r.n_fits
-        );
-    }
-    Ok(())
-}
-
-/// The full-car model's modes as reference modes.
-pub fn vehicle_reference(path: &Path) -> Result<Vec<ReferenceMode>> {
-    let params = vibmode_vehicle::VehicleParams::from_path(path)?;
-    let car = vibmode_vehicle::FullCar::new(&params)?;
-    Ok(reference_modes(&car.modes()?))
-}
-
-/// Physical-model modes as the reference modes the clustering is matched to.
-fn reference_modes(modes: &[vibmode_vehicle::ModeInfo]) -> Vec<ReferenceMode> {
-    modes.iter().map(|m| m.to_reference()).collect()
-}
-
-/// Runs the analysis with a progress bar on a terminal (records identified, per second, the
-/// time left).
-pub fn run_analysis(
-    records: &[RecordInput],
-    cfg: &AnalysisConfig,
-    reference: &[ReferenceMode],
+/// Runs `f` with a progress bar on a terminal (records read when `streamed`, then records
+/// identified, per second, the time left), cleared at the end.
+fn with_progress<T>(
     quiet: bool,
-) -> Result<AnalysisResults> {
-    if records.is_empty() {
-        bail!("no records to analyse");
-    }
-    let n_ch = AtomicUsize::new(records[0].recording.channels.len());
-    let pb = crate::progress::records_bar(quiet, None, "records identified", "records");
-    let progress = sweeps_as_records(&pb, &n_ch);
-    let res = analyze(records, cfg, reference, &progress)?;
-    pb.finish_and_clear();
-    Ok(res)
-}
-
-/// The analysis' progress (`done` of `total` record x channel fits) shown as records: a record
-/// counts when all its `n_ch` channels are fitted (the total is the records fitted: stops are
-/// not). `n_ch` is read at the first call (a streamed source knows it once read).
-fn sweeps_as_records<'a>(
-    pb: &'a indicatif::ProgressBar,
-    n_ch: &'a AtomicUsize,
-) -> impl Fn(usize, usize) + Sync + 'a {
-    let started = AtomicBool::new(false);
-    move |done: usize, total: usize| {
-        let n = n_ch.load(Ordering::SeqCst).max(1);
-        if !started.swap(true, Ordering::SeqCst) {
-            crate::progress::set_phase(
-                pb,
-                Some(total.div_ceil(n) as u64),
-                "records identified",
-                "records",
-            );
-        }
-        pb.set_position((done / n) as u64);
-    }
-}
-
-/// The name a record file is reported under: the path as the user gave it (relative stays
-/// relative), not its base name, so that `run1/record_01.wav` and `run2/record_01.wav` stay
-/// apart. The same rule as the fleet's ([`vibmode_fleet::record_file_name`]) and the Python
-/// package's.
-pub fn display_name(path: &Path) -> String {
-    vibmode_fleet::record_file_name(path)
-}
-
-/// Runs the streamed analysis of `source` with a progress display on a terminal; returns the
-/// results and the first record (for the report's figures).
-pub fn run_stream_analysis(
-    source: &mut dyn vibmode_analysis::RecordSource,
-    cfg: &AnalysisConfig,
-    reference: &[ReferenceMode],
-    quiet: bool,
-) -> Result<(AnalysisResults, RecordInput)> {
-    // Records are counted as they are read (and brought to the analysis rate), then as they
-    // are identified; the number of channels is the first record's (all must have its layout).
-    let pb = crate::progress::records_bar(quiet, None, "records read", "records");
-    let n_ch = AtomicUsize::new(0);
-    let mut counted = CountChannels {
-        source,
-        n_ch: &n_ch,
+    streamed: bool,
+    f: impl FnOnce(&Progress<'_>) -> Result<T, vibmode_run::RunError>,
+) -> Result<T> {
+    let first_phase = if streamed {
+        "records read"
+    } else {
+        "records identified"
     };
+    let pb = crate::progress::records_bar(quiet, None, first_phase, "records");
     let on_record = |n: usize| pb.set_position(n as u64);
-    let sweeps = sweeps_as_records(&pb, &n_ch);
-    let identifier = vibmode_analysis::SweepIdentifier {
-        sweep: cfg.sweep.clone(),
-        poles: cfg.poles.clone(),
+    let started = AtomicBool::new(false);
+    let on_identified = |done: usize, total: usize| {
+        if !started.swap(true, Ordering::SeqCst) {
+            crate::progress::set_phase(&pb, Some(total as u64), "records identified", "records");
+        }
+        pb.set_position(done as u64);
     };
-    let out = vibmode_analysis::analyze_source(
-        &mut counted,
-        cfg,
-        &identifier,
-        reference,
-        &on_record,
-        &sweeps,
-    )?;
+    let progress = Progress {
+        on_record: &on_record,
+        on_identified: &on_identified,
+    };
+    let out = f(&progress)?;
     pb.finish_and_clear();
     Ok(out)
-}
-
-/// A record source that notes the number of channels of the first record (for the progress in
-/// records).
-struct CountChannels<'a> {
-    source: &'a mut dyn vibmode_analysis::RecordSource,
-    n_ch: &'a AtomicUsize,
-}
-
-impl vibmode_analysis::RecordSource for CountChannels<'_> {
-    fn next_record(&mut self) -> Option<Result<RecordInput, vibmode_analysis::AnalysisError>> {
-        let r = self.source.next_record();
-        if let Some(Ok(rec)) = &r {
-            let _ = self.n_ch.compare_exchange(
-                0,
-                rec.recording.channels.len(),
-                Ordering::SeqCst,
-                Ordering::SeqCst,
-            );
-        }
-        r
-    }
-
-    fn meta(&self) -> Option<vibmode_core::RecordMeta> {
-        self.source.meta()
-    }
 }
 
 /// Prints the invariant-mode table per role; with `truth`, the true modes beside it.
 pub fn print_modes(r: &AnalysisResults, truth: Option<&[TruthRow]>) -> Result<()> {
     crate::output::print_stdout(&vibmode_report::modes_table_text(r, truth))
-}
-
-/// Writes `DIR/index.html`, `DIR/results.json`, `DIR/modes.csv` and `DIR/figures/*`.
-pub fn write_report(
-    dir: &Path,
-    records: &[RecordInput],
-    r: &AnalysisResults,
-    intro: Option<&str>,
-    extra: &[vibmode_report::ReportSection],
-) -> Result<()> {
-    vibmode_report::write_analysis_report(dir, records, r, intro, extra)
-        .with_context(|| format!("writing the report in {}", dir.display()))?;
-    Ok(())
 }
 
 /// Arguments of `vibmode demo`.
@@ -584,12 +273,12 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
             recording: r.recording.clone(),
         })
         .collect();
-    let reference = reference_modes(&sim.truth.modes);
-    let results = run_analysis(&records, &cfg, &reference, a.quiet)?;
-    let mut update = ModelUpdate::for_vehicle(Some(vehicle.clone()), &cfg)?;
-    records.iter().for_each(|r| update.add(r));
-    let update = update.finish();
-    let update_text = update.write(out.path(), &a.output)?;
+    let reference = sim.truth.modes.iter().map(|m| m.to_reference()).collect();
+    let run = Run::new(cfg).reference(reference).vehicle(vehicle)?;
+    let n_records = records.len();
+    let output: RunOutput = with_progress(a.quiet, false, |progress| {
+        run.run(RunInput::Records(records), progress)
+    })?;
     let lines: Vec<String> = sim
         .truth
         .disturbance_lines_hz
@@ -598,7 +287,7 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
         .collect();
     let intro = format!(
         "Demo: {} simulated record(s) of {} s of a 12 m city bus with a flexible body (vibmode's full-car simulator, examples/city_bus_flexible.toml: a body bending mode at 9 Hz between the axle modes) on an ISO 8608 class {} road at about {} km/h (the speed varies by 3 %), seed {}, with engine/gear lines at nominally {} (their frequency wanders by 0.1 %, their amplitude by 10 %, the engine speed differs by 2 % from record to record and the 7 Hz driveline line follows the vehicle speed), sensor noise, bias and misalignment up to 3 deg, braking, acceleration and a turn, and tones at {} Hz that alias without the anti-alias filter. The true modes are the full-car model's (red diamonds in the frequency-damping figure).",
-        records.len(),
+        n_records,
         p.duration_s,
         sim.truth.road_class,
         sim.truth.speed_kmh,
@@ -611,13 +300,9 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
             .collect::<Vec<_>>()
             .join(", "),
     );
-    write_report(
-        out.path(),
-        &records,
-        &results,
-        Some(&intro),
-        &update.sections(&results),
-    )?;
+    output
+        .write(out.path(), Some(&intro))
+        .with_context(|| format!("writing the report in {}", out.path().display()))?;
     out.commit()?;
     let mut truth: Vec<TruthRow> = sim
         .truth
@@ -643,8 +328,8 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
         ));
     }
     truth.sort_by(|x, y| x.1.total_cmp(&y.1));
-    print_modes(&results, Some(&truth))?;
-    if let Some(t) = update_text {
+    print_modes(&output.results, Some(&truth))?;
+    if let Some(t) = output.update.summary_text(&a.output) {
         crate::output::print_stdout(&t)?;
     }
     eprintln!("report: {}", a.output.join("index.html").display());

@@ -5,8 +5,8 @@ use clap::{Args, Subcommand};
 use serde::Serialize;
 use std::path::PathBuf;
 use vibmode_fleet::{
-    build_baseline, check_files_progress, ingest_files_progress, require_baseline, Checked,
-    Condition, FleetConfig, IngestLabels, Store,
+    build_baseline, check_drive_files_progress, ingest_files_progress, require_baseline, Checked,
+    Condition, Drive, FleetConfig, IngestLabels, Store,
 };
 
 /// Arguments of `vibmode fleet`.
@@ -100,6 +100,11 @@ pub struct CheckArgs {
     /// Write the results as JSON to this file, or `-` for standard output.
     #[arg(long)]
     pub json: Option<String>,
+    /// The given records are one drive with this id (at least 3 records), classified from the
+    /// medians of their features; without it, 3 or more records are the drive `all given
+    /// records` (docs/fleet.md, "Drives").
+    #[arg(long)]
+    pub drive: Option<String>,
     #[command(flatten)]
     pub read: crate::input::ReadArgs,
     /// Record files.
@@ -224,6 +229,7 @@ struct CheckJson<'a> {
     vehicle: &'a str,
     model_version: i64,
     records: &'a [Checked],
+    drives: Vec<&'a Drive>,
 }
 
 fn check(a: &CheckArgs) -> Result<()> {
@@ -242,15 +248,16 @@ fn check(a: &CheckArgs) -> Result<()> {
         "files analysed",
         "files",
     );
-    let out = check_files_progress(
+    let out = check_drive_files_progress(
         &mut store,
         &set,
         &a.files.iter().map(|f| f.as_path()).collect::<Vec<_>>(),
         &a.read.options()?,
+        a.drive.as_deref(),
         &|n| pb.set_position(n as u64),
     );
     pb.finish_and_clear();
-    let out = out?;
+    let (out, drive) = out?;
     let mut text = format!(
         "vehicle {} against model set version {}\nfile                            class     vehicle |z|  road score  evidence\n",
         a.vehicle, set.version
@@ -269,6 +276,20 @@ fn check(a: &CheckArgs) -> Result<()> {
             }
         ));
     }
+    if let Some(d) = &drive {
+        text.push_str(&format!(
+            "drive {} ({} records, median of each feature; false alarms per drive at most {} %): {}  {}\n",
+            d.drive,
+            d.records.len(),
+            100.0 * d.false_alarm_rate,
+            d.assessment.classification,
+            if d.assessment.summary.is_empty() {
+                "-"
+            } else {
+                &d.assessment.summary
+            }
+        ));
+    }
     match a.json.as_deref() {
         Some("-") => {
             eprint!("{text}");
@@ -282,6 +303,7 @@ fn check(a: &CheckArgs) -> Result<()> {
                 vehicle: &a.vehicle,
                 model_version: set.version,
                 records: &out,
+                drives: drive.iter().collect(),
             },
         )?;
     }

@@ -4,8 +4,8 @@
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
-use vibmode_segment::{SegmentParams, Segmentation};
-use vibmode_signal::{ChannelSelector, FrameStream, ReadOptions, DEFAULT_BLOCK_FRAMES};
+use vibmode_segment::{Cutting, SegmentParams, Segmentation};
+use vibmode_signal::{ChannelSelector, FrameStream, ReadOptions};
 
 /// Segmentation options shared by `segment` and `analyze`.
 #[derive(Args, Debug, Clone, Default)]
@@ -97,7 +97,8 @@ pub fn open(path: &Path, opts: &ReadOptions, sel: &[ChannelSelector]) -> Result<
     Ok(s)
 }
 
-/// The segmentation of `path`: by GPS, by vibration, or consecutive records.
+/// The segmentation of `path` as the options say: by GPS, by vibration, or consecutive
+/// records ([`vibmode_segment::plan_file`]); the GPS track's dropped fixes are noted on stderr.
 pub fn plan(
     path: &Path,
     opts: &ReadOptions,
@@ -106,47 +107,35 @@ pub fn plan(
     record_length_s: f64,
 ) -> Result<Segmentation> {
     let p = seg.params()?;
-    if let Some(track_path) = &seg.gps {
-        if seg.by_vibration {
-            bail!("give either --gps TRACK or --by-vibration, not both");
+    let track = match &seg.gps {
+        Some(track_path) => {
+            if seg.by_vibration {
+                bail!("give either --gps TRACK or --by-vibration, not both");
+            }
+            let track = vibmode_segment::read_track(track_path)?;
+            if let Some(note) = track.dropped_note() {
+                eprintln!("GPS track {}: {note}", track_path.display());
+            }
+            Some(track)
         }
-        let track = vibmode_segment::read_track(track_path)?;
-        if let Some(note) = track.dropped_note() {
-            eprintln!("GPS track {}: {note}", track_path.display());
-        }
-        let mut s = open(path, opts, sel)?;
-        let n = frames(&mut s)?;
-        let s = open(path, opts, sel)?;
-        return Ok(vibmode_segment::by_gps(
-            s.info(),
-            n,
-            &track,
-            seg.gps_offset_s,
-            record_length_s,
-            &p,
-        )?);
-    }
-    let mut s = open(path, opts, sel)?;
-    if seg.by_vibration {
-        let (plan, _) = vibmode_segment::by_vibration(&mut s, record_length_s, &p)?;
-        return Ok(plan);
-    }
-    let n = frames(&mut s)?;
-    Ok(vibmode_segment::fixed_cuts(
-        s.info(),
-        n,
+        None => None,
+    };
+    let how = match &track {
+        Some(track) => Cutting::Gps {
+            track,
+            offset_s: seg.gps_offset_s,
+        },
+        None if seg.by_vibration => Cutting::Vibration,
+        None => Cutting::Consecutive,
+    };
+    Ok(vibmode_segment::plan_file(
+        path,
+        opts,
+        sel,
+        how,
         record_length_s,
         &p,
     )?)
-}
-
-/// The number of frames of a stream (reading it to the end when its format does not say).
-fn frames(s: &mut FrameStream) -> Result<u64> {
-    if let Some(n) = s.info().n_frames {
-        return Ok(n);
-    }
-    while s.next_block(DEFAULT_BLOCK_FRAMES)?.is_some() {}
-    Ok(s.position())
 }
 
 /// One line per reason: how much was skipped.

@@ -40,6 +40,9 @@ pub fn vehicle_err(e: vibmode_vehicle::VehicleError) -> PyErr {
 
 /// An analysis error: `OSError` for an unreadable config file, `ValueError` otherwise.
 pub fn analysis_err(e: vibmode_analysis::AnalysisError) -> PyErr {
+    if let vibmode_analysis::AnalysisError::Signal(s) = e {
+        return signal_err(s);
+    }
     match &e {
         vibmode_analysis::AnalysisError::ConfigFile { message, .. }
             if message.contains("os error") =>

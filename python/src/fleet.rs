@@ -8,7 +8,7 @@ use serde::Serialize;
 use std::path::PathBuf;
 use vibmode_fleet::store::{BatchItem, NewRecord};
 use vibmode_fleet::{
-    build_baseline, check_files, ingest_files, require_baseline, Condition, FleetConfig,
+    build_baseline, check_drive_files_progress, ingest_files, require_baseline, Condition, FleetConfig,
     IngestLabels, Store,
 };
 use vibmode_fleet::{compute_features, sha256_hex, FleetError, Ingested, RecordFeatures};
@@ -124,11 +124,12 @@ struct CheckOut {
     vehicle: String,
     model_version: i64,
     records: Vec<vibmode_fleet::Checked>,
+    drives: Vec<vibmode_fleet::Drive>,
 }
 
 /// Checks files against the vehicle's latest model set; JSON as `vibmode fleet check --json`.
 #[pyfunction]
-#[pyo3(signature = (db, vehicle, files, fs=None, scale=1.0, unit=None, allow_nonuniform=false, time_unit=None))]
+#[pyo3(signature = (db, vehicle, files, fs=None, scale=1.0, unit=None, allow_nonuniform=false, time_unit=None, drive=None))]
 #[allow(clippy::too_many_arguments)]
 fn fleet_check(
     py: Python<'_>,
@@ -140,6 +141,7 @@ fn fleet_check(
     unit: Option<String>,
     allow_nonuniform: bool,
     time_unit: Option<&str>,
+    drive: Option<&str>,
 ) -> PyResult<String> {
     let opts = read_options(fs, scale, unit, allow_nonuniform, time_unit)?;
     let out = py
@@ -149,11 +151,13 @@ fn fleet_check(
             let set = require_baseline(&store, vehicle)?;
             // All or nothing, as `vibmode fleet check`.
             let paths: Vec<&std::path::Path> = files.iter().map(|f| f.as_path()).collect();
-            let records = check_files(&mut store, &set, &paths, &opts)?;
+            let (records, drive) =
+                check_drive_files_progress(&mut store, &set, &paths, &opts, drive, &|_| ())?;
             Ok::<_, vibmode_fleet::FleetError>(CheckOut {
                 vehicle: vehicle.to_string(),
                 model_version: set.version,
                 records,
+                drives: drive.into_iter().collect(),
             })
         })
         .map_err(fleet_err)?;

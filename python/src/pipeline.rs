@@ -6,8 +6,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyList, PyTuple};
 use std::path::PathBuf;
-use vibmode_analysis::{cut_records, AnalysisConfig, Preset, RecordInput};
-use vibmode_modal::ReferenceMode;
+use vibmode_analysis::{cut_records, AnalysisConfig, ConfigText, Preset, RecordInput};
 use vibmode_vehicle::{FullCar, RoadClass, SimParams, VehicleParams};
 
 use crate::errors::{analysis_err, json_err, signal_err, value_err, vehicle_err};
@@ -55,22 +54,11 @@ fn analysis_config(toml_text: Option<&str>, preset: Option<&str>) -> PyResult<St
 }
 
 fn config_of(toml_text: Option<&str>, preset: Option<&str>) -> PyResult<AnalysisConfig> {
-    let cfg = match (toml_text, preset) {
-        (Some(t), Some(p)) => {
-            let p: Preset = p.parse().map_err(analysis_err)?;
-            let name = match p {
-                Preset::Paper => "paper",
-                Preset::Vibmode => "vibmode",
-            };
-            AnalysisConfig::from_toml_str(&format!("preset = \"{name}\"\n{t}"))
-                .map_err(analysis_err)?
-        }
-        (Some(t), None) => AnalysisConfig::from_toml_str(t).map_err(analysis_err)?,
-        (None, Some(p)) => AnalysisConfig::preset(p.parse().map_err(analysis_err)?),
-        (None, None) => AnalysisConfig::default(),
-    };
-    cfg.validate().map_err(analysis_err)?;
-    Ok(cfg)
+    let preset = preset
+        .map(str::parse::<Preset>)
+        .transpose()
+        .map_err(analysis_err)?;
+    AnalysisConfig::load(toml_text.map(ConfigText::Text), preset).map_err(analysis_err)
 }
 
 /// Vehicle parameters from a file path, TOML text, or a shipped model's name.
@@ -124,8 +112,19 @@ fn analyze(
 ) -> PyResult<String> {
     let cfg = config_of(config_toml, preset)?;
     let opts = crate::signal::read_options(fs, scale, unit, allow_nonuniform, time_unit)?;
+    let all_paths: Option<Vec<PathBuf>> = inputs
+        .iter()
+        .map(|item| item.extract::<PathBuf>().ok())
+        .collect();
+    let selectors: Vec<vibmode_signal::ChannelSelector> = channels
+        .iter()
+        .flatten()
+        .map(|c| c.parse::<vibmode_signal::ChannelSelector>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| signal_err(e.into()))?;
+    let paths = all_paths.filter(|p| !p.is_empty());
     let mut records: Vec<RecordInput> = Vec::new();
-    for item in inputs.iter() {
+    for item in inputs.iter().filter(|_| paths.is_none()) {
         if let Ok(t) = item.cast::<PyTuple>() {
             let name: String = t.get_item(0)?.extract()?;
             let data: PyReadonlyArray2<'_, f64> = t.get_item(1)?.extract()?;
@@ -149,57 +148,44 @@ fn analyze(
             records.extend(cut_records(&name, &rec, cfg.record_length_s));
         }
     }
-    if records.is_empty() {
+    if records.is_empty() && paths.is_none() {
         return Err(PyValueError::new_err(
             "no records to analyse; give at least one file or array",
         ));
     }
-    let reference: Vec<ReferenceMode> = match (vehicle_kind, vehicle) {
-        (Some(k), Some(v)) => {
-            let params = vehicle_of(k, v)?;
-            let car = FullCar::new(&params).map_err(vehicle_err)?;
-            car.modes()
-                .map_err(vehicle_err)?
-                .iter()
-                .map(|m| m.to_reference())
-                .collect()
-        }
-        _ => Vec::new(),
-    };
-    let results = py
-        .detach(|| vibmode_analysis::analyze(&records, &cfg, &reference, &|_, _| {}))
-        .map_err(analysis_err)?;
-    let mut value = serde_json::to_value(&results).map_err(json_err)?;
-    // With a vehicle, its suspension fitted to the records (vibmode_vehicle::update), as the
-    // command line does: the result, or why it was not possible.
+    let mut run = vibmode_run::Run::new(cfg);
     if let (Some(k), Some(v)) = (vehicle_kind, vehicle) {
-        let params = vehicle_of(k, v)?;
-        let update = py.detach(|| model_update(&params, &records, &cfg));
-        if let serde_json::Value::Object(map) = &mut value {
-            map.insert("model_update".into(), update);
-        }
+        run = run.vehicle(vehicle_of(k, v)?).map_err(run_err)?;
     }
+    // Files only: read as streams, as `vibmode analyze` reads them (the same results.json);
+    // arrays (or a mix): the records in memory.
+    let output = match paths {
+        Some(paths) => py.detach(|| {
+            run.run(
+                vibmode_run::RunInput::files(&paths, &opts, &selectors),
+                &vibmode_run::Progress::none(),
+            )
+        }),
+        None => py.detach(|| {
+            run.run(
+                vibmode_run::RunInput::Records(records),
+                &vibmode_run::Progress::none(),
+            )
+        }),
+    }
+    .map_err(run_err)?;
+    let value = output.to_json().map_err(run_err)?;
     serde_json::to_string(&value).map_err(json_err)
 }
 
-/// The body-equation fit of `vehicle` over `records` (channels placed as the analysis places
-/// them): `BodyFitResult` as JSON, or `{"not_updated": reason}`.
-fn model_update(
-    vehicle: &VehicleParams,
-    records: &[RecordInput],
-    cfg: &AnalysisConfig,
-) -> serde_json::Value {
-    use vibmode_vehicle::update::BodyFit;
-    let run = || -> Result<serde_json::Value, String> {
-        let mut fit = BodyFit::new(vehicle, cfg.model_update.clone()).map_err(|e| e.to_string())?;
-        for r in records {
-            fit.add_record_placed(&r.recording, |c| cfg.placement_for_update(c))
-                .map_err(|e| format!("{}: {e}", r.name))?;
-        }
-        let res = fit.solve().map_err(|e| e.to_string())?;
-        serde_json::to_value(&res).map_err(|e| e.to_string())
-    };
-    run().unwrap_or_else(|why| serde_json::json!({ "not_updated": why }))
+/// A run's error as Python's: a file that cannot be read is an OSError, the rest ValueError.
+fn run_err(e: vibmode_run::RunError) -> PyErr {
+    match e {
+        vibmode_run::RunError::Analysis(a) => analysis_err(a),
+        vibmode_run::RunError::Signal(s) => signal_err(s),
+        vibmode_run::RunError::Vehicle(v) => vehicle_err(v),
+        other => PyValueError::new_err(other.to_string()),
+    }
 }
 
 /// Simulates in-service records of a vehicle: `(records, truth_json)`, each record in the

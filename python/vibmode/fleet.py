@@ -81,15 +81,19 @@ def check(
     unit: Optional[str] = None,
     allow_nonuniform: bool = False,
     time_unit: Optional[str] = None,
+    drive: Optional[str] = None,
 ) -> Dict[str, Any]:
     """Classifies ``files`` against the vehicle's latest model set (``vibmode fleet check
-    --json``): ``{'vehicle', 'model_version', 'records': [...]}``, each record with its
-    ``assessment`` (classification: normal, road, vehicle, both, or sensor for a dead, stuck or
-    clipped channel listed in ``sensor_faults``; scores, evidence). All or nothing: an error in
-    any file stores no record and no check."""
+    --json``): ``{'vehicle', 'model_version', 'records': [...], 'drives': [...]}``, each record
+    with its ``assessment`` (classification: normal, road, vehicle, both, or sensor for a dead,
+    stuck or clipped channel listed in ``sensor_faults``; scores, evidence). ``drive`` names the
+    files as one drive (at least 3), classified from the medians of their features; without it
+    3 or more files are the drive ``all given records`` (docs/fleet.md, "Drives"). All or
+    nothing: an error in any file stores no record and no check."""
     return json.loads(
         _native.fleet_check(
-            os.fspath(db), vehicle, _paths(files), fs, float(scale), unit, bool(allow_nonuniform), time_unit
+            os.fspath(db), vehicle, _paths(files), fs, float(scale), unit, bool(allow_nonuniform), time_unit,
+            drive,
         )
     )
 

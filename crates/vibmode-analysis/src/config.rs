@@ -24,6 +24,25 @@ pub enum Preset {
     Paper,
 }
 
+impl Preset {
+    /// The preset's name as configs and the command line spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Vibmode => "vibmode",
+            Preset::Paper => "paper",
+        }
+    }
+}
+
+/// Where a config's TOML comes from ([`AnalysisConfig::load`]).
+#[derive(Clone, Copy, Debug)]
+pub enum ConfigText<'a> {
+    /// A TOML file.
+    Path(&'a Path),
+    /// TOML text.
+    Text(&'a str),
+}
+
 impl std::str::FromStr for Preset {
     type Err = AnalysisError;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
@@ -232,14 +251,63 @@ impl AnalysisConfig {
 
     /// Reads a TOML config. A `preset = "paper"` key selects the base the other keys override.
     pub fn from_toml_str(text: &str) -> Result<Self, AnalysisError> {
+        Self::from_toml_with_preset(text, None)
+    }
+
+    /// The config of a run: `toml` (a file, text, or none) over the defaults of `preset` (else of
+    /// the TOML's own `preset` key, else vibmode's). A preset given here and a different
+    /// `preset` key in the TOML is an error. The one place the CLI, Python and the fleet load
+    /// an analysis config.
+    pub fn load(
+        toml: Option<ConfigText<'_>>,
+        preset: Option<Preset>,
+    ) -> Result<Self, AnalysisError> {
+        let cfg = match toml {
+            Some(ConfigText::Path(path)) => {
+                let text = vibmode_core::files::read_text_capped(path).map_err(|e| {
+                    AnalysisError::ConfigFile {
+                        path: path.display().to_string(),
+                        message: e.to_string(),
+                    }
+                })?;
+                Self::from_toml_with_preset(&text, preset).map_err(|e| match e {
+                    AnalysisError::Config { message, .. } => AnalysisError::ConfigFile {
+                        path: path.display().to_string(),
+                        message,
+                    },
+                    other => other,
+                })?
+            }
+            Some(ConfigText::Text(text)) => Self::from_toml_with_preset(text, preset)?,
+            None => Self::preset(preset.unwrap_or_default()),
+        };
+        cfg.validate()?;
+        Ok(cfg)
+    }
+
+    /// As [`AnalysisConfig::from_toml_str`], with `preset` (when given) as the base.
+    fn from_toml_with_preset(text: &str, given: Option<Preset>) -> Result<Self, AnalysisError> {
         let mut value: toml::Value = toml::from_str(text).map_err(|e| AnalysisError::Config {
             key: None,
             message: e.to_string().replace('\n', " "),
         })?;
         migrate_legacy(&mut value);
-        let preset = match value.get("preset").and_then(|v| v.as_str()) {
-            Some(s) => s.parse::<Preset>()?,
-            None => Preset::Vibmode,
+        let in_file = match value.get("preset").and_then(|v| v.as_str()) {
+            Some(s) => Some(s.parse::<Preset>()?),
+            None => None,
+        };
+        let preset = match (given, in_file) {
+            (Some(g), Some(f)) if g != f => {
+                return Err(AnalysisError::Config {
+                    key: Some("preset"),
+                    message: format!(
+                        "the config sets preset = \"{}\" but preset {} was given; give one of them",
+                        f.name(),
+                        g.name()
+                    ),
+                })
+            }
+            (g, f) => g.or(f).unwrap_or_default(),
         };
         // Merge the file over the preset's defaults.
         let mut base = toml::Value::try_from(AnalysisConfig::preset(preset)).map_err(|e| {
@@ -358,6 +426,47 @@ fn merge(base: &mut toml::Value, over: toml::Value) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `load`: the preset is the base the TOML's keys override; a TOML `preset` key that differs
+    /// from the given preset is an error naming both; no TOML is the preset itself.
+    #[test]
+    fn load_merges_the_preset_under_the_toml() {
+        let cfg = AnalysisConfig::load(
+            Some(ConfigText::Text("record_length_s = 5.12")),
+            Some(Preset::Paper),
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(cfg.preset, Preset::Paper);
+        assert_eq!(cfg.record_length_s, 5.12);
+        assert_eq!(cfg.orders(), AnalysisConfig::preset(Preset::Paper).orders());
+        let same = AnalysisConfig::load(
+            Some(ConfigText::Text("preset = \"paper\"")),
+            Some(Preset::Paper),
+        );
+        assert!(same.is_ok());
+        let err = AnalysisConfig::load(
+            Some(ConfigText::Text("preset = \"paper\"")),
+            Some(Preset::Vibmode),
+        )
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+        assert!(
+            err.contains("preset = \"paper\"") && err.contains("preset vibmode"),
+            "{err}"
+        );
+        let none =
+            AnalysisConfig::load(None, Some(Preset::Paper)).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(
+            none.orders(),
+            AnalysisConfig::preset(Preset::Paper).orders()
+        );
+        let missing = AnalysisConfig::load(
+            Some(ConfigText::Path(Path::new("/nonexistent/x.toml"))),
+            None,
+        );
+        assert!(matches!(missing, Err(AnalysisError::ConfigFile { .. })));
+    }
     use vibmode_core::Robust;
 
     #[test]

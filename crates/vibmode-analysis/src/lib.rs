@@ -37,7 +37,7 @@ pub mod store;
 pub mod stream;
 
 pub use body::{BodySsi, RecordDelay};
-pub use config::{AnalysisConfig, ChannelRole, Preset, ReportParams};
+pub use config::{AnalysisConfig, ChannelRole, ConfigText, Preset, ReportParams};
 pub use first_record::{first_record_spectra, FirstRecordSpectra, ModelPsd};
 pub use identify::{Identifier, PoleOut, SignalFits, SweepIdentifier};
 pub use lines::{LineSweep, LineTrack};

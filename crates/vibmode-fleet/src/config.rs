@@ -23,6 +23,11 @@ pub struct FleetConfig {
     /// over the unsprung channels, scatters by about 15 % between 10 s records at constant
     /// conditions).
     pub floor_level: f64,
+    /// How far above the nominal range of the road level, ln units, a record's level must lie
+    /// before its excitation is scored (default 0.69 = ln 2: one ISO 8608 road class, a factor
+    /// 2 in amplitude, as between a class B baseline and a class C road). A road the baseline's
+    /// roads or up to one class rougher drive is normal; a smoother road is never an alarm.
+    pub road_margin: f64,
     /// Floor of the spread of ln(transmissibility) (default 0.10).
     pub floor_transmissibility: f64,
     /// Bands of `bands_hz` starting below this frequency, Hz, give no transmissibility feature
@@ -82,6 +87,7 @@ impl Default for FleetConfig {
             false_alarm_rate: 0.01,
             min_nominal: 5,
             floor_level: 0.15,
+            road_margin: std::f64::consts::LN_2,
             floor_transmissibility: 0.10,
             transmissibility_min_hz: 2.0,
             floor_frequency: 0.05,
@@ -298,6 +304,13 @@ impl FleetConfig {
                 "mode_match_tol",
                 Num(self.mode_match_tol),
                 "must be in (0, 1), e.g. 0.15",
+            ));
+        }
+        if !(self.road_margin.is_finite() && (0.0..=FLOOR_MAX).contains(&self.road_margin)) {
+            return Err(bad(
+                "road_margin",
+                Num(self.road_margin),
+                &format!("must be in [0, {FLOOR_MAX}] (ln units above the nominal road level), e.g. 0.69"),
             ));
         }
         if !(self.mode_min_share > 0.0 && self.mode_min_share <= 1.0) {

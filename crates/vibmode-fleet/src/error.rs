@@ -148,6 +148,28 @@ pub enum FleetError {
         /// The baseline's channels, comma-separated.
         baseline: String,
     },
+    /// A drive with too few records for its statistic.
+    #[error("drive '{}' has {found} record(s); a drive's statistic (the median over its records) needs at least {needed}: give more records of the drive, or leave out --drive to check records one by one", vibmode_core::quoted(drive))]
+    DriveTooShort {
+        /// The drive id.
+        drive: String,
+        /// Records given.
+        found: usize,
+        /// Records needed.
+        needed: usize,
+    },
+    /// A drive given with a record stored for another vehicle.
+    #[error("drive '{}' of vehicle '{}' holds '{}', a record of vehicle '{}'; a drive holds the records of one vehicle: check it with --vehicle {} or leave it out", vibmode_core::quoted(drive), vibmode_core::quoted(vehicle), vibmode_core::quoted(record), vibmode_core::quoted(other), vibmode_core::quoted(other))]
+    DriveMixesVehicles {
+        /// The drive id.
+        drive: String,
+        /// The vehicle checked.
+        vehicle: String,
+        /// The record.
+        record: String,
+        /// The vehicle that has the record.
+        other: String,
+    },
     /// A check without a baseline.
     #[error("vehicle '{}' has no baseline yet; build one from its nominal records first (fleet baseline)", vibmode_core::quoted(vehicle))]
     NoBaseline {

@@ -10,7 +10,9 @@ use vibmode_signal::ReadOptions;
 use crate::config::FleetConfig;
 use crate::error::{FleetError, Result};
 use crate::features::{compute_features, RecordFeatures};
-use crate::model::{assess, build_model_set, Assessment, ModelSet};
+use crate::model::{
+    assess, assess_drive, build_model_set, Assessment, ModelSet, MIN_DRIVE_RECORDS,
+};
 use crate::store::{BatchItem, Condition, NewRecord, Store, Stored};
 
 /// SHA-256 of bytes, lower-case hex.
@@ -141,6 +143,17 @@ fn store_prepared(
     prepared: &[Prepared],
     checks: &[Option<(i64, Assessment)>],
 ) -> Result<Vec<Stored>> {
+    store_prepared_drive(store, labels, prepared, checks, None)
+}
+
+/// As [`store_prepared`], with a drive's verdict over the records in the same transaction.
+fn store_prepared_drive(
+    store: &mut Store,
+    labels: &IngestLabels<'_>,
+    prepared: &[Prepared],
+    checks: &[Option<(i64, Assessment)>],
+    drive: Option<&Drive>,
+) -> Result<Vec<Stored>> {
     let items: Vec<BatchItem<'_>> = prepared
         .iter()
         .zip(checks)
@@ -157,7 +170,7 @@ fn store_prepared(
             check: c.as_ref().map(|(v, a)| (*v, a)),
         })
         .collect();
-    store.store_batch(&items)
+    store.store_batch_with_drive(&items, drive)
 }
 
 fn ingested(p: Prepared, s: Stored) -> Ingested {
@@ -386,11 +399,21 @@ fn check_prepared(
     set: &ModelSet,
     prepared: Vec<Prepared>,
 ) -> Result<Vec<Checked>> {
+    check_prepared_drive(store, set, prepared, None)
+}
+
+/// As [`check_prepared`], storing a drive's verdict in the same transaction.
+fn check_prepared_drive(
+    store: &mut Store,
+    set: &ModelSet,
+    prepared: Vec<Prepared>,
+    drive: Option<&Drive>,
+) -> Result<Vec<Checked>> {
     let checks: Vec<Option<(i64, Assessment)>> = prepared
         .iter()
         .map(|p| Some((set.version, assess(set, &p.features))))
         .collect();
-    let stored = store_prepared(store, &test_labels(set), &prepared, &checks)?;
+    let stored = store_prepared_drive(store, &test_labels(set), &prepared, &checks, drive)?;
     Ok(prepared
         .into_iter()
         .zip(checks)
@@ -478,6 +501,98 @@ pub fn check_files_progress(
         progress,
     )?;
     check_prepared(store, set, prepared)
+}
+
+/// The verdict on a drive: records of one vehicle checked together ([`assess_drive`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Drive {
+    /// The drive id (`--drive ID`, else `all given records`).
+    pub drive: String,
+    /// The model-set version it was scored against.
+    pub model_version: i64,
+    /// Its records (file names as given), whose own verdicts are in the check's `records`.
+    pub records: Vec<String>,
+    /// The corner of the strongest flagged vehicle feature (the one named first), if any.
+    pub corner: Option<vibmode_analysis::Corner>,
+    /// Upper bound of the false-alarm rate per drive and feature group: the model set's
+    /// `false_alarm_rate` per record (docs/fleet.md, "Drives").
+    pub false_alarm_rate: f64,
+    /// The verdict from the medians of the features over the records.
+    #[serde(flatten)]
+    pub assessment: Assessment,
+}
+
+/// The id of a drive when none is given.
+pub const DEFAULT_DRIVE_ID: &str = "all given records";
+
+/// As [`check_files_progress`], and the given files as one drive of the vehicle: with `drive`
+/// given, at least [`MIN_DRIVE_RECORDS`] files are needed (else an error before anything is
+/// read or stored); without it, the files form the drive [`DEFAULT_DRIVE_ID`] when there are
+/// at least that many, and no drive otherwise. Every record must have the baseline's channels
+/// (one layout per drive), and with `drive` given no record may be one stored for another
+/// vehicle (one vehicle per drive); else an error, and nothing is stored.
+pub fn check_drive_files_progress(
+    store: &mut Store,
+    set: &ModelSet,
+    paths: &[&Path],
+    opts: &ReadOptions,
+    drive: Option<&str>,
+    progress: &dyn Fn(usize),
+) -> Result<(Vec<Checked>, Option<Drive>)> {
+    check_vehicle_id(&set.vehicle)?;
+    if let Some(id) = drive {
+        if paths.len() < MIN_DRIVE_RECORDS {
+            return Err(FleetError::DriveTooShort {
+                drive: id.to_string(),
+                found: paths.len(),
+                needed: MIN_DRIVE_RECORDS,
+            });
+        }
+    }
+    let layout = |name: &str, rec: &Recording| check_layout(set, name, rec);
+    let prepared = prepare_files(
+        store,
+        &test_labels(set),
+        paths,
+        opts,
+        &set.config,
+        &layout,
+        progress,
+    )?;
+    if let Some(id) = drive {
+        for p in prepared.iter().filter(|p| !p.known) {
+            if let Some(other) = store
+                .other_vehicles_with(&set.vehicle, &p.sha256)?
+                .into_iter()
+                .next()
+            {
+                return Err(FleetError::DriveMixesVehicles {
+                    drive: id.to_string(),
+                    vehicle: set.vehicle.clone(),
+                    record: p.file.clone(),
+                    other,
+                });
+            }
+        }
+    }
+    let drive = (drive.is_some() || prepared.len() >= MIN_DRIVE_RECORDS).then(|| {
+        let feats: Vec<&RecordFeatures> = prepared.iter().map(|p| &p.features).collect();
+        let assessment = assess_drive(set, &feats);
+        Drive {
+            drive: drive.unwrap_or(DEFAULT_DRIVE_ID).to_string(),
+            model_version: set.version,
+            records: prepared.iter().map(|p| p.file.clone()).collect(),
+            corner: assessment
+                .evidence
+                .iter()
+                .find(|e| e.meta.group == crate::model::Group::Vehicle)
+                .and_then(|e| e.meta.corner),
+            false_alarm_rate: set.config.false_alarm_rate,
+            assessment,
+        }
+    });
+    let checked = check_prepared_drive(store, set, prepared, drive.as_ref())?;
+    Ok((checked, drive))
 }
 
 /// Checks a file against `set` (stored as a test record unless already stored).

@@ -26,14 +26,14 @@ pub use features::{
     FaultKind, ModeEstimate, RecordFeatures, SensorFault,
 };
 pub use fleet::{
-    build_baseline, check_file, check_files, check_files_progress, check_recording,
-    check_vehicle_id, ingest_file, ingest_files, ingest_files_progress, ingest_recording,
-    record_file_name, recording_hash, require_baseline, sha256_hex, Checked, IngestLabels,
-    Ingested,
+    build_baseline, check_drive_files_progress, check_file, check_files, check_files_progress,
+    check_recording, check_vehicle_id, ingest_file, ingest_files, ingest_files_progress,
+    ingest_recording, record_file_name, recording_hash, require_baseline, sha256_hex, Checked,
+    Drive, IngestLabels, Ingested, DEFAULT_DRIVE_ID,
 };
 pub use model::{
-    assess, build_model_set, Assessment, Classification, Evidence, FeatureMeta, FeatureStat, Group,
-    Kind, KindLimit, ModeSlot, ModelSet, Scores, LOO_MARGIN,
+    assess, assess_drive, build_model_set, Assessment, Classification, Evidence, FeatureMeta,
+    FeatureStat, Group, Kind, KindLimit, ModeSlot, ModelSet, Scores, LOO_MARGIN, MIN_DRIVE_RECORDS,
 };
 pub use report::write_fleet_report;
 pub use store::{BatchItem, Condition, RecordRow, Store, Stored, VehicleStatus, SCHEMA_VERSION};

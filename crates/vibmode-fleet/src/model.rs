@@ -377,16 +377,23 @@ fn transmissibility_features(rf: &RecordFeatures, cfg: &FleetConfig) -> Vec<(Fea
         if b[0] < cfg.transmissibility_min_hz {
             continue;
         }
-        let logs: Vec<(&crate::features::CornerTransmissibility, f64)> = rf
+        let logs: Vec<(&crate::features::CornerTransmissibility, &str, f64)> = rf
             .transmissibility
             .iter()
             .filter_map(|t| {
-                let v = t.values.get(k).copied().flatten()?;
-                (v.is_finite() && v > 0.0).then(|| (t, v.ln()))
+                // The cross-spectral (H1) value where the record has it, under its own key: a
+                // model set of band-RMS ratios does not score it, nor the reverse.
+                let (v, key) = if t.h1.is_empty() {
+                    (&t.values, "transrel")
+                } else {
+                    (&t.h1, "transh1")
+                };
+                let v = v.get(k).copied().flatten()?;
+                (v.is_finite() && v > 0.0).then(|| (t, key, v.ln()))
             })
             .collect();
-        let total: f64 = logs.iter().map(|(_, v)| v).sum();
-        for (t, v) in &logs {
+        let total: f64 = logs.iter().map(|(_, _, v)| v).sum();
+        for (t, key, v) in &logs {
             let (value, against) = if logs.len() > 1 {
                 let others = (total - v) / (logs.len() - 1) as f64;
                 (v - others, " vs the other corners")
@@ -395,7 +402,7 @@ fn transmissibility_features(rf: &RecordFeatures, cfg: &FleetConfig) -> Vec<(Fea
             };
             out.push((
                 FeatureMeta {
-                    key: format!("transrel:{}:{}", t.corner, band_key(b)),
+                    key: format!("{key}:{}:{}", t.corner, band_key(b)),
                     group: Group::Vehicle,
                     kind: Kind::Transmissibility,
                     corner: Some(t.corner),
@@ -830,11 +837,12 @@ fn group_of(kind: Kind) -> Group {
 }
 
 /// The score of ln-value `x` against `f`: the robust z for vehicle features; for excitation
-/// features the distance outside the nominal range `[lo, hi]` in units of `floor_level`.
+/// features the distance above the nominal range's top `hi` plus `road_margin`, in units of
+/// `floor_level` (0 below it: a smoother road, or one up to a road class rougher, is normal).
 fn score(f: &FeatureStat, x: f64, cfg: &FleetConfig) -> f64 {
     match f.meta.group {
         Group::Vehicle => (x - f.centre) / f.sigma,
-        Group::Excitation => (x - x.clamp(f.lo, f.hi)) / cfg.floor_level,
+        Group::Excitation => (x - f.hi - cfg.road_margin).max(0.0) / cfg.floor_level,
     }
 }
 
@@ -855,6 +863,81 @@ pub fn assess(set: &ModelSet, rf: &RecordFeatures) -> Assessment {
         }
         a.summary = summary;
         a.sensor_faults = rf.sensor_faults.clone();
+    }
+    a
+}
+
+/// Fewest records a drive's statistic is computed from.
+pub const MIN_DRIVE_RECORDS: usize = 3;
+
+/// Scores a drive (records of one vehicle on one day) against the model set.
+///
+/// The drive's value of a feature is the median of its ln values over the drive's records that
+/// have it (at least half of the records with working sensors must have it, else it is
+/// `missing`); that value is scored and flagged as one record's would be, with the same
+/// limits. A feature flagged for the drive is thus beyond the limit, in the same direction, in
+/// at least half of its records: a scatter that moves one record in eight (a mode identified
+/// as another in one record, a gust of road) does not flag the drive, while a fault, which
+/// moves every record, does. The false-alarm rate per drive is at most the one per record
+/// (`false_alarm_rate`, reached when the records of a drive are fully correlated; far lower
+/// when they are independent).
+///
+/// Records with a failed sensor are left out of the medians (the summary says how many); with
+/// fewer than [`MIN_DRIVE_RECORDS`] records left the drive is classed
+/// [`Classification::Sensor`].
+pub fn assess_drive(set: &ModelSet, records: &[&RecordFeatures]) -> Assessment {
+    let usable: Vec<&RecordFeatures> = records
+        .iter()
+        .copied()
+        .filter(|r| r.sensor_faults.is_empty())
+        .collect();
+    let mut by_key: BTreeMap<String, (FeatureMeta, Vec<f64>)> = BTreeMap::new();
+    for rf in &usable {
+        for (m, x) in scalar_features(rf, &set.slots, set.body.as_ref(), &set.config) {
+            by_key
+                .entry(m.key.clone())
+                .or_insert_with(|| (m, Vec::new()))
+                .1
+                .push(x);
+        }
+    }
+    let need = usable.len().div_ceil(2).max(1);
+    let values: Vec<(FeatureMeta, f64)> = by_key
+        .into_values()
+        .filter(|(_, xs)| xs.len() >= need)
+        .filter_map(|(m, xs)| median(&xs).map(|x| (m, x)))
+        .collect();
+    let mut a = score_values(set, &values);
+    let left_out = records.len() - usable.len();
+    if left_out > 0 {
+        let mut faults: Vec<String> = records
+            .iter()
+            .flat_map(|r| r.sensor_faults.iter().map(|f| f.to_string()))
+            .collect();
+        faults.sort();
+        faults.dedup();
+        let mut summary = format!(
+            "sensor: {left_out} of {} record(s) left out ({})",
+            records.len(),
+            faults.join(", ")
+        );
+        if usable.len() < MIN_DRIVE_RECORDS {
+            a.classification = Classification::Sensor;
+        }
+        if !a.summary.is_empty() {
+            summary.push_str("; ");
+            summary.push_str(&a.summary);
+        }
+        a.summary = summary;
+        let mut sf: Vec<crate::features::SensorFault> = Vec::new();
+        for r in records {
+            for f in &r.sensor_faults {
+                if !sf.contains(f) {
+                    sf.push(f.clone());
+                }
+            }
+        }
+        a.sensor_faults = sf;
     }
     a
 }
@@ -1033,6 +1116,7 @@ mod tests {
                 sprung: "RL_sprung".into(),
                 unsprung: "RL_unsprung".into(),
                 values: vec![Some(trans)],
+                h1: Vec::new(),
             }],
             notes: Vec::new(),
             body_spectra: None,
@@ -1065,6 +1149,7 @@ mod tests {
                     sprung: format!("{corner}_sprung"),
                     unsprung: format!("{corner}_unsprung"),
                     values: vec![Some(1.0), Some(v)],
+                    h1: Vec::new(),
                 })
                 .collect();
             transmissibility_features(&r, &cfg)
@@ -1145,6 +1230,80 @@ mod tests {
         assert_eq!(a.classification, Classification::Normal);
         assert_eq!(a.missing, vec!["RL: transmissibility 2-5 Hz".to_string()]);
         assert_eq!(a.scores.n_vehicle, 0);
+    }
+
+    /// The road level is scored only above the nominal range's top plus `road_margin` (ln 2):
+    /// a smoother road and one up to a road class rougher are normal; beyond, the score is the
+    /// distance in `floor_level` units.
+    #[test]
+    fn road_level_scored_above_the_range_plus_one_road_class() {
+        let set = baseline();
+        let cfg = FleetConfig::default();
+        let hi = 1.2f64;
+        for level in [0.1, 0.5, 1.0, 2.0 * hi * 0.99] {
+            let a = assess(&set, &record(level, 0.21));
+            assert_eq!(a.classification, Classification::Normal, "{level}: {a:?}");
+            assert_eq!(a.scores.excitation_max_abs_z, 0.0, "{level}");
+        }
+        // 3 floors above the margin: score 3 (above the limit 2.58 of one feature).
+        let level = 2.0 * hi * (3.0 * cfg.floor_level).exp();
+        let a = assess(&set, &record(level, 0.21));
+        assert!((a.scores.excitation_max_abs_z - 3.0).abs() < 1e-9, "{a:?}");
+        assert_eq!(a.classification, Classification::Road);
+    }
+
+    /// A drive's value of a feature is the median over its records: one record in five moved
+    /// (a vehicle alarm on its own) leaves the drive normal; three in five moved flag the drive
+    /// with the median's score; a feature missing in more than half the records is missing.
+    #[test]
+    fn drive_is_scored_on_the_medians_by_hand() {
+        let set = baseline();
+        let ok = record(1.1, 0.21);
+        let moved = record(1.1, 0.105);
+        assert_eq!(assess(&set, &moved).classification, Classification::Vehicle);
+        let one = [&moved, &ok, &ok, &ok, &ok];
+        let a = assess_drive(&set, &one);
+        assert_eq!(a.classification, Classification::Normal, "{a:?}");
+        let three = [&moved, &ok, &moved, &ok, &moved];
+        let a = assess_drive(&set, &three);
+        assert_eq!(a.classification, Classification::Vehicle, "{a:?}");
+        let single = assess(&set, &moved);
+        assert!((a.evidence[0].z - single.evidence[0].z).abs() < 1e-12);
+        assert!((a.evidence[0].value - 0.105).abs() < 1e-12);
+        // Medians of an even count: the mean of the two middle logs.
+        let four = [&moved, &moved, &ok, &ok];
+        let a = assess_drive(&set, &four);
+        let t = set
+            .features
+            .iter()
+            .find(|f| f.meta.kind == Kind::Transmissibility)
+            .expect("trans");
+        let want = (0.5 * (0.105f64.ln() + 0.21f64.ln()) - t.centre) / t.sigma;
+        assert!(
+            (a.scores.vehicle_max_abs_z - want.abs()).abs() < 1e-12,
+            "{a:?}"
+        );
+        let mut without = record(1.1, 0.105);
+        without.transmissibility.clear();
+        let a = assess_drive(&set, &[&without, &without, &without, &moved, &moved]);
+        assert_eq!(a.classification, Classification::Normal, "{a:?}");
+        assert_eq!(a.missing, vec!["RL: transmissibility 2-5 Hz".to_string()]);
+        // Records with a failed sensor are left out of the medians and named.
+        let mut dead = record(1.1, 0.105);
+        dead.sensor_faults.push(crate::features::SensorFault {
+            channel: "RL_sprung".into(),
+            fault: crate::features::FaultKind::Dead,
+            detail: "every sample is 0".into(),
+        });
+        let a = assess_drive(&set, &[&dead, &dead, &ok, &ok, &ok]);
+        assert_eq!(a.classification, Classification::Normal, "{a:?}");
+        assert!(
+            a.summary.starts_with("sensor: 2 of 5 record(s) left out"),
+            "{}",
+            a.summary
+        );
+        let a = assess_drive(&set, &[&dead, &dead, &dead, &ok, &ok]);
+        assert_eq!(a.classification, Classification::Sensor, "{a:?}");
     }
 
     #[test]

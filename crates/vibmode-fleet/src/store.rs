@@ -51,6 +51,19 @@ const MIGRATIONS: &[&str] = &[
         checked TEXT NOT NULL,
         classification TEXT NOT NULL,
         json TEXT NOT NULL);",
+    // 2: drive verdicts (`fleet check` per drive), with the records of each.
+    "CREATE TABLE drives (
+        id INTEGER PRIMARY KEY,
+        vehicle_id INTEGER NOT NULL REFERENCES vehicles(id),
+        drive TEXT NOT NULL,
+        model_version INTEGER NOT NULL,
+        checked TEXT NOT NULL,
+        classification TEXT NOT NULL,
+        json TEXT NOT NULL);
+     CREATE TABLE drive_records (
+        drive_id INTEGER NOT NULL REFERENCES drives(id) ON DELETE CASCADE,
+        record_id INTEGER NOT NULL REFERENCES records(id) ON DELETE CASCADE,
+        PRIMARY KEY (drive_id, record_id));",
 ];
 
 /// How long a write waits for another process's transaction before giving up.
@@ -447,6 +460,22 @@ impl Store {
         }
     }
 
+    /// The vehicles other than `vehicle` that have a record with this content hash.
+    pub fn other_vehicles_with(&self, vehicle: &str, sha256: &str) -> Result<Vec<String>> {
+        let mut st = self
+            .conn
+            .prepare(
+                "SELECT DISTINCT v.name FROM records r JOIN vehicles v ON v.id = r.vehicle_id
+                 WHERE r.sha256 = ?1 AND v.name <> ?2 ORDER BY v.name",
+            )
+            .map_err(self.sql("looking up a record's vehicles"))?;
+        let rows = st
+            .query_map(params![sha256, vehicle], |r| r.get::<_, String>(0))
+            .map_err(self.sql("looking up a record's vehicles"))?;
+        rows.collect::<std::result::Result<Vec<_>, _>>()
+            .map_err(self.sql("looking up a record's vehicles"))
+    }
+
     /// The record of `vehicle` with this content hash, if stored.
     pub fn find_record(&self, vehicle: &str, sha256: &str) -> Result<Option<RecordRow>> {
         let Some(vid) = self.vehicle_id(vehicle)? else {
@@ -492,6 +521,23 @@ impl Store {
     /// back before the transaction starts: a value that could not be read later (a non-finite
     /// number) is an error and nothing is written.
     pub fn store_batch(&mut self, items: &[BatchItem<'_>]) -> Result<Vec<Stored>> {
+        self.store_batch_with_drive(items, None)
+    }
+
+    /// As [`Store::store_batch`], and in the same transaction the verdict of a drive over these
+    /// records (table `drives`, its records in `drive_records`) when `drive` is given.
+    pub fn store_batch_with_drive(
+        &mut self,
+        items: &[BatchItem<'_>],
+        drive: Option<&crate::fleet::Drive>,
+    ) -> Result<Vec<Stored>> {
+        let drive_json = match drive {
+            Some(d) => Some(to_json_checked(
+                d,
+                &format!("the verdict of drive '{}'", vibmode_core::quoted(&d.drive)),
+            )?),
+            None => None,
+        };
         let mut prepared = Vec::with_capacity(items.len());
         for it in items {
             let features = to_json_checked(
@@ -590,8 +636,64 @@ impl Store {
                 inserted,
             });
         }
+        if let (Some(d), Some(json), Some(first)) = (drive, drive_json, items.first()) {
+            let vid: i64 = tx
+                .query_row(
+                    "SELECT id FROM vehicles WHERE name = ?1",
+                    [first.record.vehicle],
+                    |r| r.get(0),
+                )
+                .map_err(err)?;
+            tx.execute(
+                "INSERT INTO drives (vehicle_id, drive, model_version, checked, classification, json)
+                 VALUES (?1, ?2, ?3, ?4, ?5, ?6)",
+                params![
+                    vid,
+                    d.drive,
+                    d.model_version,
+                    now,
+                    d.assessment.classification.to_string(),
+                    json
+                ],
+            )
+            .map_err(err)?;
+            let did = tx.last_insert_rowid();
+            for o in &out {
+                tx.execute(
+                    "INSERT OR IGNORE INTO drive_records (drive_id, record_id) VALUES (?1, ?2)",
+                    params![did, o.record_id],
+                )
+                .map_err(err)?;
+            }
+        }
         tx.commit().map_err(err)?;
         Ok(out)
+    }
+
+    /// The drive verdicts of `vehicle`, oldest first: (drive, classification, records).
+    pub fn drives(&self, vehicle: &str) -> Result<Vec<(String, String, usize)>> {
+        let Some(vid) = self.vehicle_id(vehicle)? else {
+            return Ok(Vec::new());
+        };
+        let mut st = self
+            .conn
+            .prepare(
+                "SELECT d.drive, d.classification,
+                        (SELECT COUNT(*) FROM drive_records r WHERE r.drive_id = d.id)
+                 FROM drives d WHERE d.vehicle_id = ?1 ORDER BY d.id",
+            )
+            .map_err(self.sql("reading drives"))?;
+        let rows = st
+            .query_map([vid], |r| {
+                Ok((
+                    r.get::<_, String>(0)?,
+                    r.get::<_, String>(1)?,
+                    r.get::<_, i64>(2)? as usize,
+                ))
+            })
+            .map_err(self.sql("reading drives"))?;
+        rows.collect::<std::result::Result<Vec<_>, _>>()
+            .map_err(self.sql("reading drives"))
     }
 
     /// The features of a record.
@@ -966,6 +1068,27 @@ mod tests {
         }
     }
 
+    /// A store of schema 1 (before drives) opens, is migrated to the current schema, keeps its
+    /// records and stores drives.
+    #[test]
+    fn a_schema_1_store_is_migrated_and_keeps_its_records() {
+        let d = tempfile::tempdir().expect("tmp");
+        let path = d.path().join("old.db");
+        {
+            let c = Connection::open(&path).expect("create");
+            c.execute_batch(MIGRATIONS[0]).expect("schema 1");
+            c.execute_batch(
+                "PRAGMA user_version = 1;
+                 INSERT INTO vehicles (name, created) VALUES ('bus-1', 'then');",
+            )
+            .expect("v1");
+        }
+        let s = Store::open(&path).expect("open");
+        assert_eq!(s.schema_version().expect("version"), SCHEMA_VERSION);
+        assert_eq!(s.vehicles().expect("vehicles"), vec!["bus-1".to_string()]);
+        assert!(s.drives("bus-1").expect("drives").is_empty());
+    }
+
     #[test]
     fn fresh_store_reopens_with_its_schema_version() {
         let d = tempfile::tempdir().expect("tempdir");
@@ -976,7 +1099,7 @@ mod tests {
         drop(s);
         let (s, created) = Store::init(&p).expect("init again");
         assert!(!created);
-        assert_eq!(s.schema_version().expect("version"), 1);
+        assert_eq!(s.schema_version().expect("version"), SCHEMA_VERSION);
         let s = Store::open(&p).expect("open");
         assert!(s.vehicles().expect("vehicles").is_empty());
     }

@@ -1,6 +1,6 @@
 //! End to end over seeds: simulated city-bus runs through the store, a baseline from nominal
 //! runs (class B and C roads, 30-50 km/h, two records each), then (a) a nominal run at another speed, (b) a
-//! class D and a class E road, (c) the rear dampers weakened by 45 %, (d) both.
+//! class D (one road class above the baseline's roughest: normal) and a class E road (road), (c) the rear dampers weakened by 45 %, (d) both.
 
 use std::collections::BTreeMap;
 
@@ -123,7 +123,9 @@ fn classification_over_seeds() {
         count("a normal 35 km/h C", Classification::Normal) >= 9,
         "{table}"
     );
-    assert!(count("b road D", Classification::Road) >= 8, "{table}");
+    // The baseline's roughest road is class C; class D is one road class (a factor 2 in
+    // amplitude) above it, inside `road_margin` (docs/fleet.md): normal. Class E is two.
+    assert!(count("b road D", Classification::Normal) >= 8, "{table}");
     assert_eq!(count("b road E", Classification::Road), 10, "{table}");
     assert!(count("c vehicle", Classification::Vehicle) >= 9, "{table}");
     assert!(count("d both", Classification::Both) >= 9, "{table}");

@@ -14,7 +14,7 @@ use crate::model::{information_criteria, ArmaModel, Estimator, StopReason};
 use crate::outliers::OutlierCleaning;
 use crate::params::{ArmaParams, Robust};
 use crate::prepare::{self, Prepared};
-use crate::roots::{polynomial_roots, polynomial_roots_unpolished};
+use crate::roots::{aberth_roots, polynomial_roots, polynomial_roots_unpolished};
 use crate::IdentError;
 
 /// Largest N p (p + q) for which the AR columns of the Jacobian are filtered exactly
@@ -210,8 +210,12 @@ fn stabilise(c: &mut [f64]) {
             return;
         }
     }
-    // Unpolished roots: the reflected C is a trial point of the search, not a result.
-    if let Ok(roots) = polynomial_roots_unpolished(c) {
+    // Unpolished roots: the reflected C is a trial point of the search, not a result. Aberth's
+    // iteration (O(q^2) per sweep) first, the companion matrix if it does not settle.
+    let roots = aberth_roots(c)
+        .map(Ok)
+        .unwrap_or_else(|| polynomial_roots_unpolished(c));
+    if let Ok(roots) = roots {
         let refl: Vec<Complex64> = roots
             .iter()
             .map(|&z| {
@@ -543,16 +547,26 @@ impl<'a> Search<'a> {
     fn add_huber_correction(&self, eps: &[f64], r: f64, h: &mut DMatrix<f64>) {
         let (p, q) = (self.p, self.q);
         let k = p + q;
-        let mut psi = vec![0.0; k];
-        let mut fpsi = vec![0.0; k];
-        for (t, &et) in eps.iter().enumerate().skip(p) {
-            let e = et.abs();
-            if e <= r {
-                continue;
-            }
-            let w = r / e;
+        let flagged: Vec<(usize, f64)> = eps
+            .iter()
+            .enumerate()
+            .skip(p)
+            .filter(|(_, e)| e.abs() > r)
+            .map(|(t, e)| (t, r / e.abs() - 1.0))
+            .collect();
+        if flagged.is_empty() || k == 0 {
+            return;
+        }
+        // h += sum_t f_t psi_t psi_t^T as one matrix product (k x m) (m x k) over the m flagged
+        // instants: columns psi_t of `psi`, rows f_t psi_t^T of `fpsi`.
+        let m = flagged.len();
+        let mut psi = DMatrix::<f64>::zeros(k, m);
+        let mut fpsi = DMatrix::<f64>::zeros(m, k);
+        for (col, &(t, f)) in flagged.iter().enumerate() {
+            let mut column = psi.column_mut(col);
+            let v = column.as_mut_slice();
             for i in 1..=p {
-                psi[i - 1] = if !self.cols.is_empty() {
+                v[i - 1] = if !self.cols.is_empty() {
                     self.cols[i - 1][t]
                 } else if t >= i {
                     self.yf[t - i]
@@ -561,23 +575,13 @@ impl<'a> Search<'a> {
                 };
             }
             for j in 1..=q {
-                psi[p + j - 1] = if t >= j { -self.ef[t - j] } else { 0.0 };
+                v[p + j - 1] = if t >= j { -self.ef[t - j] } else { 0.0 };
             }
-            let f = w - 1.0;
-            for (fi, &p_i) in fpsi.iter_mut().zip(&psi) {
-                *fi = f * p_i;
-            }
-            // Column by column (contiguous in nalgebra's storage); each entry gets the same single
-            // update, and rows with f psi_i = 0 are left untouched.
-            for (j, &psi_j) in psi.iter().enumerate() {
-                let mut column = h.column_mut(j);
-                for (hij, &fi) in column.as_mut_slice().iter_mut().zip(&fpsi) {
-                    if fi != 0.0 {
-                        *hij += fi * psi_j;
-                    }
-                }
+            for (i, &vi) in v.iter().enumerate() {
+                fpsi[(col, i)] = f * vi;
             }
         }
+        h.gemm(1.0, &psi, &fpsi, 1.0);
     }
 }
 
@@ -1183,6 +1187,41 @@ mod tests {
                 for j in 1..=q {
                     let direct: f64 = (p..n).map(|t| s.cols[i][t] * s.ef[t - j]).sum();
                     close(h[(i, p + j - 1)], -direct, &format!("M[{i}][{j}]"));
+                }
+            }
+            // The Huber correction as one matrix product against its definition,
+            // sum over |eps_t| > r (t >= p) of (r/|eps_t| - 1) psi_t psi_t^T.
+            let eps: Vec<f64> = (0..n).map(|_| 2.0 * uniform()).collect();
+            let r = 0.4;
+            let mut hc = DMatrix::<f64>::zeros(p + q, p + q);
+            s.add_huber_correction(&eps, r, &mut hc);
+            let k = p + q;
+            let mut want = DMatrix::<f64>::zeros(k, k);
+            for (t, e) in eps.iter().enumerate().skip(p) {
+                if e.abs() <= r {
+                    continue;
+                }
+                let f = r / e.abs() - 1.0;
+                let psi: Vec<f64> = (0..k)
+                    .map(|i| {
+                        if i < p {
+                            s.cols[i][t]
+                        } else if t > i - p {
+                            -s.ef[t - (i - p + 1)]
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect();
+                for i in 0..k {
+                    for j in 0..k {
+                        want[(i, j)] += f * psi[i] * psi[j];
+                    }
+                }
+            }
+            for i in 0..k {
+                for j in 0..k {
+                    close(hc[(i, j)], want[(i, j)], &format!("Huber[{i}][{j}]"));
                 }
             }
             for i in 1..=p {

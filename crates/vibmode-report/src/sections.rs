@@ -62,7 +62,7 @@ impl ReportSection {
         identified: &[InvariantMode],
     ) -> ReportSection {
         let intro = format!(
-            "The vehicle file's suspension and body inertias were fitted to the records from the full-car model's three body equations, which carry no road input: {} records, {} equations in {:.2}-{:.2} Hz, {:.1} % of their variance explained. The sprung mass, unsprung masses, tyres and bending are the file's. These body modes do not depend on the road's wheelbase delay, which biases output-only heave and pitch (docs/model_update.md); the updated vehicle file is updated_vehicle.toml beside this page, every number is in model_update.json and, under model_update, in results.json.",
+            "The vehicle file's suspension and body inertias were fitted to the records from the full-car model's three body equations, which carry no road input: {} records, {} equations in {:.2}-{:.2} Hz, {:.1} % of their variance explained. Each sensor's white noise, measured from its spectrum above the band, was taken out of the equations (bias-compensated least squares), and the standard deviations are the jackknife's over the records. The sprung mass, unsprung masses, tyres and bending are the file's. These body modes do not depend on the road's wheelbase delay, which biases output-only heave and pitch (docs/model_update.md); the updated vehicle file is updated_vehicle.toml beside this page, every number is in model_update.json and, under model_update, in results.json.",
             r.records,
             r.equations,
             r.band_hz[0],
@@ -83,8 +83,10 @@ impl ReportSection {
                 "file [Hz]",
                 "updated [Hz]",
                 "change [%]",
+                "sd [Hz]",
                 "file damping ratio",
                 "updated damping ratio",
+                "sd",
             ]
             .map(String::from)
             .to_vec(),
@@ -92,19 +94,23 @@ impl ReportSection {
                 .body_mode_pairs()
                 .into_iter()
                 .map(|(n, u)| {
+                    let sd = r.mode_spread(u.label);
+                    let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
                     vec![
                         n.label.to_string(),
                         format!("{:.3}", n.frequency_hz),
                         format!("{:.3}", u.frequency_hz),
                         format!("{:+.1}", 100.0 * (u.frequency_hz / n.frequency_hz - 1.0)),
+                        f(sd.map(|m| m.frequency_hz_sd)),
                         format!("{:.3}", n.damping_ratio),
                         format!("{:.3}", u.damping_ratio),
+                        f(sd.map(|m| m.damping_ratio_sd)),
                     ]
                 })
                 .collect(),
         };
         let params = ReportTable {
-            headers: ["parameter", "unit", "file", "fitted", "change [%]"]
+            headers: ["parameter", "unit", "file", "fitted", "sd", "change [%]"]
                 .map(String::from)
                 .to_vec(),
             rows: r
@@ -121,6 +127,7 @@ impl ReportSection {
                         p.unit.to_string(),
                         value(p.file),
                         value(p.fitted),
+                        p.sd.map_or("-".into(), value),
                         change,
                     ]
                 })

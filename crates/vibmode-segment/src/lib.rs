@@ -23,7 +23,7 @@ pub use gps::{
     check_fixes, parse_track, read_track, GpsFix, GpsTrack, TrackFormat, DROPPED_FIXES_MAX_REL,
     GPS_SPEED_KMH_MAX, GPS_TIME_ABS_MAX_S,
 };
-pub use plan::{by_gps, fixed_cuts, GpsAlignment};
+pub use plan::{by_gps, fixed_cuts, plan_file, Cutting, GpsAlignment};
 pub use vibration::{by_vibration, VibrationWindow};
 pub use write::{write_segments, Written};
 

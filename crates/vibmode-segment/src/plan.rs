@@ -8,7 +8,7 @@ use crate::{
 use serde::{Deserialize, Serialize};
 use vibmode_core::Num;
 use vibmode_core::RecordMeta;
-use vibmode_signal::StreamInfo;
+use vibmode_signal::{FrameStream, StreamInfo};
 
 /// How GPS times were put on the recording's time axis: `t_rec = t_gps - base + offset_s`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -385,4 +385,66 @@ pub fn by_gps(
     );
     seg.tally();
     Ok(seg)
+}
+
+/// How [`plan_file`] cuts a recording into records.
+#[derive(Debug, Clone, Copy)]
+#[non_exhaustive]
+pub enum Cutting<'a> {
+    /// Where the GPS track shows steady driving ([`by_gps`]); `offset_s` is added to the
+    /// track's times to put them on the recording's clock.
+    Gps {
+        /// The track.
+        track: &'a GpsTrack,
+        /// Seconds added to the GPS times.
+        offset_s: f64,
+    },
+    /// Where the vibration shows driving, without stops, idling or strong manoeuvres
+    /// ([`by_vibration`](crate::by_vibration)).
+    Vibration,
+    /// Consecutive records ([`fixed_cuts`]).
+    Consecutive,
+}
+
+/// The segmentation of the file `path` (channels `sel` of it, read with `opts`) into records of
+/// `record_length_s`: by GPS, by vibration or consecutive. The file is read once for the
+/// vibration, and to its end for its length when the format does not state it.
+pub fn plan_file(
+    path: &std::path::Path,
+    opts: &vibmode_signal::ReadOptions,
+    sel: &[vibmode_signal::ChannelSelector],
+    how: Cutting<'_>,
+    record_length_s: f64,
+    p: &SegmentParams,
+) -> Result<Segmentation, SegmentError> {
+    let open = || -> Result<FrameStream, SegmentError> {
+        let mut s = vibmode_signal::open_stream(path, opts)?;
+        s.select(sel)?;
+        Ok(s)
+    };
+    let mut s = open()?;
+    match how {
+        Cutting::Gps { track, offset_s } => {
+            let n = frames(&mut s)?;
+            let s = open()?;
+            by_gps(s.info(), n, track, offset_s, record_length_s, p)
+        }
+        Cutting::Vibration => Ok(crate::by_vibration(&mut s, record_length_s, p)?.0),
+        Cutting::Consecutive => {
+            let n = frames(&mut s)?;
+            fixed_cuts(s.info(), n, record_length_s, p)
+        }
+    }
+}
+
+/// The number of frames of a stream (reading it to the end when its format does not say).
+fn frames(s: &mut FrameStream) -> Result<u64, SegmentError> {
+    if let Some(n) = s.info().n_frames {
+        return Ok(n);
+    }
+    while s
+        .next_block(vibmode_signal::DEFAULT_BLOCK_FRAMES)?
+        .is_some()
+    {}
+    Ok(s.position())
 }

@@ -2,6 +2,7 @@
 
 use nalgebra::{DMatrix, SVD};
 use num_complex::Complex64;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use vibmode_core::limits::{SSI_SAMPLES_PER_LAG_MIN, SSI_TOEPLITZ_ROWS_MAX};
 use vibmode_core::SsiParams;
@@ -754,10 +755,11 @@ impl SsiCov {
         r.solve_upper_triangular(&b)
     }
 
-    /// [`SsiCov::poles_at`] for every order of `orders`.
+    /// [`SsiCov::poles_at`] for every order of `orders`, the orders on all of rayon's threads
+    /// (`RAYON_NUM_THREADS=1` for one); the result is the same whatever the thread count.
     pub fn sweep(&self, orders: &[usize]) -> Result<SsiResult, SsiError> {
         let orders = orders
-            .iter()
+            .par_iter()
             .map(|&order| {
                 Ok(SsiOrder {
                     order,

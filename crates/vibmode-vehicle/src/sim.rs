@@ -1127,6 +1127,14 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
         rng3,
     );
     let d = Discrete::new(&car, fs)?;
+    // Per sensor: cos a cos b (the vertical gain), sin a (longitudinal), sin b (lateral).
+    let tilt_gains: Vec<[f64; 3]> = tilt
+        .iter()
+        .map(|[a, b]| {
+            let (a, b) = (a.to_radians(), b.to_radians());
+            [a.cos() * b.cos(), a.sin(), b.sin()]
+        })
+        .collect();
     let mut samples: Vec<Vec<f64>> = vec![vec![0.0; n_rec * sim.records]; p];
     // State index k of `run` corresponds to array index k + 1.
     d.run(
@@ -1156,9 +1164,8 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
                     let idx = k + 1;
                     let a_x = (speed[idx + 1] - speed[idx - 1]) / (2.0 * dt);
                     let a_y = ay(time(idx));
-                    for ((s, v), [a, b]) in samples.iter_mut().zip(y).zip(&tilt) {
-                        let (a, b) = (a.to_radians(), b.to_radians());
-                        s[j] = a.cos() * b.cos() * v + a.sin() * a_x + b.sin() * a_y;
+                    for ((s, v), [cc, sa, sb]) in samples.iter_mut().zip(y).zip(&tilt_gains) {
+                        s[j] = cc * v + sa * a_x + sb * a_y;
                     }
                 } else {
                     for (s, v) in samples.iter_mut().zip(y) {

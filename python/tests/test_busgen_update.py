@@ -1,0 +1,77 @@
+"""Acceptance on busgen's bus family: the full-car model update from 8 records (issue 30 item 4).
+
+Draws BUSES buses at random every run (printed; VIBMODE_BUS_SEEDS=1,2,3 replays), simulates 8
+records each at 2 kHz, fits each twice (vehicle file with and without a front anti-roll bar; the
+buses have none) with `$VIBMODE_BIN analyze ... --vehicle bus.toml` and asserts the issue's goals:
+body pitch, heave and roll within 3 % on >= 90 % of the fits, every spring and damper within 10 %
+(expected to fail today: marked xfail, see its reason), and that no fit reported as supported
+misses them. A fit the records do not support (reported, no updated_vehicle.toml) counts as a
+failure of the goals.
+About 25 s per bus on the 2-core machine with a release binary; 4 buses stay under 4 minutes
+with CI's debug binary (opt-level 2 dependencies).
+
+Skips without ../shared/busgen or VIBMODE_BIN; fails instead when VIBMODE_REQUIRE has "busgen".
+"""
+
+import os
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tools" / "busgen"))
+
+BUSES = 4
+
+
+def _skip_or_fail(why: str):
+    if "busgen" in os.environ.get("VIBMODE_REQUIRE", "").split(","):
+        pytest.fail(f"busgen required: {why}")
+    pytest.skip(f"skipped: {why}")
+
+
+@pytest.fixture(scope="module")
+def fits(tmp_path_factory):
+    import harness
+    import update
+
+    if not os.environ.get("VIBMODE_BIN"):
+        _skip_or_fail("VIBMODE_BIN (the vibmode binary) is not set")
+    try:
+        harness.busgen_dir()
+        harness.busgen_python()
+        seeds = harness.draw_bus_seeds(BUSES, "model update")
+    except harness.Skip as e:
+        _skip_or_fail(str(e))
+    rows = update.run(seeds, [], tmp_path_factory.mktemp("update"))
+    print(update.summarize(rows))
+    return rows
+
+
+def test_a_fit_reported_as_supported_meets_the_goals(fits):
+    """The model update never writes a wrong model: every fit it reports as supported has its
+    body modes within 3 % and every spring and damper within 10 % of the bus's."""
+    import update
+
+    for r in fits:
+        assert "modes" in r, f"bus {r['bus']}: no figures ({r.get('not_updated')})"
+        if not r.get("supported", True):
+            continue
+        bad = {k: v for k, v in {**r["modes"], **r["params"]}.items()
+               if abs(v) > (update.MODE_TOL if k.startswith("body") else update.PARAM_TOL)}
+        assert not bad, f"bus {r['bus']} (front bar {r['front_bar']}): written with {bad}"
+
+
+@pytest.mark.xfail(strict=False, reason=(
+    "issue 30.1 not met yet: with busgen's unsprung noise the bias-compensated fit is consistent "
+    "but 8 records leave a spread of 2-4 % on the body modes and 6-13 % on springs and dampers "
+    "(docs/model_update.md), so the update reports the fits as not supported"))
+def test_model_update_meets_the_issues_goals(fits):
+    import update
+
+    s = update.summarize(fits)
+    assert s["modes_within_3pct"] >= update.MODE_RATE * s["runs"], (
+        f"body modes within 3 % on {s['modes_within_3pct']} of {s['runs']} fits (goal >= 90 %)")
+    assert s["all_params_within_10pct"] == s["runs"], (
+        f"every spring and damper within 10 % on {s['all_params_within_10pct']} of "
+        f"{s['runs']} fits")

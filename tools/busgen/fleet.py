@@ -1,0 +1,202 @@
+#!/usr/bin/env python3
+"""Fleet monitoring on the independent bus family (../shared/busgen): how often `vibmode fleet
+check` says what is true, per drive and per record.
+
+Per bus (bus seeds drawn at random, printed; `VIBMODE_BUS_SEEDS=1,2,3` replays):
+
+- baseline: 2 healthy drives of 8 records each (busgen defaults: class B road, 25-35 km/h,
+  nominal load), `fleet ingest --condition nominal`, `fleet baseline`;
+- a healthy drive on another day: other seeds, speed 20-40 km/h (or busgen's 25-35 km/h
+  spread), load 0.85..1.20, road class A, B or C, all drawn at random;
+- faults at a corner drawn at random: damper at 60 % and 70 %, spring at 80 %, tyre at 75 %;
+- a healthy drive on a class D road.
+
+Each drive is given to one `fleet check --json -` (its 8 records: one drive). Scored:
+
+- healthy: `normal` (per drive, per record);
+- faults: `vehicle` or `both` with the faulty corner named first (the first vehicle evidence of
+  the record or the drive); `both` counts as a false `both` unless a fault is present;
+- class D: `road`; `both` there is a false `both`.
+
+The drive's verdict is the JSON's `drives` entry when the binary writes one, else (older
+binaries) it is not scored per drive.
+
+Usage: python3 tools/busgen/fleet.py [--buses N] [--records 8] [--json OUT]
+Needs VIBMODE_BIN (else target/release/vibmode) and a Python with numpy+scipy for busgen
+(BUSGEN_PYTHON).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import random
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+from typing import Dict, List, Optional
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import harness as h  # noqa: E402
+
+CORNERS = ["fl", "fr", "rl", "rr"]
+
+#: (name, busgen fault option, scale, what is expected)
+FAULTS = [
+    ("damper60", "--damper", 0.6),
+    ("damper70", "--damper", 0.7),
+    ("spring80", "--spring", 0.8),
+    ("tyre75", "--tyre", 0.75),
+]
+
+
+def conditions(bus_seed: int, rng: random.Random) -> List[Dict]:
+    """The drives to check on one bus, with their busgen options and expectation."""
+    out = []
+    speed = rng.choice([None, round(rng.uniform(20.0, 40.0), 1)])
+    load = round(rng.uniform(0.85, 1.20), 3)
+    road = rng.choice("ABC")
+    extra = ["--load", str(load), "--road-class", road]
+    if speed is not None:
+        extra += ["--speed-kmh", str(speed)]
+    out.append({"name": "healthy", "extra": extra, "expect": "normal", "corner": None,
+                "detail": f"load {load}, road {road}, "
+                          + (f"{speed} km/h" if speed else "25-35 km/h")})
+    for name, opt, scale in FAULTS:
+        corner = rng.choice(CORNERS)
+        out.append({"name": name, "extra": [opt, f"{corner}={scale}"], "expect": "vehicle",
+                    "corner": corner.upper(), "detail": f"{opt[2:]} {corner.upper()}={scale}"})
+    out.append({"name": "roadD", "extra": ["--road-class", "D"], "expect": "road",
+                "corner": None, "detail": "class D"})
+    return out
+
+
+def first_corner(evidence: List[Dict]) -> Optional[str]:
+    for e in evidence:
+        if e.get("group") == "vehicle":
+            return e.get("corner")
+    return None
+
+
+def verdict_ok(cls: str, corner: Optional[str], cond: Dict) -> bool:
+    if cond["expect"] == "vehicle":
+        return cls in ("vehicle", "both") and corner == cond["corner"]
+    return cls == cond["expect"]
+
+
+def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random) -> Dict:
+    """Simulates, ingests, baselines and checks one bus; returns its rows."""
+    db = work / f"fleet-{bus_seed}.db"
+    if db.exists():
+        db.unlink()
+    vehicle = f"bus{bus_seed}"
+    base_seed = rng.randrange(1, 10**6)
+    h.run_vibmode(["fleet", "init", "--db", db])
+    base = []
+    for d in range(2):
+        folder = h.simulate(bus_seed, base_seed + 1000 * d, records=n_records)
+        base += h.records(folder)
+    h.run_vibmode(["fleet", "ingest", "--db", db, "--vehicle", vehicle, "-q", *base])
+    h.run_vibmode(["fleet", "baseline", "--db", db, "--vehicle", vehicle])
+    rows = []
+    for i, cond in enumerate(conditions(bus_seed, rng)):
+        seed = base_seed + 10000 * (i + 1)
+        folder = h.simulate(bus_seed, seed, *cond["extra"], records=n_records)
+        r = h.run_vibmode(["fleet", "check", "--db", db, "--vehicle", vehicle, "-q",
+                           "--json", "-", *h.records(folder)])
+        out = json.loads(r.stdout)
+        recs = [(x["classification"], first_corner(x.get("evidence", [])), x.get("summary", ""))
+                for x in out["records"]]
+        drives = out.get("drives") or []
+        drive = None
+        if drives:
+            dv = drives[0]
+            drive = (dv["classification"], dv.get("corner") or first_corner(dv.get("evidence", [])),
+                     dv.get("summary", ""))
+        rows.append({"bus": bus_seed, "cond": cond["name"], "detail": cond["detail"],
+                     "expect": cond["expect"], "corner": cond["corner"], "records": recs,
+                     "drive": drive,
+                     "record_ok": sum(verdict_ok(c, k, cond) for c, k, _ in recs),
+                     "drive_ok": None if drive is None else verdict_ok(drive[0], drive[1], cond),
+                     "false_both": sum(c == "both" for c, _, _ in recs)
+                     if cond["expect"] != "vehicle" else 0})
+    db.unlink()
+    return {"bus": bus_seed, "rows": rows}
+
+
+def summarise(buses: List[Dict]) -> Dict[str, Dict]:
+    """Per condition: records right / total, drives right / total, false `both`."""
+    summary: Dict[str, Dict] = {}
+    for b in buses:
+        for r in b["rows"]:
+            s = summary.setdefault(r["cond"], {"rec_ok": 0, "rec_n": 0, "drive_ok": 0,
+                                               "drive_n": 0, "false_both": 0})
+            s["rec_ok"] += r["record_ok"]
+            s["rec_n"] += len(r["records"])
+            s["false_both"] += r["false_both"]
+            if r["drive_ok"] is not None:
+                s["drive_ok"] += int(r["drive_ok"])
+                s["drive_n"] += 1
+    return summary
+
+
+def print_row(r: Dict) -> None:
+    classes = " ".join(f"{c}{'/' + k if k else ''}" for c, k, _ in r["records"])
+    drive = "-" if r["drive"] is None else f"{r['drive'][0]}{'/' + r['drive'][1] if r['drive'][1] else ''}"
+    print(f"bus {r['bus']:>5} {r['cond']:<9} {r['detail']:<34} records {r['record_ok']}/"
+          f"{len(r['records'])} drive {drive:<12} [{classes}]", flush=True)
+    bad = [s for (c, k, s) in r["records"] if not verdict_ok(c, k, {"expect": r["expect"],
+                                                                      "corner": r["corner"]})]
+    if bad:
+        print(f"      first wrong: {bad[0][:200]}", flush=True)
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--buses", type=int, default=4)
+    p.add_argument("--records", type=int, default=h.RECORDS, help="records per drive")
+    p.add_argument("--json", type=Path, help="write the rows and the summary here")
+    a = p.parse_args(argv)
+    try:
+        h.vibmode_bin()
+        h.busgen_dir()
+        h.busgen_python()
+    except h.Skip as e:
+        print(f"skipped: {e}")
+        return 0
+    seeds = h.draw_bus_seeds(a.buses, "fleet")
+    buses = measure(seeds, a.records)
+    summary = summarise(buses)
+    print_summary(summary)
+    if a.json:
+        a.json.write_text(json.dumps({"buses": buses, "summary": summary}, indent=1))
+    return 0
+
+
+def measure(seeds: List[int], n_records: int = h.RECORDS) -> List[Dict]:
+    work = Path(tempfile.mkdtemp(prefix="vibmode-fleet-busgen-"))
+    buses = []
+    try:
+        for s in seeds:
+            rng = random.Random(s * 7919 + n_records)
+            b = run_bus(s, n_records, work, rng)
+            for r in b["rows"]:
+                print_row(r)
+            buses.append(b)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return buses
+
+
+def print_summary(summary: Dict[str, Dict]) -> None:
+    print("summary (right = healthy normal; fault vehicle|both with its corner first; "
+          "class D road):")
+    for cond, s in summary.items():
+        print(f"  {cond:<9} records {h.rate(s['rec_ok'], s['rec_n']):<16} drives "
+              f"{h.rate(s['drive_ok'], s['drive_n']):<14} false 'both' records {s['false_both']}")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
