@@ -420,7 +420,8 @@ pub fn lines_text(
     if lines.is_empty() {
         let _ = writeln!(
             s,
-            "{indent}No periodic lines (no prominent peak with a narrow-band kurtosis below {} in {:.0} % of the records, no swept ridge).",
+            "{indent}No periodic lines (no harmonic F-test peak at p < {:e} per pool, no prominent peak with a narrow-band kurtosis below {} in {:.0} % of the records, no swept ridge).",
+            r.config.lines.f_test_alpha,
             r.config.lines.max_kurtosis,
             100.0 * r.config.lines.min_record_share
         );
@@ -428,7 +429,7 @@ pub fn lines_text(
     }
     let _ = writeln!(
         s,
-        "{indent}Periodic lines (engine/gear orders: narrow-band kurtosis near 1.5), frequency per record, Hz (a>b: swept from a to b within the record):"
+        "{indent}Periodic lines (engine/gear orders: Thomson's harmonic F-test, or a narrow-band kurtosis near 1.5 for a line that drifts), frequency per record, Hz (a>b: swept from a to b within the record):"
     );
     for t in lines {
         let per: Vec<String> = (0..t.record_hz.len().max(t.record_sweep.len()))
@@ -951,7 +952,7 @@ fn lines_table(html: &mut HtmlReport, r: &AnalysisResults, lines: &[vibmode_anal
         return;
     }
     html.paragraph(
-        "Periodic lines (engine/gear orders), tracked over the records: a prominent peak whose narrow-band signal has the kurtosis of a sine (1.5) rather than of a randomly excited mode (3). Frequency in each record, Hz (- = not found there or a stop; a>b = swept from a to b Hz within the record: a ridge of the short-time spectra along which the signal has the kurtosis of a sine).",
+        "Periodic lines (engine/gear orders), tracked over the records: a sinusoid found by Thomson's multitaper harmonic F-test at a stated false-alarm rate (docs/analysis.md), or, for a line that drifts within a record, a prominent peak whose narrow-band signal has the kurtosis of a sine (1.5) rather than of a randomly excited mode (3). Frequency in each record, Hz (- = not found there or a stop; a>b = swept from a to b Hz within the record: a ridge of the short-time spectra along which the signal has the kurtosis of a sine).",
     );
     let mut headers: Vec<String> = vec![
         "frequency [Hz]".into(),
