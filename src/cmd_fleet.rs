@@ -319,7 +319,28 @@ fn status(db: &std::path::Path) -> Result<()> {
             db.display()
         );
     }
-    let mut text = String::new();
+    // One row per vehicle first: its latest drive verdict, the corner, since when, how sure.
+    let mut text = String::from(
+        "vehicle          latest drive verdict  corner  since                 |z|/limit  drive\n",
+    );
+    for v in &st {
+        match &v.latest_drive {
+            Some(d) => text.push_str(&format!(
+                "{:<16} {:<21} {:<7} {:<21} {:>9}  {} ({} records, false alarms <= {} per drive)\n",
+                v.vehicle,
+                d.classification.to_string(),
+                d.corner.as_deref().unwrap_or("-"),
+                d.since,
+                d.vehicle_z_over_limit
+                    .map_or("-".to_string(), |z| format!("{z:.2}")),
+                d.drive,
+                d.n_records,
+                d.false_alarm_rate
+            )),
+            None => text.push_str(&format!("{:<16} no drive checked yet\n", v.vehicle)),
+        }
+    }
+    text.push('\n');
     for v in &st {
         text.push_str(&format!(
             "vehicle {}: {} nominal, {} test records, baseline {}\n",
@@ -329,6 +350,20 @@ fn status(db: &std::path::Path) -> Result<()> {
             v.baseline_version
                 .map_or("none".to_string(), |n| format!("version {n}"))
         ));
+        if !v.drives.is_empty() {
+            text.push_str("  drives, newest first:\n");
+            for d in &v.drives {
+                text.push_str(&format!(
+                    "    {} {:<8} {:<4} {} {}\n",
+                    d.checked,
+                    d.classification.to_string(),
+                    d.corner.as_deref().unwrap_or("-"),
+                    d.drive,
+                    d.summary
+                ));
+            }
+            text.push_str("  records, newest first:\n");
+        }
         for (file, class, summary) in &v.last_checks {
             text.push_str(&format!(
                 "  {file:<31} {:<8} {summary}\n",

@@ -108,6 +108,31 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
     assert_eq!(drives().len(), 2);
     assert_eq!(drives()[1].0, "all given records");
 
+    // The status leads with each vehicle's latest drive verdict and since when (the first
+    // drive of the latest run of equal verdicts: both drives are normal).
+    let st = vibmode_fleet::Store::open(std::path::Path::new(db))
+        .unwrap()
+        .status(10)
+        .unwrap();
+    let v1 = st.iter().find(|v| v.vehicle == "bus-1").unwrap();
+    let latest = v1.latest_drive.as_ref().unwrap();
+    assert_eq!(latest.drive, "all given records");
+    assert_eq!(latest.classification.to_string(), "normal");
+    assert_eq!(latest.n_records, 3);
+    assert_eq!(v1.drives.len(), 2);
+    assert_eq!(v1.drives[1].drive, "2026-11-25");
+    assert_eq!(
+        latest.since, v1.drives[1].checked,
+        "since the first normal drive"
+    );
+    let o = ok(&["fleet", "status", "--db", db]);
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    let row = text.lines().nth(1).unwrap_or("");
+    assert!(
+        row.starts_with("bus-1") && row.contains("normal") && row.contains(&latest.since),
+        "{text}"
+    );
+
     // Too few records for a named drive: refused before anything is read or stored.
     let more = simulate_csv(&d.path().join("more"), "B", "30", "31", "3");
     fails_with(

@@ -3,6 +3,8 @@
 //!
 //! Skips (with a message) when no `chromium` binary is installed; `.ci/run` installs it.
 
+mod common;
+
 use std::path::Path;
 use std::process::Command;
 
@@ -134,37 +136,7 @@ fn demo_report_renders_in_headless_chromium() {
         );
         return;
     };
-    let profile = dir.path().join("profile");
-    let run = Command::new(&browser)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--enable-logging=stderr",
-            "--v=0",
-            "--virtual-time-budget=5000",
-            "--dump-dom",
-        ])
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .arg(format!("file://{}", abs(&index)))
-        .output()
-        .expect("run chromium");
-    let dom = String::from_utf8_lossy(&run.stdout);
-    let log = String::from_utf8_lossy(&run.stderr);
-    assert!(run.status.success(), "chromium failed: {log}");
-    let console_errors: Vec<&str> = log
-        .lines()
-        .filter(|l| l.contains("CONSOLE") && (l.contains("ERROR") || l.contains("Uncaught")))
-        .collect();
-    assert!(
-        console_errors.is_empty(),
-        "console errors: {console_errors:?}"
-    );
+    let dom = render(&browser, &index, &dir.path().join("profile"));
     // Every figure made it into the rendered DOM with drawn content.
     let svgs: Vec<&str> = dom.split("<svg").skip(1).collect();
     assert!(
@@ -194,6 +166,135 @@ fn demo_report_renders_in_headless_chromium() {
     assert!(
         dom.contains("Full-car model updated from the records") && dom.contains("updated [Hz]"),
         "model update missing from the rendered page"
+    );
+}
+
+/// The DOM headless Chromium renders from `index`; fails on a browser error or a console error.
+fn render(browser: &str, index: &Path, profile: &Path) -> String {
+    let run = Command::new(browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--enable-logging=stderr",
+            "--v=0",
+            "--virtual-time-budget=5000",
+            "--dump-dom",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .arg(format!("file://{}", abs(index)))
+        .output()
+        .expect("run chromium");
+    let dom = String::from_utf8_lossy(&run.stdout).to_string();
+    let log = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "chromium failed: {log}");
+    let console_errors: Vec<&str> = log
+        .lines()
+        .filter(|l| l.contains("CONSOLE") && (l.contains("ERROR") || l.contains("Uncaught")))
+        .collect();
+    assert!(
+        console_errors.is_empty(),
+        "console errors: {console_errors:?}"
+    );
+    dom
+}
+
+/// The fleet report leads with what a maintenance planner acts on: per vehicle, the latest
+/// drive verdict, the corner, since when and how sure, then the timeline of drive verdicts,
+/// then the records and trends (issue 31); it renders in headless Chromium without errors.
+#[test]
+fn fleet_report_leads_with_the_drive_verdicts_in_headless_chromium() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let db = dir.path().join("fleet.db");
+    let db = db.to_str().expect("utf-8 path");
+    let run = |args: &[&str]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_vibmode"))
+            .args(args)
+            .output()
+            .expect("run vibmode");
+        assert!(
+            o.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    };
+    run(&["fleet", "init", "--db", db]);
+    let nominal = common::simulate_csv(&dir.path().join("nominal"), "B", "30", "11", "6");
+    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-7", "-q"];
+    args.extend(nominal.iter().map(String::as_str));
+    run(&args);
+    run(&["fleet", "baseline", "--db", db, "--vehicle", "bus-7"]);
+    let test = common::simulate_csv(&dir.path().join("test"), "B", "30", "21", "6");
+    for (drive, files) in [("monday", &test[..3]), ("tuesday", &test[3..])] {
+        let mut args = vec![
+            "fleet",
+            "check",
+            "--db",
+            db,
+            "--vehicle",
+            "bus-7",
+            "-q",
+            "--drive",
+            drive,
+        ];
+        args.extend(files.iter().map(String::as_str));
+        run(&args);
+    }
+    let out = dir.path().join("report");
+    run(&[
+        "fleet",
+        "report",
+        "--db",
+        db,
+        "-o",
+        out.to_str().expect("utf-8 path"),
+    ]);
+    let index = out.join("index.html");
+    let html = std::fs::read_to_string(&index).expect("index.html");
+    let pos = |t: &str| {
+        html.find(t)
+            .unwrap_or_else(|| panic!("{t} missing from the report"))
+    };
+    assert!(
+        pos("Latest drive verdict per vehicle") < pos("Drive verdicts, newest first")
+            && pos("Drive verdicts, newest first") < pos("Records per vehicle"),
+        "the drive verdicts lead the page"
+    );
+    let verdicts = html
+        .split("Latest drive verdict per vehicle")
+        .nth(1)
+        .and_then(|t| t.split("</table>").next())
+        .unwrap_or("");
+    assert!(
+        verdicts.contains("<td>bus-7</td>") && verdicts.contains("tuesday (3 records"),
+        "{verdicts}"
+    );
+    let timeline = html
+        .split("Drive verdicts, newest first")
+        .nth(1)
+        .and_then(|t| t.split("</table>").next())
+        .unwrap_or("");
+    assert!(
+        timeline.find("<td>tuesday</td>") < timeline.find("<td>monday</td>")
+            && timeline.contains("<td>monday</td>"),
+        "{timeline}"
+    );
+    let Some(browser) = chromium() else {
+        skipped(
+            "chromium",
+            "browser part: no chromium installed (apt-get install chromium)",
+        );
+        return;
+    };
+    let dom = render(&browser, &index, &dir.path().join("profile"));
+    assert!(
+        dom.contains("Latest drive verdict per vehicle") && dom.contains("tuesday (3 records"),
+        "drive verdicts missing from the rendered page"
     );
 }
 

@@ -36,4 +36,6 @@ pub use model::{
     FeatureStat, Group, Kind, KindLimit, ModeSlot, ModelSet, Scores, LOO_MARGIN, MIN_DRIVE_RECORDS,
 };
 pub use report::write_fleet_report;
-pub use store::{BatchItem, Condition, RecordRow, Store, Stored, VehicleStatus, SCHEMA_VERSION};
+pub use store::{
+    BatchItem, Condition, DriveStatus, RecordRow, Store, Stored, VehicleStatus, SCHEMA_VERSION,
+};

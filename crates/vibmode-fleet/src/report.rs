@@ -34,6 +34,69 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
         vehicles.len()
     ));
     let status = store.status(usize::MAX / 2)?;
+    // What a maintenance planner acts on first: per vehicle, its latest drive verdict, the
+    // corner named, since when, and how sure; then the timeline of its drive verdicts.
+    let verdicts: Vec<Vec<String>> = status
+        .iter()
+        .map(|s| match &s.latest_drive {
+            Some(d) => vec![
+                s.vehicle.clone(),
+                d.classification.to_string(),
+                d.corner.clone().unwrap_or_else(|| "-".into()),
+                d.since.clone(),
+                d.vehicle_z_over_limit
+                    .map_or("-".into(), |z| format!("{z:.2}")),
+                format!(
+                    "{} ({} records; false alarms <= {} per drive)",
+                    d.drive, d.n_records, d.false_alarm_rate
+                ),
+                d.summary.clone(),
+            ],
+            None => vec![
+                s.vehicle.clone(),
+                "no drive checked".into(),
+                "-".into(),
+                "-".into(),
+                "-".into(),
+                "-".into(),
+                String::new(),
+            ],
+        })
+        .collect();
+    html.heading(2, "Latest drive verdict per vehicle");
+    html.table(
+        &[
+            "vehicle",
+            "verdict",
+            "corner",
+            "since",
+            "|z| / limit",
+            "drive",
+            "evidence",
+        ],
+        &verdicts,
+    );
+    let timeline: Vec<Vec<String>> = status
+        .iter()
+        .flat_map(|s| {
+            s.drives.iter().map(|d| {
+                vec![
+                    s.vehicle.clone(),
+                    d.checked.clone(),
+                    d.drive.clone(),
+                    d.classification.to_string(),
+                    d.corner.clone().unwrap_or_else(|| "-".into()),
+                ]
+            })
+        })
+        .collect();
+    if !timeline.is_empty() {
+        html.heading(2, "Drive verdicts, newest first");
+        html.table(
+            &["vehicle", "checked", "drive", "verdict", "corner"],
+            &timeline,
+        );
+    }
     let rows: Vec<Vec<String>> = status
         .iter()
         .map(|s| {
@@ -57,7 +120,7 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
             ]
         })
         .collect();
-    html.heading(2, "Status");
+    html.heading(2, "Records per vehicle");
     html.table(
         &[
             "vehicle",

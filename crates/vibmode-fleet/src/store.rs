@@ -151,6 +151,35 @@ pub struct VehicleStatus {
     pub baseline_version: Option<i64>,
     /// The latest checks, newest first: (file, classification, summary).
     pub last_checks: Vec<(String, Classification, String)>,
+    /// The latest drive verdict, if a drive was checked (stores from before drives have none).
+    #[serde(default)]
+    pub latest_drive: Option<DriveStatus>,
+    /// The latest drive verdicts, newest first (at most the `last` asked for).
+    #[serde(default)]
+    pub drives: Vec<DriveStatus>,
+}
+
+/// One drive verdict as the status shows it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DriveStatus {
+    /// The drive id.
+    pub drive: String,
+    /// When it was checked (UTC, RFC 3339).
+    pub checked: String,
+    /// normal, road, vehicle, both or sensor.
+    pub classification: Classification,
+    /// The corner named first, if any.
+    pub corner: Option<String>,
+    /// One line: the flagged features per corner.
+    pub summary: String,
+    /// The largest |z| of the vehicle features against the limit (how sure: 1 at the limit).
+    pub vehicle_z_over_limit: Option<f64>,
+    /// The false-alarm rate per drive and feature group.
+    pub false_alarm_rate: f64,
+    /// Records in the drive.
+    pub n_records: usize,
+    /// The first check of the latest run of drives with this classification (since when).
+    pub since: String,
 }
 
 /// An open fleet store.
@@ -979,14 +1008,75 @@ impl Store {
                     .map_err(|e| self.corrupt(&format!("the check of {file}"), e))?;
                 last_checks.push((file, a.classification, a.summary));
             }
+            let drives = self.drive_statuses(vid, &v)?;
             out.push(VehicleStatus {
                 vehicle: v,
                 n_nominal: count("nominal")?,
                 n_test: count("test")?,
                 baseline_version,
                 last_checks,
+                latest_drive: drives.first().cloned(),
+                drives: drives.into_iter().take(last).collect(),
             });
         }
+        Ok(out)
+    }
+}
+
+impl Store {
+    /// Every drive verdict of the vehicle `vid`, newest first, each with the start of its run
+    /// of equal verdicts.
+    fn drive_statuses(&self, vid: i64, vehicle: &str) -> Result<Vec<DriveStatus>> {
+        let mut st = self
+            .conn
+            .prepare(
+                "SELECT d.drive, d.checked, d.json,
+                        (SELECT COUNT(*) FROM drive_records r WHERE r.drive_id = d.id)
+                 FROM drives d WHERE d.vehicle_id = ?1 ORDER BY d.id",
+            )
+            .map_err(self.sql("reading drives"))?;
+        let rows = st
+            .query_map([vid], |r| {
+                Ok((
+                    r.get::<_, String>(0)?,
+                    r.get::<_, String>(1)?,
+                    r.get::<_, String>(2)?,
+                    r.get::<_, i64>(3)?,
+                ))
+            })
+            .map_err(self.sql("reading drives"))?
+            .collect::<rusqlite::Result<Vec<_>>>()
+            .map_err(self.sql("reading drives"))?;
+        let mut out: Vec<DriveStatus> = Vec::with_capacity(rows.len());
+        for (drive, checked, json, n) in rows {
+            let d: crate::fleet::Drive = serde_json::from_str(&json)
+                .map_err(|e| self.corrupt(&format!("drive {drive} of {vehicle}"), e))?;
+            let class = d.assessment.classification;
+            let since = match out.last() {
+                Some(prev) if prev.classification == class => prev.since.clone(),
+                _ => checked.clone(),
+            };
+            let limit = d
+                .assessment
+                .evidence
+                .iter()
+                .find(|e| e.meta.group == crate::model::Group::Vehicle)
+                .map(|e| e.limit);
+            out.push(DriveStatus {
+                drive,
+                checked,
+                classification: class,
+                corner: d.corner.map(|c| c.to_string()),
+                summary: d.assessment.summary.clone(),
+                vehicle_z_over_limit: limit
+                    .filter(|l| *l > 0.0)
+                    .map(|l| d.assessment.scores.vehicle_max_abs_z / l),
+                false_alarm_rate: d.false_alarm_rate,
+                n_records: n.max(0) as usize,
+                since,
+            });
+        }
+        out.reverse();
         Ok(out)
     }
 }
