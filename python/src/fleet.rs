@@ -8,8 +8,8 @@ use serde::Serialize;
 use std::path::PathBuf;
 use vibmode_fleet::store::{BatchItem, NewRecord};
 use vibmode_fleet::{
-    build_baseline, check_drive_files_progress, ingest_files, require_baseline, Condition, FleetConfig,
-    IngestLabels, Store,
+    build_baseline, check_drive_files_progress, ingest_files, require_baseline, Condition,
+    FleetConfig, IngestLabels, Store,
 };
 use vibmode_fleet::{compute_features, sha256_hex, FleetError, Ingested, RecordFeatures};
 
