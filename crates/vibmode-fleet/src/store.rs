@@ -704,25 +704,12 @@ impl Store {
         let Some(vid) = self.vehicle_id(vehicle)? else {
             return Ok(Vec::new());
         };
-        let mut st = self
-            .conn
-            .prepare(
-                "SELECT d.drive, d.classification,
-                        (SELECT COUNT(*) FROM drive_records r WHERE r.drive_id = d.id)
-                 FROM drives d WHERE d.vehicle_id = ?1 ORDER BY d.id",
-            )
-            .map_err(self.sql("reading drives"))?;
-        let rows = st
-            .query_map([vid], |r| {
-                Ok((
-                    r.get::<_, String>(0)?,
-                    r.get::<_, String>(1)?,
-                    r.get::<_, i64>(2)? as usize,
-                ))
-            })
-            .map_err(self.sql("reading drives"))?;
-        rows.collect::<std::result::Result<Vec<_>, _>>()
-            .map_err(self.sql("reading drives"))
+        Ok(self
+            .drive_statuses(vid, vehicle)?
+            .into_iter()
+            .rev()
+            .map(|d| (d.drive, d.classification.to_string(), d.n_records))
+            .collect())
     }
 
     /// The features of a record.
