@@ -114,63 +114,32 @@ pub fn run(a: &AnalyzeArgs) -> Result<()> {
         cfg.record_length_s = l;
         cfg.validate()?;
     }
-    let record_length_s = cfg.record_length_s;
     // With --gps / --by-vibration each file is segmented first (a pass over it), then its
-    // records are cut where the segmentation says.
-    let plans = if a.seg.active() {
-        if a.seg.gps.is_some() && a.inputs.len() > 1 {
-            bail!("--gps TRACK goes with one recording; give one input file");
-        }
-        let mut plans = Vec::new();
-        for path in &a.inputs {
-            let plan = crate::cmd_segment::plan(path, &opts, &sel, &a.seg, record_length_s)?;
-            eprintln!("{}", crate::cmd_segment::summary(&plan));
-            if plan.records.is_empty() {
-                bail!(
-                    "no steady stretch of {record_length_s} s in {}; see the reasons above, or analyse without segmentation",
-                    path.display()
-                );
-            }
-            plans.push(plan);
-        }
-        Some(plans)
-    } else {
-        None
-    };
+    // records are cut where the segmentation says. Each file is read as a stream and cut into
+    // records as it is read; each record is brought to the analysis rate as it arrives, so
+    // memory does not grow with the file.
+    let segmenting = a.seg.segmenting(false)?;
     let mut run = Run::new(cfg);
     if let Some(p) = &a.vehicle {
         run = run.vehicle(vibmode_vehicle::VehicleParams::from_path(p)?)?;
     }
-    if let Some([plan]) = plans.as_deref() {
-        if let Some(g) = &plan.gps {
-            run = run.speed_trace(g.speed_trace.clone());
-        }
-    }
-    // Each file is read as a stream and cut into records as it is read; each record is brought
-    // to the analysis rate as it arrives, so memory does not grow with the file.
-    let input = RunInput::Files {
-        paths: &a.inputs,
-        read: &opts,
-        channels: &sel,
-        windows: plans
-            .as_ref()
-            .map(|p| p.iter().map(|s| s.windows()).collect()),
+    let input = match &segmenting {
+        Some(segmenting) => RunInput::Segmented {
+            paths: &a.inputs,
+            read: &opts,
+            channels: &sel,
+            segmenting,
+        },
+        None => RunInput::files(&a.inputs, &opts, &sel),
     };
     let output = with_progress(a.quiet, true, |progress| run.run(input, progress))?;
     output
         .write(out.path(), None)
         .with_context(|| format!("writing the report in {}", out.path().display()))?;
-    if let Some(plans) = &plans {
-        let path = out.path().join("segments.json");
-        let text = if plans.len() == 1 {
-            serde_json::to_string_pretty(&plans[0])?
-        } else {
-            serde_json::to_string_pretty(plans)?
-        };
-        std::fs::write(&path, text + "\n")
-            .with_context(|| format!("writing {}", path.display()))?;
-    }
     out.commit()?;
+    for note in &output.notes {
+        eprintln!("{note}");
+    }
     print_modes(&output.results, None)?;
     if let Some(t) = output.update.summary_text(&a.output) {
         crate::output::print_stdout(&t)?;

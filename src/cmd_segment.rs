@@ -4,7 +4,8 @@
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
-use vibmode_segment::{Cutting, SegmentParams, Segmentation};
+use vibmode_run::Segmenting;
+use vibmode_segment::SegmentParams;
 use vibmode_signal::{ChannelSelector, FrameStream, ReadOptions};
 
 /// Segmentation options shared by `segment` and `analyze`.
@@ -57,13 +58,6 @@ impl SegmentOptions {
     }
 }
 
-impl SegmentOptions {
-    /// True when records are to be cut by GPS or vibration rather than consecutively.
-    pub fn active(&self) -> bool {
-        self.gps.is_some() || self.by_vibration
-    }
-}
-
 /// Arguments of `vibmode segment`.
 #[derive(Args, Debug)]
 pub struct SegmentArgs {
@@ -97,87 +91,23 @@ pub fn open(path: &Path, opts: &ReadOptions, sel: &[ChannelSelector]) -> Result<
     Ok(s)
 }
 
-/// The segmentation of `path` as the options say: by GPS, by vibration, or consecutive
-/// records ([`vibmode_segment::plan_file`]); the GPS track's dropped fixes are noted on stderr.
-pub fn plan(
-    path: &Path,
-    opts: &ReadOptions,
-    sel: &[ChannelSelector],
-    seg: &SegmentOptions,
-    record_length_s: f64,
-) -> Result<Segmentation> {
-    let p = seg.params()?;
-    let track = match &seg.gps {
-        Some(track_path) => {
-            if seg.by_vibration {
-                bail!("give either --gps TRACK or --by-vibration, not both");
-            }
-            let track = vibmode_segment::read_track(track_path)?;
-            if let Some(note) = track.dropped_note() {
-                eprintln!("GPS track {}: {note}", track_path.display());
-            }
-            Some(track)
-        }
-        None => None,
-    };
-    let how = match &track {
-        Some(track) => Cutting::Gps {
-            track,
-            offset_s: seg.gps_offset_s,
-        },
-        None if seg.by_vibration => Cutting::Vibration,
-        None => Cutting::Consecutive,
-    };
-    Ok(vibmode_segment::plan_file(
-        path,
-        opts,
-        sel,
-        how,
-        record_length_s,
-        &p,
-    )?)
-}
-
-/// One line per reason: how much was skipped.
-pub fn summary(seg: &Segmentation) -> String {
-    let skipped: Vec<String> = seg
-        .skipped_s_by_reason
-        .iter()
-        .map(|(k, v)| format!("{k} {v:.1} s"))
-        .collect();
-    let gps = seg
-        .gps
-        .as_ref()
-        .map(|g| {
-            let dropped: usize = g.dropped_fixes.values().sum();
-            let incomplete: usize = g.incomplete_sentences.values().sum();
-            let mut t = format!(
-                "; GPS: {} fixes, {} unparseable sentences skipped",
-                g.n_fixes, g.n_bad_sentences
-            );
-            if incomplete > 0 {
-                t += &format!(", {incomplete} sentences without a fix skipped");
-            }
-            if dropped > 0 {
-                t += &format!(", {dropped} invalid fixes dropped");
-            }
-            t
+impl SegmentOptions {
+    /// How the options say to cut: by GPS, by vibration, or (`consecutive`) consecutive
+    /// records; None when neither GPS nor vibration is asked and not `consecutive`.
+    pub fn segmenting(&self, consecutive: bool) -> Result<Option<Segmenting>> {
+        let params = self.params()?;
+        Ok(match (&self.gps, self.by_vibration) {
+            (Some(_), true) => bail!("give either --gps TRACK or --by-vibration, not both"),
+            (Some(track), false) => Some(Segmenting::Gps {
+                track: track.clone(),
+                offset_s: self.gps_offset_s,
+                params,
+            }),
+            (None, true) => Some(Segmenting::Vibration { params }),
+            (None, false) if consecutive => Some(Segmenting::Consecutive { params }),
+            (None, false) => None,
         })
-        .unwrap_or_default();
-    format!(
-        "{}: {:.1} s, {} records of {} s cut by {}; skipped: {}{}",
-        seg.source,
-        seg.duration_s,
-        seg.records.len(),
-        seg.record_length_s,
-        seg.method,
-        if skipped.is_empty() {
-            "nothing".to_string()
-        } else {
-            skipped.join(", ")
-        },
-        gps
-    )
+    }
 }
 
 /// Runs `vibmode segment`.
@@ -191,7 +121,12 @@ pub fn run(a: &SegmentArgs) -> Result<()> {
     let record_length_s = a
         .record_length_s
         .unwrap_or(vibmode_analysis::AnalysisConfig::default().record_length_s);
-    let mut seg = plan(&a.input, &opts, &sel, &a.seg, record_length_s)?;
+    let how = a.seg.segmenting(true)?.context("no segmentation")?;
+    let planned = how.plan(&a.input, &opts, &sel, record_length_s)?;
+    for note in &planned.notes {
+        eprintln!("{note}");
+    }
+    let mut seg = planned.segmentation;
     let stream = open(&a.input, &opts, &sel)?;
     let ext = match &a.format {
         Some(f) => match f.as_str() {
@@ -212,7 +147,7 @@ pub fn run(a: &SegmentArgs) -> Result<()> {
         vibmode_segment::write_segments(stream, &mut seg, out.path(), &ext)?;
     }
     out.commit()?;
-    eprintln!("{}", summary(&seg));
+    eprintln!("{}", seg.summary());
     eprintln!("written: {}", a.output.join("segments.json").display());
     Ok(())
 }

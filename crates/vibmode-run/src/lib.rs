@@ -28,6 +28,8 @@
 //! Errors are [`RunError`]s: each wraps the failing layer's error (its source), one line naming
 //! the value and the fix, never a command-line flag.
 
+#[cfg(feature = "segment")]
+mod segmenting;
 mod update;
 
 use std::path::{Path, PathBuf};
@@ -41,6 +43,8 @@ use vibmode_modal::ReferenceMode;
 use vibmode_signal::{ChannelSelector, ReadOptions};
 use vibmode_vehicle::VehicleParams;
 
+#[cfg(feature = "segment")]
+pub use segmenting::{Planned, Segmenting};
 pub use update::{FeedUpdate, ModelUpdate, UpdateOutcome};
 
 /// Errors of a run; each is one line naming the value and the fix.
@@ -76,6 +80,28 @@ pub enum RunError {
         /// The first failure's reason.
         first: String,
     },
+    /// A long recording could not be segmented (its file, the GPS track, the tolerances).
+    #[cfg(feature = "segment")]
+    #[error("{0}")]
+    Segment(#[from] vibmode_segment::SegmentError),
+    /// A GPS track was given for several recordings.
+    #[error(
+        "a GPS track goes with one recording, not {n_files}; segment the recordings one at a time"
+    )]
+    GpsWithManyFiles {
+        /// Recordings given.
+        n_files: usize,
+    },
+    /// A segmentation left no record.
+    #[error("no steady stretch of {record_length_s} s in {path} ({summary}); relax the segmentation's tolerances or analyse the recording without segmentation")]
+    NoSteadyStretch {
+        /// The recording.
+        path: String,
+        /// The record length, s.
+        record_length_s: f64,
+        /// What was skipped and why.
+        summary: String,
+    },
     /// Windows given for a different number of files.
     #[error("{n_windows} lists of record windows for {n_files} files; give one list per file")]
     WindowsMismatch {
@@ -102,6 +128,21 @@ pub enum RunInput<'a> {
         channels: &'a [ChannelSelector],
         /// Per file, the record windows (from a segmentation); None: consecutive records.
         windows: Option<Vec<Vec<RecordWindow>>>,
+    },
+    /// Long recordings, each first segmented as `segmenting` says (a pass over the file), then
+    /// read as streams and cut into the records the segmentation chose. The segmentations are
+    /// in [`RunOutput::segments`]; a GPS track's speed over time becomes the results' speed
+    /// trace (one recording).
+    #[cfg(feature = "segment")]
+    Segmented {
+        /// The recordings, in order.
+        paths: &'a [PathBuf],
+        /// How to read them.
+        read: &'a ReadOptions,
+        /// The channels to keep (all when empty).
+        channels: &'a [ChannelSelector],
+        /// How to cut them.
+        segmenting: &'a Segmenting,
     },
     /// Records in memory (e.g. simulated, or arrays from Python).
     Records(Vec<RecordInput>),
@@ -217,6 +258,13 @@ impl Run {
                 let results = vibmode_analysis::analyze(&records, cfg, &self.reference, &on_fits)?;
                 (results, records)
             }
+            #[cfg(feature = "segment")]
+            RunInput::Segmented {
+                paths,
+                read,
+                channels,
+                segmenting,
+            } => return self.run_segmented(paths, read, channels, segmenting, progress),
             RunInput::Files {
                 paths,
                 read,
@@ -274,7 +322,62 @@ impl Run {
             results,
             report_records,
             update: update.finish(),
+            #[cfg(feature = "segment")]
+            segments: Vec::new(),
+            notes: Vec::new(),
         })
+    }
+
+    /// [`RunInput::Segmented`]: each recording segmented, then analysed in its windows.
+    #[cfg(feature = "segment")]
+    fn run_segmented(
+        &self,
+        paths: &[PathBuf],
+        read: &ReadOptions,
+        channels: &[ChannelSelector],
+        segmenting: &Segmenting,
+        progress: &Progress<'_>,
+    ) -> Result<RunOutput, RunError> {
+        self.config.validate()?;
+        if segmenting.is_gps() && paths.len() > 1 {
+            return Err(RunError::GpsWithManyFiles {
+                n_files: paths.len(),
+            });
+        }
+        let record_length_s = self.config.record_length_s;
+        let mut segments = Vec::with_capacity(paths.len());
+        let mut notes = Vec::new();
+        for path in paths {
+            let planned = segmenting.plan(path, read, channels, record_length_s)?;
+            notes.extend(planned.notes);
+            let seg = planned.segmentation;
+            notes.push(seg.summary());
+            if seg.records.is_empty() {
+                return Err(RunError::NoSteadyStretch {
+                    path: record_name(path),
+                    record_length_s,
+                    summary: seg.summary(),
+                });
+            }
+            segments.push(seg);
+        }
+        let windows = segments.iter().map(|s| s.windows()).collect();
+        let mut run = self.clone();
+        if let [seg] = segments.as_slice() {
+            if let (Some(g), true) = (&seg.gps, run.speed_trace.is_empty()) {
+                run.speed_trace = g.speed_trace.clone();
+            }
+        }
+        let input = RunInput::Files {
+            paths,
+            read,
+            channels,
+            windows: Some(windows),
+        };
+        let mut out = run.run(input, progress)?;
+        out.segments = segments;
+        out.notes = notes;
+        Ok(out)
     }
 }
 
@@ -288,6 +391,13 @@ pub struct RunOutput {
     pub report_records: Vec<RecordInput>,
     /// The model update's outcome (off without a vehicle).
     pub update: UpdateOutcome,
+    /// The segmentation of each recording ([`RunInput::Segmented`]; empty otherwise), written
+    /// as `segments.json`.
+    #[cfg(feature = "segment")]
+    pub segments: Vec<vibmode_segment::Segmentation>,
+    /// What the user should know about the inputs, one line each (the segmentations'
+    /// summaries, fixes dropped from a GPS track).
+    pub notes: Vec<String>,
 }
 
 impl RunOutput {
@@ -319,7 +429,26 @@ impl RunOutput {
             &sections,
         )?;
         self.update.write(dir)?;
+        #[cfg(feature = "segment")]
+        self.write_segments(dir)?;
         Ok(())
+    }
+
+    /// `dir/segments.json`: the segmentation (one recording) or the list of them.
+    #[cfg(all(feature = "report", feature = "segment"))]
+    fn write_segments(&self, dir: &Path) -> Result<(), RunError> {
+        let path = dir.join("segments.json");
+        let err = |message: String| RunError::Write {
+            path: path.display().to_string(),
+            message,
+        };
+        let text = match self.segments.as_slice() {
+            [] => return Ok(()),
+            [one] => serde_json::to_string_pretty(one),
+            many => serde_json::to_string_pretty(many),
+        }
+        .map_err(|e| err(e.to_string()))?;
+        std::fs::write(&path, text + "\n").map_err(|e| err(e.to_string()))
     }
 }
 

@@ -162,3 +162,105 @@ fn errors_name_the_layer_and_the_value() {
         .err();
     assert!(matches!(err, Some(RunError::Analysis(_))), "{err:?}");
 }
+
+/// A segmented run: one segmentation per recording in the output and in `segments.json`, its
+/// summary among the notes, the records cut where it says (here consecutive: the same modes as
+/// the unsegmented run); a GPS track with several recordings and a segmentation that leaves no
+/// record are errors naming the value.
+#[test]
+fn segmented_runs_keep_their_segmentations() {
+    use vibmode_run::Segmenting;
+    use vibmode_segment::SegmentParams;
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let (paths, _) = records(dir.path());
+    let read = ReadOptions::default();
+    let run = Run::new(AnalysisConfig::default());
+    let plain = run
+        .run(RunInput::files(&paths, &read, &[]), &Progress::none())
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(plain.segments.is_empty() && plain.notes.is_empty());
+    let consecutive = Segmenting::Consecutive {
+        params: SegmentParams::default(),
+    };
+    let seg = run
+        .run(
+            RunInput::Segmented {
+                paths: &paths,
+                read: &read,
+                channels: &[],
+                segmenting: &consecutive,
+            },
+            &Progress::none(),
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(seg.segments.len(), 3);
+    for (s, p) in seg.segments.iter().zip(&paths) {
+        assert_eq!(s.records.len(), 1, "{}", s.summary());
+        assert!(
+            seg.notes.iter().any(|n| n == &s.summary()),
+            "{:?}",
+            seg.notes
+        );
+        assert!(s.source.contains(&*p.to_string_lossy()), "{}", s.source);
+    }
+    let freqs = |o: &vibmode_run::RunOutput| -> Vec<f64> {
+        o.results
+            .roles
+            .iter()
+            .flat_map(|r| r.invariant_modes.iter().map(|m| m.frequency_hz))
+            .collect()
+    };
+    assert_eq!(freqs(&plain), freqs(&seg));
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap_or_else(|e| panic!("{e}"));
+    seg.write(&out, None).unwrap_or_else(|e| panic!("{e}"));
+    let text = std::fs::read_to_string(out.join("segments.json")).unwrap_or_else(|e| panic!("{e}"));
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(v.as_array().map(Vec::len), Some(3), "{text}");
+
+    let gps = Segmenting::Gps {
+        track: dir.path().join("track.gpx"),
+        offset_s: 0.0,
+        params: SegmentParams::default(),
+    };
+    let err = run
+        .run(
+            RunInput::Segmented {
+                paths: &paths,
+                read: &read,
+                channels: &[],
+                segmenting: &gps,
+            },
+            &Progress::none(),
+        )
+        .err();
+    assert!(
+        matches!(err, Some(RunError::GpsWithManyFiles { n_files: 3 })),
+        "{err:?}"
+    );
+    // Every window below the stop threshold: no record left.
+    let all_stops = Segmenting::Vibration {
+        params: SegmentParams {
+            stop_activity_ratio: 5.0,
+            ..SegmentParams::default()
+        },
+    };
+    let err = run
+        .run(
+            RunInput::Segmented {
+                paths: &paths[..1],
+                read: &read,
+                channels: &[],
+                segmenting: &all_stops,
+            },
+            &Progress::none(),
+        )
+        .err();
+    let msg = err.as_ref().map(|e| e.to_string()).unwrap_or_default();
+    assert!(
+        matches!(err, Some(RunError::NoSteadyStretch { .. }))
+            && msg.contains("rec0.f64")
+            && !msg.contains('\n'),
+        "{err:?}"
+    );
+}

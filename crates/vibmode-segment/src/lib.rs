@@ -341,6 +341,50 @@ impl Segmentation {
             .collect()
     }
 
+    /// One line: the recording, its length, the records cut and by what, the seconds skipped
+    /// per reason, and what was dropped from the GPS track (printed by `vibmode segment` and
+    /// `vibmode analyze`).
+    pub fn summary(&self) -> String {
+        let skipped: Vec<String> = self
+            .skipped_s_by_reason
+            .iter()
+            .map(|(k, v)| format!("{k} {v:.1} s"))
+            .collect();
+        let gps = self
+            .gps
+            .as_ref()
+            .map(|g| {
+                let dropped: usize = g.dropped_fixes.values().sum();
+                let incomplete: usize = g.incomplete_sentences.values().sum();
+                let mut t = format!(
+                    "; GPS: {} fixes, {} unparseable sentences skipped",
+                    g.n_fixes, g.n_bad_sentences
+                );
+                if incomplete > 0 {
+                    t += &format!(", {incomplete} sentences without a fix skipped");
+                }
+                if dropped > 0 {
+                    t += &format!(", {dropped} invalid fixes dropped");
+                }
+                t
+            })
+            .unwrap_or_default();
+        format!(
+            "{}: {:.1} s, {} records of {} s cut by {}; skipped: {}{}",
+            self.source,
+            self.duration_s,
+            self.records.len(),
+            self.record_length_s,
+            self.method,
+            if skipped.is_empty() {
+                "nothing".to_string()
+            } else {
+                skipped.join(", ")
+            },
+            gps
+        )
+    }
+
     pub(crate) fn tally(&mut self) {
         // A record rounded past the last frame is dropped.
         let total = (self.duration_s * self.fs_hz).round() as u64;
