@@ -4,9 +4,9 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use vibmode_analysis::{AnalysisConfig, AnalysisResults, ConfigText, Preset, RecordInput};
+use vibmode_analysis::{AnalysisConfig, AnalysisResults, ConfigText, Preset};
 use vibmode_report::TruthRow;
-use vibmode_run::{Progress, Run, RunInput, RunOutput};
+use vibmode_run::{Demo, Progress, Run, RunInput, RunOutput};
 
 /// Arguments of `vibmode analyze`.
 #[derive(Args, Debug)]
@@ -220,83 +220,26 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
         cfg.method = m.parse()?;
     }
     let out = crate::output::StagedDir::begin(&a.output, &[])?;
-    let vehicle = vibmode_vehicle::VehicleParams::city_bus_flexible();
-    let p = vibmode_vehicle::SimParams::demo(a.records, a.seed);
-    p.validate()?;
-    eprintln!(
-        "simulating {} records of 10.24 s at 20 kHz: 12 m city bus with a flexible body, ISO 8608 class B road, ~30 km/h, wandering engine/gear lines, sensor noise and misalignment, braking, a turn, tones up to 6 kHz ...",
-        a.records
-    );
-    let sim = vibmode_vehicle::simulate(&vehicle, &p)?;
+    let demo = Demo {
+        records: a.records,
+        seed: a.seed,
+    };
+    eprintln!("{}", demo.description());
+    let d = demo.simulate()?;
     if a.keep_records {
         let dir = out.path().join("records");
         std::fs::create_dir(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
-        write_simulation(&dir, &sim, RecordFormat::Wav)?;
+        write_simulation(&dir, &d.simulation, RecordFormat::Wav)?;
     }
-    let records: Vec<RecordInput> = sim
-        .records
-        .iter()
-        .enumerate()
-        .map(|(i, r)| RecordInput {
-            name: format!("record {:02} ({:.1} km/h)", i + 1, r.mean_speed_kmh),
-            recording: r.recording.clone(),
-        })
-        .collect();
-    let reference = sim.truth.modes.iter().map(|m| m.to_reference()).collect();
-    let run = Run::new(cfg).reference(reference).vehicle(vehicle)?;
-    let n_records = records.len();
+    let run = Run::new(cfg).reference(d.reference).vehicle(d.vehicle)?;
     let output: RunOutput = with_progress(a.quiet, false, |progress| {
-        run.run(RunInput::Records(records), progress)
+        run.run(RunInput::Records(d.records), progress)
     })?;
-    let lines: Vec<String> = sim
-        .truth
-        .disturbance_lines_hz
-        .iter()
-        .map(|f| format!("{f} Hz"))
-        .collect();
-    let intro = format!(
-        "Demo: {} simulated record(s) of {} s of a 12 m city bus with a flexible body (vibmode's full-car simulator, examples/city_bus_flexible.toml: a body bending mode at 9 Hz between the axle modes) on an ISO 8608 class {} road at about {} km/h (the speed varies by 3 %), seed {}, with engine/gear lines at nominally {} (their frequency wanders by 0.1 %, their amplitude by 10 %, the engine speed differs by 2 % from record to record and the 7 Hz driveline line follows the vehicle speed), sensor noise, bias and misalignment up to 3 deg, braking, acceleration and a turn, and tones at {} Hz that alias without the anti-alias filter. The true modes are the full-car model's (red diamonds in the frequency-damping figure).",
-        n_records,
-        p.duration_s,
-        sim.truth.road_class,
-        sim.truth.speed_kmh,
-        a.seed,
-        lines.join(", "),
-        sim.truth
-            .hf_tones_hz
-            .iter()
-            .map(|f| f.to_string())
-            .collect::<Vec<_>>()
-            .join(", "),
-    );
     output
-        .write(out.path(), Some(&intro))
+        .write(out.path(), Some(&d.intro))
         .with_context(|| format!("writing the report in {}", out.path().display()))?;
     out.commit()?;
-    let mut truth: Vec<TruthRow> = sim
-        .truth
-        .modes
-        .iter()
-        .map(|m| (m.label.to_string(), m.frequency_hz, m.damping_ratio))
-        .collect();
-    for line in &sim.truth.lines {
-        let lo = line
-            .record_min_hz
-            .iter()
-            .copied()
-            .fold(f64::INFINITY, f64::min);
-        let hi = line
-            .record_max_hz
-            .iter()
-            .copied()
-            .fold(f64::NEG_INFINITY, f64::max);
-        truth.push((
-            format!("engine/gear line, {lo:.2}-{hi:.2} Hz over the records"),
-            line.nominal_hz,
-            0.0,
-        ));
-    }
-    truth.sort_by(|x, y| x.1.total_cmp(&y.1));
+    let truth = d.truth;
     print_modes(&output.results, Some(&truth))?;
     if let Some(t) = output.update.summary_text(&a.output) {
         crate::output::print_stdout(&t)?;

@@ -28,6 +28,7 @@
 //! Errors are [`RunError`]s: each wraps the failing layer's error (its source), one line naming
 //! the value and the fix, never a command-line flag.
 
+mod demo;
 #[cfg(feature = "segment")]
 mod segmenting;
 mod update;
@@ -43,6 +44,7 @@ use vibmode_modal::ReferenceMode;
 use vibmode_signal::{ChannelSelector, ReadOptions};
 use vibmode_vehicle::VehicleParams;
 
+pub use demo::{Demo, DemoRecords, TruthRow};
 #[cfg(feature = "segment")]
 pub use segmenting::{Planned, Segmenting};
 pub use update::{FeedUpdate, ModelUpdate, UpdateOutcome};
