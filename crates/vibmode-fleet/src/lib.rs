@@ -14,6 +14,7 @@ pub mod error;
 pub mod features;
 pub mod fleet;
 pub mod model;
+#[cfg(feature = "report")]
 pub mod report;
 pub mod stats;
 pub mod store;
@@ -35,6 +36,7 @@ pub use model::{
     assess, assess_drive, build_model_set, Assessment, Classification, Evidence, FeatureMeta,
     FeatureStat, Group, Kind, KindLimit, ModeSlot, ModelSet, Scores, LOO_MARGIN, MIN_DRIVE_RECORDS,
 };
+#[cfg(feature = "report")]
 pub use report::write_fleet_report;
 pub use store::{
     BatchItem, Condition, DriveStatus, RecordRow, Store, Stored, VehicleStatus, SCHEMA_VERSION,
