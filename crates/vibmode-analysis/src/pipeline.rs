@@ -11,16 +11,17 @@ use vibmode_signal::{preprocess, Preprocessed};
 use vibmode_spectra::{WelchParams, Window};
 
 use crate::config::AnalysisConfig;
-use crate::identify::{Identifier, SignalFits, SweepIdentifier};
+use crate::identify::SweepIdentifier;
 use crate::lines::LineStage;
 use crate::multichannel::SsiStage;
 use crate::results::{
     AnalysisResults, ChannelAnalysis, RecordSummary, RoleAnalysis, Timing, SCHEMA_VERSION,
 };
-use crate::source::RecordInput;
 use crate::stops::{activity_ratios, band_rms, detect_stops};
 use crate::store::PoleStore;
 use crate::AnalysisError;
+use vibmode_core::RecordInput;
+use vibmode_core::{Identifier, SignalFits};
 
 /// Welch spectrum and identification of one (record, channel) signal.
 struct SignalOut {
