@@ -41,10 +41,9 @@ pub use config::{AnalysisConfig, ChannelRole, ConfigText, Preset, ReportParams};
 pub use first_record::{first_record_spectra, FirstRecordSpectra, ModelPsd};
 pub use identify::SweepIdentifier;
 pub use lines::{LineSweep, LineTrack};
-pub use multichannel::{ShapedPole, SsiAnalysis, MATCH_MAC_MIN};
+pub use multichannel::{ShapedPole, SsiAnalysis};
 pub use pipeline::{
-    analyze, analyze_prepared, analyze_with, check_records, cluster_params_for, preprocess_records,
-    RecordFacts,
+    analyze, analyze_prepared, analyze_with, check_records, preprocess_records, RecordFacts,
 };
 pub use results::{
     AnalysisResults, ChannelAnalysis, RecordSummary, RoleAnalysis, Timing, SCHEMA_VERSION,
@@ -61,6 +60,7 @@ pub use vibmode_core::{
     ClusterParams, Corner, FitSummary, ModelCoefficients, Placement, PoleFilterParams,
     PreprocessParams, Robust, Role, SpectrumParams, StopParams, SweepModel, SweepParams,
 };
+pub use vibmode_modal::{MATCH_MAC_MIN, MATCH_MAX_FREQ_DIFF_REL};
 pub use vibmode_signal::{ChainedRecords, StreamRecords};
 
 /// A number for a message: at most 9 significant digits, no trailing zeros (100.00000000000001

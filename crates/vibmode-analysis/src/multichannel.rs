@@ -9,15 +9,12 @@ use vibmode_core::{
     ClusterParams, InvariantMode, ModeMatch, ModeUncertainty, PoleObservation, ReferenceMode,
     SsiParams,
 };
+use vibmode_modal::{MATCH_MAC_MIN, MATCH_MAX_FREQ_DIFF_REL};
 use vibmode_signal::Preprocessed;
 use vibmode_ssi::{SsiCorrelations, SsiCov};
 
 use crate::lines::{LineStage, LineTrack};
 use crate::AnalysisError;
-
-/// A physical-model mode is matched to an identified mode whose shape has at least this MAC with
-/// the model's shape at the sensors (and whose frequency is within 25 %).
-pub const MATCH_MAC_MIN: f64 = 0.5;
 
 /// Most groups of the jackknife over records (each group one more identification).
 pub const JACKKNIFE_GROUPS: usize = 20;
@@ -384,7 +381,7 @@ impl SsiStage<'_> {
                 &invariant_modes,
                 reference,
                 &channels,
-                crate::pipeline::MATCH_MAX_FREQ_DIFF_REL,
+                MATCH_MAX_FREQ_DIFF_REL,
                 MATCH_MAC_MIN,
             )
         };

@@ -612,6 +612,15 @@ impl Default for ClusterParams {
 }
 
 impl ClusterParams {
+    /// These settings for signals of band `band`: an unset `freq_max_hz` becomes the band's valid
+    /// maximum.
+    pub fn for_band(&self, band: &BandLimit) -> ClusterParams {
+        ClusterParams {
+            freq_max_hz: Some(self.freq_max_hz.unwrap_or_else(|| band.valid_max_hz())),
+            ..self.clone()
+        }
+    }
+
     /// Check every field; returns the first invalid one.
     pub fn validate(&self) -> Result<(), ParamError> {
         let d = ClusterParams::default();
