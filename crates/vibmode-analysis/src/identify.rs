@@ -22,8 +22,8 @@ impl SweepIdentifier {
     pub fn arma_params(&self, band: &BandLimit) -> ArmaParams {
         ArmaParams {
             robust: self.sweep.robust,
-            max_iter: self.sweep.max_iterations,
-            tol: self.sweep.tolerance,
+            max_iterations: self.sweep.max_iterations,
+            tolerance: self.sweep.tolerance,
             band: Some(*band),
             ..ArmaParams::default()
         }

@@ -43,6 +43,7 @@ pub use params::{
     BandLimit, BodyFitParams, BodySsiParams, ClusterParams, IdentMethod, LineParams,
     PoleFilterParams, PreprocessParams, Robust, SpectrumParams, StopParams, SweepModel,
     SweepParams, DEFAULT_HUBER_FACTOR, EDGE_SHARE, EMPTY_BAND_MAX_CUTOFF_SHARE,
+    SWEEP_MAX_ITERATIONS, SWEEP_TOLERANCE,
 };
 pub use placement::{Corner, Direction, Placement, Role};
 pub use record_meta::RecordMeta;
