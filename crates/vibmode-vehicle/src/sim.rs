@@ -119,21 +119,21 @@ impl Manoeuvre {
     }
 }
 
-/// Simulator settings. Defaults: road C, default coherence (exponential, 0.2 cycles/m),
-/// tyre enveloping 3 cycles/m,
-/// 40 km/h, 8 records of 10.24 s at 20 kHz, seed 0, no manoeuvres, no disturbances,
-/// automatic warm-up, no speed wander. Missing fields take these defaults when deserialised (e.g. from a TOML
+/// Simulator settings. Defaults (defined here once: `vibmode simulate`, `vibmode demo` and
+/// Python's `simulate` take theirs from [`SimParams::default`]): road B, default coherence
+/// (exponential, 0.2 cycles/m), tyre enveloping 3 cycles/m, 30 km/h, 8 records of 10.24 s at
+/// 20 kHz, seed 1, no manoeuvres, no disturbances, automatic warm-up, no speed wander. Missing fields take these defaults when deserialised (e.g. from a TOML
 /// or JSON config); unknown fields are errors.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SimParams {
-    /// ISO 8608 road class (default C).
+    /// ISO 8608 road class (default B).
     pub road: RoadClass,
     /// Left/right track coherence (default exponential, cutoff 0.2 cycles/m).
     pub coherence: LateralCoherence,
     /// Tyre-enveloping cutoff of the road, cycles/m (default Some(3.0); see [`RoadInput`]).
     pub tyre_envelope_cycles_per_m: Option<f64>,
-    /// Nominal (initial) speed, km/h (default 40).
+    /// Nominal (initial) speed, km/h (default 30).
     pub speed_kmh: f64,
     /// Length of one record, s (default 10.24).
     pub duration_s: f64,
@@ -141,7 +141,7 @@ pub struct SimParams {
     pub fs_hz: f64,
     /// Number of records (default 8): successive segments of one continuous drive.
     pub records: usize,
-    /// Random seed (ChaCha8); the same seed gives bit-identical output (default 0).
+    /// Random seed (ChaCha8); the same seed gives bit-identical output (default 1).
     pub seed: u64,
     /// Braking / acceleration / turning events (default none).
     pub manoeuvres: Vec<Manoeuvre>,
@@ -162,14 +162,14 @@ pub struct SimParams {
 impl Default for SimParams {
     fn default() -> Self {
         SimParams {
-            road: RoadClass::C,
+            road: RoadClass::B,
             coherence: LateralCoherence::default(),
             tyre_envelope_cycles_per_m: Some(DEFAULT_TYRE_ENVELOPE_CYCLES_PER_M),
-            speed_kmh: 40.0,
+            speed_kmh: 30.0,
             duration_s: 10.24,
             fs_hz: 20000.0,
             records: 8,
-            seed: 0,
+            seed: 1,
             manoeuvres: Vec::new(),
             disturbances: Disturbances::default(),
             warmup_s: None,
@@ -182,7 +182,7 @@ impl Default for SimParams {
 impl SimParams {
     /// The settings of `vibmode demo` (use them with
     /// [`VehicleParams::city_bus_flexible`](crate::VehicleParams::city_bus_flexible)):
-    /// [`SimParams::in_service`] on an ISO 8608 class B road at 30 km/h, `records` records of
+    /// [`SimParams::in_service`] on the default ISO 8608 class B road at 30 km/h, `records` records of
     /// 10.24 s at 20 kHz, and what real buses add:
     /// - engine/gear lines of 3 kN each (strong enough to stand out of the body response, as
     ///   on the paper's bus) whose frequency wanders (relative std 1e-3, correlation time 2 s)
@@ -193,8 +193,6 @@ impl SimParams {
     /// - sensors misaligned by up to 3 deg.
     pub fn demo(records: usize, seed: u64) -> Self {
         let mut p = SimParams {
-            road: RoadClass::B,
-            speed_kmh: 30.0,
             records,
             seed,
             speed_wander_rel_std: 0.03,
@@ -218,8 +216,6 @@ impl SimParams {
     /// [`VehicleParams::city_bus`](crate::VehicleParams::city_bus)). The idealised case.
     pub fn demo_ideal(records: usize, seed: u64) -> Self {
         let mut p = SimParams {
-            road: RoadClass::B,
-            speed_kmh: 30.0,
             records,
             seed,
             ..SimParams::in_service()
