@@ -51,4 +51,4 @@ pub use recording::{
     check_finite, check_fs, Channel, ChannelSelector, Recording, RecordingView, TimeAxis,
 };
 pub use source::{cut_records, CutRecords, RecordInput, RecordSource, RecordWindow};
-pub use ssi::{SsiParams, StabilityParams};
+pub use ssi::{SsiParams, Stability, StabilityParams};

@@ -54,6 +54,6 @@ pub use error::ModalError;
 pub use matching::{
     match_reference, match_reference_shapes, MATCH_MAC_MIN, MATCH_MAX_FREQ_DIFF_REL,
 };
-pub use params::{ClusterParams, StabilisationParams};
+pub use params::{ClusterParams, StabilityParams};
 pub use stabilisation::{stabilisation, Stability};
 pub use types::{InvariantMode, ModeClass, ModeMatch, PoleObservation, ReferenceMode};
