@@ -11,7 +11,7 @@ use vibmode_core::{
 };
 use vibmode_modal::{MATCH_MAC_MIN, MATCH_MAX_FREQ_DIFF_REL};
 use vibmode_signal::Preprocessed;
-use vibmode_ssi::{SsiCorrelations, SsiCov};
+use vibmode_ssi::{SsiCorrelations, SsiCov, SsiError};
 
 use crate::lines::{LineStage, LineTrack};
 use crate::AnalysisError;
@@ -60,7 +60,8 @@ pub struct SsiAnalysis {
     pub matches: Vec<ModeMatch>,
     /// Periodic lines of all the channels, tracked over the records.
     pub lines: Vec<LineTrack>,
-    /// Records whose identification failed, with the reason.
+    /// Records whose identification failed, with the message of their `vibmode_ssi::SsiError`
+    /// (kept as text: it is what `results.json` reports).
     pub failed_records: Vec<(usize, String)>,
 }
 
@@ -116,7 +117,7 @@ impl SsiStage<'_> {
 
     /// The correlations of the records used (each channel divided by its scale), kept per
     /// record for the jackknife, and the first record's band; `None` when no record is used.
-    fn pooled(&self, scales: &[f64]) -> Result<Option<Pooled>, String> {
+    fn pooled(&self, scales: &[f64]) -> Result<Option<Pooled>, SsiError> {
         let lag_of = |r: usize| self.first_lags.map(|l| l.get(r).copied().flatten());
         let (used, lags): (Vec<&Preprocessed>, Vec<Option<usize>>) = self
             .pre
@@ -149,8 +150,7 @@ impl SsiStage<'_> {
             SsiCorrelations::with_first_lags(&segments, first.band.fs_hz, self.params, &lags)
         } else {
             SsiCorrelations::new(&segments, first.band.fs_hz, self.params)
-        }
-        .map_err(|e| e.to_string())?;
+        }?;
         Ok(Some(Pooled {
             correlations,
             band: first.band,
@@ -164,9 +164,9 @@ impl SsiStage<'_> {
         pooled: &Pooled,
         orders: &[usize],
         scales: &[f64],
-    ) -> Result<Vec<ShapedPole>, String> {
-        let plan = pooled.correlations.plan().map_err(|e| e.to_string())?;
-        let res = plan.sweep(orders).map_err(|e| e.to_string())?;
+    ) -> Result<Vec<ShapedPole>, SsiError> {
+        let plan = pooled.correlations.plan()?;
+        let res = plan.sweep(orders)?;
         Ok(self.kept(res, 0, &pooled.band, scales))
     }
 
@@ -273,7 +273,7 @@ impl SsiStage<'_> {
         r: usize,
         orders: &[usize],
         scales: &[f64],
-    ) -> Result<Vec<ShapedPole>, String> {
+    ) -> Result<Vec<ShapedPole>, SsiError> {
         let p = &self.pre[r];
         let scaled: Vec<Vec<f64>> = p
             .recording
@@ -283,8 +283,8 @@ impl SsiStage<'_> {
             .map(|(c, s)| c.samples.iter().map(|v| v / s).collect())
             .collect();
         let chans: Vec<&[f64]> = scaled.iter().map(Vec::as_slice).collect();
-        let plan = SsiCov::new(&chans, p.band.fs_hz, self.params).map_err(|e| e.to_string())?;
-        let res = plan.sweep(orders).map_err(|e| e.to_string())?;
+        let plan = SsiCov::new(&chans, p.band.fs_hz, self.params)?;
+        let res = plan.sweep(orders)?;
         Ok(self.kept(res, r, &p.band, scales))
     }
 
@@ -315,7 +315,7 @@ impl SsiStage<'_> {
         } else {
             None
         };
-        let per: Vec<Result<Vec<ShapedPole>, String>> = if let Some(p) = &correlations {
+        let per: Vec<Result<Vec<ShapedPole>, SsiError>> = if let Some(p) = &correlations {
             vec![match p {
                 Ok(Some(p)) => self.pooled_poles(p, &orders, &scales),
                 Ok(None) => Ok(Vec::new()),
@@ -332,7 +332,8 @@ impl SsiStage<'_> {
         for (r, out) in per.into_iter().enumerate() {
             match out {
                 Ok(p) => poles.extend(p),
-                Err(e) => failed_records.push((r, e)),
+                // results.json keeps the failure's one-line message.
+                Err(e) => failed_records.push((r, e.to_string())),
             }
         }
         let pooled = self.params.pool_records;
