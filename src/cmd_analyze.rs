@@ -193,10 +193,10 @@ pub struct DemoArgs {
     #[arg(long)]
     pub preset: Option<String>,
     /// Number of simulated records.
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = vibmode_vehicle::SimParams::default().records)]
     pub records: usize,
     /// Random seed of the simulation.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = vibmode_vehicle::SimParams::default().seed)]
     pub seed: u64,
     /// Also write the simulated records (WAV) and truth.json into `OUTPUT/records/`.
     #[arg(long)]

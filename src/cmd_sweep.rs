@@ -161,8 +161,8 @@ fn sweep_settings(a: &SweepArgs, band: Option<BandLimit>) -> Result<(Vec<usize>,
     sweep.validate()?;
     let params = ArmaParams {
         robust: sweep.robust,
-        max_iter: sweep.max_iterations,
-        tol: sweep.tolerance,
+        max_iterations: sweep.max_iterations,
+        tolerance: sweep.tolerance,
         band,
         ..ArmaParams::default()
     };

@@ -79,22 +79,22 @@ pub struct SimulateArgs {
     /// Vehicle parameter file (TOML).
     pub params: PathBuf,
     /// ISO 8608 road class, A (very good) to H (very poor).
-    #[arg(long, default_value = "B")]
+    #[arg(long, default_value_t = SimParams::default().road.to_string())]
     pub road: String,
     /// Vehicle speed, km/h (1 to 500; also the cruising speed of --gps-track).
-    #[arg(long = "speed-kmh", default_value_t = 30.0)]
+    #[arg(long = "speed-kmh", default_value_t = SimParams::default().speed_kmh)]
     pub speed_kmh: f64,
     /// Length of each record, s.
-    #[arg(long = "duration-s", default_value_t = 10.24)]
+    #[arg(long = "duration-s", default_value_t = SimParams::default().duration_s)]
     pub duration_s: f64,
     /// Number of records (successive segments of one drive).
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = SimParams::default().records)]
     pub records: usize,
     /// Sampling rate, Hz (a whole number for --format wav).
-    #[arg(long = "fs", default_value_t = 20000.0)]
+    #[arg(long = "fs", default_value_t = SimParams::default().fs_hz)]
     pub fs_hz: f64,
     /// Random seed: the same seed gives the same bytes.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = SimParams::default().seed)]
     pub seed: u64,
     /// Non-road effects.
     #[arg(long, value_enum, default_value_t = Effects::InService)]

@@ -239,8 +239,7 @@ fn median_time<F: FnMut() -> Result<()>>(repeat: usize, mut f: F) -> Result<f64>
         f()?;
         t.push(t0.elapsed().as_secs_f64());
     }
-    t.sort_by(|a, b| a.total_cmp(b));
-    Ok(t[t.len() / 2])
+    Ok(vibmode_core::stats::median_high_in_place(&mut t))
 }
 
 fn run(dir: &Path, quick: bool) -> Result<Value> {

@@ -4,7 +4,7 @@ use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use serde::Serialize;
-use vibmode_core::{BandLimit, PoleFilterParams};
+use vibmode_core::{BandLimit, PoleFilterParams, SweepParams};
 use vibmode_ident::{ArMethod, ArmaModel, ArmaParams, IdentError, ModeSet, PoleRejection, Robust};
 
 use crate::errors::{json_err, value_err};
@@ -15,7 +15,41 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fit_ar, m)?)?;
     m.add_function(wrap_pyfunction!(arma_psd, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(ident_defaults, m)?)?;
     Ok(())
+}
+
+/// The Huber factor of a criterion, `None` for the quadratic one (Python's `robust`).
+fn huber_factor(robust: Robust) -> Option<f64> {
+    match robust {
+        Robust::Huber { factor } => Some(factor),
+        Robust::Off => None,
+    }
+}
+
+/// The defaults of `fit_arma` (a single fit: `ArmaParams::default()`) and `sweep` (the analysis
+/// sweep: `SweepParams::default()`), as JSON `{"fit_arma": ..., "sweep": ...}`, so that Python
+/// copies no number.
+#[pyfunction]
+fn ident_defaults() -> PyResult<String> {
+    let fit = ArmaParams::default();
+    let sweep = SweepParams::default();
+    serde_json::to_string(&serde_json::json!({
+        "fit_arma": {
+            "robust": huber_factor(fit.robust),
+            "max_iterations": fit.max_iterations,
+            "tolerance": fit.tolerance,
+            "demean": fit.demean,
+        },
+        "sweep": {
+            "order_min": sweep.order_min,
+            "order_max": sweep.order_max,
+            "robust": huber_factor(sweep.robust),
+            "max_iterations": sweep.max_iterations,
+            "tolerance": sweep.tolerance,
+        },
+    }))
+    .map_err(json_err)
 }
 
 /// Checks a sampling rate.
@@ -64,7 +98,7 @@ fn robust_of(robust: Option<f64>) -> Robust {
 
 /// ARMA(p, q) by prediction-error minimisation; returns the model and its modes as JSON.
 #[pyfunction]
-#[pyo3(signature = (y, fs, p, q, robust, max_iter, tol, demean))]
+#[pyo3(signature = (y, fs, p, q, robust, max_iterations, tolerance, demean))]
 #[allow(clippy::too_many_arguments)]
 fn fit_arma(
     py: Python<'_>,
@@ -73,16 +107,16 @@ fn fit_arma(
     p: usize,
     q: usize,
     robust: Option<f64>,
-    max_iter: usize,
-    tol: f64,
+    max_iterations: usize,
+    tolerance: f64,
     demean: bool,
 ) -> PyResult<String> {
     check_fs(fs)?;
     let y = samples(&y);
     let params = ArmaParams {
         robust: robust_of(robust),
-        max_iter,
-        tol,
+        max_iterations,
+        tolerance,
         demean,
         ..ArmaParams::default()
     };
@@ -167,7 +201,7 @@ struct SweepOut {
 /// Order sweep of one signal (`vibmode sweep`): every order's fit and modes, split by the
 /// analysis' pole filters. Returns JSON.
 #[pyfunction]
-#[pyo3(signature = (y, fs, orders, model, method, robust, max_iter, tol))]
+#[pyo3(signature = (y, fs, orders, model, method, robust, max_iterations, tolerance))]
 #[allow(clippy::too_many_arguments)]
 fn sweep(
     py: Python<'_>,
@@ -177,8 +211,8 @@ fn sweep(
     model: &str,
     method: &str,
     robust: Option<f64>,
-    max_iter: usize,
-    tol: f64,
+    max_iterations: usize,
+    tolerance: f64,
 ) -> PyResult<String> {
     check_fs(fs)?;
     if orders.is_empty() || orders.contains(&0) {
@@ -189,8 +223,8 @@ fn sweep(
     let y = samples(&y);
     let params = ArmaParams {
         robust: robust_of(robust),
-        max_iter,
-        tol,
+        max_iterations,
+        tolerance,
         ..ArmaParams::default()
     };
     let fits: Vec<Result<ArmaModel, IdentError>> = match model {

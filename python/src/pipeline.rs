@@ -18,8 +18,25 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyze, m)?)?;
     m.add_function(wrap_pyfunction!(fullcar_modes, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(json_to_toml, m)?)?;
     Ok(())
+}
+
+/// The defaults of `simulate` (`SimParams::default()`, as `vibmode simulate`'s), as JSON with
+/// Python's argument names, so that Python copies no number.
+#[pyfunction]
+fn simulate_defaults() -> PyResult<String> {
+    let d = SimParams::default();
+    serde_json::to_string(&serde_json::json!({
+        "road": d.road.to_string(),
+        "speed_kmh": d.speed_kmh,
+        "duration_s": d.duration_s,
+        "records": d.records,
+        "fs": d.fs_hz,
+        "seed": d.seed,
+    }))
+    .map_err(json_err)
 }
 
 /// TOML text from JSON text (a Python dict given as settings); nulls are dropped.

@@ -106,6 +106,24 @@ def test_to_dict_round_trip(ar2_data):
     assert d["fs_hz"] == FS and d["model"]["p"] == 6
 
 
+def test_iteration_settings_have_one_name_and_defaults_from_rust(arma21_data):
+    """fit_arma and sweep name the iteration cap and tolerance alike; their defaults are read from
+    Rust (a single fit: 100 and 1e-5; each fit of the analysis sweep: 20 and 1e-4)."""
+    import inspect
+
+    fit = inspect.signature(vibmode.fit_arma).parameters
+    sw = inspect.signature(vibmode.sweep).parameters
+    native = json.loads(vibmode._native.ident_defaults())
+    for name in ("max_iterations", "tolerance", "robust"):
+        assert fit[name].default == native["fit_arma"][name]
+        assert sw[name].default == native["sweep"][name]
+    assert fit["max_iterations"].default > sw["max_iterations"].default
+    # Both are passed through under their one name: one iteration to a tolerance no step can
+    # reach cannot converge.
+    m = vibmode.fit_arma(arma21_data, FS, 2, 1, max_iterations=1, tolerance=1e-300)
+    assert m.iterations <= 1 and not m.converged
+
+
 def test_sweep_stabilises_on_the_mode(ar2_data):
     s = vibmode.sweep(ar2_data, FS, orders=range(2, 9), model="ar")
     modes = s.modes

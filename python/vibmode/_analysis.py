@@ -15,6 +15,9 @@ from ._tables import frames, has_pandas, require_pandas
 
 _BUILTIN_VEHICLES = ("city_bus", "city_bus_flexible", "passenger_car")
 
+# simulate()'s defaults, from the Rust definition (SimParams::default, as `vibmode simulate`'s).
+_SIM = json.loads(_native.simulate_defaults())
+
 
 def _deep_merge(base: Dict[str, Any], extra: Dict[str, Any]) -> Dict[str, Any]:
     out = dict(base)
@@ -192,12 +195,12 @@ class Simulation(NamedTuple):
 
 def simulate(
     vehicle: Any = "city_bus",
-    road: str = "B",
-    speed_kmh: float = 30.0,
-    duration_s: float = 10.24,
-    records: int = 8,
-    fs: float = 20000.0,
-    seed: int = 1,
+    road: str = _SIM["road"],
+    speed_kmh: float = _SIM["speed_kmh"],
+    duration_s: float = _SIM["duration_s"],
+    records: int = _SIM["records"],
+    fs: float = _SIM["fs"],
+    seed: int = _SIM["seed"],
     effects: str = "in-service",
     out_dir: Optional[Union[str, "os.PathLike[str]"]] = None,
     format: str = "wav",

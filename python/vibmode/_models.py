@@ -12,6 +12,12 @@ from . import _native
 from ._spectral import _check_fs
 from ._tables import columns
 
+# The defaults of fit_arma (a single fit) and sweep (the analysis sweep), from the Rust
+# definitions (vibmode_ident::ArmaParams, vibmode_core::SweepParams): no number is copied here.
+_DEFAULTS = json.loads(_native.ident_defaults())
+_FIT = _DEFAULTS["fit_arma"]
+_SWEEP = _DEFAULTS["sweep"]
+
 
 def _signal(y: Any) -> np.ndarray:
     a = np.asarray(y)
@@ -135,23 +141,27 @@ def fit_arma(
     fs: float,
     p: int,
     q: Optional[int] = None,
-    robust: Any = 1.6,
-    max_iter: int = 100,
-    tol: float = 1e-5,
-    demean: bool = True,
+    robust: Any = _FIT["robust"],
+    max_iterations: int = _FIT["max_iterations"],
+    tolerance: float = _FIT["tolerance"],
+    demean: bool = _FIT["demean"],
 ) -> ArmaModel:
     """ARMA(p, q) by prediction-error minimisation (Gauss-Newton, MATLAB ``armax``/``pem``'s
     method) of the signal ``y`` sampled at ``fs`` Hz.
 
     ``q`` defaults to ``p``. ``robust``: Huber factor of the robust criterion (default 1.6,
-    with additive-outlier cleaning first), or ``'off'``/``None`` for least squares. ``tol`` is
-    the relative stopping tolerance. Raises ValueError for bad orders or signals.
+    with additive-outlier cleaning first), or ``'off'``/``None`` for least squares.
+    ``max_iterations`` caps the Gauss-Newton iterations and ``tolerance`` is the relative
+    stopping tolerance (the defaults of a single fit, ``vibmode fit``'s: 100 and 1e-5; the
+    analysis sweep's are :func:`sweep`'s). Raises ValueError for bad orders or signals.
     """
     fs = _check_fs(fs)
     p = _order("p", p, 0)
     q = p if q is None else _order("q", q, 0)
-    tol = float(tol)
-    s = _native.fit_arma(_signal(y), fs, p, q, _robust(robust), _order("max_iter", max_iter, 1), tol, bool(demean))
+    s = _native.fit_arma(
+        _signal(y), fs, p, q, _robust(robust), _order("max_iterations", max_iterations, 1),
+        float(tolerance), bool(demean),
+    )
     return ArmaModel(json.loads(s))
 
 
@@ -188,12 +198,12 @@ class SweepResult:
 def sweep(
     y: Any,
     fs: float,
-    orders: Iterable[int] = range(2, 31),
+    orders: Iterable[int] = range(_SWEEP["order_min"], _SWEEP["order_max"] + 1),
     model: str = "arma",
     method: str = "burg",
-    robust: Any = 1.6,
-    max_iterations: int = 20,
-    tolerance: float = 1e-4,
+    robust: Any = _SWEEP["robust"],
+    max_iterations: int = _SWEEP["max_iterations"],
+    tolerance: float = _SWEEP["tolerance"],
     as_frame: Optional[bool] = None,
 ) -> SweepResult:
     """Fits every order of ``orders`` to ``y`` (sampled at ``fs`` Hz) and collects every mode:

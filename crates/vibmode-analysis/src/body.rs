@@ -252,13 +252,11 @@ impl BodyStage<'_> {
             .map(|(x, _)| x.recording.len() as f64 / p.fs_hz)
             .sum();
         let ssi = p.ssi_params();
-        let cluster = crate::pipeline::cluster_params_for(
-            &ClusterParams {
-                freq_max_hz: None,
-                ..self.cluster.clone()
-            },
-            &low[0].band,
-        );
+        let cluster = ClusterParams {
+            freq_max_hz: None,
+            ..self.cluster.clone()
+        }
+        .for_band(&low[0].band);
         let stage = SsiStage {
             pre: &low,
             active: self.active,

@@ -7,8 +7,8 @@ use vibmode_signal::preprocess;
 use vibmode_spectra::{PeriodogramParams, WelchParams, Window};
 
 use crate::results::AnalysisResults;
-use crate::source::RecordInput;
 use crate::AnalysisError;
+use vibmode_core::RecordInput;
 
 /// Number of points of the model-PSD grid, from Nyquist/N to Nyquist.
 pub const MODEL_GRID_POINTS: usize = 400;

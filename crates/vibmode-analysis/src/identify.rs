@@ -1,49 +1,11 @@
-//! Stage 3, identification: models fitted to each (record, channel) signal and their poles.
-//! Today the ARMA/AR order sweep per channel ([`SweepIdentifier`]); a multichannel method is a
-//! second implementation of [`Identifier`].
+//! Stage 3, identification: the ARMA/AR order sweep per channel ([`SweepIdentifier`]), an
+//! implementation of the [`Identifier`] contract of `vibmode-core`.
 
-use serde::{Deserialize, Serialize};
 use vibmode_core::{
-    BandLimit, FitSummary, ModelCoefficients, PoleFilterParams, SweepModel, SweepParams,
+    BandLimit, FitSummary, Identifier, ModelCoefficients, PoleFilterParams, PoleOut, SignalFits,
+    SweepModel, SweepParams,
 };
 use vibmode_ident::{ArMethod, ArmaModel, ArmaParams, IdentError};
-
-/// One pole pair of one fit that passed the pole filters.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct PoleOut {
-    /// Record index.
-    pub record: usize,
-    /// Model order p.
-    pub order: usize,
-    /// Natural frequency, Hz.
-    pub frequency_hz: f64,
-    /// Damping ratio.
-    pub damping_ratio: f64,
-}
-
-/// What identification found in one signal.
-#[derive(Clone, Debug, Default)]
-pub struct SignalFits {
-    /// Poles of every fit that passed the pole filters.
-    pub poles: Vec<PoleOut>,
-    /// Every fit's summary (failed fits keep their reason).
-    pub fits: Vec<FitSummary>,
-    /// Coefficients of the fits at the requested orders.
-    pub models: Vec<ModelCoefficients>,
-}
-
-/// An identification method for one signal of one record.
-pub trait Identifier: Sync {
-    /// Fits the signal `y` of record `record`, which carries the band `band`; keeps the
-    /// coefficients of the fits whose order is in `keep_orders`.
-    fn identify(
-        &self,
-        y: &[f64],
-        band: &BandLimit,
-        record: usize,
-        keep_orders: &[usize],
-    ) -> SignalFits;
-}
 
 /// The paper's method: an order sweep of ARMA(p,p) (or AR(p)) models, warm-started order to
 /// order, each fit's modes through the shared pole filters.
@@ -60,8 +22,8 @@ impl SweepIdentifier {
     pub fn arma_params(&self, band: &BandLimit) -> ArmaParams {
         ArmaParams {
             robust: self.sweep.robust,
-            max_iter: self.sweep.max_iterations,
-            tol: self.sweep.tolerance,
+            max_iterations: self.sweep.max_iterations,
+            tolerance: self.sweep.tolerance,
             band: Some(*band),
             ..ArmaParams::default()
         }

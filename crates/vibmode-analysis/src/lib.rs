@@ -6,9 +6,10 @@
 //! orders and records are then pooled per channel and per role (sprung / unsprung) and clustered
 //! into invariant modes (`vibmode-modal`), optionally matched to a physical model's modes.
 //!
-//! The analysis is a composition of named stages, each a public module: [`source`] (records),
-//! pre-processing (`vibmode_signal::preprocess`), [`identify`] (the [`Identifier`] trait and the
-//! order sweep), [`store`] (the pole store), [`stops`], clustering (`vibmode-modal`) and model
+//! The analysis is a composition of named stages, each a public module: records from a
+//! [`RecordSource`] (the contract in `vibmode-core`; [`stream`] analyses them as they arrive),
+//! pre-processing (`vibmode_signal::preprocess`), [`identify`] (the order sweep, an
+//! [`Identifier`]), [`store`] (the pole store), [`stops`], clustering (`vibmode-modal`) and model
 //! matching, composed by [`analyze`] in [`pipeline`]. Results are plain versioned serialisable
 //! structs ([`AnalysisResults`], [`SCHEMA_VERSION`]); figures and reports are drawn by
 //! `vibmode-report`, so this crate never depends on plotting.
@@ -31,7 +32,6 @@ pub mod lines;
 pub mod multichannel;
 pub mod pipeline;
 pub mod results;
-pub mod source;
 pub mod stops;
 pub mod store;
 pub mod stream;
@@ -39,23 +39,29 @@ pub mod stream;
 pub use body::{BodySsi, RecordDelay};
 pub use config::{AnalysisConfig, ChannelRole, ConfigText, Preset, ReportParams};
 pub use first_record::{first_record_spectra, FirstRecordSpectra, ModelPsd};
-pub use identify::{Identifier, PoleOut, SignalFits, SweepIdentifier};
+pub use identify::SweepIdentifier;
 pub use lines::{LineSweep, LineTrack};
-pub use multichannel::{ShapedPole, SsiAnalysis, MATCH_MAC_MIN};
+pub use multichannel::{ShapedPole, SsiAnalysis};
 pub use pipeline::{
-    analyze, analyze_prepared, analyze_with, check_records, cluster_params_for, preprocess_records,
-    RecordFacts,
+    analyze, analyze_prepared, analyze_with, check_records, preprocess_records, RecordFacts,
 };
 pub use results::{
     AnalysisResults, ChannelAnalysis, RecordSummary, RoleAnalysis, Timing, SCHEMA_VERSION,
 };
-pub use source::{cut_records, CutRecords, RecordInput, RecordSource};
 pub use store::PoleStore;
-pub use stream::{analyze_source, ChainedRecords, RecordWindow, StreamRecords};
+pub use stream::analyze_source;
+// The contracts of stages 1 and 3 live in vibmode-core (the streamed sources in
+// vibmode-signal); re-exported here so that users of the analysis need one import path.
+pub use vibmode_core::{
+    cut_records, CutRecords, Identifier, PoleOut, RecordInput, RecordSource, RecordWindow,
+    SignalFits,
+};
 pub use vibmode_core::{
     ClusterParams, Corner, FitSummary, ModelCoefficients, Placement, PoleFilterParams,
     PreprocessParams, Robust, Role, SpectrumParams, StopParams, SweepModel, SweepParams,
 };
+pub use vibmode_modal::{MATCH_MAC_MIN, MATCH_MAX_FREQ_DIFF_REL};
+pub use vibmode_signal::{ChainedRecords, StreamRecords};
 
 /// A number for a message: at most 9 significant digits, no trailing zeros (100.00000000000001
 /// -> "100").
@@ -140,18 +146,6 @@ pub enum AnalysisError {
         needed: usize,
         /// Duration needed, s.
         needed_s: f64,
-    },
-    /// A record window (segmentation) that reaches past the end of the recording.
-    #[error("record '{record}' (frames {start_frame}.. +{n_frames}) reaches past the end of the recording ({file_frames} frames); the segmentation does not fit this file")]
-    WindowOutside {
-        /// The record.
-        record: String,
-        /// Its first frame.
-        start_frame: u64,
-        /// Its length in frames.
-        n_frames: usize,
-        /// Frames in the file.
-        file_frames: u64,
     },
     /// A recording breaks its invariants.
     #[error(transparent)]

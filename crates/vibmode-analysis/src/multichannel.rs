@@ -9,15 +9,12 @@ use vibmode_core::{
     ClusterParams, InvariantMode, ModeMatch, ModeUncertainty, PoleObservation, ReferenceMode,
     SsiParams,
 };
+use vibmode_modal::{MATCH_MAC_MIN, MATCH_MAX_FREQ_DIFF_REL};
 use vibmode_signal::Preprocessed;
-use vibmode_ssi::{SsiCorrelations, SsiCov};
+use vibmode_ssi::{SsiCorrelations, SsiCov, SsiError};
 
 use crate::lines::{LineStage, LineTrack};
 use crate::AnalysisError;
-
-/// A physical-model mode is matched to an identified mode whose shape has at least this MAC with
-/// the model's shape at the sensors (and whose frequency is within 25 %).
-pub const MATCH_MAC_MIN: f64 = 0.5;
 
 /// Most groups of the jackknife over records (each group one more identification).
 pub const JACKKNIFE_GROUPS: usize = 20;
@@ -63,7 +60,8 @@ pub struct SsiAnalysis {
     pub matches: Vec<ModeMatch>,
     /// Periodic lines of all the channels, tracked over the records.
     pub lines: Vec<LineTrack>,
-    /// Records whose identification failed, with the reason.
+    /// Records whose identification failed, with the message of their `vibmode_ssi::SsiError`
+    /// (kept as text: it is what `results.json` reports).
     pub failed_records: Vec<(usize, String)>,
 }
 
@@ -119,7 +117,7 @@ impl SsiStage<'_> {
 
     /// The correlations of the records used (each channel divided by its scale), kept per
     /// record for the jackknife, and the first record's band; `None` when no record is used.
-    fn pooled(&self, scales: &[f64]) -> Result<Option<Pooled>, String> {
+    fn pooled(&self, scales: &[f64]) -> Result<Option<Pooled>, SsiError> {
         let lag_of = |r: usize| self.first_lags.map(|l| l.get(r).copied().flatten());
         let (used, lags): (Vec<&Preprocessed>, Vec<Option<usize>>) = self
             .pre
@@ -152,8 +150,7 @@ impl SsiStage<'_> {
             SsiCorrelations::with_first_lags(&segments, first.band.fs_hz, self.params, &lags)
         } else {
             SsiCorrelations::new(&segments, first.band.fs_hz, self.params)
-        }
-        .map_err(|e| e.to_string())?;
+        }?;
         Ok(Some(Pooled {
             correlations,
             band: first.band,
@@ -167,9 +164,9 @@ impl SsiStage<'_> {
         pooled: &Pooled,
         orders: &[usize],
         scales: &[f64],
-    ) -> Result<Vec<ShapedPole>, String> {
-        let plan = pooled.correlations.plan().map_err(|e| e.to_string())?;
-        let res = plan.sweep(orders).map_err(|e| e.to_string())?;
+    ) -> Result<Vec<ShapedPole>, SsiError> {
+        let plan = pooled.correlations.plan()?;
+        let res = plan.sweep(orders)?;
         Ok(self.kept(res, 0, &pooled.band, scales))
     }
 
@@ -276,7 +273,7 @@ impl SsiStage<'_> {
         r: usize,
         orders: &[usize],
         scales: &[f64],
-    ) -> Result<Vec<ShapedPole>, String> {
+    ) -> Result<Vec<ShapedPole>, SsiError> {
         let p = &self.pre[r];
         let scaled: Vec<Vec<f64>> = p
             .recording
@@ -286,8 +283,8 @@ impl SsiStage<'_> {
             .map(|(c, s)| c.samples.iter().map(|v| v / s).collect())
             .collect();
         let chans: Vec<&[f64]> = scaled.iter().map(Vec::as_slice).collect();
-        let plan = SsiCov::new(&chans, p.band.fs_hz, self.params).map_err(|e| e.to_string())?;
-        let res = plan.sweep(orders).map_err(|e| e.to_string())?;
+        let plan = SsiCov::new(&chans, p.band.fs_hz, self.params)?;
+        let res = plan.sweep(orders)?;
         Ok(self.kept(res, r, &p.band, scales))
     }
 
@@ -318,7 +315,7 @@ impl SsiStage<'_> {
         } else {
             None
         };
-        let per: Vec<Result<Vec<ShapedPole>, String>> = if let Some(p) = &correlations {
+        let per: Vec<Result<Vec<ShapedPole>, SsiError>> = if let Some(p) = &correlations {
             vec![match p {
                 Ok(Some(p)) => self.pooled_poles(p, &orders, &scales),
                 Ok(None) => Ok(Vec::new()),
@@ -335,7 +332,8 @@ impl SsiStage<'_> {
         for (r, out) in per.into_iter().enumerate() {
             match out {
                 Ok(p) => poles.extend(p),
-                Err(e) => failed_records.push((r, e)),
+                // results.json keeps the failure's one-line message.
+                Err(e) => failed_records.push((r, e.to_string())),
             }
         }
         let pooled = self.params.pool_records;
@@ -384,7 +382,7 @@ impl SsiStage<'_> {
                 &invariant_modes,
                 reference,
                 &channels,
-                crate::pipeline::MATCH_MAX_FREQ_DIFF_REL,
+                MATCH_MAX_FREQ_DIFF_REL,
                 MATCH_MAC_MIN,
             )
         };

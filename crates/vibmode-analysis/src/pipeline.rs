@@ -5,19 +5,18 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
-use vibmode_core::{BandLimit, ClusterParams, ReferenceMode, Role};
-use vibmode_modal::InvariantMode;
+use vibmode_core::{ClusterParams, Identifier, RecordInput, ReferenceMode, Role, SignalFits};
+use vibmode_modal::{InvariantMode, MATCH_MAC_MIN, MATCH_MAX_FREQ_DIFF_REL};
 use vibmode_signal::{preprocess, Preprocessed};
 use vibmode_spectra::{WelchParams, Window};
 
 use crate::config::AnalysisConfig;
-use crate::identify::{Identifier, SignalFits, SweepIdentifier};
+use crate::identify::SweepIdentifier;
 use crate::lines::LineStage;
 use crate::multichannel::SsiStage;
 use crate::results::{
     AnalysisResults, ChannelAnalysis, RecordSummary, RoleAnalysis, Timing, SCHEMA_VERSION,
 };
-use crate::source::RecordInput;
 use crate::stops::{activity_ratios, band_rms, detect_stops};
 use crate::store::PoleStore;
 use crate::AnalysisError;
@@ -114,15 +113,6 @@ pub fn preprocess_records(
         .collect()
 }
 
-/// The clustering settings for signals of band `band`: an unset `freq_max_hz` becomes the
-/// band's valid maximum.
-pub fn cluster_params_for(cfg: &ClusterParams, band: &BandLimit) -> ClusterParams {
-    ClusterParams {
-        freq_max_hz: Some(cfg.freq_max_hz.unwrap_or_else(|| band.valid_max_hz())),
-        ..cfg.clone()
-    }
-}
-
 /// Runs the analysis. `progress(done, total)` is called after each (record, channel) task.
 ///
 /// All records must have the same channel names and sampling rate.
@@ -209,7 +199,7 @@ pub fn analyze_prepared(
     }
     let active = renumber_active(&stationary);
     let n_active = active.iter().flatten().count();
-    let cluster = cluster_params_for(&cfg.cluster, &pre[0].band);
+    let cluster = cfg.cluster.for_band(&pre[0].band);
     let orders = cfg.orders();
     let support = Support {
         active: &active,
@@ -541,7 +531,7 @@ fn role_modes(
                 reference,
                 &names,
                 MATCH_MAX_FREQ_DIFF_REL,
-                crate::multichannel::MATCH_MAC_MIN,
+                MATCH_MAC_MIN,
             )
         };
         roles.push(RoleAnalysis {
@@ -554,7 +544,3 @@ fn role_modes(
     }
     Ok(roles)
 }
-
-/// A physical-model mode is matched to a structural mode within this relative
-/// frequency difference (25 %: body modes of a bus sit 15-25 % apart, wheel hop near 10 Hz).
-pub const MATCH_MAX_FREQ_DIFF_REL: f64 = 0.25;

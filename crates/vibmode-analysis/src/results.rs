@@ -9,9 +9,9 @@ use vibmode_core::{
 };
 
 use crate::config::AnalysisConfig;
-use crate::identify::PoleOut;
 use crate::lines::LineTrack;
 use crate::multichannel::SsiAnalysis;
+use vibmode_core::PoleOut;
 
 /// Version of the layout of [`AnalysisResults`] (`schema_version` in `results.json`). 2: stage
 /// sections in `config`, per-record bands, fit errors kept, model coefficients instead of model

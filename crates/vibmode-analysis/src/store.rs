@@ -3,7 +3,7 @@
 
 use vibmode_core::{PoleObservation, Role};
 
-use crate::identify::PoleOut;
+use vibmode_core::PoleOut;
 
 /// Every pole that passed the filters, per channel.
 #[derive(Clone, Debug, Default)]

@@ -1,359 +1,36 @@
-//! Stage 1 for recordings of any length: records cut from a [`FrameStream`] as it is read
-//! ([`StreamRecords`]), and an analysis that pre-processes each record as it arrives and keeps
-//! only the record at the analysis rate ([`analyze_source`]): memory is bounded by a few records
-//! at the original rate plus the whole recording at the analysis rate (1 h of 7 channels at
-//! 50 Hz: 10 MB).
+//! Stage 1 for recordings of any length: records from a [`RecordSource`] (files streamed by
+//! `vibmode_signal::StreamRecords`), and an analysis that pre-processes each record as it
+//! arrives and keeps only the record at the analysis rate ([`analyze_source`]): memory is bounded
+//! by a few records at the original rate plus the whole recording at the analysis rate (1 h of 7
+//! channels at 50 Hz: 10 MB).
 
 use rayon::prelude::*;
-use std::collections::VecDeque;
 use std::time::Instant;
 
-use vibmode_core::{Channel, RecordMeta, Recording, ReferenceMode};
-use vibmode_signal::{preprocess, FrameStream, Preprocessed, DEFAULT_BLOCK_FRAMES};
+use vibmode_core::{Identifier, RecordInput, RecordMeta, RecordSource, ReferenceMode};
+use vibmode_signal::{preprocess, Preprocessed};
 
 use crate::config::AnalysisConfig;
-use crate::identify::Identifier;
 use crate::pipeline::{analyze_prepared, check_same_layout, RecordFacts};
 use crate::results::AnalysisResults;
-use crate::source::{RecordInput, RecordSource};
 use crate::AnalysisError;
-
-/// One record to cut from a stream: `n_frames` frames from `start_frame`, with what is known of
-/// it (e.g. from a GPS track).
-#[derive(Clone, Debug, PartialEq)]
-pub struct RecordWindow {
-    /// First frame (0-based, in the file).
-    pub start_frame: u64,
-    /// Number of frames.
-    pub n_frames: usize,
-    /// Start, speed, position.
-    pub meta: RecordMeta,
-}
-
-#[derive(Debug)]
-enum Plan {
-    /// Consecutive records of `n_per` frames (as [`crate::CutRecords`]).
-    Cut {
-        n_per: usize,
-        k: u64,
-        single: Option<bool>,
-        done: bool,
-    },
-    /// Given windows, in increasing `start_frame`.
-    Windows(VecDeque<RecordWindow>),
-}
-
-/// Records read from a stream one by one: consecutive records of a fixed length (the remainder
-/// shorter than one record is dropped; a recording shorter than two records is one record, as
-/// [`crate::CutRecords`]), or given windows (segmentation). Only the frames of the record being
-/// cut (and one read block) are held.
-#[derive(Debug)]
-pub struct StreamRecords {
-    name: String,
-    stream: FrameStream,
-    /// Frames from `buf_start` on, channel by channel.
-    buf: Vec<Vec<f64>>,
-    buf_start: u64,
-    eof: bool,
-    plan: Plan,
-    last_meta: Option<RecordMeta>,
-}
-
-impl StreamRecords {
-    /// Consecutive records of `record_length_s` seconds, named `"{name} [t0-t1 s]"`.
-    pub fn cut(name: &str, stream: FrameStream, record_length_s: f64) -> Self {
-        let n_per = (record_length_s * stream.info().fs_hz).round().max(1.0) as usize;
-        Self::new(
-            name,
-            stream,
-            Plan::Cut {
-                n_per,
-                k: 0,
-                single: None,
-                done: false,
-            },
-        )
-    }
-
-    /// The records given by `windows` (sorted by start here), named `"{name} [t0-t1 s]"`. A window
-    /// reaching past the end of the file is an error when it is reached.
-    pub fn windows(name: &str, stream: FrameStream, mut windows: Vec<RecordWindow>) -> Self {
-        windows.sort_by_key(|w| w.start_frame);
-        Self::new(name, stream, Plan::Windows(windows.into()))
-    }
-
-    fn new(name: &str, stream: FrameStream, plan: Plan) -> Self {
-        let nch = stream.info().n_channels();
-        StreamRecords {
-            name: name.to_string(),
-            stream,
-            buf: vec![Vec::new(); nch],
-            buf_start: 0,
-            eof: false,
-            plan,
-            last_meta: None,
-        }
-    }
-
-    /// The stream's description.
-    pub fn info(&self) -> &vibmode_signal::StreamInfo {
-        self.stream.info()
-    }
-
-    fn buf_end(&self) -> u64 {
-        self.buf_start + self.buf.first().map_or(0, Vec::len) as u64
-    }
-
-    /// Reads blocks until the buffer reaches frame `end` (exclusive) or the file ends.
-    fn fill_to(&mut self, end: u64) -> Result<(), AnalysisError> {
-        while !self.eof && self.buf_end() < end {
-            match self.stream.next_block(DEFAULT_BLOCK_FRAMES)? {
-                Some(b) => {
-                    for (d, c) in self.buf.iter_mut().zip(b.channels) {
-                        d.extend_from_slice(&c);
-                    }
-                }
-                None => self.eof = true,
-            }
-        }
-        Ok(())
-    }
-
-    /// Drops buffered frames before `frame`.
-    fn drop_before(&mut self, frame: u64) {
-        let n = frame.saturating_sub(self.buf_start) as usize;
-        let n = n.min(self.buf.first().map_or(0, Vec::len));
-        if n > 0 {
-            for d in &mut self.buf {
-                d.drain(..n);
-            }
-            self.buf_start += n as u64;
-        }
-    }
-
-    /// Frames `start..start + n` as a recording (they must be buffered).
-    fn slice(&self, start: u64, n: usize) -> Recording {
-        let info = self.stream.info();
-        let a = (start - self.buf_start) as usize;
-        Recording {
-            fs_hz: info.fs_hz,
-            channels: info
-                .names
-                .iter()
-                .zip(&info.units)
-                .zip(&self.buf)
-                .map(|((name, unit), d)| {
-                    Channel::new(name.clone(), unit.clone(), d[a..a + n].to_vec())
-                })
-                .collect(),
-            time_axis: None,
-        }
-    }
-
-    fn range_name(&self, start: u64, n: usize) -> String {
-        let fs = self.stream.info().fs_hz;
-        format!(
-            "{} [{:.2}-{:.2} s]",
-            self.name,
-            start as f64 / fs,
-            (start + n as u64) as f64 / fs
-        )
-    }
-
-    fn next_cut(&mut self) -> Result<Option<RecordInput>, AnalysisError> {
-        let Plan::Cut {
-            n_per,
-            k,
-            single,
-            done,
-        } = self.plan
-        else {
-            return Ok(None);
-        };
-        if done {
-            return Ok(None);
-        }
-        let n_per64 = n_per as u64;
-        let single = match single {
-            Some(s) => s,
-            None => {
-                self.fill_to(2 * n_per64)?;
-                self.eof && self.buf_end() < 2 * n_per64
-            }
-        };
-        if single {
-            self.plan = Plan::Cut {
-                n_per,
-                k,
-                single: Some(true),
-                done: true,
-            };
-            let n = self.buf.first().map_or(0, Vec::len);
-            if n == 0 {
-                return Ok(None);
-            }
-            self.last_meta = None;
-            return Ok(Some(RecordInput {
-                name: self.name.clone(),
-                recording: self.slice(0, n),
-            }));
-        }
-        let start = k * n_per64;
-        self.fill_to(start + n_per64)?;
-        if self.buf_end() < start + n_per64 {
-            self.plan = Plan::Cut {
-                n_per,
-                k,
-                single: Some(false),
-                done: true,
-            };
-            return Ok(None);
-        }
-        let rec = self.slice(start, n_per);
-        let name = self.range_name(start, n_per);
-        self.drop_before(start + n_per64);
-        self.plan = Plan::Cut {
-            n_per,
-            k: k + 1,
-            single: Some(false),
-            done: false,
-        };
-        let fs = self.stream.info().fs_hz;
-        self.last_meta = Some(RecordMeta {
-            start_s: start as f64 / fs,
-            duration_s: n_per as f64 / fs,
-            ..RecordMeta::default()
-        });
-        Ok(Some(RecordInput {
-            name,
-            recording: rec,
-        }))
-    }
-
-    fn next_window(&mut self) -> Result<Option<RecordInput>, AnalysisError> {
-        let w = match &mut self.plan {
-            Plan::Windows(list) => match list.pop_front() {
-                Some(w) => w,
-                None => return Ok(None),
-            },
-            Plan::Cut { .. } => return Ok(None),
-        };
-        self.drop_before(w.start_frame);
-        let end = w.start_frame + w.n_frames as u64;
-        self.fill_to(end)?;
-        if self.buf_end() < end || w.start_frame < self.buf_start {
-            return Err(AnalysisError::WindowOutside {
-                record: self.range_name(w.start_frame, w.n_frames),
-                start_frame: w.start_frame,
-                n_frames: w.n_frames,
-                file_frames: self.buf_end(),
-            });
-        }
-        let rec = self.slice(w.start_frame, w.n_frames);
-        let name = self.range_name(w.start_frame, w.n_frames);
-        self.last_meta = Some(w.meta);
-        Ok(Some(RecordInput {
-            name,
-            recording: rec,
-        }))
-    }
-}
-
-impl RecordSource for StreamRecords {
-    fn next_record(&mut self) -> Option<Result<RecordInput, AnalysisError>> {
-        let r = match self.plan {
-            Plan::Cut { .. } => self.next_cut(),
-            Plan::Windows(_) => self.next_window(),
-        };
-        r.transpose()
-    }
-
-    fn meta(&self) -> Option<RecordMeta> {
-        self.last_meta.clone()
-    }
-}
-
-/// The records of several files one file after the other, each file opened only when the one
-/// before is used up: `open(i)` makes the source of file `i` (0..n).
-pub struct ChainedRecords<F>
-where
-    F: FnMut(usize) -> Result<StreamRecords, AnalysisError>,
-{
-    n: usize,
-    next: usize,
-    open: F,
-    current: Option<StreamRecords>,
-}
-
-impl<F> std::fmt::Debug for ChainedRecords<F>
-where
-    F: FnMut(usize) -> Result<StreamRecords, AnalysisError>,
-{
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("ChainedRecords")
-            .field("n", &self.n)
-            .field("next", &self.next)
-            .finish()
-    }
-}
-
-impl<F> ChainedRecords<F>
-where
-    F: FnMut(usize) -> Result<StreamRecords, AnalysisError>,
-{
-    /// The records of `n` sources made by `open`.
-    pub fn new(n: usize, open: F) -> Self {
-        ChainedRecords {
-            n,
-            next: 0,
-            open,
-            current: None,
-        }
-    }
-}
-
-impl<F> RecordSource for ChainedRecords<F>
-where
-    F: FnMut(usize) -> Result<StreamRecords, AnalysisError>,
-{
-    fn next_record(&mut self) -> Option<Result<RecordInput, AnalysisError>> {
-        loop {
-            if let Some(cur) = &mut self.current {
-                match cur.next_record() {
-                    Some(r) => return Some(r),
-                    None => self.current = None,
-                }
-            }
-            if self.next >= self.n {
-                return None;
-            }
-            let i = self.next;
-            self.next += 1;
-            match (self.open)(i) {
-                Ok(s) => self.current = Some(s),
-                Err(e) => return Some(Err(e)),
-            }
-        }
-    }
-
-    fn meta(&self) -> Option<RecordMeta> {
-        self.current.as_ref().and_then(|c| c.meta())
-    }
-}
 
 /// The analysis of every record of `sources`, pre-processing each record (stage 2, the ideal DFT
 /// filter per record) as it arrives, a few records at a time in parallel, and keeping only the
 /// records at the analysis rate and the first record at its original rate (for the report's
 /// figures). `on_record(n)` is called after `n` records have been pre-processed; `progress` as in
 /// [`crate::analyze`]. Returns the results and the first record.
-pub fn analyze_source(
-    source: &mut dyn RecordSource,
+pub fn analyze_source<E>(
+    source: &mut dyn RecordSource<Error = E>,
     cfg: &AnalysisConfig,
     identifier: &dyn Identifier,
     reference: &[ReferenceMode],
     on_record: &dyn Fn(usize),
     progress: &(dyn Fn(usize, usize) + Sync),
-) -> Result<(AnalysisResults, RecordInput), AnalysisError> {
+) -> Result<(AnalysisResults, RecordInput), AnalysisError>
+where
+    AnalysisError: From<E>,
+{
     let t0 = Instant::now();
     cfg.validate()?;
     let batch_len = rayon::current_num_threads().max(1);
@@ -382,9 +59,9 @@ pub fn analyze_source(
             let done: Vec<Preprocessed> = batch
                 .par_iter()
                 .map(|(r, _)| {
-                    preprocess(&r.recording, &cfg.preprocess).map_err(AnalysisError::from)
+                    preprocess(&r.recording, &cfg.preprocess).map_err(AnalysisError::Signal)
                 })
-                .collect::<Result<_, _>>()?;
+                .collect::<Result<_, AnalysisError>>()?;
             pre.extend(done);
             for (r, meta) in batch {
                 let mut f = RecordFacts::of(&r);

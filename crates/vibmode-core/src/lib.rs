@@ -21,16 +21,19 @@
 
 pub mod error;
 pub mod files;
+pub mod identify;
 pub mod limits;
 pub mod modes;
 pub mod params;
 pub mod placement;
 pub mod record_meta;
 pub mod recording;
+pub mod source;
 pub mod ssi;
 pub mod stats;
 
 pub use error::{ParamError, RecordingError};
+pub use identify::{Identifier, PoleOut, SignalFits};
 pub use limits::{cap_message, num, quoted, Num, Quoted};
 pub use modes::{
     FitSummary, InvariantMode, ModeClass, ModeMatch, ModeUncertainty, ModelCoefficients,
@@ -40,10 +43,12 @@ pub use params::{
     BandLimit, BodyFitParams, BodySsiParams, ClusterParams, IdentMethod, LineParams,
     PoleFilterParams, PreprocessParams, Robust, SpectrumParams, StopParams, SweepModel,
     SweepParams, DEFAULT_HUBER_FACTOR, EDGE_SHARE, EMPTY_BAND_MAX_CUTOFF_SHARE,
+    SWEEP_MAX_ITERATIONS, SWEEP_TOLERANCE,
 };
 pub use placement::{Corner, Direction, Placement, Role};
 pub use record_meta::RecordMeta;
 pub use recording::{
     check_finite, check_fs, Channel, ChannelSelector, Recording, RecordingView, TimeAxis,
 };
-pub use ssi::{SsiParams, StabilityParams};
+pub use source::{cut_records, CutRecords, RecordInput, RecordSource, RecordWindow};
+pub use ssi::{SsiParams, Stability, StabilityParams};

@@ -344,13 +344,22 @@ pub struct SweepParams {
     pub order_max: usize,
     /// Criterion (default Huber with factor 1.6).
     pub robust: Robust,
-    /// Iteration cap of each prediction-error fit of the sweep (default 20, MATLAB's
-    /// `MaxIterations`). A fit that reaches it is kept (`converged: false`).
+    /// Iteration cap of each prediction-error fit of the sweep (default
+    /// [`SWEEP_MAX_ITERATIONS`]). A fit that reaches it is kept (`converged: false`).
     pub max_iterations: usize,
     /// Stopping tolerance of each fit: relative predicted improvement of the next Gauss-Newton
-    /// step below which the search stops (default 1e-4, MATLAB's `Tolerance` of 0.01 %).
+    /// step below which the search stops (default [`SWEEP_TOLERANCE`]).
     pub tolerance: f64,
 }
+
+/// Default [`SweepParams::max_iterations`]: 20, MATLAB's `MaxIterations`. The sweep's fits are
+/// many and warm-started from the order below, so they are capped sooner than a single fit from
+/// its cold start (`vibmode_ident::FIT_MAX_ITERATIONS`, 100, `vibmode fit`).
+pub const SWEEP_MAX_ITERATIONS: usize = 20;
+
+/// Default [`SweepParams::tolerance`]: 1e-4, MATLAB's `Tolerance` of 0.01 % (a single fit:
+/// `vibmode_ident::FIT_TOLERANCE`, 1e-5).
+pub const SWEEP_TOLERANCE: f64 = 1e-4;
 
 impl Default for SweepParams {
     fn default() -> Self {
@@ -359,8 +368,8 @@ impl Default for SweepParams {
             order_min: 2,
             order_max: 30,
             robust: Robust::default(),
-            max_iterations: 20,
-            tolerance: 1e-4,
+            max_iterations: SWEEP_MAX_ITERATIONS,
+            tolerance: SWEEP_TOLERANCE,
         }
     }
 }
@@ -612,6 +621,15 @@ impl Default for ClusterParams {
 }
 
 impl ClusterParams {
+    /// These settings for signals of band `band`: an unset `freq_max_hz` becomes the band's valid
+    /// maximum.
+    pub fn for_band(&self, band: &BandLimit) -> ClusterParams {
+        ClusterParams {
+            freq_max_hz: Some(self.freq_max_hz.unwrap_or_else(|| band.valid_max_hz())),
+            ..self.clone()
+        }
+    }
+
     /// Check every field; returns the first invalid one.
     pub fn validate(&self) -> Result<(), ParamError> {
         let d = ClusterParams::default();

@@ -162,9 +162,73 @@ impl SsiParams {
     }
 }
 
+/// How a mode at one order relates to the modes of the previous identified order (the symbols of
+/// a stabilisation diagram). Each label implies the ones before it. One enum for the
+/// single-channel poles of an order sweep (`vibmode_modal::stabilisation`) and the shaped modes
+/// of SSI-cov (`vibmode_ssi::stabilisation`); a pole without a shape is [`Stability::Stable`] once
+/// its frequency and damping match.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stability {
+    /// No mode of the previous order within the frequency tolerance (always at the first order).
+    /// Plot symbol `o`.
+    New,
+    /// A mode of the previous order within the frequency tolerance, none also within the damping
+    /// tolerance. Plot symbol `f`.
+    Frequency,
+    /// A mode of the previous order within the frequency and damping tolerances, none also
+    /// within the MAC limit (both shapes known). Plot symbol `d`.
+    FrequencyDamping,
+    /// A mode of the previous order within every tolerance that applies: frequency, damping and,
+    /// when both have shapes, MAC. Plot symbol `s`.
+    Stable,
+}
+
+impl Stability {
+    /// The one-letter plot symbol: `o`, `f`, `d` or `s`.
+    pub fn symbol(&self) -> char {
+        match self {
+            Stability::New => 'o',
+            Stability::Frequency => 'f',
+            Stability::FrequencyDamping => 'd',
+            Stability::Stable => 's',
+        }
+    }
+}
+
+impl std::fmt::Display for Stability {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Stability::New => "new",
+            Stability::Frequency => "frequency",
+            Stability::FrequencyDamping => "frequency_damping",
+            Stability::Stable => "stable",
+        })
+    }
+}
+
+impl std::str::FromStr for Stability {
+    type Err = ParamError;
+    /// Case-insensitive names (`new`, `frequency`, `frequency_damping`, `stable`; `-` for `_`)
+    /// or symbols (`o`, `f`, `d`, `s`).
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().replace('-', "_").as_str() {
+            "new" | "o" => Ok(Stability::New),
+            "frequency" | "f" => Ok(Stability::Frequency),
+            "frequency_damping" | "d" => Ok(Stability::FrequencyDamping),
+            "stable" | "s" => Ok(Stability::Stable),
+            _ => Err(ParamError::UnknownName {
+                what: "stability",
+                value: s.to_string(),
+                valid: "new (o), frequency (f), frequency_damping (d), stable (s)",
+            }),
+        }
+    }
+}
+
 /// Stabilisation criteria between the modes of consecutive identified orders (a stabilisation
 /// diagram): a mode is *stable* when a mode of the previous order lies within all three
-/// tolerances.
+/// tolerances (the MAC only where both modes have shapes).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct StabilityParams {

@@ -1,5 +1,6 @@
 //! The one median every layer uses (spectra, identification, clustering, lines, segmentation,
-//! fleet): mean of the two middle values for an even count, NaN for no value.
+//! fleet): mean of the two middle values for an even count, NaN for no value; and the high
+//! median (the larger middle value) where the level must be an observed value.
 //!
 //! Values are ordered by [`f64::total_cmp`]; callers pass NaN-free values (every input is checked
 //! to be finite where it is read) or filter them first.
@@ -26,6 +27,18 @@ pub fn median(values: &[f64]) -> f64 {
     median_in_place(&mut values.to_vec())
 }
 
+/// The high median of `v` (Python's `statistics.median_high`): the middle value for an odd
+/// count, the larger of the two middle values for an even count, always one of the values.
+/// Reorders `v` in place (O(n)). NaN when `v` is empty. For a level that must be one of the
+/// observed values (a peak's surrounding level, a noise density).
+pub fn median_high_in_place(v: &mut [f64]) -> f64 {
+    let n = v.len();
+    if n == 0 {
+        return f64::NAN;
+    }
+    *v.select_nth_unstable_by(n / 2, f64::total_cmp).1
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -37,6 +50,9 @@ mod tests {
         assert_eq!(median(&[-1.0]), -1.0);
         assert_eq!(median(&[5.0, 5.0, 1.0, 9.0]), 5.0);
         assert!(median(&[]).is_nan());
+        assert_eq!(median_high_in_place(&mut [4.0, 1.0, 2.0, 3.0]), 3.0);
+        assert_eq!(median_high_in_place(&mut [3.0, 1.0, 2.0]), 2.0);
+        assert!(median_high_in_place(&mut []).is_nan());
     }
 
     /// Against the definition (sort, take the middle) on seeded random inputs of every length
@@ -62,6 +78,7 @@ mod tests {
                     (s[n / 2 - 1] + s[n / 2]) / 2.0
                 };
                 assert_eq!(median(&v), want, "{v:?}");
+                assert_eq!(median_high_in_place(&mut v.clone()), s[n / 2], "{v:?}");
             }
         }
     }

@@ -101,7 +101,7 @@ pub fn max_arma_order(n: usize) -> usize {
 ///
 /// Starts from the best (by the residuals' robust scale, or mean square when `Robust::Off`) of a
 /// Hannan-Rissanen estimate and a Burg AR(p) model, then runs damped Gauss-Newton. A fit that hits
-/// `max_iter` is returned with `converged: false`. `q = 0` is allowed (robust AR by prediction
+/// `max_iterations` is returned with `converged: false`. `q = 0` is allowed (robust AR by prediction
 /// error); `p = 0` is an error (no poles, no modes). With `Robust::Huber` and the default
 /// `outlier_cleaning`, additive spikes are first replaced by [`crate::clean_additive_outliers`]
 /// (count in `ArmaModel::outliers_replaced`).
@@ -940,14 +940,14 @@ fn gauss_newton(
     let mut trial_eps = vec![0.0; n];
     // Loss history for the stall rule.
     let mut history: Vec<f64> = vec![v];
-    while iterations < params.max_iter {
+    while iterations < params.max_iterations {
         let (g, h, _) = search.normal_equations(&c, &eps);
         let neg_g: Vec<f64> = g.iter().map(|v| -v).collect();
         let Some((d0, pred)) = newton_decrement(&h, &neg_g, n_eff) else {
             stop = StopReason::NoImprovement;
             break;
         };
-        if pred.is_nan() || pred <= params.tol * v {
+        if pred.is_nan() || pred <= params.tolerance * v {
             stop = StopReason::Converged;
             converged = true;
             break;
@@ -963,7 +963,7 @@ fn gauss_newton(
         let Some(t) = accepted else {
             // No step lowers V.
             stop = StopReason::NoImprovement;
-            converged = converged_without_step(pred, pred_gradient, v, &c, params.tol);
+            converged = converged_without_step(pred, pred_gradient, v, &c, params.tolerance);
             break;
         };
         a = t.a;
@@ -972,7 +972,7 @@ fn gauss_newton(
         std::mem::swap(&mut eps, &mut trial_eps);
         history.push(v);
         if history.len() > STALL_WINDOW
-            && history[history.len() - 1 - STALL_WINDOW] - v < params.tol * v
+            && history[history.len() - 1 - STALL_WINDOW] - v < params.tolerance * v
         {
             stop = StopReason::Stalled;
             converged = true;

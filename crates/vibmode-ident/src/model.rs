@@ -30,7 +30,7 @@ pub enum StopReason {
     Stalled,
     /// No trial step (Gauss-Newton with halvings, then gradient) lowered the loss.
     NoImprovement,
-    /// `max_iter` reached.
+    /// `max_iterations` reached.
     MaxIterations,
 }
 

@@ -18,12 +18,18 @@ pub use vibmode_core::Robust;
 pub struct ArmaParams {
     /// Criterion. Default `Robust::Huber { factor: 1.6 }`.
     pub robust: Robust,
-    /// Maximum Gauss-Newton iterations. Default 100.
-    pub max_iter: usize,
+    /// Maximum Gauss-Newton iterations. Default [`FIT_MAX_ITERATIONS`] (100); the analysis sweep
+    /// sets `SweepParams::max_iterations` instead. (`max_iter` is read as this, the spelling
+    /// before the one name.)
+    #[serde(alias = "max_iter")]
+    pub max_iterations: usize,
     /// Stopping tolerance (dimensionless): the search stops when the predicted relative
-    /// improvement of a Gauss-Newton step `(V - V_pred) / V` is below `tol`, or when the loss
-    /// dropped by less than `tol` (relative) over the last 5 iterations. Default 1e-5.
-    pub tol: f64,
+    /// improvement of a Gauss-Newton step `(V - V_pred) / V` is below `tolerance`, or when the
+    /// loss dropped by less than `tolerance` (relative) over the last 5 iterations. Default
+    /// [`FIT_TOLERANCE`] (1e-5); the analysis sweep sets `SweepParams::tolerance` instead. (`tol`
+    /// is read as this.)
+    #[serde(alias = "tol")]
+    pub tolerance: f64,
     /// Maximum step halvings per direction. Default 10.
     pub max_halvings: usize,
     /// Subtract the mean of `y` before fitting. Default true.
@@ -62,6 +68,17 @@ pub struct ArmaParams {
     pub band: Option<BandLimit>,
 }
 
+/// Default [`ArmaParams::max_iterations`] of a single fit (`vibmode fit`, Python's `fit_arma`):
+/// 100 Gauss-Newton iterations, enough for a fit from its cold start to converge. The analysis
+/// sweep uses `vibmode_core::SWEEP_MAX_ITERATIONS` (20, MATLAB's `MaxIterations`) instead: its
+/// fits are warm-started from the order below and many, so they are capped sooner.
+pub const FIT_MAX_ITERATIONS: usize = 100;
+
+/// Default [`ArmaParams::tolerance`] of a single fit: 1e-5 (relative predicted improvement). The
+/// analysis sweep uses `vibmode_core::SWEEP_TOLERANCE` (1e-4, MATLAB's `Tolerance` of 0.01 %)
+/// instead, for the same reason as [`FIT_MAX_ITERATIONS`].
+pub const FIT_TOLERANCE: f64 = 1e-5;
+
 /// Default [`ArmaParams::noise_floor`] (relative variance): -30 dB, see the field's documentation.
 const DEFAULT_NOISE_FLOOR: f64 = 1e-3;
 
@@ -77,8 +94,8 @@ impl Default for ArmaParams {
     fn default() -> Self {
         ArmaParams {
             robust: Robust::default(),
-            max_iter: 100,
-            tol: 1e-5,
+            max_iterations: FIT_MAX_ITERATIONS,
+            tolerance: FIT_TOLERANCE,
             max_halvings: 10,
             demean: true,
             outlier_cleaning: OutlierCleaning::default(),
@@ -90,10 +107,10 @@ impl Default for ArmaParams {
 
 impl ArmaParams {
     pub(crate) fn validate(&self) -> Result<(), IdentError> {
-        if !(self.tol.is_finite() && self.tol > 0.0) {
+        if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
             return Err(IdentError::InvalidParam {
-                name: "tol",
-                value: self.tol.to_string(),
+                name: "tolerance",
+                value: self.tolerance.to_string(),
                 fix: "use a small positive number such as 1e-5",
             });
         }

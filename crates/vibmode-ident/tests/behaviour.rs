@@ -347,7 +347,7 @@ fn hard_setting_empty_band_sweep_stays_sound() {
     // rounding level (measured ~1e-14 of the floored fit's) and the modes scatter.
     let bare = ArmaParams {
         noise_floor: 0.0,
-        max_iter: 30,
+        max_iterations: 30,
         ..quadratic()
     };
     let floored = fit_arma(&y, 30, 30, &quadratic()).unwrap();
@@ -704,11 +704,11 @@ fn bad_inputs_give_one_line_errors() {
     assert!(fit_arma(&y, 4, 4, &ArmaParams::default()).is_ok());
     // Invalid params and warm start.
     let p = ArmaParams {
-        tol: -1.0,
+        tolerance: -1.0,
         ..ArmaParams::default()
     };
     let s = one_line(fit_arma(&y, 2, 1, &p).unwrap_err());
-    assert!(s.contains("tol = -1"), "{s}");
+    assert!(s.contains("tolerance = -1"), "{s}");
     for bad_floor in [f64::NAN, -1e-8, 0.5] {
         let p = ArmaParams {
             noise_floor: bad_floor,

@@ -371,12 +371,24 @@ fn bad_cleaner_inputs_give_one_line_errors() {
 
 #[test]
 fn params_serde_defaults() {
-    // Old JSON without the new fields still deserialises (serde defaults).
+    // Old JSON without the new fields, and with the old spellings `max_iter` and `tol`, still
+    // deserialises (serde defaults and aliases).
     let p: ArmaParams = serde_json::from_str(
         r#"{"robust":{"Huber":{"factor":1.6}},"max_iter":100,"tol":1e-5,"max_halvings":10,"demean":true}"#,
     )
     .unwrap();
     assert_eq!(p, ArmaParams::default());
+    let old: ArmaParams = serde_json::from_str(
+        r#"{"robust":"off","max_iter":7,"tol":0.5,"max_halvings":10,"demean":true}"#,
+    )
+    .unwrap();
+    assert_eq!((old.max_iterations, old.tolerance), (7, 0.5));
+    // Written with the one name.
+    let v = serde_json::to_value(ArmaParams::default()).unwrap();
+    assert!(
+        v.get("max_iterations").is_some() && v.get("max_iter").is_none(),
+        "{v}"
+    );
     let a = ar_from_modes(&[(2.0, 0.05)], 50.0);
     let y = simulate_arma(&a, &[1.0], 1.0, 500, 1).unwrap();
     let m = fit_arma(&y, 2, 0, &ArmaParams::default()).unwrap();

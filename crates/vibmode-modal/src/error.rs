@@ -56,18 +56,6 @@ pub enum ModalError {
         /// Number of poles given.
         n_poles: usize,
     },
-    /// A parameter is out of its valid range.
-    #[error("{name} ({value}) {requirement}; use e.g. {name} = {suggestion}")]
-    InvalidParam {
-        /// Parameter name as in the params struct.
-        name: &'static str,
-        /// The offending value, formatted.
-        value: String,
-        /// What the value must satisfy, e.g. "must be > 0".
-        requirement: &'static str,
-        /// A valid example value (usually the default).
-        suggestion: String,
-    },
     /// A string could not be parsed into an enum.
     #[error("unknown {what} '{value}'; valid values: {valid}")]
     UnknownName {

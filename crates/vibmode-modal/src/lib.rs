@@ -51,7 +51,9 @@ mod types;
 
 pub use cluster::{analyse_poles, find_invariant_modes, ModalAnalysis};
 pub use error::ModalError;
-pub use matching::{match_reference, match_reference_shapes};
-pub use params::{ClusterParams, StabilisationParams};
+pub use matching::{
+    match_reference, match_reference_shapes, MATCH_MAC_MIN, MATCH_MAX_FREQ_DIFF_REL,
+};
+pub use params::{ClusterParams, StabilityParams};
 pub use stabilisation::{stabilisation, Stability};
 pub use types::{InvariantMode, ModeClass, ModeMatch, PoleObservation, ReferenceMode};

@@ -2,6 +2,15 @@
 
 use crate::{InvariantMode, ModeClass, ModeMatch, ReferenceMode};
 
+/// A physical-model mode is matched to a structural mode within this relative
+/// frequency difference (25 %: body modes of a bus sit 15-25 % apart, wheel hop near 10 Hz).
+pub const MATCH_MAX_FREQ_DIFF_REL: f64 = 0.25;
+
+/// A physical-model mode is matched to an identified mode whose shape has at least this MAC with
+/// the model's shape at the sensors (and whose frequency is within
+/// [`MATCH_MAX_FREQ_DIFF_REL`]).
+pub const MATCH_MAC_MIN: f64 = 0.5;
+
 /// For every reference mode, find the nearest-in-frequency **structural** invariant mode
 /// (`class == Structural`; periodic disturbances and spurious clusters are never matched).
 ///

@@ -6,8 +6,8 @@ use common::script_params;
 
 use vibmode_modal::{
     analyse_poles, find_invariant_modes, match_reference, stabilisation, ClusterParams,
-    InvariantMode, ModalError, ModeClass, ModeMatch, PoleObservation, ReferenceMode,
-    StabilisationParams, Stability,
+    InvariantMode, ModalError, ModeClass, ModeMatch, PoleObservation, ReferenceMode, Stability,
+    StabilityParams,
 };
 
 fn pole(f: f64, z: f64, order: usize, record: usize) -> PoleObservation {
@@ -233,30 +233,18 @@ fn hand_stabilisation() {
         mk(1.005, 0.205, 4, "B"), // other sweep, first order -> new
         mk(1.0, 0.2, 6, "B"),     // 0.5 %, 2.4 % -> s
     ];
-    let s = stabilisation(&poles, &StabilisationParams::default()).unwrap();
+    let s = stabilisation(&poles, &StabilityParams::default()).unwrap();
     use Stability::*;
-    assert_eq!(
-        s,
-        vec![
-            New,
-            FrequencyAndDamping,
-            New,
-            New,
-            Frequency,
-            New,
-            New,
-            FrequencyAndDamping
-        ]
-    );
+    assert_eq!(s, vec![New, Stable, New, New, Frequency, New, New, Stable]);
     let symbols: String = s.iter().map(|x| x.symbol()).collect();
     assert_eq!(symbols, "osoofoos");
     // looser frequency tolerance: 1.02 vs 1.005 becomes frequency-stable (damping 2.4 % -> s)
-    let p = StabilisationParams {
+    let p = StabilityParams {
         freq_tol_rel: 0.02,
-        ..StabilisationParams::default()
+        ..StabilityParams::default()
     };
-    assert_eq!(stabilisation(&poles, &p).unwrap()[3], FrequencyAndDamping);
-    assert_eq!("s".parse::<Stability>().unwrap(), FrequencyAndDamping);
+    assert_eq!(stabilisation(&poles, &p).unwrap()[3], Stable);
+    assert_eq!("s".parse::<Stability>().unwrap(), Stable);
     assert_eq!(
         Frequency.to_string().parse::<Stability>().unwrap(),
         Frequency
@@ -265,7 +253,24 @@ fn hand_stabilisation() {
         .parse::<Stability>()
         .unwrap_err()
         .to_string()
-        .contains("frequency-and-damping"));
+        .contains("frequency_damping"));
+    // With shapes on both poles the MAC applies too: orthogonal shapes stop at frequency and
+    // damping, equal ones are stable; a pole without a shape is judged without it.
+    let shaped = |f: f64, order: usize, shape: [[f64; 2]; 2]| {
+        let mut o = mk(f, 0.2, order, "S");
+        o.shape = Some(shape.to_vec());
+        o
+    };
+    let with_shapes = vec![
+        shaped(2.0, 2, [[1.0, 0.0], [0.0, 0.0]]),
+        shaped(2.0, 4, [[0.0, 0.0], [1.0, 0.0]]),
+        shaped(2.0, 6, [[0.0, 0.0], [1.0, 0.0]]),
+        mk(2.0, 0.2, 8, "S"),
+    ];
+    assert_eq!(
+        stabilisation(&with_shapes, &StabilityParams::default()).unwrap(),
+        vec![New, FrequencyDamping, Stable, Stable]
+    );
     assert!(stabilisation(&[], &p).unwrap().is_empty());
 }
 
@@ -306,7 +311,7 @@ fn bad_inputs_are_errors_naming_the_value() {
         matches!(e, ModalError::NonFiniteDamping { index: 3, .. }),
         "{e}"
     );
-    let e = stabilisation(&poles, &StabilisationParams::default()).unwrap_err();
+    let e = stabilisation(&poles, &StabilityParams::default()).unwrap_err();
     assert!(
         matches!(e, ModalError::NonFiniteDamping { index: 3, .. }),
         "{e}"
@@ -434,13 +439,13 @@ fn invalid_params_are_errors() {
         e.to_string(),
         "freq_tol_rel = 0 must be in [1e-4, 1]; use e.g. freq_tol_rel = 0.02"
     );
-    let sp = StabilisationParams {
-        damping_tol_rel: 0.0,
-        ..StabilisationParams::default()
+    let sp = StabilityParams {
+        damping_tol_rel: -1.0,
+        ..StabilityParams::default()
     };
     assert!(matches!(
         stabilisation(&hand_poles(), &sp),
-        Err(ModalError::InvalidParam { .. })
+        Err(ModalError::Param(_))
     ));
 }
 

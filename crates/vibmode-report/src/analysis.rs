@@ -330,7 +330,7 @@ fn matches_text(
             }
             None => {
                 // The nearest structural mode, and where it went: matching is one to one.
-                let tol = vibmode_analysis::pipeline::MATCH_MAX_FREQ_DIFF_REL;
+                let tol = vibmode_modal::MATCH_MAX_FREQ_DIFF_REL;
                 let why = if m.freq_diff_rel.is_finite() && m.freq_diff_rel.abs() > tol {
                     format!(" (none within {:.0} %)", 100.0 * tol)
                 } else if m.freq_diff_rel.is_finite() {

@@ -456,13 +456,15 @@ impl RunOutput {
 
 /// A record source that notes the number of channels of the first record (for the progress in
 /// records).
-struct CountChannels<'a> {
-    source: &'a mut dyn RecordSource,
+struct CountChannels<'a, E> {
+    source: &'a mut dyn RecordSource<Error = E>,
     n_ch: &'a AtomicUsize,
 }
 
-impl RecordSource for CountChannels<'_> {
-    fn next_record(&mut self) -> Option<Result<RecordInput, AnalysisError>> {
+impl<E> RecordSource for CountChannels<'_, E> {
+    type Error = E;
+
+    fn next_record(&mut self) -> Option<Result<RecordInput, E>> {
         let r = self.source.next_record();
         if let Some(Ok(rec)) = &r {
             let _ = self.n_ch.compare_exchange(

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use vibmode_analysis::{AnalysisConfig, AnalysisError, RecordInput, RecordSource};
+use vibmode_analysis::{AnalysisConfig, RecordInput, RecordSource};
 use vibmode_vehicle::update::{BodyFit, BodyFitResult};
 use vibmode_vehicle::VehicleParams;
 
@@ -74,14 +74,14 @@ impl ModelUpdate {
 }
 
 /// A record source that also feeds each record to the model update.
-pub struct FeedUpdate<'a> {
+pub struct FeedUpdate<'a, E> {
     /// The records.
-    pub source: &'a mut dyn RecordSource,
+    pub source: &'a mut dyn RecordSource<Error = E>,
     /// The update they feed.
     pub update: &'a mut ModelUpdate,
 }
 
-impl std::fmt::Debug for FeedUpdate<'_> {
+impl<E> std::fmt::Debug for FeedUpdate<'_, E> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("FeedUpdate")
             .field("update", &self.update)
@@ -89,8 +89,10 @@ impl std::fmt::Debug for FeedUpdate<'_> {
     }
 }
 
-impl RecordSource for FeedUpdate<'_> {
-    fn next_record(&mut self) -> Option<Result<RecordInput, AnalysisError>> {
+impl<E> RecordSource for FeedUpdate<'_, E> {
+    type Error = E;
+
+    fn next_record(&mut self) -> Option<Result<RecordInput, E>> {
         let r = self.source.next_record();
         if let Some(Ok(rec)) = &r {
             self.update.add(rec);

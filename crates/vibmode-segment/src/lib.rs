@@ -29,7 +29,7 @@ pub use write::{write_segments, Written};
 
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use vibmode_analysis::RecordWindow;
+use vibmode_core::RecordWindow;
 use vibmode_core::{num, quoted, Num, RecordMeta};
 
 /// Settings of the segmentation; the defaults are the documented tolerances.
@@ -329,7 +329,7 @@ pub struct Segmentation {
 }
 
 impl Segmentation {
-    /// The records as windows for [`vibmode_analysis::StreamRecords::windows`].
+    /// The records as windows for [`vibmode_signal::StreamRecords::windows`].
     pub fn windows(&self) -> Vec<RecordWindow> {
         self.records
             .iter()
@@ -530,12 +530,9 @@ pub enum SegmentError {
         /// What failed.
         message: String,
     },
-    /// Reading the recording failed.
+    /// Reading the recording or cutting its records failed.
     #[error(transparent)]
     Signal(#[from] vibmode_signal::SignalError),
-    /// Cutting records failed.
-    #[error(transparent)]
-    Analysis(#[from] vibmode_analysis::AnalysisError),
 }
 
 /// Unix seconds of an RFC 3339 time.

@@ -2,8 +2,8 @@
 
 use crate::{SegmentError, Segmentation};
 use std::path::{Path, PathBuf};
-use vibmode_analysis::{RecordSource, StreamRecords};
-use vibmode_signal::{FrameStream, StreamWriter};
+use vibmode_core::RecordSource;
+use vibmode_signal::{FrameStream, StreamRecords, StreamWriter};
 
 /// What [`write_segments`] wrote.
 #[derive(Clone, Debug, PartialEq)]

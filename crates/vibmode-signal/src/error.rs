@@ -9,6 +9,18 @@ pub enum SignalError {
     /// lengths) or a channel that cannot be found.
     #[error(transparent)]
     Recording(#[from] vibmode_core::RecordingError),
+    /// A record window (segmentation) that reaches past the end of the recording.
+    #[error("record '{record}' (frames {start_frame}.. +{n_frames}) reaches past the end of the recording ({file_frames} frames); the segmentation does not fit this file")]
+    WindowOutside {
+        /// The record.
+        record: String,
+        /// Its first frame.
+        start_frame: u64,
+        /// Its length in frames.
+        n_frames: usize,
+        /// Frames in the file.
+        file_frames: u64,
+    },
     /// The file could not be opened, read or written.
     #[error("cannot {action} {path_q}: {message}; check the path and permissions", path_q = vibmode_core::quoted(.path))]
     Io {

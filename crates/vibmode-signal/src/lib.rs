@@ -43,6 +43,7 @@ pub mod error;
 mod number;
 mod preprocess;
 pub mod read;
+pub mod records;
 pub mod resample;
 pub mod stream;
 pub mod stream_resample;
@@ -56,6 +57,7 @@ pub use read::{
     read_delimited, read_delimited_bytes, read_path, sidecar_candidates, time_unit_scale, Format,
     ReadOptions, Sidecar, WavSidecar,
 };
+pub use records::{ChainedRecords, StreamRecords};
 pub use resample::ResampleRecording;
 pub use resample::{resample, ResampleMethod, ResampleParams, Resampler};
 pub use stream::{open_stream, FrameBlock, FrameStream, StreamInfo, DEFAULT_BLOCK_FRAMES};

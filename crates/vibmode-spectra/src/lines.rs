@@ -157,8 +157,8 @@ fn prominent_peaks(
         let lo = k.saturating_sub(reach);
         let hi = (k + reach).min(pw.len() - 1);
         let mut near: Vec<f64> = pw[lo..=hi].to_vec();
-        near.sort_by(f64::total_cmp);
-        let prominence_db = 10.0 * (pw[k] / near[near.len() / 2]).log10();
+        let level = vibmode_core::stats::median_high_in_place(&mut near);
+        let prominence_db = 10.0 * (pw[k] / level).log10();
         if prominence_db >= min_db {
             peaks.push((k, prominence_db));
         }
@@ -474,9 +474,7 @@ pub fn ridges(spec: &Spectrogram, p: &LineParams) -> Vec<Ridge> {
                     if i == 0 || i + 1 == f.len() {
                         f[i]
                     } else {
-                        let mut w = [f[i - 1], f[i], f[i + 1]];
-                        w.sort_by(f64::total_cmp);
-                        w[1]
+                        vibmode_core::stats::median(&[f[i - 1], f[i], f[i + 1]])
                     }
                 })
                 .collect();

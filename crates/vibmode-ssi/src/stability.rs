@@ -1,27 +1,10 @@
 //! Stabilisation labels: each mode at each order compared with the modes of the previous order.
 
-use serde::{Deserialize, Serialize};
+pub use vibmode_core::Stability;
 use vibmode_core::StabilityParams;
 
 use crate::cov::{SsiMode, SsiResult};
 use crate::shape::mac;
-
-/// How a mode at one order relates to the modes of the previous identified order (the symbols of
-/// a stabilisation diagram). Each label implies the ones before it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Stability {
-    /// No mode of the previous order within the frequency tolerance (always at the first order).
-    New,
-    /// A mode of the previous order within the frequency tolerance, none also within the damping
-    /// tolerance.
-    Frequency,
-    /// A mode of the previous order within the frequency and damping tolerances, none also
-    /// within the MAC limit.
-    FrequencyDamping,
-    /// A mode of the previous order within all three: frequency, damping and MAC.
-    Stable,
-}
 
 fn label(mode: &SsiMode, previous: &[SsiMode], p: &StabilityParams) -> Stability {
     let mut best = Stability::New;

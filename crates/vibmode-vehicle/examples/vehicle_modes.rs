@@ -1,6 +1,6 @@
 //! Print the modes of the shipped vehicles and time one 10.24 s, 20 kHz, 7-channel record.
 //! Run with `cargo run --release -p vibmode-vehicle --example vehicle_modes`.
-use vibmode_vehicle::{simulate, FullCar, SimParams, VehicleParams};
+use vibmode_vehicle::{simulate, FullCar, RoadClass, SimParams, VehicleParams};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     for (name, p) in [
@@ -20,6 +20,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         (
             "1 record, quiet, no warm-up",
             SimParams {
+                road: RoadClass::C,
+                speed_kmh: 40.0,
+                seed: 0,
                 records: 1,
                 warmup_s: Some(0.0),
                 ..SimParams::default()
@@ -28,6 +31,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         (
             "1 record, quiet",
             SimParams {
+                road: RoadClass::C,
+                speed_kmh: 40.0,
+                seed: 0,
                 records: 1,
                 ..SimParams::default()
             },
@@ -35,11 +41,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         (
             "1 record, in-service",
             SimParams {
+                road: RoadClass::C,
+                speed_kmh: 40.0,
+                seed: 0,
                 records: 1,
                 ..SimParams::in_service()
             },
         ),
-        ("8 records, in-service", SimParams::in_service()),
+        (
+            "8 records, in-service",
+            SimParams {
+                road: RoadClass::C,
+                speed_kmh: 40.0,
+                seed: 0,
+                ..SimParams::in_service()
+            },
+        ),
     ] {
         let t = std::time::Instant::now();
         let s = simulate(&bus, &sim)?;

@@ -43,7 +43,7 @@ pub mod sim;
 pub mod update;
 
 pub use error::{Result, VehicleError};
-pub use lines::LineTruth;
+pub use lines::{EngineLine, LineTruth};
 pub use model::{FullCar, ModeInfo, ModeLabel, SensorPsd};
 pub use params::{
     default_sensors, Axle, Bending, Body, Corner, CornerCondition, Geometry, SensorKind,
@@ -53,6 +53,4 @@ pub use road::{
     LateralCoherence, RoadClass, RoadInput, RoadProfile, DEFAULT_TYRE_ENVELOPE_CYCLES_PER_M,
     N0_CYCLES_PER_M,
 };
-pub use sim::{
-    simulate, Disturbances, EngineLine, Manoeuvre, SimParams, SimRecord, Simulation, Tone, Truth,
-};
+pub use sim::{simulate, Disturbances, Manoeuvre, SimParams, SimRecord, Simulation, Tone, Truth};

@@ -2,12 +2,91 @@
 //! modulation, an engine speed that differs from record to record and follows the vehicle speed
 //! during acceleration. Also the other slow random processes of the simulator.
 
-use crate::sim::EngineLine;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
+
+/// A periodic engine / driveline line: a vertical force on the body.
+/// In serialised form every field but `frequency_hz` and `force_n` may be omitted: `drift_hz` (0),
+/// `drift_period_s` (30), `x_m` and `y_m` (0), `wander_rel_std` (0), `wander_correlation_s` (2),
+/// `am_rel_std` (0), `am_correlation_s` (1), `speed_coupling` (0).
+///
+/// Instantaneous frequency: `frequency_hz * g_r * (1 + w(t)) * (v(t) / v0)^speed_coupling +
+/// drift_hz * sin(2 pi t / drift_period_s)`, where `g_r` is the record's engine-speed factor
+/// ([`Disturbances::engine_speed_record_rel_std`](crate::Disturbances::engine_speed_record_rel_std)), `w` a Gauss-Markov wander of relative
+/// standard deviation `wander_rel_std` and correlation time `wander_correlation_s`, and `v / v0`
+/// the speed ratio from the manoeuvres. Amplitude: `force_n * (1 + m(t))` with `m` a
+/// Gauss-Markov modulation of standard deviation `am_rel_std`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EngineLine {
+    /// Nominal frequency, Hz.
+    pub frequency_hz: f64,
+    /// Force amplitude, N (vertical, applied to the body at (x_m, y_m)).
+    pub force_n: f64,
+    /// Peak slow frequency deviation, Hz (0 = constant frequency).
+    #[serde(default)]
+    pub drift_hz: f64,
+    /// Period of the sinusoidal frequency drift, s.
+    #[serde(default = "default_drift_period")]
+    pub drift_period_s: f64,
+    /// Body x of the force (forward from the centre of gravity), m.
+    #[serde(default)]
+    pub x_m: f64,
+    /// Body y of the force (to the left of the centre of gravity), m.
+    #[serde(default)]
+    pub y_m: f64,
+    /// Relative standard deviation of the slow random frequency wander (0 = none; real engines
+    /// ~1e-3).
+    #[serde(default)]
+    pub wander_rel_std: f64,
+    /// Correlation time of the frequency wander, s.
+    #[serde(default = "default_wander_correlation")]
+    pub wander_correlation_s: f64,
+    /// Relative standard deviation of the random amplitude modulation (0 = none; ~0.1).
+    #[serde(default)]
+    pub am_rel_std: f64,
+    /// Correlation time of the amplitude modulation, s.
+    #[serde(default = "default_am_correlation")]
+    pub am_correlation_s: f64,
+    /// Exponent of the speed ratio in the frequency: 0 = independent of the vehicle speed,
+    /// 1 = proportional to it (a driveline order in a fixed gear).
+    #[serde(default)]
+    pub speed_coupling: f64,
+}
+
+impl EngineLine {
+    /// A constant line of `force_n` at `frequency_hz` applied at the centre of gravity.
+    pub fn constant(frequency_hz: f64, force_n: f64) -> Self {
+        EngineLine {
+            frequency_hz,
+            force_n,
+            drift_hz: 0.0,
+            drift_period_s: default_drift_period(),
+            x_m: 0.0,
+            y_m: 0.0,
+            wander_rel_std: 0.0,
+            wander_correlation_s: default_wander_correlation(),
+            am_rel_std: 0.0,
+            am_correlation_s: default_am_correlation(),
+            speed_coupling: 0.0,
+        }
+    }
+}
+
+fn default_drift_period() -> f64 {
+    30.0
+}
+
+fn default_wander_correlation() -> f64 {
+    2.0
+}
+
+fn default_am_correlation() -> f64 {
+    1.0
+}
 
 /// A stationary Ornstein-Uhlenbeck (first-order Gauss-Markov) process of given standard
 /// deviation and correlation time, stepped exactly at a fixed interval:

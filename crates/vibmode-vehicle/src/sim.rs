@@ -1,7 +1,7 @@
 //! Exact (first-order-hold) discretisation and the measurement-campaign simulator.
 
 use crate::error::{invalid, Result, VehicleError};
-use crate::lines::{LineBank, LineTruth, OrnsteinUhlenbeck};
+use crate::lines::{EngineLine, LineBank, LineTruth, OrnsteinUhlenbeck};
 use crate::model::{FullCar, ModeInfo, DOF_HEAVE, DOF_PITCH, DOF_ROLL};
 use crate::params::{Corner, VehicleParams};
 use crate::road::{
@@ -14,86 +14,6 @@ use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 use vibmode_core::{Channel, Recording};
-
-/// A periodic engine / driveline line: a vertical force on the body.
-/// In serialised form every field but `frequency_hz` and `force_n` may be omitted: `drift_hz` (0),
-/// `drift_period_s` (30), `x_m` and `y_m` (0), `wander_rel_std` (0), `wander_correlation_s` (2),
-/// `am_rel_std` (0), `am_correlation_s` (1), `speed_coupling` (0).
-///
-/// Instantaneous frequency: `frequency_hz * g_r * (1 + w(t)) * (v(t) / v0)^speed_coupling +
-/// drift_hz * sin(2 pi t / drift_period_s)`, where `g_r` is the record's engine-speed factor
-/// ([`Disturbances::engine_speed_record_rel_std`]), `w` a Gauss-Markov wander of relative
-/// standard deviation `wander_rel_std` and correlation time `wander_correlation_s`, and `v / v0`
-/// the speed ratio from the manoeuvres. Amplitude: `force_n * (1 + m(t))` with `m` a
-/// Gauss-Markov modulation of standard deviation `am_rel_std`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct EngineLine {
-    /// Nominal frequency, Hz.
-    pub frequency_hz: f64,
-    /// Force amplitude, N (vertical, applied to the body at (x_m, y_m)).
-    pub force_n: f64,
-    /// Peak slow frequency deviation, Hz (0 = constant frequency).
-    #[serde(default)]
-    pub drift_hz: f64,
-    /// Period of the sinusoidal frequency drift, s.
-    #[serde(default = "default_drift_period")]
-    pub drift_period_s: f64,
-    /// Body x of the force (forward from the centre of gravity), m.
-    #[serde(default)]
-    pub x_m: f64,
-    /// Body y of the force (to the left of the centre of gravity), m.
-    #[serde(default)]
-    pub y_m: f64,
-    /// Relative standard deviation of the slow random frequency wander (0 = none; real engines
-    /// ~1e-3).
-    #[serde(default)]
-    pub wander_rel_std: f64,
-    /// Correlation time of the frequency wander, s.
-    #[serde(default = "default_wander_correlation")]
-    pub wander_correlation_s: f64,
-    /// Relative standard deviation of the random amplitude modulation (0 = none; ~0.1).
-    #[serde(default)]
-    pub am_rel_std: f64,
-    /// Correlation time of the amplitude modulation, s.
-    #[serde(default = "default_am_correlation")]
-    pub am_correlation_s: f64,
-    /// Exponent of the speed ratio in the frequency: 0 = independent of the vehicle speed,
-    /// 1 = proportional to it (a driveline order in a fixed gear).
-    #[serde(default)]
-    pub speed_coupling: f64,
-}
-
-impl EngineLine {
-    /// A constant line of `force_n` at `frequency_hz` applied at the centre of gravity.
-    pub fn constant(frequency_hz: f64, force_n: f64) -> Self {
-        EngineLine {
-            frequency_hz,
-            force_n,
-            drift_hz: 0.0,
-            drift_period_s: default_drift_period(),
-            x_m: 0.0,
-            y_m: 0.0,
-            wander_rel_std: 0.0,
-            wander_correlation_s: default_wander_correlation(),
-            am_rel_std: 0.0,
-            am_correlation_s: default_am_correlation(),
-            speed_coupling: 0.0,
-        }
-    }
-}
-
-fn default_drift_period() -> f64 {
-    30.0
-}
-
-fn default_wander_correlation() -> f64 {
-    2.0
-}
-
-fn default_am_correlation() -> f64 {
-    1.0
-}
 
 /// A sinusoidal tone added to every channel (models pick-up above the anti-alias cutoff).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -199,21 +119,21 @@ impl Manoeuvre {
     }
 }
 
-/// Simulator settings. Defaults: road C, default coherence (exponential, 0.2 cycles/m),
-/// tyre enveloping 3 cycles/m,
-/// 40 km/h, 8 records of 10.24 s at 20 kHz, seed 0, no manoeuvres, no disturbances,
-/// automatic warm-up, no speed wander. Missing fields take these defaults when deserialised (e.g. from a TOML
+/// Simulator settings. Defaults (defined here once: `vibmode simulate`, `vibmode demo` and
+/// Python's `simulate` take theirs from [`SimParams::default`]): road B, default coherence
+/// (exponential, 0.2 cycles/m), tyre enveloping 3 cycles/m, 30 km/h, 8 records of 10.24 s at
+/// 20 kHz, seed 1, no manoeuvres, no disturbances, automatic warm-up, no speed wander. Missing fields take these defaults when deserialised (e.g. from a TOML
 /// or JSON config); unknown fields are errors.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SimParams {
-    /// ISO 8608 road class (default C).
+    /// ISO 8608 road class (default B).
     pub road: RoadClass,
     /// Left/right track coherence (default exponential, cutoff 0.2 cycles/m).
     pub coherence: LateralCoherence,
     /// Tyre-enveloping cutoff of the road, cycles/m (default Some(3.0); see [`RoadInput`]).
     pub tyre_envelope_cycles_per_m: Option<f64>,
-    /// Nominal (initial) speed, km/h (default 40).
+    /// Nominal (initial) speed, km/h (default 30).
     pub speed_kmh: f64,
     /// Length of one record, s (default 10.24).
     pub duration_s: f64,
@@ -221,7 +141,7 @@ pub struct SimParams {
     pub fs_hz: f64,
     /// Number of records (default 8): successive segments of one continuous drive.
     pub records: usize,
-    /// Random seed (ChaCha8); the same seed gives bit-identical output (default 0).
+    /// Random seed (ChaCha8); the same seed gives bit-identical output (default 1).
     pub seed: u64,
     /// Braking / acceleration / turning events (default none).
     pub manoeuvres: Vec<Manoeuvre>,
@@ -242,14 +162,14 @@ pub struct SimParams {
 impl Default for SimParams {
     fn default() -> Self {
         SimParams {
-            road: RoadClass::C,
+            road: RoadClass::B,
             coherence: LateralCoherence::default(),
             tyre_envelope_cycles_per_m: Some(DEFAULT_TYRE_ENVELOPE_CYCLES_PER_M),
-            speed_kmh: 40.0,
+            speed_kmh: 30.0,
             duration_s: 10.24,
             fs_hz: 20000.0,
             records: 8,
-            seed: 0,
+            seed: 1,
             manoeuvres: Vec::new(),
             disturbances: Disturbances::default(),
             warmup_s: None,
@@ -262,7 +182,7 @@ impl Default for SimParams {
 impl SimParams {
     /// The settings of `vibmode demo` (use them with
     /// [`VehicleParams::city_bus_flexible`](crate::VehicleParams::city_bus_flexible)):
-    /// [`SimParams::in_service`] on an ISO 8608 class B road at 30 km/h, `records` records of
+    /// [`SimParams::in_service`] on the default ISO 8608 class B road at 30 km/h, `records` records of
     /// 10.24 s at 20 kHz, and what real buses add:
     /// - engine/gear lines of 3 kN each (strong enough to stand out of the body response, as
     ///   on the paper's bus) whose frequency wanders (relative std 1e-3, correlation time 2 s)
@@ -273,8 +193,6 @@ impl SimParams {
     /// - sensors misaligned by up to 3 deg.
     pub fn demo(records: usize, seed: u64) -> Self {
         let mut p = SimParams {
-            road: RoadClass::B,
-            speed_kmh: 30.0,
             records,
             seed,
             speed_wander_rel_std: 0.03,
@@ -298,8 +216,6 @@ impl SimParams {
     /// [`VehicleParams::city_bus`](crate::VehicleParams::city_bus)). The idealised case.
     pub fn demo_ideal(records: usize, seed: u64) -> Self {
         let mut p = SimParams {
-            road: RoadClass::B,
-            speed_kmh: 30.0,
             records,
             seed,
             ..SimParams::in_service()

@@ -950,10 +950,9 @@ impl BodyFit {
                     .filter(|(n, _)| n == name)
                     .map(|x| x.1)
                     .collect();
-                d.sort_by(|a, b| a.total_cmp(b));
                 ChannelNoise {
                     channel: name.clone(),
-                    density_per_hz: d[d.len() / 2],
+                    density_per_hz: vibmode_core::stats::median_high_in_place(&mut d),
                 }
             })
             .collect()

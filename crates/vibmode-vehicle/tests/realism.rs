@@ -34,6 +34,7 @@ fn peak_hz(x: &[f64], fs: f64, lo: f64, hi: f64) -> f64 {
 /// A quiet drive (class A road, low rate) with one strong line at `f0` on the body.
 fn one_line(seed: u64, line: EngineLine, dist: Disturbances) -> SimParams {
     SimParams {
+        speed_kmh: 40.0,
         road: RoadClass::A,
         fs_hz: 200.0,
         records: 6,
@@ -171,6 +172,7 @@ fn misaligned_sensors_feel_the_turn() {
             lateral_accel_m_s2: 2.0,
         };
         let mut sp = SimParams {
+            speed_kmh: 40.0,
             road: RoadClass::A,
             fs_hz: 200.0,
             records: 3,
@@ -212,6 +214,8 @@ fn speed_wander_moves_the_record_speeds() {
     let mut moved = 0;
     for seed in SEEDS {
         let sp = SimParams {
+            road: RoadClass::C,
+            speed_kmh: 40.0,
             fs_hz: 200.0,
             records: 4,
             seed,

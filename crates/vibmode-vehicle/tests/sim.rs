@@ -44,6 +44,8 @@ fn quiet(fs: f64) -> SimParams {
         .and_then(|s| s.parse().ok())
         .unwrap_or(7);
     SimParams {
+        road: RoadClass::C,
+        speed_kmh: 40.0,
         fs_hz: fs,
         duration_s: 10.24,
         records: 8,
@@ -164,6 +166,9 @@ fn spectral_peaks_at_body_and_wheel_hop_modes() {
 fn same_seed_same_output_and_records_are_successive() {
     let bus = VehicleParams::city_bus();
     let sp = SimParams {
+        road: RoadClass::C,
+        speed_kmh: 40.0,
+        seed: 0,
         fs_hz: 400.0,
         duration_s: 2.0,
         records: 3,
@@ -373,6 +378,8 @@ fn bad_sim_params_are_rejected_with_the_field_name() {
     };
     check(
         SimParams {
+            road: RoadClass::C,
+            seed: 0,
             speed_kmh: 0.0,
             ..SimParams::default()
         },
@@ -380,6 +387,9 @@ fn bad_sim_params_are_rejected_with_the_field_name() {
     );
     check(
         SimParams {
+            road: RoadClass::C,
+            speed_kmh: 40.0,
+            seed: 0,
             records: 0,
             ..SimParams::default()
         },
@@ -387,6 +397,9 @@ fn bad_sim_params_are_rejected_with_the_field_name() {
     );
     check(
         SimParams {
+            road: RoadClass::C,
+            speed_kmh: 40.0,
+            seed: 0,
             fs_hz: -1.0,
             ..SimParams::default()
         },
@@ -394,6 +407,9 @@ fn bad_sim_params_are_rejected_with_the_field_name() {
     );
     check(
         SimParams {
+            road: RoadClass::C,
+            speed_kmh: 40.0,
+            seed: 0,
             duration_s: 0.0001,
             ..SimParams::default()
         },
@@ -401,6 +417,9 @@ fn bad_sim_params_are_rejected_with_the_field_name() {
     );
     check(
         SimParams {
+            road: RoadClass::C,
+            speed_kmh: 40.0,
+            seed: 0,
             tyre_envelope_cycles_per_m: Some(-3.0),
             ..SimParams::default()
         },
@@ -414,6 +433,9 @@ fn bad_sim_params_are_rejected_with_the_field_name() {
     };
     check(
         SimParams {
+            road: RoadClass::C,
+            speed_kmh: 40.0,
+            seed: 0,
             fs_hz: 200.0,
             manoeuvres: vec![brake],
             ..SimParams::default()
@@ -424,6 +446,9 @@ fn bad_sim_params_are_rejected_with_the_field_name() {
     d.engine_lines[0].frequency_hz = -7.0;
     check(
         SimParams {
+            road: RoadClass::C,
+            speed_kmh: 40.0,
+            seed: 0,
             disturbances: d,
             ..SimParams::default()
         },
@@ -446,6 +471,8 @@ fn braking_pitches_the_body_nose_down() {
         lateral_accel_m_s2: 0.0,
     };
     let base = SimParams {
+        speed_kmh: 40.0,
+        seed: 0,
         road: RoadClass::A,
         fs_hz: 200.0,
         duration_s: 4.0,
@@ -500,6 +527,9 @@ fn sim_params_deserialise_with_defaults_and_reject_unknown_keys() {
 #[test]
 fn a_simulated_record_carries_its_sensors_names_units_and_placements() {
     let sp = SimParams {
+        road: RoadClass::C,
+        speed_kmh: 40.0,
+        seed: 0,
         fs_hz: 200.0,
         duration_s: 2.0,
         records: 1,
@@ -547,6 +577,8 @@ fn in_service_preset_runs_from_the_minimum_speed() {
     let car = VehicleParams::city_bus();
     for speed in [1.0, 5.0, 10.0] {
         let p = SimParams {
+            road: RoadClass::C,
+            seed: 0,
             speed_kmh: speed,
             records: 3,
             duration_s: 10.24,
@@ -570,6 +602,8 @@ fn in_service_preset_runs_from_the_minimum_speed() {
         );
     }
     let p = SimParams {
+        road: RoadClass::C,
+        seed: 0,
         speed_kmh: 11.0,
         ..SimParams::in_service()
     };

@@ -109,6 +109,8 @@ fn body_modes_of_the_measured_vehicle_over_seeds() {
 fn clean_records_give_the_parameters() {
     let truth = changed(VehicleParams::city_bus());
     let sp = SimParams {
+        road: RoadClass::C,
+        speed_kmh: 40.0,
         fs_hz: 200.0,
         records: 4,
         seed: 7,
@@ -157,6 +159,9 @@ fn clean_records_give_the_parameters() {
 
 fn demo_record() -> Recording {
     let sp = SimParams {
+        road: RoadClass::C,
+        speed_kmh: 40.0,
+        seed: 0,
         fs_hz: 100.0,
         records: 1,
         ..SimParams::default()
@@ -217,6 +222,9 @@ fn collinear_sprung_sensors_are_refused() {
     let sim = simulate(
         &v,
         &SimParams {
+            road: RoadClass::C,
+            speed_kmh: 40.0,
+            seed: 0,
             fs_hz: 100.0,
             records: 1,
             ..SimParams::default()
@@ -306,6 +314,8 @@ fn a_bar_the_bus_does_not_have_comes_out_as_zero() {
     let mut held = 0;
     for seed in 1..=6 {
         let sp = SimParams {
+            road: RoadClass::C,
+            speed_kmh: 40.0,
             fs_hz: 200.0,
             records: 4,
             seed,

@@ -1,9 +1,10 @@
-//! Stage 1, the record source: where records come from. Today long recordings cut into records
-//! of `record_length_s`; tomorrow streamed blocks and a database implement [`RecordSource`] too.
+//! Stage 1's contract, the record source: where records come from. A recording held in memory
+//! cut into records of `record_length_s` ([`CutRecords`]); streamed files
+//! (`vibmode_signal::StreamRecords`) and a database implement [`RecordSource`] too.
 
-use vibmode_core::Recording;
-
-use crate::AnalysisError;
+use crate::error::RecordingError;
+use crate::record_meta::RecordMeta;
+use crate::recording::Recording;
 
 /// One record to analyse, with a name for tables (usually the file name and segment).
 #[derive(Clone, Debug)]
@@ -14,19 +15,34 @@ pub struct RecordInput {
     pub recording: Recording,
 }
 
+/// One record to cut from a stream: `n_frames` frames from `start_frame`, with what is known of
+/// it (e.g. from a GPS track).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecordWindow {
+    /// First frame (0-based, in the file).
+    pub start_frame: u64,
+    /// Number of frames.
+    pub n_frames: usize,
+    /// Start, speed, position.
+    pub meta: RecordMeta,
+}
+
 /// Anything that yields records one by one.
 pub trait RecordSource {
+    /// Why a record could not be made (a read error of a file, say).
+    type Error;
+
     /// The next record, `None` when the source is exhausted.
-    fn next_record(&mut self) -> Option<Result<RecordInput, AnalysisError>>;
+    fn next_record(&mut self) -> Option<Result<RecordInput, Self::Error>>;
 
     /// Where the record last returned by [`RecordSource::next_record`] was cut from (start,
     /// speed and position), for sources that know it; `None` by default.
-    fn meta(&self) -> Option<vibmode_core::RecordMeta> {
+    fn meta(&self) -> Option<RecordMeta> {
         None
     }
 
     /// Every remaining record.
-    fn collect_records(&mut self) -> Result<Vec<RecordInput>, AnalysisError> {
+    fn collect_records(&mut self) -> Result<Vec<RecordInput>, Self::Error> {
         let mut out = Vec::new();
         while let Some(r) = self.next_record() {
             out.push(r?);
@@ -80,7 +96,9 @@ impl<'a> CutRecords<'a> {
 }
 
 impl RecordSource for CutRecords<'_> {
-    fn next_record(&mut self) -> Option<Result<RecordInput, AnalysisError>> {
+    type Error = RecordingError;
+
+    fn next_record(&mut self) -> Option<Result<RecordInput, RecordingError>> {
         if self.next >= self.n_records {
             return None;
         }
@@ -94,7 +112,7 @@ impl RecordSource for CutRecords<'_> {
         }
         let view = match self.rec.view(k * self.n_per, (k + 1) * self.n_per) {
             Ok(v) => v,
-            Err(e) => return Some(Err(e.into())),
+            Err(e) => return Some(Err(e)),
         };
         let mut recording = view.to_recording();
         recording.time_axis = None;
