@@ -4,17 +4,15 @@ use crate::input::InputArgs;
 use crate::output::write_json;
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use serde::Serialize;
 use std::path::PathBuf;
-use vibmode_report::{Curve, Figure, Scale};
-use vibmode_signal::Recording;
+use vibmode_report::Scale;
+use vibmode_run::psd::PsdMethod;
 use vibmode_spectra::{
-    Average, Detrend, PeriodogramParams, Scaling, ShortRecord, Spectrum, WelchParams, Window,
+    Average, Detrend, PeriodogramParams, Scaling, ShortRecord, WelchParams, Window,
 };
 
 /// Which spectral estimator to compute.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Method {
     /// Welch's averaged modified periodogram (scipy.signal.welch).
     Welch,
@@ -31,6 +29,16 @@ pub enum AxisScale {
     Linear,
     /// Logarithmic axis.
     Log,
+}
+
+impl From<Method> for PsdMethod {
+    fn from(m: Method) -> PsdMethod {
+        match m {
+            Method::Welch => PsdMethod::Welch,
+            Method::Periodogram => PsdMethod::Periodogram,
+            Method::Both => PsdMethod::Both,
+        }
+    }
 }
 
 impl From<AxisScale> for Scale {
@@ -137,130 +145,6 @@ impl SpectralArgs {
     }
 }
 
-#[derive(Serialize)]
-struct ChannelPsd {
-    name: String,
-    unit: String,
-    psd_unit: String,
-    method: Method,
-    frequency_hz: Vec<f64>,
-    psd: Vec<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    periodogram: Option<PlainSpectrum>,
-    notes: Vec<String>,
-}
-
-#[derive(Serialize)]
-struct PlainSpectrum {
-    frequency_hz: Vec<f64>,
-    psd: Vec<f64>,
-}
-
-#[derive(Serialize)]
-struct UsedParams {
-    fs_hz: f64,
-    n_samples: usize,
-    window: String,
-    nperseg: Option<usize>,
-    noverlap: Option<usize>,
-    nfft: usize,
-    n_segments: Option<usize>,
-    detrend: String,
-    scaling: String,
-    average: Option<String>,
-    resampled_to_hz: Option<f64>,
-    cutoff_hz: Option<f64>,
-}
-
-#[derive(Serialize)]
-struct PsdOutput {
-    source: String,
-    method: Method,
-    parameters: UsedParams,
-    channels: Vec<ChannelPsd>,
-}
-
-fn psd_unit(unit: &str, scaling: Scaling) -> String {
-    let u = if unit.is_empty() { "input units" } else { unit };
-    match scaling {
-        Scaling::Density => format!("({u})^2/Hz"),
-        Scaling::Spectrum => format!("({u})^2"),
-    }
-}
-
-/// Computes the requested spectra of every channel of `rec`.
-fn compute(
-    rec: &Recording,
-    method: Method,
-    sp: &SpectralArgs,
-) -> Result<(Vec<ChannelPsd>, UsedParams)> {
-    let wp = sp.welch_params()?;
-    let pp = sp.periodogram_params()?;
-    let mut out = Vec::new();
-    let mut first: Option<Spectrum> = None;
-    for ch in &rec.channels {
-        let (main, per) = match method {
-            Method::Welch => (
-                vibmode_spectra::welch(&ch.samples, rec.fs_hz, &wp)
-                    .with_context(|| format!("channel '{}'", ch.name))?,
-                None,
-            ),
-            Method::Periodogram => (
-                vibmode_spectra::periodogram(&ch.samples, rec.fs_hz, &pp)
-                    .with_context(|| format!("channel '{}'", ch.name))?,
-                None,
-            ),
-            Method::Both => {
-                let w = vibmode_spectra::welch(&ch.samples, rec.fs_hz, &wp)
-                    .with_context(|| format!("channel '{}'", ch.name))?;
-                let p = vibmode_spectra::periodogram(&ch.samples, rec.fs_hz, &pp)
-                    .with_context(|| format!("channel '{}'", ch.name))?;
-                (
-                    w,
-                    Some(PlainSpectrum {
-                        frequency_hz: p.freq_hz,
-                        psd: p.psd,
-                    }),
-                )
-            }
-        };
-        if first.is_none() {
-            first = Some(main.clone());
-        }
-        out.push(ChannelPsd {
-            name: ch.name.clone(),
-            unit: ch.unit.clone(),
-            psd_unit: psd_unit(&ch.unit, wp.scaling),
-            method,
-            frequency_hz: main.freq_hz.clone(),
-            psd: main.psd.clone(),
-            periodogram: per,
-            notes: main.notes.clone(),
-        });
-    }
-    let is_welch = method != Method::Periodogram;
-    let f = first.context("the input has no channels; check --channel")?;
-    let used = UsedParams {
-        fs_hz: rec.fs_hz,
-        n_samples: rec.len(),
-        window: if is_welch {
-            wp.window.to_string()
-        } else {
-            pp.window.to_string()
-        },
-        nperseg: is_welch.then_some(f.nperseg),
-        noverlap: is_welch.then_some(f.noverlap),
-        nfft: f.nfft,
-        n_segments: is_welch.then_some(f.n_segments),
-        detrend: wp.detrend.to_string(),
-        scaling: wp.scaling.to_string(),
-        average: is_welch.then(|| wp.average.to_string()),
-        resampled_to_hz: None,
-        cutoff_hz: None,
-    };
-    Ok((out, used))
-}
-
 /// Runs `vibmode psd`.
 pub fn run(a: &PsdArgs) -> Result<()> {
     crate::output::check_outputs(
@@ -277,159 +161,36 @@ pub fn run(a: &PsdArgs) -> Result<()> {
         }
     }
     let rec = a.input.load()?;
-    let (channels, mut used) = compute(&rec, a.method, &a.spectral)?;
-    // A non-finite value is never printed or written (the input limits should make this
-    // impossible; this is the last guard).
-    for c in &channels {
-        if c.psd.iter().any(|v| !v.is_finite()) {
-            anyhow::bail!(
-                "the spectrum of channel '{}' has a non-finite value; rescale the signal (another unit)",
-                c.name
-            );
-        }
-    }
-    used.resampled_to_hz = a.input.resample_to_hz;
-    used.cutoff_hz = a
+    let resampled = a
         .input
         .resample_to_hz
-        .map(|to| a.input.cutoff_hz.unwrap_or(to / 2.0));
-    let output = PsdOutput {
-        source: a.input.input.display().to_string(),
-        method: a.method,
-        parameters: used,
-        channels,
-    };
+        .map(|to| (to, a.input.cutoff_hz.unwrap_or(to / 2.0)));
+    let output = vibmode_run::psd::psd(
+        &rec,
+        &a.input.input.display().to_string(),
+        a.method.into(),
+        &a.spectral.welch_params()?,
+        &a.spectral.periodogram_params()?,
+        resampled,
+    )?;
     if let Some(path) = &a.csv {
-        write_csv(path, &output)?;
+        let text = output.csv_text();
+        vibmode_core::files::write_atomic(path, anyhow::Error::from, |tmp| {
+            Ok(std::fs::write(tmp, &text)?)
+        })
+        .with_context(|| format!("cannot write CSV file {}", path.display()))?;
     }
     if let Some(path) = &a.plot {
-        let fig = psd_figure(&output, a.xscale.into(), a.yscale.into(), a.fmax_hz);
+        let fig = output.figure(a.xscale.into(), a.yscale.into(), a.fmax_hz);
         fig.save(path)
             .with_context(|| format!("writing plot {}", path.display()))?;
     }
     match &a.json {
         Some(dest) => write_json(dest, &output)?,
-        None => print_summary(&output)?,
+        None => {
+            eprintln!("{}", output.header_line());
+            crate::output::print_stdout(&output.table_text())?;
+        }
     }
     Ok(())
-}
-
-fn print_summary(o: &PsdOutput) -> Result<()> {
-    use std::fmt::Write as _;
-    let mut text = String::new();
-    let p = &o.parameters;
-    eprintln!(
-        "{}: fs = {} Hz, {} samples, window {}, nfft {}{}",
-        o.source,
-        p.fs_hz,
-        p.n_samples,
-        p.window,
-        p.nfft,
-        match (p.nperseg, p.noverlap, p.n_segments) {
-            (Some(n), Some(ov), Some(k)) => format!(", nperseg {n}, noverlap {ov}, {k} segments"),
-            _ => String::new(),
-        }
-    );
-    let _ = writeln!(
-        text,
-        "{:<24} {:>14} {:>16} {:>12}  unit of peak / unit of rms",
-        "channel", "peak_hz", "peak", "rms"
-    );
-    for c in &o.channels {
-        let (fpk, vp) =
-            vibmode_spectra::peak(&c.frequency_hz, &c.psd).unwrap_or((f64::NAN, f64::NAN));
-        let scaling = if p.scaling == "density" {
-            Scaling::Density
-        } else {
-            Scaling::Spectrum
-        };
-        let rms = vibmode_spectra::rms(&c.frequency_hz, &c.psd, scaling);
-        let unit = if c.unit.is_empty() {
-            "input units"
-        } else {
-            c.unit.as_str()
-        };
-        let _ = writeln!(
-            text,
-            "{:<24} {:>14.4} {:>16.6e} {:>12.5e}  {} / {}",
-            c.name, fpk, vp, rms, c.psd_unit, unit
-        );
-    }
-    crate::output::print_stdout(&text)
-}
-
-fn write_csv(path: &std::path::Path, o: &PsdOutput) -> Result<()> {
-    use std::io::Write;
-    vibmode_core::files::write_atomic(path, anyhow::Error::from, |tmp| {
-        let f = std::fs::File::create(tmp)?;
-        let mut w = std::io::BufWriter::new(f);
-        let mut header = vec!["frequency_hz".to_string()];
-        header.extend(o.channels.iter().map(|c| c.name.replace(',', "_")));
-        writeln!(w, "{}", header.join(","))?;
-        if let Some(c0) = o.channels.first() {
-            for (i, f) in c0.frequency_hz.iter().enumerate() {
-                write!(w, "{f}")?;
-                for c in &o.channels {
-                    write!(w, ",{:e}", c.psd.get(i).copied().unwrap_or(f64::NAN))?;
-                }
-                writeln!(w)?;
-            }
-        }
-        w.flush()?;
-        Ok(())
-    })
-    .with_context(|| format!("cannot write CSV file {}", path.display()))
-}
-
-fn psd_figure(o: &PsdOutput, xs: Scale, ys: Scale, fmax: Option<f64>) -> Figure {
-    let several = o.channels.len() > 1;
-    let background: Vec<Curve> = o
-        .channels
-        .iter()
-        .filter_map(|c| {
-            let p = c.periodogram.as_ref()?;
-            let label = if several {
-                format!("{} periodogram", c.name)
-            } else {
-                "periodogram".into()
-            };
-            Some(Curve::new(label, p.frequency_hz.clone(), p.psd.clone()))
-        })
-        .collect();
-    let curves: Vec<Curve> = o
-        .channels
-        .iter()
-        .map(|c| {
-            let label = match (c.method, several) {
-                (Method::Periodogram, false) => "periodogram".to_string(),
-                (_, false) => "Welch".to_string(),
-                (Method::Periodogram, true) => c.name.clone(),
-                (_, true) => format!("{} Welch", c.name),
-            };
-            Curve::new(label, c.frequency_hz.clone(), c.psd.clone())
-        })
-        .collect();
-    let unit = o
-        .channels
-        .first()
-        .map(|c| c.psd_unit.clone())
-        .unwrap_or_default();
-    let nyq = o.parameters.fs_hz / 2.0;
-    let xmin = if xs == Scale::Log {
-        o.parameters.fs_hz / o.parameters.nfft as f64
-    } else {
-        0.0
-    };
-    let name = std::path::Path::new(&o.source)
-        .file_name()
-        .map(|s| s.to_string_lossy().to_string())
-        .unwrap_or_else(|| o.source.clone());
-    vibmode_report::psd_figure(
-        &format!("Power spectral density: {name}"),
-        &background,
-        &curves,
-        &unit,
-        (xs, ys),
-        (xmin, fmax.unwrap_or(nyq).min(nyq)),
-    )
 }

@@ -29,6 +29,7 @@
 //! the value and the fix, never a command-line flag.
 
 mod demo;
+pub mod psd;
 #[cfg(feature = "segment")]
 mod segmenting;
 mod update;
@@ -104,6 +105,24 @@ pub enum RunError {
         /// What was skipped and why.
         summary: String,
     },
+    /// A channel's spectrum could not be computed.
+    #[error("channel '{channel}': {source}")]
+    Spectrum {
+        /// The channel.
+        channel: String,
+        /// Why.
+        #[source]
+        source: vibmode_spectra::SpectraError,
+    },
+    /// A spectrum came out with a non-finite ordinate (never printed or written).
+    #[error("the spectrum of channel '{channel}' has a non-finite value; rescale the signal (another unit)")]
+    NonFiniteSpectrum {
+        /// The channel.
+        channel: String,
+    },
+    /// A recording without channels.
+    #[error("the recording has no channels; select at least one")]
+    NoChannels,
     /// Windows given for a different number of files.
     #[error("{n_windows} lists of record windows for {n_files} files; give one list per file")]
     WindowsMismatch {
