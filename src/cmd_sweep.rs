@@ -5,11 +5,10 @@ use crate::input::InputArgs;
 use crate::output::write_json;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use serde::Serialize;
 use std::path::PathBuf;
-use vibmode_core::{BandLimit, PoleFilterParams, SweepParams};
-use vibmode_ident::{ArMethod, ArmaParams, PoleRejection, Robust};
-use vibmode_report::panels as figures;
+use vibmode_core::{BandLimit, SweepModel, SweepParams};
+use vibmode_ident::{ArMethod, ArmaParams, Robust};
+use vibmode_run::sweep::SweepOutput;
 
 /// Arguments of `vibmode sweep`.
 #[derive(Args, Debug)]
@@ -93,53 +92,6 @@ pub fn parse_orders(s: &str) -> Result<Vec<usize>> {
     parts.into_iter().map(order).collect()
 }
 
-/// One pole pair of the sweep.
-#[derive(Serialize, Clone, Copy, Debug)]
-pub struct SweepMode {
-    /// Model order p.
-    pub order: usize,
-    /// Natural frequency, Hz.
-    pub frequency_hz: f64,
-    /// Damping ratio.
-    pub damping_ratio: f64,
-}
-
-/// A pole pair the pole filters left out, and why.
-#[derive(Serialize, Clone, Copy, Debug)]
-pub struct FilteredMode {
-    /// Model order p.
-    pub order: usize,
-    /// Natural frequency, Hz.
-    pub frequency_hz: f64,
-    /// Damping ratio.
-    pub damping_ratio: f64,
-    /// Why it is no mode.
-    pub reason: PoleRejection,
-}
-
-#[derive(Serialize)]
-struct SweepChannel {
-    name: String,
-    unit: String,
-    orders: Vec<usize>,
-    loss: Vec<f64>,
-    converged: Vec<bool>,
-    errors: Vec<Option<String>>,
-    modes: Vec<SweepMode>,
-    filtered_out: Vec<FilteredMode>,
-    welch_freq_hz: Vec<f64>,
-    welch_psd: Vec<f64>,
-}
-
-#[derive(Serialize)]
-struct SweepOutput {
-    source: String,
-    fs_hz: f64,
-    n_samples: usize,
-    model: ModelKind,
-    channels: Vec<SweepChannel>,
-}
-
 /// The orders and fit settings: the options given, else the analysis sweep's defaults (one
 /// definition, `vibmode_core::SweepParams`).
 fn sweep_settings(a: &SweepArgs, band: Option<BandLimit>) -> Result<(Vec<usize>, ArmaParams)> {
@@ -171,34 +123,11 @@ fn sweep_settings(a: &SweepArgs, band: Option<BandLimit>) -> Result<(Vec<usize>,
 
 /// The stabilisation diagram at `path` and the frequency-damping plot beside it.
 fn write_plots(path: &std::path::Path, out: &SweepOutput) -> Result<()> {
-    let mut stab = Vec::new();
-    let mut damp = Vec::new();
-    for c in &out.channels {
-        let pts: Vec<(usize, f64, f64)> = c
-            .modes
-            .iter()
-            .map(|m| (m.order, m.frequency_hz, m.damping_ratio))
-            .collect();
-        stab.push(figures::stabilisation_panel(
-            &format!("{}: stabilisation diagram", c.name),
-            &pts,
-            &c.welch_freq_hz,
-            &c.welch_psd,
-            out.fs_hz / 2.0,
-        ));
-        damp.push(figures::damping_panel(
-            &format!("{}: frequency vs damping", c.name),
-            &pts,
-            &[],
-            out.fs_hz / 2.0,
-        ));
-    }
-    figures::grid(stab, 1, 1000, 520)
-        .save(path)
+    let (stab, damp) = out.figures();
+    stab.save(path)
         .with_context(|| format!("writing plot {}", path.display()))?;
-    let dpath = figures::sibling(path, "-damping");
-    figures::grid(damp, 1, 1000, 520)
-        .save(&dpath)
+    let dpath = vibmode_report::panels::sibling(path, "-damping");
+    damp.save(&dpath)
         .with_context(|| format!("writing plot {}", dpath.display()))?;
     eprintln!("wrote {} and {}", path.display(), dpath.display());
     Ok(())
@@ -220,122 +149,32 @@ fn ar_method(a: &SweepArgs) -> Result<ArMethod> {
     })
 }
 
-/// Every fit's loss, convergence or error, and its modes split by the pole filters.
-fn collect_fits(
-    out: &mut SweepChannel,
-    orders: &[usize],
-    fits: Vec<Result<vibmode_ident::ArmaModel, vibmode_ident::IdentError>>,
-    band: &BandLimit,
-    filters: &PoleFilterParams,
-) {
-    for (&p, f) in orders.iter().zip(fits) {
-        match f {
-            Ok(m) => {
-                out.loss.push(m.loss);
-                out.converged.push(m.converged);
-                out.errors.push(None);
-                for f in vibmode_ident::filter_modes(&m, band, filters) {
-                    let (frequency_hz, damping_ratio) = (f.mode.frequency_hz, f.mode.damping_ratio);
-                    match f.rejected {
-                        None => out.modes.push(SweepMode {
-                            order: p,
-                            frequency_hz,
-                            damping_ratio,
-                        }),
-                        Some(reason) => out.filtered_out.push(FilteredMode {
-                            order: p,
-                            frequency_hz,
-                            damping_ratio,
-                            reason,
-                        }),
-                    }
-                }
-            }
-            Err(e) => {
-                out.loss.push(f64::NAN);
-                out.converged.push(false);
-                out.errors.push(Some(e.to_string()));
-            }
-        }
-    }
-}
-
 /// Runs `vibmode sweep`.
 pub fn run(a: &SweepArgs) -> Result<()> {
     crate::output::check_outputs(&a.input.input, &[], &[a.plot.as_deref()], a.json.as_deref())?;
     let (rec, band) = a.input.load_with_band()?;
     let (orders, params) = sweep_settings(a, band)?;
     let filter_band = band.unwrap_or_else(|| BandLimit::full(rec.fs_hz));
-    let filters = PoleFilterParams::default();
     let ar_method = ar_method(a)?;
-    // Fail early, with the fit's own message, if the highest order cannot be fitted at all.
-    let max_order = orders.iter().copied().max().unwrap_or(1);
-    let mut channels = Vec::new();
-    for ch in &rec.channels {
-        let fits = match a.model {
-            ModelKind::Arma => vibmode_ident::sweep_arma(&ch.samples, &orders, &params),
-            ModelKind::Ar => orders
-                .iter()
-                .map(|&p| vibmode_ident::fit_ar(&ch.samples, p, ar_method))
-                .collect(),
-        };
-        if fits.iter().all(|f| f.is_err()) {
-            if let Some(Err(e)) = fits.into_iter().last() {
-                return Err(e).with_context(|| format!("channel '{}', order {max_order}", ch.name));
-            }
-            bail!("no fits for channel '{}'", ch.name);
-        }
-        let mut out = SweepChannel {
-            name: ch.name.clone(),
-            unit: ch.unit.clone(),
-            orders: orders.clone(),
-            loss: vec![],
-            converged: vec![],
-            errors: vec![],
-            modes: vec![],
-            filtered_out: vec![],
-            welch_freq_hz: vec![],
-            welch_psd: vec![],
-        };
-        collect_fits(&mut out, &orders, fits, &filter_band, &filters);
-        let wp = vibmode_spectra::WelchParams {
-            nperseg: Some(256.min(ch.samples.len())),
-            ..Default::default()
-        };
-        let w = vibmode_spectra::welch(&ch.samples, rec.fs_hz, &wp)?;
-        out.welch_freq_hz = w.freq_hz;
-        out.welch_psd = w.psd;
-        channels.push(out);
-    }
-    let out = SweepOutput {
-        source: a.input.input.display().to_string(),
-        fs_hz: rec.fs_hz,
-        n_samples: rec.len(),
-        model: a.model,
-        channels,
+    let model = match a.model {
+        ModelKind::Arma => SweepModel::Arma,
+        ModelKind::Ar => SweepModel::Ar,
     };
+    let out = vibmode_run::sweep::sweep(
+        &rec,
+        &a.input.input.display().to_string(),
+        model,
+        ar_method,
+        &orders,
+        &params,
+        &filter_band,
+    )?;
     if let Some(path) = &a.plot {
         write_plots(path, &out)?;
     }
     match &a.json {
         Some(dest) => write_json(dest, &out)?,
-        None => {
-            let mut text = String::new();
-            for c in &out.channels {
-                let nc = c.converged.iter().filter(|x| !**x).count();
-                text += &format!(
-                    "{}: {} orders, {} pole pairs ({} more left out by the pole filters: cancelled by a zero of C or above the valid band), {} fits not converged, {} failed",
-                    c.name,
-                    c.orders.len(),
-                    c.modes.len(),
-                    c.filtered_out.len(),
-                    nc,
-                    c.errors.iter().filter(|e| e.is_some()).count()
-                );
-                text.push('\n');
-            }
-            crate::output::print_stdout(&text)?;
-        }
+        None => crate::output::print_stdout(&out.summary_text())?,
     }
     Ok(())
 }

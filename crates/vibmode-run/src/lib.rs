@@ -29,9 +29,11 @@
 //! the value and the fix, never a command-line flag.
 
 mod demo;
+pub mod fit;
 pub mod psd;
 #[cfg(feature = "segment")]
 mod segmenting;
+pub mod sweep;
 mod update;
 
 use std::path::{Path, PathBuf};
@@ -119,6 +121,34 @@ pub enum RunError {
     NonFiniteSpectrum {
         /// The channel.
         channel: String,
+    },
+    /// Every fit of a channel's sweep failed.
+    #[error("channel '{channel}', order {order}: {source}")]
+    SweepFailed {
+        /// The channel.
+        channel: String,
+        /// The highest order.
+        order: usize,
+        /// Its fit's failure.
+        #[source]
+        source: vibmode_ident::IdentError,
+    },
+    /// A channel's fit failed.
+    #[error("channel '{channel}': {source}")]
+    FitFailed {
+        /// The channel.
+        channel: String,
+        /// Why.
+        #[source]
+        source: vibmode_ident::IdentError,
+    },
+    /// A fit came out with a non-finite estimate (never printed or written).
+    #[error("channel '{channel}': the fit produced a non-finite estimate (noise variance {noise_variance}); rescale the signal or lower the order")]
+    NonFiniteFit {
+        /// The channel.
+        channel: String,
+        /// Its noise variance.
+        noise_variance: f64,
     },
     /// A recording without channels.
     #[error("the recording has no channels; select at least one")]

@@ -1,0 +1,259 @@
+//! `vibmode sweep` as a library: every model order of every channel fitted, each fit's modes
+//! through the analysis' pole filters (kept, or left out with the reason), the Welch spectrum
+//! behind the stabilisation diagram; how the sweep is summarised and drawn.
+
+use serde::Serialize;
+use vibmode_core::{BandLimit, PoleFilterParams, SweepModel};
+use vibmode_ident::{ArMethod, ArmaModel, ArmaParams, IdentError, PoleRejection};
+use vibmode_signal::Recording;
+
+use crate::RunError;
+
+/// One pole pair of the sweep.
+#[derive(Serialize, Clone, Copy, Debug, PartialEq)]
+pub struct SweepMode {
+    /// Model order p.
+    pub order: usize,
+    /// Natural frequency, Hz.
+    pub frequency_hz: f64,
+    /// Damping ratio.
+    pub damping_ratio: f64,
+}
+
+/// A pole pair the pole filters left out, and why.
+#[derive(Serialize, Clone, Copy, Debug, PartialEq)]
+pub struct FilteredMode {
+    /// Model order p.
+    pub order: usize,
+    /// Natural frequency, Hz.
+    pub frequency_hz: f64,
+    /// Damping ratio.
+    pub damping_ratio: f64,
+    /// Why it is no mode.
+    pub reason: PoleRejection,
+}
+
+/// The sweep of one channel: per order (in `orders`' order) the loss, convergence and error,
+/// and all modes kept or left out.
+#[derive(Serialize, Clone, Debug)]
+pub struct SweepChannel {
+    /// Channel name.
+    pub name: String,
+    /// Unit of the samples.
+    pub unit: String,
+    /// The orders fitted.
+    pub orders: Vec<usize>,
+    /// Each fit's criterion (NaN where it failed).
+    pub loss: Vec<f64>,
+    /// Whether each fit converged.
+    pub converged: Vec<bool>,
+    /// Why a fit failed.
+    pub errors: Vec<Option<String>>,
+    /// The pole pairs that passed the pole filters.
+    pub modes: Vec<SweepMode>,
+    /// The pole pairs the filters left out.
+    pub filtered_out: Vec<FilteredMode>,
+    /// Welch frequencies (Hann, 256 samples), Hz.
+    pub welch_freq_hz: Vec<f64>,
+    /// Welch PSD.
+    pub welch_psd: Vec<f64>,
+}
+
+/// The sweep of a recording (`vibmode sweep --json`).
+#[derive(Serialize, Clone, Debug)]
+pub struct SweepOutput {
+    /// The file.
+    pub source: String,
+    /// Sampling rate, Hz.
+    pub fs_hz: f64,
+    /// Samples per channel.
+    pub n_samples: usize,
+    /// Model structure.
+    pub model: SweepModel,
+    /// One entry per channel.
+    pub channels: Vec<SweepChannel>,
+}
+
+impl SweepChannel {
+    /// An empty sweep of `orders` for a channel.
+    pub fn new(name: &str, unit: &str, orders: &[usize]) -> Self {
+        SweepChannel {
+            name: name.to_string(),
+            unit: unit.to_string(),
+            orders: orders.to_vec(),
+            loss: Vec::new(),
+            converged: Vec::new(),
+            errors: Vec::new(),
+            modes: Vec::new(),
+            filtered_out: Vec::new(),
+            welch_freq_hz: Vec::new(),
+            welch_psd: Vec::new(),
+        }
+    }
+
+    /// Adds every fit (`fits[i]` of order `orders[i]`): its loss, convergence or error, and its
+    /// modes split by the pole filters.
+    pub fn add_fits(
+        &mut self,
+        fits: &[Result<ArmaModel, IdentError>],
+        band: &BandLimit,
+        filters: &PoleFilterParams,
+    ) {
+        for (&order, f) in self.orders.iter().zip(fits) {
+            match f {
+                Ok(m) => {
+                    self.loss.push(m.loss);
+                    self.converged.push(m.converged);
+                    self.errors.push(None);
+                    for fm in vibmode_ident::filter_modes(m, band, filters) {
+                        let (frequency_hz, damping_ratio) =
+                            (fm.mode.frequency_hz, fm.mode.damping_ratio);
+                        match fm.rejected {
+                            None => self.modes.push(SweepMode {
+                                order,
+                                frequency_hz,
+                                damping_ratio,
+                            }),
+                            Some(reason) => self.filtered_out.push(FilteredMode {
+                                order,
+                                frequency_hz,
+                                damping_ratio,
+                                reason,
+                            }),
+                        }
+                    }
+                }
+                Err(e) => {
+                    self.loss.push(f64::NAN);
+                    self.converged.push(false);
+                    self.errors.push(Some(e.to_string()));
+                }
+            }
+        }
+    }
+}
+
+/// The fits of one signal at every order: ARMA(p, p) warm-started order to order, or AR(p) by
+/// `ar_method`.
+pub fn sweep_fits(
+    y: &[f64],
+    model: SweepModel,
+    ar_method: ArMethod,
+    orders: &[usize],
+    params: &ArmaParams,
+) -> Vec<Result<ArmaModel, IdentError>> {
+    match model {
+        SweepModel::Arma => vibmode_ident::sweep_arma(y, orders, params),
+        SweepModel::Ar => orders
+            .iter()
+            .map(|&p| vibmode_ident::fit_ar(y, p, ar_method))
+            .collect(),
+    }
+}
+
+/// The sweep of every channel of `rec` (read from `source`). `band`: what the signal carries
+/// (the pole filters' band). A channel whose every fit fails is an error with the highest
+/// order's reason.
+pub fn sweep(
+    rec: &Recording,
+    source: &str,
+    model: SweepModel,
+    ar_method: ArMethod,
+    orders: &[usize],
+    params: &ArmaParams,
+    band: &BandLimit,
+) -> Result<SweepOutput, RunError> {
+    let filters = PoleFilterParams::default();
+    let max_order = orders.iter().copied().max().unwrap_or(1);
+    let mut channels = Vec::new();
+    for ch in &rec.channels {
+        let fits = sweep_fits(&ch.samples, model, ar_method, orders, params);
+        if fits.iter().all(|f| f.is_err()) {
+            if let Some(Err(e)) = fits.into_iter().last() {
+                return Err(RunError::SweepFailed {
+                    channel: ch.name.clone(),
+                    order: max_order,
+                    source: e,
+                });
+            }
+            return Err(RunError::NoChannels);
+        }
+        let mut out = SweepChannel::new(&ch.name, &ch.unit, orders);
+        out.add_fits(&fits, band, &filters);
+        let wp = vibmode_spectra::WelchParams {
+            nperseg: Some(256.min(ch.samples.len())),
+            ..Default::default()
+        };
+        let w = vibmode_spectra::welch(&ch.samples, rec.fs_hz, &wp).map_err(|source| {
+            RunError::Spectrum {
+                channel: ch.name.clone(),
+                source,
+            }
+        })?;
+        out.welch_freq_hz = w.freq_hz;
+        out.welch_psd = w.psd;
+        channels.push(out);
+    }
+    Ok(SweepOutput {
+        source: source.to_string(),
+        fs_hz: rec.fs_hz,
+        n_samples: rec.len(),
+        model,
+        channels,
+    })
+}
+
+impl SweepOutput {
+    /// One line per channel: orders, pole pairs kept and left out, fits not converged and
+    /// failed.
+    pub fn summary_text(&self) -> String {
+        let mut text = String::new();
+        for c in &self.channels {
+            let nc = c.converged.iter().filter(|x| !**x).count();
+            text += &format!(
+                "{}: {} orders, {} pole pairs ({} more left out by the pole filters: cancelled by a zero of C or above the valid band), {} fits not converged, {} failed",
+                c.name,
+                c.orders.len(),
+                c.modes.len(),
+                c.filtered_out.len(),
+                nc,
+                c.errors.iter().filter(|e| e.is_some()).count()
+            );
+            text.push('\n');
+        }
+        text
+    }
+
+    /// The stabilisation diagrams (one panel per channel, over its Welch spectrum) and the
+    /// frequency-damping plots.
+    #[cfg(feature = "report")]
+    pub fn figures(&self) -> (vibmode_report::Figure, vibmode_report::Figure) {
+        use vibmode_report::panels as figures;
+        let mut stab = Vec::new();
+        let mut damp = Vec::new();
+        for c in &self.channels {
+            let pts: Vec<(usize, f64, f64)> = c
+                .modes
+                .iter()
+                .map(|m| (m.order, m.frequency_hz, m.damping_ratio))
+                .collect();
+            stab.push(figures::stabilisation_panel(
+                &format!("{}: stabilisation diagram", c.name),
+                &pts,
+                &c.welch_freq_hz,
+                &c.welch_psd,
+                self.fs_hz / 2.0,
+            ));
+            damp.push(figures::damping_panel(
+                &format!("{}: frequency vs damping", c.name),
+                &pts,
+                &[],
+                self.fs_hz / 2.0,
+            ));
+        }
+        (
+            figures::grid(stab, 1, 1000, 520),
+            figures::grid(damp, 1, 1000, 520),
+        )
+    }
+}
