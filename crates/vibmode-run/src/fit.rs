@@ -326,6 +326,7 @@ pub fn fit_figure(
 }
 
 /// Points of the model-PSD grid of `fit --plot`, 0 to Nyquist.
+#[cfg(feature = "report")]
 const MODEL_GRID_POINTS: usize = 1000;
 
 #[cfg(test)]
