@@ -6,12 +6,9 @@ use crate::input::InputArgs;
 use crate::output::write_json;
 use anyhow::{Context, Result};
 use clap::Args;
-use serde::Serialize;
-use std::fmt::Write as _;
 use std::path::PathBuf;
-use vibmode_core::{InvariantMode, ModeClass, SsiParams};
-use vibmode_report::panels as figures;
-use vibmode_ssi::{RecordSsi, RecordSsiOptions};
+use vibmode_core::SsiParams;
+use vibmode_ssi::RecordSsiOptions;
 
 /// Arguments of `vibmode ssi`.
 #[derive(Args, Debug)]
@@ -55,15 +52,6 @@ pub struct SsiArgs {
     /// samples). Off by default.
     #[arg(long)]
     pub uncertainty_blocks: Option<usize>,
-}
-
-#[derive(Serialize)]
-struct SsiOutput {
-    source: String,
-    channels: Vec<String>,
-    /// Parameters, every order's modes and labels, and the clusters (structural ones first).
-    #[serde(flatten)]
-    found: RecordSsi,
 }
 
 /// The SSI parameters and the orders to identify (`--orders` as given, or the default range).
@@ -126,7 +114,6 @@ pub fn run(a: &SsiArgs) -> Result<()> {
     crate::output::check_outputs(&a.input.input, &[], &[a.plot.as_deref()], a.json.as_deref())?;
     let (p, orders) = params(a)?;
     let (rec, band) = a.input.load_with_band()?;
-    let chans: Vec<&[f64]> = rec.channels.iter().map(|c| c.samples.as_slice()).collect();
     let options = RecordSsiOptions {
         normalise: !a.no_normalise,
         valid_max_hz: band.map(|b| b.valid_max_hz()),
@@ -134,135 +121,17 @@ pub fn run(a: &SsiArgs) -> Result<()> {
         orders: Some(orders),
         ..RecordSsiOptions::default()
     };
-    let found = vibmode_ssi::identify_record(&chans, rec.fs_hz, &p, &options)?;
-    let f_max = options.valid_max_hz.unwrap_or(rec.fs_hz / 2.0);
-    let out = SsiOutput {
-        source: a.input.input.display().to_string(),
-        channels: rec.channels.iter().map(|c| c.name.clone()).collect(),
-        found,
-    };
+    let out = vibmode_run::ssi::ssi(&rec, &a.input.input.display().to_string(), &p, &options)?;
     if let Some(path) = &a.plot {
-        write_plot(path, &out, &rec, f_max)?;
+        let f_max = options.valid_max_hz.unwrap_or(rec.fs_hz / 2.0);
+        out.figure(&rec, f_max)?
+            .save(path)
+            .with_context(|| format!("writing plot {}", path.display()))?;
+        eprintln!("wrote {}", path.display());
     }
     match &a.json {
         Some(dest) => write_json(dest, &out)?,
-        None => crate::output::print_stdout(&summary(&out))?,
+        None => crate::output::print_stdout(&out.summary_text())?,
     }
-    Ok(())
-}
-
-/// The modes that stay over the orders, with their shapes (modulus and phase per channel).
-fn summary(out: &SsiOutput) -> String {
-    let mut s = format!(
-        "{}: SSI-cov of {} channels ({} samples at {} Hz), {} block rows (lags {}..{}), orders {}..{}\n",
-        out.source,
-        out.channels.len(),
-        out.found.n_samples,
-        out.found.fs_hz,
-        out.found.params.block_rows,
-        out.found.params.first_lag,
-        out.found.params.first_lag + 2 * out.found.params.block_rows - 2,
-        out.found.result.orders.first().map_or(0, |o| o.order),
-        out.found.result.orders.last().map_or(0, |o| o.order),
-    );
-    let structural: Vec<&InvariantMode> = out
-        .found
-        .modes
-        .iter()
-        .filter(|m| m.class == ModeClass::Structural)
-        .collect();
-    if structural.is_empty() {
-        s.push_str(
-            "No mode stays over half the orders (poles scattered); try more block rows, more samples or a longer record.\n",
-        );
-    }
-    for m in structural {
-        let _ = write!(
-            s,
-            "  {:>8.3} Hz  damping {:.4}  in {:.0} % of orders",
-            m.frequency_hz,
-            m.damping_ratio,
-            100.0 * m.order_share
-        );
-        if let Some((med, _)) = m.shape_mac {
-            let _ = write!(s, ", shape MAC {med:.2}");
-        }
-        if let Some(u) = &m.uncertainty {
-            let _ = write!(
-                s,
-                ", sd {:.4} Hz / damping {:.4} (first order, {} blocks)",
-                u.frequency_std_hz,
-                u.damping_std,
-                out.found.uncertainty_blocks.unwrap_or(0)
-            );
-        }
-        s.push('\n');
-        if let Some(shape) = &m.shape {
-            let parts: Vec<String> = out
-                .channels
-                .iter()
-                .zip(shape)
-                .map(|(c, v)| {
-                    format!(
-                        "{c} {:.2}/{:+.0}deg",
-                        v[0].hypot(v[1]),
-                        v[1].atan2(v[0]).to_degrees()
-                    )
-                })
-                .collect();
-            let _ = writeln!(s, "      shape: {}", parts.join(", "));
-        }
-    }
-    s
-}
-
-fn write_plot(
-    path: &std::path::Path,
-    out: &SsiOutput,
-    rec: &vibmode_core::Recording,
-    f_max: f64,
-) -> Result<()> {
-    let pts: Vec<(usize, f64, f64)> = out
-        .found
-        .result
-        .orders
-        .iter()
-        .flat_map(|o| {
-            o.modes
-                .iter()
-                .map(move |m| (o.order, m.frequency_hz, m.damping_ratio))
-        })
-        .collect();
-    // The Welch PSD summed over the channels, drawn behind the poles.
-    let mut freq = Vec::new();
-    let mut psd: Vec<f64> = Vec::new();
-    for ch in &rec.channels {
-        let wp = vibmode_spectra::WelchParams {
-            nperseg: Some(256.min(ch.samples.len())),
-            ..Default::default()
-        };
-        let w = vibmode_spectra::welch(&ch.samples, rec.fs_hz, &wp)?;
-        if psd.is_empty() {
-            psd = vec![0.0; w.psd.len()];
-            freq = w.freq_hz;
-        }
-        for (a, b) in psd.iter_mut().zip(&w.psd) {
-            *a += b;
-        }
-    }
-    let panel = figures::stabilisation_panel(
-        &format!(
-            "SSI-cov stabilisation diagram ({} channels)",
-            out.channels.len()
-        ),
-        &pts,
-        &freq,
-        &psd,
-        f_max,
-    );
-    figures::grid(vec![panel], 1, 1000, 520)
-        .save(path)
-        .with_context(|| format!("writing plot {}", path.display()))?;
-    eprintln!("wrote {}", path.display());
     Ok(())
 }

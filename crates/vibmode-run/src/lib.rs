@@ -33,6 +33,7 @@ pub mod fit;
 pub mod psd;
 #[cfg(feature = "segment")]
 mod segmenting;
+pub mod ssi;
 pub mod sweep;
 mod update;
 
@@ -150,6 +151,9 @@ pub enum RunError {
         /// Its noise variance.
         noise_variance: f64,
     },
+    /// SSI-cov of a record failed.
+    #[error("{0}")]
+    Ssi(#[from] vibmode_ssi::SsiError),
     /// A recording without channels.
     #[error("the recording has no channels; select at least one")]
     NoChannels,
