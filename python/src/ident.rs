@@ -4,8 +4,8 @@ use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use serde::Serialize;
-use vibmode_core::{BandLimit, PoleFilterParams, SweepParams};
-use vibmode_ident::{ArMethod, ArmaModel, ArmaParams, IdentError, ModeSet, PoleRejection, Robust};
+use vibmode_core::{BandLimit, PoleFilterParams, SweepModel, SweepParams};
+use vibmode_ident::{ArMethod, ArmaModel, ArmaParams, IdentError, ModeSet, Robust};
 
 use crate::errors::{json_err, value_err};
 
@@ -159,23 +159,6 @@ fn arma_psd<'py>(
     Ok(vibmode_ident::arma_psd(&a, &c, noise_variance, &f, fs).into_pyarray(py))
 }
 
-/// One pole pair of the sweep.
-#[derive(Serialize)]
-struct SweepMode {
-    order: usize,
-    frequency_hz: f64,
-    damping_ratio: f64,
-}
-
-/// A pole pair the pole filters left out, and why.
-#[derive(Serialize)]
-struct Filtered {
-    order: usize,
-    frequency_hz: f64,
-    damping_ratio: f64,
-    reason: PoleRejection,
-}
-
 /// One fit of the sweep.
 #[derive(Serialize)]
 struct SweepFit {
@@ -194,8 +177,8 @@ struct SweepOut {
     n_samples: usize,
     model: String,
     fits: Vec<SweepFit>,
-    modes: Vec<SweepMode>,
-    filtered_out: Vec<Filtered>,
+    modes: Vec<vibmode_run::sweep::SweepMode>,
+    filtered_out: Vec<vibmode_run::sweep::FilteredMode>,
 }
 
 /// Order sweep of one signal (`vibmode sweep`): every order's fit and modes, split by the
@@ -227,23 +210,17 @@ fn sweep(
         tolerance,
         ..ArmaParams::default()
     };
-    let fits: Vec<Result<ArmaModel, IdentError>> = match model {
-        "arma" => py.detach(|| vibmode_ident::sweep_arma(&y, &orders, &params)),
-        "ar" => {
-            let m: ArMethod = method.parse().map_err(value_err)?;
-            py.detach(|| {
-                orders
-                    .iter()
-                    .map(|&p| vibmode_ident::fit_ar(&y, p, m))
-                    .collect()
-            })
-        }
+    let (kind, ar_method) = match model {
+        "arma" => (SweepModel::Arma, ArMethod::Burg),
+        "ar" => (SweepModel::Ar, method.parse().map_err(value_err)?),
         other => {
             return Err(PyValueError::new_err(format!(
                 "model = '{other}' is unknown; use 'arma' (ARMA(p, p)) or 'ar'"
             )))
         }
     };
+    let fits: Vec<Result<ArmaModel, IdentError>> =
+        py.detach(|| vibmode_run::sweep::sweep_fits(&y, kind, ar_method, &orders, &params));
     if let Some(Err(e)) = fits
         .iter()
         .find(|f| f.is_err())
@@ -251,20 +228,19 @@ fn sweep(
     {
         return Err(value_err(e));
     }
+    // The modes split by the pole filters: the sweep's one collection (`vibmode sweep`'s).
     let band = BandLimit::full(fs);
-    let filters = PoleFilterParams::default();
-    let mut out = SweepOut {
+    let mut ch = vibmode_run::sweep::SweepChannel::new("", "", &orders);
+    ch.add_fits(&fits, &band, &PoleFilterParams::default());
+    let out = SweepOut {
         fs_hz: fs,
         n_samples: y.len(),
         model: model.to_string(),
-        fits: Vec::new(),
-        modes: Vec::new(),
-        filtered_out: Vec::new(),
-    };
-    for (&order, f) in orders.iter().zip(fits) {
-        match f {
-            Ok(m) => {
-                out.fits.push(SweepFit {
+        fits: orders
+            .iter()
+            .zip(&fits)
+            .map(|(&order, f)| match f {
+                Ok(m) => SweepFit {
                     order,
                     loss: Some(m.loss),
                     noise_variance: Some(m.noise_variance),
@@ -272,35 +248,20 @@ fn sweep(
                     converged: m.converged,
                     iterations: m.iterations,
                     error: None,
-                });
-                for fm in vibmode_ident::filter_modes(&m, &band, &filters) {
-                    let (frequency_hz, damping_ratio) =
-                        (fm.mode.frequency_hz, fm.mode.damping_ratio);
-                    match fm.rejected {
-                        None => out.modes.push(SweepMode {
-                            order,
-                            frequency_hz,
-                            damping_ratio,
-                        }),
-                        Some(reason) => out.filtered_out.push(Filtered {
-                            order,
-                            frequency_hz,
-                            damping_ratio,
-                            reason,
-                        }),
-                    }
-                }
-            }
-            Err(e) => out.fits.push(SweepFit {
-                order,
-                loss: None,
-                noise_variance: None,
-                aic: None,
-                converged: false,
-                iterations: 0,
-                error: Some(e.to_string()),
-            }),
-        }
-    }
+                },
+                Err(e) => SweepFit {
+                    order,
+                    loss: None,
+                    noise_variance: None,
+                    aic: None,
+                    converged: false,
+                    iterations: 0,
+                    error: Some(e.to_string()),
+                },
+            })
+            .collect(),
+        modes: ch.modes,
+        filtered_out: ch.filtered_out,
+    };
     serde_json::to_string(&out).map_err(json_err)
 }
