@@ -18,6 +18,9 @@ Each drive is given to one `fleet check --json -` (its 8 records: one drive). Sc
   the record or the drive); `both` counts as a false `both` unless a fault is present;
 - class D: `road`; `both` there is a false `both`.
 
+The component a fault drive names (`drives[].component`: damper, spring, tyre or suspension) is
+counted apart: a right fault drive whose component is the fault's.
+
 The drive's verdict is the JSON's `drives` entry when the binary writes one, else (older
 binaries) it is not scored per drive.
 
@@ -67,7 +70,8 @@ def conditions(bus_seed: int, rng: random.Random) -> List[Dict]:
     for name, opt, scale in FAULTS:
         corner = rng.choice(CORNERS)
         out.append({"name": name, "extra": [opt, f"{corner}={scale}"], "expect": "vehicle",
-                    "corner": corner.upper(), "detail": f"{opt[2:]} {corner.upper()}={scale}"})
+                    "corner": corner.upper(), "component": opt[2:],
+                    "detail": f"{opt[2:]} {corner.upper()}={scale}"})
     out.append({"name": "roadD", "extra": ["--road-class", "D"], "expect": "road",
                 "corner": None, "detail": "class D"})
     return out
@@ -114,12 +118,14 @@ def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random) -> Di
         if drives:
             dv = drives[0]
             drive = (dv["classification"], dv.get("corner") or first_corner(dv.get("evidence", [])),
-                     dv.get("summary", ""))
+                     dv.get("summary", ""), dv.get("component"))
         rows.append({"bus": bus_seed, "cond": cond["name"], "detail": cond["detail"],
                      "expect": cond["expect"], "corner": cond["corner"], "records": recs,
                      "drive": drive,
                      "record_ok": sum(verdict_ok(c, k, cond) for c, k, _ in recs),
                      "drive_ok": None if drive is None else verdict_ok(drive[0], drive[1], cond),
+                     "component_ok": None if drive is None or not cond.get("component")
+                     else verdict_ok(drive[0], drive[1], cond) and drive[3] == cond["component"],
                      "false_both": sum(c == "both" for c, _, _ in recs)
                      if cond["expect"] != "vehicle" else 0})
     db.unlink()
@@ -132,21 +138,26 @@ def summarise(buses: List[Dict]) -> Dict[str, Dict]:
     for b in buses:
         for r in b["rows"]:
             s = summary.setdefault(r["cond"], {"rec_ok": 0, "rec_n": 0, "drive_ok": 0,
-                                               "drive_n": 0, "false_both": 0})
+                                               "drive_n": 0, "false_both": 0,
+                                               "component_ok": 0})
             s["rec_ok"] += r["record_ok"]
             s["rec_n"] += len(r["records"])
             s["false_both"] += r["false_both"]
             if r["drive_ok"] is not None:
                 s["drive_ok"] += int(r["drive_ok"])
                 s["drive_n"] += 1
+            if r.get("component_ok"):
+                s["component_ok"] += 1
     return summary
 
 
 def print_row(r: Dict) -> None:
     classes = " ".join(f"{c}{'/' + k if k else ''}" for c, k, _ in r["records"])
-    drive = "-" if r["drive"] is None else f"{r['drive'][0]}{'/' + r['drive'][1] if r['drive'][1] else ''}"
+    drive = "-" if r["drive"] is None else (
+        f"{r['drive'][0]}{'/' + r['drive'][1] if r['drive'][1] else ''}"
+        f"{'/' + r['drive'][3] if r['drive'][3] else ''}")
     print(f"bus {r['bus']:>5} {r['cond']:<9} {r['detail']:<34} records {r['record_ok']}/"
-          f"{len(r['records'])} drive {drive:<12} [{classes}]", flush=True)
+          f"{len(r['records'])} drive {drive:<18} [{classes}]", flush=True)
     bad = [s for (c, k, s) in r["records"] if not verdict_ok(c, k, {"expect": r["expect"],
                                                                       "corner": r["corner"]})]
     if bad:
@@ -192,10 +203,13 @@ def measure(seeds: List[int], n_records: int = h.RECORDS) -> List[Dict]:
 
 def print_summary(summary: Dict[str, Dict]) -> None:
     print("summary (right = healthy normal; fault vehicle|both with its corner first; "
-          "class D road):")
+          "class D road; component = right drives naming the fault's component):")
     for cond, s in summary.items():
+        comp = (f" component {s.get('component_ok', 0)}/{s['drive_n']}"
+                if cond not in ("healthy", "roadD") else "")
         print(f"  {cond:<9} records {h.rate(s['rec_ok'], s['rec_n']):<16} drives "
-              f"{h.rate(s['drive_ok'], s['drive_n']):<14} false 'both' records {s['false_both']}")
+              f"{h.rate(s['drive_ok'], s['drive_n']):<14} false 'both' records "
+              f"{s['false_both']}{comp}")
 
 
 if __name__ == "__main__":
