@@ -24,7 +24,11 @@ counted apart: a right fault drive whose component is the fault's.
 The drive's verdict is the JSON's `drives` entry when the binary writes one, else (older
 binaries) it is not scored per drive.
 
-Usage: python3 tools/busgen/fleet.py [--buses N] [--records 8] [--json OUT]
+`--test-extra=--no-periodic` (with `=`: the value starts with dashes) adds busgen options to
+every checked drive (not the baseline), e.g. to see what the driveline lines or the sensor
+noise do to a verdict.
+
+Usage: python3 tools/busgen/fleet.py [--buses N] [--records 8] [--json OUT] [--test-extra OPTS]
 Needs VIBMODE_BIN (else target/release/vibmode) and a Python with numpy+scipy for busgen
 (BUSGEN_PYTHON).
 """
@@ -90,7 +94,8 @@ def verdict_ok(cls: str, corner: Optional[str], cond: Dict) -> bool:
     return cls == cond["expect"]
 
 
-def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random) -> Dict:
+def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
+            test_extra: Optional[List[str]] = None) -> Dict:
     """Simulates, ingests, baselines and checks one bus; returns its rows."""
     db = work / f"fleet-{bus_seed}.db"
     if db.exists():
@@ -107,7 +112,8 @@ def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random) -> Di
     rows = []
     for i, cond in enumerate(conditions(bus_seed, rng)):
         seed = base_seed + 10000 * (i + 1)
-        folder = h.simulate(bus_seed, seed, *cond["extra"], records=n_records)
+        folder = h.simulate(bus_seed, seed, *cond["extra"], *(test_extra or []),
+                            records=n_records)
         r = h.run_vibmode(["fleet", "check", "--db", db, "--vehicle", vehicle, "-q",
                            "--json", "-", *h.records(folder)])
         out = json.loads(r.stdout)
@@ -169,6 +175,9 @@ def main(argv: Optional[List[str]] = None) -> int:
     p.add_argument("--buses", type=int, default=4)
     p.add_argument("--records", type=int, default=h.RECORDS, help="records per drive")
     p.add_argument("--json", type=Path, help="write the rows and the summary here")
+    p.add_argument("--test-extra", default="",
+                   help="busgen options added to every checked drive, "
+                        "e.g. --test-extra=--no-periodic")
     a = p.parse_args(argv)
     try:
         h.vibmode_bin()
@@ -178,7 +187,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         print(f"skipped: {e}")
         return 0
     seeds = h.draw_bus_seeds(a.buses, "fleet")
-    buses = measure(seeds, a.records)
+    buses = measure(seeds, a.records, a.test_extra.split())
     summary = summarise(buses)
     print_summary(summary)
     if a.json:
@@ -186,13 +195,14 @@ def main(argv: Optional[List[str]] = None) -> int:
     return 0
 
 
-def measure(seeds: List[int], n_records: int = h.RECORDS) -> List[Dict]:
+def measure(seeds: List[int], n_records: int = h.RECORDS,
+            test_extra: Optional[List[str]] = None) -> List[Dict]:
     work = Path(tempfile.mkdtemp(prefix="vibmode-fleet-busgen-"))
     buses = []
     try:
         for s in seeds:
             rng = random.Random(s * 7919 + n_records)
-            b = run_bus(s, n_records, work, rng)
+            b = run_bus(s, n_records, work, rng, test_extra)
             for r in b["rows"]:
                 print_row(r)
             buses.append(b)
