@@ -278,11 +278,16 @@ fn check(a: &CheckArgs) -> Result<()> {
     }
     if let Some(d) = &drive {
         text.push_str(&format!(
-            "drive {} ({} records, median of each feature; false alarms per drive at most {} %): {}  {}\n",
+            "drive {} ({} records, median of each feature; false alarms per drive at most {} %): {}{}  {}\n",
             d.drive,
             d.records.len(),
             100.0 * d.false_alarm_rate,
             d.assessment.classification,
+            match (d.corner, d.assessment.component) {
+                (Some(c), Some(k)) => format!(" ({c} {k})"),
+                (Some(c), None) => format!(" ({c})"),
+                _ => String::new(),
+            },
             if d.assessment.summary.is_empty() {
                 "-"
             } else {
@@ -321,15 +326,15 @@ fn status(db: &std::path::Path) -> Result<()> {
     }
     // One row per vehicle first: its latest drive verdict, the corner, since when, how sure.
     let mut text = String::from(
-        "vehicle          latest drive verdict  corner  since                 |z|/limit  drive\n",
+        "vehicle          latest drive verdict  corner, component  since                 |z|/limit  drive\n",
     );
     for v in &st {
         match &v.latest_drive {
             Some(d) => text.push_str(&format!(
-                "{:<16} {:<21} {:<7} {:<21} {:>9}  {} ({} records, false alarms <= {} per drive)\n",
+                "{:<16} {:<21} {:<18} {:<21} {:>9}  {} ({} records, false alarms <= {} per drive)\n",
                 v.vehicle,
                 d.classification.to_string(),
-                d.corner.as_deref().unwrap_or("-"),
+                d.place(),
                 d.since,
                 d.vehicle_z_over_limit
                     .map_or("-".to_string(), |z| format!("{z:.2}")),
@@ -354,10 +359,10 @@ fn status(db: &std::path::Path) -> Result<()> {
             text.push_str("  drives, newest first:\n");
             for d in &v.drives {
                 text.push_str(&format!(
-                    "    {} {:<8} {:<4} {} {}\n",
+                    "    {} {:<8} {:<15} {} {}\n",
                     d.checked,
                     d.classification.to_string(),
-                    d.corner.as_deref().unwrap_or("-"),
+                    d.place(),
                     d.drive,
                     d.summary
                 ));

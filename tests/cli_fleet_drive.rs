@@ -65,6 +65,8 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
     assert_eq!(dr["records"].as_array().unwrap().len(), 4);
     assert_eq!(dr["false_alarm_rate"], 0.01);
     assert_eq!(dr["classification"], "normal", "{dr}");
+    // No vehicle evidence: no component named.
+    assert!(dr.get("component").is_none(), "{dr}");
     assert_eq!(n_test(db, "bus-1"), 4);
     let drives = || {
         vibmode_fleet::Store::open(std::path::Path::new(db))

@@ -18,10 +18,17 @@ Each drive is given to one `fleet check --json -` (its 8 records: one drive). Sc
   the record or the drive); `both` counts as a false `both` unless a fault is present;
 - class D: `road`; `both` there is a false `both`.
 
+The component a fault drive names (`drives[].component`: damper, spring, tyre or suspension) is
+counted apart: a right fault drive whose component is the fault's.
+
 The drive's verdict is the JSON's `drives` entry when the binary writes one, else (older
 binaries) it is not scored per drive.
 
-Usage: python3 tools/busgen/fleet.py [--buses N] [--records 8] [--json OUT]
+`--test-extra=--no-periodic` (with `=`: the value starts with dashes) adds busgen options to
+every checked drive (not the baseline), e.g. to see what the driveline lines or the sensor
+noise do to a verdict.
+
+Usage: python3 tools/busgen/fleet.py [--buses N] [--records 8] [--json OUT] [--test-extra OPTS]
 Needs VIBMODE_BIN (else target/release/vibmode) and a Python with numpy+scipy for busgen
 (BUSGEN_PYTHON).
 """
@@ -67,7 +74,8 @@ def conditions(bus_seed: int, rng: random.Random) -> List[Dict]:
     for name, opt, scale in FAULTS:
         corner = rng.choice(CORNERS)
         out.append({"name": name, "extra": [opt, f"{corner}={scale}"], "expect": "vehicle",
-                    "corner": corner.upper(), "detail": f"{opt[2:]} {corner.upper()}={scale}"})
+                    "corner": corner.upper(), "component": opt[2:],
+                    "detail": f"{opt[2:]} {corner.upper()}={scale}"})
     out.append({"name": "roadD", "extra": ["--road-class", "D"], "expect": "road",
                 "corner": None, "detail": "class D"})
     return out
@@ -86,7 +94,8 @@ def verdict_ok(cls: str, corner: Optional[str], cond: Dict) -> bool:
     return cls == cond["expect"]
 
 
-def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random) -> Dict:
+def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
+            test_extra: Optional[List[str]] = None) -> Dict:
     """Simulates, ingests, baselines and checks one bus; returns its rows."""
     db = work / f"fleet-{bus_seed}.db"
     if db.exists():
@@ -103,7 +112,8 @@ def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random) -> Di
     rows = []
     for i, cond in enumerate(conditions(bus_seed, rng)):
         seed = base_seed + 10000 * (i + 1)
-        folder = h.simulate(bus_seed, seed, *cond["extra"], records=n_records)
+        folder = h.simulate(bus_seed, seed, *cond["extra"], *(test_extra or []),
+                            records=n_records)
         r = h.run_vibmode(["fleet", "check", "--db", db, "--vehicle", vehicle, "-q",
                            "--json", "-", *h.records(folder)])
         out = json.loads(r.stdout)
@@ -114,12 +124,14 @@ def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random) -> Di
         if drives:
             dv = drives[0]
             drive = (dv["classification"], dv.get("corner") or first_corner(dv.get("evidence", [])),
-                     dv.get("summary", ""))
+                     dv.get("summary", ""), dv.get("component"))
         rows.append({"bus": bus_seed, "cond": cond["name"], "detail": cond["detail"],
                      "expect": cond["expect"], "corner": cond["corner"], "records": recs,
                      "drive": drive,
                      "record_ok": sum(verdict_ok(c, k, cond) for c, k, _ in recs),
                      "drive_ok": None if drive is None else verdict_ok(drive[0], drive[1], cond),
+                     "component_ok": None if drive is None or not cond.get("component")
+                     else verdict_ok(drive[0], drive[1], cond) and drive[3] == cond["component"],
                      "false_both": sum(c == "both" for c, _, _ in recs)
                      if cond["expect"] != "vehicle" else 0})
     db.unlink()
@@ -132,21 +144,26 @@ def summarise(buses: List[Dict]) -> Dict[str, Dict]:
     for b in buses:
         for r in b["rows"]:
             s = summary.setdefault(r["cond"], {"rec_ok": 0, "rec_n": 0, "drive_ok": 0,
-                                               "drive_n": 0, "false_both": 0})
+                                               "drive_n": 0, "false_both": 0,
+                                               "component_ok": 0})
             s["rec_ok"] += r["record_ok"]
             s["rec_n"] += len(r["records"])
             s["false_both"] += r["false_both"]
             if r["drive_ok"] is not None:
                 s["drive_ok"] += int(r["drive_ok"])
                 s["drive_n"] += 1
+            if r.get("component_ok"):
+                s["component_ok"] += 1
     return summary
 
 
 def print_row(r: Dict) -> None:
     classes = " ".join(f"{c}{'/' + k if k else ''}" for c, k, _ in r["records"])
-    drive = "-" if r["drive"] is None else f"{r['drive'][0]}{'/' + r['drive'][1] if r['drive'][1] else ''}"
+    drive = "-" if r["drive"] is None else (
+        f"{r['drive'][0]}{'/' + r['drive'][1] if r['drive'][1] else ''}"
+        f"{'/' + r['drive'][3] if r['drive'][3] else ''}")
     print(f"bus {r['bus']:>5} {r['cond']:<9} {r['detail']:<34} records {r['record_ok']}/"
-          f"{len(r['records'])} drive {drive:<12} [{classes}]", flush=True)
+          f"{len(r['records'])} drive {drive:<18} [{classes}]", flush=True)
     bad = [s for (c, k, s) in r["records"] if not verdict_ok(c, k, {"expect": r["expect"],
                                                                       "corner": r["corner"]})]
     if bad:
@@ -158,6 +175,9 @@ def main(argv: Optional[List[str]] = None) -> int:
     p.add_argument("--buses", type=int, default=4)
     p.add_argument("--records", type=int, default=h.RECORDS, help="records per drive")
     p.add_argument("--json", type=Path, help="write the rows and the summary here")
+    p.add_argument("--test-extra", default="",
+                   help="busgen options added to every checked drive, "
+                        "e.g. --test-extra=--no-periodic")
     a = p.parse_args(argv)
     try:
         h.vibmode_bin()
@@ -167,7 +187,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         print(f"skipped: {e}")
         return 0
     seeds = h.draw_bus_seeds(a.buses, "fleet")
-    buses = measure(seeds, a.records)
+    buses = measure(seeds, a.records, a.test_extra.split())
     summary = summarise(buses)
     print_summary(summary)
     if a.json:
@@ -175,13 +195,14 @@ def main(argv: Optional[List[str]] = None) -> int:
     return 0
 
 
-def measure(seeds: List[int], n_records: int = h.RECORDS) -> List[Dict]:
+def measure(seeds: List[int], n_records: int = h.RECORDS,
+            test_extra: Optional[List[str]] = None) -> List[Dict]:
     work = Path(tempfile.mkdtemp(prefix="vibmode-fleet-busgen-"))
     buses = []
     try:
         for s in seeds:
             rng = random.Random(s * 7919 + n_records)
-            b = run_bus(s, n_records, work, rng)
+            b = run_bus(s, n_records, work, rng, test_extra)
             for r in b["rows"]:
                 print_row(r)
             buses.append(b)
@@ -192,10 +213,13 @@ def measure(seeds: List[int], n_records: int = h.RECORDS) -> List[Dict]:
 
 def print_summary(summary: Dict[str, Dict]) -> None:
     print("summary (right = healthy normal; fault vehicle|both with its corner first; "
-          "class D road):")
+          "class D road; component = right drives naming the fault's component):")
     for cond, s in summary.items():
+        comp = (f" component {s.get('component_ok', 0)}/{s['drive_n']}"
+                if cond not in ("healthy", "roadD") else "")
         print(f"  {cond:<9} records {h.rate(s['rec_ok'], s['rec_n']):<16} drives "
-              f"{h.rate(s['drive_ok'], s['drive_n']):<14} false 'both' records {s['false_both']}")
+              f"{h.rate(s['drive_ok'], s['drive_n']):<14} false 'both' records "
+              f"{s['false_both']}{comp}")
 
 
 if __name__ == "__main__":

@@ -33,8 +33,9 @@ pub use fleet::{
     Drive, IngestLabels, Ingested, DEFAULT_DRIVE_ID,
 };
 pub use model::{
-    assess, assess_drive, build_model_set, Assessment, Classification, Evidence, FeatureMeta,
-    FeatureStat, Group, Kind, KindLimit, ModeSlot, ModelSet, Scores, LOO_MARGIN, MIN_DRIVE_RECORDS,
+    assess, assess_drive, build_model_set, Assessment, Classification, Component, Evidence,
+    FeatureMeta, FeatureStat, Group, Kind, KindLimit, ModeSlot, ModelSet, Scores, LOO_MARGIN,
+    MIN_DRIVE_RECORDS,
 };
 #[cfg(feature = "report")]
 pub use report::write_fleet_report;

@@ -234,6 +234,34 @@ impl fmt::Display for Classification {
     }
 }
 
+/// The component of a corner a vehicle verdict points at (docs/fleet.md, "Which component").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Component {
+    /// The damper: the wheel's level above wheel hop raised against its neighbours.
+    Damper,
+    /// The spring: the body's response to the wheel motions lowered at the corner while the
+    /// wheel's level above wheel hop is not raised.
+    Spring,
+    /// The tyre: the wheel's level above wheel hop lowered against its neighbours, or its
+    /// wheel-hop frequency lowered.
+    Tyre,
+    /// The corner's suspension, without telling the component: the evidence fits more than one
+    /// component, or none of the rules above.
+    Suspension,
+}
+
+impl fmt::Display for Component {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Component::Damper => "damper",
+            Component::Spring => "spring",
+            Component::Tyre => "tyre",
+            Component::Suspension => "suspension",
+        })
+    }
+}
+
 /// One feature's comparison with the model set.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Evidence {
@@ -286,6 +314,10 @@ pub struct Assessment {
     /// before it existed.
     #[serde(default)]
     pub sensor_faults: Vec<crate::features::SensorFault>,
+    /// The component of the corner named first (the corner of the first vehicle evidence),
+    /// when a vehicle feature is flagged; absent in checks stored before it existed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub component: Option<Component>,
 }
 
 fn band_label(b: &[f64; 2]) -> String {
@@ -989,11 +1021,100 @@ fn score_values(set: &ModelSet, values: &[(FeatureMeta, f64)]) -> Assessment {
         classification: Classification::from_alarms(vehicle, road),
         scores,
         summary: summary(&evidence),
+        component: component(set, values, &evidence),
         evidence,
         missing,
         sensor_faults: Vec::new(),
     }
 }
+
+/// Signed score of the level ratio of `kind` that `corner` takes part in, read from that corner
+/// (its unsprung level over its neighbour's), if the values and the model set have it.
+fn corner_ratio_z(
+    set: &ModelSet,
+    values: &[(FeatureMeta, f64)],
+    kind: Kind,
+    corner: Corner,
+) -> Option<f64> {
+    let pairs = if kind == Kind::SideRatio {
+        AXLES
+    } else {
+        TRACKS
+    };
+    let (name, first, _) = pairs
+        .iter()
+        .find(|(_, a, b)| *a == corner || *b == corner)?;
+    let key = ratio_key(kind, name, &set.config.ratio_band_hz);
+    let f = set.features.iter().find(|f| f.meta.key == key)?;
+    let x = values.iter().find(|(m, _)| m.key == key).map(|(_, v)| *v)?;
+    let z = score(f, x, &set.config);
+    Some(if *first == corner { z } else { -z })
+}
+
+/// The component of the corner named first (that of the strongest flagged vehicle feature),
+/// from the flagged vehicle features of that corner:
+///
+/// - a level ratio at and above wheel hop read from the corner (after [`attribute_ratios`]):
+///   lowered is the tyre (a softer tyre lowers the wheel hop and the wheel's response above
+///   it), raised is the damper (a weaker damper lets the wheel move more at and above wheel
+///   hop);
+/// - a wheel-hop frequency of the corner lowered: the tyre;
+/// - the body's response to the wheel motions lowered at the corner, with neither of the
+///   above: the spring, if the corner's unsprung level ratios are present and none of them,
+///   read from the corner, lies more than [`SPRING_MAX_LEVEL_Z`] spreads above its centre (a
+///   damper weak enough to lower the body's response raises the wheel's level); else the
+///   suspension;
+/// - tyre and damper evidence together, or only other features (transmissibility, mode
+///   damping, a raised response): the suspension.
+///
+/// `None` without a flagged vehicle feature on a corner.
+fn component(
+    set: &ModelSet,
+    values: &[(FeatureMeta, f64)],
+    evidence: &[Evidence],
+) -> Option<Component> {
+    let corner = evidence
+        .iter()
+        .find(|e| e.meta.group == Group::Vehicle)?
+        .meta
+        .corner?;
+    let at: Vec<&Evidence> = evidence
+        .iter()
+        .filter(|e| e.meta.group == Group::Vehicle && e.meta.corner == Some(corner))
+        .collect();
+    let tyre = at.iter().any(|e| match e.meta.kind {
+        Kind::SideRatio | Kind::TrackRatio => e.z < 0.0,
+        Kind::ModeFrequency => e.meta.label.starts_with("wheel-hop") && e.z < 0.0,
+        _ => false,
+    });
+    let damper = at
+        .iter()
+        .any(|e| matches!(e.meta.kind, Kind::SideRatio | Kind::TrackRatio) && e.z > 0.0);
+    let body_lowered = at
+        .iter()
+        .any(|e| e.meta.kind == Kind::BodyResponse && e.z < 0.0);
+    Some(match (tyre, damper) {
+        (true, false) => Component::Tyre,
+        (false, true) => Component::Damper,
+        (true, true) => Component::Suspension,
+        (false, false) if body_lowered => {
+            let levels: Vec<f64> = [Kind::SideRatio, Kind::TrackRatio]
+                .into_iter()
+                .filter_map(|k| corner_ratio_z(set, values, k, corner))
+                .collect();
+            if !levels.is_empty() && levels.iter().all(|z| *z <= SPRING_MAX_LEVEL_Z) {
+                Component::Spring
+            } else {
+                Component::Suspension
+            }
+        }
+        (false, false) => Component::Suspension,
+    })
+}
+
+/// Largest score (spreads above the centre) of a corner's unsprung level ratio, read from the
+/// corner, at which a lowered body response is named the spring rather than the suspension.
+pub const SPRING_MAX_LEVEL_Z: f64 = 1.0;
 
 /// A level ratio of two wheels says that one of them moved, not which. A wheel station's fault
 /// moves the two ratios it takes part in (its axle's left/right and its side's front/rear) the
@@ -1582,7 +1703,7 @@ mod tests {
         assert_eq!(e.meta.label, "level vs FL 8-20 Hz");
         assert!((e.value - 1.5).abs() < 1e-12 && e.z > 0.0, "{e:?}");
         // Without the right-hand channels only the left track's ratio exists: flagged, it
-        // stays on its channel pair.
+        // stays on its channel pair (no corner, so no component).
         let mut r = wheels([0.6, 1.0, 1.0, 1.0]);
         r.channels
             .retain(|c| matches!(c.corner, Some(Corner::FL | Corner::RL)));
@@ -1594,5 +1715,100 @@ mod tests {
             "{}",
             a.summary
         );
+        assert_eq!(a.component, None);
+    }
+
+    /// Nominal wheel levels within +-2 % of 1, a different pattern per record.
+    fn wheel_set() -> ModelSet {
+        let recs: Vec<RecordFeatures> = (0..8)
+            .map(|i| {
+                let e = |k: usize| 1.0 + 0.02 * (((i * 3 + k * 5) % 7) as f64 / 3.0 - 1.0);
+                wheels([e(0), e(1), e(2), e(3)])
+            })
+            .collect();
+        let names: Vec<String> = (0..8).map(|i| format!("n{i}")).collect();
+        build_model_set("bus", &names, &recs, &FleetConfig::default()).expect("set")
+    }
+
+    #[test]
+    fn the_component_follows_the_direction_of_the_wheel_level() {
+        let set = wheel_set();
+        // A healthy record: no vehicle evidence, no component.
+        let a = assess(&set, &wheels([3.0, 3.0, 3.0, 3.0]));
+        assert_eq!(
+            (a.classification, a.component),
+            (Classification::Normal, None)
+        );
+        // FL 40 % lower: the tyre; RL 50 % higher: the damper.
+        let a = assess(&set, &wheels([0.6, 1.0, 1.0, 1.0]));
+        assert_eq!(a.component, Some(Component::Tyre), "{a:?}");
+        let a = assess(&set, &wheels([1.0, 1.0, 1.5, 1.0]));
+        assert_eq!(a.component, Some(Component::Damper), "{a:?}");
+        // JSON: `component` beside the classification; an assessment stored before it existed
+        // reads as none.
+        let json = serde_json::to_value(&a).expect("json");
+        assert_eq!(json["component"], "damper");
+        let mut old = json.clone();
+        old.as_object_mut().expect("object").remove("component");
+        let back: Assessment = serde_json::from_value(old).expect("old assessment");
+        assert_eq!(back.component, None);
+    }
+
+    /// A flagged body response of `corner` with score `z`.
+    fn body_evidence(corner: Corner, z: f64) -> Evidence {
+        Evidence {
+            meta: FeatureMeta {
+                key: format!("body:{corner}_sprung:2-4Hz"),
+                group: Group::Vehicle,
+                kind: Kind::BodyResponse,
+                corner: Some(corner),
+                channel: format!("{corner}_sprung"),
+                label: "body response to wheel motion 2-4 Hz vs the front axle".into(),
+            },
+            value: 1.0,
+            centre: 1.0,
+            z,
+            change_pct: 0.0,
+            limit: 4.0,
+            flagged: true,
+        }
+    }
+
+    #[test]
+    fn a_lowered_body_response_is_the_spring_only_when_the_wheel_level_is_not_raised() {
+        let set = wheel_set();
+        let cfg = &set.config;
+        let values = |l: [f64; 4]| scalar_features(&wheels(l), &set.slots, None, cfg);
+        let lowered = [body_evidence(Corner::RL, -6.0)];
+        // The wheel levels as nominal: the spring.
+        assert_eq!(
+            component(&set, &values([1.0; 4]), &lowered),
+            Some(Component::Spring)
+        );
+        // RL's level 8 % up: against FL (nominal centre ln(FL/RL) = -0.020, pooled spread
+        // 0.035) (0.077 - 0.020) / 0.035 = 1.6 spreads above, below the limit (the record alone
+        // is normal) but above SPRING_MAX_LEVEL_Z: a weak damper cannot be excluded.
+        assert_eq!(
+            assess(&set, &wheels([1.0, 1.0, 1.08, 1.0])).classification,
+            Classification::Normal
+        );
+        assert_eq!(
+            component(&set, &values([1.0, 1.0, 1.08, 1.0]), &lowered),
+            Some(Component::Suspension)
+        );
+        // RL's level 2 % down (within the scatter): still the spring.
+        assert_eq!(
+            component(&set, &values([1.0, 1.0, 0.98, 1.0]), &lowered),
+            Some(Component::Spring)
+        );
+        // Without the wheel levels it cannot tell the spring from the damper.
+        assert_eq!(component(&set, &[], &lowered), Some(Component::Suspension));
+        // A raised body response is no spring sign.
+        assert_eq!(
+            component(&set, &values([1.0; 4]), &[body_evidence(Corner::RL, 6.0)]),
+            Some(Component::Suspension)
+        );
+        // Nothing flagged: nothing named.
+        assert_eq!(component(&set, &values([1.0; 4]), &[]), None);
     }
 }

@@ -42,7 +42,7 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
             Some(d) => vec![
                 s.vehicle.clone(),
                 d.classification.to_string(),
-                d.corner.clone().unwrap_or_else(|| "-".into()),
+                d.place(),
                 d.since.clone(),
                 d.vehicle_z_over_limit
                     .map_or("-".into(), |z| format!("{z:.2}")),
@@ -68,7 +68,7 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
         &[
             "vehicle",
             "verdict",
-            "corner",
+            "corner, component",
             "since",
             "|z| / limit",
             "drive",
@@ -85,7 +85,7 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
                     d.checked.clone(),
                     d.drive.clone(),
                     d.classification.to_string(),
-                    d.corner.clone().unwrap_or_else(|| "-".into()),
+                    d.place(),
                 ]
             })
         })
@@ -93,7 +93,13 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
     if !timeline.is_empty() {
         html.heading(2, "Drive verdicts, newest first");
         html.table(
-            &["vehicle", "checked", "drive", "verdict", "corner"],
+            &[
+                "vehicle",
+                "checked",
+                "drive",
+                "verdict",
+                "corner, component",
+            ],
             &timeline,
         );
     }

@@ -170,6 +170,10 @@ pub struct DriveStatus {
     pub classification: Classification,
     /// The corner named first, if any.
     pub corner: Option<String>,
+    /// The component of that corner (damper, spring, tyre or suspension), if named; absent in
+    /// drives stored before it existed.
+    #[serde(default)]
+    pub component: Option<crate::model::Component>,
     /// One line: the flagged features per corner.
     pub summary: String,
     /// The largest |z| of the vehicle features against the limit (how sure: 1 at the limit).
@@ -180,6 +184,18 @@ pub struct DriveStatus {
     pub n_records: usize,
     /// The first check of the latest run of drives with this classification (since when).
     pub since: String,
+}
+
+impl DriveStatus {
+    /// The corner and its component as tables show them: `RL damper`, `RL` (no component
+    /// named), `-` (no corner).
+    pub fn place(&self) -> String {
+        match (&self.corner, self.component) {
+            (Some(c), Some(k)) => format!("{c} {k}"),
+            (Some(c), None) => c.clone(),
+            (None, _) => "-".into(),
+        }
+    }
 }
 
 /// An open fleet store.
@@ -1054,6 +1070,7 @@ impl Store {
                 checked,
                 classification: class,
                 corner: d.corner.map(|c| c.to_string()),
+                component: d.assessment.component,
                 summary: d.assessment.summary.clone(),
                 vehicle_z_over_limit: limit
                     .filter(|l| *l > 0.0)
@@ -1290,6 +1307,7 @@ mod tests {
             summary: String::new(),
             missing: Vec::new(),
             sensor_faults: Vec::new(),
+            component: None,
         };
         let f = features();
         let e = s
