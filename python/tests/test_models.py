@@ -126,6 +126,10 @@ def test_iteration_settings_have_one_name_and_defaults_from_rust(arma21_data):
     assert not one.converged and not three.converged
     assert one.iterations < three.iterations
     assert vibmode.fit_arma(arma21_data, FS, 2, 1).converged
+    # The earlier names still work, with a DeprecationWarning, and mean the same.
+    with pytest.warns(DeprecationWarning, match="max_iterations"):
+        old = vibmode.fit_arma(arma21_data, FS, 2, 1, max_iter=1, tol=1e-300)
+    assert old.iterations == one.iterations and not old.converged
 
 
 def test_sweep_stabilises_on_the_mode(ar2_data):

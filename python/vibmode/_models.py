@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import json
+import warnings
 from typing import Any, Dict, Iterable, Optional
 
 import numpy as np
@@ -145,6 +146,9 @@ def fit_arma(
     max_iterations: int = _FIT["max_iterations"],
     tolerance: float = _FIT["tolerance"],
     demean: bool = _FIT["demean"],
+    *,
+    max_iter: Optional[int] = None,
+    tol: Optional[float] = None,
 ) -> ArmaModel:
     """ARMA(p, q) by prediction-error minimisation (Gauss-Newton, MATLAB ``armax``/``pem``'s
     method) of the signal ``y`` sampled at ``fs`` Hz.
@@ -153,8 +157,18 @@ def fit_arma(
     with additive-outlier cleaning first), or ``'off'``/``None`` for least squares.
     ``max_iterations`` caps the Gauss-Newton iterations and ``tolerance`` is the relative
     stopping tolerance (the defaults of a single fit, ``vibmode fit``'s: 100 and 1e-5; the
-    analysis sweep's are :func:`sweep`'s). Raises ValueError for bad orders or signals.
+    analysis sweep's are :func:`sweep`'s). ``max_iter`` and ``tol``, the names of earlier
+    versions, are still accepted (a DeprecationWarning). Raises ValueError for bad orders or
+    signals.
     """
+    if max_iter is not None or tol is not None:
+        warnings.warn(
+            "fit_arma: max_iter and tol are now max_iterations and tolerance",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        max_iterations = max_iterations if max_iter is None else max_iter
+        tolerance = tolerance if tol is None else tol
     fs = _check_fs(fs)
     p = _order("p", p, 0)
     q = p if q is None else _order("q", q, 0)
