@@ -83,7 +83,7 @@ def main():
     h.astype("<f8").tofile(taps)
     rows = []
     out = os.path.join(tmp, "out200.f32")
-    secs, rss, err = timed([VIBMODE, "resample", path, "--to", "200", "--method", "fir", "-q", "-o", out])
+    secs, rss, err = timed([VIBMODE, "resample", path, "--fs-out", "200", "--method", "fir", "-q", "-o", out])
     rows.append(("vibmode resample --method fir (streamed, 110 dB, 7109 taps)", secs, rss))
     for f in [out, out + ".json"]:
         os.remove(f)

@@ -14,9 +14,14 @@ use vibmode_signal::{ResampleParams, StreamResampleParams};
 pub struct ResampleArgs {
     #[command(flatten)]
     pub input: InputArgs,
-    /// Target sampling rate in Hz.
-    #[arg(long = "to")]
-    pub to_hz: f64,
+    /// The older spelling of `--fs-out` (hidden; still accepted).
+    #[arg(
+        long = "to",
+        value_name = "HZ",
+        hide = true,
+        conflicts_with = "fs_out_hz"
+    )]
+    pub to_hz: Option<f64>,
     /// Skip the anti-alias filter (plain decimation; shows aliasing).
     #[arg(long)]
     pub no_filter: bool,
@@ -45,9 +50,9 @@ const AUTO_IDEAL_MAX_BYTES: u64 = 64 << 20;
 
 /// Runs `vibmode resample`.
 pub fn run(a: &ResampleArgs) -> Result<()> {
-    if a.input.resample_to_hz.is_some() {
-        bail!("use --to HZ with `vibmode resample` (--resample-to is for the analysis commands)");
-    }
+    let Some(fs_out_hz) = a.input.fs_out_hz.or(a.to_hz) else {
+        bail!("vibmode resample needs the rate to resample to: --fs-out HZ, e.g. --fs-out 200");
+    };
     // Every output checked before any work (an output that is the input would be truncated
     // while still being read).
     crate::output::check_outputs(
@@ -77,11 +82,11 @@ pub fn run(a: &ResampleArgs) -> Result<()> {
         if a.no_filter {
             bail!("--no-filter applies to --method ideal (plain decimation of the whole record); drop one of them");
         }
-        return run_streamed(a);
+        return run_streamed(a, fs_out_hz);
     }
     let raw = a.input.load_raw()?;
     let p = ResampleParams {
-        to_hz: a.to_hz,
+        fs_out_hz,
         cutoff_hz: a.input.cutoff_hz,
         filter: !a.no_filter,
     };
@@ -101,14 +106,14 @@ pub fn run(a: &ResampleArgs) -> Result<()> {
         } else {
             format!(
                 "ideal DFT low-pass at {} Hz",
-                a.input.cutoff_hz.unwrap_or(a.to_hz / 2.0)
+                a.input.cutoff_hz.unwrap_or(fs_out_hz / 2.0)
             )
         },
         a.output.display()
     );
     if let Some(path) = &a.plot {
         let fig =
-            vibmode_report::antialias_figure(&raw, a.to_hz, a.input.cutoff_hz, a.plot_seconds)?;
+            vibmode_report::antialias_figure(&raw, fs_out_hz, a.input.cutoff_hz, a.plot_seconds)?;
         fig.save(path)
             .with_context(|| format!("writing plot {}", path.display()))?;
     }
@@ -116,11 +121,11 @@ pub fn run(a: &ResampleArgs) -> Result<()> {
 }
 
 /// `--method fir`: read, filter and write block by block.
-fn run_streamed(a: &ResampleArgs) -> Result<()> {
+fn run_streamed(a: &ResampleArgs, fs_out_hz: f64) -> Result<()> {
     let mut stream = a.input.open_stream()?;
     let info = stream.info().clone();
     let p = StreamResampleParams {
-        to_hz: a.to_hz,
+        fs_out_hz,
         cutoff_hz: a.input.cutoff_hz,
         ..StreamResampleParams::default()
     };
@@ -197,7 +202,7 @@ fn run_streamed(a: &ResampleArgs) -> Result<()> {
             time_axis: None,
         };
         let fig =
-            vibmode_report::antialias_figure(&raw, a.to_hz, a.input.cutoff_hz, a.plot_seconds)?;
+            vibmode_report::antialias_figure(&raw, fs_out_hz, a.input.cutoff_hz, a.plot_seconds)?;
         fig.save(path)
             .with_context(|| format!("writing plot {}", path.display()))?;
     }

@@ -51,7 +51,7 @@ fn streamed_resample_writes_every_format_and_agrees_with_the_ideal_filter() {
         let err = stderr(&ok(&[
             "resample",
             &s(&input),
-            "--to",
+            "--fs-out",
             "100",
             "--method",
             "fir",
@@ -75,7 +75,7 @@ fn streamed_resample_writes_every_format_and_agrees_with_the_ideal_filter() {
     ok(&[
         "resample",
         &s(&input),
-        "--to",
+        "--fs-out",
         "100",
         "--cutoff",
         "45",
@@ -299,7 +299,7 @@ fn bad_input_is_one_line_with_exit_code_2_and_nothing_half_written() {
         vec![
             "resample",
             c,
-            "--to",
+            "--fs-out",
             "50",
             "--method",
             "fir",
@@ -322,7 +322,7 @@ fn bad_input_is_one_line_with_exit_code_2_and_nothing_half_written() {
         &[
             "resample",
             w,
-            "--to",
+            "--fs-out",
             "50",
             "--method",
             "fir",

@@ -31,7 +31,7 @@
 //!
 //! // Ideal anti-alias filter at 25 Hz, then keep every 10th sample (1000 Hz -> 100 Hz):
 //! // the 10 Hz tone passes unchanged.
-//! let p = ResampleParams { to_hz: 100.0, cutoff_hz: Some(25.0), filter: true };
+//! let p = ResampleParams { fs_out_hz: 100.0, cutoff_hz: Some(25.0), filter: true };
 //! let low = rec.resample(&p).unwrap();
 //! assert_eq!(low.len(), 100);
 //! let expected = (2.0 * std::f64::consts::PI * 10.0 * 7.0 / 100.0).sin();

@@ -31,8 +31,10 @@ use serde::{Deserialize, Serialize};
 /// Parameters of [`FirDecimator`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StreamResampleParams {
-    /// Output rate, Hz. Default 200.
-    pub to_hz: f64,
+    /// The rate to resample to, Hz (as [`crate::ResampleParams::fs_out_hz`]; the older key
+    /// `to_hz` is still read). Default 200.
+    #[serde(alias = "to_hz")]
+    pub fs_out_hz: f64,
     /// Pass-band edge, Hz. Default `None` = 0.8 x the lower Nyquist frequency.
     pub cutoff_hz: Option<f64>,
     /// Stop-band attenuation (and pass-band ripple, `10^(-A/20)`) of the Kaiser design, dB.
@@ -43,7 +45,7 @@ pub struct StreamResampleParams {
 impl Default for StreamResampleParams {
     fn default() -> Self {
         StreamResampleParams {
-            to_hz: 200.0,
+            fs_out_hz: 200.0,
             cutoff_hz: None,
             attenuation_db: 110.0,
         }
@@ -177,10 +179,10 @@ impl FirDesign {
                 "must be a positive rate in Hz".into(),
             ));
         }
-        if !(p.to_hz.is_finite() && p.to_hz > 0.0) {
+        if !(p.fs_out_hz.is_finite() && p.fs_out_hz > 0.0) {
             return Err(invalid(
-                "to_hz",
-                p.to_hz,
+                "fs_out_hz",
+                p.fs_out_hz,
                 "must be a positive rate in Hz, e.g. 200".into(),
             ));
         }
@@ -191,13 +193,13 @@ impl FirDesign {
                 "must lie in 40..200 dB, e.g. 110".into(),
             ));
         }
-        let (up, down) = rational_ratio(p.to_hz / fs_in_hz, 1024).ok_or_else(|| {
+        let (up, down) = rational_ratio(p.fs_out_hz / fs_in_hz, 1024).ok_or_else(|| {
             invalid(
-                "to_hz",
-                p.to_hz,
+                "fs_out_hz",
+                p.fs_out_hz,
                 format!(
                     "{} / {fs_in_hz} Hz is not a ratio of whole numbers L/M with L <= 1024; the streaming filter needs one (e.g. 20000 -> 200 Hz); resample the whole record instead",
-                    p.to_hz
+                    p.fs_out_hz
                 ),
             )
         })?;

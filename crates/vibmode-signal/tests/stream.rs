@@ -281,7 +281,7 @@ fn pass_band_flat_to_1e_5_and_stop_band_below_minus_100_db() {
         let d = FirDesign::new(
             fs,
             &StreamResampleParams {
-                to_hz: to,
+                fs_out_hz: to,
                 cutoff_hz: cutoff,
                 ..Default::default()
             },
@@ -345,7 +345,7 @@ fn agrees_with_the_whole_record_ideal_filter_away_from_the_ends_over_seeds() {
     let fs = 20_000.0;
     let n = 200_000; // 10 s
     let p = StreamResampleParams {
-        to_hz: 200.0,
+        fs_out_hz: 200.0,
         ..Default::default()
     };
     let mut worst_db = f64::NEG_INFINITY;
@@ -355,7 +355,7 @@ fn agrees_with_the_whole_record_ideal_filter_away_from_the_ends_over_seeds() {
             &x,
             fs,
             &ResampleParams {
-                to_hz: 200.0,
+                fs_out_hz: 200.0,
                 cutoff_hz: Some(90.0),
                 filter: true,
             },
@@ -387,7 +387,7 @@ fn output_does_not_depend_on_block_sizes_and_has_ceil_n_l_over_m_samples() {
     let fs = 44_100.0;
     let x = random_recording(1, 30_011, 2, fs);
     let p = StreamResampleParams {
-        to_hz: 200.0,
+        fs_out_hz: 200.0,
         ..Default::default()
     };
     let run = |block: usize| {
