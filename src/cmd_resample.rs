@@ -2,12 +2,13 @@
 
 use crate::input::InputArgs;
 use anyhow::{bail, Context, Result};
+use clap::builder::TypedValueParser;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use vibmode_signal::ResampleRecording;
-use vibmode_signal::{ResampleParams, StreamResampleParams};
+use vibmode_signal::{ResampleParams, ResamplerKind, StreamResampleParams};
 
 /// Arguments of `vibmode resample`.
 #[derive(Args, Debug)]
@@ -35,18 +36,22 @@ pub struct ResampleArgs {
     /// Seconds of signal shown in the time panel of the plot (default: 0.5 s).
     #[arg(long = "plot-seconds", default_value_t = 0.5)]
     pub plot_seconds: f64,
-    /// Filter: `ideal` (the paper's DFT low-pass over the whole record, in memory), `fir`
+    /// Resampler: `ideal` (the paper's DFT low-pass over the whole record, in memory), `fir`
     /// (streamed block by block: linear-phase FIR, pass band to the cutoff, >= 100 dB stop band;
     /// any length in bounded memory) or `auto` (ideal up to 64 MiB of input file, fir above).
-    #[arg(long, default_value = "auto")]
-    pub method: String,
+    /// (`--method` is still accepted.)
+    #[arg(long, alias = "method", default_value = "auto", value_parser = resampler_parser())]
+    pub resampler: ResamplerKind,
     /// No progress bar.
     #[arg(long, short = 'q')]
     pub quiet: bool,
 }
 
-/// Input files up to this size are resampled whole with the ideal filter by `--method auto`.
-const AUTO_IDEAL_MAX_BYTES: u64 = 64 << 20;
+/// The values `--resampler` takes: the library's [`ResamplerKind`], by the names it parses.
+fn resampler_parser() -> impl TypedValueParser<Value = ResamplerKind> {
+    clap::builder::PossibleValuesParser::new(ResamplerKind::NAMES)
+        .try_map(|s: String| s.parse::<ResamplerKind>())
+}
 
 /// Runs `vibmode resample`.
 pub fn run(a: &ResampleArgs) -> Result<()> {
@@ -67,20 +72,10 @@ pub fn run(a: &ResampleArgs) -> Result<()> {
             a.plot_seconds
         );
     }
-    let streamed = match a.method.as_str() {
-        "fir" => true,
-        "ideal" => false,
-        "auto" => {
-            !a.no_filter
-                && std::fs::metadata(&a.input.input)
-                    .map(|m| m.len() > AUTO_IDEAL_MAX_BYTES)
-                    .unwrap_or(false)
-        }
-        other => bail!("--method {other}: use ideal, fir or auto"),
-    };
-    if streamed {
+    let input_bytes = std::fs::metadata(&a.input.input).ok().map(|m| m.len());
+    if a.resampler.streams(input_bytes, !a.no_filter) {
         if a.no_filter {
-            bail!("--no-filter applies to --method ideal (plain decimation of the whole record); drop one of them");
+            bail!("--no-filter applies to --resampler ideal (plain decimation of the whole record); drop one of them");
         }
         return run_streamed(a, fs_out_hz);
     }
@@ -120,7 +115,7 @@ pub fn run(a: &ResampleArgs) -> Result<()> {
     Ok(())
 }
 
-/// `--method fir`: read, filter and write block by block.
+/// `--resampler fir`: read, filter and write block by block.
 fn run_streamed(a: &ResampleArgs, fs_out_hz: f64) -> Result<()> {
     let mut stream = a.input.open_stream()?;
     let info = stream.info().clone();

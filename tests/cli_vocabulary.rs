@@ -70,3 +70,71 @@ fn analysis_commands_take_fs_out_and_the_old_resample_to() {
         "--resample-to differs from --fs-out"
     );
 }
+
+/// `--estimator` (fit, sweep) and `--resampler` (resample) each name one thing; `--method`,
+/// their older spelling there, gives the same output.
+#[test]
+fn fit_and_sweep_take_estimator_and_the_old_method() {
+    let d = tempfile::tempdir().unwrap();
+    let files = simulate_csv(d.path(), "B", "30", "3", "1");
+    let f = files[0].as_str();
+    let base = [
+        "fit", f, "-c", "0", "--model", "ar", "--order", "8", "--json", "-",
+    ];
+    let new = ok(&[&base[..], &["--estimator", "yule-walker"]].concat());
+    let old = ok(&[&base[..], &["--method", "yule-walker"]].concat());
+    let burg = ok(&[&base[..], &["--estimator", "burg"]].concat());
+    assert_eq!(old.stdout, new.stdout, "--method differs from --estimator");
+    assert_ne!(burg.stdout, new.stdout, "--estimator was not applied");
+    let sweep = [
+        "sweep", f, "-c", "0", "--model", "ar", "--orders", "4:8", "--json", "-",
+    ];
+    let new = ok(&[&sweep[..], &["--estimator", "ls"]].concat());
+    let old = ok(&[&sweep[..], &["--method", "ls"]].concat());
+    assert_eq!(
+        old.stdout, new.stdout,
+        "sweep: --method differs from --estimator"
+    );
+    fails_with(
+        &[&base[..], &["--estimator", "pem"]].concat(),
+        &["--estimator pem", "--model arma"],
+    );
+}
+
+#[test]
+fn resample_takes_resampler_and_the_old_method() {
+    let d = tempfile::tempdir().unwrap();
+    let files = simulate_csv(d.path(), "B", "30", "3", "1");
+    let f = files[0].as_str();
+    let mut outputs = Vec::new();
+    for (flag, value) in [
+        ("--resampler", "fir"),
+        ("--method", "fir"),
+        ("--resampler", "ideal"),
+    ] {
+        let out = d.path().join(format!("r{}.csv", outputs.len()));
+        ok(&["resample", f, "--fs-out", "50", flag, value, "-o", s(&out)]);
+        outputs.push(std::fs::read_to_string(&out).unwrap());
+    }
+    assert_eq!(
+        outputs[1], outputs[0],
+        "--method fir differs from --resampler fir"
+    );
+    // The FIR and the ideal filter differ in their last digits: the option reached the run.
+    assert_ne!(outputs[2], outputs[0], "--resampler was not applied");
+    let out = d.path().join("x.csv");
+    fails_with(
+        &[
+            "resample",
+            f,
+            "--fs-out",
+            "50",
+            "--resampler",
+            "fir",
+            "--no-filter",
+            "-o",
+            s(&out),
+        ],
+        &["--resampler ideal"],
+    );
+}

@@ -62,7 +62,8 @@ pub use resample::ResampleRecording;
 pub use resample::{resample, ResampleMethod, ResampleParams, Resampler};
 pub use stream::{open_stream, FrameBlock, FrameStream, StreamInfo, DEFAULT_BLOCK_FRAMES};
 pub use stream_resample::{
-    resample_stream, FirDecimator, FirDesign, StreamResampleParams, StreamResampleSummary,
+    resample_stream, FirDecimator, FirDesign, ResamplerKind, StreamResampleParams,
+    StreamResampleSummary,
 };
 pub use stream_write::StreamWriter;
 pub use vibmode_core::{

@@ -52,6 +52,61 @@ impl Default for StreamResampleParams {
     }
 }
 
+/// Which resampler a file goes through (`vibmode resample --resampler`): the paper's ideal DFT
+/// filter over the whole record in memory ([`crate::Resampler`]), the streamed FIR
+/// ([`FirDecimator`], any length in bounded memory), or `Auto` (the default): ideal for input
+/// files up to [`ResamplerKind::AUTO_IDEAL_MAX_BYTES`], FIR above.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ResamplerKind {
+    /// Ideal up to [`ResamplerKind::AUTO_IDEAL_MAX_BYTES`] of input file, streamed FIR above
+    /// (ideal whenever no anti-alias filter is asked for).
+    #[default]
+    Auto,
+    /// The ideal DFT low-pass over the whole record.
+    Ideal,
+    /// The streamed linear-phase FIR.
+    Fir,
+}
+
+impl ResamplerKind {
+    /// The names [`ResamplerKind::from_str`](std::str::FromStr) accepts.
+    pub const NAMES: [&'static str; 3] = ["auto", "ideal", "fir"];
+
+    /// Input files up to this size are resampled whole with the ideal filter by `Auto` (64 MiB).
+    pub const AUTO_IDEAL_MAX_BYTES: u64 = 64 << 20;
+
+    /// Whether a file of `input_bytes` (`None`: size unknown) goes through the streamed FIR;
+    /// `filter = false` (plain decimation, which only the ideal resampler does) keeps `Auto`
+    /// on the ideal resampler.
+    pub fn streams(self, input_bytes: Option<u64>, filter: bool) -> bool {
+        match self {
+            ResamplerKind::Fir => true,
+            ResamplerKind::Ideal => false,
+            ResamplerKind::Auto => {
+                filter && input_bytes.is_some_and(|n| n > Self::AUTO_IDEAL_MAX_BYTES)
+            }
+        }
+    }
+}
+
+impl std::str::FromStr for ResamplerKind {
+    type Err = vibmode_core::ParamError;
+    /// Accepts the [`ResamplerKind::NAMES`] (case-insensitive).
+    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "auto" => Ok(ResamplerKind::Auto),
+            "ideal" => Ok(ResamplerKind::Ideal),
+            "fir" => Ok(ResamplerKind::Fir),
+            _ => Err(vibmode_core::ParamError::UnknownName {
+                what: "resampler",
+                value: s.to_string(),
+                valid: "auto, ideal, fir",
+            }),
+        }
+    }
+}
+
 /// The designed filter, as used (for messages and documentation of a run).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FirDesign {

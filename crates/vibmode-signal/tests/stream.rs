@@ -418,3 +418,24 @@ fn output_does_not_depend_on_block_sizes_and_has_ceil_n_l_over_m_samples() {
         assert_eq!(run(block), a);
     }
 }
+
+#[test]
+fn resampler_kind_auto_streams_only_large_filtered_inputs() {
+    use vibmode_signal::ResamplerKind;
+    let big = Some(ResamplerKind::AUTO_IDEAL_MAX_BYTES + 1);
+    let small = Some(ResamplerKind::AUTO_IDEAL_MAX_BYTES);
+    assert!(ResamplerKind::Auto.streams(big, true));
+    assert!(!ResamplerKind::Auto.streams(small, true));
+    assert!(!ResamplerKind::Auto.streams(big, false));
+    assert!(!ResamplerKind::Auto.streams(None, true));
+    assert!(ResamplerKind::Fir.streams(small, true));
+    assert!(!ResamplerKind::Ideal.streams(big, true));
+    for name in ResamplerKind::NAMES {
+        assert!(name.parse::<ResamplerKind>().is_ok(), "{name}");
+    }
+    let e = "sinc".parse::<ResamplerKind>().unwrap_err().to_string();
+    assert!(
+        e.contains("'sinc'") && e.contains("auto, ideal, fir"),
+        "{e}"
+    );
+}
