@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Decimating an hours-long recording to 200 Hz: `vibmode resample --method fir` (streamed)
+"""Decimating an hours-long recording to 200 Hz: `vibmode resample --resampler fir` (streamed)
 against scipy.signal.resample_poly and soxr on the same raw f32 file, in one run.
 
 Usage (from the repository root; needs numpy, scipy, soxr and a release build):
@@ -83,8 +83,8 @@ def main():
     h.astype("<f8").tofile(taps)
     rows = []
     out = os.path.join(tmp, "out200.f32")
-    secs, rss, err = timed([VIBMODE, "resample", path, "--to", "200", "--method", "fir", "-q", "-o", out])
-    rows.append(("vibmode resample --method fir (streamed, 110 dB, 7109 taps)", secs, rss))
+    secs, rss, err = timed([VIBMODE, "resample", path, "--fs-out", "200", "--resampler", "fir", "-q", "-o", out])
+    rows.append(("vibmode resample --resampler fir (streamed, 110 dB, 7109 taps)", secs, rss))
     for f in [out, out + ".json"]:
         os.remove(f)
     peer = os.path.join(tmp, "peer.py")

@@ -79,7 +79,7 @@ def main():
         sm = {}
         for rate in ([50] if args.skip_paper else [50, 200]):
             raw = os.path.join(tmp, f"r{rate}.f64")
-            run([exe, "resample", wavs[0], "--to", str(rate), "--cutoff", "25", "-o", raw])
+            run([exe, "resample", wavs[0], "--fs-out", str(rate), "--cutoff", "25", "-o", raw])
             y = load_f64(raw, 7, 0)
             times = []
             for p in sm_orders:

@@ -4,10 +4,11 @@ use crate::cmd_psd::SpectralArgs;
 use crate::input::InputArgs;
 use crate::output::write_json;
 use anyhow::{bail, Context, Result};
+use clap::builder::TypedValueParser;
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use vibmode_core::{BandLimit, ClusterParams};
-use vibmode_ident::{ArMethod, ArmaParams, Robust};
+use vibmode_ident::{ArmaParams, Estimator, Robust};
 use vibmode_run::fit::FitModel;
 
 /// Model structure.
@@ -19,17 +20,11 @@ pub enum ModelKind {
     Arma,
 }
 
-/// Estimation method.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FitMethod {
-    /// Yule-Walker (AR only).
-    YuleWalker,
-    /// Burg (AR only).
-    Burg,
-    /// Forward-backward least squares (AR only).
-    Ls,
-    /// Prediction-error minimisation (ARMA; the default for --model arma).
-    Pem,
+/// The values `--estimator` takes (shared by `fit` and `sweep`): the library's
+/// [`Estimator`], by the names it parses.
+pub fn estimator_parser() -> impl TypedValueParser<Value = Estimator> {
+    clap::builder::PossibleValuesParser::new(Estimator::NAMES)
+        .try_map(|s: String| s.parse::<Estimator>())
 }
 
 /// Arguments of `vibmode fit`.
@@ -46,9 +41,9 @@ pub struct FitArgs {
     /// MA order q for ARMA (default: p, the paper's ARMA(p,p)).
     #[arg(long = "ma-order")]
     pub ma_order: Option<usize>,
-    /// Estimation method (default: burg for AR, pem for ARMA).
-    #[arg(long, value_enum)]
-    pub method: Option<FitMethod>,
+    /// Estimator (default: burg for AR, pem for ARMA). (`--method` is still accepted.)
+    #[arg(long, alias = "method", value_parser = estimator_parser())]
+    pub estimator: Option<Estimator>,
     /// Robust criterion for PEM: a Huber factor (default 1.6, times the robust std of the
     /// initial residuals) or `off` for the purely quadratic criterion.
     #[arg(long)]
@@ -71,27 +66,25 @@ fn parse_robust(s: Option<&str>) -> Result<Robust> {
     Ok(s.map_or(Ok(Robust::default()), str::parse::<Robust>)?)
 }
 
-/// What `--model`, `--method` and `--ma-order` ask for.
+/// What `--model`, `--estimator` and `--ma-order` ask for.
 fn fit_model(a: &FitArgs) -> Result<FitModel> {
     match a.model {
         ModelKind::Ar => {
             if a.ma_order.is_some_and(|q| q > 0) {
                 bail!("--ma-order applies to --model arma; drop it or use --model arma");
             }
-            let method = match a.method.unwrap_or(FitMethod::Burg) {
-                FitMethod::YuleWalker => ArMethod::YuleWalker,
-                FitMethod::Burg => ArMethod::Burg,
-                FitMethod::Ls => ArMethod::LeastSquares,
-                FitMethod::Pem => {
-                    bail!("--method pem is for --model arma; for AR use yule-walker, burg or ls")
-                }
+            let Some(method) = a.estimator.unwrap_or(Estimator::Burg).ar_method() else {
+                bail!("--estimator pem is for --model arma; for AR use yule-walker, burg or ls")
             };
             Ok(FitModel::Ar { method })
         }
         ModelKind::Arma => {
-            if let Some(m) = a.method {
-                if m != FitMethod::Pem {
-                    bail!("--model arma is fitted by --method pem; {m:?} applies to --model ar");
+            if let Some(m) = a.estimator {
+                if m != Estimator::PredictionError {
+                    bail!(
+                        "--model arma is fitted by --estimator pem; {} applies to --model ar",
+                        m.name()
+                    );
                 }
             }
             Ok(FitModel::Arma {

@@ -163,7 +163,7 @@ pub fn run(a: &PsdArgs) -> Result<()> {
     let rec = a.input.load()?;
     let resampled = a
         .input
-        .resample_to_hz
+        .fs_out_hz
         .map(|to| (to, a.input.cutoff_hz.unwrap_or(to / 2.0)));
     let output = vibmode_run::psd::psd(
         &rec,

@@ -2,21 +2,27 @@
 
 use crate::input::InputArgs;
 use anyhow::{bail, Context, Result};
+use clap::builder::TypedValueParser;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use vibmode_signal::ResampleRecording;
-use vibmode_signal::{ResampleParams, StreamResampleParams};
+use vibmode_signal::{ResampleParams, ResamplerKind, StreamResampleParams};
 
 /// Arguments of `vibmode resample`.
 #[derive(Args, Debug)]
 pub struct ResampleArgs {
     #[command(flatten)]
     pub input: InputArgs,
-    /// Target sampling rate in Hz.
-    #[arg(long = "to")]
-    pub to_hz: f64,
+    /// The older spelling of `--fs-out` (hidden; still accepted).
+    #[arg(
+        long = "to",
+        value_name = "HZ",
+        hide = true,
+        conflicts_with = "fs_out_hz"
+    )]
+    pub to_hz: Option<f64>,
     /// Skip the anti-alias filter (plain decimation; shows aliasing).
     #[arg(long)]
     pub no_filter: bool,
@@ -30,24 +36,28 @@ pub struct ResampleArgs {
     /// Seconds of signal shown in the time panel of the plot (default: 0.5 s).
     #[arg(long = "plot-seconds", default_value_t = 0.5)]
     pub plot_seconds: f64,
-    /// Filter: `ideal` (the paper's DFT low-pass over the whole record, in memory), `fir`
+    /// Resampler: `ideal` (the paper's DFT low-pass over the whole record, in memory), `fir`
     /// (streamed block by block: linear-phase FIR, pass band to the cutoff, >= 100 dB stop band;
     /// any length in bounded memory) or `auto` (ideal up to 64 MiB of input file, fir above).
-    #[arg(long, default_value = "auto")]
-    pub method: String,
+    /// (`--method` is still accepted.)
+    #[arg(long, alias = "method", default_value = "auto", value_parser = resampler_parser())]
+    pub resampler: ResamplerKind,
     /// No progress bar.
     #[arg(long, short = 'q')]
     pub quiet: bool,
 }
 
-/// Input files up to this size are resampled whole with the ideal filter by `--method auto`.
-const AUTO_IDEAL_MAX_BYTES: u64 = 64 << 20;
+/// The values `--resampler` takes: the library's [`ResamplerKind`], by the names it parses.
+fn resampler_parser() -> impl TypedValueParser<Value = ResamplerKind> {
+    clap::builder::PossibleValuesParser::new(ResamplerKind::NAMES)
+        .try_map(|s: String| s.parse::<ResamplerKind>())
+}
 
 /// Runs `vibmode resample`.
 pub fn run(a: &ResampleArgs) -> Result<()> {
-    if a.input.resample_to_hz.is_some() {
-        bail!("use --to HZ with `vibmode resample` (--resample-to is for the analysis commands)");
-    }
+    let Some(fs_out_hz) = a.input.fs_out_hz.or(a.to_hz) else {
+        bail!("vibmode resample needs the rate to resample to: --fs-out HZ, e.g. --fs-out 200");
+    };
     // Every output checked before any work (an output that is the input would be truncated
     // while still being read).
     crate::output::check_outputs(
@@ -62,26 +72,16 @@ pub fn run(a: &ResampleArgs) -> Result<()> {
             a.plot_seconds
         );
     }
-    let streamed = match a.method.as_str() {
-        "fir" => true,
-        "ideal" => false,
-        "auto" => {
-            !a.no_filter
-                && std::fs::metadata(&a.input.input)
-                    .map(|m| m.len() > AUTO_IDEAL_MAX_BYTES)
-                    .unwrap_or(false)
-        }
-        other => bail!("--method {other}: use ideal, fir or auto"),
-    };
-    if streamed {
+    let input_bytes = std::fs::metadata(&a.input.input).ok().map(|m| m.len());
+    if a.resampler.streams(input_bytes, !a.no_filter) {
         if a.no_filter {
-            bail!("--no-filter applies to --method ideal (plain decimation of the whole record); drop one of them");
+            bail!("--no-filter applies to --resampler ideal (plain decimation of the whole record); drop one of them");
         }
-        return run_streamed(a);
+        return run_streamed(a, fs_out_hz);
     }
     let raw = a.input.load_raw()?;
     let p = ResampleParams {
-        to_hz: a.to_hz,
+        fs_out_hz,
         cutoff_hz: a.input.cutoff_hz,
         filter: !a.no_filter,
     };
@@ -101,26 +101,26 @@ pub fn run(a: &ResampleArgs) -> Result<()> {
         } else {
             format!(
                 "ideal DFT low-pass at {} Hz",
-                a.input.cutoff_hz.unwrap_or(a.to_hz / 2.0)
+                a.input.cutoff_hz.unwrap_or(fs_out_hz / 2.0)
             )
         },
         a.output.display()
     );
     if let Some(path) = &a.plot {
         let fig =
-            vibmode_report::antialias_figure(&raw, a.to_hz, a.input.cutoff_hz, a.plot_seconds)?;
+            vibmode_report::antialias_figure(&raw, fs_out_hz, a.input.cutoff_hz, a.plot_seconds)?;
         fig.save(path)
             .with_context(|| format!("writing plot {}", path.display()))?;
     }
     Ok(())
 }
 
-/// `--method fir`: read, filter and write block by block.
-fn run_streamed(a: &ResampleArgs) -> Result<()> {
+/// `--resampler fir`: read, filter and write block by block.
+fn run_streamed(a: &ResampleArgs, fs_out_hz: f64) -> Result<()> {
     let mut stream = a.input.open_stream()?;
     let info = stream.info().clone();
     let p = StreamResampleParams {
-        to_hz: a.to_hz,
+        fs_out_hz,
         cutoff_hz: a.input.cutoff_hz,
         ..StreamResampleParams::default()
     };
@@ -197,7 +197,7 @@ fn run_streamed(a: &ResampleArgs) -> Result<()> {
             time_axis: None,
         };
         let fig =
-            vibmode_report::antialias_figure(&raw, a.to_hz, a.input.cutoff_hz, a.plot_seconds)?;
+            vibmode_report::antialias_figure(&raw, fs_out_hz, a.input.cutoff_hz, a.plot_seconds)?;
         fig.save(path)
             .with_context(|| format!("writing plot {}", path.display()))?;
     }

@@ -1,13 +1,13 @@
 //! `vibmode sweep`: fit every model order and collect every mode (stabilisation diagram).
 
-use crate::cmd_fit::{FitMethod, ModelKind};
+use crate::cmd_fit::{estimator_parser, ModelKind};
 use crate::input::InputArgs;
 use crate::output::write_json;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::PathBuf;
 use vibmode_core::{BandLimit, SweepModel, SweepParams};
-use vibmode_ident::{ArMethod, ArmaParams, Robust};
+use vibmode_ident::{ArMethod, ArmaParams, Estimator, Robust};
 use vibmode_run::sweep::SweepOutput;
 
 /// Arguments of `vibmode sweep`.
@@ -23,9 +23,9 @@ pub struct SweepArgs {
     /// Model structure: arma (ARMA(p,p)) or ar.
     #[arg(long, value_enum, default_value_t = ModelKind::Arma)]
     pub model: ModelKind,
-    /// Estimation method (default: burg for AR, pem for ARMA).
-    #[arg(long, value_enum)]
-    pub method: Option<FitMethod>,
+    /// Estimator (default: burg for AR, pem for ARMA). (`--method` is still accepted.)
+    #[arg(long, alias = "method", value_parser = estimator_parser())]
+    pub estimator: Option<Estimator>,
     /// Robust criterion: a Huber factor (default 1.6, the analysis sweep's) or `off`.
     #[arg(long)]
     pub robust: Option<String>,
@@ -135,16 +135,19 @@ fn write_plots(path: &std::path::Path, out: &SweepOutput) -> Result<()> {
 
 /// The AR estimator of `--model ar` (ARMA is fitted by PEM).
 fn ar_method(a: &SweepArgs) -> Result<ArMethod> {
-    Ok(match (a.model, a.method) {
-        (ModelKind::Ar, None | Some(FitMethod::Burg)) => ArMethod::Burg,
-        (ModelKind::Ar, Some(FitMethod::YuleWalker)) => ArMethod::YuleWalker,
-        (ModelKind::Ar, Some(FitMethod::Ls)) => ArMethod::LeastSquares,
-        (ModelKind::Ar, Some(FitMethod::Pem)) => {
-            bail!("--method pem is for --model arma; for AR use yule-walker, burg or ls")
-        }
-        (ModelKind::Arma, None | Some(FitMethod::Pem)) => ArMethod::Burg,
+    Ok(match (a.model, a.estimator) {
+        (ModelKind::Ar, e) => match e.unwrap_or(Estimator::Burg).ar_method() {
+            Some(m) => m,
+            None => {
+                bail!("--estimator pem is for --model arma; for AR use yule-walker, burg or ls")
+            }
+        },
+        (ModelKind::Arma, None | Some(Estimator::PredictionError)) => ArMethod::Burg,
         (ModelKind::Arma, Some(m)) => {
-            bail!("--model arma is fitted by --method pem; {m:?} applies to --model ar")
+            bail!(
+                "--model arma is fitted by --estimator pem; {} applies to --model ar",
+                m.name()
+            )
         }
     })
 }

@@ -80,9 +80,10 @@ pub struct InputArgs {
     pub channel: ChannelArgs,
     #[command(flatten)]
     pub read: ReadArgs,
-    /// Resample to this rate in Hz (ideal DFT anti-alias filter first) before analysis.
-    #[arg(long = "resample-to")]
-    pub resample_to_hz: Option<f64>,
+    /// Resample to this rate in Hz (ideal DFT anti-alias filter first) before the analysis; for
+    /// `vibmode resample`, the output's rate. (`--resample-to` is still accepted.)
+    #[arg(long = "fs-out", value_name = "HZ", alias = "resample-to")]
+    pub fs_out_hz: Option<f64>,
     /// Cutoff of the ideal anti-alias filter in Hz (default: the new Nyquist frequency).
     #[arg(long = "cutoff")]
     pub cutoff_hz: Option<f64>,
@@ -92,10 +93,10 @@ impl InputArgs {
     /// Reads the file, selects channels and optionally resamples.
     pub fn load(&self) -> Result<Recording> {
         let rec = self.load_raw()?;
-        match self.resample_to_hz {
-            Some(to_hz) => {
+        match self.fs_out_hz {
+            Some(fs_out_hz) => {
                 let p = ResampleParams {
-                    to_hz,
+                    fs_out_hz,
                     cutoff_hz: self.cutoff_hz,
                     filter: true,
                 };
@@ -103,7 +104,7 @@ impl InputArgs {
             }
             None => {
                 if let Some(c) = self.cutoff_hz {
-                    anyhow::bail!("--cutoff {c} needs --resample-to HZ (the rate to resample to)");
+                    anyhow::bail!("--cutoff {c} needs --fs-out HZ (the rate to resample to)");
                 }
                 Ok(rec)
             }
@@ -115,7 +116,7 @@ impl InputArgs {
     /// `None` for a file used as it is (the identification then judges the band itself).
     pub fn load_with_band(&self) -> Result<(Recording, Option<vibmode_core::BandLimit>)> {
         let rec = self.load()?;
-        let band = self.resample_to_hz.map(|_| {
+        let band = self.fs_out_hz.map(|_| {
             let nyquist = rec.fs_hz / 2.0;
             vibmode_core::BandLimit::ideal_lowpass(rec.fs_hz, self.cutoff_hz.unwrap_or(nyquist))
         });

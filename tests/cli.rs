@@ -102,7 +102,7 @@ fn fit_finds_the_tone_and_resample_writes_a_readable_file() {
     let o = vibmode(&[
         "resample",
         f.to_str().unwrap(),
-        "--to",
+        "--fs-out",
         "50",
         "-o",
         out.to_str().unwrap(),
@@ -149,7 +149,7 @@ fn bad_input_gives_one_line_and_exit_code_2() {
     fails_with(&["psd", g, "--channel", "zz"], &["zz", "available"]);
     fails_with(&["psd", g, "--nperseg", "5000"], &["5000"]);
     fails_with(&["fit", g, "--order", "900"], &["order"]);
-    fails_with(&["resample", g, "--to=-1", "-o", "x.csv"], &["-1"]);
+    fails_with(&["resample", g, "--fs-out=-1", "-o", "x.csv"], &["-1"]);
     fails_with(&["fullcar", "no/such/bus.toml"], &["no/such/bus.toml"]);
     let bad_bus = d.path().join("bus.toml");
     let bus = std::fs::read_to_string(concat!(

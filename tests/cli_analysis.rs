@@ -124,7 +124,7 @@ fn analyze_and_sweep_errors_are_one_line_with_exit_code_2() {
     // Resampling onto its own input is refused and leaves the input whole.
     let before = std::fs::read(a).unwrap();
     fails_with(
-        &["resample", a, "--to", "25", "-o", a],
+        &["resample", a, "--fs-out", "25", "-o", a],
         &["is an input file"],
     );
     assert_eq!(std::fs::read(a).unwrap(), before);
@@ -264,7 +264,7 @@ fn ssi_identifies_a_simulated_record_and_reports_errors() {
     let wav = wav.to_str().unwrap();
     let plot = d.path().join("stab.svg");
     // The record at 50 Hz with 30 block rows, as every successful call below.
-    let base = ["ssi", wav, "--resample-to", "50", "--block-rows", "30"];
+    let base = ["ssi", wav, "--fs-out", "50", "--block-rows", "30"];
     let o = vibmode(&[&base[..], &["--plot", plot.to_str().unwrap()]].concat());
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

@@ -54,7 +54,7 @@ fn extreme_sample_magnitudes_are_refused_not_turned_into_nan() {
     );
     let out = d.path().join("r.csv");
     fails_with(
-        &["resample", s(&big), "--to", "50", "-o", s(&out)],
+        &["resample", s(&big), "--fs-out", "50", "-o", s(&out)],
         &["1e60"],
     );
     assert!(!out.exists());
@@ -82,11 +82,11 @@ fn resource_bombs_are_refused_in_seconds() {
     csv(&f, 200.0, 2048, &[("a", &tone)]);
     let out = d.path().join("x.csv");
     fails_with(
-        &["resample", s(&f), "--to", "1e20", "-o", s(&out)],
+        &["resample", s(&f), "--fs-out", "1e20", "-o", s(&out)],
         &["1e20", "outside"],
     );
     fails_with(
-        &["resample", s(&f), "--to", "1e7", "-o", s(&out)],
+        &["resample", s(&f), "--fs-out", "1e7", "-o", s(&out)],
         &["upsamples at most 16"],
     );
     assert!(!out.exists());
@@ -167,7 +167,7 @@ fn outputs_are_checked_before_any_work_and_never_half_written() {
         &[
             "resample",
             s(&f),
-            "--to",
+            "--fs-out",
             "50",
             "-o",
             s(&r),
@@ -186,7 +186,7 @@ fn outputs_are_checked_before_any_work_and_never_half_written() {
     );
     // The input is never the output.
     fails_with(
-        &["resample", s(&f), "--to", "50", "-o", s(&f)],
+        &["resample", s(&f), "--fs-out", "50", "-o", s(&f)],
         &["is an input file"],
     );
     assert!(std::fs::read_to_string(&f)
@@ -380,13 +380,13 @@ fn kill_9_leaves_the_old_or_the_new_output_never_a_mix() {
     let out = d.path().join("r");
     std::fs::create_dir(&out).unwrap();
     let target = out.join("x.csv");
-    ok(&["resample", s(&f), "--to", "100", "-o", s(&target)]);
+    ok(&["resample", s(&f), "--fs-out", "100", "-o", s(&target)]);
     let fresh = d.path().join("fresh");
     std::fs::create_dir(&fresh).unwrap();
     ok(&[
         "resample",
         s(&f),
-        "--to",
+        "--fs-out",
         "200",
         "-o",
         s(&fresh.join("x.csv")),
@@ -408,7 +408,7 @@ fn kill_9_leaves_the_old_or_the_new_output_never_a_mix() {
     for delay_ms in [0u64, 10, 30, 60, 100, 200, 350, 600] {
         let before = visible(&out);
         let mut child = bin()
-            .args(["resample", s(&f), "--to", "200", "-o", s(&target)])
+            .args(["resample", s(&f), "--fs-out", "200", "-o", s(&target)])
             .stderr(Stdio::null())
             .spawn()
             .unwrap();

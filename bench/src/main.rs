@@ -285,7 +285,7 @@ fn run(dir: &Path, quick: bool) -> Result<Value> {
         time_axis: None,
     };
     let rp = vibmode_signal::ResampleParams {
-        to_hz: 200.0,
+        fs_out_hz: 200.0,
         cutoff_hz: None,
         filter: true,
     };

@@ -190,7 +190,7 @@ fn resample_rows<'py>(
         .as_slice()
         .map_err(|_| PyValueError::new_err("x must be C-contiguous (internal)"))?;
     let p = ResampleParams {
-        to_hz: fs_out,
+        fs_out_hz: fs_out,
         cutoff_hz,
         filter,
     };

@@ -210,14 +210,8 @@ impl AnalysisConfig {
             cluster: ClusterParams::default(),
             lines: LineParams::default(),
             method: IdentMethod::default(),
-            // Measured on the demo (docs/ssi.md): 40 block rows (lags to 1.6 s at 50 Hz) and
-            // correlations pooled over the records find the body modes; per record, 10 s is too
-            // short.
-            ssi: SsiParams {
-                block_rows: 40,
-                pool_records: true,
-                ..SsiParams::default()
-            },
+            // Not the single-record default: more block rows, pooled (`ANALYSIS_BLOCK_ROWS`).
+            ssi: SsiParams::for_analysis(),
             report: ReportParams::default(),
             model_update: BodyFitParams::default(),
             body_ssi: BodySsiParams::default(),
@@ -493,6 +487,20 @@ mod tests {
         assert!(e.to_string().contains("ordermax"), "{e}");
         let e = AnalysisConfig::from_toml_str("[preprocess]\ncutoff_hz = 40\n").unwrap_err();
         assert!(e.to_string().contains("cutoff_hz = 40"), "{e}");
+    }
+
+    /// A partial `[ssi]` section keeps the analysis' SSI settings (40 block rows, pooled) for
+    /// the keys it does not set, not the single-record defaults (20, per record).
+    #[test]
+    fn a_partial_ssi_section_keeps_the_analysis_settings() {
+        let c = AnalysisConfig::from_toml_str("[ssi]\norder_max = 40\n").unwrap();
+        assert_eq!(c.ssi.order_max, 40);
+        assert_eq!(c.ssi.block_rows, vibmode_core::ANALYSIS_BLOCK_ROWS);
+        assert!(c.ssi.pool_records);
+        assert_ne!(c.ssi.block_rows, SsiParams::default().block_rows);
+        for p in [Preset::Vibmode, Preset::Paper] {
+            assert_eq!(AnalysisConfig::preset(p).ssi, SsiParams::for_analysis());
+        }
     }
 
     #[test]

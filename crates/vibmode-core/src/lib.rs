@@ -51,4 +51,6 @@ pub use recording::{
     check_finite, check_fs, Channel, ChannelSelector, Recording, RecordingView, TimeAxis,
 };
 pub use source::{cut_records, CutRecords, RecordInput, RecordSource, RecordWindow};
-pub use ssi::{SsiParams, Stability, StabilityParams};
+pub use ssi::{
+    SsiParams, Stability, StabilityParams, ANALYSIS_BLOCK_ROWS, SINGLE_RECORD_BLOCK_ROWS,
+};

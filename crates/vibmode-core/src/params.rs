@@ -99,7 +99,10 @@ pub struct PreprocessParams {
     /// Cutoff of the ideal DFT anti-alias filter, Hz (default 25 Hz, as in the paper).
     pub cutoff_hz: f64,
     /// Sampling rate of the analysis after resampling, Hz (default 50 Hz: twice the cutoff, so no
-    /// empty band; the paper uses 200 Hz).
+    /// empty band; the paper uses 200 Hz). Not a one-off resampling target (that is `fs_out_hz`,
+    /// `--fs-out`, of `vibmode resample` and the single-record commands): this is the rate every
+    /// stage of the analysis after pre-processing works at, and what its spectra, model orders
+    /// and SSI lags are counted in; stage 2 resamples each record to it.
     pub analysis_fs_hz: f64,
 }
 

@@ -7,11 +7,26 @@ use serde::{Deserialize, Serialize};
 use crate::error::ParamError;
 use crate::limits::{SSI_FIRST_LAG_MAX, SSI_ORDER_MAX, SSI_TOEPLITZ_ROWS_MAX};
 
-/// SSI-cov: the block Toeplitz matrix and the model orders identified from it.
+/// Block rows of SSI-cov on one record ([`SsiParams::default`]; `vibmode ssi`, Python's
+/// `ssi_cov`): 20, lags 1..=39, which a single record of a few thousand samples still estimates
+/// (each lag's correlation averages `N - lag` products of that record alone).
+pub const SINGLE_RECORD_BLOCK_ROWS: usize = 20;
+
+/// Block rows of SSI-cov in the analysis of many records ([`SsiParams::for_analysis`], the
+/// `[ssi]` section's default): 40, lags to 1.6 s at 50 Hz. Longer than on one record because the
+/// analysis pools the correlations over its records, so the long lags that the lightly damped
+/// body modes need are averaged over all of them; chosen on the demo (docs/ssi.md: per record,
+/// or pooled with 20 block rows, heave was not found).
+pub const ANALYSIS_BLOCK_ROWS: usize = 40;
+
+/// SSI-cov: the block Toeplitz matrix and the model orders identified from it. Two uses, two
+/// named defaults: [`SsiParams::default`] for one record, [`SsiParams::for_analysis`] for the
+/// analysis of many records (more block rows, correlations pooled over the records).
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SsiParams {
-    /// Number of block rows `i` of the block Toeplitz matrix of output correlations (default 20).
+    /// Number of block rows `i` of the block Toeplitz matrix of output correlations (default
+    /// [`SINGLE_RECORD_BLOCK_ROWS`] = 20; in the analysis [`ANALYSIS_BLOCK_ROWS`] = 40).
     /// The matrix holds the lags 1..=2i-1 and is `(i * l) x (i * l)` for `l` channels; the
     /// highest identifiable order is `(i - 1) * l`, and each channel needs at least `2 i` samples.
     pub block_rows: usize,
@@ -28,8 +43,9 @@ pub struct SsiParams {
     pub reference_channels: Option<Vec<usize>>,
     /// In the analysis of many records: `true` identifies once from the correlations averaged
     /// over all records used (long data for lightly damped, low modes; the poles then vary over
-    /// orders only); `false` (default) identifies each record alone, as the ARMA sweep does, so
-    /// that a mode must recur over records.
+    /// orders only, the analysis' default, [`SsiParams::for_analysis`]); `false` (the default
+    /// of one record, where there is nothing to pool) identifies each record alone, as the ARMA
+    /// sweep does, so that a mode must recur over records.
     pub pool_records: bool,
     /// First correlation lag of the Toeplitz matrix, samples (default 1): the matrix holds the
     /// lags `first_lag..=first_lag + 2i - 2`. Lag 0 carries the measurement noise. A larger
@@ -40,9 +56,11 @@ pub struct SsiParams {
 }
 
 impl Default for SsiParams {
+    /// The settings for one record (`vibmode ssi`); the analysis of many records uses
+    /// [`SsiParams::for_analysis`].
     fn default() -> Self {
         SsiParams {
-            block_rows: 20,
+            block_rows: SINGLE_RECORD_BLOCK_ROWS,
             order_min: 2,
             order_max: 60,
             order_step: 2,
@@ -54,6 +72,17 @@ impl Default for SsiParams {
 }
 
 impl SsiParams {
+    /// The settings of the analysis of many records (the `[ssi]` section's defaults):
+    /// [`ANALYSIS_BLOCK_ROWS`] block rows and the correlations pooled over the records; the
+    /// orders and lags as [`SsiParams::default`].
+    pub fn for_analysis() -> Self {
+        SsiParams {
+            block_rows: ANALYSIS_BLOCK_ROWS,
+            pool_records: true,
+            ..SsiParams::default()
+        }
+    }
+
     /// The identified orders: `order_min, order_min + order_step, ...` up to `order_max`
     /// (inclusive when reached). Empty only for parameters that fail [`SsiParams::validate`].
     pub fn orders(&self) -> Vec<usize> {

@@ -34,7 +34,12 @@ impl FromStr for ArMethod {
             "yule-walker" | "yw" | "yulewalker" | "yule_walker" => Ok(ArMethod::YuleWalker),
             "burg" => Ok(ArMethod::Burg),
             "ls" | "least-squares" | "least_squares" | "fbls" => Ok(ArMethod::LeastSquares),
-            _ => Err(IdentError::ParseArMethod(s.to_string())),
+            _ => Err(vibmode_core::ParamError::UnknownName {
+                what: "AR method",
+                value: s.to_string(),
+                valid: "yule-walker (or yw), burg, ls",
+            }
+            .into()),
         }
     }
 }

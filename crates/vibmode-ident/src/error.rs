@@ -77,19 +77,10 @@ pub enum IdentError {
         /// Polynomial degree.
         degree: usize,
     },
-    /// A parameter value is out of range.
-    #[error("invalid {name} = {value}; {fix}")]
-    InvalidParam {
-        /// Parameter name.
-        name: &'static str,
-        /// Offending value (formatted).
-        value: String,
-        /// How to fix it.
-        fix: &'static str,
-    },
-    /// An unknown AR method name was given.
-    #[error("unknown AR method '{0}'; valid values: yule-walker (or yw), burg, ls")]
-    ParseArMethod(String),
+    /// A parameter value out of range, or an unknown name (an AR method): core's one shape of
+    /// a parameter error.
+    #[error(transparent)]
+    Param(#[from] vibmode_core::ParamError),
     /// A warm-start model has orders that do not fit the requested ones.
     #[error("warm-start model has orders (p={init_p}, q={init_q}) larger than the requested (p={p}, q={q}); pass a lower-order model or none")]
     InitMismatch {

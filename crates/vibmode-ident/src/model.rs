@@ -18,6 +18,55 @@ pub enum Estimator {
     PredictionError,
 }
 
+impl Estimator {
+    /// The names [`Estimator::from_str`](std::str::FromStr) accepts first (the command line's
+    /// `--estimator` values), in the order of the enum.
+    pub const NAMES: [&'static str; 4] = ["yule-walker", "burg", "ls", "pem"];
+
+    /// The estimator's name as [`Estimator::NAMES`] spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Estimator::YuleWalker => "yule-walker",
+            Estimator::Burg => "burg",
+            Estimator::LeastSquares => "ls",
+            Estimator::PredictionError => "pem",
+        }
+    }
+
+    /// The AR method of a closed-form estimator; `None` for prediction-error minimisation
+    /// (which fits ARMA models).
+    pub fn ar_method(self) -> Option<crate::ArMethod> {
+        match self {
+            Estimator::YuleWalker => Some(crate::ArMethod::YuleWalker),
+            Estimator::Burg => Some(crate::ArMethod::Burg),
+            Estimator::LeastSquares => Some(crate::ArMethod::LeastSquares),
+            Estimator::PredictionError => None,
+        }
+    }
+}
+
+impl std::str::FromStr for Estimator {
+    type Err = vibmode_core::ParamError;
+    /// Accepts the [`Estimator::NAMES`], `pem`'s long form `prediction-error`, and the AR
+    /// spellings of [`crate::ArMethod`] (`yw`, `least-squares`, ...; case-insensitive).
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let t = s.trim().to_ascii_lowercase();
+        if matches!(t.as_str(), "pem" | "prediction-error" | "prediction_error") {
+            return Ok(Estimator::PredictionError);
+        }
+        match t.parse::<crate::ArMethod>() {
+            Ok(crate::ArMethod::YuleWalker) => Ok(Estimator::YuleWalker),
+            Ok(crate::ArMethod::Burg) => Ok(Estimator::Burg),
+            Ok(crate::ArMethod::LeastSquares) => Ok(Estimator::LeastSquares),
+            Err(_) => Err(vibmode_core::ParamError::UnknownName {
+                what: "estimator",
+                value: s.to_string(),
+                valid: "yule-walker, burg, ls, pem",
+            }),
+        }
+    }
+}
+
 /// Why the prediction-error search stopped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum StopReason {
@@ -243,6 +292,26 @@ pub fn modes_from_poles(poles: &[Complex64], fs_hz: f64) -> ModeSet {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn estimator_names_parse_back_and_map_to_the_ar_methods() {
+        for name in Estimator::NAMES {
+            let e: Estimator = name.parse().unwrap();
+            assert_eq!(e.name(), name);
+        }
+        assert_eq!("YW".parse::<Estimator>().unwrap(), Estimator::YuleWalker);
+        assert_eq!(
+            "prediction-error".parse::<Estimator>().unwrap(),
+            Estimator::PredictionError
+        );
+        assert_eq!(
+            Estimator::LeastSquares.ar_method(),
+            Some(crate::ArMethod::LeastSquares)
+        );
+        assert_eq!(Estimator::PredictionError.ar_method(), None);
+        let e = "newton".parse::<Estimator>().unwrap_err().to_string();
+        assert!(e.contains("'newton'") && e.contains("burg"), "{e}");
+    }
 
     #[test]
     fn mode_from_known_pole() {

@@ -18,6 +18,7 @@ use nalgebra::DMatrix;
 use crate::ar::burg;
 use crate::linalg::{check_signal, cholesky_solve_ridged, median, predict_errors, robust_std};
 use crate::IdentError;
+use vibmode_core::ParamError;
 
 /// Settings of the robust AR filter-cleaner ([`clean_additive_outliers`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -48,25 +49,31 @@ impl Default for CleanerParams {
 impl CleanerParams {
     pub(crate) fn validate(&self) -> Result<(), IdentError> {
         if self.ar_order == 0 {
-            return Err(IdentError::InvalidParam {
-                name: "cleaner ar_order",
-                value: "0".to_string(),
-                fix: "use an AR predictor order of at least 1, e.g. 20, or OutlierCleaning::Off",
-            });
+            return Err(ParamError::out_of_range(
+                "ar_order",
+                0,
+                "must be an AR predictor order of at least 1 (or OutlierCleaning::Off)",
+                CleanerParams::default().ar_order,
+            )
+            .into());
         }
         if !(self.threshold.is_finite() && self.threshold > 0.0) {
-            return Err(IdentError::InvalidParam {
-                name: "cleaner threshold",
-                value: self.threshold.to_string(),
-                fix: "use a positive number of robust standard deviations such as 4.0",
-            });
+            return Err(ParamError::out_of_range(
+                "threshold",
+                self.threshold,
+                "must be a positive number of robust standard deviations",
+                CleanerParams::default().threshold,
+            )
+            .into());
         }
         if self.passes == 0 {
-            return Err(IdentError::InvalidParam {
-                name: "cleaner passes",
-                value: "0".to_string(),
-                fix: "use at least 1 pass, e.g. 3, or OutlierCleaning::Off",
-            });
+            return Err(ParamError::out_of_range(
+                "passes",
+                0,
+                "must be at least 1 (or OutlierCleaning::Off)",
+                CleanerParams::default().passes,
+            )
+            .into());
         }
         Ok(())
     }

@@ -8,10 +8,10 @@ use serde::{Deserialize, Serialize};
 use crate::outliers::OutlierCleaning;
 use crate::IdentError;
 
-use vibmode_core::BandLimit;
 /// Robustification of the prediction-error criterion: defined once, in `vibmode-core` (a Huber
 /// factor or `off`, one spelling in TOML, JSON, the command line and Python).
 pub use vibmode_core::Robust;
+use vibmode_core::{BandLimit, ParamError};
 
 /// Settings of the prediction-error search.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -108,26 +108,32 @@ impl Default for ArmaParams {
 impl ArmaParams {
     pub(crate) fn validate(&self) -> Result<(), IdentError> {
         if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
-            return Err(IdentError::InvalidParam {
-                name: "tolerance",
-                value: self.tolerance.to_string(),
-                fix: "use a small positive number such as 1e-5",
-            });
+            return Err(ParamError::out_of_range(
+                "tolerance",
+                self.tolerance,
+                "must be a small positive number",
+                FIT_TOLERANCE,
+            )
+            .into());
         }
         if !(self.noise_floor.is_finite() && (0.0..MAX_NOISE_FLOOR).contains(&self.noise_floor)) {
-            return Err(IdentError::InvalidParam {
-                name: "noise_floor",
-                value: self.noise_floor.to_string(),
-                fix: "use a small relative variance in [0, 0.1) such as 1e-3 (the default), or 0 for none",
-            });
+            return Err(ParamError::out_of_range(
+                "noise_floor",
+                self.noise_floor,
+                "must be a relative variance in [0, 0.1) (0 for none)",
+                ArmaParams::default().noise_floor,
+            )
+            .into());
         }
         if let Robust::Huber { factor } = self.robust {
             if !(factor.is_finite() && factor > 0.0) {
-                return Err(IdentError::InvalidParam {
-                    name: "Huber factor",
-                    value: factor.to_string(),
-                    fix: "use a positive factor such as 1.6, or off",
-                });
+                return Err(ParamError::out_of_range(
+                    "robust",
+                    factor,
+                    "must be a positive Huber factor, or off",
+                    Robust::default(),
+                )
+                .into());
             }
         }
         Ok(())

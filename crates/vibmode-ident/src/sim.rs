@@ -78,11 +78,13 @@ pub fn simulate_arma(
         }
     }
     if !(lambda.is_finite() && lambda >= 0.0) {
-        return Err(IdentError::InvalidParam {
-            name: "lambda",
-            value: lambda.to_string(),
-            fix: "pass a finite, non-negative innovation variance",
-        });
+        return Err(vibmode_core::ParamError::out_of_range(
+            "lambda",
+            lambda,
+            "must be a finite, non-negative innovation variance",
+            1.0,
+        )
+        .into());
     }
     let an: Vec<f64> = a.iter().map(|v| v / a[0]).collect();
     let rmax = polynomial_roots(&an)?

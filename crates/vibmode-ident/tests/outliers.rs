@@ -344,7 +344,10 @@ fn bad_cleaner_inputs_give_one_line_errors() {
         ),
     ] {
         let e = clean_additive_outliers(&y, &cp).unwrap_err();
-        assert!(matches!(e, IdentError::InvalidParam { .. }));
+        assert!(matches!(
+            e,
+            IdentError::Param(vibmode_core::ParamError::OutOfRange { .. })
+        ));
         let msg = e.to_string();
         assert!(msg.contains(name) && !msg.contains('\n'), "{msg}");
         let params = ArmaParams {
@@ -396,4 +399,46 @@ fn params_serde_defaults() {
     v.as_object_mut().unwrap().remove("outliers_replaced");
     let back: ArmaModel = serde_json::from_value(v).unwrap();
     assert_eq!(back, m);
+}
+
+/// A bad parameter of a fit is core's `ParamError` (one shape across crates), one line naming
+/// the key, the value and a valid value.
+#[test]
+fn bad_fit_parameters_are_core_param_errors() {
+    let y: Vec<f64> = (0..400).map(|i| (0.3 * i as f64).sin()).collect();
+    for (params, needle) in [
+        (
+            ArmaParams {
+                tolerance: -1.0,
+                ..ArmaParams::default()
+            },
+            "tolerance = -1",
+        ),
+        (
+            ArmaParams {
+                noise_floor: 0.5,
+                ..ArmaParams::default()
+            },
+            "noise_floor = 0.5",
+        ),
+    ] {
+        let e = vibmode_ident::fit_arma(&y, 4, 4, &params).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                IdentError::Param(vibmode_core::ParamError::OutOfRange { .. })
+            ),
+            "{e:?}"
+        );
+        let msg = e.to_string();
+        assert!(
+            msg.contains(needle) && msg.contains("use e.g.") && !msg.contains('\n'),
+            "{msg}"
+        );
+    }
+    let e = "newton"
+        .parse::<vibmode_ident::ArMethod>()
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("'newton'") && e.contains("burg"), "{e}");
 }

@@ -11,11 +11,11 @@ fn input_err(e: impl std::fmt::Display) -> ReportError {
 }
 
 /// The paper's Fig. 3-4 for the first channel of `raw`: time (top, the first `seconds`) and
-/// periodograms (bottom) of the raw record, the record resampled to `to_hz` without filter, and
+/// periodograms (bottom) of the raw record, the record resampled to `fs_out_hz` without filter, and
 /// resampled with the ideal filter at `cutoff_hz` (default: the new Nyquist frequency).
 pub fn antialias_figure(
     raw: &Recording,
-    to_hz: f64,
+    fs_out_hz: f64,
     cutoff_hz: Option<f64>,
     seconds: f64,
 ) -> Result<Figure, ReportError> {
@@ -27,7 +27,7 @@ pub fn antialias_figure(
     let resampled = |filter: bool| {
         first
             .resample(&ResampleParams {
-                to_hz,
+                fs_out_hz,
                 cutoff_hz,
                 filter,
             })
@@ -35,7 +35,7 @@ pub fn antialias_figure(
     };
     let plain = resampled(false)?;
     let filt = resampled(true)?;
-    let cutoff = cutoff_hz.unwrap_or(to_hz / 2.0);
+    let cutoff = cutoff_hz.unwrap_or(fs_out_hz / 2.0);
     let t_end = seconds.min(first.duration_s());
     let time_series = |rec: &Recording, label: &str, width: u32| -> Series {
         let n = ((t_end * rec.fs_hz).ceil() as usize + 1).min(rec.len());
@@ -61,7 +61,7 @@ pub fn antialias_figure(
             .freq_hz
             .iter()
             .zip(&s.psd)
-            .filter(|(f, _)| **f <= to_hz / 2.0 && **f > 0.0)
+            .filter(|(f, _)| **f <= fs_out_hz / 2.0 && **f > 0.0)
             .map(|(f, p)| (*f, *p))
             .unzip();
         Ok(Series::line(x, y)
@@ -73,8 +73,8 @@ pub fn antialias_figure(
             .with_alpha(if width == 1 { 0.6 } else { 1.0 }))
     };
     let raw_label = format!("raw {} Hz", raw.fs_hz);
-    let plain_label = format!("{to_hz} Hz, no filter");
-    let filt_label = format!("{to_hz} Hz, ideal filter {cutoff} Hz");
+    let plain_label = format!("{fs_out_hz} Hz, no filter");
+    let filt_label = format!("{fs_out_hz} Hz, ideal filter {cutoff} Hz");
     let u = if unit.is_empty() {
         "input units".to_string()
     } else {
@@ -94,7 +94,7 @@ pub fn antialias_figure(
                 format!("PSD [({u})^2/Hz]"),
             )
             .with_scales(Scale::Linear, Scale::Log)
-            .with_x_range(0.0, to_hz / 2.0)
+            .with_x_range(0.0, fs_out_hz / 2.0)
             .with_series(spec(&first, &raw_label, 1)?)
             .with_series(spec(&plain, &plain_label, 2)?)
             .with_series(spec(&filt, &filt_label, 2)?),

@@ -101,7 +101,7 @@ pub fn by_vibration(
             info.fs_hz,
             nch,
             &StreamResampleParams {
-                to_hz: info.fs_hz / factor,
+                fs_out_hz: info.fs_hz / factor,
                 cutoff_hz: Some(ACTIVITY_MAX_HZ),
                 ..StreamResampleParams::default()
             },

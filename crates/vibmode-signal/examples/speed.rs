@@ -54,7 +54,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         assert_eq!(back.len(), 204_800);
     });
     let p200 = ResampleParams {
-        to_hz: 200.0,
+        fs_out_hz: 200.0,
         cutoff_hz: Some(25.0),
         filter: true,
     };

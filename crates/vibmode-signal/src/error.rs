@@ -198,7 +198,7 @@ pub enum SignalError {
     /// An invalid parameter value (resampling, read options...).
     #[error("{name} = {value} is invalid: {fix}")]
     InvalidParam {
-        /// Parameter name, e.g. "to_hz".
+        /// Parameter name, e.g. "fs_out_hz".
         name: &'static str,
         /// The value as text.
         value: String,

@@ -31,7 +31,7 @@
 //!
 //! // Ideal anti-alias filter at 25 Hz, then keep every 10th sample (1000 Hz -> 100 Hz):
 //! // the 10 Hz tone passes unchanged.
-//! let p = ResampleParams { to_hz: 100.0, cutoff_hz: Some(25.0), filter: true };
+//! let p = ResampleParams { fs_out_hz: 100.0, cutoff_hz: Some(25.0), filter: true };
 //! let low = rec.resample(&p).unwrap();
 //! assert_eq!(low.len(), 100);
 //! let expected = (2.0 * std::f64::consts::PI * 10.0 * 7.0 / 100.0).sin();
@@ -62,7 +62,8 @@ pub use resample::ResampleRecording;
 pub use resample::{resample, ResampleMethod, ResampleParams, Resampler};
 pub use stream::{open_stream, FrameBlock, FrameStream, StreamInfo, DEFAULT_BLOCK_FRAMES};
 pub use stream_resample::{
-    resample_stream, FirDecimator, FirDesign, StreamResampleParams, StreamResampleSummary,
+    resample_stream, FirDecimator, FirDesign, ResamplerKind, StreamResampleParams,
+    StreamResampleSummary,
 };
 pub use stream_write::StreamWriter;
 pub use vibmode_core::{

@@ -42,7 +42,7 @@ pub fn preprocess(rec: &Recording, p: &PreprocessParams) -> Result<Preprocessed>
         });
     }
     let wanted = ResampleParams {
-        to_hz: p.analysis_fs_hz,
+        fs_out_hz: p.analysis_fs_hz,
         cutoff_hz: Some(p.cutoff_hz.min(rec.fs_hz / 2.0)),
         filter: true,
     };

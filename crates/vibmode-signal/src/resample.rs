@@ -1,8 +1,8 @@
 //! The paper's ideal (rectangular DFT) anti-alias filter and resampling.
 //!
 //! # Methods
-//! Let `N` be the record length, `fs_in` its rate, `to_hz` the requested rate and
-//! `r = fs_in / to_hz`.
+//! Let `N` be the record length, `fs_in` its rate, `fs_out_hz` the requested rate and
+//! `r = fs_in / fs_out_hz`.
 //!
 //! - **Integer ratio** (`r` = D, an integer within 1e-9): the paper's method. With `filter`, the
 //!   whole record is transformed (real FFT, any length), every bin with `|f_k| > cutoff_hz` is
@@ -11,15 +11,15 @@
 //!   `fs_in / D`. Without `filter`, it is plain decimation `x[0], x[D], x[2D], ...` (aliasing shows,
 //!   as in the paper's Fig. 3-4). When D divides N the decimation is done in the frequency domain
 //!   (folding the spectrum onto `N / D` bins), which is mathematically identical and faster.
-//! - **Non-integer ratio**: Fourier resampling to `num = round(N to_hz / fs_in)` samples (ties to
+//! - **Non-integer ratio**: Fourier resampling to `num = round(N fs_out_hz / fs_in)` samples (ties to
 //!   even, like Python's `round`), like
 //!   `scipy.signal.resample(x, num)`: the ideal cutoff is applied, the spectrum is truncated (or
 //!   zero-padded when upsampling) to `num` samples with scipy's handling of the Nyquist bin for
 //!   even lengths (doubled when downsampling, halved when upsampling), inverse FFT, scaled by
-//!   `num / N`. The output rate is `fs_in num / N` (reported in [`Resampler::fs_out_hz`]), which
-//!   differs from `to_hz` by less than `0.5 / N` relative when `N to_hz / fs_in` is not an integer.
-//!   Without `filter`, samples are linearly interpolated at `t = m / to_hz` (no anti-aliasing;
-//!   `floor((N - 1) to_hz / fs_in) + 1` samples).
+//!   `num / N`. The output rate is `fs_in num / N` (reported by [`Resampler::fs_out_hz`]), which
+//!   differs from the requested `fs_out_hz` by less than `0.5 / N` relative when `N fs_out_hz / fs_in` is not an integer.
+//!   Without `filter`, samples are linearly interpolated at `t = m / fs_out_hz` (no anti-aliasing;
+//!   `floor((N - 1) fs_out_hz / fs_in) + 1` samples).
 //!
 //! # Relation to `scipy.signal.resample`
 //! With the default cutoff (the output Nyquist frequency) the Fourier path equals
@@ -48,10 +48,13 @@ use vibmode_core::{check_fs, Channel, Num, Recording, RecordingError, TimeAxis};
 /// Parameters of [`resample`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ResampleParams {
-    /// Target sampling rate, Hz. Default 200.0 (the paper: 20 kHz -> 200 Hz).
-    pub to_hz: f64,
+    /// The rate to resample to, Hz (the one name of a target rate: `--fs-out` on the command
+    /// line, `fs_out` in Python; the older key `to_hz` is still read). Default 200.0 (the paper:
+    /// 20 kHz -> 200 Hz).
+    #[serde(alias = "to_hz")]
+    pub fs_out_hz: f64,
     /// Cutoff of the ideal low-pass, Hz (bins with |f| > cutoff are zeroed). Default `None` =
-    /// the output Nyquist frequency. The paper uses 25 Hz with `to_hz` = 200.
+    /// the output Nyquist frequency. The paper uses 25 Hz with `fs_out_hz` = 200.
     pub cutoff_hz: Option<f64>,
     /// Apply the ideal anti-alias filter. Default true; false gives plain decimation (integer
     /// ratios) or linear interpolation (other ratios), which alias.
@@ -61,7 +64,7 @@ pub struct ResampleParams {
 impl Default for ResampleParams {
     fn default() -> Self {
         ResampleParams {
-            to_hz: 200.0,
+            fs_out_hz: 200.0,
             cutoff_hz: None,
             filter: true,
         }
@@ -146,10 +149,10 @@ fn fft_err(e: realfft::FftError) -> SignalError {
     }
 }
 
-/// How a record of `n_in` samples at `fs_hz` is resampled to `p.to_hz`: the method, the
+/// How a record of `n_in` samples at `fs_hz` is resampled to `p.fs_out_hz`: the method, the
 /// decimation factor (integer ratios), the number of output samples and the output rate.
 fn plan_kind(n_in: usize, fs_hz: f64, p: &ResampleParams) -> (Kind, usize, usize, f64) {
-    let ratio = fs_hz / p.to_hz;
+    let ratio = fs_hz / p.fs_out_hz;
     let d = ratio.round();
     let integer = d >= 1.0 && (ratio - d).abs() <= 1e-9 * ratio;
     if integer {
@@ -162,10 +165,10 @@ fn plan_kind(n_in: usize, fs_hz: f64, p: &ResampleParams) -> (Kind, usize, usize
         };
         (kind, dd, n_out, fs_hz / d)
     } else if p.filter {
-        let num = (n_in as f64 * p.to_hz / fs_hz).round_ties_even();
+        let num = (n_in as f64 * p.fs_out_hz / fs_hz).round_ties_even();
         let fs_out = fs_hz * num / n_in as f64;
-        let fs_out = if (fs_out - p.to_hz).abs() <= 1e-9 * p.to_hz {
-            p.to_hz
+        let fs_out = if (fs_out - p.fs_out_hz).abs() <= 1e-9 * p.fs_out_hz {
+            p.fs_out_hz
         } else {
             fs_out
         };
@@ -174,9 +177,9 @@ fn plan_kind(n_in: usize, fs_hz: f64, p: &ResampleParams) -> (Kind, usize, usize
         let n_out = if n_in == 0 {
             0
         } else {
-            ((n_in - 1) as f64 * p.to_hz / fs_hz * (1.0 + 1e-12)).floor() as usize + 1
+            ((n_in - 1) as f64 * p.fs_out_hz / fs_hz * (1.0 + 1e-12)).floor() as usize + 1
         };
-        (Kind::Linear, 0, n_out, p.to_hz)
+        (Kind::Linear, 0, n_out, p.fs_out_hz)
     }
 }
 
@@ -271,23 +274,23 @@ impl Ffts {
 impl Resampler {
     /// Plans a resampler for records of `n_in` samples at `fs_hz`.
     ///
-    /// Errors: `fs_hz` or `to_hz` not positive and finite; `cutoff_hz` not positive or above the
+    /// Errors: `fs_hz` or `fs_out_hz` not positive and finite; `cutoff_hz` not positive or above the
     /// output Nyquist frequency `min(fs_in, fs_out) / 2`; fewer than 2 output samples.
     pub fn new(n_in: usize, fs_hz: f64, p: &ResampleParams) -> Result<Resampler> {
         check_fs(fs_hz, "input fs_hz")?;
-        if !(p.to_hz.is_finite() && p.to_hz > 0.0) {
+        if !(p.fs_out_hz.is_finite() && p.fs_out_hz > 0.0) {
             return Err(invalid(
-                "to_hz",
-                p.to_hz,
+                "fs_out_hz",
+                p.fs_out_hz,
                 "the target rate must be a positive finite number of Hz, e.g. 200".into(),
             ));
         }
-        check_fs(p.to_hz, "target rate to_hz")?;
-        let ratio = p.to_hz / fs_hz;
+        check_fs(p.fs_out_hz, "target rate fs_out_hz")?;
+        let ratio = p.fs_out_hz / fs_hz;
         if ratio > UPSAMPLE_RATIO_MAX {
             return Err(invalid(
-                "to_hz",
-                p.to_hz,
+                "fs_out_hz",
+                p.fs_out_hz,
                 format!(
                     "it is {} times the input rate {} Hz; vibmode upsamples at most {UPSAMPLE_RATIO_MAX} times: check the rates' units",
                     Num(ratio),
@@ -297,8 +300,8 @@ impl Resampler {
         }
         if (n_in as f64 * ratio) > SAMPLES_OUT_MAX as f64 {
             return Err(invalid(
-                "to_hz",
-                p.to_hz,
+                "fs_out_hz",
+                p.fs_out_hz,
                 format!(
                     "{n_in} samples would become {} samples, more than the {SAMPLES_OUT_MAX} vibmode makes at once; cut the recording into parts",
                     Num((n_in as f64 * ratio).round())
@@ -308,11 +311,11 @@ impl Resampler {
         let (kind, factor, n_out, fs_out) = plan_kind(n_in, fs_hz, p);
         if n_out < 2 {
             return Err(SignalError::TooShort {
-                what: format!("resampling from {fs_hz} Hz to {} Hz", p.to_hz),
+                what: format!("resampling from {fs_hz} Hz to {} Hz", p.fs_out_hz),
                 n: n_in,
                 fix: format!(
                     "that gives {n_out} output samples; need at least 2 (a record of at least {:.0} samples)",
-                    (2.0 * fs_hz / p.to_hz).ceil()
+                    (2.0 * fs_hz / p.fs_out_hz).ceil()
                 ),
             });
         }
@@ -509,7 +512,7 @@ impl Resampler {
 /// use vibmode_signal::{resample, ResampleParams};
 /// // 1 Hz sine at 1000 Hz, to 100 Hz: the tone is far below the cutoff and passes unchanged.
 /// let x: Vec<f64> = (0..1000).map(|i| (2.0 * std::f64::consts::PI * i as f64 / 1000.0).sin()).collect();
-/// let y = resample(&x, 1000.0, &ResampleParams { to_hz: 100.0, ..Default::default() }).unwrap();
+/// let y = resample(&x, 1000.0, &ResampleParams { fs_out_hz: 100.0, ..Default::default() }).unwrap();
 /// assert_eq!(y.len(), 100);
 /// assert!((y[25] - 1.0).abs() < 1e-12);
 /// ```
@@ -538,8 +541,8 @@ impl ResampleRecording for Recording {
         let total = r.n_out() as u64 * self.channels.len() as u64;
         if total > SAMPLES_OUT_MAX {
             return Err(invalid(
-                "to_hz",
-                p.to_hz,
+                "fs_out_hz",
+                p.fs_out_hz,
                 format!(
                     "{} channels of {} samples each are more than the {SAMPLES_OUT_MAX} samples vibmode makes at once; cut the recording into parts",
                     self.channels.len(),

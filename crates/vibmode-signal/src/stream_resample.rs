@@ -31,8 +31,10 @@ use serde::{Deserialize, Serialize};
 /// Parameters of [`FirDecimator`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StreamResampleParams {
-    /// Output rate, Hz. Default 200.
-    pub to_hz: f64,
+    /// The rate to resample to, Hz (as [`crate::ResampleParams::fs_out_hz`]; the older key
+    /// `to_hz` is still read). Default 200.
+    #[serde(alias = "to_hz")]
+    pub fs_out_hz: f64,
     /// Pass-band edge, Hz. Default `None` = 0.8 x the lower Nyquist frequency.
     pub cutoff_hz: Option<f64>,
     /// Stop-band attenuation (and pass-band ripple, `10^(-A/20)`) of the Kaiser design, dB.
@@ -43,9 +45,64 @@ pub struct StreamResampleParams {
 impl Default for StreamResampleParams {
     fn default() -> Self {
         StreamResampleParams {
-            to_hz: 200.0,
+            fs_out_hz: 200.0,
             cutoff_hz: None,
             attenuation_db: 110.0,
+        }
+    }
+}
+
+/// Which resampler a file goes through (`vibmode resample --resampler`): the paper's ideal DFT
+/// filter over the whole record in memory ([`crate::Resampler`]), the streamed FIR
+/// ([`FirDecimator`], any length in bounded memory), or `Auto` (the default): ideal for input
+/// files up to [`ResamplerKind::AUTO_IDEAL_MAX_BYTES`], FIR above.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ResamplerKind {
+    /// Ideal up to [`ResamplerKind::AUTO_IDEAL_MAX_BYTES`] of input file, streamed FIR above
+    /// (ideal whenever no anti-alias filter is asked for).
+    #[default]
+    Auto,
+    /// The ideal DFT low-pass over the whole record.
+    Ideal,
+    /// The streamed linear-phase FIR.
+    Fir,
+}
+
+impl ResamplerKind {
+    /// The names [`ResamplerKind::from_str`](std::str::FromStr) accepts.
+    pub const NAMES: [&'static str; 3] = ["auto", "ideal", "fir"];
+
+    /// Input files up to this size are resampled whole with the ideal filter by `Auto` (64 MiB).
+    pub const AUTO_IDEAL_MAX_BYTES: u64 = 64 << 20;
+
+    /// Whether a file of `input_bytes` (`None`: size unknown) goes through the streamed FIR;
+    /// `filter = false` (plain decimation, which only the ideal resampler does) keeps `Auto`
+    /// on the ideal resampler.
+    pub fn streams(self, input_bytes: Option<u64>, filter: bool) -> bool {
+        match self {
+            ResamplerKind::Fir => true,
+            ResamplerKind::Ideal => false,
+            ResamplerKind::Auto => {
+                filter && input_bytes.is_some_and(|n| n > Self::AUTO_IDEAL_MAX_BYTES)
+            }
+        }
+    }
+}
+
+impl std::str::FromStr for ResamplerKind {
+    type Err = vibmode_core::ParamError;
+    /// Accepts the [`ResamplerKind::NAMES`] (case-insensitive).
+    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "auto" => Ok(ResamplerKind::Auto),
+            "ideal" => Ok(ResamplerKind::Ideal),
+            "fir" => Ok(ResamplerKind::Fir),
+            _ => Err(vibmode_core::ParamError::UnknownName {
+                what: "resampler",
+                value: s.to_string(),
+                valid: "auto, ideal, fir",
+            }),
         }
     }
 }
@@ -177,10 +234,10 @@ impl FirDesign {
                 "must be a positive rate in Hz".into(),
             ));
         }
-        if !(p.to_hz.is_finite() && p.to_hz > 0.0) {
+        if !(p.fs_out_hz.is_finite() && p.fs_out_hz > 0.0) {
             return Err(invalid(
-                "to_hz",
-                p.to_hz,
+                "fs_out_hz",
+                p.fs_out_hz,
                 "must be a positive rate in Hz, e.g. 200".into(),
             ));
         }
@@ -191,13 +248,13 @@ impl FirDesign {
                 "must lie in 40..200 dB, e.g. 110".into(),
             ));
         }
-        let (up, down) = rational_ratio(p.to_hz / fs_in_hz, 1024).ok_or_else(|| {
+        let (up, down) = rational_ratio(p.fs_out_hz / fs_in_hz, 1024).ok_or_else(|| {
             invalid(
-                "to_hz",
-                p.to_hz,
+                "fs_out_hz",
+                p.fs_out_hz,
                 format!(
                     "{} / {fs_in_hz} Hz is not a ratio of whole numbers L/M with L <= 1024; the streaming filter needs one (e.g. 20000 -> 200 Hz); resample the whole record instead",
-                    p.to_hz
+                    p.fs_out_hz
                 ),
             )
         })?;

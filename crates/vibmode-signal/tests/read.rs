@@ -593,7 +593,7 @@ fn real_rc_slab_smartphone_file() {
         .unwrap();
     let low = z
         .resample(&vibmode_signal::ResampleParams {
-            to_hz: 50.0,
+            fs_out_hz: 50.0,
             ..Default::default()
         })
         .unwrap();

@@ -8,9 +8,9 @@ use vibmode_signal::{
     resample, Channel, Recording, ResampleMethod, ResampleParams, Resampler, SignalError,
 };
 
-fn params(to_hz: f64, cutoff_hz: Option<f64>, filter: bool) -> ResampleParams {
+fn params(fs_out_hz: f64, cutoff_hz: Option<f64>, filter: bool) -> ResampleParams {
     ResampleParams {
-        to_hz,
+        fs_out_hz,
         cutoff_hz,
         filter,
     }
@@ -86,7 +86,7 @@ fn hand_case_constant_and_plain_decimation() {
     assert_eq!(y, vec![0.0, 2.0, 4.0, 6.0, 8.0]);
     let y = resample(&x, 10.0, &params(10.0 / 3.0, None, false)).unwrap();
     assert_eq!(y, vec![0.0, 3.0, 6.0, 9.0]);
-    // Without filter, non-integer ratio: linear interpolation at t = m / to_hz.
+    // Without filter, non-integer ratio: linear interpolation at t = m / fs_out_hz.
     let y = resample(&x, 10.0, &params(4.0, None, false)).unwrap();
     assert_eq!(y.len(), 4); // t = 0, 0.25, 0.5, 0.75 s <= 0.9 s
     for (m, v) in y.iter().enumerate() {
@@ -359,7 +359,7 @@ fn error_paths() {
         s
     };
     let e = msg(resample(&x, 100.0, &params(0.0, None, true)).unwrap_err());
-    assert!(e.contains("to_hz = 0") && !e.contains("--"), "{e}");
+    assert!(e.contains("fs_out_hz = 0") && !e.contains("--"), "{e}");
     let e = msg(resample(&x, 100.0, &params(f64::NAN, None, true)).unwrap_err());
     assert!(e.contains("NaN"), "{e}");
     let e = msg(resample(&x, -5.0, &params(10.0, None, true)).unwrap_err());
@@ -402,4 +402,28 @@ fn seven_channels_paper_size_resample_each_channel() {
     // Channels are resampled independently: channel 3 alone gives the same samples.
     let alone = resample(&rec.channels[3].samples, 20_000.0, &p).unwrap();
     assert_eq!(out.channels[3].samples, alone);
+}
+
+#[test]
+fn the_target_rate_is_read_as_fs_out_hz_and_as_the_older_to_hz() {
+    let new: ResampleParams =
+        serde_json::from_str(r#"{"fs_out_hz": 50.0, "cutoff_hz": 20.0, "filter": true}"#).unwrap();
+    let old: ResampleParams =
+        serde_json::from_str(r#"{"to_hz": 50.0, "cutoff_hz": 20.0, "filter": true}"#).unwrap();
+    assert_eq!(new.fs_out_hz, 50.0);
+    assert_eq!(old, new);
+    // Written under the one name.
+    let text = serde_json::to_string(&new).unwrap();
+    assert!(
+        text.contains("\"fs_out_hz\":50.0") && !text.contains("to_hz"),
+        "{text}"
+    );
+    let s_new: vibmode_signal::StreamResampleParams =
+        serde_json::from_str(r#"{"fs_out_hz": 50.0, "cutoff_hz": null, "attenuation_db": 110.0}"#)
+            .unwrap();
+    let s_old: vibmode_signal::StreamResampleParams =
+        serde_json::from_str(r#"{"to_hz": 50.0, "cutoff_hz": null, "attenuation_db": 110.0}"#)
+            .unwrap();
+    assert_eq!(s_new.fs_out_hz, 50.0);
+    assert_eq!(s_old, s_new);
 }

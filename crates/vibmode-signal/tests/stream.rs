@@ -281,7 +281,7 @@ fn pass_band_flat_to_1e_5_and_stop_band_below_minus_100_db() {
         let d = FirDesign::new(
             fs,
             &StreamResampleParams {
-                to_hz: to,
+                fs_out_hz: to,
                 cutoff_hz: cutoff,
                 ..Default::default()
             },
@@ -345,7 +345,7 @@ fn agrees_with_the_whole_record_ideal_filter_away_from_the_ends_over_seeds() {
     let fs = 20_000.0;
     let n = 200_000; // 10 s
     let p = StreamResampleParams {
-        to_hz: 200.0,
+        fs_out_hz: 200.0,
         ..Default::default()
     };
     let mut worst_db = f64::NEG_INFINITY;
@@ -355,7 +355,7 @@ fn agrees_with_the_whole_record_ideal_filter_away_from_the_ends_over_seeds() {
             &x,
             fs,
             &ResampleParams {
-                to_hz: 200.0,
+                fs_out_hz: 200.0,
                 cutoff_hz: Some(90.0),
                 filter: true,
             },
@@ -387,7 +387,7 @@ fn output_does_not_depend_on_block_sizes_and_has_ceil_n_l_over_m_samples() {
     let fs = 44_100.0;
     let x = random_recording(1, 30_011, 2, fs);
     let p = StreamResampleParams {
-        to_hz: 200.0,
+        fs_out_hz: 200.0,
         ..Default::default()
     };
     let run = |block: usize| {
@@ -417,4 +417,25 @@ fn output_does_not_depend_on_block_sizes_and_has_ceil_n_l_over_m_samples() {
     for block in [1, 441, 5000] {
         assert_eq!(run(block), a);
     }
+}
+
+#[test]
+fn resampler_kind_auto_streams_only_large_filtered_inputs() {
+    use vibmode_signal::ResamplerKind;
+    let big = Some(ResamplerKind::AUTO_IDEAL_MAX_BYTES + 1);
+    let small = Some(ResamplerKind::AUTO_IDEAL_MAX_BYTES);
+    assert!(ResamplerKind::Auto.streams(big, true));
+    assert!(!ResamplerKind::Auto.streams(small, true));
+    assert!(!ResamplerKind::Auto.streams(big, false));
+    assert!(!ResamplerKind::Auto.streams(None, true));
+    assert!(ResamplerKind::Fir.streams(small, true));
+    assert!(!ResamplerKind::Ideal.streams(big, true));
+    for name in ResamplerKind::NAMES {
+        assert!(name.parse::<ResamplerKind>().is_ok(), "{name}");
+    }
+    let e = "sinc".parse::<ResamplerKind>().unwrap_err().to_string();
+    assert!(
+        e.contains("'sinc'") && e.contains("auto, ideal, fir"),
+        "{e}"
+    );
 }
