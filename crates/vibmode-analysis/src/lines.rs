@@ -270,12 +270,13 @@ impl<'a> LineStage<'a> {
     /// Lines of the pool `channels` by the F-test combined over the records used on each channel
     /// (Fisher: `-2 sum ln p_r` against chi-square with `2R` degrees of freedom) and over the
     /// channels (Bonferroni: the smallest combined p-value times the number of channels) at each
-    /// frequency of the first record's grid: `(frequency Hz, combined p-value)` at each local minimum of the
-    /// combined p-value over `+- W` below `f_test_alpha`, between `max(2 W, min_frequency_hz)` and the
-    /// cutoff minus `W`.
+    /// frequency of the first record's grid: `(frequency Hz, combined p-value)` at each local
+    /// minimum of the combined p-value over `+- W` below `f_test_combined_alpha / n_f`, between
+    /// `max(2 W, min_frequency_hz)` and the cutoff minus `W`, where `n_f` = band width x record
+    /// length is the number of independent frequencies searched.
     /// Without a line at a frequency the combined p-value is at least uniform (Bonferroni is
-    /// conservative), so a pool reports a false line at a given frequency with probability at
-    /// most `f_test_alpha`.
+    /// conservative), so a pool reports a false line anywhere in the band with probability at
+    /// most `f_test_combined_alpha` per analysis (Bonferroni over the frequencies).
     fn combined_lines(&self, channels: &[usize]) -> Vec<(f64, f64)> {
         let recs: Vec<(&Preprocessed, &Vec<HarmonicF>)> = self
             .pre
@@ -328,7 +329,11 @@ impl<'a> LineStage<'a> {
             .collect();
         let df = h0.freq_hz.get(1).copied().unwrap_or(f64::NAN);
         let reach = ((w / df).round() as usize).max(1);
-        let ln_alpha = self.params.f_test_alpha.ln();
+        // Bonferroni over the independent frequencies searched: (hi - lo) Hz x T s.
+        let record_s =
+            p0.recording.channels.first().map_or(0, |c| c.samples.len()) as f64 / p0.band.fs_hz;
+        let n_freq = ((hi - lo) * record_s).max(1.0);
+        let ln_alpha = (self.params.f_test_combined_alpha / n_freq).ln();
         let n = ln_p.len();
         let mut out = Vec::new();
         for j in 0..n {
@@ -367,7 +372,8 @@ impl<'a> LineStage<'a> {
     /// F-test's (see `f_lines`) and the kurtosis rule's. Within `half_width_hz` of each other
     /// they are one line, at the kurtosis rule's frequency where it has one (the periodogram's
     /// peak is nearer the mean of a line that drifts within the record; the F-test peaks where
-    /// it dwells, at the ends of its drift), else at the most prominent.
+    /// it dwells, at the ends of its drift), else at the most prominent, with the smallest
+    /// F-test p-value of those merged (NaN when none was the F-test's).
     fn record_lines(&self, channels: &[usize]) -> Vec<Option<Vec<LineCandidate>>> {
         (0..self.pre.len())
             .map(|r| {
@@ -399,9 +405,17 @@ impl<'a> LineStage<'a> {
                 for l in all {
                     match merged.last_mut() {
                         Some(m) if l.frequency_hz - m.frequency_hz <= self.params.half_width_hz => {
+                            // The F-test's evidence stays with the merged line.
+                            let p_value = match (l.p_value.is_nan(), m.p_value.is_nan()) {
+                                (true, true) => f64::NAN,
+                                (true, false) => m.p_value,
+                                (false, true) => l.p_value,
+                                (false, false) => l.p_value.min(m.p_value),
+                            };
                             if better(&l, m) {
                                 *m = l;
                             }
+                            m.p_value = p_value;
                         }
                         _ => merged.push(l),
                     }
@@ -677,6 +691,10 @@ struct Building {
 pub const ORDER_MATCH_REL_TOL: f64 = 0.01;
 /// Largest engine-speed change between records tried by the common-factor matching.
 pub const ENGINE_SPEED_CHANGE_MAX: f64 = 0.15;
+/// A common factor beyond `track_rel_tol` is taken only when at least this many of the record's
+/// lines fall within [`ORDER_MATCH_REL_TOL`] of tracks after dividing by it, or when those that do
+/// are all F-test lines.
+pub const MIN_LINES_FOR_SPEED_CHANGE: usize = 2;
 
 /// Matches candidates (indices into `lines`) to tracks whose latest frequency is within `tol`
 /// of the candidate's frequency divided by `scale`; each track and candidate once, the smallest
@@ -773,7 +791,9 @@ fn assign(lines: &[LineCandidate], tracks: &[Building], g: f64, tol: f64) -> Ass
 /// within [`ORDER_MATCH_REL_TOL`] of a track after dividing by the factor join it, then each
 /// line left (it drifts on its own) joins the nearest free track within `track_rel_tol` after
 /// the same division; ties go to the factor that placed more lines itself, then to the smaller
-/// total distance. A line not placed starts a new track. Tracks found
+/// total distance. A factor beyond `track_rel_tol` must place at least
+/// [`MIN_LINES_FOR_SPEED_CHANGE`] lines itself, or only F-test lines (a kurtosis-rule line alone
+/// does not move a track). A line not placed starts a new track. Tracks found
 /// in fewer than `min_record_share` of the `n_used` records are dropped.
 ///
 /// Swept lines (`sweeps[r]`, empty or shorter for none) are placed first in their record: a
@@ -837,6 +857,19 @@ pub(crate) fn track(
         let mut best: Option<Assignment> = None;
         for g in scales {
             let a = assign(lines, &tracks, g, p.track_rel_tol);
+            // A speed change beyond the tracking tolerance needs two lines that agree on it, or
+            // one line of the F-test: a single line defines a factor that places itself on any
+            // track within 15 %, and a kurtosis-rule line (no stated false-alarm rate) may be a
+            // lightly damped mode's peak (busgen's bending joined to an engine order).
+            let by_f_test = a.pairs[..a.by_factor]
+                .iter()
+                .all(|&(i, _)| lines[i].p_value.is_finite());
+            if (g - 1.0).abs() > p.track_rel_tol
+                && a.by_factor < MIN_LINES_FOR_SPEED_CHANGE
+                && !by_f_test
+            {
+                continue;
+            }
             if best.as_ref().map_or(true, |b| a.better_than(b)) {
                 best = Some(a);
             }
@@ -969,6 +1002,55 @@ mod tests {
         assert_eq!(t.len(), 1);
         assert_eq!(t[0].record_hz, vec![Some(7.0), Some(7.1), None, Some(7.05)]);
         assert!((t[0].record_share - 0.75).abs() < 1e-12);
+    }
+
+    /// A line of the kurtosis rule alone (no F-test p-value).
+    fn k_line(f: f64) -> LineCandidate {
+        LineCandidate {
+            p_value: f64::NAN,
+            ..line(f, 20.0)
+        }
+    }
+
+    #[test]
+    fn a_lone_kurtosis_line_does_not_move_a_track_by_its_own_speed_change() {
+        let p = LineParams::default();
+        // busgen bus 12811: a 7.1 Hz engine order, and in record 2 only a kurtosis-rule peak of
+        // the bending at 7.93 Hz (11.5 % away): alone it defines a factor of 1.115 that would put
+        // it on the line's track, and the bending would be called the line there.
+        let recs = vec![
+            Some(vec![line(7.11, 20.0)]),
+            Some(vec![line(7.13, 20.0)]),
+            Some(vec![k_line(7.93)]),
+            Some(vec![line(7.12, 20.0)]),
+        ];
+        let t = track(&recs, &[], &p, 4);
+        let main = t
+            .iter()
+            .find(|x| x.record_hz[0].is_some())
+            .expect("the line's track");
+        assert_eq!(
+            main.record_hz,
+            vec![Some(7.11), Some(7.13), None, Some(7.12)],
+            "{t:?}"
+        );
+        // An F-test line moving by the same factor (an engine speed change) still follows.
+        let recs = vec![
+            Some(vec![line(7.11, 20.0)]),
+            Some(vec![line(7.13, 20.0)]),
+            Some(vec![line(7.93, 20.0)]),
+        ];
+        let t = track(&recs, &[], &p, 3);
+        assert_eq!(t.len(), 1, "{t:?}");
+        assert_eq!(t[0].record_hz, vec![Some(7.11), Some(7.13), Some(7.93)]);
+        // Two kurtosis-rule lines agreeing on the factor move their tracks too.
+        let recs = vec![
+            Some(vec![line(7.0, 20.0), line(11.0, 20.0)]),
+            Some(vec![k_line(7.7), k_line(12.1)]),
+        ];
+        let t = track(&recs, &[], &p, 2);
+        assert_eq!(t.len(), 2, "{t:?}");
+        assert_eq!(t[0].record_hz, vec![Some(7.0), Some(7.7)]);
     }
 
     fn sweep(start: f64, end: f64) -> LineSweep {
