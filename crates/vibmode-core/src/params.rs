@@ -871,8 +871,8 @@ pub struct LineParams {
     /// per channel, Bonferroni over the pool's channels) per pool and analysis, over the whole
     /// band searched: the combined p-value at one frequency must be below this divided by the
     /// number of independent frequencies searched, `(band width Hz) x (record length s)`
-    /// (Bonferroni over the frequencies). Default 1e-3: 4.5e-6 per frequency for 10.24 s records
-    /// over 3-24.6 Hz (docs/analysis.md, "Lines"). In (0, 0.1].
+    /// (Bonferroni over the frequencies). Default 0.01: 4.5e-5 per frequency for 10.24 s records
+    /// over 3-24.6 Hz (docs/analysis.md, "Periodic lines"). In (0, 0.1].
     pub f_test_combined_alpha: f64,
     /// Time-half-bandwidth product `NW` of the F-test's Slepian tapers (default 4: a 10.24 s
     /// record's tapers are concentrated in +-0.39 Hz). In [1, 20].
@@ -901,7 +901,7 @@ impl Default for LineParams {
             sweep_rate_max_hz_per_s: 2.5,
             sweep_min_range_hz: 0.5,
             f_test_alpha: 1e-4,
-            f_test_combined_alpha: 1e-3,
+            f_test_combined_alpha: 1e-2,
             f_test_nw: 4.0,
             f_test_tapers: 7,
             min_frequency_hz: 3.0,
