@@ -695,6 +695,8 @@ struct Building {
     sweep: Vec<Option<LineSweep>>,
     /// Holds a sweep in the record being placed: no steady line joins it there.
     busy: bool,
+    /// Its latest line was an F-test line (a steady line with a p-value).
+    last_f: bool,
 }
 
 /// Engine orders of one record are matched to the tracks together when, scaled by one common
@@ -709,7 +711,7 @@ pub const ENGINE_SPEED_CHANGE_MAX: f64 = 0.15;
 pub const MIN_STEADY_RECORDS_OF_A_SWEEP: usize = 2;
 /// A common factor beyond `track_rel_tol` is taken only when at least this many of the record's
 /// lines fall within [`ORDER_MATCH_REL_TOL`] of tracks after dividing by it, or when those that do
-/// are all F-test lines.
+/// are all F-test lines joining tracks whose latest line was an F-test line.
 pub const MIN_LINES_FOR_SPEED_CHANGE: usize = 2;
 
 /// Matches candidates (indices into `lines`) to tracks whose latest frequency is within `tol`
@@ -808,8 +810,8 @@ fn assign(lines: &[LineCandidate], tracks: &[Building], g: f64, tol: f64) -> Ass
 /// line left (it drifts on its own) joins the nearest free track within `track_rel_tol` after
 /// the same division; ties go to the factor that placed more lines itself, then to the smaller
 /// total distance. A factor beyond `track_rel_tol` must place at least
-/// [`MIN_LINES_FOR_SPEED_CHANGE`] lines itself, or only F-test lines (a kurtosis-rule line alone
-/// does not move a track). A line not placed starts a new track. Tracks found
+/// [`MIN_LINES_FOR_SPEED_CHANGE`] lines itself, or only F-test lines onto tracks whose latest line
+/// was an F-test line (a kurtosis-rule line alone does not move a track, nor join one). A line not placed starts a new track. Tracks found
 /// in fewer than `min_record_share` of the `n_used` records are dropped.
 ///
 /// Swept lines (`sweeps[r]`, empty or shorter for none) are placed first in their record: a
@@ -855,6 +857,7 @@ pub(crate) fn track(
                         kurtosis: Vec::new(),
                         sweep,
                         busy: true,
+                        last_f: false,
                     });
                 }
             }
@@ -874,12 +877,13 @@ pub(crate) fn track(
         for g in scales {
             let a = assign(lines, &tracks, g, p.track_rel_tol);
             // A speed change beyond the tracking tolerance needs two lines that agree on it, or
-            // one line of the F-test: a single line defines a factor that places itself on any
-            // track within 15 %, and a kurtosis-rule line (no stated false-alarm rate) may be a
-            // lightly damped mode's peak (busgen's bending joined to an engine order).
+            // one F-test line continuing an F-test line: a single line defines a factor that
+            // places itself on any track within 15 %, and a kurtosis-rule line (no stated
+            // false-alarm rate) may be a lightly damped mode's peak (busgen's bending joined to
+            // an engine order, or an engine order to the bending's track).
             let by_f_test = a.pairs[..a.by_factor]
                 .iter()
-                .all(|&(i, _)| lines[i].p_value.is_finite());
+                .all(|&(i, j)| lines[i].p_value.is_finite() && tracks[j].last_f);
             if (g - 1.0).abs() > p.track_rel_tol
                 && a.by_factor < MIN_LINES_FOR_SPEED_CHANGE
                 && !by_f_test
@@ -898,6 +902,7 @@ pub(crate) fn track(
             let (l, t) = (&lines[*i], &mut tracks[*j]);
             t.hz[r] = Some(l.frequency_hz);
             t.last_hz = l.frequency_hz;
+            t.last_f = l.p_value.is_finite();
             t.kurtosis.push(l.kurtosis);
         }
         for (i, l) in lines.iter().enumerate() {
@@ -910,6 +915,7 @@ pub(crate) fn track(
                     kurtosis: vec![l.kurtosis],
                     sweep: vec![None; n],
                     busy: false,
+                    last_f: l.p_value.is_finite(),
                 });
             }
         }
@@ -1059,6 +1065,19 @@ mod tests {
         let t = track(&recs, &[], &p, 3);
         assert_eq!(t.len(), 1, "{t:?}");
         assert_eq!(t[0].record_hz, vec![Some(7.11), Some(7.13), Some(7.93)]);
+        // Nor does an F-test line join, by its own factor, a track whose latest line was the
+        // kurtosis rule's (busgen bus 17998: the 7.13 Hz order joined the bending's 8.61 Hz peak).
+        let recs = vec![
+            Some(vec![k_line(8.38)]),
+            Some(vec![k_line(8.61)]),
+            Some(vec![line(7.70, 20.0)]),
+        ];
+        let t = track(&recs, &[], &p, 3);
+        assert!(
+            t.iter()
+                .all(|x| x.record_hz[2].is_none() || x.record_hz[1].is_none()),
+            "{t:?}"
+        );
         // Two kurtosis-rule lines agreeing on the factor move their tracks too.
         let recs = vec![
             Some(vec![line(7.0, 20.0), line(11.0, 20.0)]),
