@@ -888,6 +888,13 @@ pub struct LineParams {
     /// 0.18 false detections per record over 0-25 Hz on one channel; a track needs detections in
     /// `min_record_share` of the records. In (0, 0.1].
     pub f_test_alpha: f64,
+    /// False-alarm probability of the F-test combined over the records (Fisher over the records
+    /// per channel, Bonferroni over the pool's channels) per pool and analysis, over the whole
+    /// band searched: the combined p-value at one frequency must be below this divided by the
+    /// number of independent frequencies searched, `(band width Hz) x (record length s)`
+    /// (Bonferroni over the frequencies). Default 0.01: 4.5e-5 per frequency for 10.24 s records
+    /// over 3-24.6 Hz (docs/analysis.md, "Periodic lines"). In (0, 0.1].
+    pub f_test_combined_alpha: f64,
     /// Time-half-bandwidth product `NW` of the F-test's Slepian tapers (default 4: a 10.24 s
     /// record's tapers are concentrated in +-0.39 Hz). In [1, 20].
     pub f_test_nw: f64,
@@ -915,6 +922,7 @@ impl Default for LineParams {
             sweep_rate_max_hz_per_s: 2.5,
             sweep_min_range_hz: 0.5,
             f_test_alpha: 1e-4,
+            f_test_combined_alpha: 1e-2,
             f_test_nw: 4.0,
             f_test_tapers: 7,
             min_frequency_hz: 3.0,
@@ -1024,6 +1032,17 @@ impl LineParams {
                 self.f_test_alpha,
                 "must be in (0, 0.1] (false-alarm probability per record, channel and frequency)",
                 d.f_test_alpha,
+            ));
+        }
+        if !(self.f_test_combined_alpha.is_finite()
+            && self.f_test_combined_alpha > 0.0
+            && self.f_test_combined_alpha <= 0.1)
+        {
+            return Err(bad(
+                "f_test_combined_alpha",
+                self.f_test_combined_alpha,
+                "must be in (0, 0.1] (false-alarm probability of the combined test per pool and analysis)",
+                d.f_test_combined_alpha,
             ));
         }
         if !(self.f_test_nw.is_finite() && (1.0..=20.0).contains(&self.f_test_nw)) {
