@@ -165,11 +165,14 @@ fn key(e: &anyhow::Error) -> Option<Hint> {
 
 fn segment_hint(e: &SegmentError) -> Option<Hint> {
     match e {
-        SegmentError::InvalidParam { name, .. } => Some(match *name {
+        SegmentError::Param(
+            ParamError::OutOfRange { name, .. } | ParamError::OutOfRangeHere { name, .. },
+        ) => Some(match *name {
             "record_length_s" => Hint::RecordLength,
             "gps_offset_s" => Hint::GpsOffset,
             _ => Hint::SegmentConfig,
         }),
+        SegmentError::Param(_) => Some(Hint::SegmentConfig),
         SegmentError::NoOverlap { .. } => Some(Hint::GpsOffset),
         SegmentError::Signal(s) => signal_hint(s),
         _ => None,

@@ -148,6 +148,18 @@ pub enum ParamError {
         /// The valid names.
         valid: &'static str,
     },
+    /// A value out of a range that depends on the data (the record length, the rate, the
+    /// channels), so that the rule and the valid example are worked out for it.
+    #[error("{name} = {value} must be {rule}")]
+    OutOfRangeHere {
+        /// Parameter name as in the params struct (and the TOML key).
+        name: &'static str,
+        /// The offending value, formatted.
+        value: String,
+        /// The rule with the data's numbers and a valid value, e.g. "at least 0.02 s here
+        /// (...), e.g. 10.24".
+        rule: String,
+    },
 }
 
 impl ParamError {

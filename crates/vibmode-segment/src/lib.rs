@@ -94,7 +94,11 @@ pub const VIBRATION_CELLS_MAX: f64 = 16_777_216.0;
 pub const GPS_OFFSET_S_MAX: f64 = 1e6;
 
 fn invalid(name: &'static str, value: f64, rule: String) -> SegmentError {
-    SegmentError::InvalidParam { name, value, rule }
+    SegmentError::Param(vibmode_core::ParamError::OutOfRangeHere {
+        name,
+        value: num(&value).to_string(),
+        rule,
+    })
 }
 
 impl SegmentParams {
@@ -509,19 +513,9 @@ pub enum SegmentError {
         /// The record length, s.
         record_length_s: f64,
     },
-    /// A setting out of range.
-    #[error(
-        "segmentation setting {name} = {} is invalid: it must be {rule}",
-        num(value)
-    )]
-    InvalidParam {
-        /// Name.
-        name: &'static str,
-        /// Value.
-        value: f64,
-        /// The rule.
-        rule: String,
-    },
+    /// A setting out of range: core's one shape of a parameter error.
+    #[error("segmentation setting {0}")]
+    Param(#[from] vibmode_core::ParamError),
     /// Writing the records or segments.json failed.
     #[error("cannot write {path}: {message}; check the folder and free space")]
     Write {

@@ -276,14 +276,14 @@ pub fn by_gps(
 ) -> Result<Segmentation, SegmentError> {
     p.validate(record_length_s)?;
     if !(offset_s.is_finite() && offset_s.abs() <= GPS_OFFSET_S_MAX) {
-        return Err(SegmentError::InvalidParam {
-            name: "gps_offset_s",
-            value: offset_s,
-            rule: format!(
+        return Err(crate::invalid(
+            "gps_offset_s",
+            offset_s,
+            format!(
                 "a number of seconds within +-{} (11.6 days), e.g. 3600",
                 Num(GPS_OFFSET_S_MAX)
             ),
-        });
+        ));
     }
     let duration_s = check_length(info, n_frames, record_length_s)?;
     p.check_work(record_length_s, info.fs_hz, duration_s, true)?;

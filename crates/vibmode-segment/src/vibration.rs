@@ -63,28 +63,28 @@ pub fn by_vibration(
     // The record length against the rate first (no duration yet), then the window against it.
     p.check_work(record_length_s, stream.info().fs_hz, 0.0, false)?;
     if p.window_s > record_length_s {
-        return Err(SegmentError::InvalidParam {
-            name: "window_s",
-            value: p.window_s,
-            rule: format!(
+        return Err(crate::invalid(
+            "window_s",
+            p.window_s,
+            format!(
                 "at most the record length ({} s; window_s defaults to 1): give a longer record length or a shorter window_s",
                 vibmode_core::Num(record_length_s)
             ),
-        });
+        ));
     }
     let info = stream.info().clone();
     let nch = info.n_channels();
     let check_cells = |n_windows: f64| {
         if n_windows * nch as f64 > crate::VIBRATION_CELLS_MAX {
-            Err(SegmentError::InvalidParam {
-                name: "window_s",
-                value: p.window_s,
-                rule: format!(
+            Err(crate::invalid(
+                "window_s",
+                p.window_s,
+                format!(
                     "long enough for at most {} windows x channels ({} channels here; a window is at least 2 samples at about 20 Hz), e.g. 1",
                     crate::VIBRATION_CELLS_MAX,
                     nch
                 ),
-            })
+            ))
         } else {
             Ok(())
         }

@@ -432,7 +432,10 @@ fn segmentation_settings_are_bounded_against_the_recording() {
     };
     let e = by_gps(&info, 30_000, &t, 0.0, L, &step).unwrap_err();
     assert!(
-        matches!(e, SegmentError::InvalidParam { name: "step_s", .. }),
+        matches!(
+            e,
+            SegmentError::Param(vibmode_core::ParamError::OutOfRangeHere { name: "step_s", .. })
+        ),
         "{e}"
     );
     let m = e.to_string();
