@@ -25,7 +25,7 @@ pub enum FleetCommand {
         #[arg(long)]
         db: PathBuf,
         /// Settings (TOML; docs/fleet.md): feature bands, false-alarm rate, spread floors and
-        /// the per-record analysis under [analysis]. Fixed once the first record is stored.
+        /// the per-record analysis under `[analysis]`. Fixed once the first record is stored.
         #[arg(long)]
         config: Option<PathBuf>,
     },

@@ -51,7 +51,7 @@ pub enum RecordingError {
         /// Largest |sample|.
         peak: f64,
     },
-    /// More channels than [`CHANNELS_MAX`].
+    /// More channels than [`CHANNELS_MAX`](crate::limits::CHANNELS_MAX).
     #[error("{} has {count} channels; vibmode reads at most {max}: select the columns you need or split the file", quoted(.what))]
     TooManyChannels {
         /// Where.

@@ -247,12 +247,12 @@ pub fn line_candidates(
 }
 
 /// The lines of `x` (sampled at `fs_hz`, Hz) from its harmonic F-test `h`
-/// ([`HarmonicPlan::f_test`] with `p.f_test_nw`, `p.f_test_tapers`): every local maximum of F
-/// over `+- W` with `P(F > F_obs) < p.f_test_alpha`, between `max(2 W, p.min_frequency_hz)` and
-/// `hi_hz - W`, each with the
-/// narrow-band kurtosis of its band (`p.half_width_hz`, for information) and as prominence the
-/// line's power over the residual of the tapers' fit, `10 log10(F / (K - 1))` dB. All are
-/// `periodic`. Sorted by frequency.
+/// ([`HarmonicPlan::f_test`](crate::HarmonicPlan::f_test) with `p.f_test_nw`,
+/// `p.f_test_tapers`): every local maximum of F over `+- W` with
+/// `P(F > F_obs) < p.f_test_alpha`, between `max(2 W, p.min_frequency_hz)` and `hi_hz - W`,
+/// each with the narrow-band kurtosis of its band (`p.half_width_hz`, for information) and as
+/// prominence the line's power over the residual of the tapers' fit, `10 log10(F / (K - 1))`
+/// dB. All are `periodic`. Sorted by frequency.
 pub fn f_test_line_candidates(
     h: &HarmonicF,
     x: &[f64],
