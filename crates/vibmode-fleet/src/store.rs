@@ -295,11 +295,34 @@ impl Store {
         conn.busy_timeout(BUSY_TIMEOUT)
             .map_err(|e| Store::not_a_store(&p, e))?;
         let mut store = Store { conn, path: p };
+        // A foreign database is refused before anything (the journal mode) is changed in it.
+        store.refuse_foreign()?;
+        // WAL before the schema: a store is in WAL from its first transaction, so the
+        // processes that meet here wait for each other's writes instead of deadlocking.
+        store.configure()?;
         let created = store.create_schema()?;
         store.check_schema()?;
-        store.configure()?;
         store.migrate()?;
         Ok((store, created))
+    }
+
+    /// An SQLite file with tables but no fleet schema, or with another application's meta
+    /// table, is not one `init` may write to.
+    fn refuse_foreign(&self) -> Result<()> {
+        let p = &self.path;
+        let err = |e: rusqlite::Error| Store::not_a_store(p, e);
+        let version: i64 = self
+            .conn
+            .query_row("PRAGMA user_version", [], |r| r.get(0))
+            .map_err(err)?;
+        let objects: i64 = self
+            .conn
+            .query_row("SELECT COUNT(*) FROM sqlite_master", [], |r| r.get(0))
+            .map_err(err)?;
+        if version == 0 && objects == 0 {
+            return Ok(());
+        }
+        self.check_schema()
     }
 
     /// In one immediate transaction: an empty database (no table, `user_version` 0) gets the
@@ -404,9 +427,29 @@ impl Store {
         self.conn
             .busy_timeout(BUSY_TIMEOUT)
             .map_err(|e| Store::not_a_store(&p, e))?;
-        self.conn
-            .query_row("PRAGMA journal_mode=WAL", [], |r| r.get::<_, String>(0))
-            .map_err(|e| Store::not_a_store(&p, e))?;
+        // Switching to WAL takes an exclusive lock. Two processes switching at once both hold
+        // a shared lock and want the exclusive one; SQLite answers one of them SQLITE_BUSY at
+        // once, without the busy handler (it would deadlock). That one tries again.
+        let deadline = std::time::Instant::now() + BUSY_TIMEOUT;
+        let mut attempt = 0u32;
+        loop {
+            match self
+                .conn
+                .query_row("PRAGMA journal_mode=WAL", [], |r| r.get::<_, String>(0))
+            {
+                Ok(_) => break,
+                Err(rusqlite::Error::SqliteFailure(e, _))
+                    if e.code == rusqlite::ErrorCode::DatabaseBusy
+                        && std::time::Instant::now() < deadline =>
+                {
+                    attempt += 1;
+                    // 5..40 ms, varied by process and attempt so that the two part.
+                    let ms = 5 + (u64::from(std::process::id()) + u64::from(attempt) * 7) % 36;
+                    std::thread::sleep(std::time::Duration::from_millis(ms));
+                }
+                Err(e) => return Err(Store::not_a_store(&p, e)),
+            }
+        }
         self.conn
             .execute_batch("PRAGMA foreign_keys=ON;")
             .map_err(|e| Store::not_a_store(&p, e))?;
@@ -1218,6 +1261,11 @@ mod tests {
             .expect("foreign");
         drop(c);
         assert!(matches!(Store::open(&q), Err(FleetError::NotAStore { .. })));
+        // init refuses it too and leaves it byte for byte (its journal mode not switched).
+        let before = std::fs::read(&q).expect("read");
+        assert!(matches!(Store::init(&q), Err(FleetError::NotAStore { .. })));
+        assert_eq!(std::fs::read(&q).expect("read"), before);
+        assert!(!d.path().join("other.db-wal").exists());
         // A newer schema.
         let r = d.path().join("newer.db");
         drop(Store::init(&r).expect("init"));
