@@ -43,8 +43,9 @@ pub struct AnalyzeArgs {
     /// Corner of a channel, `NAME=FL|FR|RL|RR` (repeat for several).
     #[arg(long = "corner", value_name = "NAME=CORNER")]
     pub corners: Vec<String>,
-    /// Identification: both (the default), arma (per channel) or ssi-cov (all channels at once,
-    /// with mode shapes); overrides the config's `method`.
+    /// Identification methods, a comma-separated list: arma (per channel), ssi-cov (all
+    /// channels at once, with mode shapes); `both` (the default) is both. Overrides the
+    /// config's `method`.
     #[arg(long)]
     pub method: Option<String>,
     /// Records of this length in seconds from long files (overrides the config's
@@ -204,7 +205,8 @@ pub struct DemoArgs {
     /// No progress bar.
     #[arg(long, short = 'q')]
     pub quiet: bool,
-    /// Identification: both (the default), arma or ssi-cov.
+    /// Identification methods, a comma-separated list of arma and ssi-cov; `both` (the
+    /// default) is both.
     #[arg(long)]
     pub method: Option<String>,
 }

@@ -80,7 +80,7 @@ fn main() -> Result<(), Box<dyn Error>> {
                 .collect::<Result<_, Box<dyn Error>>>()?,
         };
         let mut cfg = AnalysisConfig {
-            method: IdentMethod::SsiCov,
+            method: IdentMethod::SsiCov.into(),
             ..AnalysisConfig::default()
         };
         cfg.ssi.first_lag = first_lag;

@@ -257,11 +257,14 @@ impl BodyStage<'_> {
             ..self.cluster.clone()
         }
         .for_band(&low[0].band);
+        let pool_records = ssi.pool_records;
+        let method = vibmode_ssi::SsiCovIdentifier { params: ssi };
         let stage = SsiStage {
             pre: &low,
             active: self.active,
             n_active: n_records,
-            params: &ssi,
+            method: &method,
+            pool_records,
             cluster: &cluster,
             drop_band_edge: true,
             first_lags: Some(&lags),

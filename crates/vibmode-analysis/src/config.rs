@@ -5,8 +5,8 @@ use std::path::Path;
 
 use crate::AnalysisError;
 use vibmode_core::{
-    BodyFitParams, BodySsiParams, ClusterParams, Corner, IdentMethod, LineParams, PoleFilterParams,
-    PreprocessParams, Role, SpectrumParams, SsiParams, StopParams, SweepParams,
+    BodyFitParams, BodySsiParams, ClusterParams, Corner, IdentMethod, IdentMethods, LineParams,
+    PoleFilterParams, PreprocessParams, Role, SpectrumParams, SsiParams, StopParams, SweepParams,
 };
 
 /// Named sets of defaults.
@@ -111,9 +111,9 @@ pub struct AnalysisConfig {
     /// one guessed from the name (containing "unsprung"/"wheel"/"axle" -> unsprung,
     /// "sprung"/"body"/"floor" -> sprung, corner FL/FR/RL/RR as a token).
     pub channels: Vec<ChannelRole>,
-    /// Identification method: `"arma"` (per channel), `"ssi-cov"` (all channels at once, with
-    /// mode shapes) or `"both"`.
-    pub method: IdentMethod,
+    /// Identification methods: a list of `"arma"` (per channel) and `"ssi-cov"` (all channels
+    /// at once, with mode shapes); one name, or `"both"`, is read too.
+    pub method: IdentMethods,
     /// Pre-processing: ideal anti-alias filter and resampling.
     pub preprocess: PreprocessParams,
     /// Spectra of every record.
@@ -209,7 +209,7 @@ impl AnalysisConfig {
             stops: StopParams::default(),
             cluster: ClusterParams::default(),
             lines: LineParams::default(),
-            method: IdentMethod::default(),
+            method: IdentMethods::default(),
             // Not the single-record default: more block rows, pooled (`ANALYSIS_BLOCK_ROWS`).
             ssi: SsiParams::for_analysis(),
             report: ReportParams::default(),
@@ -237,7 +237,7 @@ impl AnalysisConfig {
                 report: ReportParams {
                     model_psd_orders: vec![10, 20],
                 },
-                method: IdentMethod::Arma,
+                method: IdentMethod::Arma.into(),
                 ..base
             },
         }

@@ -5,13 +5,13 @@
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+pub use vibmode_core::ShapedPole;
 use vibmode_core::{
-    ClusterParams, InvariantMode, ModeMatch, ModeUncertainty, PoleObservation, ReferenceMode,
-    SsiParams,
+    ClusterParams, InvariantMode, ModeMatch, ModeUncertainty, MultichannelIdentifier,
+    PoleObservation, PooledIdentification, ReferenceMode,
 };
 use vibmode_modal::{MATCH_MAC_MIN, MATCH_MAX_FREQ_DIFF_REL};
 use vibmode_signal::Preprocessed;
-use vibmode_ssi::{SsiCorrelations, SsiCov, SsiError};
 
 use crate::lines::{LineStage, LineTrack};
 use crate::AnalysisError;
@@ -19,31 +19,9 @@ use crate::AnalysisError;
 /// Most groups of the jackknife over records (each group one more identification).
 pub const JACKKNIFE_GROUPS: usize = 20;
 
-/// The pooled records' correlations (kept per record) and the band of the first.
-struct Pooled {
-    correlations: SsiCorrelations,
-    band: vibmode_core::BandLimit,
-}
-
-/// Name of the pseudo-channel of the multichannel poles in the pole store and the clusters.
+/// Name of the pseudo-channel of the multichannel poles in the pole store and the clusters
+/// (SSI-cov's [`MultichannelIdentifier::name`]).
 pub const SSI_CHANNEL: &str = "ssi-cov";
-
-/// One pole of one SSI-cov order of one record, with its shape.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ShapedPole {
-    /// Record index.
-    pub record: usize,
-    /// Model order (state dimension).
-    pub order: usize,
-    /// Natural frequency, Hz.
-    pub frequency_hz: f64,
-    /// Damping ratio.
-    pub damping_ratio: f64,
-    /// Modal phase collinearity of the shape (1 = a real, normal mode).
-    pub mpc: f64,
-    /// Complex shape, one `[re, im]` per channel of [`SsiAnalysis::channels`].
-    pub shape: Vec<[f64; 2]>,
-}
 
 /// Everything the multichannel identification found.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -60,33 +38,28 @@ pub struct SsiAnalysis {
     pub matches: Vec<ModeMatch>,
     /// Periodic lines of all the channels, tracked over the records.
     pub lines: Vec<LineTrack>,
-    /// Records whose identification failed, with the message of their `vibmode_ssi::SsiError`
-    /// (kept as text: it is what `results.json` reports).
+    /// Records whose identification failed, with the message of the method's error (kept as
+    /// text: it is what `results.json` reports).
     pub failed_records: Vec<(usize, String)>,
 }
 
-pub(crate) struct SsiStage<'a> {
+/// Stage 3b over the records: a [`MultichannelIdentifier`] (SSI-cov) on every active record
+/// (or on the active records pooled), then clustering, classing and matching.
+pub(crate) struct SsiStage<'a, M: MultichannelIdentifier> {
     pub pre: &'a [Preprocessed],
     pub active: &'a [Option<usize>],
     pub n_active: usize,
-    pub params: &'a SsiParams,
+    /// The identification method.
+    pub method: &'a M,
+    /// Identify the active records together (one pooled identification) instead of one by one.
+    pub pool_records: bool,
     pub cluster: &'a ClusterParams,
     pub drop_band_edge: bool,
     /// Each record's own first lag (pooled records only): records with `None` are left out.
     pub first_lags: Option<&'a [Option<usize>]>,
 }
 
-impl SsiStage<'_> {
-    /// Orders actually identifiable: the configured ones up to the Hankel rank of `n_channels`.
-    fn orders(&self, n_channels: usize) -> Vec<usize> {
-        let max = self.params.block_rows.saturating_sub(1) * n_channels;
-        self.params
-            .orders()
-            .into_iter()
-            .filter(|&o| o <= max)
-            .collect()
-    }
-
+impl<M: MultichannelIdentifier> SsiStage<'_, M> {
     /// RMS of each channel over the records used (1 where it is zero): SSI sees every channel
     /// divided by it, so that strong channels (the wheels) do not hide the modes of weak ones
     /// (the body); the shapes are scaled back.
@@ -115,9 +88,22 @@ impl SsiStage<'_> {
             .collect()
     }
 
-    /// The correlations of the records used (each channel divided by its scale), kept per
-    /// record for the jackknife, and the first record's band; `None` when no record is used.
-    fn pooled(&self, scales: &[f64]) -> Result<Option<Pooled>, SsiError> {
+    /// Record `p`'s channels, each divided by its scale.
+    fn scaled(p: &Preprocessed, scales: &[f64]) -> Vec<Vec<f64>> {
+        p.recording
+            .channels
+            .iter()
+            .zip(scales)
+            .map(|(c, s)| c.samples.iter().map(|v| v / s).collect())
+            .collect()
+    }
+
+    /// The records used (each channel divided by its scale) pooled for one identification, and
+    /// the first record's band; `None` when no record is used.
+    fn pooled(
+        &self,
+        scales: &[f64],
+    ) -> Result<Option<(M::Pooled, vibmode_core::BandLimit)>, M::Error> {
         let lag_of = |r: usize| self.first_lags.map(|l| l.get(r).copied().flatten());
         let (used, lags): (Vec<&Preprocessed>, Vec<Option<usize>>) = self
             .pre
@@ -130,44 +116,19 @@ impl SsiStage<'_> {
         let Some(first) = used.first() else {
             return Ok(None);
         };
-        let scaled: Vec<Vec<Vec<f64>>> = used
-            .iter()
-            .map(|p| {
-                p.recording
-                    .channels
-                    .iter()
-                    .zip(scales)
-                    .map(|(c, s)| c.samples.iter().map(|v| v / s).collect())
-                    .collect()
-            })
-            .collect();
+        let scaled: Vec<Vec<Vec<f64>>> = used.iter().map(|p| Self::scaled(p, scales)).collect();
         let segments: Vec<Vec<&[f64]>> = scaled
             .iter()
             .map(|rec| rec.iter().map(Vec::as_slice).collect())
             .collect();
-        let correlations = if self.first_lags.is_some() {
-            let lags: Vec<usize> = lags.into_iter().flatten().collect();
-            SsiCorrelations::with_first_lags(&segments, first.band.fs_hz, self.params, &lags)
-        } else {
-            SsiCorrelations::new(&segments, first.band.fs_hz, self.params)
-        }?;
-        Ok(Some(Pooled {
-            correlations,
-            band: first.band,
-        }))
-    }
-
-    /// One identification from the correlations averaged over the records used (record index
-    /// 0 for every pole).
-    fn pooled_poles(
-        &self,
-        pooled: &Pooled,
-        orders: &[usize],
-        scales: &[f64],
-    ) -> Result<Vec<ShapedPole>, SsiError> {
-        let plan = pooled.correlations.plan()?;
-        let res = plan.sweep(orders)?;
-        Ok(self.kept(res, 0, &pooled.band, scales))
+        let lags: Option<Vec<usize>> = self
+            .first_lags
+            .is_some()
+            .then(|| lags.into_iter().flatten().collect());
+        let pooled = self
+            .method
+            .pool(&segments, first.band.fs_hz, lags.as_deref())?;
+        Ok(Some((pooled, first.band)))
     }
 
     /// Standard deviations of the supported modes' frequency and damping by a delete-a-group
@@ -178,29 +139,23 @@ impl SsiStage<'_> {
     /// repetition fails.
     fn jackknife(
         &self,
-        pooled: &Pooled,
+        pooled: &M::Pooled,
+        band: &vibmode_core::BandLimit,
         modes: &mut [InvariantMode],
         orders: &[usize],
         scales: &[f64],
     ) {
-        let groups = pooled.correlations.n_segments().min(JACKKNIFE_GROUPS);
+        let groups = pooled.n_records().min(JACKKNIFE_GROUPS);
         if groups < 2 || !modes.iter().any(InvariantMode::is_invariant) {
             return;
         }
-        let Ok(plans) = pooled.correlations.jackknife(groups) else {
+        let Ok(reps) = pooled.jackknife(groups, orders) else {
             return;
         };
-        let reps: Vec<Vec<ShapedPole>> = match plans
-            .par_iter()
-            .map(|p| {
-                p.sweep(orders)
-                    .map(|r| self.kept(r, 0, &pooled.band, scales))
-            })
-            .collect::<Result<Vec<_>, _>>()
-        {
-            Ok(r) => r,
-            Err(_) => return,
-        };
+        let reps: Vec<Vec<ShapedPole>> = reps
+            .into_iter()
+            .map(|rep| self.kept(rep, 0, band, scales))
+            .collect();
         for m in modes.iter_mut().filter(|m| m.is_invariant()) {
             let Some(shape) = m.shape.clone() else {
                 continue;
@@ -238,10 +193,10 @@ impl SsiStage<'_> {
         }
     }
 
-    /// The poles of an SSI result below the valid band, with shapes scaled back.
+    /// The poles below the valid band, as record `r`'s, with shapes scaled back.
     fn kept(
         &self,
-        res: vibmode_ssi::SsiResult,
+        poles: Vec<ShapedPole>,
         r: usize,
         band: &vibmode_core::BandLimit,
         scales: &[f64],
@@ -251,20 +206,14 @@ impl SsiStage<'_> {
         } else {
             band.fs_hz / 2.0
         };
-        res.orders
+        poles
             .into_iter()
-            .flat_map(|o| {
-                let order = o.order;
-                o.modes.into_iter().map(move |m| ShapedPole {
-                    record: r,
-                    order,
-                    frequency_hz: m.frequency_hz,
-                    damping_ratio: m.damping_ratio,
-                    mpc: m.mpc,
-                    shape: vibmode_modal::shapes::rescaled(&m.shape, scales),
-                })
-            })
             .filter(|q| q.frequency_hz < f_max)
+            .map(|q| ShapedPole {
+                record: r,
+                shape: vibmode_modal::shapes::rescaled(&q.shape, scales),
+                ..q
+            })
             .collect()
     }
 
@@ -273,19 +222,12 @@ impl SsiStage<'_> {
         r: usize,
         orders: &[usize],
         scales: &[f64],
-    ) -> Result<Vec<ShapedPole>, SsiError> {
+    ) -> Result<Vec<ShapedPole>, M::Error> {
         let p = &self.pre[r];
-        let scaled: Vec<Vec<f64>> = p
-            .recording
-            .channels
-            .iter()
-            .zip(scales)
-            .map(|(c, s)| c.samples.iter().map(|v| v / s).collect())
-            .collect();
+        let scaled = Self::scaled(p, scales);
         let chans: Vec<&[f64]> = scaled.iter().map(Vec::as_slice).collect();
-        let plan = SsiCov::new(&chans, p.band.fs_hz, self.params)?;
-        let res = plan.sweep(orders)?;
-        Ok(self.kept(res, r, &p.band, scales))
+        let poles = self.method.identify_record(&chans, p.band.fs_hz, orders)?;
+        Ok(self.kept(poles, r, &p.band, scales))
     }
 
     /// Identifies, clusters, classes (with the pool's own line tracks and `other_tracks`, those
@@ -308,16 +250,18 @@ impl SsiStage<'_> {
                     .collect()
             })
             .unwrap_or_default();
-        let orders = self.orders(channels.len());
+        let orders = self.method.orders(channels.len());
         let scales = self.channel_scales();
-        let correlations = if self.params.pool_records {
+        let pooled = if self.pool_records {
             Some(self.pooled(&scales))
         } else {
             None
         };
-        let per: Vec<Result<Vec<ShapedPole>, SsiError>> = if let Some(p) = &correlations {
+        let per: Vec<Result<Vec<ShapedPole>, M::Error>> = if let Some(p) = &pooled {
             vec![match p {
-                Ok(Some(p)) => self.pooled_poles(p, &orders, &scales),
+                Ok(Some((p, band))) => p
+                    .identify(&orders)
+                    .map(|poles| self.kept(poles, 0, band, &scales)),
                 Ok(None) => Ok(Vec::new()),
                 Err(e) => Err(e.clone()),
             }]
@@ -336,11 +280,11 @@ impl SsiStage<'_> {
                 Err(e) => failed_records.push((r, e.to_string())),
             }
         }
-        let pooled = self.params.pool_records;
+        let pooled_records = self.pool_records;
         let obs: Vec<PoleObservation> = poles
             .iter()
             .filter_map(|q| {
-                let rec = if pooled {
+                let rec = if pooled_records {
                     0
                 } else {
                     self.active.get(q.record).copied().flatten()?
@@ -350,13 +294,13 @@ impl SsiStage<'_> {
                     q.damping_ratio,
                     q.order,
                     rec,
-                    SSI_CHANNEL,
+                    self.method.name(),
                 );
                 o.shape = Some(q.shape.clone());
                 Some(o)
             })
             .collect();
-        let n_records = if pooled { 1 } else { self.n_active };
+        let n_records = if pooled_records { 1 } else { self.n_active };
         let mut invariant_modes = if orders.is_empty() || self.n_active == 0 {
             Vec::new()
         } else {
@@ -372,8 +316,8 @@ impl SsiStage<'_> {
         let mut known: Vec<LineTrack> = tracks.clone();
         known.extend(other_tracks.iter().cloned());
         lines.classify(&mut invariant_modes, &all, &known);
-        if let Some(Ok(Some(p))) = &correlations {
-            self.jackknife(p, &mut invariant_modes, &orders, &scales);
+        if let Some(Ok(Some((p, band)))) = &pooled {
+            self.jackknife(p, band, &mut invariant_modes, &orders, &scales);
         }
         let matches = if reference.is_empty() {
             Vec::new()

@@ -222,11 +222,15 @@ pub fn analyze_prepared(
     let role_tracks: Vec<crate::LineTrack> =
         roles.iter().flat_map(|r| r.lines.iter().cloned()).collect();
     let ssi = if cfg.method.runs_ssi() {
+        let method = vibmode_ssi::SsiCovIdentifier {
+            params: cfg.ssi.clone(),
+        };
         let stage = SsiStage {
             pre: &pre,
             active: &active,
             n_active,
-            params: &cfg.ssi,
+            method: &method,
+            pool_records: cfg.ssi.pool_records,
             cluster: &cluster,
             drop_band_edge: cfg.poles.drop_band_edge,
             first_lags: None,

@@ -56,7 +56,7 @@ fn body_heave_pitch_and_roll_within_3_percent_over_five_seeds() {
         .map(|m| m.to_reference())
         .collect();
     let cfg = AnalysisConfig {
-        method: IdentMethod::SsiCov,
+        method: IdentMethod::SsiCov.into(),
         ..AnalysisConfig::default()
     };
     let mut failed = Vec::new();

@@ -36,7 +36,7 @@ fn ssi_finds_roll_and_bending_over_five_seeds() {
         let (_, sim) = common::realistic_demo(seed);
         let records = common::inputs(&sim);
         let cfg = AnalysisConfig {
-            method: IdentMethod::SsiCov,
+            method: IdentMethod::SsiCov.into(),
             ..AnalysisConfig::default()
         };
         let res = analyze(&records, &cfg, &reference, &|_, _| {}).expect("analysis");

@@ -33,14 +33,16 @@ pub mod ssi;
 pub mod stats;
 
 pub use error::{ParamError, RecordingError};
-pub use identify::{Identifier, PoleOut, SignalFits};
+pub use identify::{
+    Identifier, MultichannelIdentifier, PoleOut, PooledIdentification, ShapedPole, SignalFits,
+};
 pub use limits::{cap_message, num, quoted, Num, Quoted};
 pub use modes::{
     FitSummary, InvariantMode, ModeClass, ModeMatch, ModeUncertainty, ModelCoefficients,
     PoleObservation, ReferenceMode, SupportFailure, UncertaintyMethod,
 };
 pub use params::{
-    BandLimit, BodyFitParams, BodySsiParams, ClusterParams, IdentMethod, LineParams,
+    BandLimit, BodyFitParams, BodySsiParams, ClusterParams, IdentMethod, IdentMethods, LineParams,
     PoleFilterParams, PreprocessParams, Robust, SpectrumParams, StopParams, SweepModel,
     SweepParams, DEFAULT_HUBER_FACTOR, EDGE_SHARE, EMPTY_BAND_MAX_CUTOFF_SHARE,
     SWEEP_MAX_ITERATIONS, SWEEP_TOLERANCE,

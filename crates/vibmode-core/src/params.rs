@@ -138,31 +138,16 @@ impl PreprocessParams {
     }
 }
 
-/// Identification method of the analysis.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+/// One identification method of the analysis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
+#[non_exhaustive]
 pub enum IdentMethod {
-    /// The paper's per-channel ARMA (or AR) order sweep.
+    /// The paper's per-channel ARMA (or AR) order sweep (an [`crate::Identifier`]).
     Arma,
     /// Multichannel covariance-driven stochastic subspace identification (all channels of a
-    /// record at once, with mode shapes).
+    /// record at once, with mode shapes; a [`crate::MultichannelIdentifier`]).
     SsiCov,
-    /// Both, side by side (the default: the ARMA pools find modes of single channels that
-    /// SSI-cov misses, SSI-cov separates close modes by their shapes; measured on the real
-    /// recordings in docs/analysis.md).
-    #[default]
-    Both,
-}
-
-impl IdentMethod {
-    /// True when the ARMA/AR sweep runs.
-    pub fn runs_arma(self) -> bool {
-        matches!(self, IdentMethod::Arma | IdentMethod::Both)
-    }
-    /// True when SSI-cov runs.
-    pub fn runs_ssi(self) -> bool {
-        matches!(self, IdentMethod::SsiCov | IdentMethod::Both)
-    }
 }
 
 impl FromStr for IdentMethod {
@@ -171,11 +156,10 @@ impl FromStr for IdentMethod {
         match s.trim().to_ascii_lowercase().as_str() {
             "arma" => Ok(IdentMethod::Arma),
             "ssi-cov" | "ssi" | "ssicov" => Ok(IdentMethod::SsiCov),
-            "both" => Ok(IdentMethod::Both),
             _ => Err(ParamError::UnknownName {
                 what: "method",
                 value: s.to_string(),
-                valid: "arma, ssi-cov, both",
+                valid: "arma, ssi-cov, both (or a list such as arma,ssi-cov)",
             }),
         }
     }
@@ -186,8 +170,108 @@ impl fmt::Display for IdentMethod {
         f.write_str(match self {
             IdentMethod::Arma => "arma",
             IdentMethod::SsiCov => "ssi-cov",
-            IdentMethod::Both => "both",
         })
+    }
+}
+
+/// The identification methods an analysis runs: a non-empty set, kept sorted. The default runs
+/// both side by side (the ARMA pools find modes of single channels that SSI-cov misses,
+/// SSI-cov separates close modes by their shapes; measured on the real recordings in
+/// docs/analysis.md).
+///
+/// Read from a list (`["arma", "ssi-cov"]`, or `arma,ssi-cov` as text) or one name; `"both"`
+/// is every method. Written as a list.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[serde(into = "Vec<IdentMethod>")]
+pub struct IdentMethods(Vec<IdentMethod>);
+
+impl IdentMethods {
+    /// Every method ("both").
+    pub fn all() -> IdentMethods {
+        IdentMethods(vec![IdentMethod::Arma, IdentMethod::SsiCov])
+    }
+    /// The given methods, sorted, duplicates removed; `None` when there are none.
+    pub fn new(methods: impl IntoIterator<Item = IdentMethod>) -> Option<IdentMethods> {
+        let mut v: Vec<IdentMethod> = methods.into_iter().collect();
+        v.sort();
+        v.dedup();
+        (!v.is_empty()).then_some(IdentMethods(v))
+    }
+    /// True when `m` runs.
+    pub fn runs(&self, m: IdentMethod) -> bool {
+        self.0.contains(&m)
+    }
+    /// True when the ARMA/AR sweep runs.
+    pub fn runs_arma(&self) -> bool {
+        self.runs(IdentMethod::Arma)
+    }
+    /// True when SSI-cov runs.
+    pub fn runs_ssi(&self) -> bool {
+        self.runs(IdentMethod::SsiCov)
+    }
+    /// The methods, sorted.
+    pub fn iter(&self) -> impl Iterator<Item = IdentMethod> + '_ {
+        self.0.iter().copied()
+    }
+}
+
+impl Default for IdentMethods {
+    fn default() -> IdentMethods {
+        IdentMethods::all()
+    }
+}
+
+impl From<IdentMethod> for IdentMethods {
+    fn from(m: IdentMethod) -> IdentMethods {
+        IdentMethods(vec![m])
+    }
+}
+
+impl From<IdentMethods> for Vec<IdentMethod> {
+    fn from(m: IdentMethods) -> Vec<IdentMethod> {
+        m.0
+    }
+}
+
+impl FromStr for IdentMethods {
+    type Err = ParamError;
+    /// `both`, one method, or methods separated by commas.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if s.trim().eq_ignore_ascii_case("both") {
+            return Ok(IdentMethods::all());
+        }
+        let methods = s
+            .split(',')
+            .map(str::parse)
+            .collect::<Result<Vec<IdentMethod>, _>>()?;
+        IdentMethods::new(methods).ok_or_else(|| ParamError::UnknownName {
+            what: "method",
+            value: s.to_string(),
+            valid: "arma, ssi-cov, both (or a list such as arma,ssi-cov)",
+        })
+    }
+}
+
+impl fmt::Display for IdentMethods {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let names: Vec<String> = self.0.iter().map(ToString::to_string).collect();
+        f.write_str(&names.join(","))
+    }
+}
+
+impl<'de> Deserialize<'de> for IdentMethods {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Form {
+            Text(String),
+            List(Vec<String>),
+        }
+        let parsed = match Form::deserialize(d)? {
+            Form::Text(s) => s.parse(),
+            Form::List(v) => v.join(",").parse(),
+        };
+        parsed.map_err(serde::de::Error::custom)
     }
 }
 
@@ -727,6 +811,42 @@ impl ClusterParams {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn methods_are_a_list_read_from_a_list_a_name_or_both() {
+        use IdentMethod::{Arma, SsiCov};
+        #[derive(Deserialize, Serialize)]
+        struct T {
+            method: IdentMethods,
+        }
+        let read = |s: &str| toml::from_str::<T>(s).map(|t| t.method);
+        let both = IdentMethods::new([Arma, SsiCov]).unwrap();
+        assert_eq!(read("method = \"both\"").unwrap(), both);
+        assert_eq!(read("method = [\"ssi-cov\", \"arma\"]").unwrap(), both);
+        assert_eq!(read("method = \"ssi-cov,arma,arma\"").unwrap(), both);
+        assert_eq!(read("method = \"arma\"").unwrap(), Arma.into());
+        assert_eq!(read("method = [\"ssi\"]").unwrap(), SsiCov.into());
+        assert!(read("method = []").is_err());
+        assert!(read("method = \"magic\"").is_err());
+        assert!(read("method = \"arma,\"").is_err());
+        // Written as a list, read back the same.
+        let text = toml::to_string(&T {
+            method: both.clone(),
+        })
+        .unwrap();
+        assert_eq!(text.trim(), "method = [\"arma\", \"ssi-cov\"]");
+        assert_eq!(read(&text).unwrap(), both);
+        assert_eq!(IdentMethods::default(), both);
+        assert!(both.runs_arma() && both.runs_ssi());
+        let only: IdentMethods = "ssi-cov".parse().unwrap();
+        assert!(!only.runs_arma() && only.runs_ssi());
+        assert_eq!(both.to_string(), "arma,ssi-cov");
+        let e = "arma,fft".parse::<IdentMethods>().unwrap_err().to_string();
+        assert!(
+            e.contains("fft") && e.contains("arma, ssi-cov, both"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn robust_has_one_spelling_in_toml_and_text() {

@@ -74,7 +74,7 @@ impl Default for FleetConfig {
         FleetConfig {
             // The features use the per-channel modes only: no multichannel identification.
             analysis: AnalysisConfig {
-                method: vibmode_core::IdentMethod::Arma,
+                method: vibmode_core::IdentMethod::Arma.into(),
                 ..AnalysisConfig::default()
             },
             bands_hz: vec![

@@ -19,6 +19,7 @@
 mod cov;
 mod eig;
 mod error;
+mod identifier;
 mod perturb;
 mod record;
 mod shape;
@@ -28,6 +29,7 @@ pub use cov::{
     jackknife_std, samples_needed, ssi_cov, SsiCorrelations, SsiCov, SsiMode, SsiOrder, SsiResult,
 };
 pub use error::SsiError;
+pub use identifier::{PooledSsi, SsiCovIdentifier};
 pub use perturb::{PoleStd, SsiPerturbation};
 pub use record::{identify_record, RecordSsi, RecordSsiOptions};
 pub use shape::{mac, mpc};

@@ -682,3 +682,75 @@ fn one_record_pipeline_is_invariant_to_channel_units() {
         }
     }
 }
+
+/// SSI-cov through the analysis's contract (`MultichannelIdentifier`): four records of the
+/// three-mode system identified together recover every mode (frequency within 1 %, damping
+/// within 0.02, MAC > 0.99) on each of 6 seeds, as one record of the same total length does;
+/// the delete-a-group jackknife gives one repetition per group, each holding every mode within
+/// 2 %; and the orders offered stop at the block Toeplitz rank bound `(block_rows - 1) l`.
+#[test]
+fn the_identifier_contract_pools_records_and_jackknifes_them() {
+    use vibmode_core::{MultichannelIdentifier, PooledIdentification};
+    use vibmode_ssi::SsiCovIdentifier;
+    let method = SsiCovIdentifier {
+        params: SsiParams {
+            block_rows: 20,
+            order_min: 2,
+            order_max: 200,
+            order_step: 2,
+            ..SsiParams::default()
+        },
+    };
+    let offered = method.orders(5);
+    assert_eq!(offered.first(), Some(&2));
+    assert_eq!(offered.last(), Some(&(19 * 5 - 1)));
+    let near = |poles: &[vibmode_core::ShapedPole], m: usize| {
+        let (f, z) = MODES[m];
+        poles
+            .iter()
+            .filter(|q| q.order == 6)
+            .min_by(|a, b| {
+                (a.frequency_hz - f)
+                    .abs()
+                    .total_cmp(&(b.frequency_hz - f).abs())
+            })
+            .map(|q| {
+                (
+                    (q.frequency_hz - f).abs() / f,
+                    (q.damping_ratio - z).abs(),
+                    mac(&q.shape, &real_shape(&SHAPES[m])),
+                )
+            })
+    };
+    for seed in 0..6u64 {
+        let recs: Vec<Vec<Vec<f64>>> = (0..4).map(|k| simulate(10_000, 100 * seed + k)).collect();
+        let views: Vec<Vec<&[f64]>> = recs
+            .iter()
+            .map(|r| r.iter().map(Vec::as_slice).collect())
+            .collect();
+        let pooled = method.pool(&views, FS, None).unwrap();
+        assert_eq!(pooled.n_records(), 4);
+        let poles = pooled.identify(&[6]).unwrap();
+        assert!(poles.iter().all(|q| q.record == 0 && q.order == 6));
+        for m in 0..MODES.len() {
+            let (ef, ez, mc) = near(&poles, m).unwrap();
+            assert!(
+                ef <= 0.01 && ez <= 0.02 && mc > 0.99,
+                "seed {seed} mode {m}: {ef} {ez} {mc}"
+            );
+        }
+        let reps = pooled.jackknife(4, &[6]).unwrap();
+        assert_eq!(reps.len(), 4);
+        for rep in &reps {
+            for m in 0..MODES.len() {
+                assert!(near(rep, m).unwrap().0 <= 0.02, "seed {seed} mode {m}");
+            }
+        }
+        // One record through the same contract.
+        let one = method.identify_record(&views[0], FS, &[6]).unwrap();
+        assert!(near(&one, 0).is_some());
+        // Fewer than 2 groups, or more groups than records: the method's own error.
+        assert!(pooled.jackknife(1, &[6]).is_err());
+        assert!(pooled.jackknife(5, &[6]).is_err());
+    }
+}
