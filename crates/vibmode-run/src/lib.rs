@@ -294,8 +294,28 @@ impl Run {
 
     /// Runs the analysis (and the model update, with a vehicle) on `input`.
     pub fn run(&self, input: RunInput<'_>, progress: &Progress<'_>) -> Result<RunOutput, RunError> {
+        self.config.validate()?;
+        match input {
+            #[cfg(feature = "segment")]
+            RunInput::Segmented {
+                paths,
+                read,
+                channels,
+                segmenting,
+            } => self.run_segmented(paths, read, channels, segmenting, progress),
+            input => self.analyse(input, &self.speed_trace, progress),
+        }
+    }
+
+    /// Records in memory or files (in their windows, when given): the analysis and the model
+    /// update in one pass over the records; `speed_trace` goes into the results.
+    fn analyse(
+        &self,
+        input: RunInput<'_>,
+        speed_trace: &[[f64; 2]],
+        progress: &Progress<'_>,
+    ) -> Result<RunOutput, RunError> {
         let cfg = &self.config;
-        cfg.validate()?;
         let mut update = ModelUpdate::for_vehicle(self.vehicle.clone(), cfg)?;
         // The identification reports (record x channel) fits; shown as records.
         let n_ch = AtomicUsize::new(0);
@@ -313,6 +333,7 @@ impl Run {
                 let results = vibmode_analysis::analyze(&records, cfg, &self.reference, &on_fits)?;
                 (results, records)
             }
+            // `run` cuts segmented inputs first and analyses them as files in their windows.
             #[cfg(feature = "segment")]
             RunInput::Segmented {
                 paths,
@@ -370,8 +391,8 @@ impl Run {
             }
         };
         check_some_fit(&results)?;
-        if !self.speed_trace.is_empty() {
-            results.drive_speed_trace = self.speed_trace.clone();
+        if !speed_trace.is_empty() {
+            results.drive_speed_trace = speed_trace.to_vec();
         }
         Ok(RunOutput {
             results,
@@ -393,7 +414,6 @@ impl Run {
         segmenting: &Segmenting,
         progress: &Progress<'_>,
     ) -> Result<RunOutput, RunError> {
-        self.config.validate()?;
         if segmenting.is_gps() && paths.len() > 1 {
             return Err(RunError::GpsWithManyFiles {
                 n_files: paths.len(),
@@ -406,30 +426,32 @@ impl Run {
             let planned = segmenting.plan(path, read, channels, record_length_s)?;
             notes.extend(planned.notes);
             let seg = planned.segmentation;
-            notes.push(seg.summary());
+            let summary = seg.summary();
             if seg.records.is_empty() {
                 return Err(RunError::NoSteadyStretch {
                     path: record_name(path),
                     record_length_s,
-                    summary: seg.summary(),
+                    summary,
                 });
             }
+            notes.push(summary);
             segments.push(seg);
         }
         let windows = segments.iter().map(|s| s.windows()).collect();
-        let mut run = self.clone();
-        if let [seg] = segments.as_slice() {
-            if let (Some(g), true) = (&seg.gps, run.speed_trace.is_empty()) {
-                run.speed_trace = g.speed_trace.clone();
+        // The run's own speed trace first, else a single GPS-segmented recording's.
+        let speed_trace = match segments.as_slice() {
+            [seg] if self.speed_trace.is_empty() => {
+                seg.gps.as_ref().map_or(&[][..], |g| g.speed_trace.as_slice())
             }
-        }
+            _ => self.speed_trace.as_slice(),
+        };
         let input = RunInput::Files {
             paths,
             read,
             channels,
             windows: Some(windows),
         };
-        let mut out = run.run(input, progress)?;
+        let mut out = self.analyse(input, speed_trace, progress)?;
         out.segments = segments;
         out.notes = notes;
         Ok(out)
