@@ -39,7 +39,7 @@ pub use identify::{
 pub use limits::{cap_message, num, quoted, Num, Quoted};
 pub use modes::{
     FitSummary, InvariantMode, ModeClass, ModeMatch, ModeUncertainty, ModelCoefficients,
-    PoleObservation, ReferenceMode, SupportFailure, UncertaintyMethod,
+    PoleObservation, ReferenceMode, SupportFailure, TruthRow, UncertaintyMethod,
 };
 pub use params::{
     BandLimit, BodyFitParams, BodySsiParams, ClusterParams, IdentMethod, IdentMethods, LineParams,

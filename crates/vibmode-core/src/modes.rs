@@ -367,3 +367,7 @@ impl InvariantMode {
         out
     }
 }
+
+/// A true mode or line of a simulation, printed beside the identified ones: label, frequency in
+/// Hz, damping ratio (0 for a line).
+pub type TruthRow = (String, f64, f64);

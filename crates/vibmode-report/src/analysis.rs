@@ -13,9 +13,7 @@ use crate::html::HtmlReport;
 use crate::model::{Figure, Panel, Scale, Series, SeriesStyle};
 use crate::panels::{damping_panel, grid, mode_marks, positive_freq, stabilisation_panel};
 
-/// A true mode of a simulation, printed beside the identified ones: label, frequency (Hz),
-/// damping ratio.
-pub type TruthRow = (String, f64, f64);
+pub use vibmode_core::TruthRow;
 
 /// Files written by [`write_analysis_report`].
 #[derive(Clone, Debug, PartialEq)]

@@ -26,8 +26,7 @@ impl Default for Demo {
     }
 }
 
-/// A true mode or line of the demo: label, frequency in Hz, damping ratio (0 for a line).
-pub type TruthRow = (String, f64, f64);
+pub use vibmode_core::TruthRow;
 
 /// A simulated demo, ready to run: its records, the modes to match, the vehicle to update and
 /// the words around it.
