@@ -440,9 +440,10 @@ impl Run {
         let windows = segments.iter().map(|s| s.windows()).collect();
         // The run's own speed trace first, else a single GPS-segmented recording's.
         let speed_trace = match segments.as_slice() {
-            [seg] if self.speed_trace.is_empty() => {
-                seg.gps.as_ref().map_or(&[][..], |g| g.speed_trace.as_slice())
-            }
+            [seg] if self.speed_trace.is_empty() => seg
+                .gps
+                .as_ref()
+                .map_or(&[][..], |g| g.speed_trace.as_slice()),
             _ => self.speed_trace.as_slice(),
         };
         let input = RunInput::Files {
