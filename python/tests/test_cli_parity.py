@@ -1,0 +1,63 @@
+"""Python's `analyze` and the command line's `vibmode analyze` are one library run
+(`vibmode_run::Run`): on the same files with the same settings their results.json are equal,
+field by field, apart from the run time. The binary is the one `cargo test` built
+(`VIBMODE_BIN`, as `.ci/run` sets it); without it the test is skipped with the reason."""
+
+import json
+import os
+import pathlib
+import subprocess
+
+import pytest
+
+import vibmode
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+def binary():
+    given = os.environ.get("VIBMODE_BIN")
+    for p in ([pathlib.Path(given)] if given else []) + [
+        ROOT / "target" / "debug" / "vibmode",
+        ROOT / "target" / "release" / "vibmode",
+    ]:
+        if p.is_file():
+            return p
+    return None
+
+
+def differences(a, b, at=""):
+    """Every path where two JSON values differ (type, keys, lengths or values)."""
+    if type(a) is not type(b):
+        return [f"{at}: {type(a).__name__} vs {type(b).__name__}"]
+    if isinstance(a, dict):
+        out = [f"{at}.{k}: only in one" for k in sorted(set(a) ^ set(b))]
+        for k in sorted(set(a) & set(b)):
+            out += differences(a[k], b[k], f"{at}.{k}")
+        return out
+    if isinstance(a, list):
+        if len(a) != len(b):
+            return [f"{at}: {len(a)} vs {len(b)} items"]
+        return [d for i, (x, y) in enumerate(zip(a, b)) for d in differences(x, y, f"{at}[{i}]")]
+    return [] if a == b else [f"{at}: {str(a)[:60]} vs {str(b)[:60]}"]
+
+
+def test_python_and_cli_give_the_same_results_json(tmp_path):
+    exe = binary()
+    if exe is None:
+        pytest.skip("no vibmode binary (set VIBMODE_BIN or run cargo build first)")
+    paths = vibmode.simulate("city_bus", records=3, fs=200.0, effects="in-service", seed=5,
+                             out_dir=tmp_path / "recs", format="f32").paths
+    paths = [str(p) for p in paths]
+    config = "[sweep]\norder_max = 8\n"
+    (tmp_path / "cfg.toml").write_text(config)
+    py = vibmode.analyze(paths, config=config, as_frames=False)
+    subprocess.run([str(exe), "analyze", "-q", "--config", str(tmp_path / "cfg.toml"),
+                    "-o", str(tmp_path / "out"), *paths], check=True, capture_output=True)
+    cli = json.loads((tmp_path / "out" / "results.json").read_text())
+    for r in (py, cli):
+        r.pop("timing")
+    diffs = differences(py, cli)
+    assert diffs == [], "\n".join(diffs[:20])
+    # Something was found, so the comparison compared results, not two empty lists.
+    assert any(m["class"] == "structural" for role in cli["roles"] for m in role["invariant_modes"])
