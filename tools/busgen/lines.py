@@ -26,7 +26,9 @@ Scores per bus:
 - structural classed periodic: a false report (above) within max(2 %, zeta) of the bending or of
   a wheel-hop mode (group `unsprung`): that mode was called a line.
 - bending structural: where a sensor sees the bending (`observable_in` non-empty), an invariant
-  mode of a pool classed `structural` within `BENDING_REL` (2 %) of its frequency.
+  mode of a pool classed `structural` within `BENDING_REL` (2 %) of its frequency. Each row
+  prints the bending's largest `visibility` over the sensors (busgen's truth: its modal peak in
+  a channel over the strongest mode's peak there; `observable_in` takes 0.05 and up).
 
 Prints one row per bus and the summary; exit status 0 (it measures, it does not judge).
 """
@@ -155,7 +157,8 @@ def row(bus: int, t: Dict, s: Dict) -> str:
             bend = "no (" + "; ".join(f"{h[1]['frequency_hz']:.2f} {h[1]['class']} in {h[0]}" for h in hits) + ")"
         else:
             bend = "no (none within 2 %)"
-        bend = f"{b['f_n_hz']:.2f}/{b['zeta']:.3f}: {bend}"
+        vis = max(b.get("visibility", {}).values(), default=float("nan"))
+        bend = f"{b['f_n_hz']:.2f}/{b['zeta']:.3f} (visibility {vis:.2f}): {bend}"
     return (f"bus {bus:5d}: lines {fmt_hz(s['lines'])} | judged {fmt_hz(s['apart'])} found "
             f"{len(s['found'])}/{len(s['apart'])} missed {fmt_hz(missed)} | false "
             f"{'; '.join(f'{r:.2f} [{w[0]}]' for r, w in s['false']) or '-'} | structural periodic "

@@ -135,7 +135,7 @@ impl<M: MultichannelIdentifier> SsiStage<'_, M> {
     /// jackknife over the records (at most [`JACKKNIFE_GROUPS`] groups of consecutive records):
     /// the pooled identification repeated without each group, each mode's median frequency and
     /// damping over the repetition's poles near it (within the clustering's radius, shapes with
-    /// MAC at least `1 - shape_tol`). Nothing is set with fewer than 2 records or when a
+    /// MAC at least `1 - shape_tol`, both shapes scaled as identified, as clustered). Nothing is set with fewer than 2 records or when a
     /// repetition fails.
     fn jackknife(
         &self,
@@ -145,6 +145,7 @@ impl<M: MultichannelIdentifier> SsiStage<'_, M> {
         orders: &[usize],
         scales: &[f64],
     ) {
+        let inverse = inverse_scales(scales);
         let groups = pooled.n_records().min(JACKKNIFE_GROUPS);
         if groups < 2 || !modes.iter().any(InvariantMode::is_invariant) {
             return;
@@ -157,9 +158,10 @@ impl<M: MultichannelIdentifier> SsiStage<'_, M> {
             .map(|rep| self.kept(rep, 0, band, scales))
             .collect();
         for m in modes.iter_mut().filter(|m| m.is_invariant()) {
-            let Some(shape) = m.shape.clone() else {
+            let Some(shape) = m.shape.as_deref() else {
                 continue;
             };
+            let scaled = vibmode_modal::shapes::rescaled(shape, &inverse);
             let tol = self
                 .cluster
                 .freq_tol_rel
@@ -171,8 +173,10 @@ impl<M: MultichannelIdentifier> SsiStage<'_, M> {
                     .filter(|q| (q.frequency_hz / m.frequency_hz - 1.0).abs() <= tol)
                     .filter(|q| {
                         self.cluster.shape_tol <= 0.0
-                            || vibmode_modal::shapes::mac(&q.shape, &shape)
-                                >= 1.0 - self.cluster.shape_tol
+                            || vibmode_modal::shapes::mac(
+                                &vibmode_modal::shapes::rescaled(&q.shape, &inverse),
+                                &scaled,
+                            ) >= 1.0 - self.cluster.shape_tol
                     })
                     .map(|q| (q.frequency_hz, q.damping_ratio))
                     .unzip();
@@ -281,30 +285,24 @@ impl<M: MultichannelIdentifier> SsiStage<'_, M> {
             }
         }
         let pooled_records = self.pool_records;
-        let obs: Vec<PoleObservation> = poles
-            .iter()
-            .filter_map(|q| {
-                let rec = if pooled_records {
-                    0
+        let (obs, of_pole): (Vec<PoleObservation>, Vec<usize>) =
+            observations(&poles, &scales, self.method.name(), |r| {
+                if pooled_records {
+                    Some(0)
                 } else {
-                    self.active.get(q.record).copied().flatten()?
-                };
-                let mut o = PoleObservation::new(
-                    q.frequency_hz,
-                    q.damping_ratio,
-                    q.order,
-                    rec,
-                    self.method.name(),
-                );
-                o.shape = Some(q.shape.clone());
-                Some(o)
+                    self.active.get(r).copied().flatten()
+                }
             })
-            .collect();
+            .into_iter()
+            .unzip();
         let n_records = if pooled_records { 1 } else { self.n_active };
         let mut invariant_modes = if orders.is_empty() || self.n_active == 0 {
             Vec::new()
         } else {
-            vibmode_modal::find_invariant_modes(&obs, n_records, &orders, self.cluster)?
+            let a = vibmode_modal::analyse_poles(&obs, n_records, &orders, self.cluster)?;
+            let mut modes = a.modes;
+            physical_shapes(&mut modes, &a.labels, &of_pole, &poles);
+            modes
         };
         let all: Vec<usize> = (0..channels.len()).collect();
         let tracks = match own_tracks {
@@ -339,5 +337,137 @@ impl<M: MultichannelIdentifier> SsiStage<'_, M> {
             lines: tracks,
             failed_records,
         })
+    }
+}
+
+/// `1 / scale` of each channel: brings physical shapes back to the scaled channels SSI-cov saw.
+fn inverse_scales(scales: &[f64]) -> Vec<f64> {
+    scales.iter().map(|s| 1.0 / s).collect()
+}
+
+/// The poles as the clustering sees them, each in record `record_of(pole.record)` (`None`: left
+/// out). Their shapes are those SSI-cov identified, each channel still divided by its scale
+/// (`scales`, [`SsiStage::channel_scales`]): there every channel's estimation error is of one size
+/// (its noise relative to its RMS), whereas in physical units the strong, noisy wheel channels
+/// dominate the MAC, and the shape of a mode the body sensors see and the wheels barely do (the
+/// bending, under the wheel-hop band) scatters with their noise from order to order and falls
+/// apart into clusters too small to be supported.
+fn observations(
+    poles: &[ShapedPole],
+    scales: &[f64],
+    channel: &str,
+    record_of: impl Fn(usize) -> Option<usize>,
+) -> Vec<(PoleObservation, usize)> {
+    let inverse = inverse_scales(scales);
+    poles
+        .iter()
+        .enumerate()
+        .filter_map(|(i, q)| {
+            let mut o = PoleObservation::new(
+                q.frequency_hz,
+                q.damping_ratio,
+                q.order,
+                record_of(q.record)?,
+                channel,
+            );
+            o.shape = Some(vibmode_modal::shapes::rescaled(&q.shape, &inverse));
+            Some((o, i))
+        })
+        .collect()
+}
+
+/// Each cluster's mean shape and the (median, lowest) MAC of its poles' shapes with it, in the
+/// channels' units (the clustering compared them scaled): `labels` are the clustering's, one per
+/// observation, `of_pole` the pole of each observation.
+fn physical_shapes(
+    modes: &mut [InvariantMode],
+    labels: &[Option<usize>],
+    of_pole: &[usize],
+    poles: &[ShapedPole],
+) {
+    for (k, m) in modes.iter_mut().enumerate() {
+        let shapes: Vec<&[[f64; 2]]> = labels
+            .iter()
+            .zip(of_pole)
+            .filter(|(l, _)| **l == Some(k))
+            .filter_map(|(_, &i)| poles.get(i).map(|q| q.shape.as_slice()))
+            .collect();
+        let Some(mean) = vibmode_modal::shapes::mean_shape(&shapes) else {
+            continue;
+        };
+        let mut macs: Vec<f64> = shapes
+            .iter()
+            .map(|s| vibmode_modal::shapes::mac(s, &mean))
+            .collect();
+        macs.sort_by(f64::total_cmp);
+        let lowest = macs.first().copied().unwrap_or(0.0);
+        m.shape_mac = Some((vibmode_modal::stats::median(&macs), lowest));
+        m.shape = Some(mean);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use vibmode_core::ModeClass;
+
+    /// A body mode seen by two body channels (RMS 1) and barely by four wheel channels (RMS 10,
+    /// the wheels' identified components pure noise of the body's size in their units), in
+    /// every order of a sweep: one pole per order, frequency and damping scattered a little.
+    fn body_mode_poles(orders: &[usize], seed: u64) -> Vec<ShapedPole> {
+        let mut state: u64 = 0x2545_f491_4f6c_dd1d ^ seed.wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        orders
+            .iter()
+            .map(|&order| {
+                let mut shape: Vec<[f64; 2]> =
+                    (0..4).map(|_| [2.0 * uniform(), 2.0 * uniform()]).collect();
+                shape.push([1.0 + 0.05 * uniform(), 0.0]);
+                shape.push([-1.0 + 0.05 * uniform(), 0.0]);
+                ShapedPole {
+                    record: 0,
+                    order,
+                    frequency_hz: 8.0 * (1.0 + 0.002 * uniform()),
+                    damping_ratio: 0.03 * (1.0 + 0.1 * uniform()),
+                    mpc: 1.0,
+                    shape,
+                }
+            })
+            .collect()
+    }
+
+    fn best_order_share(poles: &[ShapedPole], scales: &[f64], orders: &[usize]) -> f64 {
+        let obs: Vec<PoleObservation> = observations(poles, scales, SSI_CHANNEL, Some)
+            .into_iter()
+            .map(|(o, _)| o)
+            .collect();
+        let modes = vibmode_modal::find_invariant_modes(&obs, 1, orders, &ClusterParams::default())
+            .unwrap_or_default();
+        modes
+            .iter()
+            .filter(|m| m.class == ModeClass::Structural)
+            .map(|m| m.order_share)
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn a_body_mode_under_noisy_wheels_is_one_supported_cluster() {
+        let orders: Vec<usize> = (1..=30).map(|k| 2 * k).collect();
+        let scales = [10.0, 10.0, 10.0, 10.0, 1.0, 1.0];
+        for seed in 1..=8 {
+            let poles = body_mode_poles(&orders, seed);
+            // Clustered as identified (wheels divided by 10): one cluster in nearly every order.
+            let scaled = best_order_share(&poles, &scales, &orders);
+            assert!(scaled >= 0.9, "seed {seed}: {scaled}");
+            // The same poles compared in the channels' units (no scaling) fall apart: the
+            // wheels' noise makes the MAC, and no cluster reaches `min_order_share`.
+            let physical = best_order_share(&poles, &[1.0; 6], &orders);
+            assert!(physical < 0.5, "seed {seed}: {physical}");
+        }
     }
 }
