@@ -14,7 +14,7 @@ use crate::model::{information_criteria, ArmaModel, Estimator, StopReason};
 use crate::outliers::OutlierCleaning;
 use crate::params::{ArmaParams, Robust};
 use crate::prepare::{self, Prepared};
-use crate::roots::{aberth_roots, polynomial_roots, polynomial_roots_unpolished};
+use crate::roots::{aberth_roots_from, polynomial_roots, polynomial_roots_unpolished};
 use crate::IdentError;
 
 /// Largest N p (p + q) for which the AR columns of the Jacobian are filtered exactly
@@ -259,6 +259,13 @@ fn poly_from_roots(roots: &[Complex64]) -> Vec<f64> {
 /// are reflected (z -> 1/conj z). Rebuilding C from its roots loses many digits when they crowd
 /// near the circle, so it is avoided where the radial shrink suffices.
 fn stabilise(c: &mut [f64]) {
+    stabilise_from(c, &mut Vec::new());
+}
+
+/// As [`stabilise`], the roots' iteration started from `roots_cache` (the roots of the C last
+/// reflected in the same search, when of the same degree: the trial steps of one search move C
+/// little), which then receives the roots of this C.
+fn stabilise_from(c: &mut [f64], roots_cache: &mut Vec<Complex64>) {
     if c.len() <= 1 || is_min_phase(c) {
         return;
     }
@@ -272,10 +279,12 @@ fn stabilise(c: &mut [f64]) {
     }
     // Unpolished roots: the reflected C is a trial point of the search, not a result. Aberth's
     // iteration (O(q^2) per sweep) first, the companion matrix if it does not settle.
-    let roots = aberth_roots(c)
+    let roots = aberth_roots_from(c, roots_cache)
         .map(Ok)
         .unwrap_or_else(|| polynomial_roots_unpolished(c));
     if let Ok(roots) = roots {
+        roots_cache.clear();
+        roots_cache.extend_from_slice(&roots);
         let refl: Vec<Complex64> = roots
             .iter()
             .map(|&z| {
@@ -863,15 +872,16 @@ impl LineSearch<'_> {
         dir: &[f64],
         (h, neg_g): (&DMatrix<f64>, &[f64]),
         trial: &mut [f64],
+        roots_cache: &mut Vec<Complex64>,
     ) -> (Option<Trial>, f64) {
         let mut reflected = 0usize;
-        let accepted = self.run(point, dir, 1.0, trial, &mut reflected);
+        let accepted = self.run(point, dir, 1.0, trial, &mut reflected, roots_cache);
         if accepted.is_some() {
             return (accepted, f64::INFINITY);
         }
         let (dg, s0, pred_gradient) = scaled_gradient_step(h, neg_g, self.ys.len() - self.p);
         let accepted = self
-            .run(point, &dg, s0, trial, &mut reflected)
+            .run(point, &dg, s0, trial, &mut reflected, roots_cache)
             .map(|t| Trial {
                 halvings: t.halvings + self.max_halvings + 1,
                 ..t
@@ -892,6 +902,7 @@ impl LineSearch<'_> {
         s0: f64,
         trial: &mut [f64],
         reflected: &mut usize,
+        roots_cache: &mut Vec<Complex64>,
     ) -> Option<Trial> {
         let mut s = s0;
         for hv in 0..=self.max_halvings {
@@ -902,7 +913,7 @@ impl LineSearch<'_> {
                     continue;
                 }
                 *reflected += 1;
-                stabilise(&mut nc);
+                stabilise_from(&mut nc, roots_cache);
             }
             predict_errors(self.ys, &na, &nc, trial);
             let vt = mean_loss(&trial[self.p..], self.rho);
@@ -1015,6 +1026,8 @@ fn gauss_newton(
     let mut stop = StopReason::MaxIterations;
     let mut converged = false;
     let mut trial_eps = vec![0.0; n];
+    // Roots of the C last reflected into the unit circle: the next reflection's starting point.
+    let mut roots_cache: Vec<Complex64> = Vec::new();
     // Loss history for the stall rule.
     let mut history: Vec<f64> = vec![v];
     while iterations < params.max_iterations {
@@ -1035,8 +1048,13 @@ fn gauss_newton(
         } else {
             d0
         };
-        let (accepted, pred_gradient) =
-            line.descend((&a, &c, v), &dir, (&h, &neg_g), &mut trial_eps);
+        let (accepted, pred_gradient) = line.descend(
+            (&a, &c, v),
+            &dir,
+            (&h, &neg_g),
+            &mut trial_eps,
+            &mut roots_cache,
+        );
         let Some(t) = accepted else {
             // No step lowers V.
             stop = StopReason::NoImprovement;
