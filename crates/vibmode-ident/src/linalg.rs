@@ -99,8 +99,16 @@ pub(crate) fn lagged_gram(
     for j in 1..=lz {
         m[(0, j - 1)] = lagged_dot(x.x, 1, z.x, j, t0);
     }
+    // A block of one signal with itself is symmetric bit for bit: `lagged_dot(x, i, x, 1)` sums
+    // the same products in the same order as `lagged_dot(x, 1, x, i)` (multiplication commutes
+    // exactly), so its first column is its first row.
+    let same = std::ptr::eq(x.x, z.x) && lx == lz;
     for i in 2..=lx {
-        m[(i - 1, 0)] = lagged_dot(x.x, i, z.x, 1, t0);
+        m[(i - 1, 0)] = if same {
+            m[(0, i - 1)]
+        } else {
+            lagged_dot(x.x, i, z.x, 1, t0)
+        };
     }
     let (ni, t0i) = (n as isize, t0 as isize);
     for i in 1..lx {
@@ -361,6 +369,37 @@ mod tests {
             }
             let want = (s[0] + s[1]) + (s[2] + s[3]) + tail;
             assert_eq!(dot(&x, &z).to_bits(), want.to_bits(), "n = {n}");
+        }
+    }
+
+    /// The Gram block of a signal with itself (first column copied from the first row) equals,
+    /// bit for bit, the block of the signal with a copy of itself (every entry summed).
+    #[test]
+    fn symmetric_lagged_gram_is_the_general_one_bit_for_bit() {
+        let x: Vec<f64> = (0..301)
+            .map(|t| ((t * 7919 % 1009) as f64).sin() * 1.7)
+            .collect();
+        let copy = x.clone();
+        for &(l, t0) in &[(1usize, 0usize), (6, 0), (13, 13), (30, 45)] {
+            let mut same = DMatrix::<f64>::zeros(l, l);
+            let mut general = DMatrix::<f64>::zeros(l, l);
+            lagged_gram(
+                Lags::new(&x, l),
+                Lags::new(&x, l),
+                t0,
+                same.view_mut((0, 0), (l, l)),
+                -1.0,
+            );
+            lagged_gram(
+                Lags::new(&x, l),
+                Lags::new(&copy, l),
+                t0,
+                general.view_mut((0, 0), (l, l)),
+                -1.0,
+            );
+            for (a, b) in same.iter().zip(general.iter()) {
+                assert_eq!(a.to_bits(), b.to_bits(), "l {l} t0 {t0}");
+            }
         }
     }
 
