@@ -396,31 +396,50 @@ fn hannan_rissanen(ys: &[f64], p: usize, q: usize, ladder: &[Vec<f64>]) -> (Vec<
 /// Solves `h x = b` after Jacobi scaling, with relative ridge `mu` (added to the unit diagonal),
 /// escalating the ridge if the factorisation fails.
 fn solve_scaled(h: &DMatrix<f64>, b: &[f64], mu: f64) -> Option<Vec<f64>> {
-    let k = h.nrows();
-    let d: Vec<f64> = (0..k)
-        .map(|i| {
-            let v = h[(i, i)];
-            if v > 0.0 && v.is_finite() {
-                v.sqrt()
-            } else {
-                1.0
-            }
-        })
-        .collect();
-    let hs = DMatrix::from_fn(k, k, |i, j| h[(i, j)] / (d[i] * d[j]));
-    let bs: Vec<f64> = (0..k).map(|i| b[i] / d[i]).collect();
-    let mut ridge = mu;
-    for _ in 0..RIDGE_ESCALATIONS {
-        if let Some(x) = cholesky_solve(&hs, &bs, ridge) {
-            return Some(x.iter().zip(&d).map(|(v, di)| v / di).collect());
-        }
-        ridge = if ridge > 0.0 {
-            ridge * RIDGE_GROWTH
-        } else {
-            MIN_RIDGE
-        };
+    Scaled::new(h, b).solve(mu)
+}
+
+/// The Jacobi-scaled system `D^-1 h D^-1 (D x) = D^-1 b` (D = sqrt(diag h), 1 where that is not
+/// positive), formed once for solves with several ridges.
+struct Scaled {
+    d: Vec<f64>,
+    hs: DMatrix<f64>,
+    bs: Vec<f64>,
+}
+
+impl Scaled {
+    fn new(h: &DMatrix<f64>, b: &[f64]) -> Self {
+        let k = h.nrows();
+        let d: Vec<f64> = (0..k)
+            .map(|i| {
+                let v = h[(i, i)];
+                if v > 0.0 && v.is_finite() {
+                    v.sqrt()
+                } else {
+                    1.0
+                }
+            })
+            .collect();
+        let hs = DMatrix::from_fn(k, k, |i, j| h[(i, j)] / (d[i] * d[j]));
+        let bs: Vec<f64> = (0..k).map(|i| b[i] / d[i]).collect();
+        Scaled { d, hs, bs }
     }
-    None
+
+    /// The solution with relative ridge `mu`, escalated while the factorisation fails.
+    fn solve(&self, mu: f64) -> Option<Vec<f64>> {
+        let mut ridge = mu;
+        for _ in 0..RIDGE_ESCALATIONS {
+            if let Some(x) = cholesky_solve(&self.hs, &self.bs, ridge) {
+                return Some(x.iter().zip(&self.d).map(|(v, di)| v / di).collect());
+            }
+            ridge = if ridge > 0.0 {
+                ridge * RIDGE_GROWTH
+            } else {
+                MIN_RIDGE
+            };
+        }
+        None
+    }
 }
 
 /// Scratch buffers and fixed data of one search.
@@ -932,8 +951,8 @@ impl LineSearch<'_> {
 
 /// Gauss-Newton step `d0` (with a negligible ridge) and the Newton decrement, the predicted
 /// decrease of V per sample `d0 . (-g) / n_eff`. None when the normal matrix cannot be factored.
-fn newton_decrement(h: &DMatrix<f64>, neg_g: &[f64], n_eff: usize) -> Option<(Vec<f64>, f64)> {
-    let d0 = solve_scaled(h, neg_g, NEWTON_DECREMENT_RIDGE)?;
+fn newton_decrement(scaled: &Scaled, neg_g: &[f64], n_eff: usize) -> Option<(Vec<f64>, f64)> {
+    let d0 = scaled.solve(NEWTON_DECREMENT_RIDGE)?;
     let pred = d0.iter().zip(neg_g).map(|(x, y)| x * y).sum::<f64>() / n_eff as f64;
     Some((d0, pred))
 }
@@ -1033,7 +1052,9 @@ fn gauss_newton(
     while iterations < params.max_iterations {
         let (g, h, _) = search.normal_equations(&c, &eps);
         let neg_g: Vec<f64> = g.iter().map(|v| -v).collect();
-        let Some((d0, pred)) = newton_decrement(&h, &neg_g, n_eff) else {
+        // The scaled system is formed once for both solves of the iteration.
+        let scaled = Scaled::new(&h, &neg_g);
+        let Some((d0, pred)) = newton_decrement(&scaled, &neg_g, n_eff) else {
             stop = StopReason::NoImprovement;
             break;
         };
@@ -1044,7 +1065,7 @@ fn gauss_newton(
         }
         iterations += 1;
         let dir = if mu > MU_MIN {
-            solve_scaled(&h, &neg_g, mu).unwrap_or(d0)
+            scaled.solve(mu).unwrap_or(d0)
         } else {
             d0
         };
