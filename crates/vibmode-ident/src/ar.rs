@@ -177,6 +177,26 @@ pub(crate) fn levinson(r: &[f64], p: usize) -> (Vec<f64>, Vec<f64>) {
 
 /// Burg's method on demeaned `x`: (A coefficients, reflection coefficients, noise variance).
 pub(crate) fn burg(x: &[f64], p: usize) -> (Vec<f64>, Vec<f64>, f64) {
+    burg_visiting(x, p, |_, _| {})
+}
+
+/// The Burg AR polynomials of every order `0..=p` of `x` (`[1]`, `[1, a_1]`, ...): the order-m
+/// polynomial of Burg's recursion does not depend on the final order, so one pass to order `p`
+/// gives, bit for bit, what [`burg`] of each order `m <= p` returns.
+pub(crate) fn burg_ladder(x: &[f64], p: usize) -> Vec<Vec<f64>> {
+    let mut ladder = Vec::with_capacity(p + 1);
+    ladder.push(vec![1.0]);
+    burg_visiting(x, p, |m, a| ladder.push(a[..=m].to_vec()));
+    ladder
+}
+
+/// Burg's recursion to order `p`, calling `visit(m, a)` with the order-m coefficients (`a[..=m]`)
+/// after each step.
+fn burg_visiting(
+    x: &[f64],
+    p: usize,
+    mut visit: impl FnMut(usize, &[f64]),
+) -> (Vec<f64>, Vec<f64>, f64) {
     let n = x.len();
     let mut f = x.to_vec();
     let mut b = x.to_vec();
@@ -184,6 +204,7 @@ pub(crate) fn burg(x: &[f64], p: usize) -> (Vec<f64>, Vec<f64>, f64) {
     a[0] = 1.0;
     let mut refl = Vec::with_capacity(p);
     let mut energy = 0.0;
+    let mut prev = a.clone();
     for m in 1..=p {
         // Errors f_{m-1}(t), b_{m-1}(t-1) for t = m..N-1.
         let num = dot(&f[m..n], &b[m - 1..n - 1]);
@@ -195,12 +216,13 @@ pub(crate) fn burg(x: &[f64], p: usize) -> (Vec<f64>, Vec<f64>, f64) {
             f[t] = ft + k * bt;
             b[t] = bt + k * ft;
         }
-        let prev = a.clone();
+        prev[..m].copy_from_slice(&a[..m]);
         for i in 1..m {
             a[i] = prev[i] + k * prev[m - i];
         }
         a[m] = k;
         refl.push(k);
+        visit(m, &a);
         if m == p {
             energy = dot(&f[m..n], &f[m..n]) + dot(&b[m..n], &b[m..n]);
         }
@@ -280,6 +302,27 @@ pub(crate) fn fb_least_squares(x: &[f64], p: usize) -> (Vec<f64>, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One Burg pass gives, bit for bit, the polynomial [`burg`] returns for every lower order.
+    #[test]
+    fn burg_ladder_matches_burg_of_each_order() {
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let x: Vec<f64> = (0..300)
+            .map(|t| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                (t as f64 * 0.3).sin() + (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            })
+            .collect();
+        let ladder = burg_ladder(&x, 40);
+        assert_eq!(ladder.len(), 41);
+        for (m, a) in ladder.iter().enumerate() {
+            let want = burg(&x, m).0;
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(a), bits(&want), "order {m}");
+        }
+    }
 
     #[test]
     fn ar1_yule_walker_by_hand() {

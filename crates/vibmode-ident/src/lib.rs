@@ -9,7 +9,7 @@
 //! * additive outliers (spikes in the signal) removed before robust fits by a robust AR
 //!   filter-cleaner ([`clean_additive_outliers`], [`OutlierCleaning`]);
 //! * model spectra in the units of a one-sided Welch density ([`ArmaModel::model_psd`]);
-//! * poles (balanced companion matrix, [`polynomial_roots`]) and modes: natural frequency in Hz
+//! * poles (Aberth-Ehrlich or balanced companion matrix, polished: [`polynomial_roots`]) and modes: natural frequency in Hz
 //!   and damping ratio ([`ArmaModel::modes`]).
 //!
 //! Sign convention: `A(q) y_t = C(q) e_t`, `A(z) = 1 + a1 z^-1 + ... + ap z^-p`,

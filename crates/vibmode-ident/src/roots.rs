@@ -1,4 +1,4 @@
-//! Polynomial roots via the eigenvalues of a balanced companion matrix.
+//! Polynomial roots: the Aberth-Ehrlich iteration, or the eigenvalues of a balanced companion matrix.
 
 use nalgebra::{linalg::balancing::balance_parlett_reinsch, DMatrix, Schur};
 use num_complex::Complex64;
@@ -8,8 +8,9 @@ use crate::IdentError;
 /// Roots of the polynomial `coeffs[0] z^n + coeffs[1] z^(n-1) + ... + coeffs[n]` (highest power
 /// first, as `numpy.roots`). For `A = [1, a1, ..., ap]` these are the model poles.
 ///
-/// Method: companion matrix, Parlett-Reinsch balancing (nalgebra's
-/// `linalg::balancing::balance_parlett_reinsch`), real Schur decomposition, then at most four
+/// Method: the Aberth-Ehrlich iteration's roots made an exact conjugate set (else, when it does not
+/// settle or a root is neither paired nor real: companion matrix, Parlett-Reinsch balancing
+/// (nalgebra's `linalg::balancing::balance_parlett_reinsch`), real Schur decomposition), then at most four
 /// guarded Newton polishing steps per root on the original polynomial, its value evaluated in
 /// double-double arithmetic (a step is kept only if it lowers |p(z)| and is small against the
 /// distance to the nearest other root). The eigenvalues alone carry errors of about eps x the
@@ -41,7 +42,15 @@ const ABERTH_MAX_ITERATIONS: usize = 200;
 /// does not settle within [`ABERTH_MAX_ITERATIONS`] or a value is not finite: the caller then
 /// falls back to the companion matrix. Roots of a real polynomial come in conjugate pairs only
 /// to the iteration's accuracy.
+#[cfg(test)]
 pub(crate) fn aberth_roots(coeffs: &[f64]) -> Option<Vec<Complex64>> {
+    aberth_roots_from(coeffs, &[])
+}
+
+/// As [`aberth_roots`], started from `start` when it holds as many finite points as the degree
+/// (the roots of a nearby polynomial: a few sweeps then suffice instead of 10 to 30), else on the
+/// circle. The roots agree with the cold start's to the iteration's accuracy, not bit for bit.
+pub(crate) fn aberth_roots_from(coeffs: &[f64], start: &[Complex64]) -> Option<Vec<Complex64>> {
     let lead = *coeffs.first()?;
     if lead == 0.0 || coeffs.iter().any(|v| !v.is_finite()) {
         return None;
@@ -56,9 +65,16 @@ pub(crate) fn aberth_roots(coeffs: &[f64]) -> Option<Vec<Complex64>> {
     } else {
         0.5
     };
-    let mut z: Vec<Complex64> = (0..n)
-        .map(|k| Complex64::from_polar(radius, std::f64::consts::TAU * k as f64 / n as f64 + 0.4))
-        .collect();
+    let warm = start.len() == n && start.iter().all(|z| z.re.is_finite() && z.im.is_finite());
+    let mut z: Vec<Complex64> = if warm {
+        start.to_vec()
+    } else {
+        (0..n)
+            .map(|k| {
+                Complex64::from_polar(radius, std::f64::consts::TAU * k as f64 / n as f64 + 0.4)
+            })
+            .collect()
+    };
     let mut done = vec![false; n];
     for _ in 0..ABERTH_MAX_ITERATIONS {
         let mut moving = 0usize;
@@ -119,18 +135,17 @@ fn roots_impl(coeffs: &[f64], polished: bool) -> Result<Vec<Complex64>, IdentErr
     if n == 1 {
         roots.push(Complex64::new(-c[1], 0.0));
     } else if n >= 2 {
-        let mut m = DMatrix::<f64>::zeros(n, n);
-        for j in 0..n {
-            m[(0, j)] = -c[j + 1];
-        }
-        for i in 1..n {
-            m[(i, i - 1)] = 1.0;
-        }
-        balance_parlett_reinsch(&mut m);
-        let schur = Schur::try_new(m, f64::EPSILON, SCHUR_ITERATIONS_PER_ROOT * n.max(10))
-            .ok_or(IdentError::RootsNotConverged { degree: n })?;
-        let eig = schur.complex_eigenvalues();
-        let raw: Vec<Complex64> = eig.iter().map(|z| Complex64::new(z.re, z.im)).collect();
+        // Polished roots start from Aberth's (O(n^2) per sweep), made an exact conjugate set;
+        // the companion matrix's Schur form (O(n^3)) when that fails.
+        let aberth = if polished {
+            aberth_roots_from(&c, &[]).and_then(|z| conjugate_set(&z))
+        } else {
+            None
+        };
+        let raw = match aberth {
+            Some(z) => z,
+            None => companion_eigenvalues(&c)?,
+        };
         // Polish on the caller's coefficients (dividing by the leading one would round them).
         let original = &coeffs[..end];
         if polished {
@@ -143,6 +158,70 @@ fn roots_impl(coeffs: &[f64], polished: bool) -> Result<Vec<Complex64>, IdentErr
     }
     roots.extend(std::iter::repeat(Complex64::new(0.0, 0.0)).take(zeros_at_origin));
     Ok(roots)
+}
+
+/// A root without a conjugate partner is taken as real when its imaginary part is at most this
+/// fraction of its modulus (Aberth's roots of a real polynomial are real only to its accuracy).
+const REAL_ROOT_TOL: f64 = 1e-7;
+
+/// A root `z` and the nearest other root `w` are a conjugate pair when `|w - conj z|` is below this
+/// fraction of `|Im z|`.
+const PAIR_TOL: f64 = 0.25;
+
+/// Aberth's roots `z` of a real polynomial as an exact conjugate set, as the real Schur form gives
+/// it: each pair replaced by the mean of `z` and `conj w` and its conjugate, each unpaired root with
+/// a negligible imaginary part ([`REAL_ROOT_TOL`]) by its real part. None when a root fits neither
+/// (the caller then uses the companion matrix).
+fn conjugate_set(z: &[Complex64]) -> Option<Vec<Complex64>> {
+    let n = z.len();
+    let mut used = vec![false; n];
+    let mut out = Vec::with_capacity(n);
+    let mut upper: Vec<usize> = (0..n).filter(|&i| z[i].im > 0.0).collect();
+    upper.sort_by(|&a, &b| z[b].im.total_cmp(&z[a].im));
+    for &i in &upper {
+        let target = z[i].conj();
+        let partner = (0..n)
+            .filter(|&j| j != i && !used[j] && z[j].im < 0.0)
+            .min_by(|&a, &b| (z[a] - target).norm().total_cmp(&(z[b] - target).norm()));
+        if let Some(j) = partner {
+            if (z[j] - target).norm() < PAIR_TOL * z[i].im {
+                used[i] = true;
+                used[j] = true;
+                let m = (z[i] + z[j].conj()) * 0.5;
+                out.push(m);
+                out.push(m.conj());
+            }
+        }
+    }
+    for i in 0..n {
+        if !used[i] {
+            if z[i].im.abs() > REAL_ROOT_TOL * z[i].norm() {
+                return None;
+            }
+            out.push(Complex64::new(z[i].re, 0.0));
+        }
+    }
+    Some(out)
+}
+
+/// Eigenvalues of the balanced companion matrix of the monic `c` (degree >= 2): real Schur form,
+/// exact conjugate pairs.
+fn companion_eigenvalues(c: &[f64]) -> Result<Vec<Complex64>, IdentError> {
+    let n = c.len() - 1;
+    {
+        let mut m = DMatrix::<f64>::zeros(n, n);
+        for j in 0..n {
+            m[(0, j)] = -c[j + 1];
+        }
+        for i in 1..n {
+            m[(i, i - 1)] = 1.0;
+        }
+        balance_parlett_reinsch(&mut m);
+        let schur = Schur::try_new(m, f64::EPSILON, SCHUR_ITERATIONS_PER_ROOT * n.max(10))
+            .ok_or(IdentError::RootsNotConverged { degree: n })?;
+        let eig = schur.complex_eigenvalues();
+        Ok(eig.iter().map(|z| Complex64::new(z.re, z.im)).collect())
+    }
 }
 
 /// Schur iterations allowed per eigenvalue (for at least 10 of them): the QR algorithm needs
@@ -281,7 +360,7 @@ mod tests {
     /// (z - 0.5)(z + 0.25)(z^2 - z + 0.5) (roots 0.5, -0.25, 0.5 +- 0.5i).
     /// Aberth's roots against the companion matrix's (the definition: the same set) on seeded
     /// random real polynomials of degree 1..60 with roots inside and outside the unit circle, as
-    /// a trial C of the ARMA search has them.
+    /// a trial C of the ARMA search has them; started on the circle and from nearby roots.
     #[test]
     fn aberth_roots_match_the_companion_matrix() {
         let mut state = 0x2545_f491_4f6c_dd1d_u64;
@@ -291,7 +370,8 @@ mod tests {
             state ^= state << 17;
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
-        let mut fallbacks = 0;
+        // Runs that fell back to the companion matrix, started cold and warm.
+        let mut fallbacks = [0usize; 2];
         for case in 0..300 {
             let n = 1 + case % 60;
             let mut roots = Vec::new();
@@ -316,37 +396,124 @@ mod tests {
                 c = next;
             }
             let c: Vec<f64> = c.iter().map(|v| v.re).collect();
-            let Some(got) = aberth_roots(&c) else {
-                fallbacks += 1;
-                continue;
-            };
-            let want = polynomial_roots(&c).unwrap_or_default();
-            assert_eq!(got.len(), want.len());
-            for w in &want {
-                let d = got
-                    .iter()
-                    .map(|g| (g - w).norm())
-                    .fold(f64::INFINITY, f64::min);
-                // Clustered roots are ill-conditioned for both methods: the tolerance is on the
-                // polynomial's value, scaled by its size there.
-                let scale: f64 =
-                    c.iter().map(|v| v.abs()).sum::<f64>() * w.norm().max(1.0).powi(n as i32);
-                let nearest = got
-                    .iter()
-                    .min_by(|a, b| (*a - w).norm().total_cmp(&(*b - w).norm()));
-                let val = nearest
-                    .map(|g| horner(&c, *g).0.norm())
-                    .unwrap_or(f64::INFINITY);
-                assert!(
-                    d < 1e-6 || val <= 1e-11 * scale,
-                    "case {case} n {n}: {w} nearest {d} away, |p| {val}"
-                );
+            // Cold (on the circle), and warm from the roots of a nearby polynomial (each root
+            // moved by 1e-3 of its modulus, as between two trial steps of a search).
+            let start: Vec<Complex64> = roots
+                .iter()
+                .enumerate()
+                .map(|(k, r)| r * (1.0 + Complex64::from_polar(1e-3, k as f64)))
+                .collect();
+            for (warm, got) in [
+                (false, aberth_roots(&c)),
+                (true, aberth_roots_from(&c, &start)),
+            ] {
+                let Some(got) = got else {
+                    fallbacks[usize::from(warm)] += 1;
+                    continue;
+                };
+                let want = polynomial_roots(&c).unwrap_or_default();
+                assert_eq!(got.len(), want.len());
+                for w in &want {
+                    let d = got
+                        .iter()
+                        .map(|g| (g - w).norm())
+                        .fold(f64::INFINITY, f64::min);
+                    // Clustered roots are ill-conditioned for both methods: the tolerance is on the
+                    // polynomial's value, scaled by its size there.
+                    let scale: f64 =
+                        c.iter().map(|v| v.abs()).sum::<f64>() * w.norm().max(1.0).powi(n as i32);
+                    let nearest = got
+                        .iter()
+                        .min_by(|a, b| (*a - w).norm().total_cmp(&(*b - w).norm()));
+                    let val = nearest
+                        .map(|g| horner(&c, *g).0.norm())
+                        .unwrap_or(f64::INFINITY);
+                    assert!(
+                        d < 1e-6 || val <= 1e-11 * scale,
+                        "case {case} n {n} warm {warm}: {w} nearest {d} away, |p| {val}"
+                    );
+                }
             }
         }
         assert!(
-            fallbacks <= 3,
-            "{fallbacks} of 300 cases fell back to the companion matrix"
+            fallbacks[0] <= 3 && fallbacks[1] <= 3,
+            "{fallbacks:?} of 300 cases (cold, warm) fell back to the companion matrix"
         );
+    }
+
+    /// Polished roots (from Aberth's, made a conjugate set) against the polished companion-matrix
+    /// eigenvalues (the previous method) on seeded random real polynomials of degree 2..60 with
+    /// conjugate pairs and real roots inside and outside the unit circle, some lightly damped
+    /// poles near z = 1 as at 200 Hz: the same set, and every complex root's conjugate in it bit
+    /// for bit.
+    #[test]
+    fn polished_roots_are_a_conjugate_set_matching_the_companion_matrix() {
+        let mut state = 0x1234_5678_9abc_def1_u64;
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for case in 0..200 {
+            let n = 2 + case % 59;
+            let mut roots = Vec::new();
+            while roots.len() < n {
+                if roots.len() + 2 <= n && uniform() < 0.8 {
+                    // Half of the pairs lightly damped near z = 1 (1-20 Hz at 200 Hz).
+                    let z = if uniform() < 0.5 {
+                        let w = std::f64::consts::TAU * (1.0 + 19.0 * uniform()) / 200.0;
+                        Complex64::from_polar((-0.02 * w * uniform()).exp(), w)
+                    } else {
+                        Complex64::from_polar(
+                            0.3 + 0.9 * uniform(),
+                            std::f64::consts::PI * uniform(),
+                        )
+                    };
+                    roots.push(z);
+                    roots.push(z.conj());
+                } else {
+                    let r = 0.3 + 0.9 * uniform();
+                    roots.push(Complex64::new(if uniform() < 0.5 { r } else { -r }, 0.0));
+                }
+            }
+            let mut c = vec![Complex64::new(1.0, 0.0)];
+            for &r in &roots {
+                let mut next = vec![Complex64::new(0.0, 0.0); c.len() + 1];
+                for (i, &ci) in c.iter().enumerate() {
+                    next[i] += ci;
+                    next[i + 1] -= ci * r;
+                }
+                c = next;
+            }
+            let c: Vec<f64> = c.iter().map(|v| v.re).collect();
+            let got = polynomial_roots(&c).unwrap_or_default();
+            let raw = companion_eigenvalues(&c).unwrap_or_default();
+            let want: Vec<Complex64> = (0..raw.len())
+                .map(|i| polish(&c, raw[i], &raw, i))
+                .collect();
+            assert_eq!(got.len(), n, "case {case}");
+            for z in &got {
+                assert!(
+                    got.iter().any(|w| *w == z.conj()),
+                    "case {case}: {z} without its conjugate"
+                );
+            }
+            let scale: f64 = c.iter().map(|v| v.abs()).sum();
+            for w in &want {
+                let nearest = got
+                    .iter()
+                    .min_by(|a, b| (*a - w).norm().total_cmp(&(*b - w).norm()))
+                    .copied()
+                    .unwrap_or(Complex64::new(f64::NAN, 0.0));
+                let d = (nearest - w).norm();
+                let val = horner(&c, nearest).0.norm();
+                assert!(
+                    d < 1e-9 || val <= 1e-12 * scale * w.norm().max(1.0).powi(n as i32),
+                    "case {case} n {n}: {w} nearest {nearest} ({d} away, |p| {val})"
+                );
+            }
+        }
     }
 
     #[test]
