@@ -95,7 +95,8 @@ pub struct RecordFeatures {
     pub line_free: Option<LineFree>,
 }
 
-/// A record's transmissibility with the bins of its periodic lines left out of the band sums: a line
+/// A record's transmissibility with the bins of its periodic lines left out of the band sums
+/// (and its unsprung levels with them replaced by the continuum under them): a line
 /// (an engine or driveline order entering at the engine mounts or the axle) moves the body and,
 /// through the suspension, the wheel at one frequency, so it is coherent between the sprung and
 /// the unsprung channel and pulls the transmissibility towards the path from the body to the
@@ -108,6 +109,11 @@ pub struct LineFree {
     /// Per entry of [`RecordFeatures::transmissibility`] (same order): the cross-spectral (H1)
     /// value per band without the line bins; `None` where the band keeps no unsprung power.
     pub h1: Vec<Vec<Option<f64>>>,
+    /// Per entry of [`RecordFeatures::channels`] (same order): the RMS in `ratio_band_hz` with
+    /// the bins of the lines found in an unsprung channel replaced by their neighbours'
+    /// continuum ([`continuum`]), for the unsprung level ratios.
+    #[serde(default)]
+    pub ratio_band_rms: Vec<Option<f64>>,
 }
 
 /// Half-width, in Welch bins, of the band left out around a detected periodic line: a Hann
@@ -126,6 +132,44 @@ pub fn line_bins(freq: &[f64], lines: &[(f64, f64)]) -> Vec<bool> {
     let w = LINE_HALF_WIDTH_BINS * df;
     freq.iter()
         .map(|f| lines.iter().any(|(lo, hi)| *f >= lo - w && *f <= hi + w))
+        .collect()
+}
+
+/// Half-width, in bins, of the neighbourhood whose median replaces a line bin in
+/// [`continuum`].
+pub const CONTINUUM_HALF_BINS: usize = 4;
+
+/// `psd` with each bin of `lines` replaced by the median of the bins within
+/// [`CONTINUUM_HALF_BINS`] that are not lines (kept where there is none): the line's power
+/// removed, the broadband response under it kept. For the unsprung level ratios, whose band
+/// holds the wheel hop: zeroing the bins instead takes out part of a wheel-hop peak where a
+/// line sits on it in one record and not the next (vibmode's simulator moves its engine lines
+/// with the speed), which scattered the ratios and hid a damper at 50 %.
+pub fn continuum(psd: &[f64], lines: &[bool]) -> Vec<f64> {
+    let is_line = |j: usize| lines.get(j).copied().unwrap_or(false);
+    (0..psd.len())
+        .map(|i| {
+            if !is_line(i) {
+                return psd[i];
+            }
+            let lo = i.saturating_sub(CONTINUUM_HALF_BINS);
+            let hi = (i + CONTINUUM_HALF_BINS + 1).min(psd.len());
+            let mut w: Vec<f64> = (lo..hi)
+                .filter(|j| !is_line(*j))
+                .map(|j| psd[j])
+                .filter(|x| x.is_finite())
+                .collect();
+            if w.is_empty() {
+                return psd[i];
+            }
+            w.sort_by(f64::total_cmp);
+            let n = w.len();
+            if n % 2 == 1 {
+                w[n / 2]
+            } else {
+                0.5 * (w[n / 2 - 1] + w[n / 2])
+            }
+        })
         .collect()
 }
 
@@ -541,6 +585,18 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
         .map(|l| l.frequency_range_hz)
         .collect();
     let lines = line_bins(&freq, &line_ranges);
+    // For the unsprung level ratios: the lines found in an unsprung channel (an order entering
+    // at the axle), replaced by the continuum under them.
+    let unsprung_ranges: Vec<(f64, f64)> = results
+        .channels
+        .iter()
+        .filter(|a| a.role == Role::Unsprung)
+        .flat_map(|a| a.lines.iter())
+        .filter(|l| l.has_steady_record())
+        .map(|l| l.frequency_range_hz)
+        .collect();
+    let unsprung_lines = line_bins(&freq, &unsprung_ranges);
+    let [rlo, rhi] = cfg.ratio_band_hz;
     let line_free = LineFree {
         line_bins_hz: freq
             .iter()
@@ -566,6 +622,11 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
                     })
                     .unwrap_or_default()
             })
+            .collect(),
+        ratio_band_rms: psd
+            .iter()
+            .take(channels.len())
+            .map(|p| finite(band_rms(&freq, &continuum(p, &unsprung_lines), rlo, rhi)))
             .collect(),
     };
     if !channels.iter().any(|c| c.role == Role::Unsprung) {
@@ -778,6 +839,19 @@ mod tests {
             .collect();
         assert_eq!(hits, vec![6.5, 7.0, 7.5, 9.5, 10.0, 10.5]);
         assert!(line_bins(&freq, &[]).iter().all(|l| !l));
+    }
+
+    /// The continuum by hand: line bins 3 and 4 of `[1, 2, 3, 50, 60, 4, 5, 6, 7]` become the
+    /// median of the other bins within 4 (bins 0-2 and 5-8: 1, 2, 3, 4, 5, 6, 7, 8 minus the
+    /// ends as the window allows); other bins are kept.
+    #[test]
+    fn continuum_by_hand() {
+        let p = [1.0, 2.0, 3.0, 50.0, 60.0, 4.0, 5.0, 6.0, 7.0];
+        let lines = [false, false, false, true, true, false, false, false, false];
+        let c = continuum(&p, &lines);
+        // Bin 3: bins 0..=7 without 3, 4: 1, 2, 3, 4, 5, 6 -> median 3.5.
+        // Bin 4: bins 0..=8 without 3, 4: 1, 2, 3, 4, 5, 6, 7 -> median 4.
+        assert_eq!(c, vec![1.0, 2.0, 3.0, 3.5, 4.0, 4.0, 5.0, 6.0, 7.0]);
     }
 
     /// White noise `u` at the wheel, `y = 0.5 u` on the body, and a line at 7.0 Hz entering at

@@ -69,13 +69,16 @@ const TRACKS: [(&str, Corner, Corner); 2] = [
     ("right", Corner::FR, Corner::RR),
 ];
 
-fn ratio_key(kind: Kind, name: &str, band: &[f64; 2]) -> String {
+/// The key of a level ratio; `line_free` (the unsprung lines replaced by their continuum) has
+/// its own.
+fn ratio_key(kind: Kind, name: &str, band: &[f64; 2], line_free: bool) -> String {
     let prefix = if kind == Kind::SideRatio {
         "side"
     } else {
         "track"
     };
-    format!("{prefix}:{name}:{}", band_key(band))
+    let lf = if line_free { ":lf" } else { "" };
+    format!("{prefix}:{name}:{}{lf}", band_key(band))
 }
 
 /// Where a feature comes from, and its name in tables.
@@ -483,7 +486,8 @@ fn transmissibility_features(
 /// response.
 ///
 /// `line_free` (the model set's [`ModelSet::line_free`]): the transmissibility with the periodic
-/// lines left out, under its own key.
+/// lines left out and the level ratios with the unsprung lines replaced by their continuum,
+/// under their own keys.
 pub fn scalar_features(
     rf: &RecordFeatures,
     slots: &[ModeSlot],
@@ -520,10 +524,22 @@ pub fn scalar_features(
     // over rear wheel of each side. Both wheels of a pair roll on the same road class at the same
     // speed (on one side, on the same track), so the road level and its spectrum cancel.
     let unsprung = |corner: Corner| {
-        rf.channels
+        let i = rf
+            .channels
             .iter()
-            .find(|c| c.role == Role::Unsprung && c.corner == Some(corner))
-            .and_then(|c| Some((c, c.ratio_band_rms.and_then(finite_positive)?)))
+            .position(|c| c.role == Role::Unsprung && c.corner == Some(corner))?;
+        let c = &rf.channels[i];
+        let level = if line_free {
+            rf.line_free
+                .as_ref()?
+                .ratio_band_rms
+                .get(i)
+                .copied()
+                .flatten()
+        } else {
+            c.ratio_band_rms
+        };
+        Some((c, level.and_then(finite_positive)?))
     };
     let band = cfg.ratio_band_hz;
     for (kind, pairs) in [(Kind::SideRatio, AXLES), (Kind::TrackRatio, TRACKS)] {
@@ -533,7 +549,7 @@ pub fn scalar_features(
             };
             out.push((
                 FeatureMeta {
-                    key: ratio_key(kind, name, &band),
+                    key: ratio_key(kind, name, &band, line_free),
                     group: Group::Vehicle,
                     kind,
                     corner: None,
@@ -1124,7 +1140,7 @@ fn corner_ratio_z(
     let (name, first, _) = pairs
         .iter()
         .find(|(_, a, b)| *a == corner || *b == corner)?;
-    let key = ratio_key(kind, name, &set.config.ratio_band_hz);
+    let key = ratio_key(kind, name, &set.config.ratio_band_hz, set.line_free);
     let f = set.features.iter().find(|f| f.meta.key == key)?;
     let x = values.iter().find(|(m, _)| m.key == key).map(|(_, v)| *v)?;
     let z = score(f, x, &set.config);
@@ -1221,7 +1237,7 @@ fn attribute_ratios(set: &ModelSet, values: &[(FeatureMeta, f64)], evidence: &mu
         let (name, first, _) = pairs
             .iter()
             .find(|(_, a, b)| *a == corner || *b == corner)?;
-        let z = signed_z(&ratio_key(other_kind, name, &band))?;
+        let z = signed_z(&ratio_key(other_kind, name, &band, set.line_free))?;
         Some(if *first == corner { z } else { -z })
     };
     for e in evidence
@@ -1235,7 +1251,7 @@ fn attribute_ratios(set: &ModelSet, values: &[(FeatureMeta, f64)], evidence: &mu
         };
         let Some((_, a, b)) = pairs
             .iter()
-            .find(|(name, _, _)| e.meta.key == ratio_key(e.meta.kind, name, &band))
+            .find(|(name, _, _)| e.meta.key == ratio_key(e.meta.kind, name, &band, set.line_free))
             .copied()
         else {
             continue;

@@ -1297,6 +1297,7 @@ mod tests {
         f.line_free = line_free.then(|| crate::features::LineFree {
             line_bins_hz: Vec::new(),
             h1: vec![vec![Some(t)]],
+            ratio_band_rms: vec![None],
         });
         f
     }
