@@ -102,8 +102,8 @@ def test_found_faults_name_their_component(measured):
 
 
 @pytest.mark.xfail(reason="issue 31 item 3 not met: a spring at 80 % at one corner is not "
-                          "detected (0 of 6 drives measured; the body response per drive does "
-                          "not separate it, docs/fleet.md)", strict=False)
+                          "detected (0 of 9 drives on the 9 buses of docs/fleet.md; the body "
+                          "response per drive does not separate it)", strict=False)
 def test_spring_80_found_with_its_corner(measured):
     s = measured["spring80"]
     assert _drive_rate(s) >= 0.90, s

@@ -170,6 +170,27 @@ pub enum FleetError {
         /// The vehicle that has the record.
         other: String,
     },
+    /// A check against a model set built before the features left the periodic lines out.
+    #[error("the baseline of vehicle '{}' (model set version {version}) was built before the transmissibility left out the engine and driveline lines; build it again (fleet baseline), after ingesting healthy records again if its nominal records are that old", vibmode_core::quoted(vehicle))]
+    StaleBaseline {
+        /// The vehicle.
+        vehicle: String,
+        /// The model set's version in the store.
+        version: i64,
+    },
+    /// A baseline whose nominal records are too few once those stored before the line-free
+    /// features are left out.
+    #[error("vehicle '{}' has {old} nominal record(s) stored before the transmissibility left out the engine and driveline lines and {current} stored since; a baseline needs at least {needed} of the latter: ingest healthy records again (the older ones stay stored)", vibmode_core::quoted(vehicle))]
+    NominalBeforeLineFree {
+        /// The vehicle.
+        vehicle: String,
+        /// Nominal records without line-free features.
+        old: usize,
+        /// Nominal records with them.
+        current: usize,
+        /// Minimum.
+        needed: usize,
+    },
     /// A check without a baseline.
     #[error("vehicle '{}' has no baseline yet; build one from its nominal records first (fleet baseline)", vibmode_core::quoted(vehicle))]
     NoBaseline {

@@ -355,6 +355,28 @@ pub fn build_baseline(store: &mut Store, vehicle: &str, cfg: &FleetConfig) -> Re
             ));
         }
     }
+    // Records stored before the line-free features: left out (kept in the store) when enough
+    // newer ones remain, else the baseline is refused (a model set of the older features would
+    // score the transmissibility with the periodic lines in).
+    let old = feats.iter().filter(|f| f.line_free.is_none()).count();
+    if old > 0 {
+        let current = feats.len() - old;
+        if current < cfg.min_nominal {
+            return Err(FleetError::NominalBeforeLineFree {
+                vehicle: vehicle.to_string(),
+                old,
+                current,
+                needed: cfg.min_nominal,
+            });
+        }
+        let keep: Vec<bool> = feats.iter().map(|f| f.line_free.is_some()).collect();
+        let mut k = keep.iter();
+        names.retain(|_| k.next().copied().unwrap_or(false));
+        feats.retain(|f| f.line_free.is_some());
+        notes.push(format!(
+            "{old} nominal record(s) stored before the transmissibility left out the periodic lines are left out of the baseline (they stay stored)"
+        ));
+    }
     let mut set = build_model_set(vehicle, &names, &feats, cfg)?;
     set.notes.extend(notes);
     store.save_model_set(&mut set)?;
@@ -376,12 +398,27 @@ pub struct Checked {
 }
 
 /// The vehicle's latest model set; errors name the fix when there is none.
+/// A model set built before the line-free features is refused ([`FleetError::StaleBaseline`]).
 pub fn require_baseline(store: &Store, vehicle: &str) -> Result<ModelSet> {
-    store
+    let set = store
         .latest_model_set(vehicle)?
         .ok_or_else(|| FleetError::NoBaseline {
             vehicle: vehicle.to_string(),
+        })?;
+    require_line_free(&set)?;
+    Ok(set)
+}
+
+/// Refuses a model set built before the line-free features ([`ModelSet::line_free`]).
+fn require_line_free(set: &ModelSet) -> Result<()> {
+    if set.line_free {
+        Ok(())
+    } else {
+        Err(FleetError::StaleBaseline {
+            vehicle: set.vehicle.clone(),
+            version: set.version,
         })
+    }
 }
 
 fn test_labels(set: &ModelSet) -> IngestLabels<'_> {
@@ -409,6 +446,7 @@ fn check_prepared_drive(
     prepared: Vec<Prepared>,
     drive: Option<&Drive>,
 ) -> Result<Vec<Checked>> {
+    require_line_free(set)?;
     let checks: Vec<Option<(i64, Assessment)>> = prepared
         .iter()
         .map(|p| Some((set.version, assess(set, &p.features))))

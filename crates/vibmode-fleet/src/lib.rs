@@ -24,7 +24,7 @@ pub use config::FleetConfig;
 pub use error::{FleetError, Result};
 pub use features::{
     check_sampling, compute_features, sensor_faults, ChannelFeatures, CornerTransmissibility,
-    FaultKind, ModeEstimate, RecordFeatures, SensorFault,
+    FaultKind, LineFree, ModeEstimate, RecordFeatures, SensorFault, LINE_HALF_WIDTH_BINS,
 };
 pub use fleet::{
     build_baseline, check_drive_files_progress, check_file, check_files, check_files_progress,

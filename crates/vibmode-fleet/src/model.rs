@@ -69,13 +69,16 @@ const TRACKS: [(&str, Corner, Corner); 2] = [
     ("right", Corner::FR, Corner::RR),
 ];
 
-fn ratio_key(kind: Kind, name: &str, band: &[f64; 2]) -> String {
+/// The key of a level ratio; `line_free` (the unsprung lines replaced by their continuum) has
+/// its own.
+fn ratio_key(kind: Kind, name: &str, band: &[f64; 2], line_free: bool) -> String {
     let prefix = if kind == Kind::SideRatio {
         "side"
     } else {
         "track"
     };
-    format!("{prefix}:{name}:{}", band_key(band))
+    let lf = if line_free { ":lf" } else { "" };
+    format!("{prefix}:{name}:{}{lf}", band_key(band))
 }
 
 /// Where a feature comes from, and its name in tables.
@@ -128,7 +131,19 @@ pub struct ModeSlot {
     pub name: String,
     /// Share of nominal records that contain it.
     pub share: f64,
+    /// Median damping ratio over the nominal records; a record's mode whose damping lies more
+    /// than [`MODE_DAMPING_CLASS_RATIO`] from it is another physical mode and is not matched to
+    /// the slot. Absent in model sets stored before it existed (then any damping matches).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damping_ratio: Option<f64>,
 }
+
+/// Two estimates near one frequency whose damping ratios differ by more than this factor are
+/// two physical modes (on busgen the 9 Hz cluster of one channel is the body's bending mode,
+/// damping 0.02-0.05, in one record and a wheel or axle mode, 0.2-0.33, in the next), so they
+/// are not one mode of the model set; a damper at 60 % lowers a wheel mode's damping by a factor
+/// of about 0.6-0.8, well inside it.
+pub const MODE_DAMPING_CLASS_RATIO: f64 = 3.0;
 
 /// The control limit of one kind of feature.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -181,6 +196,12 @@ pub struct ModelSet {
     /// What the model set lacks and why.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
+    /// Built from the line-free transmissibility ([`RecordFeatures::line_free`]
+    /// of every nominal record); false in model sets stored before it existed and in model sets
+    /// built from records stored before it: a check against such a set is refused
+    /// ([`FleetError::StaleBaseline`]).
+    #[serde(default)]
+    pub line_free: bool,
 }
 
 impl ModelSet {
@@ -403,7 +424,14 @@ fn body_features(
 /// corners that have the band, so that what moves every corner alike (the load, whose extra
 /// mass lowers every corner's damping per mass; the speed; the road's spectrum) cancels and a
 /// corner's own damper, spring or tyre stays. With a single corner the absolute value is kept.
-fn transmissibility_features(rf: &RecordFeatures, cfg: &FleetConfig) -> Vec<(FeatureMeta, f64)> {
+///
+/// With `line_free`, the values with the periodic lines left out ([`RecordFeatures::line_free`],
+/// key `transh1lf`); a record without them gives none.
+fn transmissibility_features(
+    rf: &RecordFeatures,
+    cfg: &FleetConfig,
+    line_free: bool,
+) -> Vec<(FeatureMeta, f64)> {
     let mut out = Vec::new();
     for (k, b) in rf.bands_hz.iter().enumerate() {
         if b[0] < cfg.transmissibility_min_hz {
@@ -412,7 +440,13 @@ fn transmissibility_features(rf: &RecordFeatures, cfg: &FleetConfig) -> Vec<(Fea
         let logs: Vec<(&crate::features::CornerTransmissibility, &str, f64)> = rf
             .transmissibility
             .iter()
-            .filter_map(|t| {
+            .enumerate()
+            .filter_map(|(i, t)| {
+                if line_free {
+                    let lf = rf.line_free.as_ref()?.h1.get(i)?;
+                    let v = lf.get(k).copied().flatten()?;
+                    return (v.is_finite() && v > 0.0).then(|| (t, "transh1lf", v.ln()));
+                }
                 // The cross-spectral (H1) value where the record has it, under its own key: a
                 // model set of band-RMS ratios does not score it, nor the reverse.
                 let (v, key) = if t.h1.is_empty() {
@@ -450,11 +484,16 @@ fn transmissibility_features(rf: &RecordFeatures, cfg: &FleetConfig) -> Vec<(Fea
 
 /// Scalar features of a record, as ln(value), given the model set's modes and nominal body
 /// response.
+///
+/// `line_free` (the model set's [`ModelSet::line_free`]): the transmissibility with the periodic
+/// lines left out and the level ratios with the unsprung lines replaced by their continuum,
+/// under their own keys.
 pub fn scalar_features(
     rf: &RecordFeatures,
     slots: &[ModeSlot],
     body: Option<&BodyModel>,
     cfg: &FleetConfig,
+    line_free: bool,
 ) -> Vec<(FeatureMeta, f64)> {
     let mut out = body.map_or_else(Vec::new, |b| body_features(rf, b, cfg));
     // Road level per band: the mean of ln(band RMS) over the unsprung channels that have it.
@@ -480,15 +519,27 @@ pub fn scalar_features(
             ));
         }
     }
-    out.extend(transmissibility_features(rf, cfg));
+    out.extend(transmissibility_features(rf, cfg, line_free));
     // Unsprung level ratios at and above wheel hop: left over right wheel of each axle, front
     // over rear wheel of each side. Both wheels of a pair roll on the same road class at the same
     // speed (on one side, on the same track), so the road level and its spectrum cancel.
     let unsprung = |corner: Corner| {
-        rf.channels
+        let i = rf
+            .channels
             .iter()
-            .find(|c| c.role == Role::Unsprung && c.corner == Some(corner))
-            .and_then(|c| Some((c, c.ratio_band_rms.and_then(finite_positive)?)))
+            .position(|c| c.role == Role::Unsprung && c.corner == Some(corner))?;
+        let c = &rf.channels[i];
+        let level = if line_free {
+            rf.line_free
+                .as_ref()?
+                .ratio_band_rms
+                .get(i)
+                .copied()
+                .flatten()
+        } else {
+            c.ratio_band_rms
+        };
+        Some((c, level.and_then(finite_positive)?))
     };
     let band = cfg.ratio_band_hz;
     for (kind, pairs) in [(Kind::SideRatio, AXLES), (Kind::TrackRatio, TRACKS)] {
@@ -498,7 +549,7 @@ pub fn scalar_features(
             };
             out.push((
                 FeatureMeta {
-                    key: ratio_key(kind, name, &band),
+                    key: ratio_key(kind, name, &band, line_free),
                     group: Group::Vehicle,
                     kind,
                     corner: None,
@@ -509,8 +560,9 @@ pub fn scalar_features(
             ));
         }
     }
-    // Each record mode goes to its nearest slot of the channel (in ln f) if within the match
-    // tolerance and nearer than half-way to the next slot; each slot takes its nearest mode.
+    // Each record mode goes to its nearest slot of the channel (in ln f) among the slots of its
+    // damping class (within MODE_DAMPING_CLASS_RATIO of the slot's damping) if within the match
+    // tolerance; each slot takes its nearest mode.
     let mut best: BTreeMap<usize, (f64, f64, f64)> = BTreeMap::new();
     for ch in &rf.channels {
         let ch_slots: Vec<(usize, &ModeSlot)> = slots
@@ -525,6 +577,11 @@ pub fn scalar_features(
             let lf = m.frequency_hz.ln();
             let nearest = ch_slots
                 .iter()
+                .filter(|(_, s)| {
+                    s.damping_ratio.map_or(true, |z| {
+                        (m.damping_ratio.ln() - z.ln()).abs() <= MODE_DAMPING_CLASS_RATIO.ln()
+                    })
+                })
                 .map(|(i, s)| (*i, (lf - s.frequency_hz.ln()).abs()))
                 .min_by(|a, b| a.1.total_cmp(&b.1));
             if let Some((i, d)) = nearest {
@@ -558,8 +615,8 @@ fn finite_positive(x: f64) -> Option<f64> {
     (x.is_finite() && x > 0.0).then_some(x)
 }
 
-/// A channel's role, corner and (record, frequency) of its modes.
-type ChannelModes = (Role, Option<Corner>, Vec<(usize, f64)>);
+/// A channel's role, corner and (record, frequency, damping ratio) of its modes.
+type ChannelModes = (Role, Option<Corner>, Vec<(usize, f64, f64)>);
 
 fn mode_name(role: Role, f: f64) -> &'static str {
     if role == Role::Unsprung && f >= 5.0 {
@@ -572,7 +629,9 @@ fn mode_name(role: Role, f: f64) -> &'static str {
 }
 
 /// The modes of the model set: per channel, groups of modes whose neighbours lie within
-/// `mode_group_tol` of each other, present in at least `mode_min_share` of the records.
+/// `mode_group_tol` of each other in frequency and within [`MODE_DAMPING_CLASS_RATIO`] in
+/// damping (a group is split where its sorted damping ratios jump by more than that factor:
+/// two physical modes near one frequency), present in at least `mode_min_share` of the records.
 pub fn mode_slots(records: &[RecordFeatures], cfg: &FleetConfig) -> Vec<ModeSlot> {
     let mut by_channel: BTreeMap<String, ChannelModes> = BTreeMap::new();
     for (r, rf) in records.iter().enumerate() {
@@ -582,7 +641,7 @@ pub fn mode_slots(records: &[RecordFeatures], cfg: &FleetConfig) -> Vec<ModeSlot
                 .or_insert((ch.role, ch.corner, Vec::new()));
             for m in &ch.modes {
                 if m.frequency_hz > 0.0 && m.frequency_hz.is_finite() && m.damping_ratio > 0.0 {
-                    e.2.push((r, m.frequency_hz));
+                    e.2.push((r, m.frequency_hz, m.damping_ratio));
                 }
             }
         }
@@ -591,7 +650,7 @@ pub fn mode_slots(records: &[RecordFeatures], cfg: &FleetConfig) -> Vec<ModeSlot
     let mut slots = Vec::new();
     for (name, (role, corner, mut modes)) in by_channel {
         modes.sort_by(|a, b| a.1.total_cmp(&b.1));
-        let mut groups: Vec<Vec<(usize, f64)>> = Vec::new();
+        let mut groups: Vec<Vec<(usize, f64, f64)>> = Vec::new();
         for m in modes {
             match groups.last_mut() {
                 Some(g)
@@ -603,6 +662,7 @@ pub fn mode_slots(records: &[RecordFeatures], cfg: &FleetConfig) -> Vec<ModeSlot
                 _ => groups.push(vec![m]),
             }
         }
+        let groups = groups.into_iter().flat_map(split_by_damping);
         for g in groups {
             let mut recs: Vec<usize> = g.iter().map(|m| m.0).collect();
             recs.sort_unstable();
@@ -613,6 +673,7 @@ pub fn mode_slots(records: &[RecordFeatures], cfg: &FleetConfig) -> Vec<ModeSlot
             }
             let freqs: Vec<f64> = g.iter().map(|m| m.1).collect();
             let Some(f) = median(&freqs) else { continue };
+            let dampings: Vec<f64> = g.iter().map(|m| m.2).collect();
             slots.push(ModeSlot {
                 channel: name.clone(),
                 role,
@@ -620,10 +681,31 @@ pub fn mode_slots(records: &[RecordFeatures], cfg: &FleetConfig) -> Vec<ModeSlot
                 frequency_hz: f,
                 name: mode_name(role, f).to_string(),
                 share,
+                damping_ratio: median(&dampings),
             });
         }
     }
     slots
+}
+
+/// Splits a frequency group of (record, frequency, damping) where its damping ratios, sorted,
+/// jump by more than [`MODE_DAMPING_CLASS_RATIO`].
+fn split_by_damping(mut g: Vec<(usize, f64, f64)>) -> Vec<Vec<(usize, f64, f64)>> {
+    g.sort_by(|a, b| a.2.total_cmp(&b.2));
+    let mut out: Vec<Vec<(usize, f64, f64)>> = Vec::new();
+    for m in g {
+        match out.last_mut() {
+            Some(cur)
+                if cur
+                    .last()
+                    .is_some_and(|l| m.2 <= l.2 * MODE_DAMPING_CLASS_RATIO) =>
+            {
+                cur.push(m)
+            }
+            _ => out.push(vec![m]),
+        }
+    }
+    out
 }
 
 fn floor_of(kind: Kind, cfg: &FleetConfig) -> f64 {
@@ -768,13 +850,14 @@ pub fn build_model_set(
         });
     }
     let slots = mode_slots(records, cfg);
+    let line_free = records.iter().all(|r| r.line_free.is_some());
     let mut notes = Vec::new();
     let body = fit_body(records, cfg, &mut notes);
     let values: Vec<Vec<(FeatureMeta, f64)>> = records
         .iter()
         .enumerate()
         .map(|(i, r)| {
-            let mut v = scalar_features(r, &slots, None, cfg);
+            let mut v = scalar_features(r, &slots, None, cfg, line_free);
             if let Some((_, loo)) = &body {
                 v.extend(loo[i].iter().cloned());
             }
@@ -858,6 +941,7 @@ pub fn build_model_set(
             .unwrap_or_default(),
         body: body.map(|b| b.0),
         notes,
+        line_free,
     })
 }
 
@@ -883,7 +967,13 @@ fn score(f: &FeatureStat, x: f64, cfg: &FleetConfig) -> f64 {
 /// A record with a failed sensor is classed [`Classification::Sensor`] whatever its scores
 /// (which cover its working channels only); the summary names the channels first.
 pub fn assess(set: &ModelSet, rf: &RecordFeatures) -> Assessment {
-    let values = scalar_features(rf, &set.slots, set.body.as_ref(), &set.config);
+    let values = scalar_features(
+        rf,
+        &set.slots,
+        set.body.as_ref(),
+        &set.config,
+        set.line_free,
+    );
     let mut a = score_values(set, &values);
     if !rf.sensor_faults.is_empty() {
         a.classification = Classification::Sensor;
@@ -925,7 +1015,13 @@ pub fn assess_drive(set: &ModelSet, records: &[&RecordFeatures]) -> Assessment {
         .collect();
     let mut by_key: BTreeMap<String, (FeatureMeta, Vec<f64>)> = BTreeMap::new();
     for rf in &usable {
-        for (m, x) in scalar_features(rf, &set.slots, set.body.as_ref(), &set.config) {
+        for (m, x) in scalar_features(
+            rf,
+            &set.slots,
+            set.body.as_ref(),
+            &set.config,
+            set.line_free,
+        ) {
             by_key
                 .entry(m.key.clone())
                 .or_insert_with(|| (m, Vec::new()))
@@ -1044,7 +1140,7 @@ fn corner_ratio_z(
     let (name, first, _) = pairs
         .iter()
         .find(|(_, a, b)| *a == corner || *b == corner)?;
-    let key = ratio_key(kind, name, &set.config.ratio_band_hz);
+    let key = ratio_key(kind, name, &set.config.ratio_band_hz, set.line_free);
     let f = set.features.iter().find(|f| f.meta.key == key)?;
     let x = values.iter().find(|(m, _)| m.key == key).map(|(_, v)| *v)?;
     let z = score(f, x, &set.config);
@@ -1141,7 +1237,7 @@ fn attribute_ratios(set: &ModelSet, values: &[(FeatureMeta, f64)], evidence: &mu
         let (name, first, _) = pairs
             .iter()
             .find(|(_, a, b)| *a == corner || *b == corner)?;
-        let z = signed_z(&ratio_key(other_kind, name, &band))?;
+        let z = signed_z(&ratio_key(other_kind, name, &band, set.line_free))?;
         Some(if *first == corner { z } else { -z })
     };
     for e in evidence
@@ -1155,7 +1251,7 @@ fn attribute_ratios(set: &ModelSet, values: &[(FeatureMeta, f64)], evidence: &mu
         };
         let Some((_, a, b)) = pairs
             .iter()
-            .find(|(name, _, _)| e.meta.key == ratio_key(e.meta.kind, name, &band))
+            .find(|(name, _, _)| e.meta.key == ratio_key(e.meta.kind, name, &band, set.line_free))
             .copied()
         else {
             continue;
@@ -1214,7 +1310,7 @@ fn summary(evidence: &[Evidence]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::features::{ChannelFeatures, CornerTransmissibility};
+    use crate::features::{ChannelFeatures, CornerTransmissibility, ModeEstimate};
     use crate::stats::MAD_TO_SIGMA;
 
     /// A record with one unsprung level and one transmissibility in band 2-5 Hz.
@@ -1242,6 +1338,7 @@ mod tests {
             notes: Vec::new(),
             body_spectra: None,
             sensor_faults: Vec::new(),
+            line_free: None,
         }
     }
 
@@ -1273,7 +1370,7 @@ mod tests {
                     h1: Vec::new(),
                 })
                 .collect();
-            transmissibility_features(&r, &cfg)
+            transmissibility_features(&r, &cfg, false)
         };
         let base = rec(0.2, 0.3, 0.4);
         assert_eq!(base.len(), 3, "one band of three corners: {base:?}");
@@ -1371,6 +1468,63 @@ mod tests {
         let a = assess(&set, &record(level, 0.21));
         assert!((a.scores.excitation_max_abs_z - 3.0).abs() < 1e-9, "{a:?}");
         assert_eq!(a.classification, Classification::Road);
+    }
+
+    /// A record with one mode of `RL_unsprung`.
+    fn moded(f: f64, zeta: f64) -> RecordFeatures {
+        let mut r = record(1.0, 1.0);
+        r.channels[0].modes = vec![ModeEstimate {
+            frequency_hz: f,
+            damping_ratio: zeta,
+        }];
+        r
+    }
+
+    /// A 9 Hz cluster that is the bending mode (damping 0.03) in some records and an axle mode
+    /// (0.28) in others is two modes: with 4 and 4 of 8 records neither is in 60 % of them and
+    /// the model set has no slot; with 6 axle and 2 bending it has one, the axle mode (damping
+    /// the median of 0.28-0.33, 0.305), which a record's bending mode (0.03) is not matched to while a damping
+    /// of 0.18 (a weaker damper) is, and scored.
+    #[test]
+    fn modes_of_two_damping_classes_near_one_frequency_are_not_one_slot() {
+        let cfg = FleetConfig::default();
+        let half: Vec<RecordFeatures> = (0..8)
+            .map(|i| {
+                if i % 2 == 0 {
+                    moded(9.0 + 0.02 * i as f64, 0.03)
+                } else {
+                    moded(9.2 + 0.02 * i as f64, 0.28)
+                }
+            })
+            .collect();
+        assert!(mode_slots(&half, &cfg).is_empty());
+        let mostly: Vec<RecordFeatures> = (0..8)
+            .map(|i| {
+                if i < 2 {
+                    moded(9.0, 0.03)
+                } else {
+                    moded(9.1 + 0.02 * i as f64, 0.26 + 0.01 * i as f64)
+                }
+            })
+            .collect();
+        let slots = mode_slots(&mostly, &cfg);
+        assert_eq!(slots.len(), 1, "{slots:?}");
+        let z = slots[0].damping_ratio.expect("damping");
+        assert!((z - 0.305).abs() < 1e-9, "{z}");
+        let damping = |r: &RecordFeatures| {
+            scalar_features(r, &slots, None, &cfg, false)
+                .into_iter()
+                .find(|(m, _)| m.kind == Kind::ModeDamping)
+                .map(|(_, x)| x.exp())
+        };
+        assert_eq!(damping(&moded(9.1, 0.03)), None);
+        let weaker = damping(&moded(9.1, 0.18)).expect("matched");
+        assert!((weaker - 0.18).abs() < 1e-12);
+        // A model set stored before the damping class matches any damping.
+        let mut old = slots.clone();
+        old[0].damping_ratio = None;
+        let any = scalar_features(&moded(9.1, 0.03), &old, None, &cfg, false);
+        assert!(any.iter().any(|(m, _)| m.kind == Kind::ModeDamping));
     }
 
     /// A drive's value of a feature is the median over its records: one record in five moved
@@ -1490,6 +1644,7 @@ mod tests {
             notes: Vec::new(),
             body_spectra: Some(s),
             sensor_faults: Vec::new(),
+            line_free: None,
         }
     }
 
@@ -1591,6 +1746,7 @@ mod tests {
             notes: Vec::new(),
             body_spectra: None,
             sensor_faults: Vec::new(),
+            line_free: None,
         }
     }
 
@@ -1778,7 +1934,8 @@ mod tests {
     fn a_lowered_body_response_is_the_spring_only_when_the_wheel_level_is_not_raised() {
         let set = wheel_set();
         let cfg = &set.config;
-        let values = |l: [f64; 4]| scalar_features(&wheels(l), &set.slots, None, cfg);
+        let values =
+            |l: [f64; 4]| scalar_features(&wheels(l), &set.slots, None, cfg, set.line_free);
         let lowered = [body_evidence(Corner::RL, -6.0)];
         // The wheel levels as nominal: the spring.
         assert_eq!(

@@ -1202,6 +1202,7 @@ mod tests {
             notes: Vec::new(),
             body_spectra: None,
             sensor_faults: Vec::new(),
+            line_free: None,
         }
     }
 
@@ -1280,6 +1281,100 @@ mod tests {
             Store::open(&d.path().join("none.db")),
             Err(FleetError::NoStore { .. })
         ));
+    }
+
+    /// Features of one RL corner whose transmissibility is `t` (with and without lines alike),
+    /// with the line-free values when `line_free`.
+    fn corner_features(t: f64, line_free: bool) -> RecordFeatures {
+        let mut f = features();
+        f.transmissibility = vec![crate::features::CornerTransmissibility {
+            corner: Corner::RL,
+            sprung: "RL_sprung".into(),
+            unsprung: "RL_unsprung".into(),
+            values: vec![Some(t)],
+            h1: vec![Some(t)],
+        }];
+        f.line_free = line_free.then(|| crate::features::LineFree {
+            line_bins_hz: Vec::new(),
+            h1: vec![vec![Some(t)]],
+            ratio_band_rms: vec![None],
+        });
+        f
+    }
+
+    /// Nominal records stored before the line-free features: with fewer than `min_nominal`
+    /// newer ones the baseline is refused naming both counts and nothing is stored; a model set
+    /// built from them (stored by an older version) is refused by a check with the fix; with
+    /// enough newer records the baseline is built from those alone, says so, and is accepted.
+    #[test]
+    fn records_and_baselines_before_the_line_free_features_are_named_not_mixed() {
+        let d = tempfile::tempdir().expect("tempdir");
+        let (mut s, _) = Store::init(&d.path().join("f.db")).expect("init");
+        let cfg = FleetConfig::default();
+        let insert = |s: &mut Store, i: usize, line_free: bool| {
+            let sha = format!("sha{i}");
+            let name = format!("r{i}.csv");
+            let rec = NewRecord {
+                vehicle: "bus-1",
+                sha256: &sha,
+                file_name: &name,
+                condition: Condition::Nominal,
+                road: Some("B"),
+                metadata: serde_json::json!({}),
+            };
+            let t = 0.5 + 0.01 * i as f64;
+            s.insert_record(&rec, &corner_features(t, line_free))
+                .expect("insert");
+        };
+        for i in 0..6 {
+            insert(&mut s, i, false);
+        }
+        let e = crate::fleet::build_baseline(&mut s, "bus-1", &cfg).expect_err("all old");
+        assert!(
+            matches!(
+                e,
+                FleetError::NominalBeforeLineFree {
+                    old: 6,
+                    current: 0,
+                    needed: 5,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert_eq!(s.latest_model_set("bus-1").expect("none"), None);
+        // A model set of the older features, as an older version stored it.
+        let old: Vec<RecordFeatures> = (0..6)
+            .map(|i| corner_features(0.5 + 0.01 * i as f64, false))
+            .collect();
+        let names: Vec<String> = (0..6).map(|i| format!("r{i}.csv")).collect();
+        let mut set = crate::model::build_model_set("bus-1", &names, &old, &cfg).expect("old set");
+        assert!(!set.line_free);
+        s.save_model_set(&mut set).expect("save");
+        let e = crate::fleet::require_baseline(&s, "bus-1").expect_err("stale");
+        assert!(
+            matches!(e, FleetError::StaleBaseline { version: 1, .. }),
+            "{e}"
+        );
+        assert!(e.to_string().contains("build it again"), "{e}");
+        for i in 6..11 {
+            insert(&mut s, i, true);
+        }
+        let set = crate::fleet::build_baseline(&mut s, "bus-1", &cfg).expect("line-free");
+        assert!(set.line_free);
+        assert_eq!(
+            set.records,
+            (6..11).map(|i| format!("r{i}.csv")).collect::<Vec<_>>()
+        );
+        assert!(set
+            .features
+            .iter()
+            .any(|f| f.meta.key.starts_with("transh1lf:")));
+        assert!(set
+            .notes
+            .iter()
+            .any(|n| n.starts_with("6 nominal record(s) stored before")));
+        assert!(crate::fleet::require_baseline(&s, "bus-1").is_ok());
     }
 
     #[test]
