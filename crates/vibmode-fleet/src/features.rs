@@ -3,7 +3,10 @@
 //! channel. See docs/fleet.md for the formulas.
 
 use serde::{Deserialize, Serialize};
-use vibmode_analysis::{analyze, cut_records, AnalysisConfig, Corner, Role};
+use vibmode_analysis::{
+    analyze_prepared, check_records, cut_records, preprocess_records, AnalysisConfig, Corner,
+    RecordFacts, Role, SweepIdentifier,
+};
 use vibmode_core::{ModeClass, Recording};
 use vibmode_spectra::{band_rms, WelchParams, Window};
 
@@ -410,9 +413,12 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
         .collect();
     let mut cross: Vec<Vec<(f64, f64)>> = vec![Vec::new(); pairs.len()];
     let mut body: Option<BodySpectra> = None;
-    for r in &records {
-        let pre = vibmode_signal::preprocess(&r.recording, &acfg.preprocess)
-            .map_err(|e| fail(e.to_string()))?;
+    // Each record pre-processed once (in parallel): the spectra here and the analysis below
+    // share it.
+    acfg.validate().map_err(|e| fail(e.to_string()))?;
+    check_records(&records).map_err(|e| fail(e.to_string()))?;
+    let pres = preprocess_records(&records, acfg).map_err(|e| fail(e.to_string()))?;
+    for pre in &pres {
         fs = pre.band.fs_hz;
         if !body_u.is_empty() && !body_y.is_empty() {
             let samples = |idx: &[usize]| -> Vec<&[f64]> {
@@ -491,7 +497,21 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
             }
         }
     }
-    let results = analyze(&records, acfg, &[], &|_, _| {}).map_err(|e| fail(e.to_string()))?;
+    let identifier = SweepIdentifier {
+        sweep: acfg.sweep.clone(),
+        poles: acfg.poles.clone(),
+    };
+    let facts = records.iter().map(RecordFacts::of).collect();
+    let results = analyze_prepared(
+        facts,
+        pres,
+        acfg,
+        &identifier,
+        &[],
+        &|_, _| {},
+        std::time::Instant::now(),
+    )
+    .map_err(|e| fail(e.to_string()))?;
     let mut channels = Vec::new();
     for (c, ch) in rec.channels.iter().enumerate() {
         let placement = acfg.placement_of(ch);
