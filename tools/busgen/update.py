@@ -121,7 +121,8 @@ def score(folder: Path, front_bar: bool, out: Path) -> Dict:
     vf.write_text(vehicle_toml(t, front_bar))
     res = harness.analyze(folder, "--vehicle", vf, out=out / "out")
     mu = res.get("model_update") or {}
-    row: Dict = {"bus": t["bus_seed"], "front_bar": front_bar}
+    row: Dict = {"bus": t["bus_seed"], "front_bar": front_bar,
+                 "written": (out / "out" / "updated_vehicle.toml").is_file()}
     if "not_updated" in mu:
         row["not_updated"] = mu["not_updated"]
         # A fit the records do not support still leaves its figures in model_update.json.
