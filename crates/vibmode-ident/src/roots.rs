@@ -356,8 +356,21 @@ mod tests {
         r
     }
 
-    /// Unpolished roots are the same set as polished ones to eps x condition: by hand for
-    /// (z - 0.5)(z + 0.25)(z^2 - z + 0.5) (roots 0.5, -0.25, 0.5 +- 0.5i).
+    /// The real coefficients of `prod (z - r)` over `roots` (closed under conjugation), highest
+    /// power first.
+    fn real_polynomial(roots: &[Complex64]) -> Vec<f64> {
+        let mut c = vec![Complex64::new(1.0, 0.0)];
+        for &r in roots {
+            let mut next = vec![Complex64::new(0.0, 0.0); c.len() + 1];
+            for (i, &ci) in c.iter().enumerate() {
+                next[i] += ci;
+                next[i + 1] -= ci * r;
+            }
+            c = next;
+        }
+        c.iter().map(|v| v.re).collect()
+    }
+
     /// Aberth's roots against the companion matrix's (the definition: the same set) on seeded
     /// random real polynomials of degree 1..60 with roots inside and outside the unit circle, as
     /// a trial C of the ARMA search has them; started on the circle and from nearby roots.
@@ -386,16 +399,7 @@ mod tests {
                     roots.push(Complex64::new(if uniform() < 0.5 { r } else { -r }, 0.0));
                 }
             }
-            let mut c = vec![Complex64::new(1.0, 0.0)];
-            for &r in &roots {
-                let mut next = vec![Complex64::new(0.0, 0.0); c.len() + 1];
-                for (i, &ci) in c.iter().enumerate() {
-                    next[i] += ci;
-                    next[i + 1] -= ci * r;
-                }
-                c = next;
-            }
-            let c: Vec<f64> = c.iter().map(|v| v.re).collect();
+            let c = real_polynomial(&roots);
             // Cold (on the circle), and warm from the roots of a nearby polynomial (each root
             // moved by 1e-3 of its modulus, as between two trial steps of a search).
             let start: Vec<Complex64> = roots
@@ -477,16 +481,7 @@ mod tests {
                     roots.push(Complex64::new(if uniform() < 0.5 { r } else { -r }, 0.0));
                 }
             }
-            let mut c = vec![Complex64::new(1.0, 0.0)];
-            for &r in &roots {
-                let mut next = vec![Complex64::new(0.0, 0.0); c.len() + 1];
-                for (i, &ci) in c.iter().enumerate() {
-                    next[i] += ci;
-                    next[i + 1] -= ci * r;
-                }
-                c = next;
-            }
-            let c: Vec<f64> = c.iter().map(|v| v.re).collect();
+            let c = real_polynomial(&roots);
             let got = polynomial_roots(&c).unwrap_or_default();
             let raw = companion_eigenvalues(&c).unwrap_or_default();
             let want: Vec<Complex64> = (0..raw.len())
@@ -538,6 +533,8 @@ mod tests {
         assert!(aberth_roots(&[1.0, f64::NAN]).is_none());
     }
 
+    /// Unpolished roots are the same set as polished ones to eps x condition: by hand for
+    /// (z - 0.5)(z + 0.25)(z^2 - z + 0.5) (roots 0.5, -0.25, 0.5 +- 0.5i).
     #[test]
     fn unpolished_roots_by_hand() {
         // (z^2 - 0.25 z - 0.125)(z^2 - z + 0.5) = z^4 - 1.25 z^3 + 0.625 z^2 + 0 z - 0.0625
