@@ -125,6 +125,35 @@ pub fn front_rear_delay(
 /// motion, common to front and rear, dominates the wheels' channels.
 pub const DELAY_BAND_LOW_HZ: f64 = 2.0;
 
+/// Why the body-band SSI-cov did not run (`results.json`'s `body_ssi_not_run` is its text).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum BodySsiNotRun {
+    /// `[body_ssi] enabled = false`.
+    #[error("switched off ([body_ssi] enabled = false)")]
+    SwitchedOff,
+    /// No record was given.
+    #[error("no records")]
+    NoRecords,
+    /// No front and rear wheel channel on one side.
+    #[error("no wheel channels at a front and a rear corner of one side (FL and RL, or FR and RR) to measure the wheelbase delay; give them the role unsprung and their corners")]
+    NoWheelPair,
+    /// No record has a measured delay; `example` is one record's reason.
+    #[error("no record with a measured wheelbase delay (e.g. {example})")]
+    NoDelay {
+        /// Why one record was left out.
+        example: String,
+    },
+    /// A record could not be resampled to the body rate.
+    #[error("resampling to {fs_hz} Hz: {source}")]
+    Resampling {
+        /// The body rate, Hz.
+        fs_hz: f64,
+        /// The resampler's error.
+        source: vibmode_signal::SignalError,
+    },
+}
+
 pub(crate) struct BodyStage<'a> {
     pub pre: &'a [Preprocessed],
     pub active: &'a [Option<usize>],
@@ -133,7 +162,7 @@ pub(crate) struct BodyStage<'a> {
 }
 
 impl BodyStage<'_> {
-    /// Runs the stage; `Err(reason)` when it cannot (no wheel pair, no record with a delay,
+    /// Runs the stage; `Ok(Err(why))` when it cannot (no wheel pair, no record with a delay,
     /// too short records), which the analysis reports instead of the modes.
     pub fn run(
         &self,
@@ -141,14 +170,14 @@ impl BodyStage<'_> {
         tracks: &[LineTrack],
         other_tracks: &[LineTrack],
         reference: &[vibmode_core::ReferenceMode],
-    ) -> Result<Result<BodySsi, String>, AnalysisError> {
+    ) -> Result<Result<BodySsi, BodySsiNotRun>, AnalysisError> {
         let p: &BodySsiParams = &self.cfg.body_ssi;
         let Some(first) = self.pre.first() else {
-            return Ok(Err("no records".into()));
+            return Ok(Err(BodySsiNotRun::NoRecords));
         };
         let pairs = delay_pairs(first, self.cfg);
         if pairs.is_empty() {
-            return Ok(Err("no wheel channels at a front and a rear corner of one side (FL and RL, or FR and RR) to measure the wheelbase delay; give them the role unsprung and their corners".into()));
+            return Ok(Err(BodySsiNotRun::NoWheelPair));
         }
         let names = |i: usize| first.recording.channels[i].name.clone();
         let delay_pairs: Vec<[String; 2]> =
@@ -159,6 +188,8 @@ impl BodyStage<'_> {
         };
         let i = p.block_rows;
         let mut delays = Vec::with_capacity(self.pre.len());
+        // The records used (active ones), resampled to the body rate, and each one's first lag:
+        // a stop is neither resampled nor identified.
         let mut low = Vec::with_capacity(self.pre.len());
         let mut lags = Vec::with_capacity(self.pre.len());
         for (r, pr) in self.pre.iter().enumerate() {
@@ -168,68 +199,73 @@ impl BodyStage<'_> {
                 first_lag: None,
                 left_out: Some(why),
             };
-            let resampled = vibmode_signal::preprocess(&pr.recording, &body_pre);
-            let (d, l) = if self.active.get(r).copied().flatten().is_none() {
-                (left("stationary".into(), f64::NAN), None)
-            } else {
-                let fs = pr.band.fs_hz;
-                let sig: Vec<(&[f64], &[f64])> = pairs
-                    .iter()
-                    .map(|&(f, b)| {
-                        (
-                            pr.recording.channels[f].samples.as_slice(),
-                            pr.recording.channels[b].samples.as_slice(),
-                        )
-                    })
-                    .collect();
-                let band = [DELAY_BAND_LOW_HZ, pr.band.valid_max_hz()];
-                match front_rear_delay(&sig, fs, p.max_delay_s, band) {
-                    None => (
-                        left("a wheel channel is constant or too short".into(), f64::NAN),
-                        None,
-                    ),
-                    Some((_, corr)) if corr < p.min_delay_correlation => (
-                        left(
-                            format!(
-                                "front/rear correlation {corr:.2} below min_delay_correlation {}",
-                                p.min_delay_correlation
-                            ),
-                            corr,
+            if self.active.get(r).copied().flatten().is_none() {
+                delays.push(left("stationary".into(), f64::NAN));
+                continue;
+            }
+            let resampled = vibmode_signal::preprocess(&pr.recording, &body_pre).map_err(|e| {
+                BodySsiNotRun::Resampling {
+                    fs_hz: p.fs_hz,
+                    source: e,
+                }
+            });
+            let fs = pr.band.fs_hz;
+            let sig: Vec<(&[f64], &[f64])> = pairs
+                .iter()
+                .map(|&(f, b)| {
+                    (
+                        pr.recording.channels[f].samples.as_slice(),
+                        pr.recording.channels[b].samples.as_slice(),
+                    )
+                })
+                .collect();
+            let band = [DELAY_BAND_LOW_HZ, pr.band.valid_max_hz()];
+            let (d, l) = match front_rear_delay(&sig, fs, p.max_delay_s, band) {
+                None => (
+                    left("a wheel channel is constant or too short".into(), f64::NAN),
+                    None,
+                ),
+                Some((_, corr)) if corr < p.min_delay_correlation => (
+                    left(
+                        format!(
+                            "front/rear correlation {corr:.2} below min_delay_correlation {}",
+                            p.min_delay_correlation
                         ),
-                        None,
+                        corr,
                     ),
-                    Some((delay, corr)) => {
-                        let lag = p.first_lag(delay);
-                        let n = resampled.as_ref().map_or(0, |x| x.recording.len());
-                        if !vibmode_ssi::samples_needed(i, lag).is_some_and(|needed| n >= needed) {
-                            (
-                                left(
-                                    format!(
-                                        "{n} samples at {} Hz, too few for the lags {lag}..{} beyond its delay of {delay:.2} s",
-                                        p.fs_hz,
-                                        lag.saturating_add(2 * i - 2)
-                                    ),
-                                    corr,
+                    None,
+                ),
+                Some((delay, corr)) => {
+                    let lag = p.first_lag(delay);
+                    let n = resampled.as_ref().map_or(0, |x| x.recording.len());
+                    if !vibmode_ssi::samples_needed(i, lag).is_some_and(|needed| n >= needed) {
+                        (
+                            left(
+                                format!(
+                                    "{n} samples at {} Hz, too few for the lags {lag}..{} beyond its delay of {delay:.2} s",
+                                    p.fs_hz,
+                                    lag.saturating_add(2 * i - 2)
                                 ),
-                                None,
-                            )
-                        } else {
-                            (
-                                RecordDelay {
-                                    delay_s: Some(delay),
-                                    correlation: corr,
-                                    first_lag: Some(lag),
-                                    left_out: None,
-                                },
-                                Some(lag),
-                            )
-                        }
+                                corr,
+                            ),
+                            None,
+                        )
+                    } else {
+                        (
+                            RecordDelay {
+                                delay_s: Some(delay),
+                                correlation: corr,
+                                first_lag: Some(lag),
+                                left_out: None,
+                            },
+                            Some(lag),
+                        )
                     }
                 }
             };
             let res = match resampled {
                 Ok(x) => x,
-                Err(e) => return Ok(Err(format!("resampling to {} Hz: {e}", p.fs_hz))),
+                Err(why) => return Ok(Err(why)),
             };
             delays.push(d);
             lags.push(l);
@@ -237,14 +273,14 @@ impl BodyStage<'_> {
         }
         let n_records = lags.iter().flatten().count();
         if n_records == 0 {
-            let why = delays
+            let example = delays
                 .iter()
                 .find_map(|d| d.left_out.clone())
                 .unwrap_or_default();
-            return Ok(Err(format!(
-                "no record with a measured wheelbase delay (e.g. {why})"
-            )));
+            return Ok(Err(BodySsiNotRun::NoDelay { example }));
         }
+        // `low` holds the active records in order: the k-th is active record k.
+        let low_active: Vec<Option<usize>> = (0..low.len()).map(Some).collect();
         let duration_s = low
             .iter()
             .zip(&lags)
@@ -261,7 +297,7 @@ impl BodyStage<'_> {
         let method = vibmode_ssi::SsiCovIdentifier { params: ssi };
         let stage = SsiStage {
             pre: &low,
-            active: self.active,
+            active: &low_active,
             n_active: n_records,
             method: &method,
             pool_records,

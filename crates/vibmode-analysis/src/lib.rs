@@ -36,7 +36,7 @@ pub mod stops;
 pub mod store;
 pub mod stream;
 
-pub use body::{BodySsi, RecordDelay};
+pub use body::{BodySsi, BodySsiNotRun, RecordDelay};
 pub use config::{AnalysisConfig, ChannelRole, ConfigText, Preset, ReportParams};
 pub use first_record::{first_record_spectra, FirstRecordSpectra, ModelPsd};
 pub use identify::SweepIdentifier;

@@ -270,9 +270,13 @@ impl<M: MultichannelIdentifier> SsiStage<'_, M> {
                 Err(e) => Err(e.clone()),
             }]
         } else {
+            // Only the records used: a stop's poles would be dropped below.
             (0..self.pre.len())
                 .into_par_iter()
-                .map(|r| self.record_poles(r, &orders, &scales))
+                .map(|r| match self.active.get(r).copied().flatten() {
+                    Some(_) => self.record_poles(r, &orders, &scales),
+                    None => Ok(Vec::new()),
+                })
                 .collect()
         };
         let mut poles = Vec::new();

@@ -10,6 +10,7 @@ use vibmode_modal::{InvariantMode, MATCH_MAC_MIN, MATCH_MAX_FREQ_DIFF_REL};
 use vibmode_signal::{preprocess, Preprocessed};
 use vibmode_spectra::{WelchParams, Window};
 
+use crate::body::BodySsiNotRun;
 use crate::config::AnalysisConfig;
 use crate::identify::SweepIdentifier;
 use crate::lines::LineStage;
@@ -249,13 +250,10 @@ pub fn analyze_prepared(
             };
             match stage.run(&lines, &main.lines, &role_tracks, reference)? {
                 Ok(b) => (Some(b), None),
-                Err(why) => (None, Some(why)),
+                Err(why) => (None, Some(why.to_string())),
             }
         }
-        Some(_) => (
-            None,
-            Some("switched off ([body_ssi] enabled = false)".to_string()),
-        ),
+        Some(_) => (None, Some(BodySsiNotRun::SwitchedOff.to_string())),
         None => (None, None),
     };
     let fits = channels.iter().flat_map(|c| c.fits.iter());
