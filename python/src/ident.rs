@@ -220,7 +220,7 @@ fn sweep(
         }
     };
     let fits: Vec<Result<ArmaModel, IdentError>> =
-        py.detach(|| vibmode_run::sweep::sweep_fits(&y, kind, ar_method, &orders, &params));
+        py.detach(|| vibmode_ident::sweep_fits(&y, kind, ar_method, &orders, &params));
     if let Some(Err(e)) = fits
         .iter()
         .find(|f| f.is_err())

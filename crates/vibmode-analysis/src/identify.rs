@@ -3,7 +3,7 @@
 
 use vibmode_core::{
     BandLimit, FitSummary, Identifier, ModelCoefficients, PoleFilterParams, PoleOut, SignalFits,
-    SweepModel, SweepParams,
+    SweepParams,
 };
 use vibmode_ident::{ArMethod, ArmaModel, ArmaParams, IdentError};
 
@@ -30,14 +30,13 @@ impl SweepIdentifier {
     }
 
     fn fits(&self, y: &[f64], band: &BandLimit) -> Vec<Result<ArmaModel, IdentError>> {
-        let orders = self.sweep.orders();
-        match self.sweep.model {
-            SweepModel::Arma => vibmode_ident::sweep_arma(y, &orders, &self.arma_params(band)),
-            SweepModel::Ar => orders
-                .iter()
-                .map(|&p| vibmode_ident::fit_ar(y, p, ArMethod::Burg))
-                .collect(),
-        }
+        vibmode_ident::sweep_fits(
+            y,
+            self.sweep.model,
+            ArMethod::Burg,
+            &self.sweep.orders(),
+            &self.arma_params(band),
+        )
     }
 }
 

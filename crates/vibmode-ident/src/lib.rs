@@ -56,6 +56,7 @@ mod poles;
 mod prepare;
 mod roots;
 pub mod sim;
+mod sweep;
 
 pub use ar::{fit_ar, max_ar_order, ArMethod};
 pub use arma::{fit_arma, fit_arma_warm, max_arma_order, prediction_error_variance, sweep_arma};
@@ -69,3 +70,4 @@ pub use outliers::{clean_additive_outliers, CleanedSignal, CleanerParams, Outlie
 pub use params::{ArmaParams, Robust, FIT_MAX_ITERATIONS, FIT_TOLERANCE};
 pub use poles::{cancelled_by_zero, filter_mode_set, filter_modes, FilteredMode, PoleRejection};
 pub use roots::polynomial_roots;
+pub use sweep::sweep_fits;

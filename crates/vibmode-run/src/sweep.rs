@@ -133,24 +133,6 @@ impl SweepChannel {
     }
 }
 
-/// The fits of one signal at every order: ARMA(p, p) warm-started order to order, or AR(p) by
-/// `ar_method`.
-pub fn sweep_fits(
-    y: &[f64],
-    model: SweepModel,
-    ar_method: ArMethod,
-    orders: &[usize],
-    params: &ArmaParams,
-) -> Vec<Result<ArmaModel, IdentError>> {
-    match model {
-        SweepModel::Arma => vibmode_ident::sweep_arma(y, orders, params),
-        SweepModel::Ar => orders
-            .iter()
-            .map(|&p| vibmode_ident::fit_ar(y, p, ar_method))
-            .collect(),
-    }
-}
-
 /// The sweep of every channel of `rec` (read from `source`). `band`: what the signal carries
 /// (the pole filters' band). A channel whose every fit fails is an error with the highest
 /// order's reason.
@@ -167,7 +149,7 @@ pub fn sweep(
     let max_order = orders.iter().copied().max().unwrap_or(1);
     let mut channels = Vec::new();
     for ch in &rec.channels {
-        let fits = sweep_fits(&ch.samples, model, ar_method, orders, params);
+        let fits = vibmode_ident::sweep_fits(&ch.samples, model, ar_method, orders, params);
         if fits.iter().all(|f| f.is_err()) {
             if let Some(Err(e)) = fits.into_iter().last() {
                 return Err(RunError::SweepFailed {
