@@ -106,7 +106,7 @@ pub fn run(a: &FitArgs) -> Result<()> {
     };
     let filter_band = band.unwrap_or_else(|| BandLimit::full(rec.fs_hz));
     let model = fit_model(a)?;
-    let (out, models) = vibmode_run::fit::fit(
+    let out = vibmode_run::fit::fit(
         &rec,
         &a.input.input.display().to_string(),
         model,
@@ -118,7 +118,6 @@ pub fn run(a: &FitArgs) -> Result<()> {
     if let Some(path) = &a.plot {
         let fig = vibmode_run::fit::fit_figure(
             &rec,
-            &models,
             &out.channels,
             &a.spectral.welch_params()?,
             &a.spectral.periodogram_params()?,

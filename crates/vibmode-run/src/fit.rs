@@ -42,7 +42,9 @@ pub struct ModeOut {
     pub filtered_out: Option<PoleRejection>,
 }
 
-/// One channel's fitted model in the JSON output.
+/// One channel's fitted model in the JSON output: the model's own fields (orders, A and C,
+/// noise variance, loss, criteria, standard errors, ...) flattened beside the channel, the
+/// estimator's name and the modes.
 #[derive(Serialize, Clone, Debug)]
 pub struct ChannelFit {
     /// Channel name.
@@ -51,36 +53,11 @@ pub struct ChannelFit {
     pub unit: String,
     /// Model structure.
     pub model: SweepModel,
-    /// Estimator (yule-walker, burg, ls or pem).
-    pub method: String,
-    /// AR order.
-    pub p: usize,
-    /// MA order.
-    pub q: usize,
-    /// A(q) coefficients, leading 1.
-    pub a: Vec<f64>,
-    /// C(q) coefficients, leading 1.
-    pub c: Vec<f64>,
-    /// Innovation variance.
-    pub noise_variance: f64,
-    /// The criterion minimised.
-    pub loss: f64,
-    /// Gauss-Newton iterations.
-    pub iterations: usize,
-    /// Whether the search converged.
-    pub converged: bool,
-    /// Akaike's information criterion.
-    pub aic: f64,
-    /// Bayesian information criterion.
-    pub bic: f64,
-    /// Final prediction error.
-    pub fpe: f64,
-    /// Standard errors of the coefficients.
-    pub std_errors: Vec<f64>,
-    /// Additive outliers replaced before fitting.
-    pub outliers_replaced: usize,
-    /// White noise added to an emptied band before fitting (variance).
-    pub noise_floor_variance: f64,
+    /// Estimator (yule-walker, burg, ls or pem): `fit.estimator`'s name.
+    pub method: &'static str,
+    /// The fitted model.
+    #[serde(flatten)]
+    pub fit: ArmaModel,
     /// The modes, each with the pole filters' verdict.
     pub modes: Vec<ModeOut>,
     /// Real poles.
@@ -114,23 +91,20 @@ pub fn fit(
     p: usize,
     params: &ArmaParams,
     band: &BandLimit,
-) -> Result<(FitOutput, Vec<ArmaModel>), RunError> {
+) -> Result<FitOutput, RunError> {
     let mut channels = Vec::new();
-    let mut models = Vec::new();
     for ch in &rec.channels {
         let fail = |source| RunError::FitFailed {
             channel: ch.name.clone(),
             source,
         };
-        let (m, method, kind) = match model {
+        let (m, kind) = match model {
             FitModel::Ar { method } => (
                 vibmode_ident::fit_ar(&ch.samples, p, method).map_err(fail)?,
-                method.to_string(),
                 SweepModel::Ar,
             ),
             FitModel::Arma { q } => (
                 vibmode_ident::fit_arma(&ch.samples, p, q, params).map_err(fail)?,
-                "pem".to_string(),
                 SweepModel::Arma,
             ),
         };
@@ -143,19 +117,15 @@ pub fn fit(
                 noise_variance: m.noise_variance,
             });
         }
-        channels.push(channel_fit(&ch.name, &ch.unit, kind, method, &m, band));
-        models.push(m);
+        channels.push(channel_fit(&ch.name, &ch.unit, kind, m, band));
     }
-    Ok((
-        FitOutput {
-            source: source.to_string(),
-            fs_hz: rec.fs_hz,
-            n_samples: rec.len(),
-            robust: params.robust.to_string(),
-            channels,
-        },
-        models,
-    ))
+    Ok(FitOutput {
+        source: source.to_string(),
+        fs_hz: rec.fs_hz,
+        n_samples: rec.len(),
+        robust: params.robust.to_string(),
+        channels,
+    })
 }
 
 /// Converts a fitted model to its JSON form.
@@ -163,31 +133,16 @@ pub fn channel_fit(
     name: &str,
     unit: &str,
     kind: SweepModel,
-    method: String,
-    m: &ArmaModel,
+    m: ArmaModel,
     band: &BandLimit,
 ) -> ChannelFit {
     let ms = m.modes(band.fs_hz);
-    let filtered = vibmode_ident::filter_mode_set(m, &ms, band, &PoleFilterParams::default());
+    let filtered = vibmode_ident::filter_mode_set(&m, &ms, band, &PoleFilterParams::default());
     ChannelFit {
         name: name.to_string(),
         unit: unit.to_string(),
         model: kind,
-        method,
-        p: m.p,
-        q: m.q,
-        a: m.a.clone(),
-        c: m.c.clone(),
-        noise_variance: m.noise_variance,
-        loss: m.loss,
-        iterations: m.iterations,
-        converged: m.converged,
-        aic: m.aic,
-        bic: m.bic,
-        fpe: m.fpe,
-        std_errors: m.std_errors.clone(),
-        outliers_replaced: m.outliers_replaced,
-        noise_floor_variance: m.noise_floor_variance,
+        method: m.estimator.name(),
         modes: filtered
             .iter()
             .map(|f| ModeOut {
@@ -201,6 +156,7 @@ pub fn channel_fit(
             .collect(),
         real_poles: ms.real_poles.clone(),
         unstable_poles: ms.unstable_poles.iter().map(|z| [z.re, z.im]).collect(),
+        fit: m,
     }
 }
 
@@ -218,23 +174,27 @@ pub fn table_text(o: &FitOutput, zmax: f64) -> String {
             } else {
                 "ARMA"
             },
-            c.p,
+            c.fit.p,
             if c.model == SweepModel::Arma {
-                format!(",{}", c.q)
+                format!(",{}", c.fit.q)
             } else {
                 String::new()
             },
             c.method,
-            c.iterations,
-            if c.converged { "" } else { " (NOT converged)" },
-            c.noise_variance,
-            c.loss,
-            c.aic
+            c.fit.iterations,
+            if c.fit.converged {
+                ""
+            } else {
+                " (NOT converged)"
+            },
+            c.fit.noise_variance,
+            c.fit.loss,
+            c.fit.aic
         ));
-        if c.noise_floor_variance > 0.0 {
+        if c.fit.noise_floor_variance > 0.0 {
             s.push_str(&format!(
                 "  (the signal has an empty band: a white noise floor of variance {:.3e} was added before fitting, and is included in the noise variance and loss)\n",
-                c.noise_floor_variance
+                c.fit.noise_floor_variance
             ));
         }
         s.push_str(&format!("  {:>12} {:>14}  \n", "freq_hz", "damping_ratio"));
@@ -278,7 +238,6 @@ pub fn table_text(o: &FitOutput, zmax: f64) -> String {
 #[cfg(feature = "report")]
 pub fn fit_figure(
     rec: &Recording,
-    models: &[ArmaModel],
     fits: &[ChannelFit],
     welch: &vibmode_spectra::WelchParams,
     periodogram: &vibmode_spectra::PeriodogramParams,
@@ -291,7 +250,7 @@ pub fn fit_figure(
         .map(|i| i as f64 * nyquist / MODEL_GRID_POINTS as f64)
         .collect();
     let mut panels = Vec::new();
-    for ((ch, m), f) in rec.channels.iter().zip(models).zip(fits) {
+    for (ch, f) in rec.channels.iter().zip(fits) {
         let spectrum_err = |source| RunError::Spectrum {
             channel: ch.name.clone(),
             source,
@@ -299,8 +258,8 @@ pub fn fit_figure(
         let per = vibmode_spectra::periodogram(&ch.samples, rec.fs_hz, pp).map_err(spectrum_err)?;
         let wel = vibmode_spectra::welch(&ch.samples, rec.fs_hz, wp).map_err(spectrum_err)?;
         let structure = match f.model {
-            SweepModel::Ar => format!("AR({})", f.p),
-            SweepModel::Arma => format!("ARMA({},{})", f.p, f.q),
+            SweepModel::Ar => format!("AR({})", f.fit.p),
+            SweepModel::Arma => format!("ARMA({},{})", f.fit.p, f.fit.q),
         };
         let unit = if ch.unit.is_empty() {
             "input units"
@@ -312,7 +271,7 @@ pub fn fit_figure(
             psd_unit: format!("({unit})^2/Hz"),
             periodogram: Curve::new("periodogram", per.freq_hz, per.psd),
             welch: Curve::new("Welch", wel.freq_hz, wel.psd),
-            model: Curve::new("model", grid.clone(), m.model_psd(&grid, rec.fs_hz)),
+            model: Curve::new("model", grid.clone(), f.fit.model_psd(&grid, rec.fs_hz)),
             marks_hz: f
                 .modes
                 .iter()
@@ -346,6 +305,13 @@ mod tests {
 
     #[test]
     fn table_marks_modes_and_says_why_pole_pairs_are_left_out() {
+        // An ARMA(2,2) model whose header the table prints (the numbers are not checked here).
+        let y: Vec<f64> = (0..200).map(|t| ((t * 7919) % 101) as f64 - 50.0).collect();
+        let mut model = vibmode_ident::fit_ar(&y, 2, vibmode_ident::ArMethod::Burg).unwrap();
+        model.q = 2;
+        model.c = vec![1.0; 3];
+        model.iterations = 3;
+        model.converged = true;
         let out = FitOutput {
             source: "x.csv".into(),
             fs_hz: 200.0,
@@ -355,21 +321,8 @@ mod tests {
                 name: "z".into(),
                 unit: String::new(),
                 model: SweepModel::Arma,
-                method: "pem".into(),
-                p: 2,
-                q: 2,
-                a: vec![1.0; 3],
-                c: vec![1.0; 3],
-                noise_variance: 1.0,
-                loss: 1.0,
-                iterations: 3,
-                converged: true,
-                aic: 0.0,
-                bic: 0.0,
-                fpe: 1.0,
-                std_errors: vec![],
-                outliers_replaced: 0,
-                noise_floor_variance: 0.0,
+                method: "pem",
+                fit: model,
                 modes: vec![
                     mode(0.92, 0.34, None),
                     mode(10.58, 0.01, Some(PoleRejection::PoleZeroCancellation)),
