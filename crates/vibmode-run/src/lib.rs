@@ -219,6 +219,19 @@ impl<'a> RunInput<'a> {
     }
 }
 
+/// The records [`Run::analyse`] reads: [`RunInput`] once a segmented input has been cut.
+enum Records<'a> {
+    /// In memory.
+    Memory(Vec<RecordInput>),
+    /// Files read as streams, cut into records or into the given windows.
+    Files {
+        paths: &'a [PathBuf],
+        read: &'a ReadOptions,
+        channels: &'a [ChannelSelector],
+        windows: Option<Vec<Vec<RecordWindow>>>,
+    },
+}
+
 /// Progress callbacks: `on_record(n)` after each record read (streamed input), and
 /// `on_identified(done, total)` as records are identified (a record counts when all its channels
 /// are; stops are not identified and not counted), from any thread.
@@ -303,7 +316,24 @@ impl Run {
                 channels,
                 segmenting,
             } => self.run_segmented(paths, read, channels, segmenting, progress),
-            input => self.analyse(input, &self.speed_trace, progress),
+            RunInput::Records(records) => {
+                self.analyse(Records::Memory(records), &self.speed_trace, progress)
+            }
+            RunInput::Files {
+                paths,
+                read,
+                channels,
+                windows,
+            } => self.analyse(
+                Records::Files {
+                    paths,
+                    read,
+                    channels,
+                    windows,
+                },
+                &self.speed_trace,
+                progress,
+            ),
         }
     }
 
@@ -311,7 +341,7 @@ impl Run {
     /// update in one pass over the records; `speed_trace` goes into the results.
     fn analyse(
         &self,
-        input: RunInput<'_>,
+        input: Records<'_>,
         speed_trace: &[[f64; 2]],
         progress: &Progress<'_>,
     ) -> Result<RunOutput, RunError> {
@@ -324,7 +354,7 @@ impl Run {
             (progress.on_identified)(done / n, total.div_ceil(n));
         };
         let (mut results, report_records) = match input {
-            RunInput::Records(records) => {
+            Records::Memory(records) => {
                 n_ch.store(
                     records.first().map_or(0, |r| r.recording.channels.len()),
                     Ordering::SeqCst,
@@ -333,15 +363,7 @@ impl Run {
                 let results = vibmode_analysis::analyze(&records, cfg, &self.reference, &on_fits)?;
                 (results, records)
             }
-            // `run` cuts segmented inputs first and analyses them as files in their windows.
-            #[cfg(feature = "segment")]
-            RunInput::Segmented {
-                paths,
-                read,
-                channels,
-                segmenting,
-            } => return self.run_segmented(paths, read, channels, segmenting, progress),
-            RunInput::Files {
+            Records::Files {
                 paths,
                 read,
                 channels,
@@ -446,7 +468,7 @@ impl Run {
                 .map_or(&[][..], |g| g.speed_trace.as_slice()),
             _ => self.speed_trace.as_slice(),
         };
-        let input = RunInput::Files {
+        let input = Records::Files {
             paths,
             read,
             channels,
