@@ -183,6 +183,37 @@ def summarize(rows: List[Dict]) -> Dict[str, float]:
             "params_within_10pct": sum(per_param), "params": len(per_param)}
 
 
+def accuracy(rows: List[Dict]) -> Dict[str, float]:
+    """The fit's errors over every row with figures, supported or not (the estimator's accuracy,
+    apart from whether it trusts itself): median absolute body-mode error, modes within 3 %, fits
+    with all three, median absolute spring and damper error, parameters within 10 %, the range of
+    the modes' relative standard deviations, and how many fits were supported."""
+    def med(v: List[float]) -> float:
+        v = sorted(v)
+        return float("nan") if not v else 0.5 * (v[(len(v) - 1) // 2] + v[len(v) // 2])
+
+    fig = [r for r in rows if "modes" in r]
+    modes = [abs(v) for r in fig for v in r["modes"].values()]
+    springs = [abs(v) for r in fig for k, v in r["params"].items() if k.startswith("spring")]
+    dampers = [abs(v) for r in fig for k, v in r["params"].items() if k.startswith("damper")]
+    sds = [v for r in fig for v in r.get("mode_sd", {}).values()]
+    heave = [r["modes"]["body heave"] for r in fig if "body heave" in r["modes"]]
+    return {"fits": len(rows), "with_figures": len(fig),
+            "mode_error_median": med(modes),
+            "modes_within_3pct": sum(v <= MODE_TOL for v in modes), "modes": len(modes),
+            "fits_all_three_within_3pct": sum(
+                1 for r in fig if len(r["modes"]) == 3
+                and all(abs(v) <= MODE_TOL for v in r["modes"].values())),
+            "spring_error_median": med(springs), "damper_error_median": med(dampers),
+            "params_within_10pct": sum(v <= PARAM_TOL for v in springs + dampers),
+            "params": len(springs) + len(dampers),
+            "heave_error_mean": sum(heave) / len(heave) if heave else float("nan"),
+            "mode_sd_min": min(sds) if sds else float("nan"),
+            "mode_sd_max": max(sds) if sds else float("nan"),
+            "mode_sd_median": med(sds),
+            "supported": sum(1 for r in fig if r.get("supported", True))}
+
+
 def run(seeds: List[int], extra: List[str], work: Optional[Path] = None) -> List[Dict]:
     work = work or Path(tempfile.mkdtemp(prefix="vibmode-upd-"))
     rows = []
@@ -217,8 +248,18 @@ def main(argv: Optional[List[str]] = None) -> int:
           f"{harness.rate(s['all_params_within_10pct'], s['runs'])}; single parameters within 10 %: "
           f"{harness.rate(s['params_within_10pct'], s['params'])}; updated "
           f"{harness.rate(s['updated'], s['runs'])}")
+    acc = accuracy(rows)
+    print("accuracy over every fit with figures (supported or not): "
+          f"body-mode error median {100 * acc['mode_error_median']:.1f} %, "
+          f"{acc['modes_within_3pct']}/{acc['modes']} modes within 3 %, "
+          f"{acc['fits_all_three_within_3pct']}/{acc['fits']} fits with all three; "
+          f"springs median {100 * acc['spring_error_median']:.1f} %, dampers "
+          f"{100 * acc['damper_error_median']:.1f} %, {acc['params_within_10pct']}/{acc['params']} "
+          f"springs and dampers within 10 %; heave mean {100 * acc['heave_error_mean']:+.1f} %; "
+          f"mode sd {100 * acc['mode_sd_min']:.1f}-{100 * acc['mode_sd_max']:.1f} % "
+          f"(median {100 * acc['mode_sd_median']:.1f} %); supported {acc['supported']}/{acc['fits']}")
     if a.json:
-        a.json.write_text(json.dumps({"rows": rows, "summary": s}, indent=1))
+        a.json.write_text(json.dumps({"rows": rows, "summary": s, "accuracy": acc}, indent=1))
     return 0
 
 
