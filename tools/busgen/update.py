@@ -113,13 +113,15 @@ def fitted_params(mu: Dict) -> Dict[str, float]:
     return out
 
 
-def score(folder: Path, front_bar: bool, out: Path) -> Dict:
-    """One update on one folder: its errors against the truth (or why it was not updated)."""
+def score(folder: Path, front_bar: bool, out: Path, config: Optional[Path] = None) -> Dict:
+    """One update on one folder: its errors against the truth (or why it was not updated).
+    `config`: an analysis config given to `vibmode analyze` (e.g. its `[model_update]`)."""
     t = harness.truth(folder)
     out.mkdir(parents=True, exist_ok=True)
     vf = out / "bus.toml"
     vf.write_text(vehicle_toml(t, front_bar))
-    res = harness.analyze(folder, "--vehicle", vf, out=out / "out")
+    extra = ["--config", str(config)] if config else []
+    res = harness.analyze(folder, "--vehicle", vf, *extra, out=out / "out")
     mu = res.get("model_update") or {}
     row: Dict = {"bus": t["bus_seed"], "front_bar": front_bar,
                  "written": (out / "out" / "updated_vehicle.toml").is_file()}
@@ -214,13 +216,14 @@ def accuracy(rows: List[Dict]) -> Dict[str, float]:
             "supported": sum(1 for r in fig if r.get("supported", True))}
 
 
-def run(seeds: List[int], extra: List[str], work: Optional[Path] = None) -> List[Dict]:
+def run(seeds: List[int], extra: List[str], work: Optional[Path] = None,
+        config: Optional[Path] = None) -> List[Dict]:
     work = work or Path(tempfile.mkdtemp(prefix="vibmode-upd-"))
     rows = []
     for s in seeds:
         folder = harness.simulate(s, 1000 + s, *extra)
         for bar in (False, True):
-            r = score(folder, bar, work / f"bus{s}-{'bar' if bar else 'nobar'}")
+            r = score(folder, bar, work / f"bus{s}-{'bar' if bar else 'nobar'}", config)
             print(fmt_row(r), flush=True)
             rows.append(r)
     return rows
@@ -233,12 +236,14 @@ def main(argv: Optional[List[str]] = None) -> int:
     ap.add_argument("--no-noise", action="store_true", help="simulate without sensor noise")
     ap.add_argument("--json", type=Path, help="write the rows and the summary here")
     ap.add_argument("--work", type=Path, help="keep each run's vehicle file and output here")
+    ap.add_argument("--config", type=Path,
+                    help="analysis config for every analyze (e.g. [model_update] edge_s = 0.5)")
     a = ap.parse_args(argv)
     try:
         seeds = harness.draw_bus_seeds(a.buses, "model update")
         if a.nominal and 0 not in seeds:
             seeds = [0] + seeds
-        rows = run(seeds, ["--no-noise"] if a.no_noise else [], a.work)
+        rows = run(seeds, ["--no-noise"] if a.no_noise else [], a.work, a.config)
     except harness.Skip as e:
         print(f"skipped: {e}")
         return 0

@@ -1115,8 +1115,10 @@ impl BodyFit {
 /// positive semi-definite and its regressor block positive definite), at most 1.
 ///
 /// With `lambda` = 1 the fit is bias-compensated least squares; with the smallest eigenvalue it
-/// is generalized total least squares, the maximum-likelihood fit of a linear model whose every
-/// column is noisy with known covariance shape. Both are consistent; with few records the
+/// is generalized total least squares (the maximum-likelihood fit of a linear model whose every
+/// column is noisy, for independent equations whose noise covariance is known up to a factor;
+/// here the band-passed equations are not independent, so it is that fit's form, not its
+/// optimality). Both are consistent; with few records the
 /// eigenvalue falls below 1 by chance and subtracting the whole expected share leaves a nearly
 /// singular, or indefinite, matrix whose inverse scatters and biases the fit (docs/model_update.md,
 /// "Sensor noise"). An eigenvalue above 1 says the equations hold more error than the sensors'
