@@ -11,6 +11,7 @@ ks_r, cs_f, cs_r times spring_scale / damper_scale per corner) with the truth.
     python tools/busgen/update.py --buses 6            # 6 buses drawn at random
     VIBMODE_BUS_SEEDS=0,17 python tools/busgen/update.py
     python tools/busgen/update.py --buses 3 --no-noise
+    python tools/busgen/update.py --buses 3 --added-noise 0.0025,2.6e-4   # unsprung noise / 4
 
 Prints one row per bus and file variant, then the rates. busgen needs numpy and scipy
 (BUSGEN_PYTHON); the binary is VIBMODE_BIN or target/release/vibmode.
@@ -20,6 +21,9 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
+import random
+import shutil
 import sys
 import tempfile
 from pathlib import Path
@@ -216,12 +220,40 @@ def accuracy(rows: List[Dict]) -> Dict[str, float]:
             "supported": sum(1 for r in fig if r.get("supported", True))}
 
 
+def with_noise(clean: Path, densities: List[float], out: Path, seed: int) -> Path:
+    """A copy of a folder of noise-free records with white noise added: one-sided densities
+    `densities` = [unsprung, sprung] in (m/s^2)^2/Hz on the channels named unsprung_* and
+    sprung_* (variance density * fs / 2 per sample), from random.Random(seed)."""
+    out.mkdir(parents=True, exist_ok=True)
+    shutil.copy(clean / "truth.json", out / "truth.json")
+    rng = random.Random(seed)
+    for f in harness.records(clean):
+        lines = f.read_text().splitlines()
+        head = lines[0].split(",")
+        rows = [[float(v) for v in ln.split(",")] for ln in lines[1:]]
+        fs = 1.0 / (rows[1][0] - rows[0][0])
+        sig = [math.sqrt(densities[0 if h.startswith("unsprung") else 1] * fs / 2)
+               if h.split("_")[0] in ("unsprung", "sprung") else 0.0 for h in head]
+        text = [lines[0]]
+        for r in rows:
+            text.append(",".join(repr(v + rng.gauss(0.0, g)) if g > 0 else repr(v)
+                                 for v, g in zip(r, sig)))
+        (out / f.name).write_text("\n".join(text) + "\n")
+    return out
+
+
 def run(seeds: List[int], extra: List[str], work: Optional[Path] = None,
-        config: Optional[Path] = None) -> List[Dict]:
+        config: Optional[Path] = None, added_noise: Optional[List[float]] = None) -> List[Dict]:
+    """Each bus simulated (busgen options `extra`) and fitted with and without a front bar; with
+    `added_noise` ([unsprung, sprung] densities), its noise-free records with that noise added."""
     work = work or Path(tempfile.mkdtemp(prefix="vibmode-upd-"))
     rows = []
     for s in seeds:
-        folder = harness.simulate(s, 1000 + s, *extra)
+        if added_noise is not None:
+            folder = with_noise(harness.simulate(s, 1000 + s, "--no-noise", *extra), added_noise,
+                                work / f"bus{s}-records", s)
+        else:
+            folder = harness.simulate(s, 1000 + s, *extra)
         for bar in (False, True):
             r = score(folder, bar, work / f"bus{s}-{'bar' if bar else 'nobar'}", config)
             print(fmt_row(r), flush=True)
@@ -236,6 +268,10 @@ def main(argv: Optional[List[str]] = None) -> int:
     ap.add_argument("--no-noise", action="store_true", help="simulate without sensor noise")
     ap.add_argument("--json", type=Path, help="write the rows and the summary here")
     ap.add_argument("--work", type=Path, help="keep each run's vehicle file and output here")
+    ap.add_argument("--added-noise", metavar="UNSPRUNG,SPRUNG",
+                    help="noise-free records with white noise of these one-sided densities, "
+                         "(m/s^2)^2/Hz, added to the unsprung and sprung channels (busgen's own "
+                         "noise measures about 0.01,2.6e-4): which sensors' noise limits the fit")
     ap.add_argument("--config", type=Path,
                     help="analysis config for every analyze (e.g. [model_update] edge_s = 0.5)")
     a = ap.parse_args(argv)
@@ -243,7 +279,12 @@ def main(argv: Optional[List[str]] = None) -> int:
         seeds = harness.draw_bus_seeds(a.buses, "model update")
         if a.nominal and 0 not in seeds:
             seeds = [0] + seeds
-        rows = run(seeds, ["--no-noise"] if a.no_noise else [], a.work, a.config)
+        added = [float(v) for v in a.added_noise.split(",")] if a.added_noise else None
+        if added is not None and (len(added) != 2 or not all(v >= 0 for v in added)):
+            print(f"--added-noise {a.added_noise}: give two densities >= 0, e.g. 0.01,2.6e-4")
+            return 2
+        rows = run(seeds, ["--no-noise"] if a.no_noise and added is None else [], a.work,
+                   a.config, added)
     except harness.Skip as e:
         print(f"skipped: {e}")
         return 0
