@@ -7,11 +7,12 @@
 //! squares over three or more sensors), the wheel coordinates from the unsprung sensors. With the
 //! sprung mass fixed at the vehicle file's value, the rows are linear in the pitch and roll
 //! inertias, the four suspension springs and dampers and the anti-roll bars present in the file:
-//! a least-squares problem whose normal equations are summed record by record, each record's
-//! with its sensors' noise share taken out (bias-compensated least squares: every regressor is a
-//! measured, noisy signal; the noise densities come from each channel's spectrum above the
-//! band), and whose parameters and body modes get jackknife standard deviations over the
-//! records (docs/model_update.md).
+//! a least-squares problem whose normal equations are summed record by record, with the
+//! sensors' noise share taken out (every regressor is a measured, noisy signal; the noise
+//! densities come from each channel's spectrum above the band; as much of the share as leaves
+//! the equations positive semi-definite, at most all of it: generalized total least squares,
+//! [`noise_scale`]), and whose parameters and body modes get jackknife standard deviations over
+//! the records (docs/model_update.md).
 //!
 //! The rows are differentiated twice, so that they hold for the measured accelerations and their
 //! first and second derivatives (`M a'' + C a' + K a = 0`): nothing is integrated. The
@@ -1118,10 +1119,9 @@ impl BodyFit {
 /// is generalized total least squares (the maximum-likelihood fit of a linear model whose every
 /// column is noisy, for independent equations whose noise covariance is known up to a factor;
 /// here the band-passed equations are not independent, so it is that fit's form, not its
-/// optimality). Both are consistent; with few records the
-/// eigenvalue falls below 1 by chance and subtracting the whole expected share leaves a nearly
-/// singular, or indefinite, matrix whose inverse scatters and biases the fit (docs/model_update.md,
-/// "Sensor noise"). An eigenvalue above 1 says the equations hold more error than the sensors'
+/// optimality). Both are consistent; with few records the eigenvalue falls below 1 by chance
+/// and subtracting the whole expected share leaves a nearly singular, or indefinite, matrix
+/// whose inverse scatters and biases the fit (docs/model_update.md, "Sensor noise"). An eigenvalue above 1 says the equations hold more error than the sensors'
 /// noise (a model error: manoeuvres, bending, lines), which is not the noise's shape, so no more
 /// than the expected share is taken out. 1 when there is no noise share (no flat floor found),
 /// or when `raw` is not positive definite (then the fit says why).
