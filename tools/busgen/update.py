@@ -11,6 +11,7 @@ ks_r, cs_f, cs_r times spring_scale / damper_scale per corner) with the truth.
     python tools/busgen/update.py --buses 6            # 6 buses drawn at random
     VIBMODE_BUS_SEEDS=0,17 python tools/busgen/update.py
     python tools/busgen/update.py --buses 3 --no-noise
+    python tools/busgen/update.py --buses 3 --added-noise 0.0025,2.6e-4   # unsprung noise / 4
 
 Prints one row per bus and file variant, then the rates. busgen needs numpy and scipy
 (BUSGEN_PYTHON); the binary is VIBMODE_BIN or target/release/vibmode.
@@ -20,6 +21,9 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
+import random
+import shutil
 import sys
 import tempfile
 from pathlib import Path
@@ -44,8 +48,9 @@ GENERIC = dict(pitch_inertia_kgm2=115000.0, roll_inertia_kgm2=16000.0, cg_height
 def vehicle_toml(truth: Dict, front_bar: bool) -> str:
     """A vibmode vehicle file for a busgen truth.json: the bus's geometry, masses and tyres, the
     generic suspension and inertias (those are fitted), sensors named as busgen's channels.
-    `front_bar`: keep the generic front anti-roll bar in the file (busgen's buses have none, so
-    the update should find it absent). No bending section: the update's band is below it."""
+    `front_bar`: keep the generic front anti-roll bar in the file (half of busgen's buses have
+    none, and the update should find it absent there; the other half draw one of 0-200 kN m/rad,
+    which a file without a bar cannot represent: `represents_bus`). No bending section: the update's band is below it."""
     b = truth["bus"]
     g = GENERIC
     lines = [
@@ -113,15 +118,18 @@ def fitted_params(mu: Dict) -> Dict[str, float]:
     return out
 
 
-def score(folder: Path, front_bar: bool, out: Path) -> Dict:
-    """One update on one folder: its errors against the truth (or why it was not updated)."""
+def score(folder: Path, front_bar: bool, out: Path, config: Optional[Path] = None) -> Dict:
+    """One update on one folder: its errors against the truth (or why it was not updated).
+    `config`: an analysis config given to `vibmode analyze` (e.g. its `[model_update]`)."""
     t = harness.truth(folder)
     out.mkdir(parents=True, exist_ok=True)
     vf = out / "bus.toml"
     vf.write_text(vehicle_toml(t, front_bar))
-    res = harness.analyze(folder, "--vehicle", vf, out=out / "out")
+    extra = ["--config", str(config)] if config else []
+    res = harness.analyze(folder, "--vehicle", vf, *extra, out=out / "out")
     mu = res.get("model_update") or {}
     row: Dict = {"bus": t["bus_seed"], "front_bar": front_bar,
+                 "bus_front_bar_nm_per_rad": t["bus"]["karb_f"],
                  "written": (out / "out" / "updated_vehicle.toml").is_file()}
     if "not_updated" in mu:
         row["not_updated"] = mu["not_updated"]
@@ -152,8 +160,20 @@ def score(folder: Path, front_bar: bool, out: Path) -> Dict:
     return row
 
 
+#: A front bar below this (N m/rad) changes the bus's roll by well under 1 %: taken as none.
+NEGLIGIBLE_BAR_NM_PER_RAD = 10e3
+
+
+def represents_bus(r: Dict) -> bool:
+    """Whether the row's vehicle file can represent its bus: it has a front bar, or the bus has
+    none (a file without one cannot fit the roll stiffness of a bus that has one)."""
+    return r["front_bar"] or r.get("bus_front_bar_nm_per_rad", 0.0) < NEGLIGIBLE_BAR_NM_PER_RAD
+
+
 def fmt_row(r: Dict) -> str:
     head = f"bus {r['bus']:>5} {'front bar' if r['front_bar'] else 'no bar   '}"
+    if r.get("bus_front_bar_nm_per_rad", 0.0) >= NEGLIGIBLE_BAR_NM_PER_RAD:
+        head += f" (bus has a {r['bus_front_bar_nm_per_rad'] / 1e3:.0f} kN m/rad front bar)"
     if "modes" not in r:
         return f"{head}  NOT UPDATED: {r['not_updated'][:150]}"
     sds = r.get("param_sd", {})
@@ -183,13 +203,73 @@ def summarize(rows: List[Dict]) -> Dict[str, float]:
             "params_within_10pct": sum(per_param), "params": len(per_param)}
 
 
-def run(seeds: List[int], extra: List[str], work: Optional[Path] = None) -> List[Dict]:
+def accuracy(rows: List[Dict]) -> Dict[str, float]:
+    """The fit's errors over every row with figures, supported or not (the estimator's accuracy,
+    apart from whether it trusts itself): median absolute body-mode error, modes within 3 %, fits
+    with all three, median absolute spring and damper error, parameters within 10 %, the range of
+    the modes' relative standard deviations, and how many fits were supported."""
+    def med(v: List[float]) -> float:
+        v = sorted(v)
+        return float("nan") if not v else 0.5 * (v[(len(v) - 1) // 2] + v[len(v) // 2])
+
+    fig = [r for r in rows if "modes" in r]
+    modes = [abs(v) for r in fig for v in r["modes"].values()]
+    springs = [abs(v) for r in fig for k, v in r["params"].items() if k.startswith("spring")]
+    dampers = [abs(v) for r in fig for k, v in r["params"].items() if k.startswith("damper")]
+    sds = [v for r in fig for v in r.get("mode_sd", {}).values()]
+    heave = [r["modes"]["body heave"] for r in fig if "body heave" in r["modes"]]
+    return {"fits": len(rows), "with_figures": len(fig),
+            "mode_error_median": med(modes),
+            "modes_within_3pct": sum(v <= MODE_TOL for v in modes), "modes": len(modes),
+            "fits_all_three_within_3pct": sum(
+                1 for r in fig if len(r["modes"]) == 3
+                and all(abs(v) <= MODE_TOL for v in r["modes"].values())),
+            "spring_error_median": med(springs), "damper_error_median": med(dampers),
+            "params_within_10pct": sum(v <= PARAM_TOL for v in springs + dampers),
+            "params": len(springs) + len(dampers),
+            "heave_error_mean": sum(heave) / len(heave) if heave else float("nan"),
+            "mode_sd_min": min(sds) if sds else float("nan"),
+            "mode_sd_max": max(sds) if sds else float("nan"),
+            "mode_sd_median": med(sds),
+            "supported": sum(1 for r in fig if r.get("supported", True))}
+
+
+def with_noise(clean: Path, densities: List[float], out: Path, seed: int) -> Path:
+    """A copy of a folder of noise-free records with white noise added: one-sided densities
+    `densities` = [unsprung, sprung] in (m/s^2)^2/Hz on the channels named unsprung_* and
+    sprung_* (variance density * fs / 2 per sample), from random.Random(seed)."""
+    out.mkdir(parents=True, exist_ok=True)
+    shutil.copy(clean / "truth.json", out / "truth.json")
+    rng = random.Random(seed)
+    for f in harness.records(clean):
+        lines = f.read_text().splitlines()
+        head = lines[0].split(",")
+        rows = [[float(v) for v in ln.split(",")] for ln in lines[1:]]
+        fs = 1.0 / (rows[1][0] - rows[0][0])
+        sig = [math.sqrt(densities[0 if h.startswith("unsprung") else 1] * fs / 2)
+               if h.split("_")[0] in ("unsprung", "sprung") else 0.0 for h in head]
+        text = [lines[0]]
+        for r in rows:
+            text.append(",".join(repr(v + rng.gauss(0.0, g)) if g > 0 else repr(v)
+                                 for v, g in zip(r, sig)))
+        (out / f.name).write_text("\n".join(text) + "\n")
+    return out
+
+
+def run(seeds: List[int], extra: List[str], work: Optional[Path] = None,
+        config: Optional[Path] = None, added_noise: Optional[List[float]] = None) -> List[Dict]:
+    """Each bus simulated (busgen options `extra`) and fitted with and without a front bar; with
+    `added_noise` ([unsprung, sprung] densities), its noise-free records with that noise added."""
     work = work or Path(tempfile.mkdtemp(prefix="vibmode-upd-"))
     rows = []
     for s in seeds:
-        folder = harness.simulate(s, 1000 + s, *extra)
+        if added_noise is not None:
+            folder = with_noise(harness.simulate(s, 1000 + s, "--no-noise", *extra), added_noise,
+                                work / f"bus{s}-records", s)
+        else:
+            folder = harness.simulate(s, 1000 + s, *extra)
         for bar in (False, True):
-            r = score(folder, bar, work / f"bus{s}-{'bar' if bar else 'nobar'}")
+            r = score(folder, bar, work / f"bus{s}-{'bar' if bar else 'nobar'}", config)
             print(fmt_row(r), flush=True)
             rows.append(r)
     return rows
@@ -202,12 +282,23 @@ def main(argv: Optional[List[str]] = None) -> int:
     ap.add_argument("--no-noise", action="store_true", help="simulate without sensor noise")
     ap.add_argument("--json", type=Path, help="write the rows and the summary here")
     ap.add_argument("--work", type=Path, help="keep each run's vehicle file and output here")
+    ap.add_argument("--added-noise", metavar="UNSPRUNG,SPRUNG",
+                    help="noise-free records with white noise of these one-sided densities, "
+                         "(m/s^2)^2/Hz, added to the unsprung and sprung channels (busgen's own "
+                         "noise measures about 0.01,2.6e-4): which sensors' noise limits the fit")
+    ap.add_argument("--config", type=Path,
+                    help="analysis config for every analyze (e.g. [model_update] edge_s = 0.5)")
     a = ap.parse_args(argv)
     try:
         seeds = harness.draw_bus_seeds(a.buses, "model update")
         if a.nominal and 0 not in seeds:
             seeds = [0] + seeds
-        rows = run(seeds, ["--no-noise"] if a.no_noise else [], a.work)
+        added = [float(v) for v in a.added_noise.split(",")] if a.added_noise else None
+        if added is not None and (len(added) != 2 or not all(v >= 0 for v in added)):
+            print(f"--added-noise {a.added_noise}: give two densities >= 0, e.g. 0.01,2.6e-4")
+            return 2
+        rows = run(seeds, ["--no-noise"] if a.no_noise and added is None else [], a.work,
+                   a.config, added)
     except harness.Skip as e:
         print(f"skipped: {e}")
         return 0
@@ -217,9 +308,26 @@ def main(argv: Optional[List[str]] = None) -> int:
           f"{harness.rate(s['all_params_within_10pct'], s['runs'])}; single parameters within 10 %: "
           f"{harness.rate(s['params_within_10pct'], s['params'])}; updated "
           f"{harness.rate(s['updated'], s['runs'])}")
+    for acc, what in ((accuracy(rows), "every fit"),
+                      (accuracy([r for r in rows if represents_bus(r)]),
+                       "the fits whose file can represent the bus")):
+        print_accuracy(acc, what)
     if a.json:
-        a.json.write_text(json.dumps({"rows": rows, "summary": s}, indent=1))
+        a.json.write_text(json.dumps({"rows": rows, "summary": s, "accuracy": accuracy(rows)},
+                                     indent=1))
     return 0
+
+
+def print_accuracy(acc: Dict, what: str) -> None:
+    print(f"accuracy over {what} with figures (supported or not): "
+          f"body-mode error median {100 * acc['mode_error_median']:.1f} %, "
+          f"{acc['modes_within_3pct']}/{acc['modes']} modes within 3 %, "
+          f"{acc['fits_all_three_within_3pct']}/{acc['fits']} fits with all three; "
+          f"springs median {100 * acc['spring_error_median']:.1f} %, dampers "
+          f"{100 * acc['damper_error_median']:.1f} %, {acc['params_within_10pct']}/{acc['params']} "
+          f"springs and dampers within 10 %; heave mean {100 * acc['heave_error_mean']:+.1f} %; "
+          f"mode sd {100 * acc['mode_sd_min']:.1f}-{100 * acc['mode_sd_max']:.1f} % "
+          f"(median {100 * acc['mode_sd_median']:.1f} %); supported {acc['supported']}/{acc['fits']}")
 
 
 if __name__ == "__main__":

@@ -24,9 +24,13 @@ The fit (the algorithm of crates/vibmode-vehicle/src/update.rs, written again he
   h_l[(t-j) mod m] (directly, numpy indexing); the rows' linear map L_k of each channel's k-th
   signal (rows evaluated at unit inputs); share = sum_channels s^2 sum_kl sum_t c_kl(t) L_k^T L_l
   with s^2 = density fs / 2.
-* theta = solve(sum_r (Z_r^T Z_r - N_r)) (the unbounded solution; this case is feasible); the
-  jackknife over the 3 records: sd = sqrt((R-1)/R sum (theta_(-r) - mean)^2) for every parameter
-  and for the three body modes' frequency and damping (scipy.linalg.eigvals).
+* The share taken out, lambda: with G = sum_r Z_r^T Z_r and N = sum_r N_r, the largest generalized
+  eigenvalue mu of N v = mu G v (scipy.linalg.eigh(N, G)); lambda = 1 / mu when mu > 1, else 1
+  (generalized total least squares, capped at the whole expected share).
+* theta = solve(G - lambda N) (the unbounded solution; this case is feasible); the
+  jackknife over the 3 records, lambda found again for each: sd = sqrt((R-1)/R sum (theta_(-r) -
+  mean)^2) for every parameter and for the three body modes' frequency and damping
+  (scipy.linalg.eigvals).
 
 Rust tolerance (crates/vibmode-vehicle/tests/reference.rs): densities, parameters, modes and
 their standard deviations relative 1e-6 (same algorithm; different FFT, median selection and
@@ -144,12 +148,18 @@ def fit(p, records):
             for k in range(3):
                 for l in range(3):
                     N = N + var * c[k, l] * (L[k].T @ L[l])
-        grams.append(G - N)
+        grams.append((G, N))
         dens.append(ds)
     ms = p["body"]["mass_kg"]
 
+    def share(G, N):
+        mu = scipy.linalg.eigh(N, G, eigvals_only=True).max()
+        return 1.0 / mu if mu > 1.0 else 1.0
+
     def solve(Gs):
-        Gt = sum(Gs)
+        G, N = sum(g for g, _ in Gs), sum(q for _, q in Gs)
+        lam = share(G, N)
+        Gt = G - lam * N
         nu = Gt.shape[0] - 1
         th = np.linalg.solve(Gt[:nu, :nu], Gt[:nu, nu])
         assert np.all(th > 0), th
@@ -161,9 +171,9 @@ def fit(p, records):
                 q["bars"][a] = float(th[col])
                 col += 1
         fq, zq = bf.modes(*bf.matrices(p, q["springs"], q["dampers"], q["bars"], q["inertia"])[:3])
-        return th, fq, zq, q
+        return th, fq, zq, q, lam
 
-    th, fq, zq, q = solve(grams)
+    th, fq, zq, q, lam = solve(grams)
     loo = [solve([g for i, g in enumerate(grams) if i != r]) for r in range(len(grams))]
     R = len(grams)
 
@@ -174,7 +184,7 @@ def fit(p, records):
     return dict(band_hz=list(band), params=q, theta_si=th.tolist(), theta_sd=jack([l[0] for l in loo]),
                 body_frequency_hz=fq, body_damping_ratio=zq,
                 body_frequency_sd=jack([l[1] for l in loo]), body_damping_sd=jack([l[2] for l in loo]),
-                density=dens)
+                noise_share=lam, noise_share_without_each=[l[4] for l in loo], density=dens)
 
 
 def main():

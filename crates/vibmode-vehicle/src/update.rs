@@ -7,11 +7,12 @@
 //! squares over three or more sensors), the wheel coordinates from the unsprung sensors. With the
 //! sprung mass fixed at the vehicle file's value, the rows are linear in the pitch and roll
 //! inertias, the four suspension springs and dampers and the anti-roll bars present in the file:
-//! a least-squares problem whose normal equations are summed record by record, each record's
-//! with its sensors' noise share taken out (bias-compensated least squares: every regressor is a
-//! measured, noisy signal; the noise densities come from each channel's spectrum above the
-//! band), and whose parameters and body modes get jackknife standard deviations over the
-//! records (docs/model_update.md).
+//! a least-squares problem whose normal equations are summed record by record, with the
+//! sensors' noise share taken out (every regressor is a measured, noisy signal; the noise
+//! densities come from each channel's spectrum above the band; as much of the share as leaves
+//! the equations positive semi-definite, at most all of it: generalized total least squares,
+//! [`noise_scale`]), and whose parameters and body modes get jackknife standard deviations over
+//! the records (docs/model_update.md).
 //!
 //! The rows are differentiated twice, so that they hold for the measured accelerations and their
 //! first and second derivatives (`M a'' + C a' + K a = 0`): nothing is integrated. The
@@ -76,9 +77,10 @@ pub struct BodyFit {
     nominal_modes: Vec<ModeInfo>,
     /// Sum over records of `Z^T Z`, `Z = [X | y]` the equations' regressors and right side.
     gram: DMatrix<f64>,
-    /// Per record: its `Z^T Z` minus the share its sensors' noise is expected to add
-    /// (bias compensation; the fit and the jackknife sum these).
-    per_record: Vec<DMatrix<f64>>,
+    /// Per record: its `Z^T Z` and the share its sensors' noise is expected to add to it
+    /// (the fit and the jackknife sum these and take out the noise's share, scaled by
+    /// [`noise_scale`]).
+    per_record: Vec<(DMatrix<f64>, DMatrix<f64>)>,
     /// Per record and used channel: the noise density estimated from the channel's spectrum
     /// above the band, (m/s^2)^2/Hz (0 where no such band exists).
     noise: Vec<(String, f64)>,
@@ -142,6 +144,10 @@ pub struct BodyFitResult {
     /// Each used channel's noise density, estimated from its spectrum above the band and
     /// subtracted from the equations (median over the records), (m/s^2)^2/Hz.
     pub noise_density: Vec<ChannelNoise>,
+    /// The share of the noise's expected contribution taken out of the normal equations
+    /// ([`noise_scale`]): 1 = all of it (bias-compensated least squares); below 1 when the
+    /// equations become singular before (generalized total least squares).
+    pub noise_share: f64,
 }
 
 /// Relative standard deviation of a body mode's frequency above which the fit is not supported.
@@ -367,7 +373,15 @@ impl BodyFitResult {
             .map(|c| c.channel.as_str())
             .collect();
         s.push_str(&format!(
-            "  (sprung mass, unsprung masses, tyres and bending are the file's; the sensors' white noise, measured above the band, taken out of the equations{})\n",
+            "  (sprung mass, unsprung masses, tyres and bending are the file's; the sensors' white noise, measured above the band, taken out of the equations{}{})\n",
+            if self.noise_share < 1.0 {
+                format!(
+                    " ({:.0} % of its expected share, where the equations become singular: generalized total least squares)",
+                    100.0 * self.noise_share
+                )
+            } else {
+                String::new()
+            },
             if floorless.is_empty() {
                 String::new()
             } else {
@@ -720,7 +734,7 @@ impl BodyFit {
             }
         }
         self.gram += &gram;
-        self.per_record.push(gram - noise_gram);
+        self.per_record.push((gram, noise_gram));
         self.records += 1;
         Ok(())
     }
@@ -787,11 +801,13 @@ impl BodyFit {
             ));
         }
         let n = self.gram.nrows() - 1;
-        let total = self
+        let zero = || DMatrix::<f64>::zeros(n + 1, n + 1);
+        let (raw, noise) = self
             .per_record
             .iter()
-            .fold(DMatrix::zeros(n + 1, n + 1), |a, g| a + g);
-        let (th, at_zero) = self.solve_gram(&total)?;
+            .fold((zero(), zero()), |(a, b), (g, q)| (a + g, b + q));
+        let scale = noise_scale(&raw, &noise);
+        let (th, at_zero) = self.solve_gram(&(&raw - &noise * scale))?;
         let (ata, atb, btb) = (
             self.gram.view((0, 0), (n, n)),
             self.gram.view((0, n), (n, 1)),
@@ -812,9 +828,11 @@ impl BodyFit {
         let mut loo_values: Vec<Vec<f64>> = Vec::new();
         let mut loo_modes: Vec<Vec<Option<(f64, f64)>>> = Vec::new();
         if self.records >= 3 {
-            for (r, g) in self.per_record.iter().enumerate() {
+            for (r, (g, q)) in self.per_record.iter().enumerate() {
+                let (raw_r, noise_r) = (&raw - g, &noise - q);
+                let scale_r = noise_scale(&raw_r, &noise_r);
                 let fit = self
-                    .solve_gram(&(&total - g))
+                    .solve_gram(&(&raw_r - &noise_r * scale_r))
                     .and_then(|(t, z)| Ok((self.vehicle_from(&t, &z)?, t)))
                     .and_then(|((vv, _), t)| Ok((FullCar::new(&vv)?.modes()?, t)));
                 match fit {
@@ -930,6 +948,7 @@ impl BodyFit {
             supported: not_supported.is_none(),
             not_supported,
             noise_density: self.noise_summary(),
+            noise_share: scale,
         })
     }
 
@@ -1088,6 +1107,46 @@ impl BodyFit {
             })
             .collect();
         Ok((v, absent))
+    }
+}
+
+/// How much of the noise's expected share `noise` is taken out of the normal equations `raw`
+/// (both augmented, `[X | y]^T [X | y]`): the smallest `lambda` at which `raw - lambda noise`
+/// becomes singular (the generalized eigenvalue of the pencil, so that the corrected matrix stays
+/// positive semi-definite and its regressor block positive definite), at most 1.
+///
+/// With `lambda` = 1 the fit is bias-compensated least squares; with the smallest eigenvalue it
+/// is generalized total least squares (the maximum-likelihood fit of a linear model whose every
+/// column is noisy, for independent equations whose noise covariance is known up to a factor;
+/// here the band-passed equations are not independent, so it is that fit's form, not its
+/// optimality). Both are consistent; with few records the eigenvalue falls below 1 by chance
+/// and subtracting the whole expected share leaves a nearly singular, or indefinite, matrix
+/// whose inverse scatters and biases the fit (docs/model_update.md, "Sensor noise"). An eigenvalue above 1 says the equations hold more error than the sensors'
+/// noise (a model error: manoeuvres, bending, lines), which is not the noise's shape, so no more
+/// than the expected share is taken out. 1 when there is no noise share (no flat floor found),
+/// or when `raw` is not positive definite (then the fit says why).
+pub fn noise_scale(raw: &DMatrix<f64>, noise: &DMatrix<f64>) -> f64 {
+    // raw = L L^T; raw v = lambda noise v  <=>  L^-1 noise L^-T u = (1 / lambda) u.
+    let Some(ch) = raw.clone().cholesky() else {
+        return 1.0;
+    };
+    let l = ch.l();
+    let Some(a) = l.solve_lower_triangular(noise) else {
+        return 1.0;
+    };
+    let Some(b) = l.solve_lower_triangular(&a.transpose()) else {
+        return 1.0;
+    };
+    let sym = 0.5 * (&b + b.transpose());
+    let mu = sym
+        .symmetric_eigenvalues()
+        .iter()
+        .cloned()
+        .fold(0.0_f64, f64::max);
+    if mu.is_finite() && mu > 1.0 {
+        1.0 / mu
+    } else {
+        1.0
     }
 }
 
@@ -1514,7 +1573,7 @@ mod tests {
             };
             let mut fit = BodyFit::new(&v, BodyFitParams::default()).unwrap();
             fit.add_record(&rec).unwrap();
-            let corrected = &fit.per_record[0];
+            let corrected = &fit.per_record[0].0 - &fit.per_record[0].1;
             let raw = &fit.gram;
             let k = raw.nrows();
             ratios.push(
@@ -1553,6 +1612,60 @@ mod tests {
         assert!(
             (all - 1.0).abs() < 0.02,
             "all unknowns: raw / noise share {all}"
+        );
+    }
+
+    /// By hand: the share taken out is the smallest generalized eigenvalue of `raw v = l noise v`,
+    /// capped at 1. raw = [[2, 1], [1, 2]] (eigenvalues 1 and 3), noise = 4 I: l = 1/4. With
+    /// noise = I / 2 the eigenvalues are 2 and 6: capped at 1. No noise: 1. A raw matrix that is
+    /// not positive definite: 1 (the fit then says why).
+    #[test]
+    fn noise_scale_by_hand() {
+        let raw = DMatrix::from_row_slice(2, 2, &[2.0, 1.0, 1.0, 2.0]);
+        let eye = DMatrix::<f64>::identity(2, 2);
+        assert!((noise_scale(&raw, &(&eye * 4.0)) - 0.25).abs() < 1e-12);
+        assert_eq!(noise_scale(&raw, &(&eye * 0.5)), 1.0);
+        assert_eq!(noise_scale(&raw, &DMatrix::zeros(2, 2)), 1.0);
+        let indefinite = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
+        assert_eq!(noise_scale(&indefinite, &eye), 1.0);
+    }
+
+    /// Identity over seeded random pencils (a signal and a noise whose share is estimated up to
+    /// 50 % off): when the share is below 1, `raw - l noise` is
+    /// positive semi-definite with one eigenvalue 0 (to 1e-9 of the largest); when it is 1,
+    /// `raw - noise` is positive definite.
+    #[test]
+    fn noise_scale_leaves_the_corrected_matrix_just_singular() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(30);
+        let (mut below, mut capped) = (0, 0);
+        for _ in 0..200 {
+            let n = rng.gen_range(2..14);
+            let x = DMatrix::from_fn(3 * n, n, |_, _| rng.gen_range(-1.0..1.0));
+            let e = DMatrix::from_fn(2 * n, n, |_, _| rng.gen_range(-1.0..1.0));
+            // The noise's share as estimated, off from what the equations hold by up to 50 %.
+            let held = e.transpose() * &e * rng.gen_range(0.5..50.0);
+            let raw = x.transpose() * &x + &held;
+            let noise = &held * rng.gen_range(0.5..1.5);
+            let l = noise_scale(&raw, &noise);
+            let eig = (&raw - &noise * l).symmetric_eigenvalues();
+            let (lo, hi) = eig
+                .iter()
+                .fold((f64::INFINITY, 0.0_f64), |(a, b), &v| (a.min(v), b.max(v)));
+            if l < 1.0 {
+                below += 1;
+                assert!(
+                    lo.abs() <= 1e-9 * hi,
+                    "share {l}: smallest eigenvalue {lo} of {hi}"
+                );
+            } else {
+                capped += 1;
+                assert!(lo > 0.0, "share 1: smallest eigenvalue {lo}");
+            }
+        }
+        assert!(
+            below > 20 && capped > 20,
+            "below 1: {below}, capped: {capped}"
         );
     }
 
