@@ -1266,8 +1266,6 @@ fn attribute_ratios(set: &ModelSet, values: &[(FeatureMeta, f64)], evidence: &mu
         let x = values.iter().find(|(m, _)| m.key == key).map(|(_, v)| *v)?;
         Some(score(f, x, &set.config))
     };
-    // The other ratio of a corner (its side's for an axle ratio, its axle's for a side's), as
-    // a z-score of the corner's level over its neighbour's.
     // The spread of a ratio kind (pooled: one per kind).
     let sigma_of = |kind: Kind| -> Option<f64> {
         set.features
@@ -1287,6 +1285,8 @@ fn attribute_ratios(set: &ModelSet, values: &[(FeatureMeta, f64)], evidence: &mu
             .map(|e| e.z.abs() / e.limit)
             .fold(0.0, f64::max)
     };
+    // The other ratio of a corner (its side's for an axle ratio, its axle's for a side's), as
+    // a z-score of the corner's level over its neighbour's.
     let other = |kind: Kind, corner: Corner| -> Option<f64> {
         let (other_kind, pairs) = if kind == Kind::SideRatio {
             (Kind::TrackRatio, TRACKS)
