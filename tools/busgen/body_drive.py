@@ -20,7 +20,21 @@ and, for the nominal records, the leave-one-out scatter (standard deviation) of 
 `xpooled` value (`H` fitted without the record). `H` is fitted as vibmode does,
 `(sum S_yu)(sum S_uu)^-1` over the nominal records.
 
+Then two other candidates for a soft spring, from the same summed cross-spectra, per sprung
+channel relative to the mean of the other sprung channels, as the drive's value minus the
+baseline's (both drives of the baseline summed), ln units, in LOW_BANDS_HZ:
+
+- `level`: the sprung channel's RMS (`0.5 ln sum S_yy`): the body's modes tilt towards a soft
+  corner (its floor moves more at the heave, pitch and roll frequencies);
+- `h1`: the corner's own transmissibility from the cross-spectrum of its sprung and unsprung
+  channels, `0.5 ln (sum |S_yu|^2 / S_uu / sum S_uu)` (sprung-sensor noise does not bias it).
+
+`--spring-scale` sets the spring drive's scale (default fleet.py's 0.8; same corner and seeds).
+The last lines give per candidate the healthy and class D drives' spread (standard deviation
+over the buses) and the spring drives' values at the spring's corner.
+
 Usage: VIBMODE_BUS_SEEDS=41744,92730,45348 python3 tools/busgen/body_drive.py [--buses N]
+       [--spring-scale S]
 Needs VIBMODE_BIN, BUSGEN_PYTHON, and numpy in the Python running it.
 """
 
@@ -42,6 +56,8 @@ import fleet  # noqa: E402
 import harness as h  # noqa: E402
 
 BAND_HZ = (2.0, 4.0)
+#: Bands of the low-frequency spring candidates, Hz.
+LOW_BANDS_HZ = [(1.0, 1.5), (1.5, 2.5), (2.5, 4.0)]
 
 
 def _complex(a) -> np.ndarray:
@@ -49,8 +65,9 @@ def _complex(a) -> np.ndarray:
     return a[..., 0] + 1j * a[..., 1]
 
 
-def run_bus(bus_seed: int, n_records: int, work: Path) -> Dict:
-    """As fleet.run_bus (same random draws), keeping the store; the drives' record lists."""
+def run_bus(bus_seed: int, n_records: int, work: Path, spring_scale: float = 0.8) -> Dict:
+    """As fleet.run_bus (same random draws), keeping the store; the drives' record lists. The
+    spring drive has `spring_scale` (fleet.py's 0.8 by default)."""
     rng = random.Random(bus_seed * 7919 + n_records)
     db = work / f"fleet-{bus_seed}.db"
     vehicle = f"bus{bus_seed}"
@@ -63,6 +80,9 @@ def run_bus(bus_seed: int, n_records: int, work: Path) -> Dict:
     h.run_vibmode(["fleet", "baseline", "--db", db, "--vehicle", vehicle])
     drives = []
     for i, cond in enumerate(fleet.conditions(bus_seed, rng)):
+        if cond["name"] == "spring80" and spring_scale != 0.8:
+            cond = dict(cond, extra=["--spring", f"{cond['corner'].lower()}={spring_scale}"],
+                        detail=f"spring {cond['corner']}={spring_scale}")
         recs = h.records(h.simulate(bus_seed, base_seed + 10000 * (i + 1), *cond["extra"],
                                     records=n_records))
         h.run_vibmode(["fleet", "check", "--db", db, "--vehicle", vehicle, "-q", "--json", "-",
@@ -81,7 +101,7 @@ def load(db: Path) -> Dict[str, Dict]:
         if not bs:
             continue
         nu, ny = len(bs["unsprung"]), len(bs["sprung"])
-        out[fn] = {"f": np.array(bs["freq_hz"]),
+        out[fn] = {"f": np.array(bs["freq_hz"]), "unsprung": bs["unsprung"],
                    "suu": _complex(bs["s_uu"]).reshape(-1, nu, nu),
                    "syu": _complex(bs["s_yu"]).reshape(-1, ny, nu),
                    "syy": np.array(bs["s_yy"]), "cond": cond, "sprung": bs["sprung"]}
@@ -96,7 +116,8 @@ def fit_h(rs: List[Dict]) -> np.ndarray:
 
 
 def pool(rs: List[Dict]) -> Dict:
-    return {"f": rs[0]["f"], "suu": sum(r["suu"] for r in rs),
+    return {"f": rs[0]["f"], "unsprung": rs[0]["unsprung"], "sprung": rs[0]["sprung"],
+            "suu": sum(r["suu"] for r in rs),
             "syu": sum(r["syu"] for r in rs), "syy": sum(r["syy"] for r in rs)}
 
 
@@ -124,6 +145,24 @@ def cond_max(r: Dict) -> float:
     return float(max(np.linalg.cond(s) for s in r["suu"][m]))
 
 
+def low_candidates(r: Dict) -> Dict[str, np.ndarray]:
+    """`level` and `h1` per band of LOW_BANDS_HZ and sprung channel, each relative to the mean
+    of the other sprung channels (ln units)."""
+    corners = [c.split("_")[-1].upper() for c in r["unsprung"]]
+    own = [corners.index(c.split("_")[-1].upper()) for c in r["sprung"]]
+    out = {}
+    for lo, hi in LOW_BANDS_HZ:
+        m = (r["f"] >= lo) & (r["f"] < hi)
+        level = np.array([0.5 * np.log(r["syy"][m, j].sum()) for j in range(len(own))])
+        h1 = np.array([0.5 * np.log((abs(r["syu"][m, j, i]) ** 2 / r["suu"][m, i, i].real).sum()
+                                    / r["suu"][m, i, i].real.sum())
+                       for j, i in enumerate(own)])
+        for name, v in (("level", level), ("h1", h1)):
+            out[f"{name} {lo:g}-{hi:g} Hz"] = np.array(
+                [v[j] - np.delete(v, j).mean() for j in range(len(v))])
+    return out
+
+
 def fmt(v: np.ndarray) -> str:
     return " ".join(f"{x:+.2f}" for x in v)
 
@@ -132,6 +171,7 @@ def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--buses", type=int, default=3)
     p.add_argument("--records", type=int, default=h.RECORDS)
+    p.add_argument("--spring-scale", type=float, default=0.8)
     a = p.parse_args()
     try:
         h.vibmode_bin()
@@ -141,9 +181,11 @@ def main() -> int:
         print(f"skipped: {e}")
         return 0
     seeds = h.draw_bus_seeds(a.buses, "body per drive")
+    # candidate -> ("healthy" | "spring", values at the spring's corner or every channel)
+    low: Dict[str, Dict[str, List[float]]] = {}
     with tempfile.TemporaryDirectory(prefix="vibmode-body-drive-") as work:
         for s in seeds:
-            bus = run_bus(s, a.records, Path(work))
+            bus = run_bus(s, a.records, Path(work), a.spring_scale)
             recs = load(bus["db"])
             nominal = [k for k, v in recs.items() if v["cond"] == "nominal"]
             hm = fit_h([recs[k] for k in nominal])
@@ -152,13 +194,32 @@ def main() -> int:
             print(f"bus {s}: {len(nominal)} nominal records; per-record xpooled leave-one-out "
                   f"sd (FR RL RR) {fmt(loo.std(0))}; /sqrt({a.records}) "
                   f"{fmt(loo.std(0) / np.sqrt(a.records))}")
+            base_low = low_candidates(pool([recs[k] for k in nominal]))
             for d in bus["drives"]:
                 rs = [recs[k] for k in d["records"] if k in recs]
+                dl = low_candidates(pool(rs))
+                name = d["cond"]["name"]
+                sprung = [c.split("_")[-1].upper() for c in rs[0]["sprung"]]
+                for k, v in dl.items():
+                    x = v - base_low[k]
+                    e = low.setdefault(k, {"healthy": [], "spring": []})
+                    if name in ("healthy", "roadD"):
+                        e["healthy"] += list(x)
+                    elif name == "spring80" and d["cond"]["corner"] in sprung:
+                        e["spring"].append(float(x[sprung.index(d["cond"]["corner"])]))
+                print(f"  {name:<9} low " + "; ".join(f"{k} {fmt(v - base_low[k])}"
+                                                    for k, v in dl.items()), flush=True)
                 med = np.median([power_ratio(hm, r) for r in rs], axis=0)
                 pl = pool(rs)
                 print(f"  {d['cond']['name']:<9} {d['cond']['detail']:<30} median {fmt(med)} | "
                       f"pooled {fmt(power_ratio(hm, pl))} | xpooled {fmt(projection(hm, pl))} | "
                       f"cond {cond_max(pl):.0f}", flush=True)
+    print(f"low-frequency candidates (drive minus baseline, ln; spring at {a.spring_scale}):")
+    for k, e in low.items():
+        hv = np.array(e["healthy"])
+        print(f"  {k:<18} healthy and class D drives: sd {hv.std():.3f}, largest |x| "
+              f"{abs(hv).max():.3f} ({len(hv)} values); spring at its corner: "
+              + " ".join(f"{x:+.2f}" for x in e["spring"]))
     return 0
 
 

@@ -28,7 +28,8 @@ binaries) it is not scored per drive.
 every checked drive (not the baseline), e.g. to see what the driveline lines or the sensor
 noise do to a verdict.
 
-Usage: python3 tools/busgen/fleet.py [--buses N] [--records 8] [--json OUT] [--test-extra OPTS]
+Usage: python3 tools/busgen/fleet.py [--buses N] [--records 8] [--json OUT] [--keep DIR]
+       [--test-extra OPTS]
 Needs VIBMODE_BIN (else target/release/vibmode) and a Python with numpy+scipy for busgen
 (BUSGEN_PYTHON).
 """
@@ -95,8 +96,11 @@ def verdict_ok(cls: str, corner: Optional[str], cond: Dict) -> bool:
 
 
 def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
-            test_extra: Optional[List[str]] = None) -> Dict:
-    """Simulates, ingests, baselines and checks one bus; returns its rows."""
+            test_extra: Optional[List[str]] = None, keep: bool = False) -> Dict:
+    """Simulates, ingests, baselines and checks one bus; returns its rows.
+
+    The store is deleted unless `keep` (then it stays in `work` as fleet-SEED.db, beside each
+    check's JSON as check-SEED-CONDITION.json)."""
     db = work / f"fleet-{bus_seed}.db"
     if db.exists():
         db.unlink()
@@ -117,6 +121,8 @@ def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
         r = h.run_vibmode(["fleet", "check", "--db", db, "--vehicle", vehicle, "-q",
                            "--json", "-", *h.records(folder)])
         out = json.loads(r.stdout)
+        if keep:
+            (work / f"check-{bus_seed}-{cond['name']}.json").write_text(r.stdout)
         recs = [(x["classification"], first_corner(x.get("evidence", [])), x.get("summary", ""))
                 for x in out["records"]]
         drives = out.get("drives") or []
@@ -134,7 +140,8 @@ def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
                      else verdict_ok(drive[0], drive[1], cond) and drive[3] == cond["component"],
                      "false_both": sum(c == "both" for c, _, _ in recs)
                      if cond["expect"] != "vehicle" else 0})
-    db.unlink()
+    if not keep:
+        db.unlink()
     return {"bus": bus_seed, "rows": rows}
 
 
@@ -175,6 +182,8 @@ def main(argv: Optional[List[str]] = None) -> int:
     p.add_argument("--buses", type=int, default=4)
     p.add_argument("--records", type=int, default=h.RECORDS, help="records per drive")
     p.add_argument("--json", type=Path, help="write the rows and the summary here")
+    p.add_argument("--keep", type=Path,
+                   help="keep each bus's store and checks' JSON in this folder (made if absent)")
     p.add_argument("--test-extra", default="",
                    help="busgen options added to every checked drive, "
                         "e.g. --test-extra=--no-periodic")
@@ -187,7 +196,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         print(f"skipped: {e}")
         return 0
     seeds = h.draw_bus_seeds(a.buses, "fleet")
-    buses = measure(seeds, a.records, a.test_extra.split())
+    buses = measure(seeds, a.records, a.test_extra.split(), a.keep)
     summary = summarise(buses)
     print_summary(summary)
     if a.json:
@@ -196,18 +205,22 @@ def main(argv: Optional[List[str]] = None) -> int:
 
 
 def measure(seeds: List[int], n_records: int = h.RECORDS,
-            test_extra: Optional[List[str]] = None) -> List[Dict]:
-    work = Path(tempfile.mkdtemp(prefix="vibmode-fleet-busgen-"))
+            test_extra: Optional[List[str]] = None, keep: Optional[Path] = None) -> List[Dict]:
+    """Runs the buses of `seeds`; with `keep`, their stores and checks stay in that folder."""
+    if keep is not None:
+        keep.mkdir(parents=True, exist_ok=True)
+    work = keep if keep is not None else Path(tempfile.mkdtemp(prefix="vibmode-fleet-busgen-"))
     buses = []
     try:
         for s in seeds:
             rng = random.Random(s * 7919 + n_records)
-            b = run_bus(s, n_records, work, rng, test_extra)
+            b = run_bus(s, n_records, work, rng, test_extra, keep is not None)
             for r in b["rows"]:
                 print_row(r)
             buses.append(b)
     finally:
-        shutil.rmtree(work, ignore_errors=True)
+        if keep is None:
+            shutil.rmtree(work, ignore_errors=True)
     return buses
 
 

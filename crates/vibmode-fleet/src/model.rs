@@ -1212,19 +1212,78 @@ fn component(
 /// corner, at which a lowered body response is named the spring rather than the suspension.
 pub const SPRING_MAX_LEVEL_Z: f64 = 1.0;
 
+/// What a wheel of a flagged level ratio's pair says besides that ratio (see
+/// [`attribute_ratios`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct WheelEvidence {
+    /// The wheel's other level ratio, read from the wheel, in spreads, positive in the flagged
+    /// ratio's direction (it moved the same way); `None` without it.
+    other_z: Option<f64>,
+    /// The largest `|z| / limit` of the wheel's own flagged vehicle features that are not level
+    /// ratios (transmissibility, body response, its channels' modes); 0 without any.
+    own: f64,
+}
+
+/// Log-odds (natural) between the two wheels of a flagged level ratio above which their other
+/// ratios decide alone: ln 20, odds of 20 to 1.
+pub const RATIO_DECISIVE_LOG_ODDS: f64 = 2.995_732_273_553_991;
+
+/// True when the flagged ratio is charged to the first wheel `a` of its pair, false for `b`.
+/// `shift` is the flagged ratio's change from its centre (ln units) over the spread of the
+/// other ratios.
+///
+/// If wheel `a` moved by that change, its other ratio moves by `shift` spreads and `b`'s stays
+/// (and the reverse): with unit-variance scores the log-likelihood ratio of `a` against `b` is
+/// `(a.other_z - b.other_z) shift`. The other ratios decide when its magnitude is at least
+/// [`RATIO_DECISIVE_LOG_ODDS`], or when neither wheel has flagged features of its own; else the
+/// wheel whose own features are flagged (the stronger, in limits, if both are) takes the ratio:
+/// a fault at a wheel station moves that corner's transmissibility, body response or wheel-hop
+/// mode, while the left/right ratio's spread (0.10 in ln) is the size of a weak damper's effect
+/// on it, so its other ratios may not tell the wheels apart (busgen bus 43872, RL damper at 60 %:
+/// FL's other ratio 1.8 spreads, RL's 1.5, log-odds 1.0 for FL; RL's transmissibility 5-8 Hz
+/// -37 %).
+fn charge_to_first(a: WheelEvidence, b: WheelEvidence, shift: f64) -> bool {
+    let (za, zb) = (a.other_z.unwrap_or(0.0), b.other_z.unwrap_or(0.0));
+    let log_odds = (za - zb) * shift;
+    if (a.own > 0.0 || b.own > 0.0) && log_odds.abs() < RATIO_DECISIVE_LOG_ODDS {
+        return a.own >= b.own;
+    }
+    za >= zb
+}
+
 /// A level ratio of two wheels says that one of them moved, not which. A wheel station's fault
 /// moves the two ratios it takes part in (its axle's left/right and its side's front/rear) the
 /// same way when both are read from that wheel (its level against each neighbour); a healthy
-/// wheel's other ratio stays. A flagged ratio is given to the wheel of its pair whose other
-/// ratio, read from that wheel, lies further from its nominal centre in the flagged direction
-/// (in spreads), and turned to read from that wheel (`FL: level vs FR 8-20 Hz -40 %`). Without
-/// either other ratio it stays on its channel pair.
+/// wheel's other ratio stays; and it moves the corner's own features where the corner has them
+/// (a weak damper lowers its transmissibility: busgen bus 43872, RL damper at 60 %, "RL:
+/// transmissibility 5-8 Hz vs the other corners -37 %"). A flagged ratio is charged to a wheel of
+/// its pair by [`charge_to_first`] and turned to read from that wheel (`FL: level vs FR 8-20 Hz
+/// -40 %`). Without either other ratio it stays on its channel pair.
 fn attribute_ratios(set: &ModelSet, values: &[(FeatureMeta, f64)], evidence: &mut [Evidence]) {
     let band = set.config.ratio_band_hz;
     let signed_z = |key: &str| -> Option<f64> {
         let f = set.features.iter().find(|f| f.meta.key == key)?;
         let x = values.iter().find(|(m, _)| m.key == key).map(|(_, v)| *v)?;
         Some(score(f, x, &set.config))
+    };
+    // The spread of a ratio kind (pooled: one per kind).
+    let sigma_of = |kind: Kind| -> Option<f64> {
+        set.features
+            .iter()
+            .find(|f| f.meta.kind == kind)
+            .map(|f| f.sigma)
+    };
+    // The largest |z| / limit of a corner's own flagged vehicle features that are not ratios.
+    let own = |corner: Corner| -> f64 {
+        evidence
+            .iter()
+            .filter(|e| {
+                e.meta.group == Group::Vehicle
+                    && e.meta.corner == Some(corner)
+                    && !matches!(e.meta.kind, Kind::SideRatio | Kind::TrackRatio)
+            })
+            .map(|e| e.z.abs() / e.limit)
+            .fold(0.0, f64::max)
     };
     // The other ratio of a corner (its side's for an axle ratio, its axle's for a side's), as
     // a z-score of the corner's level over its neighbour's.
@@ -1240,6 +1299,11 @@ fn attribute_ratios(set: &ModelSet, values: &[(FeatureMeta, f64)], evidence: &mu
         let z = signed_z(&ratio_key(other_kind, name, &band, set.line_free))?;
         Some(if *first == corner { z } else { -z })
     };
+    // Computed before the loop changes the evidence (the ratios only; their corners move).
+    let own_of: BTreeMap<Corner, f64> = [Corner::FL, Corner::FR, Corner::RL, Corner::RR]
+        .into_iter()
+        .map(|c| (c, own(c)))
+        .collect();
     for e in evidence
         .iter_mut()
         .filter(|e| matches!(e.meta.kind, Kind::SideRatio | Kind::TrackRatio))
@@ -1262,8 +1326,27 @@ fn attribute_ratios(set: &ModelSet, values: &[(FeatureMeta, f64)], evidence: &mu
         }
         // Read from a, the flagged ratio moved by sign(e.z); read from b, by -sign(e.z).
         let dir = e.z.signum();
+        let wa = WheelEvidence {
+            other_z: za.map(|z| dir * z),
+            own: own_of.get(&a).copied().unwrap_or(0.0),
+        };
+        let wb = WheelEvidence {
+            other_z: zb.map(|z| -dir * z),
+            own: own_of.get(&b).copied().unwrap_or(0.0),
+        };
+        // The flagged ratio's change in spreads of the other kind (spreads are pooled per
+        // kind, so both other ratios have one).
+        let other_kind = if e.meta.kind == Kind::SideRatio {
+            Kind::TrackRatio
+        } else {
+            Kind::SideRatio
+        };
+        let shift = match (sigma_of(e.meta.kind), sigma_of(other_kind)) {
+            (Some(s), Some(so)) if so > 0.0 => e.z.abs() * s / so,
+            _ => 0.0,
+        };
         let label = |o: Corner| format!("level vs {o} {}", band_label(&band));
-        if dir * za.unwrap_or(0.0) >= -dir * zb.unwrap_or(0.0) {
+        if charge_to_first(wa, wb, shift) {
             e.meta.corner = Some(a);
             e.meta.label = label(b);
         } else {
@@ -1872,6 +1955,102 @@ mod tests {
             a.summary
         );
         assert_eq!(a.component, None);
+    }
+
+    #[test]
+    fn the_wheel_a_ratio_is_charged_to_by_hand() {
+        let w = |other_z: Option<f64>, own: f64| WheelEvidence { other_z, own };
+        // Neither wheel's own features flagged: the further other ratio (the rule before),
+        // whatever the odds.
+        assert!(charge_to_first(w(Some(1.8), 0.0), w(Some(1.5), 0.0), 3.2));
+        assert!(!charge_to_first(w(Some(1.5), 0.0), w(Some(1.8), 0.0), 3.2));
+        assert!(charge_to_first(w(None, 0.0), w(Some(-0.5), 0.0), 3.2));
+        // Bus 43872's RL damper (FL/RL -27 %, 0.32 in ln, 3.2 side-ratio spreads): FL's other
+        // ratio 1.8, RL's 1.5, log-odds 0.96 for FL; RL's transmissibility flagged at 1.3
+        // limits, FL has no feature of its own: RL.
+        assert!(!charge_to_first(w(Some(1.8), 0.0), w(Some(1.5), 1.3), 3.2));
+        // Log-odds (1.8 - 0.8) x 3.2 = 3.2, above ln 20 = 3.0: the ratios decide.
+        assert!(charge_to_first(w(Some(1.8), 0.0), w(Some(0.8), 1.3), 3.2));
+        // 2.8 below it: the own features.
+        assert!(!charge_to_first(
+            w(Some(1.8), 0.0),
+            w(Some(0.925), 1.3),
+            3.2
+        ));
+        // Both corners' own features flagged, the ratios undecided: the stronger.
+        assert!(charge_to_first(w(Some(0.2), 2.0), w(Some(0.5), 1.1), 3.2));
+        assert!(!charge_to_first(w(Some(0.5), 1.1), w(Some(0.2), 2.0), 3.2));
+        // Busgen bus 43872's RR tyre, one record: RR's other ratio 3.2 spreads, FR's 0.5, the
+        // flagged ratio 6.1 track spreads (3.2 side spreads): log-odds 8.6, so FR's lone
+        // transmissibility flag (1.5 limits) does not take it.
+        assert!(!charge_to_first(w(Some(0.5), 1.5), w(Some(3.2), 0.0), 3.2));
+    }
+
+    /// Four wheels with levels `l` and a wheel-hop mode each at `f` Hz (FL, FR, RL, RR).
+    fn wheels_with_modes(l: [f64; 4], f: [f64; 4]) -> RecordFeatures {
+        let mut r = wheels(l);
+        for (c, f) in r.channels.iter_mut().zip(f) {
+            c.modes = vec![ModeEstimate {
+                frequency_hz: f,
+                damping_ratio: 0.2,
+            }];
+        }
+        r
+    }
+
+    #[test]
+    fn a_ratio_goes_to_the_wheel_whose_own_features_moved() {
+        let recs: Vec<RecordFeatures> = (0..8)
+            .map(|i| {
+                let e = |k: usize| 1.0 + 0.02 * (((i * 3 + k * 5) % 7) as f64 / 3.0 - 1.0);
+                wheels_with_modes([e(0), e(1), e(2), e(3)], [10.0 * e(1); 4])
+            })
+            .collect();
+        let names: Vec<String> = (0..8).map(|i| format!("n{i}")).collect();
+        // A frequency floor below the nominal scatter (0.02 in ln), so that a wheel hop within
+        // the match tolerance (15 %) can pass its limit.
+        let cfg = FleetConfig {
+            floor_frequency: 0.01,
+            ..FleetConfig::default()
+        };
+        let set = build_model_set("bus", &names, &recs, &cfg).expect("set");
+        let nominal = [10.0; 4];
+        // FL 15 % lower and RL 15 % higher: FL/RL moves by ln(0.85 / 1.15) = -0.30, flagged;
+        // the other ratios, FL/FR -0.16 and RL/RR +0.14 (spread 0.10), stay within their
+        // limits, FL's a little further: the ratio alone goes to FL.
+        let levels = [0.85, 1.0, 1.15, 1.0];
+        let a = assess(&set, &wheels_with_modes(levels, nominal));
+        assert!(a.summary.starts_with("FL: level vs RL"), "{}", a.summary);
+        // RL's wheel hop 11 % lower as well (ln 0.89 / 0.015 = -8 spreads, flagged): RL.
+        let a = assess(&set, &wheels_with_modes(levels, [10.0, 10.0, 8.9, 10.0]));
+        assert!(
+            a.evidence
+                .iter()
+                .any(|e| e.meta.kind == Kind::ModeFrequency && e.meta.corner == Some(Corner::RL)),
+            "{}",
+            a.summary
+        );
+        let e = a
+            .evidence
+            .iter()
+            .find(|e| e.meta.kind == Kind::TrackRatio)
+            .expect("track ratio flagged");
+        assert_eq!(e.meta.corner, Some(Corner::RL), "{}", a.summary);
+        assert_eq!(e.meta.label, "level vs FL 8-20 Hz");
+        assert!(e.z > 0.0 && (e.value - 1.15 / 0.85).abs() < 1e-12, "{e:?}");
+        // FL 45 % lower: FL/FR -6 spreads (ln 0.55 / 0.10), RL/RR +1.4, the flagged FL/RL
+        // ln(0.55 / 1.15) = -0.74, 7.4 side-ratio spreads: log-odds (6 - 1.4) x 7.4 = 34 for FL,
+        // so the ratios decide, whatever RL's wheel hop says.
+        let a = assess(
+            &set,
+            &wheels_with_modes([0.55, 1.0, 1.15, 1.0], [10.0, 10.0, 8.9, 10.0]),
+        );
+        let e = a
+            .evidence
+            .iter()
+            .find(|e| e.meta.kind == Kind::TrackRatio)
+            .expect("track ratio flagged");
+        assert_eq!(e.meta.corner, Some(Corner::FL), "{}", a.summary);
     }
 
     /// Nominal wheel levels within +-2 % of 1, a different pattern per record.
