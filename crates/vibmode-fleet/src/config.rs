@@ -6,6 +6,9 @@ use vibmode_core::Num;
 
 use crate::error::{FleetError, Result};
 
+/// Periods of the lowest band edge a record must span (4 periods of 0.5 Hz: 8 s).
+pub const MIN_PERIODS: f64 = 4.0;
+
 /// Feature bands, statistics floors and the false-alarm rate. Every model set stores the
 /// settings it was built with; checks use the model set's.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -186,9 +189,7 @@ impl FleetConfig {
     /// The shortest record the features may be computed from, s: 4 periods of the lowest band
     /// edge of `bands_hz` and one Welch segment at the analysis rate (8 s with the defaults).
     pub fn min_record_s(&self) -> f64 {
-        let by_band = self
-            .lowest_band_edge_hz()
-            .map_or(0.0, |f| crate::features::MIN_PERIODS / f);
+        let by_band = self.lowest_band_edge_hz().map_or(0.0, |f| MIN_PERIODS / f);
         let by_welch =
             self.analysis.spectra.nperseg as f64 / self.analysis.preprocess.analysis_fs_hz;
         by_band.max(by_welch)

@@ -229,8 +229,7 @@ impl std::fmt::Display for SensorFault {
 pub const CLIPPED_SHARE: f64 = 0.01;
 /// Fewest samples at one extreme that count as clipped, however short the record.
 pub const CLIPPED_MIN_SAMPLES: usize = 10;
-/// Periods of the lowest band edge a record must span (4 periods of 0.5 Hz: 8 s).
-pub const MIN_PERIODS: f64 = 4.0;
+pub use crate::config::MIN_PERIODS;
 
 /// The sensor faults of the channels of `rec` that have a role (sprung or unsprung; other
 /// columns, such as a speed, are not sensors of the features).

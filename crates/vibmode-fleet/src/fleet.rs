@@ -11,7 +11,7 @@ use crate::config::FleetConfig;
 use crate::error::{FleetError, Result};
 use crate::features::{compute_features, RecordFeatures};
 use crate::model::{
-    assess, assess_drive, build_model_set, Assessment, ModelSet, MIN_DRIVE_RECORDS,
+    assess, assess_drive, build_model_set, Assessment, Drive, ModelSet, MIN_DRIVE_RECORDS,
 };
 use crate::store::{BatchItem, Condition, NewRecord, Store, Stored};
 
@@ -539,25 +539,6 @@ pub fn check_files_progress(
         progress,
     )?;
     check_prepared(store, set, prepared)
-}
-
-/// The verdict on a drive: records of one vehicle checked together ([`assess_drive`]).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Drive {
-    /// The drive id (`--drive ID`, else `all given records`).
-    pub drive: String,
-    /// The model-set version it was scored against.
-    pub model_version: i64,
-    /// Its records (file names as given), whose own verdicts are in the check's `records`.
-    pub records: Vec<String>,
-    /// The corner of the strongest flagged vehicle feature (the one named first), if any.
-    pub corner: Option<vibmode_analysis::Corner>,
-    /// Upper bound of the false-alarm rate per drive and feature group: the model set's
-    /// `false_alarm_rate` per record (docs/fleet.md, "Drives").
-    pub false_alarm_rate: f64,
-    /// The verdict from the medians of the features over the records.
-    #[serde(flatten)]
-    pub assessment: Assessment,
 }
 
 /// The id of a drive when none is given.

@@ -30,10 +30,10 @@ pub use fleet::{
     build_baseline, check_drive_files_progress, check_file, check_files, check_files_progress,
     check_recording, check_vehicle_id, ingest_file, ingest_files, ingest_files_progress,
     ingest_recording, record_file_name, recording_hash, require_baseline, sha256_hex, Checked,
-    Drive, IngestLabels, Ingested, DEFAULT_DRIVE_ID,
+    IngestLabels, Ingested, DEFAULT_DRIVE_ID,
 };
 pub use model::{
-    assess, assess_drive, build_model_set, Assessment, Classification, Component, Evidence,
+    assess, assess_drive, build_model_set, Assessment, Classification, Component, Drive, Evidence,
     FeatureMeta, FeatureStat, Group, Kind, KindLimit, ModeSlot, ModelSet, Scores, LOO_MARGIN,
     MIN_DRIVE_RECORDS,
 };

@@ -617,7 +617,7 @@ impl Store {
     pub fn store_batch_with_drive(
         &mut self,
         items: &[BatchItem<'_>],
-        drive: Option<&crate::fleet::Drive>,
+        drive: Option<&crate::model::Drive>,
     ) -> Result<Vec<Stored>> {
         let drive_json = match drive {
             Some(d) => Some(to_json_checked(
@@ -1095,7 +1095,7 @@ impl Store {
             .map_err(self.sql("reading drives"))?;
         let mut out: Vec<DriveStatus> = Vec::with_capacity(rows.len());
         for (drive, checked, json, n) in rows {
-            let d: crate::fleet::Drive = serde_json::from_str(&json)
+            let d: crate::model::Drive = serde_json::from_str(&json)
                 .map_err(|e| self.corrupt(&format!("drive {drive} of {vehicle}"), e))?;
             let class = d.assessment.classification;
             let since = match out.last() {
