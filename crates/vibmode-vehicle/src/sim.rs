@@ -825,173 +825,81 @@ fn speed_profile(
     Ok(speed)
 }
 
-/// Samples per block handed from the simulation's second thread (engine-line forces, sensor
-/// effects) to the response's.
-const BLOCK: usize = 8192;
+/// Samples per block of the sensor effects handed from their thread to the response's.
+const EFFECT_BLOCK: usize = 8192;
 
-/// Blocks of engine-line forces the second thread may compute ahead of the response: bounds
-/// their memory (32 x 8192 x 24 bytes, 6 MB) and covers the first pass over the sensor noise,
-/// which the second thread draws meanwhile.
-const FORCE_BLOCKS_AHEAD: usize = 32;
-
-/// The draws of the sensor effects: each channel's bias, its tones' phases and the generator's
-/// state where each block of its noise starts.
-struct SensorEffects {
-    bias: Vec<f64>,
-    phases: Vec<Vec<f64>>,
-    starts: Vec<Vec<ChaCha8Rng>>,
-}
-
-impl SensorEffects {
-    /// Draws from `rng` in the order that keeps a seed's output bit-identical (the `p` biases,
-    /// then per channel its tones' phases and its noise over `len` samples, sample by sample),
-    /// keeping the generator's state at the start of each [`BLOCK`].
-    fn draw(p: usize, len: usize, dist: &Disturbances, rng: &mut ChaCha8Rng) -> Self {
-        let bias = (0..p)
-            .map(|_| {
-                if dist.sensor_bias_max_m_s2 > 0.0 {
-                    rng.gen_range(-1.0..1.0) * dist.sensor_bias_max_m_s2
-                } else {
-                    0.0
-                }
-            })
-            .collect();
-        let mut phases = Vec::with_capacity(p);
-        let mut starts = Vec::with_capacity(p);
-        for _ in 0..p {
-            phases.push(
-                dist.hf_tones
-                    .iter()
-                    .map(|_| rng.gen_range(0.0..2.0 * PI))
-                    .collect(),
-            );
-            starts.push(
-                (0..len.div_ceil(BLOCK))
-                    .map(|b| {
-                        let at = rng.clone();
-                        if dist.sensor_noise_std_m_s2 > 0.0 {
-                            for _ in b * BLOCK..((b + 1) * BLOCK).min(len) {
-                                let _: f64 = rng.sample(StandardNormal);
-                            }
+/// Writes each of the `p` channels' bias, high-frequency tones and white sensor noise into `blocks`
+/// (`blocks[b][c]`: block `b` of channel `c`, [`EFFECT_BLOCK`] samples but the last) and sends
+/// each block on `tx` once written, in order; returns the biases drawn. The draws from `rng` are
+/// in the order that keeps a seed's output bit-identical (the biases, then per channel its tones'
+/// phases and its noise sample by sample): a first pass draws them all and keeps where each
+/// block's noise starts, so that the blocks can then be written in time order.
+fn sensor_effects<'a>(
+    p: usize,
+    blocks: Vec<Vec<&'a mut [f64]>>,
+    dist: &Disturbances,
+    dt: f64,
+    rng: &mut ChaCha8Rng,
+    tx: std::sync::mpsc::Sender<Vec<&'a mut [f64]>>,
+) -> Vec<f64> {
+    let bias: Vec<f64> = (0..p)
+        .map(|_| {
+            if dist.sensor_bias_max_m_s2 > 0.0 {
+                rng.gen_range(-1.0..1.0) * dist.sensor_bias_max_m_s2
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let noisy = dist.sensor_noise_std_m_s2 > 0.0;
+    // Per channel: its tones' phases and the generator's state at the start of each block.
+    let mut phases: Vec<Vec<f64>> = Vec::with_capacity(p);
+    let mut starts: Vec<Vec<ChaCha8Rng>> = Vec::with_capacity(p);
+    for c in 0..p {
+        phases.push(
+            dist.hf_tones
+                .iter()
+                .map(|_| rng.gen_range(0.0..2.0 * PI))
+                .collect(),
+        );
+        starts.push(
+            blocks
+                .iter()
+                .map(|b| {
+                    let at = rng.clone();
+                    if noisy {
+                        for _ in 0..b[c].len() {
+                            let _: f64 = rng.sample(StandardNormal);
                         }
-                        at
-                    })
-                    .collect(),
-            );
-        }
-        SensorEffects {
-            bias,
-            phases,
-            starts,
-        }
+                    }
+                    at
+                })
+                .collect(),
+        );
     }
-
-    /// Writes block `b` of each channel (`block[c]`): bias + tones + noise.
-    fn write(&self, b: usize, block: &mut [&mut [f64]], dist: &Disturbances, dt: f64) {
-        let j0 = b * BLOCK;
+    for (b, mut block) in blocks.into_iter().enumerate() {
+        let j0 = b * EFFECT_BLOCK;
         for (c, s) in block.iter_mut().enumerate() {
-            let mut rng = self.starts[c][b].clone();
+            let mut rng = starts[c][b].clone();
             for (i, v) in s.iter_mut().enumerate() {
                 let t = (j0 + i) as f64 * dt;
-                let mut add = self.bias[c];
-                for (tone, ph) in dist.hf_tones.iter().zip(&self.phases[c]) {
+                let mut add = bias[c];
+                for (tone, ph) in dist.hf_tones.iter().zip(&phases[c]) {
                     add += tone.amplitude_m_s2 * (2.0 * PI * tone.frequency_hz * t + ph).sin();
                 }
-                if dist.sensor_noise_std_m_s2 > 0.0 {
+                if noisy {
                     let g: f64 = rng.sample(StandardNormal);
                     add += g * dist.sensor_noise_std_m_s2;
                 }
                 *v = add;
             }
         }
-    }
-}
-
-/// What the simulation's second thread computes ahead of the response: the engine lines'
-/// generalised forces and the sensor effects.
-struct Ahead<'a, 'r> {
-    /// The engine lines, stepped in time order.
-    lines: &'r mut LineBank,
-    /// Samples of line forces: one per call of the response's input.
-    n_forces: usize,
-    /// Channels.
-    p: usize,
-    /// The `p` channels' output, block by block (`blocks[b][c]`: block `b` of channel `c`).
-    blocks: Vec<Vec<&'a mut [f64]>>,
-    /// Output samples per channel.
-    n_out: usize,
-    /// Response samples before the first output sample (the warm-up).
-    n_warm: usize,
-    dist: &'r Disturbances,
-    dt: f64,
-    /// The generator of the sensor effects.
-    rng: &'r mut ChaCha8Rng,
-}
-
-impl<'a> Ahead<'a, '_> {
-    /// Sends the line forces `[heave, pitch, roll]` of input call k (time `time(k)`, speed over
-    /// the nominal speed `speed_ratio(k)`) in blocks on `forces` (at most [`FORCE_BLOCKS_AHEAD`]
-    /// waiting), and writes the sensor effects into the output, sending each block on `effects`
-    /// as soon as the forces sent cover its samples: when the response waits for an effects
-    /// block, that block is sent or being written, so neither thread waits for the other for
-    /// ever. Returns the biases drawn.
-    fn run(
-        mut self,
-        time: impl Fn(usize) -> f64,
-        speed_ratio: impl Fn(usize) -> f64,
-        forces: std::sync::mpsc::SyncSender<Vec<[f64; 3]>>,
-        effects: std::sync::mpsc::Sender<Vec<&'a mut [f64]>>,
-    ) -> Vec<f64> {
-        let p = self.p;
-        let mut drawn: Option<SensorEffects> = None;
-        let mut blocks = std::mem::take(&mut self.blocks).into_iter().enumerate();
-        let mut next_effect = 0;
-        let n_force_blocks = self.n_forces.div_ceil(BLOCK);
-        for fb in 0..=n_force_blocks {
-            // Samples of the forces sent so far (all of them after the last block).
-            let covered = if fb < n_force_blocks {
-                let k0 = fb * BLOCK;
-                let block: Vec<[f64; 3]> = (k0..((fb + 1) * BLOCK).min(self.n_forces))
-                    .map(|k| {
-                        let mut f = [0.0; 3];
-                        for (l, force) in self.lines.forces(time(k), speed_ratio(k)) {
-                            f[0] += force;
-                            f[1] += force * l.x_m;
-                            f[2] += force * l.y_m;
-                        }
-                        f
-                    })
-                    .collect();
-                if forces.send(block).is_err() {
-                    // The response's thread stopped (a panic, passed on by the scope).
-                    break;
-                }
-                (fb + 1) * BLOCK
-            } else {
-                usize::MAX
-            };
-            while next_effect * BLOCK < self.n_out
-                && self.n_warm + ((next_effect + 1) * BLOCK).min(self.n_out) <= covered
-            {
-                let e = drawn
-                    .get_or_insert_with(|| SensorEffects::draw(p, self.n_out, self.dist, self.rng));
-                let Some((b, mut block)) = blocks.next() else {
-                    break;
-                };
-                e.write(b, &mut block, self.dist, self.dt);
-                if effects.send(block).is_err() {
-                    break;
-                }
-                next_effect += 1;
-            }
-            if fb + 1 == FORCE_BLOCKS_AHEAD && drawn.is_none() {
-                drawn = Some(SensorEffects::draw(p, self.n_out, self.dist, self.rng));
-            }
+        if tx.send(block).is_err() {
+            // The response's thread stopped (a panic, passed on by the scope).
+            break;
         }
-        drawn
-            .unwrap_or_else(|| SensorEffects::draw(p, self.n_out, self.dist, self.rng))
-            .bias
     }
+    bias
 }
 
 /// Cuts the drive into records of `n_rec` samples, from the end (`split_off`) so the drive is
@@ -1042,6 +950,16 @@ fn wheel_tracks(wheelbase_m: f64) -> [(usize, f64); 4] {
             if c.is_front() { wheelbase_m } else { 0.0 },
         )
     })
+}
+
+/// Adds the engine/gear lines' generalised forces at time `t` (s) to `f` (heave N, pitch and
+/// roll N m), stepping the lines' random processes.
+fn add_line_forces(f: &mut [f64], lines: &mut LineBank, t: f64, speed_ratio: f64) {
+    for (l, force) in lines.forces(t, speed_ratio) {
+        f[DOF_HEAVE] += force;
+        f[DOF_PITCH] += force * l.x_m;
+        f[DOF_ROLL] += force * l.y_m;
+    }
 }
 
 /// Multiplies the speed by `1 + u(t)`, `u` the speed wander (stream 4 of the seed), kept
@@ -1198,41 +1116,21 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
         .collect();
     let n_out = n_rec * sim.records;
     let mut samples: Vec<Vec<f64>> = vec![vec![0.0; n_out]; p];
-    // The engine lines and the sensor effects do not depend on the vehicle's response: a second
-    // thread computes the lines' forces ahead of the response and writes the sensor effects into
-    // `samples`, handing both over block by block; the response is then added to what is there
-    // (`add + value`, the same sum as before).
+    // The sensor effects do not depend on the vehicle's response: a second thread writes them
+    // into `samples` block by block (ahead of the response) and hands each block over; the
+    // response is then added to what is there (`add + value`, the same sum as before).
     let bias = {
-        let mut blocks: Vec<Vec<&mut [f64]>> =
-            (0..n_out.div_ceil(BLOCK)).map(|_| Vec::new()).collect();
+        let mut blocks: Vec<Vec<&mut [f64]>> = (0..n_out.div_ceil(EFFECT_BLOCK))
+            .map(|_| Vec::new())
+            .collect();
         for s in samples.iter_mut() {
-            for (b, chunk) in s.chunks_mut(BLOCK).enumerate() {
+            for (b, chunk) in s.chunks_mut(EFFECT_BLOCK).enumerate() {
                 blocks[b].push(chunk);
             }
         }
-        let (tx_forces, rx_forces) = std::sync::mpsc::sync_channel(FORCE_BLOCKS_AHEAD);
-        let (tx_effects, rx_effects) = std::sync::mpsc::channel::<Vec<&mut [f64]>>();
-        let ahead = Ahead {
-            lines: &mut lines,
-            n_forces: n_total + 1,
-            p,
-            blocks,
-            n_out,
-            n_warm,
-            dist,
-            dt,
-            rng: &mut rng2,
-        };
+        let (tx, rx) = std::sync::mpsc::channel::<Vec<&mut [f64]>>();
         std::thread::scope(|scope| {
-            // Input call k is for array index k + 1.
-            let second = scope.spawn(|| {
-                ahead.run(
-                    |k| time(k + 1),
-                    |k| speed_manoeuvres[k + 1] / v0,
-                    tx_forces,
-                    tx_effects,
-                )
-            });
+            let effects = scope.spawn(|| sensor_effects(p, blocks, dist, dt, &mut rng2, tx));
             // The road heights of index k are used three times (input k - 1, road velocity at
             // k - 2 and k): kept for the last four indices.
             let cache = std::cell::RefCell::new([(usize::MAX, [0.0; 4]); 4]);
@@ -1247,29 +1145,20 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
                 }
                 slot.1
             };
-            // The second thread sends every block in order and fails only by a panic, which the
-            // scope's end passes on (zeros stand in meanwhile).
-            let mut forces: Vec<[f64; 3]> = Vec::new();
             let mut block: Vec<&mut [f64]> = Vec::new();
             // State index k of `run` corresponds to array index k + 1.
             d.run(
                 n_total,
                 &[DOF_HEAVE, DOF_PITCH, DOF_ROLL],
                 |k, u| {
-                    if k % BLOCK == 0 {
-                        forces = rx_forces.recv().unwrap_or_else(|_| vec![[0.0; 3]; BLOCK]);
-                    }
                     let idx = k + 1;
                     let r = road_at(idx);
                     u.iter_mut().for_each(|v| *v = 0.0);
                     u[..4].copy_from_slice(&r);
+                    let t = time(idx);
                     let f = &mut u[4..4 + n];
-                    let lf = forces.get(k % BLOCK).copied().unwrap_or([0.0; 3]);
-                    f[DOF_HEAVE] = lf[0];
-                    f[DOF_PITCH] = lf[1];
-                    f[DOF_ROLL] = lf[2];
+                    add_line_forces(f, &mut lines, t, speed_manoeuvres[idx] / v0);
                     if !sim.manoeuvres.is_empty() {
-                        let t = time(idx);
                         f[DOF_PITCH] += body_m * ax(t) * h_cg;
                         f[DOF_ROLL] += body_m * ay(t) * h_cg;
                     }
@@ -1282,9 +1171,11 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
                     if k < n_warm {
                         return;
                     }
-                    let j = (k - n_warm) % BLOCK;
+                    let j = (k - n_warm) % EFFECT_BLOCK;
                     if j == 0 {
-                        match rx_effects.recv() {
+                        // The effects thread sends every block in order; it fails only by a panic,
+                        // which the scope's end passes on.
+                        match rx.recv() {
                             Ok(b) => block = b,
                             Err(_) => return,
                         }
@@ -1304,7 +1195,7 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
                     }
                 },
             );
-            second.join()
+            effects.join()
         })
     };
     let bias = match bias {
