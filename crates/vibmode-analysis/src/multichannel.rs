@@ -59,6 +59,23 @@ pub(crate) struct SsiStage<'a, M: MultichannelIdentifier> {
     pub first_lags: Option<&'a [Option<usize>]>,
 }
 
+/// The identifications of [`SsiStage::poles`], for [`SsiStage::finish`].
+pub(crate) struct SsiPoles<M: MultichannelIdentifier> {
+    channels: Vec<String>,
+    orders: Vec<usize>,
+    scales: Vec<f64>,
+    /// Per record (or one for the pool): its poles kept, or why its identification failed.
+    per: Vec<Result<Vec<ShapedPole>, M::Error>>,
+    jackknife: Option<JackknifeReps>,
+}
+
+/// The jackknife's repetitions: how many groups of records, and per group the poles identified
+/// without it.
+struct JackknifeReps {
+    groups: usize,
+    reps: Vec<Vec<ShapedPole>>,
+}
+
 impl<M: MultichannelIdentifier> SsiStage<'_, M> {
     /// RMS of each channel over the records used (1 where it is zero): SSI sees every channel
     /// divided by it, so that strong channels (the wheels) do not hide the modes of weak ones
@@ -135,28 +152,15 @@ impl<M: MultichannelIdentifier> SsiStage<'_, M> {
     /// jackknife over the records (at most [`JACKKNIFE_GROUPS`] groups of consecutive records):
     /// the pooled identification repeated without each group, each mode's median frequency and
     /// damping over the repetition's poles near it (within the clustering's radius, shapes with
-    /// MAC at least `1 - shape_tol`, both shapes scaled as identified, as clustered). Nothing is set with fewer than 2 records or when a
-    /// repetition fails.
-    fn jackknife(
-        &self,
-        pooled: &M::Pooled,
-        band: &vibmode_core::BandLimit,
-        modes: &mut [InvariantMode],
-        orders: &[usize],
-        scales: &[f64],
-    ) {
+    /// MAC at least `1 - shape_tol`, both shapes scaled as identified, as clustered), from the
+    /// repetitions `reps` ([`Self::jackknife_reps`]). Nothing is set with fewer than 2 records or
+    /// when a repetition failed (`reps` is then `None`).
+    fn jackknife(&self, reps: Option<&JackknifeReps>, modes: &mut [InvariantMode], scales: &[f64]) {
         let inverse = inverse_scales(scales);
-        let groups = pooled.n_records().min(JACKKNIFE_GROUPS);
-        if groups < 2 || !modes.iter().any(InvariantMode::is_invariant) {
-            return;
-        }
-        let Ok(reps) = pooled.jackknife(groups, orders) else {
+        let Some(JackknifeReps { groups, reps }) = reps else {
             return;
         };
-        let reps: Vec<Vec<ShapedPole>> = reps
-            .into_iter()
-            .map(|rep| self.kept(rep, 0, band, scales))
-            .collect();
+        let groups = *groups;
         for m in modes.iter_mut().filter(|m| m.is_invariant()) {
             let Some(shape) = m.shape.as_deref() else {
                 continue;
@@ -167,7 +171,7 @@ impl<M: MultichannelIdentifier> SsiStage<'_, M> {
                 .freq_tol_rel
                 .max(self.cluster.freq_tol_per_damping * m.damping_ratio);
             let (mut fs, mut zs) = (Vec::new(), Vec::new());
-            for rep in &reps {
+            for rep in reps {
                 let (f, z): (Vec<f64>, Vec<f64>) = rep
                     .iter()
                     .filter(|q| (q.frequency_hz / m.frequency_hz - 1.0).abs() <= tol)
@@ -195,6 +199,30 @@ impl<M: MultichannelIdentifier> SsiStage<'_, M> {
                 });
             }
         }
+    }
+
+    /// The jackknife's repetitions of the pooled identification (see [`Self::jackknife`]), each
+    /// without one group of records, their poles kept as the pool's; `None` with fewer than 2
+    /// groups or when a repetition fails.
+    fn jackknife_reps(
+        &self,
+        pooled: &M::Pooled,
+        band: &vibmode_core::BandLimit,
+        orders: &[usize],
+        scales: &[f64],
+    ) -> Option<JackknifeReps> {
+        let groups = pooled.n_records().min(JACKKNIFE_GROUPS);
+        if groups < 2 {
+            return None;
+        }
+        let reps = pooled.jackknife(groups, orders).ok()?;
+        Some(JackknifeReps {
+            groups,
+            reps: reps
+                .into_iter()
+                .map(|rep| self.kept(rep, 0, band, scales))
+                .collect(),
+        })
     }
 
     /// The poles below the valid band, as record `r`'s, with shapes scaled back.
@@ -235,7 +263,8 @@ impl<M: MultichannelIdentifier> SsiStage<'_, M> {
     }
 
     /// Identifies, clusters, classes (with the pool's own line tracks and `other_tracks`, those
-    /// of the role pools; `own_tracks` when they are known already) and matches to `reference`.
+    /// of the role pools; `own_tracks` when they are known already) and matches to `reference`:
+    /// [`Self::poles`], then [`Self::finish`].
     pub fn run(
         &self,
         lines: &LineStage<'_>,
@@ -243,6 +272,13 @@ impl<M: MultichannelIdentifier> SsiStage<'_, M> {
         other_tracks: &[LineTrack],
         reference: &[ReferenceMode],
     ) -> Result<SsiAnalysis, AnalysisError> {
+        self.finish(self.poles(), lines, own_tracks, other_tracks, reference)
+    }
+
+    /// The identifications (of every active record, or of the pool and its jackknife
+    /// repetitions): what needs neither the line evidence nor the other stages, so it can run
+    /// beside them.
+    pub fn poles(&self) -> SsiPoles<M> {
         let channels: Vec<String> = self
             .pre
             .first()
@@ -279,6 +315,36 @@ impl<M: MultichannelIdentifier> SsiStage<'_, M> {
                 })
                 .collect()
         };
+        let jackknife = match &pooled {
+            Some(Ok(Some((p, band)))) => self.jackknife_reps(p, band, &orders, &scales),
+            _ => None,
+        };
+        SsiPoles {
+            channels,
+            orders,
+            scales,
+            per,
+            jackknife,
+        }
+    }
+
+    /// Clusters the poles, classes the clusters (as [`Self::run`] says) and matches them to
+    /// `reference`.
+    pub fn finish(
+        &self,
+        poles: SsiPoles<M>,
+        lines: &LineStage<'_>,
+        own_tracks: Option<&[LineTrack]>,
+        other_tracks: &[LineTrack],
+        reference: &[ReferenceMode],
+    ) -> Result<SsiAnalysis, AnalysisError> {
+        let SsiPoles {
+            channels,
+            orders,
+            scales,
+            per,
+            jackknife,
+        } = poles;
         let mut poles = Vec::new();
         let mut failed_records = Vec::new();
         for (r, out) in per.into_iter().enumerate() {
@@ -318,9 +384,7 @@ impl<M: MultichannelIdentifier> SsiStage<'_, M> {
         let mut known: Vec<LineTrack> = tracks.clone();
         known.extend(other_tracks.iter().cloned());
         lines.classify(&mut invariant_modes, &all, &known);
-        if let Some(Ok(Some((p, band)))) = &pooled {
-            self.jackknife(p, band, &mut invariant_modes, &orders, &scales);
-        }
+        self.jackknife(jackknife.as_ref(), &mut invariant_modes, &scales);
         let matches = if reference.is_empty() {
             Vec::new()
         } else {

@@ -195,12 +195,32 @@ pub fn analyze_prepared(
     let activity_rms = record_activity(&outs, facts.len(), n_ch, cfg);
     let activity_ratio = activity_ratios(&activity_rms, n_ch);
     let stationary = detect_stops(&activity_ratio, &cfg.stops);
-    if cfg.method.runs_arma() {
-        identify_used(&pre, &mut outs, &stationary, cfg, identifier, progress);
-    }
     let active = renumber_active(&stationary);
     let n_active = active.iter().flatten().count();
     let cluster = cfg.cluster.for_band(&pre[0].band);
+    let ssi_method = vibmode_ssi::SsiCovIdentifier {
+        params: cfg.ssi.clone(),
+    };
+    let ssi_stage = SsiStage {
+        pre: &pre,
+        active: &active,
+        n_active,
+        method: &ssi_method,
+        pool_records: cfg.ssi.pool_records,
+        cluster: &cluster,
+        drop_band_edge: cfg.poles.drop_band_edge,
+        first_lags: None,
+    };
+    // SSI-cov's identifications need nothing of the sweep: they run beside it (and fill the
+    // cores the sweep's last channels leave idle); their clustering and classing come after.
+    let ((), ssi_poles) = rayon::join(
+        || {
+            if cfg.method.runs_arma() {
+                identify_used(&pre, &mut outs, &stationary, cfg, identifier, progress);
+            }
+        },
+        || cfg.method.runs_ssi().then(|| ssi_stage.poles()),
+    );
     let orders = cfg.orders();
     let support = Support {
         active: &active,
@@ -222,23 +242,9 @@ pub fn analyze_prepared(
     let roles = role_modes(&channels, &store, &support, &lines, reference)?;
     let role_tracks: Vec<crate::LineTrack> =
         roles.iter().flat_map(|r| r.lines.iter().cloned()).collect();
-    let ssi = if cfg.method.runs_ssi() {
-        let method = vibmode_ssi::SsiCovIdentifier {
-            params: cfg.ssi.clone(),
-        };
-        let stage = SsiStage {
-            pre: &pre,
-            active: &active,
-            n_active,
-            method: &method,
-            pool_records: cfg.ssi.pool_records,
-            cluster: &cluster,
-            drop_band_edge: cfg.poles.drop_band_edge,
-            first_lags: None,
-        };
-        Some(stage.run(&lines, None, &role_tracks, reference)?)
-    } else {
-        None
+    let ssi = match ssi_poles {
+        Some(poles) => Some(ssi_stage.finish(poles, &lines, None, &role_tracks, reference)?),
+        None => None,
     };
     let (body_ssi, body_ssi_not_run) = match &ssi {
         Some(main) if cfg.body_ssi.enabled => {

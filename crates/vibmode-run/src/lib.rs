@@ -349,9 +349,10 @@ impl Run {
         let mut update = ModelUpdate::for_vehicle(self.vehicle.clone(), cfg)?;
         // The identification reports (record x channel) fits; shown as records.
         let n_ch = AtomicUsize::new(0);
+        let on_identified = progress.on_identified;
         let on_fits = |done: usize, total: usize| {
             let n = n_ch.load(Ordering::SeqCst).max(1);
-            (progress.on_identified)(done / n, total.div_ceil(n));
+            on_identified(done / n, total.div_ceil(n));
         };
         let (mut results, report_records) = match input {
             Records::Memory(records) => {
@@ -359,9 +360,13 @@ impl Run {
                     records.first().map_or(0, |r| r.recording.channels.len()),
                     Ordering::SeqCst,
                 );
-                records.iter().for_each(|r| update.add(r));
-                let results = vibmode_analysis::analyze(&records, cfg, &self.reference, &on_fits)?;
-                (results, records)
+                // The model update's pass over the records runs beside the analysis (it reads
+                // them only), on the thread pool's other cores while the analysis is serial.
+                let ((), results) = rayon::join(
+                    || records.iter().for_each(|r| update.add(r)),
+                    || vibmode_analysis::analyze(&records, cfg, &self.reference, &on_fits),
+                );
+                (results?, records)
             }
             Records::Files {
                 paths,

@@ -5,8 +5,11 @@
 //! ends. Most sensor values (`-0.012345`, `1.5e-3`) have a decimal mantissa `m < 2^53` and a
 //! power of ten `10^k` with `|k| <= 22`: both are exact `f64`s, so one IEEE multiplication or
 //! division gives the correctly rounded value (Clinger's fast path), which is what
-//! `str::parse::<f64>` returns too. Digits are read eight at a time (SWAR). More than 19 digits
-//! (leading zeros included), larger mantissas and larger exponents are handed to
+//! `str::parse::<f64>` returns too. Digits are read eight at a time (SWAR). A mantissa above
+//! 2^53 of at most 19 digits over `10^k`, `1 <= k <= 22` (shortest round-trip output such as
+//! `0.44836338772330214` has 16-17 digits), is the floating-point quotient moved to the correctly
+//! rounded neighbour by exact 128-bit comparisons with the midpoints beside it. More than 19
+//! digits (leading zeros included), other large mantissas and larger exponents are handed to
 //! `str::parse::<f64>` (Eisel-Lemire and big-number fallback). Words such as `inf` or `NaN`,
 //! quotes and other text are [`Scan::Invalid`] here; the caller then uses the general cell
 //! parser, which accepts everything Rust's `f64` parser does.
@@ -25,8 +28,9 @@ const MAX_EXACT_MANTISSA: u64 = 1 << 53;
 pub(crate) enum Scan {
     /// A number, converted exactly by the fast path (always finite).
     Fast(f64),
-    /// A syntactically valid number that needs `str::parse::<f64>` (more than 19 significant
-    /// digits, mantissa above 2^53, or a power of ten outside 10^-22 ..= 10^22).
+    /// A syntactically valid number that needs `str::parse::<f64>` (more than 19 digits, a
+    /// mantissa above 2^53 not over a power of ten 10^-1 ..= 10^-22, or a power of ten outside
+    /// 10^-22 ..= 10^22).
     Slow,
     /// Not a plain decimal number at this position.
     Invalid,
@@ -57,6 +61,102 @@ fn eight_digits(t: u64) -> u64 {
         .wrapping_mul(MUL1)
         .wrapping_add(((v >> 16) & MASK).wrapping_mul(MUL2))
         >> 32
+}
+
+/// `5^k` for `k = 0..=22` (all below 2^52).
+const POW5: [u64; 23] = {
+    let mut t = [1u64; 23];
+    let mut k = 1;
+    while k < 23 {
+        t[k] = t[k - 1] * 5;
+        k += 1;
+    }
+    t
+};
+
+/// How `m` compares with `c 5^k 2^s` (exact, in 128-bit integers; `c < 2^55`, `5^k < 2^52`).
+#[inline(always)]
+fn cmp_scaled(m: u64, c: u64, p5: u64, s: i32) -> std::cmp::Ordering {
+    let rhs = c as u128 * p5 as u128; // < 2^107
+    if s >= 0 {
+        if s as u32 > rhs.leading_zeros() {
+            return std::cmp::Ordering::Less; // rhs 2^s >= 2^128 > m
+        }
+        (m as u128).cmp(&(rhs << s))
+    } else {
+        let t = (-s) as u32;
+        if t > (m as u128).leading_zeros() {
+            return std::cmp::Ordering::Greater; // m 2^t >= 2^128 > rhs
+        }
+        ((m as u128) << t).cmp(&rhs)
+    }
+}
+
+/// `m / 10^k` correctly rounded (to nearest, ties to even) for `m < 2^64` and `1 <= k <= 22`:
+/// the floating-point quotient (within two units in the last place of it) moved to the right
+/// neighbour by comparing the exact value `m / (5^k 2^k)` with the midpoints beside it. `None`
+/// if that takes more than a few steps (never expected; the caller then uses `str::parse`).
+#[inline]
+fn quotient_pow10(m: u64, k: usize) -> Option<f64> {
+    use std::cmp::Ordering::{Equal, Greater, Less};
+    const HIDDEN: u64 = 1 << 52;
+    let q = m as f64 / POW10[k];
+    // A normal double: m / 10^k lies between 2^53 / 10^22 and 2^64 / 10.
+    let bits = q.to_bits();
+    let mut mant = (bits & (HIDDEN - 1)) | HIDDEN;
+    let mut e = ((bits >> 52) & 0x7ff) as i32 - 1075; // q = mant 2^e
+    let p5 = POW5[k];
+    let k = k as i32;
+    for _ in 0..4 {
+        // Upper midpoint (2 mant + 1) 2^(e-1); lower one (2 mant - 1) 2^(e-1), or
+        // (4 mant - 1) 2^(e-2) at the bottom of the binade. v = m / (5^k 2^k).
+        let upper = cmp_scaled(m, 2 * mant + 1, p5, e - 1 + k);
+        let lower = if mant == HIDDEN {
+            cmp_scaled(m, 4 * mant - 1, p5, e - 2 + k)
+        } else {
+            cmp_scaled(m, 2 * mant - 1, p5, e - 1 + k)
+        };
+        match (upper, lower) {
+            (Greater, _) => {
+                mant += 1;
+                if mant == 2 * HIDDEN {
+                    mant = HIDDEN;
+                    e += 1;
+                }
+            }
+            (Less, Less) => {
+                mant -= 1;
+                if mant < HIDDEN {
+                    mant = 2 * HIDDEN - 1;
+                    e -= 1;
+                }
+            }
+            (Equal, _) => {
+                if mant & 1 == 1 {
+                    mant += 1;
+                    if mant == 2 * HIDDEN {
+                        mant = HIDDEN;
+                        e += 1;
+                    }
+                }
+                return Some(f64::from_bits(((e + 1075) as u64) << 52 | (mant - HIDDEN)));
+            }
+            (Less, Equal) => {
+                if mant & 1 == 1 {
+                    mant -= 1;
+                    if mant < HIDDEN {
+                        mant = 2 * HIDDEN - 1;
+                        e -= 1;
+                    }
+                }
+                return Some(f64::from_bits(((e + 1075) as u64) << 52 | (mant - HIDDEN)));
+            }
+            (Less, Greater) => {
+                return Some(f64::from_bits(((e + 1075) as u64) << 52 | (mant - HIDDEN)));
+            }
+        }
+    }
+    None
 }
 
 /// Reads the run of ASCII digits at `s[i..]` into `m` (`m = m * 10^count + digits`, wrapping:
@@ -158,7 +258,17 @@ pub(crate) fn scan_number(s: &[u8], mut i: usize, decimal_comma: bool) -> (Scan,
     if m == 0 {
         return (Scan::Fast(f64::from_bits(sign_bit)), i);
     }
-    if m > MAX_EXACT_MANTISSA || !(-22..=22).contains(&exp10) {
+    if m > MAX_EXACT_MANTISSA {
+        // Up to 19 digits (the simulator's and most loggers' shortest round-trip output has
+        // 16-17) and a decimal fraction: the quotient by a power of ten, checked exactly.
+        if (-22..=-1).contains(&exp10) {
+            if let Some(v) = quotient_pow10(m, (-exp10) as usize) {
+                return (Scan::Fast(f64::from_bits(v.to_bits() | sign_bit)), i);
+            }
+        }
+        return (Scan::Slow, i);
+    }
+    if !(-22..=22).contains(&exp10) {
         return (Scan::Slow, i);
     }
     // Both m and 10^|exp10| are exact doubles: one correctly rounded operation. (m <= 2^53, so
@@ -374,5 +484,69 @@ mod tests {
         }
         // The fast path is really exercised (most numbers above have <= 15 digits).
         assert!(n_fast > n, "fast path taken for only {n_fast} of {}", 2 * n);
+    }
+
+    /// Mantissas above 2^53 with up to 19 digits divided by 10^1 ..= 10^22 (the quotient
+    /// checked against its midpoints) agree with `str::parse` bit for bit, and take that path.
+    #[test]
+    fn long_mantissas_over_powers_of_ten_match_str_parse() {
+        let mut rng = ChaCha8Rng::seed_from_u64(20261126);
+        for _ in 0..200_000 {
+            let digits = rng.gen_range(16..=19);
+            let mut m: u64 = rng.gen_range(1..10);
+            for _ in 1..digits {
+                m = m * 10 + rng.gen_range(0..10);
+            }
+            if m <= MAX_EXACT_MANTISSA {
+                continue;
+            }
+            let k = rng.gen_range(1..=22usize);
+            let d = m.to_string();
+            let t = if k >= d.len() {
+                format!("0.{}{d}", "0".repeat(k - d.len()))
+            } else {
+                format!("{}.{}", &d[..d.len() - k], &d[d.len() - k..])
+            };
+            // Leading zeros count towards the 19 digits of the fast paths.
+            let n_digits = t.bytes().filter(u8::is_ascii_digit).count();
+            let t = if rng.gen_bool(0.5) {
+                format!("-{t}")
+            } else {
+                t
+            };
+            assert!(check(&t) || n_digits > 19, "{t}: not the fast path");
+        }
+        // Shortest round-trip output of doubles of sensor size (16-17 digits).
+        for _ in 0..100_000 {
+            let v: f64 = rng.gen_range(-20.0..20.0);
+            // Below 1 the leading zeros may make more than 19 digits (str::parse then).
+            assert!(check(&v.to_string()) || v.abs() < 1.0, "{v}");
+        }
+    }
+
+    /// Exact ties between two doubles round to the even one, also at the bottom and the top of
+    /// a binade: `M + 1/2` for M in [2^52, 2^53) (written `M.5`: `m / 10`, `m = 5 (2 M + 1)`);
+    /// `M + 0.25` and `M + 0.75` (not ties) agree with `str::parse` too.
+    #[test]
+    fn exact_ties_round_to_even() {
+        let lo = 1u64 << 52;
+        for mm in [
+            lo,
+            lo + 1,
+            lo + 2,
+            lo + 12345,
+            (1u64 << 53) - 2,
+            (1u64 << 53) - 1,
+        ] {
+            let half = format!("{mm}.5");
+            let want = if mm % 2 == 0 { mm } else { mm + 1 } as f64;
+            let (got, fast) = parse_cell(half.as_bytes(), false);
+            assert_eq!(got.map(f64::to_bits), Some(want.to_bits()), "{half}");
+            assert!(fast, "{half}");
+            check(&half);
+            for q in ["25", "75"] {
+                assert!(check(&format!("{mm}.{q}")), "{mm}.{q}");
+            }
+        }
     }
 }

@@ -650,50 +650,77 @@ impl Discrete {
 
     /// Run over `len` samples. `input(k, u)` fills u (len nu) for sample k in 0..=len;
     /// `rdot(k)` gives the road velocity at sample k; `sink(k, y)` receives the outputs.
+    /// `forces` lists, in ascending order, the degrees of freedom whose generalised force
+    /// `input` may set to a non-zero value; the other forces stay 0 and are left out of the
+    /// sums (adding `a * 0` changes no sum but the sign of a zero).
     fn run(
         &self,
         len: usize,
+        forces: &[usize],
         mut input: impl FnMut(usize, &mut [f64]),
         mut rdot: impl FnMut(usize) -> [f64; 4],
         mut sink: impl FnMut(usize, &[f64]),
     ) {
         let (ns, nu, np) = (self.ns, self.nu, self.np);
-        let mut u0 = vec![0.0; nu];
-        let mut u1 = vec![0.0; nu];
-        input(0, &mut u0);
-        let mut x = self.initial_state(&u0[..4]);
+        // The road heights, then the forces that may be non-zero.
+        let active: Vec<usize> = (0..4).chain(forces.iter().map(|&i| 4 + i)).collect();
+        let active = &active[..];
+        let na = active.len();
+        // The input matrices' active columns, row by row, in the order of `active`.
+        let pick = |m: &[f64], rows: usize| -> Vec<f64> {
+            (0..rows)
+                .flat_map(|i| active.iter().map(move |&j| m[i * nu + j]))
+                .collect()
+        };
+        let (ga, gb, dy) = (pick(&self.ga, ns), pick(&self.gb, ns), pick(&self.dy, np));
+        let mut u = vec![0.0; nu];
+        let mut u0 = vec![0.0; na];
+        let mut u1 = vec![0.0; na];
+        let gather = |u: &[f64], to: &mut [f64]| {
+            for (t, &j) in to.iter_mut().zip(active) {
+                *t = u[j];
+            }
+        };
+        input(0, &mut u);
+        gather(&u, &mut u0);
+        let mut x = self.initial_state(&u[..4]);
         let mut xn = vec![0.0; ns];
         let mut y = vec![0.0; np];
         for k in 0..len {
             let rd = rdot(k);
-            for (s, ys) in y.iter_mut().enumerate() {
-                let c = &self.cy[s * ns..(s + 1) * ns];
-                let d = &self.dy[s * nu..(s + 1) * nu];
-                let e = &self.ey[s * 4..(s + 1) * 4];
+            for (((ys, c), d), e) in y
+                .iter_mut()
+                .zip(self.cy.chunks_exact(ns))
+                .zip(dy.chunks_exact(na))
+                .zip(self.ey.chunks_exact(4))
+            {
                 let mut acc = 0.0;
-                for i in 0..ns {
-                    acc += c[i] * x[i];
+                for (ci, xi) in c.iter().zip(&x) {
+                    acc += ci * xi;
                 }
-                for i in 0..nu {
-                    acc += d[i] * u0[i];
+                for (di, ui) in d.iter().zip(&u0) {
+                    acc += di * ui;
                 }
-                for i in 0..4 {
-                    acc += e[i] * rd[i];
+                for (ei, ri) in e.iter().zip(&rd) {
+                    acc += ei * ri;
                 }
                 *ys = acc;
             }
             sink(k, &y);
-            input(k + 1, &mut u1);
-            for (i, xi) in xn.iter_mut().enumerate() {
-                let p = &self.phi[i * ns..(i + 1) * ns];
-                let a = &self.ga[i * nu..(i + 1) * nu];
-                let b = &self.gb[i * nu..(i + 1) * nu];
+            input(k + 1, &mut u);
+            gather(&u, &mut u1);
+            for (((xi, p), a), b) in xn
+                .iter_mut()
+                .zip(self.phi.chunks_exact(ns))
+                .zip(ga.chunks_exact(na))
+                .zip(gb.chunks_exact(na))
+            {
                 let mut acc = 0.0;
-                for j in 0..ns {
-                    acc += p[j] * x[j];
+                for (pj, xj) in p.iter().zip(&x) {
+                    acc += pj * xj;
                 }
-                for j in 0..nu {
-                    acc += a[j] * u0[j] + b[j] * u1[j];
+                for ((aj, bj), (v0, v1)) in a.iter().zip(b).zip(u0.iter().zip(&u1)) {
+                    acc += aj * v0 + bj * v1;
                 }
                 *xi = acc;
             }
@@ -729,6 +756,7 @@ impl FullCar {
         let at = |k: usize| road_m[k.min(len - 1)];
         d.run(
             len,
+            &[],
             |k, u| {
                 u.iter_mut().for_each(|v| *v = 0.0);
                 u[..4].copy_from_slice(&at(k));
@@ -797,15 +825,24 @@ fn speed_profile(
     Ok(speed)
 }
 
-/// Adds each channel's bias, the high-frequency tones and white sensor noise (in this order of
-/// draws from `rng`, which keeps a seed's output bit-identical); returns the biases drawn.
-fn add_sensor_effects(
-    samples: &mut [Vec<f64>],
+/// Samples per block of the sensor effects handed from their thread to the response's.
+const EFFECT_BLOCK: usize = 8192;
+
+/// Writes each of the `p` channels' bias, high-frequency tones and white sensor noise into `blocks`
+/// (`blocks[b][c]`: block `b` of channel `c`, [`EFFECT_BLOCK`] samples but the last) and sends
+/// each block on `tx` once written, in order; returns the biases drawn. The draws from `rng` are
+/// in the order that keeps a seed's output bit-identical (the biases, then per channel its tones'
+/// phases and its noise sample by sample): a first pass draws them all and keeps where each
+/// block's noise starts, so that the blocks can then be written in time order.
+fn sensor_effects<'a>(
+    p: usize,
+    blocks: Vec<Vec<&'a mut [f64]>>,
     dist: &Disturbances,
     dt: f64,
     rng: &mut ChaCha8Rng,
+    tx: std::sync::mpsc::Sender<Vec<&'a mut [f64]>>,
 ) -> Vec<f64> {
-    let bias: Vec<f64> = (0..samples.len())
+    let bias: Vec<f64> = (0..p)
         .map(|_| {
             if dist.sensor_bias_max_m_s2 > 0.0 {
                 rng.gen_range(-1.0..1.0) * dist.sensor_bias_max_m_s2
@@ -814,23 +851,52 @@ fn add_sensor_effects(
             }
         })
         .collect();
-    for (c, s) in samples.iter_mut().enumerate() {
-        let phases: Vec<f64> = dist
-            .hf_tones
-            .iter()
-            .map(|_| rng.gen_range(0.0..2.0 * PI))
-            .collect();
-        for (j, v) in s.iter_mut().enumerate() {
-            let t = j as f64 * dt;
-            let mut add = bias[c];
-            for (tone, ph) in dist.hf_tones.iter().zip(&phases) {
-                add += tone.amplitude_m_s2 * (2.0 * PI * tone.frequency_hz * t + ph).sin();
+    let noisy = dist.sensor_noise_std_m_s2 > 0.0;
+    // Per channel: its tones' phases and the generator's state at the start of each block.
+    let mut phases: Vec<Vec<f64>> = Vec::with_capacity(p);
+    let mut starts: Vec<Vec<ChaCha8Rng>> = Vec::with_capacity(p);
+    for c in 0..p {
+        phases.push(
+            dist.hf_tones
+                .iter()
+                .map(|_| rng.gen_range(0.0..2.0 * PI))
+                .collect(),
+        );
+        starts.push(
+            blocks
+                .iter()
+                .map(|b| {
+                    let at = rng.clone();
+                    if noisy {
+                        for _ in 0..b[c].len() {
+                            let _: f64 = rng.sample(StandardNormal);
+                        }
+                    }
+                    at
+                })
+                .collect(),
+        );
+    }
+    for (b, mut block) in blocks.into_iter().enumerate() {
+        let j0 = b * EFFECT_BLOCK;
+        for (c, s) in block.iter_mut().enumerate() {
+            let mut rng = starts[c][b].clone();
+            for (i, v) in s.iter_mut().enumerate() {
+                let t = (j0 + i) as f64 * dt;
+                let mut add = bias[c];
+                for (tone, ph) in dist.hf_tones.iter().zip(&phases[c]) {
+                    add += tone.amplitude_m_s2 * (2.0 * PI * tone.frequency_hz * t + ph).sin();
+                }
+                if noisy {
+                    let g: f64 = rng.sample(StandardNormal);
+                    add += g * dist.sensor_noise_std_m_s2;
+                }
+                *v = add;
             }
-            if dist.sensor_noise_std_m_s2 > 0.0 {
-                let g: f64 = rng.sample(StandardNormal);
-                add += g * dist.sensor_noise_std_m_s2;
-            }
-            *v += add;
+        }
+        if tx.send(block).is_err() {
+            // The response's thread stopped (a panic, passed on by the scope).
+            break;
         }
     }
     bias
@@ -1021,11 +1087,8 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
     let road = RoadProfile::generate(&sim.road_input(), length, dx, &mut rng)?;
     let mut rng2 = ChaCha8Rng::seed_from_u64(sim.seed);
     rng2.set_stream(2);
-    // Road heights for every index: front axle at pos + wb, rear at pos.
+    // Road heights: front axle at pos + wb, rear at pos.
     let corners = wheel_tracks(wb);
-    let road_at = |k: usize| -> [f64; 4] {
-        std::array::from_fn(|i| road.height_m(corners[i].0, pos[k] + corners[i].1))
-    };
     // Generalised forces.
     let n = car.n;
     let mut rng3 = ChaCha8Rng::seed_from_u64(sim.seed);
@@ -1051,47 +1114,94 @@ pub fn simulate(vehicle: &VehicleParams, sim: &SimParams) -> Result<Simulation> 
             [a.cos() * b.cos(), a.sin(), b.sin()]
         })
         .collect();
-    let mut samples: Vec<Vec<f64>> = vec![vec![0.0; n_rec * sim.records]; p];
-    // State index k of `run` corresponds to array index k + 1.
-    d.run(
-        n_total,
-        |k, u| {
-            let idx = k + 1;
-            let r = road_at(idx);
-            u.iter_mut().for_each(|v| *v = 0.0);
-            u[..4].copy_from_slice(&r);
-            let t = time(idx);
-            let f = &mut u[4..4 + n];
-            add_line_forces(f, &mut lines, t, speed_manoeuvres[idx] / v0);
-            if !sim.manoeuvres.is_empty() {
-                f[DOF_PITCH] += body_m * ax(t) * h_cg;
-                f[DOF_ROLL] += body_m * ay(t) * h_cg;
+    let n_out = n_rec * sim.records;
+    let mut samples: Vec<Vec<f64>> = vec![vec![0.0; n_out]; p];
+    // The sensor effects do not depend on the vehicle's response: a second thread writes them
+    // into `samples` block by block (ahead of the response) and hands each block over; the
+    // response is then added to what is there (`add + value`, the same sum as before).
+    let bias = {
+        let mut blocks: Vec<Vec<&mut [f64]>> = (0..n_out.div_ceil(EFFECT_BLOCK))
+            .map(|_| Vec::new())
+            .collect();
+        for s in samples.iter_mut() {
+            for (b, chunk) in s.chunks_mut(EFFECT_BLOCK).enumerate() {
+                blocks[b].push(chunk);
             }
-        },
-        |k| {
-            let (a, b) = (road_at(k), road_at(k + 2));
-            std::array::from_fn(|i| (b[i] - a[i]) / (2.0 * dt))
-        },
-        |k, y| {
-            if k >= n_warm {
-                let j = k - n_warm;
-                if dist.sensor_misalignment_max_deg > 0.0 {
-                    // Longitudinal acceleration from the speed, lateral from the manoeuvres.
-                    let idx = k + 1;
-                    let a_x = (speed[idx + 1] - speed[idx - 1]) / (2.0 * dt);
-                    let a_y = ay(time(idx));
-                    for ((s, v), [cc, sa, sb]) in samples.iter_mut().zip(y).zip(&tilt_gains) {
-                        s[j] = cc * v + sa * a_x + sb * a_y;
-                    }
-                } else {
-                    for (s, v) in samples.iter_mut().zip(y) {
-                        s[j] = *v;
-                    }
+        }
+        let (tx, rx) = std::sync::mpsc::channel::<Vec<&mut [f64]>>();
+        std::thread::scope(|scope| {
+            let effects = scope.spawn(|| sensor_effects(p, blocks, dist, dt, &mut rng2, tx));
+            // The road heights of index k are used three times (input k - 1, road velocity at
+            // k - 2 and k): kept for the last four indices.
+            let cache = std::cell::RefCell::new([(usize::MAX, [0.0; 4]); 4]);
+            let road_at = |k: usize| -> [f64; 4] {
+                let mut c = cache.borrow_mut();
+                let slot = &mut c[k % 4];
+                if slot.0 != k {
+                    *slot = (
+                        k,
+                        std::array::from_fn(|i| road.height_m(corners[i].0, pos[k] + corners[i].1)),
+                    );
                 }
-            }
-        },
-    );
-    let bias = add_sensor_effects(&mut samples, dist, dt, &mut rng2);
+                slot.1
+            };
+            let mut block: Vec<&mut [f64]> = Vec::new();
+            // State index k of `run` corresponds to array index k + 1.
+            d.run(
+                n_total,
+                &[DOF_HEAVE, DOF_PITCH, DOF_ROLL],
+                |k, u| {
+                    let idx = k + 1;
+                    let r = road_at(idx);
+                    u.iter_mut().for_each(|v| *v = 0.0);
+                    u[..4].copy_from_slice(&r);
+                    let t = time(idx);
+                    let f = &mut u[4..4 + n];
+                    add_line_forces(f, &mut lines, t, speed_manoeuvres[idx] / v0);
+                    if !sim.manoeuvres.is_empty() {
+                        f[DOF_PITCH] += body_m * ax(t) * h_cg;
+                        f[DOF_ROLL] += body_m * ay(t) * h_cg;
+                    }
+                },
+                |k| {
+                    let (a, b) = (road_at(k), road_at(k + 2));
+                    std::array::from_fn(|i| (b[i] - a[i]) / (2.0 * dt))
+                },
+                |k, y| {
+                    if k < n_warm {
+                        return;
+                    }
+                    let j = (k - n_warm) % EFFECT_BLOCK;
+                    if j == 0 {
+                        // The effects thread sends every block in order; it fails only by a panic,
+                        // which the scope's end passes on.
+                        match rx.recv() {
+                            Ok(b) => block = b,
+                            Err(_) => return,
+                        }
+                    }
+                    if dist.sensor_misalignment_max_deg > 0.0 {
+                        // Longitudinal acceleration from the speed, lateral from the manoeuvres.
+                        let idx = k + 1;
+                        let a_x = (speed[idx + 1] - speed[idx - 1]) / (2.0 * dt);
+                        let a_y = ay(time(idx));
+                        for ((s, v), [cc, sa, sb]) in block.iter_mut().zip(y).zip(&tilt_gains) {
+                            s[j] += cc * v + sa * a_x + sb * a_y;
+                        }
+                    } else {
+                        for (s, v) in block.iter_mut().zip(y) {
+                            s[j] += *v;
+                        }
+                    }
+                },
+            );
+            effects.join()
+        })
+    };
+    let bias = match bias {
+        Ok(b) => b,
+        Err(panic) => std::panic::resume_unwind(panic),
+    };
     let records = split_records(samples, &car, &speed, n_warm, n_rec, fs);
     Ok(Simulation {
         records,

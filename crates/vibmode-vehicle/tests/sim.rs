@@ -609,3 +609,92 @@ fn in_service_preset_runs_from_the_minimum_speed() {
     };
     assert_eq!(p.clone().manoeuvres_fitted_to_speed(), p);
 }
+
+/// The sensor effects are the documented draws of the seed's stream 2 (after one start phase per
+/// engine line): per channel its bias, then per channel its tones' phases and its noise sample
+/// by sample, over the whole drive; redrawn here in that order, one sample at a time, and
+/// compared bit for bit with what the simulator added (records long enough that the simulator's blocks of
+/// samples and both records' boundaries are crossed).
+#[test]
+fn sensor_effects_are_the_seeds_draws_in_order() {
+    use rand_distr::StandardNormal;
+    let bus = VehicleParams::city_bus();
+    let fs = 2000.0;
+    let tones = vec![
+        Tone {
+            frequency_hz: 150.0,
+            amplitude_m_s2: 0.3,
+        },
+        Tone {
+            frequency_hz: 1300.0,
+            amplitude_m_s2: 0.1,
+        },
+    ];
+    let noise = 0.05;
+    let bias_max = 0.2;
+    let lines = vec![EngineLine::constant(7.0, 500.0)];
+    let sp = SimParams {
+        disturbances: Disturbances {
+            engine_lines: lines.clone(),
+            sensor_noise_std_m_s2: noise,
+            sensor_bias_max_m_s2: bias_max,
+            hf_tones: tones.clone(),
+            ..Disturbances::default()
+        },
+        records: 2,
+        ..quiet(fs)
+    };
+    let with = simulate(&bus, &sp).unwrap();
+    let without = simulate(
+        &bus,
+        &SimParams {
+            disturbances: Disturbances {
+                engine_lines: lines.clone(),
+                ..Disturbances::default()
+            },
+            ..sp.clone()
+        },
+    )
+    .unwrap();
+    let channel = |s: &Simulation, c: usize| -> Vec<f64> {
+        s.records
+            .iter()
+            .flat_map(|r| r.recording.channels[c].samples.iter().copied())
+            .collect()
+    };
+    let n = channel(&with, 0).len();
+    assert!(n > 2 * 8192, "{n} samples: too few to cross the blocks");
+    let mut rng = ChaCha8Rng::seed_from_u64(sp.seed);
+    rng.set_stream(2);
+    for _ in &lines {
+        let _: f64 = rng.gen_range(0.0..2.0 * std::f64::consts::PI);
+    }
+    let bias: Vec<f64> = (0..7)
+        .map(|_| rng.gen_range(-1.0..1.0) * bias_max)
+        .collect();
+    assert_eq!(with.truth.sensor_bias_m_s2, bias);
+    for (c, b) in bias.iter().enumerate() {
+        let phases: Vec<f64> = tones
+            .iter()
+            .map(|_| rng.gen_range(0.0..2.0 * std::f64::consts::PI))
+            .collect();
+        let (x, q) = (channel(&with, c), channel(&without, c));
+        for j in 0..n {
+            let t = j as f64 * (1.0 / fs);
+            let mut add = *b;
+            for (tone, ph) in tones.iter().zip(&phases) {
+                add += tone.amplitude_m_s2
+                    * (2.0 * std::f64::consts::PI * tone.frequency_hz * t + ph).sin();
+            }
+            let g: f64 = rng.sample(StandardNormal);
+            add += g * noise;
+            // The same sums in the same order: bit for bit.
+            assert_eq!(
+                x[j].to_bits(),
+                (q[j] + add).to_bits(),
+                "channel {c}, sample {j}: {} added, {add} drawn",
+                x[j] - q[j]
+            );
+        }
+    }
+}
