@@ -1,14 +1,24 @@
-//! What the report draws of the first record (the paper's Fig. 5-7), computed again from the
-//! record and the model coefficients kept in the results, so the results carry no report-only
-//! arrays.
+//! What the report draws of the first record (the paper's Fig. 5-7), computed from the record
+//! as the analysis pre-processed it ([`FirstRecord::prepared`]) and the model coefficients kept in
+//! the results, so the results carry no report-only arrays.
 
 use serde::{Deserialize, Serialize};
-use vibmode_signal::preprocess;
+use vibmode_signal::Preprocessed;
 use vibmode_spectra::{PeriodogramParams, WelchParams, Window};
 
 use crate::results::AnalysisResults;
 use crate::AnalysisError;
 use vibmode_core::RecordInput;
+
+/// The first record of an analysis as read and as pre-processed (the analysis rate): what the
+/// report draws, kept by the analysis so that it is not pre-processed twice.
+#[derive(Clone, Debug)]
+pub struct FirstRecord {
+    /// The record at its own rate.
+    pub record: RecordInput,
+    /// The record at the analysis rate, as the analysis used it.
+    pub prepared: Preprocessed,
+}
 
 /// Number of points of the model-PSD grid, from Nyquist/N to Nyquist.
 pub const MODEL_GRID_POINTS: usize = 400;
@@ -41,14 +51,13 @@ pub struct FirstRecordSpectra {
     pub models: Vec<ModelPsd>,
 }
 
-/// The spectra of `records[0]` for every channel of `results`.
+/// The spectra of the first record, `pre` (at the analysis rate, as the analysis pre-processed
+/// it), for every channel of `results`.
 pub fn first_record_spectra(
-    records: &[RecordInput],
+    pre: &Preprocessed,
     results: &AnalysisResults,
 ) -> Result<Vec<FirstRecordSpectra>, AnalysisError> {
-    let first = records.first().ok_or(AnalysisError::NoRecords)?;
     let cfg = &results.config;
-    let pre = preprocess(&first.recording, &cfg.preprocess)?;
     let fs = pre.band.fs_hz;
     let grid: Vec<f64> = (1..=MODEL_GRID_POINTS)
         .map(|i| i as f64 * fs / 2.0 / MODEL_GRID_POINTS as f64)

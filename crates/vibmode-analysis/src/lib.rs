@@ -38,12 +38,13 @@ pub mod stream;
 
 pub use body::{BodySsi, BodySsiNotRun, RecordDelay};
 pub use config::{AnalysisConfig, ChannelRole, ConfigText, Preset, ReportParams};
-pub use first_record::{first_record_spectra, FirstRecordSpectra, ModelPsd};
+pub use first_record::{first_record_spectra, FirstRecord, FirstRecordSpectra, ModelPsd};
 pub use identify::SweepIdentifier;
 pub use lines::{LineSweep, LineTrack};
 pub use multichannel::{ShapedPole, SsiAnalysis};
 pub use pipeline::{
-    analyze, analyze_prepared, analyze_with, check_records, preprocess_records, RecordFacts,
+    analyze, analyze_keeping_first, analyze_prepared, analyze_with, check_records,
+    preprocess_records, RecordFacts,
 };
 pub use results::{
     AnalysisResults, ChannelAnalysis, RecordSummary, RoleAnalysis, Timing, SCHEMA_VERSION,

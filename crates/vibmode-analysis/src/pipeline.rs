@@ -138,12 +138,26 @@ pub fn analyze_with(
     reference: &[ReferenceMode],
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<AnalysisResults, AnalysisError> {
+    analyze_keeping_first(records, cfg, identifier, reference, progress).map(|(r, _)| r)
+}
+
+/// [`analyze_with`], also returning the first record at the analysis rate as the analysis
+/// pre-processed it (what the report draws: [`crate::first_record_spectra`]).
+pub fn analyze_keeping_first(
+    records: &[RecordInput],
+    cfg: &AnalysisConfig,
+    identifier: &dyn Identifier,
+    reference: &[ReferenceMode],
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<(AnalysisResults, Preprocessed), AnalysisError> {
     let t0 = Instant::now();
     cfg.validate()?;
     check_records(records)?;
     let pre = preprocess_records(records, cfg)?;
+    let first = pre.first().cloned().ok_or(AnalysisError::NoRecords)?;
     let facts = records.iter().map(RecordFacts::of).collect();
-    analyze_prepared(facts, pre, cfg, identifier, reference, progress, t0)
+    let results = analyze_prepared(facts, pre, cfg, identifier, reference, progress, t0)?;
+    Ok((results, first))
 }
 
 /// What the results keep of a record at its original rate (the samples themselves are not kept).

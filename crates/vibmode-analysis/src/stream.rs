@@ -13,13 +13,13 @@ use vibmode_signal::{preprocess, Preprocessed};
 use crate::config::AnalysisConfig;
 use crate::pipeline::{analyze_prepared, check_same_layout, RecordFacts};
 use crate::results::AnalysisResults;
-use crate::AnalysisError;
+use crate::{AnalysisError, FirstRecord};
 
 /// The analysis of every record of `sources`, pre-processing each record (stage 2, the ideal DFT
 /// filter per record) as it arrives, a few records at a time in parallel, and keeping only the
-/// records at the analysis rate and the first record at its original rate (for the report's
+/// records at the analysis rate and the first record at its original rate too (for the report's
 /// figures). `on_record(n)` is called after `n` records have been pre-processed; `progress` as in
-/// [`crate::analyze`]. Returns the results and the first record.
+/// [`crate::analyze`]. Returns the results and the first record, as read and as pre-processed.
 pub fn analyze_source<E>(
     source: &mut dyn RecordSource<Error = E>,
     cfg: &AnalysisConfig,
@@ -27,7 +27,7 @@ pub fn analyze_source<E>(
     reference: &[ReferenceMode],
     on_record: &dyn Fn(usize),
     progress: &(dyn Fn(usize, usize) + Sync),
-) -> Result<(AnalysisResults, RecordInput), AnalysisError>
+) -> Result<(AnalysisResults, FirstRecord), AnalysisError>
 where
     AnalysisError: From<E>,
 {
@@ -74,7 +74,8 @@ where
             on_record(facts.len());
         }
     }
-    let first = first.ok_or(AnalysisError::NoRecords)?;
+    let record = first.ok_or(AnalysisError::NoRecords)?;
+    let prepared = pre.first().cloned().ok_or(AnalysisError::NoRecords)?;
     let results = analyze_prepared(facts, pre, cfg, identifier, reference, progress, t0)?;
-    Ok((results, first))
+    Ok((results, FirstRecord { record, prepared }))
 }

@@ -68,7 +68,10 @@ fn streamed_and_in_memory_analyses_agree_over_seeds() {
             ))
         });
         let (st, first) = analyze_source(&mut src, &cfg, &id, &[], &|_| {}, &|_, _| {}).unwrap();
-        assert_eq!(first.recording.len(), 5120);
+        assert_eq!(first.record.recording.len(), 5120);
+        // the first record at the analysis rate, as the in-memory analysis pre-processes it
+        let pre = vibmode_signal::preprocess(&first.record.recording, &cfg.preprocess).unwrap();
+        assert_eq!(first.prepared, pre);
         assert_eq!(st.records.len(), mem.records.len());
         for (a, b) in st.records.iter().zip(&mem.records) {
             assert_eq!(a.name, b.name);

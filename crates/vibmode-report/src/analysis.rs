@@ -5,7 +5,9 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use vibmode_analysis::{first_record_spectra, AnalysisResults, FirstRecordSpectra, RecordInput};
+use vibmode_analysis::{
+    first_record_spectra, AnalysisResults, FirstRecord, FirstRecordSpectra, RecordInput,
+};
 use vibmode_core::{InvariantMode, ModeClass, Recording, Robust, SweepModel};
 
 use crate::error::ReportError;
@@ -1236,11 +1238,12 @@ fn shape_figures(
 }
 
 /// Writes `DIR/index.html`, `DIR/results.json`, `DIR/modes.csv` and `DIR/figures/*.svg|png` for
-/// the analysis `r` of `records`; `intro` is a first paragraph (e.g. what was simulated), `extra`
+/// the analysis `r` whose first record is `first` (as read and as the analysis pre-processed it);
+/// `intro` is a first paragraph (e.g. what was simulated), `extra`
 /// are sections after the modes' tables (e.g. the model update).
 pub fn write_analysis_report(
     dir: &Path,
-    records: &[RecordInput],
+    first: &FirstRecord,
     r: &AnalysisResults,
     intro: Option<&str>,
     extra: &[crate::ReportSection],
@@ -1265,11 +1268,9 @@ pub fn write_analysis_report(
     write_text(&results_json, &(json + "\n"))?;
     let modes_csv_path = dir.join("modes.csv");
     write_text(&modes_csv_path, &modes_csv(r))?;
-    let first = records
-        .first()
-        .ok_or_else(|| ReportError::Analysis("no records".into()))?;
-    let spectra =
-        first_record_spectra(records, r).map_err(|e| ReportError::Analysis(e.to_string()))?;
+    let spectra = first_record_spectra(&first.prepared, r)
+        .map_err(|e| ReportError::Analysis(e.to_string()))?;
+    let first = &first.record;
     let mut html = HtmlReport::new("vibmode: vibration modes from in-service accelerations");
     if let Some(t) = intro {
         html.paragraph(t);

@@ -41,8 +41,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use vibmode_analysis::{
-    AnalysisConfig, AnalysisError, AnalysisResults, ChainedRecords, RecordInput, RecordSource,
-    RecordWindow, StreamRecords, SweepIdentifier,
+    AnalysisConfig, AnalysisError, AnalysisResults, ChainedRecords, FirstRecord, RecordInput,
+    RecordSource, RecordWindow, StreamRecords, SweepIdentifier,
 };
 use vibmode_modal::ReferenceMode;
 use vibmode_signal::{ChannelSelector, ReadOptions};
@@ -354,7 +354,7 @@ impl Run {
             let n = n_ch.load(Ordering::SeqCst).max(1);
             on_identified(done / n, total.div_ceil(n));
         };
-        let (mut results, report_records) = match input {
+        let (mut results, report_first) = match input {
             Records::Memory(records) => {
                 n_ch.store(
                     records.first().map_or(0, |r| r.recording.channels.len()),
@@ -362,11 +362,25 @@ impl Run {
                 );
                 // The model update's pass over the records runs beside the analysis (it reads
                 // them only), on the thread pool's other cores while the analysis is serial.
-                let ((), results) = rayon::join(
+                let identifier = SweepIdentifier {
+                    sweep: cfg.sweep.clone(),
+                    poles: cfg.poles.clone(),
+                };
+                let ((), analysed) = rayon::join(
                     || records.iter().for_each(|r| update.add(r)),
-                    || vibmode_analysis::analyze(&records, cfg, &self.reference, &on_fits),
+                    || {
+                        vibmode_analysis::analyze_keeping_first(
+                            &records,
+                            cfg,
+                            &identifier,
+                            &self.reference,
+                            &on_fits,
+                        )
+                    },
                 );
-                (results?, records)
+                let (results, prepared) = analysed?;
+                let record = records.into_iter().next().ok_or(AnalysisError::NoRecords)?;
+                (results, FirstRecord { record, prepared })
             }
             Records::Files {
                 paths,
@@ -414,7 +428,7 @@ impl Run {
                     progress.on_record,
                     &on_fits,
                 )?;
-                (results, vec![first])
+                (results, first)
             }
         };
         check_some_fit(&results)?;
@@ -423,7 +437,7 @@ impl Run {
         }
         Ok(RunOutput {
             results,
-            report_records,
+            report_first,
             update: update.finish(),
             #[cfg(feature = "segment")]
             segments: Vec::new(),
@@ -492,8 +506,8 @@ pub struct RunOutput {
     /// The analysis.
     pub results: AnalysisResults,
     /// The records whose spectra and models the report draws (the first record of a streamed
-    /// run; all records of one in memory).
-    pub report_records: Vec<RecordInput>,
+    /// The first record, as read and at the analysis rate: what the report draws.
+    pub report_first: FirstRecord,
     /// The model update's outcome (off without a vehicle).
     pub update: UpdateOutcome,
     /// The segmentation of each recording ([`RunInput::Segmented`]; empty otherwise), written
@@ -528,7 +542,7 @@ impl RunOutput {
         let sections = self.update.sections(&self.results);
         vibmode_report::write_analysis_report(
             dir,
-            &self.report_records,
+            &self.report_first,
             &self.results,
             intro,
             &sections,
