@@ -4,7 +4,7 @@
 use vibmode_core::{BandLimit, PreprocessParams, Recording};
 
 use crate::error::Result;
-use crate::resample::{ResampleParams, ResampleRecording, Resampler};
+use crate::resample::{planned_fs_out_hz, ResampleParams, ResampleRecording};
 
 /// A record at the analysis rate and the band it carries.
 #[derive(Clone, Debug, PartialEq)]
@@ -46,16 +46,12 @@ pub fn preprocess(rec: &Recording, p: &PreprocessParams) -> Result<Preprocessed>
         cutoff_hz: Some(p.cutoff_hz.min(rec.fs_hz / 2.0)),
         filter: true,
     };
-    let planned = Resampler::new(rec.len(), rec.fs_hz, &wanted).or_else(|_| {
-        let loose = ResampleParams {
-            cutoff_hz: None,
-            ..wanted.clone()
-        };
-        Resampler::new(rec.len(), rec.fs_hz, &loose)
-    })?;
-    let cutoff_hz = wanted.cutoff_hz.map_or(planned.fs_out_hz() / 2.0, |c| {
-        c.min(planned.fs_out_hz() / 2.0)
-    });
+    // The rate the one planned resampler will have (it does not depend on the cutoff), so that
+    // the cutoff is clamped to its Nyquist frequency before planning.
+    let fs_out_hz = planned_fs_out_hz(rec.len(), rec.fs_hz, &wanted);
+    let cutoff_hz = wanted
+        .cutoff_hz
+        .map_or(fs_out_hz / 2.0, |c| c.min(fs_out_hz / 2.0));
     let params = ResampleParams {
         cutoff_hz: Some(cutoff_hz),
         ..wanted

@@ -151,6 +151,14 @@ fn fft_err(e: realfft::FftError) -> SignalError {
 
 /// How a record of `n_in` samples at `fs_hz` is resampled to `p.fs_out_hz`: the method, the
 /// decimation factor (integer ratios), the number of output samples and the output rate.
+/// The output rate, Hz, of a [`Resampler`] planned for `n_in` samples at `fs_hz` with `p` (its
+/// [`Resampler::fs_out_hz`]), without planning it: with a non-integer rate ratio it is
+/// `n_out / duration`, which can fall a hair below `p.fs_out_hz`. It does not depend on
+/// `p.cutoff_hz`. Meaningful only for inputs [`Resampler::new`] accepts.
+pub fn planned_fs_out_hz(n_in: usize, fs_hz: f64, p: &ResampleParams) -> f64 {
+    plan_kind(n_in, fs_hz, p).3
+}
+
 fn plan_kind(n_in: usize, fs_hz: f64, p: &ResampleParams) -> (Kind, usize, usize, f64) {
     let ratio = fs_hz / p.fs_out_hz;
     let d = ratio.round();
@@ -580,5 +588,40 @@ impl ResampleRecording for Recording {
                 start_s: t.start_s,
             }),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rate without planning is the planned resampler's, bit for bit, for integer and
+    /// non-integer ratios, with and without the filter and a cutoff.
+    #[test]
+    fn planned_fs_out_hz_is_the_resamplers_rate() {
+        for &(n_in, fs_hz, fs_out_hz) in &[
+            (204_800, 20_000.0, 50.0),
+            (204_800, 20_000.0, 500.0),
+            (4_251, 425.08, 50.0),
+            (1_000, 100.0, 33.3),
+            (999, 200.0, 200.0),
+            (5_000, 50.0, 120.0),
+        ] {
+            for filter in [true, false] {
+                for cutoff_hz in [None, Some(0.3 * f64::min(fs_out_hz, fs_hz))] {
+                    let p = ResampleParams {
+                        fs_out_hz,
+                        cutoff_hz: if filter { cutoff_hz } else { None },
+                        filter,
+                    };
+                    let planned = Resampler::new(n_in, fs_hz, &p).unwrap().fs_out_hz();
+                    assert_eq!(
+                        planned_fs_out_hz(n_in, fs_hz, &p).to_bits(),
+                        planned.to_bits(),
+                        "{n_in} samples at {fs_hz} Hz to {fs_out_hz} Hz, filter {filter}"
+                    );
+                }
+            }
+        }
     }
 }
