@@ -174,9 +174,7 @@ def main() -> int:
     p.add_argument("--spring-scale", type=float, default=0.8)
     a = p.parse_args()
     try:
-        h.vibmode_bin()
-        h.busgen_dir()
-        h.busgen_python()
+        h.check_tools()
     except h.Skip as e:
         print(f"skipped: {e}")
         return 0

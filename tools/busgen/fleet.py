@@ -189,9 +189,7 @@ def main(argv: Optional[List[str]] = None) -> int:
                         "e.g. --test-extra=--no-periodic")
     a = p.parse_args(argv)
     try:
-        h.vibmode_bin()
-        h.busgen_dir()
-        h.busgen_python()
+        h.check_tools()
     except h.Skip as e:
         print(f"skipped: {e}")
         return 0

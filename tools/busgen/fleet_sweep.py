@@ -227,9 +227,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     p.add_argument("--json", type=Path, help="write the rows and the summary here")
     a = p.parse_args(argv)
     try:
-        h.vibmode_bin()
-        h.busgen_dir()
-        h.busgen_python()
+        h.check_tools()
     except h.Skip as e:
         print(f"skipped: {e}")
         return 0

@@ -65,6 +65,13 @@ def vibmode_bin() -> str:
     return b
 
 
+def check_tools() -> None:
+    """Raises :class:`Skip` unless the vibmode binary, busgen and busgen's Python are all found."""
+    vibmode_bin()
+    busgen_dir()
+    busgen_python()
+
+
 def required() -> bool:
     """True when CI says busgen is present and the run must not skip (VIBMODE_REQUIRE has busgen)."""
     return "busgen" in os.environ.get("VIBMODE_REQUIRE", "").split(",")

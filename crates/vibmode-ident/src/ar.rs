@@ -306,14 +306,9 @@ mod tests {
     /// One Burg pass gives, bit for bit, the polynomial [`burg`] returns for every lower order.
     #[test]
     fn burg_ladder_matches_burg_of_each_order() {
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut uniform = crate::linalg::xorshift_uniform(0x2545_f491_4f6c_dd1d_u64);
         let x: Vec<f64> = (0..300)
-            .map(|t| {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
-                (t as f64 * 0.3).sin() + (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-            })
+            .map(|t| (t as f64 * 0.3).sin() + uniform() - 0.5)
             .collect();
         let ladder = burg_ladder(&x, 40);
         assert_eq!(ladder.len(), 41);

@@ -1273,13 +1273,8 @@ mod tests {
     /// column (the definition) and direct sums, on seeded random signals and minimum-phase C over many seeds and orders.
     #[test]
     fn exact_ar_columns_and_gram_match_direct_sums() {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut uniform = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut u01 = crate::linalg::xorshift_uniform(0x9e37_79b9_7f4a_7c15_u64);
+        let mut uniform = move || u01() - 0.5;
         for case in 0..60 {
             let p = 1 + case % 9;
             let (q, n) = (case % (p + 1), 40 + 3 * case);
@@ -1366,13 +1361,8 @@ mod tests {
     /// gives, bit for bit, the models of `fit_arma_warm` chained order to order.
     #[test]
     fn sweep_equals_chained_warm_fits() {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut noise = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut uniform = crate::linalg::xorshift_uniform(0x9e37_79b9_7f4a_7c15_u64);
+        let mut noise = move || uniform() - 0.5;
         // A lightly damped resonance plus noise, with one spike for the outlier cleaner.
         let mut y = vec![0.0; 600];
         for t in 2..y.len() {

@@ -341,6 +341,19 @@ pub(crate) fn is_min_phase(c: &[f64]) -> bool {
     true
 }
 
+/// A seeded xorshift64 generator of uniform numbers in [0, 1) (53 bits), for the crate's tests:
+/// the same seed, the same sequence.
+#[cfg(test)]
+pub(crate) fn xorshift_uniform(seed: u64) -> impl FnMut() -> f64 {
+    let mut state = seed;
+    move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -349,13 +362,8 @@ mod tests {
     /// added pairwise, plus the tail summed in order (the arithmetic the ARMA results rest on).
     #[test]
     fn dot_rounds_as_four_running_sums() {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut uniform = crate::linalg::xorshift_uniform(0x9e37_79b9_7f4a_7c15_u64);
+        let mut next = move || uniform() - 0.5;
         for n in 0..40 {
             let x: Vec<f64> = (0..n).map(|_| next() * 1e3).collect();
             let z: Vec<f64> = (0..n + 3).map(|_| next()).collect();

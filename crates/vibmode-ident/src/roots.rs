@@ -376,13 +376,7 @@ mod tests {
     /// a trial C of the ARMA search has them; started on the circle and from nearby roots.
     #[test]
     fn aberth_roots_match_the_companion_matrix() {
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut uniform = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut uniform = crate::linalg::xorshift_uniform(0x2545_f491_4f6c_dd1d_u64);
         // Runs that fell back to the companion matrix, started cold and warm.
         let mut fallbacks = [0usize; 2];
         for case in 0..300 {
@@ -452,13 +446,7 @@ mod tests {
     /// for bit.
     #[test]
     fn polished_roots_are_a_conjugate_set_matching_the_companion_matrix() {
-        let mut state = 0x1234_5678_9abc_def1_u64;
-        let mut uniform = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut uniform = crate::linalg::xorshift_uniform(0x1234_5678_9abc_def1_u64);
         for case in 0..200 {
             let n = 2 + case % 59;
             let mut roots = Vec::new();
