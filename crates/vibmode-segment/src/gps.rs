@@ -1,4 +1,4 @@
-//! GPS tracks: GPX (`gpx` crate), NMEA 0183 RMC/GGA (`nmea` crate) and CSV (`csv` crate).
+//! GPS tracks: GPX (read with the `roxmltree` XML parser), NMEA 0183 RMC/GGA (`nmea` crate) and CSV (`csv` crate).
 //!
 //! - **GPX**: every `<trkpt>` of every track and segment (then `<rtept>`, `<wpt>` if there are no
 //!   track points) with a `<time>`; `<speed>` (m/s) when present.
@@ -343,49 +343,130 @@ fn raw_track(p: &str, format: TrackFormat, fixes: Vec<GpsFix>, absolute: bool) -
 }
 
 fn read_gpx(text: &str, p: &str) -> Result<Raw, SegmentError> {
-    let g = gpx::read(text.as_bytes()).map_err(|e| match e {
-        // The GPX reader refuses a coordinate out of range for the whole file (such a file is
-        // not valid GPX); the value is named, short.
-        gpx::errors::GpxError::LonLatOutOfBoundsError(name, range, v) => track_err(
+    let doc = roxmltree::Document::parse(text).map_err(|e| {
+        track_err(
             p,
             format!(
-                "{name} {} is outside {range} degrees, which makes the file invalid GPX; fix or delete that point",
-                Num(v)
+                "{}; check that it is a valid GPX file",
+                short(&e.to_string())
             ),
-        ),
-        e => track_err(
-            p,
-            format!("{}; check that it is a valid GPX file", short(&e.to_string())),
-        ),
+        )
     })?;
-    let mut points: Vec<&gpx::Waypoint> = g
-        .tracks
-        .iter()
-        .flat_map(|t| t.segments.iter())
-        .flat_map(|s| s.points.iter())
+    let root = doc.root_element();
+    if root.tag_name().name() != "gpx" {
+        return Err(track_err(
+            p,
+            format!(
+                "the root element is <{}>, not <gpx>; check that it is a valid GPX file",
+                short(root.tag_name().name())
+            ),
+        ));
+    }
+    // Track points of every track and segment; else route points; else waypoints.
+    let mut points: Vec<roxmltree::Node<'_, '_>> = children(root, "trk")
+        .flat_map(|t| children(t, "trkseg"))
+        .flat_map(|s| children(s, "trkpt"))
         .collect();
     if points.is_empty() {
-        points = g.routes.iter().flat_map(|r| r.points.iter()).collect();
+        points = children(root, "rte")
+            .flat_map(|r| children(r, "rtept"))
+            .collect();
     }
     if points.is_empty() {
-        points = g.waypoints.iter().collect();
+        points = children(root, "wpt").collect();
     }
     let mut fixes = Vec::with_capacity(points.len());
     let mut places = Vec::with_capacity(points.len());
     for (k, w) in points.into_iter().enumerate() {
-        let Some(t) = w.time else { continue };
-        let t: time::OffsetDateTime = t.into();
-        let pt = w.point();
+        let place = format!("point {}", k + 1);
+        // A coordinate out of range, or not a number, makes the file invalid GPX: refused as a
+        // whole, the value named, short.
+        let coord = |name: &str, limit: f64| -> Result<f64, SegmentError> {
+            let Some(cell) = w.attribute(name) else {
+                return Err(track_err(
+                    p,
+                    format!("{place} has no {name} attribute, which makes the file invalid GPX; fix or delete that point"),
+                ));
+            };
+            match cell.trim().parse::<f64>() {
+                Ok(v) if (-limit..=limit).contains(&v) => Ok(v),
+                Ok(v) => Err(track_err(
+                    p,
+                    format!(
+                        "{place}: {name} {} is outside -{limit}..{limit} degrees, which makes the file invalid GPX; fix or delete that point",
+                        Num(v)
+                    ),
+                )),
+                Err(_) => Err(track_err(
+                    p,
+                    format!(
+                        "{place}: {name} {} is not a number, which makes the file invalid GPX; fix or delete that point",
+                        quoted(cell)
+                    ),
+                )),
+            }
+        };
+        let lat_deg = coord("lat", 90.0)?;
+        let lon_deg = coord("lon", 180.0)?;
+        let child_text =
+            |name: &str| children_named(w, name).map(|c| c.text().unwrap_or("").trim().to_string());
+        // A point without a time cannot be placed on the recording: skipped.
+        let Some(time_text) = child_text("time") else {
+            continue;
+        };
+        let Some(t_s) = parse_rfc3339(&time_text) else {
+            return Err(track_err(
+                p,
+                format!(
+                    "{place}: time {} is not an RFC 3339 time (2024-05-02T07:31:00Z), which makes the file invalid GPX; fix or delete that point",
+                    quoted(&time_text)
+                ),
+            ));
+        };
+        // GPX 1.0's `<speed>`, m/s; a speed that is not finite is dropped by the common check.
+        let speed_kmh = match child_text("speed") {
+            None => None,
+            Some(v) => match v.parse::<f64>() {
+                Ok(v) => Some(v * 3.6),
+                Err(_) => {
+                    return Err(track_err(
+                        p,
+                        format!(
+                            "{place}: speed {} is not a number, which makes the file invalid GPX; fix or delete that point",
+                            quoted(&v)
+                        ),
+                    ))
+                }
+            },
+        };
         fixes.push(GpsFix {
-            t_s: t.unix_timestamp_nanos() as f64 / 1e9,
-            lat_deg: pt.y(),
-            lon_deg: pt.x(),
-            speed_kmh: w.speed.map(|v| v * 3.6),
+            t_s,
+            lat_deg,
+            lon_deg,
+            speed_kmh,
             course_deg: None,
         });
-        places.push(format!("point {}", k + 1));
+        places.push(place);
     }
     Ok((raw_track(p, TrackFormat::Gpx, fixes, true), places))
+}
+
+/// The child elements of `n` called `name` (any namespace).
+fn children<'a, 'i: 'a>(
+    n: roxmltree::Node<'a, 'i>,
+    name: &'static str,
+) -> impl Iterator<Item = roxmltree::Node<'a, 'i>> {
+    n.children()
+        .filter(move |c| c.is_element() && c.tag_name().name() == name)
+}
+
+/// The first child element of `n` called `name` (any namespace).
+fn children_named<'a, 'i>(
+    n: roxmltree::Node<'a, 'i>,
+    name: &str,
+) -> Option<roxmltree::Node<'a, 'i>> {
+    n.children()
+        .find(|c| c.is_element() && c.tag_name().name() == name)
 }
 
 fn read_nmea(text: &str, p: &str) -> Result<Raw, SegmentError> {

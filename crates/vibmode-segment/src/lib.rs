@@ -4,7 +4,7 @@
 //! drives steadily, as the paper's records were cut with a GPS track recorder
 //! (`../shared/paper/METHOD.md` section 1), and says why the rest was skipped:
 //!
-//! - [`gps`]: GPS tracks from GPX (`gpx` crate), NMEA 0183 RMC/GGA sentences (`nmea` crate;
+//! - [`gps`]: GPS tracks from GPX (`roxmltree`), NMEA 0183 RMC/GGA sentences (`nmea` crate;
 //!   unparseable sentences are skipped and counted) or CSV (time, latitude, longitude, speed);
 //! - [`by_gps`]: records where the speed is steady and the heading nearly constant for a whole
 //!   record; stops, braking, accelerating and turns are skipped;
@@ -529,18 +529,89 @@ pub enum SegmentError {
     Signal(#[from] vibmode_signal::SignalError),
 }
 
-/// Unix seconds of an RFC 3339 time.
+/// Unix seconds of an RFC 3339 time (`2024-05-02T07:31:00Z`, `2024-05-02T09:31:00.25+02:00`).
 pub fn parse_rfc3339(text: &str) -> Option<f64> {
-    let t =
-        time::OffsetDateTime::parse(text.trim(), &time::format_description::well_known::Rfc3339)
-            .ok()?;
-    Some(t.unix_timestamp_nanos() as f64 / 1e9)
+    let t = chrono::DateTime::parse_from_rfc3339(text.trim()).ok()?;
+    Some(t.timestamp() as f64 + f64::from(t.timestamp_subsec_nanos()) / 1e9)
 }
 
-/// RFC 3339 (UTC, millisecond precision) of Unix seconds.
+/// RFC 3339 (UTC, `Z`) of Unix seconds rounded to the millisecond, the fraction written only
+/// when it is not zero and without trailing zeros (`07:31:00Z`, `07:31:00.5Z`, `07:31:00.125Z`);
+/// `None` outside the years 0000-9999.
 pub fn format_rfc3339(unix_s: f64) -> Option<String> {
-    let ns = (unix_s * 1e3).round() as i128 * 1_000_000;
-    let t = time::OffsetDateTime::from_unix_timestamp_nanos(ns).ok()?;
-    t.format(&time::format_description::well_known::Rfc3339)
-        .ok()
+    use chrono::Datelike;
+    let ms = (unix_s * 1e3).round();
+    if !ms.is_finite() || ms.abs() > 1e15 {
+        return None;
+    }
+    let t = chrono::DateTime::from_timestamp_millis(ms as i64)?;
+    if !(0..=9999).contains(&t.year()) {
+        return None;
+    }
+    let mut out = t.format("%Y-%m-%dT%H:%M:%S").to_string();
+    let frac = t.timestamp_subsec_millis();
+    if frac != 0 {
+        let digits = format!("{frac:03}");
+        out.push('.');
+        out.push_str(digits.trim_end_matches('0'));
+    }
+    out.push('Z');
+    Some(out)
+}
+
+#[cfg(test)]
+mod rfc3339_tests {
+    use super::*;
+
+    /// By hand: 2024-05-02T07:31:00Z is 19845 days after 1970-01-01, plus 7 h 31 min.
+    #[test]
+    fn rfc3339_by_hand() {
+        let t0 = 19845.0 * 86400.0 + 7.0 * 3600.0 + 31.0 * 60.0;
+        assert_eq!(t0, 1714635060.0);
+        assert_eq!(parse_rfc3339("2024-05-02T07:31:00Z"), Some(t0));
+        assert_eq!(
+            parse_rfc3339(" 2024-05-02T09:31:00.5+02:00 "),
+            Some(t0 + 0.5)
+        );
+        assert_eq!(parse_rfc3339("2024-05-02 07:31"), None);
+        assert_eq!(format_rfc3339(t0).as_deref(), Some("2024-05-02T07:31:00Z"));
+        assert_eq!(
+            format_rfc3339(t0 + 0.5).as_deref(),
+            Some("2024-05-02T07:31:00.5Z")
+        );
+        assert_eq!(
+            format_rfc3339(t0 + 0.125).as_deref(),
+            Some("2024-05-02T07:31:00.125Z")
+        );
+        assert_eq!(
+            format_rfc3339(t0 + 0.0004).as_deref(),
+            Some("2024-05-02T07:31:00Z")
+        );
+        assert_eq!(
+            format_rfc3339(-0.5).as_deref(),
+            Some("1969-12-31T23:59:59.5Z")
+        );
+        assert_eq!(format_rfc3339(1e12), None);
+        assert_eq!(format_rfc3339(f64::NAN), None);
+    }
+
+    /// Formatting then parsing gives the time back to the millisecond, over seeded random times
+    /// from 1900 to 2200.
+    #[test]
+    fn rfc3339_round_trips_to_the_millisecond() {
+        let mut x = 0x2545_f491_4f6c_dd1d_u64;
+        for _ in 0..2000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let u = (x >> 11) as f64 / (1u64 << 53) as f64;
+            let t = -2.2e9 + u * 9.5e9;
+            let s = format_rfc3339(t).unwrap();
+            let back = parse_rfc3339(&s).unwrap();
+            assert!(
+                (back - (t * 1e3).round() / 1e3).abs() < 1e-6,
+                "{t} {s} {back}"
+            );
+        }
+    }
 }

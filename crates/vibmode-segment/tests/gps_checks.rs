@@ -569,3 +569,67 @@ fn a_gpx_coordinate_out_of_range_is_refused_naming_the_value() {
         );
     }
 }
+
+/// GPX 1.1 with a namespace prefix, route points when there is no track, a point without a
+/// time skipped, and the times read to the millisecond (by hand: 07:31:00Z is 1714635060 s).
+#[test]
+fn gpx_route_points_with_a_prefix_are_read_and_untimed_points_skipped() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = r#"<?xml version="1.0"?>
+<g:gpx xmlns:g="http://www.topografix.com/GPX/1/1" version="1.1" creator="hand">
+  <g:rte>
+    <g:rtept lat="45.5" lon="9.25"><g:time>2024-05-02T07:31:00Z</g:time></g:rtept>
+    <g:rtept lat="45.6" lon="9.35"></g:rtept>
+    <g:rtept lat="-45.75" lon="-9.5"><g:time>2024-05-02T09:31:01.25+02:00</g:time></g:rtept>
+  </g:rte>
+</g:gpx>"#;
+    let t = read_track(&write(dir.path(), "r.gpx", text)).unwrap();
+    let got: Vec<(f64, f64, f64)> = t
+        .fixes
+        .iter()
+        .map(|f| (f.t_s, f.lat_deg, f.lon_deg))
+        .collect();
+    assert_eq!(
+        got,
+        vec![(1714635060.0, 45.5, 9.25), (1714635061.25, -45.75, -9.5)]
+    );
+    assert!(t.fixes.iter().all(|f| f.speed_kmh.is_none()));
+}
+
+/// A time, a coordinate or a speed that is not what GPX allows refuses the file in one line
+/// naming the point and the value.
+#[test]
+fn a_gpx_point_with_a_malformed_value_is_refused_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    for (point, want) in [
+        (
+            r#"<trkpt lat="45" lon="9"><time>yesterday</time></trkpt>"#,
+            "time yesterday is not an RFC 3339 time",
+        ),
+        (
+            r#"<trkpt lat="north" lon="9"><time>2024-05-02T07:31:00Z</time></trkpt>"#,
+            "lat north is not a number",
+        ),
+        (
+            r#"<trkpt lon="9"><time>2024-05-02T07:31:00Z</time></trkpt>"#,
+            "has no lat attribute",
+        ),
+        (
+            r#"<trkpt lat="45" lon="9"><time>2024-05-02T07:31:00Z</time><speed>fast</speed></trkpt>"#,
+            "speed fast is not a number",
+        ),
+    ] {
+        let text = format!(r#"<gpx version="1.0"><trk><trkseg>{point}</trkseg></trk></gpx>"#);
+        let e = read_track(&write(dir.path(), "m.gpx", &text))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("point 1") && e.contains(want) && !e.contains('\n'),
+            "{e}"
+        );
+    }
+    let e = read_track(&write(dir.path(), "k.gpx", "<kml></kml>"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("<kml>, not <gpx>"), "{e}");
+}
