@@ -194,12 +194,8 @@ fn matrix(n: usize, m: usize, v: &[Complex64]) -> DMatrix<Complex64> {
 /// Errors: no spectra; spectra of different channels or bins; no bin with a well-conditioned
 /// pooled `S_uu`.
 pub fn fit_body_model(spectra: &[&BodySpectra]) -> Result<BodyModel> {
-    let fail = |reason: String| FleetError::BodyModel { reason };
     let Some(first) = spectra.first() else {
-        return Err(fail(
-            "no nominal record has body spectra; ingest records with sprung and unsprung channels"
-                .into(),
-        ));
+        return Err(FleetError::NoBodySpectra);
     };
     for s in spectra {
         if !s.consistent()
@@ -207,15 +203,14 @@ pub fn fit_body_model(spectra: &[&BodySpectra]) -> Result<BodyModel> {
             || s.unsprung != first.unsprung
             || s.sprung != first.sprung
         {
-            return Err(fail(format!(
-                "the nominal records' body spectra differ (channels [{}] / [{}] and {} bins, against [{}] / [{}] and {} bins); build the baseline from records of one layout and one analysis rate",
-                s.sprung.join(", "),
-                s.unsprung.join(", "),
-                s.freq_hz.len(),
-                first.sprung.join(", "),
-                first.unsprung.join(", "),
-                first.freq_hz.len()
-            )));
+            return Err(FleetError::BodySpectraDiffer {
+                sprung: s.sprung.clone(),
+                unsprung: s.unsprung.clone(),
+                bins: s.freq_hz.len(),
+                first_sprung: first.sprung.clone(),
+                first_unsprung: first.unsprung.clone(),
+                first_bins: first.freq_hz.len(),
+            });
         }
     }
     let (nu, ny) = (first.unsprung.len(), first.sprung.len());
@@ -254,9 +249,10 @@ pub fn fit_body_model(spectra: &[&BodySpectra]) -> Result<BodyModel> {
     }
     if h.iter().all(Vec::is_empty) {
         let best = condition.iter().copied().fold(f64::INFINITY, f64::min);
-        return Err(fail(format!(
-            "the pooled wheel cross-spectra of the nominal records are singular in every body bin (best condition number {best:.3e}, at most {MAX_CONDITION:e} needed); baseline records at several speeds tell the wheels apart"
-        )));
+        return Err(FleetError::BodySpectraSingular {
+            best_condition: best,
+            max_condition: MAX_CONDITION,
+        });
     }
     Ok(BodyModel {
         freq_hz: first.freq_hz.clone(),
@@ -396,6 +392,11 @@ pub(crate) mod tests {
             vec![4.0],
         );
         let e = fit_body_model(&[&s, &s]).expect_err("singular");
+        assert!(
+            matches!(e, FleetError::BodySpectraSingular { best_condition, max_condition }
+                if best_condition > max_condition),
+            "{e:?}"
+        );
         let msg = e.to_string();
         assert!(msg.contains("singular in every body bin"), "{msg}");
         assert!(
@@ -403,6 +404,7 @@ pub(crate) mod tests {
             "{msg}"
         );
         let e = fit_body_model(&[]).expect_err("none");
+        assert!(matches!(e, FleetError::NoBodySpectra), "{e:?}");
         assert!(
             e.to_string().contains("no nominal record has body spectra"),
             "{e}"

@@ -69,13 +69,41 @@ pub enum FleetError {
         /// The check's message.
         reason: String,
     },
-    /// A record too short or too slowly sampled for the features.
-    #[error("'{}' cannot be scored: {reason}", vibmode_core::quoted(record))]
-    RecordUnfit {
+    /// A record sampled too slowly for the highest feature band.
+    #[error(
+        "'{}' cannot be scored: it is sampled at {} Hz, but the feature bands reach {} Hz, which needs at least {} Hz; record at a higher rate",
+        vibmode_core::quoted(record),
+        vibmode_core::Num(*fs_hz),
+        vibmode_core::Num(*min_fs_hz / 2.0),
+        vibmode_core::Num(*min_fs_hz)
+    )]
+    RecordUnderSampled {
         /// The record (file name).
         record: String,
-        /// What is wrong and the minimum.
-        reason: String,
+        /// Its sampling rate, Hz.
+        fs_hz: f64,
+        /// The lowest rate the feature bands need (twice their highest edge), Hz.
+        min_fs_hz: f64,
+    },
+    /// A record too short for the lowest feature band.
+    #[error(
+        "'{}' cannot be scored: it lasts {} s, but the features need at least {} s ({periods} periods of the lowest band edge, {} Hz, and one Welch segment); give longer records",
+        vibmode_core::quoted(record),
+        vibmode_core::Num(*duration_s),
+        vibmode_core::Num(*min_duration_s),
+        vibmode_core::Num(*lowest_band_edge_hz)
+    )]
+    RecordTooShort {
+        /// The record (file name).
+        record: String,
+        /// Its duration, s.
+        duration_s: f64,
+        /// The shortest duration the features need, s.
+        min_duration_s: f64,
+        /// Periods of the lowest band edge asked for.
+        periods: f64,
+        /// The lowest band edge, Hz.
+        lowest_band_edge_hz: f64,
     },
     /// A nominal record with a faulty sensor (it would spoil the baseline).
     #[error("'{}' is to be nominal but {faults}; a nominal record needs every sensor working: fix the logger or leave the file out", vibmode_core::quoted(record))]
@@ -120,11 +148,40 @@ pub enum FleetError {
         /// The identifier given.
         vehicle: String,
     },
-    /// The body's response to the wheel motions cannot be fitted from the nominal records.
-    #[error("body response to wheel motion: {reason}")]
-    BodyModel {
-        /// Why, with the fix.
-        reason: String,
+    /// The body's response to the wheel motions: no nominal record has body spectra.
+    #[error("body response to wheel motion: no nominal record has body spectra; ingest records with sprung and unsprung channels")]
+    NoBodySpectra,
+    /// The body's response to the wheel motions: nominal records of different layouts.
+    #[error(
+        "body response to wheel motion: the nominal records' body spectra differ (channels [{}] / [{}] and {bins} bins, against [{}] / [{}] and {first_bins} bins); build the baseline from records of one layout and one analysis rate",
+        sprung.join(", "),
+        unsprung.join(", "),
+        first_sprung.join(", "),
+        first_unsprung.join(", ")
+    )]
+    BodySpectraDiffer {
+        /// The differing record's sprung channels.
+        sprung: Vec<String>,
+        /// Its unsprung channels.
+        unsprung: Vec<String>,
+        /// Its frequency bins.
+        bins: usize,
+        /// The first record's sprung channels.
+        first_sprung: Vec<String>,
+        /// Its unsprung channels.
+        first_unsprung: Vec<String>,
+        /// Its frequency bins.
+        first_bins: usize,
+    },
+    /// The body's response to the wheel motions: the pooled wheel cross-spectra are singular.
+    #[error(
+        "body response to wheel motion: the pooled wheel cross-spectra of the nominal records are singular in every body bin (best condition number {best_condition:.3e}, at most {max_condition:e} needed); baseline records at several speeds tell the wheels apart"
+    )]
+    BodySpectraSingular {
+        /// The smallest condition number over the bins.
+        best_condition: f64,
+        /// The largest accepted.
+        max_condition: f64,
     },
     /// Too few nominal records for a baseline.
     #[error("vehicle '{}' has {found} nominal record(s) with features; a baseline needs at least {needed}: ingest more nominal runs", vibmode_core::quoted(vehicle))]

@@ -14,7 +14,6 @@ use crate::body::{body_spectra, BodySpectra};
 
 use crate::config::FleetConfig;
 use crate::error::{FleetError, Result};
-use vibmode_core::Num;
 
 /// One identified mode of a channel.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -289,29 +288,24 @@ pub fn sensor_faults(rec: &Recording, acfg: &AnalysisConfig) -> Vec<SensorFault>
 /// lowest band edge of `bands_hz` and one Welch segment at the analysis rate. Else an error
 /// stating the minimum.
 pub fn check_sampling(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<()> {
-    let unfit = |reason: String| FleetError::RecordUnfit {
-        record: name.to_string(),
-        reason,
-    };
     let min_fs = cfg.min_fs_hz();
     if rec.fs_hz.is_nan() || rec.fs_hz < min_fs {
-        return Err(unfit(format!(
-            "it is sampled at {} Hz, but the feature bands reach {} Hz, which needs at least {} Hz; record at a higher rate",
-            Num(rec.fs_hz),
-            Num(min_fs / 2.0),
-            Num(min_fs)
-        )));
+        return Err(FleetError::RecordUnderSampled {
+            record: name.to_string(),
+            fs_hz: rec.fs_hz,
+            min_fs_hz: min_fs,
+        });
     }
     let min_s = cfg.min_record_s();
     let duration = rec.duration_s();
     if duration.is_nan() || duration < min_s {
-        return Err(unfit(format!(
-            "it lasts {} s, but the features need at least {} s ({} periods of the lowest band edge, {} Hz, and one Welch segment); give longer records",
-            Num(duration),
-            Num(min_s),
-            MIN_PERIODS,
-            Num(cfg.lowest_band_edge_hz().unwrap_or(0.0))
-        )));
+        return Err(FleetError::RecordTooShort {
+            record: name.to_string(),
+            duration_s: duration,
+            min_duration_s: min_s,
+            periods: MIN_PERIODS,
+            lowest_band_edge_hz: cfg.lowest_band_edge_hz().unwrap_or(0.0),
+        });
     }
     Ok(())
 }
@@ -712,7 +706,7 @@ pub fn h1_band_values(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use vibmode_core::Channel;
+    use vibmode_core::{Channel, Num};
 
     /// H1 band value by hand: a cross-spectrum `0.5 e^(i theta) S_uu` gives 0.5 in every band
     /// whatever the phase and the weights; a band without unsprung power gives none.
@@ -798,6 +792,38 @@ mod tests {
                 .collect(),
         )
         .expect("recording")
+    }
+
+    /// By hand with the default settings: a record at half the rate the bands need, and one a
+    /// sample shorter than the shortest allowed, are refused naming their rate and duration.
+    #[test]
+    fn a_slow_or_short_record_is_refused_naming_its_rate_or_duration() {
+        let cfg = FleetConfig::default();
+        let (min_fs, min_s) = (cfg.min_fs_hz(), cfg.min_record_s());
+        let slow = recording(min_fs / 2.0, vec![("FL_unsprung", vec![0.0; 4096])]);
+        match check_sampling("a.csv", &slow, &cfg) {
+            Err(e @ FleetError::RecordUnderSampled { .. }) => {
+                let m = e.to_string();
+                let want = format!("sampled at {} Hz", Num(min_fs / 2.0));
+                assert!(m.contains(&want) && m.contains("a.csv"), "{m}");
+            }
+            other => panic!("{other:?}"),
+        }
+        let fs = min_fs * 2.0;
+        let n = (min_s * fs).ceil() as usize - 2;
+        let short = recording(fs, vec![("FL_unsprung", vec![0.0; n])]);
+        match check_sampling("b.csv", &short, &cfg) {
+            Err(FleetError::RecordTooShort {
+                duration_s,
+                min_duration_s,
+                ..
+            }) => {
+                assert!(duration_s < min_duration_s && min_duration_s == min_s);
+            }
+            other => panic!("{other:?}"),
+        }
+        let fine = recording(fs, vec![("FL_unsprung", vec![0.0; n + 4])]);
+        assert!(check_sampling("c.csv", &fine, &cfg).is_ok());
     }
 
     #[test]
