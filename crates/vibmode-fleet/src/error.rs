@@ -254,17 +254,57 @@ pub enum FleetError {
         /// The vehicle.
         vehicle: String,
     },
-    /// A record's features cannot be computed.
+    /// A record's features cannot be computed: the analysis refused it or its settings.
     #[error(
-        "features of '{}' cannot be computed: {}",
-        vibmode_core::quoted(record),
-        vibmode_core::cap_message(reason, 250)
+        "features of '{}' cannot be computed: {source}",
+        vibmode_core::quoted(record)
     )]
-    Features {
+    FeaturesAnalysis {
         /// The record (file name).
         record: String,
-        /// Why, with the fix.
-        reason: String,
+        /// The analysis' error.
+        #[source]
+        source: vibmode_analysis::AnalysisError,
+    },
+    /// A record's features cannot be computed: a spectrum of it failed.
+    #[error(
+        "features of '{}' cannot be computed: {source}",
+        vibmode_core::quoted(record)
+    )]
+    FeaturesSpectra {
+        /// The record (file name).
+        record: String,
+        /// The spectrum's error.
+        #[source]
+        source: vibmode_spectra::SpectraError,
+    },
+    /// A record whose pieces give spectra of different lengths.
+    #[error("features of '{}' cannot be computed: its segments give spectra of {first_bins} and {other_bins} bins; give records of one length", vibmode_core::quoted(record))]
+    SpectraBinsDiffer {
+        /// The record (file name).
+        record: String,
+        /// Bins of the first piece's spectrum.
+        first_bins: usize,
+        /// Bins of the piece that differs.
+        other_bins: usize,
+    },
+    /// A record that gives no feature at all.
+    #[error(
+        "features of '{}' cannot be computed: no corner has both a sprung and an unsprung channel and no structural mode was found in channels [{}]; name channels by role and corner (e.g. FL_unsprung, FL_sprung) or give longer records",
+        vibmode_core::quoted(record),
+        vibmode_core::cap_message(&channels.join(", "), 200)
+    )]
+    NoRecordFeature {
+        /// The record (file name).
+        record: String,
+        /// Its channels.
+        channels: Vec<String>,
+    },
+    /// A baseline without any vehicle feature.
+    #[error("the nominal records of vehicle '{}' give no vehicle feature (transmissibility or mode) in enough of them; name channels by role and corner (e.g. RL_unsprung, RL_sprung)", vibmode_core::quoted(vehicle))]
+    NoVehicleFeature {
+        /// The vehicle.
+        vehicle: String,
     },
     /// A condition label that is not nominal or test.
     #[error(
@@ -335,3 +375,35 @@ pub enum FleetError {
 
 /// Result of this crate.
 pub type Result<T, E = FleetError> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The typed feature errors carry their values into one line each, a long channel list
+    /// capped, and keep the underlying error as their source.
+    #[test]
+    fn feature_errors_name_their_values_in_one_line() {
+        let many: Vec<String> = (0..100).map(|k| format!("channel_{k}")).collect();
+        let e = FleetError::NoRecordFeature {
+            record: "a.csv".into(),
+            channels: many,
+        };
+        let m = e.to_string();
+        assert!(m.contains("'a.csv'") && m.contains("channel_0, channel_1") && m.len() < 600);
+        assert!(!m.contains("channel_99") && !m.contains('\n'), "{m}");
+        let e = FleetError::SpectraBinsDiffer {
+            record: "b.csv".into(),
+            first_bins: 129,
+            other_bins: 65,
+        };
+        assert!(e.to_string().contains("129 and 65 bins"), "{e}");
+        let source = vibmode_spectra::SpectraError::LengthMismatch { len_x: 3, len_y: 8 };
+        let e = FleetError::FeaturesSpectra {
+            record: "c.csv".into(),
+            source,
+        };
+        let src = std::error::Error::source(&e).map(|s| s.to_string());
+        assert!(src.is_some() && e.to_string().ends_with(&src.unwrap_or_default()));
+    }
+}

@@ -8,7 +8,7 @@ use vibmode_analysis::{
     RecordFacts, Role, SweepIdentifier,
 };
 use vibmode_core::{ModeClass, Recording};
-use vibmode_spectra::{band_rms, WelchParams, Window};
+use vibmode_spectra::{band_rms, SpectraError, WelchParams, Window};
 
 use crate::body::{body_spectra, BodySpectra};
 
@@ -366,9 +366,18 @@ pub fn compute_features(name: &str, rec: &Recording, cfg: &FleetConfig) -> Resul
 fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordFeatures> {
     let acfg: &AnalysisConfig = &cfg.analysis;
     let records = cut_records(name, rec, acfg.record_length_s);
-    let fail = |reason: String| FleetError::Features {
+    let analysis = |source: vibmode_analysis::AnalysisError| FleetError::FeaturesAnalysis {
         record: name.to_string(),
-        reason,
+        source,
+    };
+    let spectra = |source: SpectraError| FleetError::FeaturesSpectra {
+        record: name.to_string(),
+        source,
+    };
+    let bins_differ = |first_bins: usize, other_bins: usize| FleetError::SpectraBinsDiffer {
+        record: name.to_string(),
+        first_bins,
+        other_bins,
     };
     let mut notes = Vec::new();
     // Mean Welch PSD over the records, per channel, at the analysis rate.
@@ -408,9 +417,9 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
     let mut body: Option<BodySpectra> = None;
     // Each record pre-processed once (in parallel): the spectra here and the analysis below
     // share it.
-    acfg.validate().map_err(|e| fail(e.to_string()))?;
-    check_records(&records).map_err(|e| fail(e.to_string()))?;
-    let pres = preprocess_records(&records, acfg).map_err(|e| fail(e.to_string()))?;
+    acfg.validate().map_err(analysis)?;
+    check_records(&records).map_err(analysis)?;
+    let pres = preprocess_records(&records, acfg).map_err(analysis)?;
     for pre in &pres {
         fs = pre.band.fs_hz;
         if !body_u.is_empty() && !body_y.is_empty() {
@@ -430,12 +439,14 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
                 fs,
                 cfg.body_band_hz,
             )
-            .map_err(|e| fail(e.to_string()))?;
+            .map_err(spectra)?;
             body = Some(match body.take() {
                 None => s.scaled(1.0 / records.len() as f64),
-                Some(acc) => acc.add_scaled(&s, 1.0 / records.len() as f64).ok_or_else(|| {
-                    fail("its records give body spectra of different bins; give records of one length".into())
-                })?,
+                Some(acc) => {
+                    let (first_bins, other_bins) = (acc.freq_hz.len(), s.freq_hz.len());
+                    acc.add_scaled(&s, 1.0 / records.len() as f64)
+                        .ok_or_else(|| bins_differ(first_bins, other_bins))?
+                }
             });
         }
         for (c, ch) in pre.recording.channels.iter().enumerate() {
@@ -444,18 +455,13 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
                 nperseg: Some(acfg.spectra.nperseg.min(ch.samples.len())),
                 ..WelchParams::default()
             };
-            let w = vibmode_spectra::welch(&ch.samples, pre.band.fs_hz, &wp)
-                .map_err(|e| fail(e.to_string()))?;
+            let w = vibmode_spectra::welch(&ch.samples, pre.band.fs_hz, &wp).map_err(spectra)?;
             if psd.len() <= c {
                 psd.push(vec![0.0; w.psd.len()]);
                 freq = w.freq_hz.clone();
             }
             if psd[c].len() != w.psd.len() {
-                return Err(fail(format!(
-                    "its segments give spectra of {} and {} bins; give records of one length",
-                    psd[c].len(),
-                    w.psd.len()
-                )));
+                return Err(bins_differ(psd[c].len(), w.psd.len()));
             }
             for (a, b) in psd[c].iter_mut().zip(&w.psd) {
                 *a += b / records.len() as f64;
@@ -471,17 +477,12 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
                 nperseg: Some(acfg.spectra.nperseg.min(xu.len())),
                 ..WelchParams::default()
             };
-            let c = vibmode_spectra::csd(xu, xs, pre.band.fs_hz, &wp)
-                .map_err(|e| fail(e.to_string()))?;
+            let c = vibmode_spectra::csd(xu, xs, pre.band.fs_hz, &wp).map_err(spectra)?;
             if cross[k].is_empty() {
                 cross[k] = vec![(0.0, 0.0); c.csd.len()];
             }
             if cross[k].len() != c.csd.len() {
-                return Err(fail(format!(
-                    "its segments give cross-spectra of {} and {} bins; give records of one length",
-                    cross[k].len(),
-                    c.csd.len()
-                )));
+                return Err(bins_differ(cross[k].len(), c.csd.len()));
             }
             let n = records.len() as f64;
             for (a, b) in cross[k].iter_mut().zip(&c.csd) {
@@ -504,7 +505,7 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
         &|_, _| {},
         std::time::Instant::now(),
     )
-    .map_err(|e| fail(e.to_string()))?;
+    .map_err(analysis)?;
     let mut channels = Vec::new();
     for (c, ch) in rec.channels.iter().enumerate() {
         let placement = acfg.placement_of(ch);
@@ -647,10 +648,10 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
     }
     let n_modes: usize = channels.iter().map(|c| c.modes.len()).sum();
     if transmissibility.is_empty() && n_modes == 0 {
-        return Err(fail(format!(
-            "no corner has both a sprung and an unsprung channel and no structural mode was found in channels [{}]; name channels by role and corner (e.g. FL_unsprung, FL_sprung) or give longer records",
-            rec.names().join(", ")
-        )));
+        return Err(FleetError::NoRecordFeature {
+            record: name.to_string(),
+            channels: rec.names().iter().map(|c| c.to_string()).collect(),
+        });
     }
     Ok(RecordFeatures {
         analysis_fs_hz: fs,

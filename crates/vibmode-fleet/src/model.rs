@@ -866,9 +866,8 @@ pub fn build_model_set(
         .collect();
     let features = feature_stats(&values, cfg);
     if !features.iter().any(|f| f.meta.group == Group::Vehicle) {
-        return Err(FleetError::Features {
-            record: format!("the nominal records of vehicle '{vehicle}'"),
-            reason: "no vehicle feature (transmissibility or mode) is present in enough of them; name channels by role and corner (e.g. RL_unsprung, RL_sprung)".into(),
+        return Err(FleetError::NoVehicleFeature {
+            vehicle: vehicle.to_string(),
         });
     }
     let count = |g: Group| features.iter().filter(|f| f.meta.group == g).count();
