@@ -621,7 +621,8 @@ impl<'a> LineStage<'a> {
     ///
     /// A cluster is a line only with harmonic evidence: a steady track (F-test detections in at
     /// least `min_record_share` of the records, or by the test combined over the records) within
-    /// half of `half_width_hz` of its frequency. Then a
+    /// half of `half_width_hz` of its frequency, at a frequency the track holds in at least
+    /// [`MIN_RECORDS_TO_CLASS`] records. Then a
     /// cluster damped below [`LINE_DAMPING_MAX`] (what identification makes of a sine: a pole
     /// near the unit circle, supported or not) is a periodic disturbance; a more damped one is a
     /// mode with the line on its flank and stays as classed. A cluster the damping rule called
@@ -637,15 +638,17 @@ impl<'a> LineStage<'a> {
             // narrower than a band (a line drifting within the records, seen at either end of
             // its drift), else of its frequency in some record (the tracker follows engine speed
             // changes of up to 15 % over the records; the range between is no line).
+            // Only frequencies the track holds in at least MIN_RECORDS_TO_CLASS records count.
             let on_track = tracks.iter().any(|t| {
-                let (lo, hi) = t.frequency_range_hz;
-                if t.has_steady_record() && hi - lo <= 2.0 * hw {
+                let held = held_frequencies(t, hw);
+                let lo = held.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = held.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                if held.is_empty() {
+                    false
+                } else if hi - lo <= 2.0 * hw {
                     lo - 0.5 * hw <= m.frequency_hz && m.frequency_hz <= hi + 0.5 * hw
                 } else {
-                    t.record_hz
-                        .iter()
-                        .flatten()
-                        .any(|f| (f - m.frequency_hz).abs() <= 0.5 * hw)
+                    held.iter().any(|f| (f - m.frequency_hz).abs() <= 0.5 * hw)
                 }
             });
             let light = m.damping_ratio < LINE_DAMPING_MAX;
@@ -660,6 +663,24 @@ impl<'a> LineStage<'a> {
             }
         }
     }
+}
+
+/// A track's steady frequencies that classify clusters: those of records with at least
+/// [`MIN_RECORDS_TO_CLASS`] of the track's records (their own included) within `hw` Hz of them,
+/// or all of them when the track has fewer records (an analysis of one record: the idling bus)
+/// or holds a sweep (the engine speed change that took the line to a frequency it holds in one
+/// record: the demo's driveline line braked from 7 to 5.3 Hz).
+fn held_frequencies(t: &LineTrack, hw: f64) -> Vec<f64> {
+    let fs: Vec<f64> = t.record_hz.iter().flatten().copied().collect();
+    let need = if t.record_sweep.iter().any(Option::is_some) {
+        1
+    } else {
+        MIN_RECORDS_TO_CLASS.min(fs.len())
+    };
+    fs.iter()
+        .copied()
+        .filter(|f| fs.iter().filter(|g| (*g - f).abs() <= hw).count() >= need)
+        .collect()
 }
 
 /// `ln P(X > x)` for X chi-square with `2r` degrees of freedom (`r >= 1`):
@@ -709,6 +730,12 @@ pub const ENGINE_SPEED_CHANGE_MAX: f64 = 0.15;
 /// records (one steady peak after a ridge can be noise: 2.2 % of records hold a false F-test line
 /// in 3-25 Hz).
 pub const MIN_STEADY_RECORDS_OF_A_SWEEP: usize = 2;
+/// A track classes a cluster periodic only at a frequency it holds (within `half_width_hz`) in
+/// at least this many records (or in all its records when it has fewer, or when it holds a
+/// sweep): in one record a track can take a peak of another line or of a mode (busgen buses 30411, 22764, 94423: one record's
+/// peak 3-11 % off a line steady in the others classed an SSI-cov cluster of the wheel-hop band
+/// periodic).
+pub const MIN_RECORDS_TO_CLASS: usize = 2;
 /// A common factor beyond `track_rel_tol` is taken only when at least this many of the record's
 /// lines fall within [`ORDER_MATCH_REL_TOL`] of tracks after dividing by it, or when those that do
 /// are all F-test lines joining tracks whose latest line was an F-test line.
@@ -1196,6 +1223,125 @@ mod tests {
             ),
             "{t:?}"
         );
+    }
+
+    fn light_cluster(f: f64, class: ModeClass) -> InvariantMode {
+        InvariantMode {
+            frequency_hz: f,
+            frequency_std_hz: 0.0,
+            damping_ratio: 0.015,
+            damping_iqr: (0.01, 0.02),
+            order_share: 0.17,
+            record_share: 1.0,
+            n_poles: 5,
+            channels: vec!["a".into()],
+            roles: vec![],
+            min_order: 10,
+            class,
+            line_kurtosis: None,
+            shape: None,
+            shape_mac: None,
+            uncertainty: None,
+        }
+    }
+
+    fn steady_track(record_hz: Vec<Option<f64>>) -> LineTrack {
+        let fs: Vec<f64> = record_hz.iter().flatten().copied().collect();
+        LineTrack {
+            frequency_hz: fs[0],
+            frequency_range_hz: (
+                fs.iter().copied().fold(f64::INFINITY, f64::min),
+                fs.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            ),
+            record_share: fs.len() as f64 / record_hz.len() as f64,
+            record_hz,
+            kurtosis: 1.6,
+            record_sweep: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_track_classes_clusters_only_at_frequencies_it_holds_in_two_records() {
+        let p = LineParams::default();
+        let pre = records(|_, _| 0.0);
+        let stage = LineStage::new(&pre, vec![true; 8], &p);
+        // busgen bus 30411's SSI-cov track: the 11.15 Hz order in five records, a 10.70 Hz peak
+        // in one; a light cluster at 10.87 Hz (in the range, 0.17 Hz from the lone peak) and one
+        // at 10.72 Hz (at the lone peak), both spurious, and one at 11.15 Hz.
+        let lone = steady_track(vec![
+            Some(11.165),
+            Some(11.176),
+            Some(11.146),
+            Some(10.703),
+            None,
+            Some(11.135),
+            None,
+            None,
+        ]);
+        let mut modes = vec![
+            light_cluster(10.87, ModeClass::Spurious),
+            light_cluster(10.72, ModeClass::Spurious),
+            light_cluster(11.15, ModeClass::Spurious),
+        ];
+        stage.classify(&mut modes, &[0], std::slice::from_ref(&lone));
+        let classes: Vec<ModeClass> = modes.iter().map(|m| m.class).collect();
+        assert_eq!(
+            classes,
+            [
+                ModeClass::Spurious,
+                ModeClass::Spurious,
+                ModeClass::PeriodicDisturbance
+            ]
+        );
+        // The same peak in two records is held: the cluster on it is a line.
+        let mut held = lone.clone();
+        held.record_hz[4] = Some(10.69);
+        let mut modes = vec![light_cluster(10.72, ModeClass::Spurious)];
+        stage.classify(&mut modes, &[0], &[held]);
+        assert_eq!(modes[0].class, ModeClass::PeriodicDisturbance);
+        // A line drifting within the records (the range narrower than two half-widths, each
+        // end held by two records) classes a cluster between its ends.
+        let drift = steady_track(vec![
+            Some(10.9),
+            Some(10.95),
+            Some(11.2),
+            Some(11.25),
+            None,
+            None,
+            None,
+            None,
+        ]);
+        let mut modes = vec![light_cluster(11.07, ModeClass::Structural)];
+        stage.classify(&mut modes, &[0], &[drift]);
+        assert_eq!(modes[0].class, ModeClass::PeriodicDisturbance);
+        // A track of one record (a file of one record: the idling bus) classes at its frequency.
+        let single = steady_track(vec![Some(10.83), None, None, None, None, None, None, None]);
+        let mut modes = vec![light_cluster(10.84, ModeClass::Structural)];
+        stage.classify(&mut modes, &[0], &[single]);
+        assert_eq!(modes[0].class, ModeClass::PeriodicDisturbance);
+        // A line braked from 7 to 5.26 Hz in record 1 and steady there in record 2 (the demo's
+        // driveline line): the sweep is the speed change, the frequency of one record counts.
+        let mut braked = steady_track(vec![
+            Some(7.02),
+            None,
+            Some(5.26),
+            None,
+            None,
+            None,
+            None,
+            None,
+        ]);
+        let mut alone = braked.clone();
+        braked.record_sweep = vec![None; 8];
+        braked.record_sweep[1] = Some(sweep(7.04, 5.16));
+        let mut modes = vec![light_cluster(5.2, ModeClass::Structural)];
+        stage.classify(&mut modes, &[0], &[braked]);
+        assert_eq!(modes[0].class, ModeClass::PeriodicDisturbance);
+        // Without the sweep, two records at frequencies 29 % apart hold neither.
+        alone.record_sweep = vec![None; 8];
+        let mut modes = vec![light_cluster(5.2, ModeClass::Structural)];
+        stage.classify(&mut modes, &[0], &[alone]);
+        assert_eq!(modes[0].class, ModeClass::Structural);
     }
 
     #[test]
