@@ -130,14 +130,15 @@ fn a_short_file_is_one_record_and_channels_must_agree() {
     assert!(e.contains("zz") && e.contains("c1"), "{e}");
 }
 
-/// Four channels with roles (two unsprung, two sprung: both role pools are clustered) and a
-/// line at 9 Hz on every channel (a track on the unsprung ones): AR(2) resonances driven by white noise, at 500 Hz, quiet (a
-/// stop) during the third record.
+/// Four channels with roles (two unsprung, front and rear of one side: the body stage runs;
+/// two sprung: both role pools are clustered) and a line at 9 Hz on every channel (a track on
+/// the unsprung ones): AR(2) resonances driven by white noise, at 500 Hz, quiet (a stop)
+/// during the third record.
 fn recording_with_roles(seed: u64, seconds: f64) -> Recording {
     let fs = 500.0;
     let n = (fs * seconds) as usize;
     let mut r = ChaCha8Rng::seed_from_u64(seed);
-    let names = ["FL_unsprung", "FR_unsprung", "FR_sprung", "RL_sprung"];
+    let names = ["FL_unsprung", "RL_unsprung", "FR_sprung", "RL_sprung"];
     let modes = [(1.3, 0.15), (1.3, 0.15), (8.0, 0.1), (8.0, 0.1)];
     let stop = (2.0 * 10.24 * fs) as usize..(3.0 * 10.24 * fs) as usize;
     let chans = names
@@ -201,7 +202,8 @@ fn streamed_analysis_is_the_same_on_one_thread_and_on_two() {
     };
     let one = run(1);
     let two = run(2);
-    // What the test is about is there: 7 records, one stop, both pools, a line classed.
+    // What the test is about is there: 7 records, one stop, both pools, a line track, the
+    // body stage.
     assert_eq!(one.records.len(), 7);
     assert_eq!(one.n_stationary, 1);
     assert_eq!(one.roles.len(), 2);
@@ -210,6 +212,7 @@ fn streamed_analysis_is_the_same_on_one_thread_and_on_two() {
         .iter()
         .all(|c| !c.invariant_modes.is_empty() && !c.poles.is_empty()));
     assert!(one.channels.iter().any(|c| !c.lines.is_empty()));
+    assert!(one.body_ssi.is_some());
     assert_eq!(
         serde_json::to_string(&one).unwrap(),
         serde_json::to_string(&two).unwrap()
