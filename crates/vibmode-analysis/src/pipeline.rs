@@ -510,24 +510,56 @@ fn channel_modes(
         .into_iter()
         .filter(|&role| stored.iter().any(|s| s.placement.role == role))
         .collect();
-    // The pools first (the largest tasks), then the channels; each result in its own slot.
+    // Each result in its own slot (the pools, then the channels). The tasks are started
+    // largest first (by number of poles) and taken in that order by whichever thread is free,
+    // so that the largest pool does not start last and run alone.
     enum Pool<'n> {
         Role(Role),
         Channel(&'n str),
     }
-    let tasks: Vec<Pool<'_>> = roles
+    let tasks: Vec<(Pool<'_>, usize)> = roles
         .iter()
-        .map(|&r| Pool::Role(r))
-        .chain(first.channels.iter().map(|ch| Pool::Channel(&ch.name)))
-        .collect();
-    let store: &PoleStore = store;
-    let mut clustered: Vec<Result<Vec<InvariantMode>, AnalysisError>> = tasks
-        .par_iter()
-        .map(|t| match *t {
-            Pool::Role(role) => support.cluster(store, |_, r| r == role),
-            Pool::Channel(name) => support.cluster(store, |n, _| n == name),
+        .map(|&r| {
+            let n = stored
+                .iter()
+                .filter(|s| s.placement.role == r)
+                .map(|s| s.poles.len())
+                .sum();
+            (Pool::Role(r), n)
         })
+        .chain(
+            first
+                .channels
+                .iter()
+                .zip(&stored)
+                .map(|(ch, s)| (Pool::Channel(&ch.name), s.poles.len())),
+        )
         .collect();
+    let mut by_size: Vec<usize> = (0..tasks.len()).collect();
+    by_size.sort_by_key(|&k| std::cmp::Reverse(tasks[k].1));
+    let store: &PoleStore = store;
+    let mut slots: Vec<Option<Result<Vec<InvariantMode>, AnalysisError>>> =
+        (0..tasks.len()).map(|_| None).collect();
+    {
+        let mut slot_of: Vec<Option<&mut Option<_>>> = slots.iter_mut().map(Some).collect();
+        rayon::scope_fifo(|scope| {
+            for &k in &by_size {
+                let Some(slot) = slot_of[k].take() else {
+                    continue;
+                };
+                let task = &tasks[k].0;
+                scope.spawn_fifo(move |_| {
+                    *slot = Some(match *task {
+                        Pool::Role(role) => support.cluster(store, |_, r| r == role),
+                        Pool::Channel(name) => support.cluster(store, |n, _| n == name),
+                    });
+                });
+            }
+        });
+    }
+    // Every slot is filled once the scope ends.
+    let mut clustered: Vec<Result<Vec<InvariantMode>, AnalysisError>> =
+        slots.into_iter().flatten().collect();
     let per_channel = clustered.split_off(roles.len());
     let mut channels = Vec::with_capacity(first.n_channels());
     for (c, ((ch, s), modes)) in first
