@@ -217,4 +217,56 @@ fn streamed_analysis_is_the_same_on_one_thread_and_on_two() {
         serde_json::to_string(&one).unwrap(),
         serde_json::to_string(&two).unwrap()
     );
+    // Each channel's modes and each pool's are the clustering of its own poles alone (the
+    // records renumbered without the stop): no result went to another's slot.
+    let mut k = 0;
+    let active: Vec<Option<usize>> = one
+        .records
+        .iter()
+        .map(|r| {
+            (!r.stationary).then(|| {
+                k += 1;
+                k - 1
+            })
+        })
+        .collect();
+    let cluster = cfg.cluster.for_band(&one.records[0].band);
+    let clustered = |chs: &[&vibmode_analysis::ChannelAnalysis]| {
+        let obs: Vec<vibmode_core::PoleObservation> = chs
+            .iter()
+            .flat_map(|c| {
+                c.poles.iter().filter_map(|p| {
+                    Some(vibmode_core::PoleObservation {
+                        frequency_hz: p.frequency_hz,
+                        damping_ratio: p.damping_ratio,
+                        order: p.order,
+                        record: active[p.record]?,
+                        channel: c.name.clone(),
+                        role: Some(c.role),
+                        shape: None,
+                    })
+                })
+            })
+            .collect();
+        let modes = vibmode_modal::find_invariant_modes(&obs, k, &cfg.orders(), &cluster).unwrap();
+        modes
+            .iter()
+            .map(|m| (m.frequency_hz, m.damping_ratio, m.n_poles))
+            .collect::<Vec<_>>()
+    };
+    let got = |modes: &[vibmode_core::InvariantMode]| {
+        modes
+            .iter()
+            .map(|m| (m.frequency_hz, m.damping_ratio, m.n_poles))
+            .collect::<Vec<_>>()
+    };
+    for c in &one.channels {
+        assert_eq!(got(&c.invariant_modes), clustered(&[c]), "{}", c.name);
+    }
+    for r in &one.roles {
+        let chs: Vec<&vibmode_analysis::ChannelAnalysis> =
+            one.channels.iter().filter(|c| c.role == r.role).collect();
+        assert_eq!(chs.len(), 2);
+        assert_eq!(got(&r.invariant_modes), clustered(&chs), "{:?}", r.role);
+    }
 }
