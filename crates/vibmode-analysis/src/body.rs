@@ -9,6 +9,7 @@
 //! driven at different speeds then excite heave and pitch in different proportions, and the
 //! pooled correlations separate them; this needs hours of driving, not minutes.
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use vibmode_core::{BodySsiParams, ClusterParams, Corner, Direction, PreprocessParams, Role};
 use vibmode_signal::Preprocessed;
@@ -192,76 +193,93 @@ impl BodyStage<'_> {
         // a stop is neither resampled nor identified.
         let mut low = Vec::with_capacity(self.pre.len());
         let mut lags = Vec::with_capacity(self.pre.len());
-        for (r, pr) in self.pre.iter().enumerate() {
-            let left = |why: String, corr: f64| RecordDelay {
-                delay_s: None,
-                correlation: corr,
-                first_lag: None,
-                left_out: Some(why),
-            };
-            if self.active.get(r).copied().flatten().is_none() {
+        let left = |why: String, corr: f64| RecordDelay {
+            delay_s: None,
+            correlation: corr,
+            first_lag: None,
+            left_out: Some(why),
+        };
+        // Each record's delay and resampling depend on that record only: in parallel, then
+        // taken in record order (the first resampling failure in order is the one reported).
+        type Outcome = (
+            RecordDelay,
+            Option<usize>,
+            Result<vibmode_signal::Preprocessed, BodySsiNotRun>,
+        );
+        let outcomes: Vec<Option<Outcome>> = self
+            .pre
+            .par_iter()
+            .enumerate()
+            .map(|(r, pr)| {
+                // A stop (no active index) is neither resampled nor identified.
+                self.active.get(r).copied().flatten()?;
+                let resampled = vibmode_signal::preprocess(&pr.recording, &body_pre).map_err(|e| {
+                    BodySsiNotRun::Resampling {
+                        fs_hz: p.fs_hz,
+                        source: e,
+                    }
+                });
+                let fs = pr.band.fs_hz;
+                let sig: Vec<(&[f64], &[f64])> = pairs
+                    .iter()
+                    .map(|&(f, b)| {
+                        (
+                            pr.recording.channels[f].samples.as_slice(),
+                            pr.recording.channels[b].samples.as_slice(),
+                        )
+                    })
+                    .collect();
+                let band = [DELAY_BAND_LOW_HZ, pr.band.valid_max_hz()];
+                let (d, l) = match front_rear_delay(&sig, fs, p.max_delay_s, band) {
+                    None => (
+                        left("a wheel channel is constant or too short".into(), f64::NAN),
+                        None,
+                    ),
+                    Some((_, corr)) if corr < p.min_delay_correlation => (
+                        left(
+                            format!(
+                                "front/rear correlation {corr:.2} below min_delay_correlation {}",
+                                p.min_delay_correlation
+                            ),
+                            corr,
+                        ),
+                        None,
+                    ),
+                    Some((delay, corr)) => {
+                        let lag = p.first_lag(delay);
+                        let n = resampled.as_ref().map_or(0, |x| x.recording.len());
+                        if !vibmode_ssi::samples_needed(i, lag).is_some_and(|needed| n >= needed) {
+                            (
+                                left(
+                                    format!(
+                                        "{n} samples at {} Hz, too few for the lags {lag}..{} beyond its delay of {delay:.2} s",
+                                        p.fs_hz,
+                                        lag.saturating_add(2 * i - 2)
+                                    ),
+                                    corr,
+                                ),
+                                None,
+                            )
+                        } else {
+                            (
+                                RecordDelay {
+                                    delay_s: Some(delay),
+                                    correlation: corr,
+                                    first_lag: Some(lag),
+                                    left_out: None,
+                                },
+                                Some(lag),
+                            )
+                        }
+                    }
+                };
+                Some((d, l, resampled))
+            })
+            .collect();
+        for outcome in outcomes {
+            let Some((d, l, resampled)) = outcome else {
                 delays.push(left("stationary".into(), f64::NAN));
                 continue;
-            }
-            let resampled = vibmode_signal::preprocess(&pr.recording, &body_pre).map_err(|e| {
-                BodySsiNotRun::Resampling {
-                    fs_hz: p.fs_hz,
-                    source: e,
-                }
-            });
-            let fs = pr.band.fs_hz;
-            let sig: Vec<(&[f64], &[f64])> = pairs
-                .iter()
-                .map(|&(f, b)| {
-                    (
-                        pr.recording.channels[f].samples.as_slice(),
-                        pr.recording.channels[b].samples.as_slice(),
-                    )
-                })
-                .collect();
-            let band = [DELAY_BAND_LOW_HZ, pr.band.valid_max_hz()];
-            let (d, l) = match front_rear_delay(&sig, fs, p.max_delay_s, band) {
-                None => (
-                    left("a wheel channel is constant or too short".into(), f64::NAN),
-                    None,
-                ),
-                Some((_, corr)) if corr < p.min_delay_correlation => (
-                    left(
-                        format!(
-                            "front/rear correlation {corr:.2} below min_delay_correlation {}",
-                            p.min_delay_correlation
-                        ),
-                        corr,
-                    ),
-                    None,
-                ),
-                Some((delay, corr)) => {
-                    let lag = p.first_lag(delay);
-                    let n = resampled.as_ref().map_or(0, |x| x.recording.len());
-                    if !vibmode_ssi::samples_needed(i, lag).is_some_and(|needed| n >= needed) {
-                        (
-                            left(
-                                format!(
-                                    "{n} samples at {} Hz, too few for the lags {lag}..{} beyond its delay of {delay:.2} s",
-                                    p.fs_hz,
-                                    lag.saturating_add(2 * i - 2)
-                                ),
-                                corr,
-                            ),
-                            None,
-                        )
-                    } else {
-                        (
-                            RecordDelay {
-                                delay_s: Some(delay),
-                                correlation: corr,
-                                first_lag: Some(lag),
-                                left_out: None,
-                            },
-                            Some(lag),
-                        )
-                    }
-                }
             };
             let res = match resampled {
                 Ok(x) => x,

@@ -9,6 +9,7 @@
 //! pool within half a band-width of its frequency. A cluster the damping rule calls periodic is a
 //! structural mode when that kurtosis is at least [`GAUSSIAN_KURTOSIS_MIN`] (clearly random).
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use vibmode_core::{InvariantMode, LineParams, ModeClass};
 use vibmode_signal::Preprocessed;
@@ -200,26 +201,42 @@ impl<'a> LineStage<'a> {
                 .collect();
             Some((h, steady, swept, by_kurtosis))
         };
+        // Each record's candidates depend on that record only: the records in parallel (the
+        // same values as one after another), collected in record order.
+        type PerRecord = (
+            Vec<Vec<LineCandidate>>,
+            Vec<Vec<SweptCandidate>>,
+            Vec<HarmonicF>,
+            Vec<Vec<LineCandidate>>,
+        );
+        let per_record: Vec<PerRecord> = pre
+            .par_iter()
+            .zip(used.par_iter())
+            .map(|(p, &u)| {
+                let (mut c, mut s, mut f, mut kc) =
+                    (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+                if u && enabled {
+                    let all: Option<Vec<PerChannel>> = p
+                        .recording
+                        .channels
+                        .iter()
+                        .map(|ch| per_channel(p, &ch.samples))
+                        .collect();
+                    for (h, steady, sw, k) in all.unwrap_or_default() {
+                        f.push(h);
+                        c.push(steady);
+                        s.push(sw);
+                        kc.push(k);
+                    }
+                }
+                (c, s, f, kc)
+            })
+            .collect();
         let mut candidates = Vec::with_capacity(pre.len());
         let mut swept = Vec::with_capacity(pre.len());
         let mut f_tests = Vec::with_capacity(pre.len());
         let mut kurtosis_candidates = Vec::with_capacity(pre.len());
-        for (p, &u) in pre.iter().zip(&used) {
-            let (mut c, mut s, mut f, mut kc) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-            if u && enabled {
-                let all: Option<Vec<PerChannel>> = p
-                    .recording
-                    .channels
-                    .iter()
-                    .map(|ch| per_channel(p, &ch.samples))
-                    .collect();
-                for (h, steady, sw, k) in all.unwrap_or_default() {
-                    f.push(h);
-                    c.push(steady);
-                    s.push(sw);
-                    kc.push(k);
-                }
-            }
+        for (c, s, f, kc) in per_record {
             kurtosis_candidates.push(kc);
             candidates.push(c);
             swept.push(s);

@@ -244,7 +244,7 @@ pub fn analyze_prepared(
     };
     let lines = LineStage::new(&pre, stationary.iter().map(|s| !s).collect(), &cfg.lines);
     let mut store = PoleStore::new();
-    let channels = channel_modes(
+    let (channels, role_pools) = channel_modes(
         &pre[0].recording,
         &outs,
         &stationary,
@@ -253,7 +253,7 @@ pub fn analyze_prepared(
         &lines,
         &mut store,
     )?;
-    let roles = role_modes(&channels, &store, &support, &lines, reference)?;
+    let roles = role_modes(&channels, role_pools, &lines, reference);
     let role_tracks: Vec<crate::LineTrack> =
         roles.iter().flat_map(|r| r.lines.iter().cloned()).collect();
     let ssi = match ssi_poles {
@@ -466,7 +466,17 @@ impl Support<'_> {
     }
 }
 
-/// Stages 4 and 6 per channel: each channel's poles stored and clustered alone.
+/// The roles whose channels are pooled, in the order they are reported.
+const POOLED_ROLES: [Role; 2] = [Role::Sprung, Role::Unsprung];
+
+/// A role and the invariant modes of its channels' pooled poles.
+type RolePool = (Role, Vec<InvariantMode>);
+
+/// Stages 4 and 6 per channel: each channel's poles stored and clustered alone; and the
+/// clustering of stage 6 per role (the poles of all channels of a role together), returned
+/// beside the channels for [`role_modes`]: `(role, its invariant modes)` for every role of
+/// [`POOLED_ROLES`] that has channels. The clusterings depend on the store only, so they run
+/// in parallel (each one as it would alone).
 fn channel_modes(
     first: &vibmode_core::Recording,
     outs: &[SignalOut],
@@ -475,8 +485,13 @@ fn channel_modes(
     support: &Support<'_>,
     lines: &LineStage<'_>,
     store: &mut PoleStore,
-) -> Result<Vec<ChannelAnalysis>, AnalysisError> {
-    let mut channels = Vec::with_capacity(first.n_channels());
+) -> Result<(Vec<ChannelAnalysis>, Vec<RolePool>), AnalysisError> {
+    struct Stored<'o> {
+        placement: vibmode_core::Placement,
+        mine: Vec<&'o SignalOut>,
+        poles: Vec<vibmode_core::PoleOut>,
+    }
+    let mut stored = Vec::with_capacity(first.n_channels());
     for (c, ch) in first.channels.iter().enumerate() {
         let placement = cfg.placement_of(ch);
         let mine: Vec<&SignalOut> = outs.iter().filter(|o| o.channel == c).collect();
@@ -485,23 +500,94 @@ fn channel_modes(
             .flat_map(|o| o.fits.poles.iter().copied())
             .collect();
         store.add(&ch.name, placement.role, &poles);
-        let mut invariant_modes = support.cluster(store, |n, _| n == ch.name)?;
+        stored.push(Stored {
+            placement,
+            mine,
+            poles,
+        });
+    }
+    let roles: Vec<Role> = POOLED_ROLES
+        .into_iter()
+        .filter(|&role| stored.iter().any(|s| s.placement.role == role))
+        .collect();
+    // Each result in its own slot (the pools, then the channels). The tasks are started
+    // largest first (by number of poles) and taken in that order by whichever thread is free,
+    // so that the largest pool does not start last and run alone.
+    enum Pool<'n> {
+        Role(Role),
+        Channel(&'n str),
+    }
+    let tasks: Vec<(Pool<'_>, usize)> = roles
+        .iter()
+        .map(|&r| {
+            let n = stored
+                .iter()
+                .filter(|s| s.placement.role == r)
+                .map(|s| s.poles.len())
+                .sum();
+            (Pool::Role(r), n)
+        })
+        .chain(
+            first
+                .channels
+                .iter()
+                .zip(&stored)
+                .map(|(ch, s)| (Pool::Channel(&ch.name), s.poles.len())),
+        )
+        .collect();
+    let mut by_size: Vec<usize> = (0..tasks.len()).collect();
+    by_size.sort_by_key(|&k| std::cmp::Reverse(tasks[k].1));
+    let store: &PoleStore = store;
+    let mut slots: Vec<Option<Result<Vec<InvariantMode>, AnalysisError>>> =
+        (0..tasks.len()).map(|_| None).collect();
+    {
+        let mut slot_of: Vec<Option<&mut Option<_>>> = slots.iter_mut().map(Some).collect();
+        rayon::scope_fifo(|scope| {
+            for &k in &by_size {
+                let Some(slot) = slot_of[k].take() else {
+                    continue;
+                };
+                let task = &tasks[k].0;
+                scope.spawn_fifo(move |_| {
+                    *slot = Some(match *task {
+                        Pool::Role(role) => support.cluster(store, |_, r| r == role),
+                        Pool::Channel(name) => support.cluster(store, |n, _| n == name),
+                    });
+                });
+            }
+        });
+    }
+    // Every slot is filled once the scope ends.
+    let mut clustered: Vec<Result<Vec<InvariantMode>, AnalysisError>> =
+        slots.into_iter().flatten().collect();
+    let per_channel = clustered.split_off(roles.len());
+    let mut channels = Vec::with_capacity(first.n_channels());
+    for (c, ((ch, s), modes)) in first
+        .channels
+        .iter()
+        .zip(stored)
+        .zip(per_channel)
+        .enumerate()
+    {
+        let mut invariant_modes = modes?;
         let tracks = lines.tracks(&[c]);
         lines.classify(&mut invariant_modes, &[c], &tracks);
-        let (welch_freq_hz, welch_psd) = mean_welch(&mine, stationary);
+        let (welch_freq_hz, welch_psd) = mean_welch(&s.mine, stationary);
         channels.push(ChannelAnalysis {
             name: ch.name.clone(),
             unit: ch.unit.clone(),
-            role: placement.role,
-            placement,
+            role: s.placement.role,
+            placement: s.placement,
             welch_freq_hz,
             welch_psd,
-            poles,
-            fits: mine
+            poles: s.poles,
+            fits: s
+                .mine
                 .iter()
                 .flat_map(|o| o.fits.fits.iter().cloned())
                 .collect(),
-            first_record_models: mine
+            first_record_models: s
+                .mine
                 .iter()
                 .find(|o| o.record == 0)
                 .map(|o| o.fits.models.clone())
@@ -510,37 +596,38 @@ fn channel_modes(
             lines: tracks,
         });
     }
-    Ok(channels)
+    let pools = roles
+        .into_iter()
+        .zip(clustered)
+        .map(|(role, modes)| modes.map(|m| (role, m)))
+        .collect::<Result<_, _>>()?;
+    Ok((channels, pools))
 }
 
-/// Stages 6 and 7 per role: the poles of all channels of a role clustered together, and the
-/// structural modes matched to the physical model's. Channels without a role (`Role::Other`:
+/// Stages 6 and 7 per role: the invariant modes of each role's pool (clustered by
+/// [`channel_modes`]) classed against the lines, and the structural modes matched to the
+/// physical model's. Channels without a role (`Role::Other`:
 /// x, y and z of one sensor, or sensors of unknown place) are not pooled: their modes differ,
 /// and each is analysed alone (`ChannelAnalysis::invariant_modes`).
 fn role_modes(
     channels: &[ChannelAnalysis],
-    store: &PoleStore,
-    support: &Support<'_>,
+    pools: Vec<RolePool>,
     lines: &LineStage<'_>,
     reference: &[ReferenceMode],
-) -> Result<Vec<RoleAnalysis>, AnalysisError> {
+) -> Vec<RoleAnalysis> {
     let mut roles = Vec::new();
-    for role in [Role::Sprung, Role::Unsprung] {
+    for (role, mut invariant) in pools {
         let names: Vec<String> = channels
             .iter()
             .filter(|c| c.role == role)
             .map(|c| c.name.clone())
             .collect();
-        if names.is_empty() {
-            continue;
-        }
         let idx: Vec<usize> = channels
             .iter()
             .enumerate()
             .filter(|(_, c)| c.role == role)
             .map(|(i, _)| i)
             .collect();
-        let mut invariant = support.cluster(store, |_, r| r == role)?;
         let tracks = lines.tracks(&idx);
         lines.classify(&mut invariant, &idx, &tracks);
         let matches = if reference.is_empty() {
@@ -564,5 +651,5 @@ fn role_modes(
             lines: tracks,
         });
     }
-    Ok(roles)
+    roles
 }

@@ -1237,6 +1237,97 @@ fn shape_figures(
     Ok(())
 }
 
+/// The line of the top-level `channels` key in the pretty-printed results when it holds no
+/// channel: [`write_results_json`] writes the channels there, one at a time.
+const EMPTY_CHANNELS_LINE: &str = "\n  \"channels\": [],\n";
+
+/// Writes `path` (`results.json`): `r`, with each of `extra`'s JSON values under its key, as
+/// `serde_json::to_string_pretty` of the whole value writes it (keys sorted, two-space indent)
+/// plus a newline, byte for byte; but only one channel's results are held as a JSON value at a
+/// time (the channels' fits and poles are nearly all of it: an hour of records makes 56 MB of
+/// text and several times that as one value), and the text goes to the file as it is made.
+fn write_results_json(
+    path: &Path,
+    r: &AnalysisResults,
+    extra: &[crate::ReportSection],
+) -> Result<(), ReportError> {
+    use std::io::Write;
+    let err = |message: String| ReportError::Write {
+        path: path.to_path_buf(),
+        message,
+    };
+    let json_err = |e: serde_json::Error| err(e.to_string());
+    let io_err = |e: std::io::Error| err(e.to_string());
+    let with_extra = |mut value: serde_json::Value| {
+        if let serde_json::Value::Object(map) = &mut value {
+            for (key, v) in extra.iter().filter_map(|s| s.json.as_ref()) {
+                map.insert(key.clone(), v.clone());
+            }
+        }
+        value
+    };
+    let rest = AnalysisResults {
+        schema_version: r.schema_version,
+        drive_speed_trace: r.drive_speed_trace.clone(),
+        config: r.config.clone(),
+        records: r.records.clone(),
+        channels: Vec::new(),
+        roles: r.roles.clone(),
+        ssi: r.ssi.clone(),
+        body_ssi: r.body_ssi.clone(),
+        body_ssi_not_run: r.body_ssi_not_run.clone(),
+        reference_modes: r.reference_modes.clone(),
+        n_stationary: r.n_stationary,
+        n_fits: r.n_fits,
+        n_not_converged: r.n_not_converged,
+        n_failed: r.n_failed,
+        timing: r.timing.clone(),
+    };
+    let text =
+        serde_json::to_string_pretty(&with_extra(serde_json::to_value(&rest).map_err(json_err)?))
+            .map_err(json_err)?;
+    let file = std::fs::File::create(path).map_err(io_err)?;
+    let mut w = std::io::BufWriter::new(file);
+    match text.find(EMPTY_CHANNELS_LINE) {
+        Some(at) if !r.channels.is_empty() => {
+            w.write_all(&text.as_bytes()[..at]).map_err(io_err)?;
+            w.write_all(b"\n  \"channels\": [\n").map_err(io_err)?;
+            for (k, ch) in r.channels.iter().enumerate() {
+                // Through a value, as before: its maps' keys sorted.
+                let one = serde_json::to_value(ch).map_err(json_err)?;
+                let one = serde_json::to_string_pretty(&one).map_err(json_err)?;
+                // An array element two levels deep: every line indented by four spaces (a
+                // JSON string holds no raw line break).
+                for (j, line) in one.split('\n').enumerate() {
+                    if j > 0 {
+                        w.write_all(b"\n").map_err(io_err)?;
+                    }
+                    w.write_all(b"    ").map_err(io_err)?;
+                    w.write_all(line.as_bytes()).map_err(io_err)?;
+                }
+                let end: &[u8] = if k + 1 < r.channels.len() {
+                    b",\n"
+                } else {
+                    b"\n"
+                };
+                w.write_all(end).map_err(io_err)?;
+            }
+            w.write_all(b"  ],\n").map_err(io_err)?;
+            w.write_all(&text.as_bytes()[at + EMPTY_CHANNELS_LINE.len()..])
+                .map_err(io_err)?;
+        }
+        Some(_) => w.write_all(text.as_bytes()).map_err(io_err)?,
+        // Not where expected (never with today's keys): the whole value at once.
+        None => {
+            let all = with_extra(serde_json::to_value(r).map_err(json_err)?);
+            let all = serde_json::to_string_pretty(&all).map_err(json_err)?;
+            w.write_all(all.as_bytes()).map_err(io_err)?;
+        }
+    }
+    w.write_all(b"\n").map_err(io_err)?;
+    w.flush().map_err(io_err)
+}
+
 /// Writes `DIR/index.html`, `DIR/results.json`, `DIR/modes.csv` and `DIR/figures/*.svg|png` for
 /// the analysis `r` whose first record is `first` (as read and as the analysis pre-processed it);
 /// `intro` is a first paragraph (e.g. what was simulated), `extra`
@@ -1254,18 +1345,7 @@ pub fn write_analysis_report(
         message: e.to_string(),
     })?;
     let results_json = dir.join("results.json");
-    let json_err = |e: serde_json::Error| ReportError::Write {
-        path: results_json.clone(),
-        message: e.to_string(),
-    };
-    let mut value = serde_json::to_value(r).map_err(json_err)?;
-    if let serde_json::Value::Object(map) = &mut value {
-        for (key, v) in extra.iter().filter_map(|s| s.json.as_ref()) {
-            map.insert(key.clone(), v.clone());
-        }
-    }
-    let json = serde_json::to_string_pretty(&value).map_err(json_err)?;
-    write_text(&results_json, &(json + "\n"))?;
+    write_results_json(&results_json, r, extra)?;
     let modes_csv_path = dir.join("modes.csv");
     write_text(&modes_csv_path, &modes_csv(r))?;
     let spectra = first_record_spectra(&first.prepared, r)
@@ -1317,6 +1397,81 @@ pub fn write_analysis_report(
 mod tests {
     use super::*;
     use vibmode_analysis::{LineSweep, LineTrack};
+
+    /// Three channels (two with roles, so both pools are reported) of filtered noise, two
+    /// records, analysed with low orders: results with every kind of entry.
+    fn small_results() -> AnalysisResults {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let fs = 200.0;
+        let n = 4096;
+        let names = ["FL_unsprung", "FR_sprung", "acc_z"];
+        let record = |k: usize, rng: &mut rand_chacha::ChaCha8Rng| {
+            let channels = names
+                .iter()
+                .map(|name| {
+                    let (mut y1, mut y2) = (0.0, 0.0);
+                    let samples = (0..n)
+                        .map(|_| {
+                            let y = 1.8 * y1 - 0.9 * y2 + rng.gen_range(-1.0..1.0);
+                            y2 = y1;
+                            y1 = y;
+                            y
+                        })
+                        .collect();
+                    vibmode_signal::Channel::new(name.to_string(), "m/s^2".to_string(), samples)
+                })
+                .collect();
+            RecordInput {
+                name: format!("record_{k}"),
+                recording: vibmode_signal::Recording {
+                    fs_hz: fs,
+                    channels,
+                    time_axis: None,
+                },
+            }
+        };
+        let records: Vec<RecordInput> = (0..2).map(|k| record(k, &mut rng)).collect();
+        let mut cfg = vibmode_analysis::AnalysisConfig::default();
+        cfg.sweep.order_max = 6;
+        vibmode_analysis::analyze(&records, &cfg, &[], &|_, _| {}).unwrap()
+    }
+
+    #[test]
+    fn results_json_is_the_whole_value_pretty_printed_byte_for_byte() {
+        let mut r = small_results();
+        r.timing.elapsed_s = 1.25;
+        assert_eq!(r.channels.len(), 3);
+        assert!(r.channels.iter().all(|c| !c.fits.is_empty()));
+        let extra = crate::ReportSection {
+            title: "extra".into(),
+            paragraphs: Vec::new(),
+            tables: Vec::new(),
+            figures: Vec::new(),
+            json: Some((
+                "model_update".into(),
+                serde_json::json!({"b": [1.5, null], "a": 2}),
+            )),
+        };
+        let dir = tempfile::tempdir().unwrap();
+        for (k, extra) in [vec![], vec![extra]].iter().enumerate() {
+            for channels in [r.channels.len(), 1, 0] {
+                let mut r = r.clone();
+                r.channels.truncate(channels);
+                let mut whole = serde_json::to_value(&r).unwrap();
+                if let serde_json::Value::Object(map) = &mut whole {
+                    for (key, v) in extra.iter().filter_map(|s| s.json.as_ref()) {
+                        map.insert(key.clone(), v.clone());
+                    }
+                }
+                let expected = serde_json::to_string_pretty(&whole).unwrap() + "\n";
+                let path = dir.path().join(format!("results_{k}_{channels}.json"));
+                write_results_json(&path, &r, extra).unwrap();
+                let written = std::fs::read_to_string(&path).unwrap();
+                assert_eq!(written, expected, "{} channels, extra {k}", channels);
+            }
+        }
+    }
 
     #[test]
     fn a_swept_entry_shows_start_and_end_and_is_listed() {
