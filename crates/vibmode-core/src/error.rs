@@ -96,6 +96,16 @@ pub enum RecordingError {
         /// Its 0-based index.
         index: usize,
     },
+    /// Two channels of one recording with the same name: selections and results are by name.
+    #[error("channels {} and {} are both named '{}'; give each channel its own name (in the file's header or its sidecar)", .first + 1, .second + 1, quoted(.name))]
+    SameName {
+        /// The name.
+        name: String,
+        /// 0-based index of the first channel with it.
+        first: usize,
+        /// 0-based index of the second.
+        second: usize,
+    },
     /// Channels of different lengths in one recording.
     #[error("channel '{}' has {found} samples but '{}' has {expected}; all channels must have the same length", quoted(.channel), quoted(.first))]
     LengthMismatch {

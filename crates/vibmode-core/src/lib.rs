@@ -50,7 +50,8 @@ pub use params::{
 pub use placement::{Corner, Direction, Placement, Role};
 pub use record_meta::RecordMeta;
 pub use recording::{
-    check_finite, check_fs, Channel, ChannelSelector, Recording, RecordingView, TimeAxis,
+    check_finite, check_fs, check_unique_names, Channel, ChannelSelector, Recording, RecordingView,
+    TimeAxis,
 };
 pub use source::{cut_records, CutRecords, RecordInput, RecordSource, RecordWindow};
 pub use ssi::{

@@ -51,10 +51,30 @@ pub struct TimeAxis {
     pub start_s: f64,
 }
 
+/// Checks that no two channel names are equal ([`RecordingError::SameName`] names the first
+/// pair, by 0-based index).
+pub fn check_unique_names<'a>(
+    names: impl IntoIterator<Item = &'a str>,
+) -> Result<(), RecordingError> {
+    let mut seen: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
+    for (k, n) in names.into_iter().enumerate() {
+        if let Some(&first) = seen.get(n) {
+            return Err(RecordingError::SameName {
+                name: n.to_string(),
+                first,
+                second: k,
+            });
+        }
+        seen.insert(n, k);
+    }
+    Ok(())
+}
+
 /// A multichannel recording at one uniform sampling rate.
 ///
 /// Invariant (checked by [`Recording::new`] and by the readers): `fs_hz` is positive and finite,
-/// all channels have the same number of samples, and every sample is finite.
+/// all channels have the same number of samples, every sample is finite, and no two channels
+/// have the same name.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Recording {
     /// Sampling rate, Hz.
@@ -128,6 +148,7 @@ impl Recording {
     /// lengths, finite samples. `time_axis` is `None`.
     pub fn new(fs_hz: f64, channels: Vec<Channel>) -> Result<Recording, RecordingError> {
         check_fs(fs_hz, "fs_hz")?;
+        check_unique_names(channels.iter().map(|c| c.name.as_str()))?;
         if let Some(first) = channels.first() {
             for c in &channels {
                 if c.samples.len() != first.samples.len() {

@@ -9,6 +9,18 @@ pub enum SignalError {
     /// lengths) or a channel that cannot be found.
     #[error(transparent)]
     Recording(#[from] vibmode_core::RecordingError),
+    /// A file with two channels of the same name.
+    #[error("{}: channels {} and {} are both named '{}'; give each channel its own name (in the file's header or its sidecar)", vibmode_core::quoted(.path), .first + 1, .second + 1, vibmode_core::quoted(.name))]
+    SameChannelName {
+        /// The file.
+        path: String,
+        /// The name.
+        name: String,
+        /// 0-based index of the first channel with it (the time column not counted).
+        first: usize,
+        /// 0-based index of the second.
+        second: usize,
+    },
     /// A record window (segmentation) that reaches past the end of the recording.
     #[error("record '{record}' (frames {start_frame}.. +{n_frames}) reaches past the end of the recording ({file_frames} frames); the segmentation does not fit this file")]
     WindowOutside {
@@ -230,4 +242,24 @@ pub(crate) fn io_err(
         path: path.display().to_string(),
         message: e.to_string(),
     }
+}
+
+/// [`vibmode_core::check_unique_names`] for the channels of the file `path`.
+pub(crate) fn check_names_of<'a>(
+    path: &std::path::Path,
+    names: impl IntoIterator<Item = &'a str>,
+) -> Result<()> {
+    vibmode_core::check_unique_names(names).map_err(|e| match e {
+        vibmode_core::RecordingError::SameName {
+            name,
+            first,
+            second,
+        } => SignalError::SameChannelName {
+            path: path.display().to_string(),
+            name,
+            first,
+            second,
+        },
+        other => SignalError::Recording(other),
+    })
 }

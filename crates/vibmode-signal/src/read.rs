@@ -169,6 +169,7 @@ pub fn read_path(path: &Path, opts: &ReadOptions) -> Result<Recording> {
         Format::Wav => read_wav(path, opts)?,
         Format::Raw => read_raw(path, opts)?,
     };
+    crate::error::check_names_of(path, rec.channels.iter().map(|c| c.name.as_str()))?;
     if let Some(u) = &opts.unit {
         for c in &mut rec.channels {
             if c.unit.is_empty() {

@@ -149,6 +149,7 @@ pub fn open_stream(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
         Format::Wav => open_wav(path, opts)?,
         Format::Delimited => open_delimited(path, opts)?,
     };
+    crate::error::check_names_of(path, s.info.names.iter().map(String::as_str))?;
     if let Some(u) = &opts.unit {
         for unit in &mut s.info.units {
             if unit.is_empty() {

@@ -675,3 +675,25 @@ fn wav_keeps_channel_names_and_units_through_its_sidecar() {
     let plain = vibmode_signal::read_path(&path, &vibmode_signal::ReadOptions::default()).unwrap();
     assert_eq!(plain.channels[0].name, "ch0");
 }
+
+/// Two channels of one name (a header `t,acc,x,acc`) are refused by the whole-file and the
+/// streamed readers alike, naming the file, the name and both channels (1-based, the time column
+/// not counted); `Recording::new` refuses them too.
+#[test]
+fn channels_of_one_name_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(
+        dir.path(),
+        "dup.csv",
+        "t,acc,x,acc\n0,1,2,3\n0.01,1,2,3\n0.02,1,2,3\n0.03,1,2,3\n",
+    );
+    let want = "channels 1 and 3 are both named 'acc'";
+    let e = err_of(read_path(&p, &ReadOptions::default()));
+    assert!(e.contains(want) && e.contains("dup.csv"), "{e}");
+    let e = err_of(vibmode_signal::open_stream(&p, &ReadOptions::default()).map(|_| ()));
+    assert!(e.contains(want) && e.contains("dup.csv"), "{e}");
+    let ch = |n: &str| Channel::new(n, "m/s^2", vec![0.0; 4]);
+    let e = err_of(Recording::new(100.0, vec![ch("a"), ch("b"), ch("b")]));
+    assert!(e.contains("channels 2 and 3 are both named 'b'"), "{e}");
+    assert!(Recording::new(100.0, vec![ch("a"), ch("b")]).is_ok());
+}
