@@ -13,6 +13,7 @@ import math
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 
 
@@ -35,10 +36,12 @@ def main():
         while done < n_records:
             n = min(a.chunk, n_records - done)
             d = os.path.join(tmp, f"drive{seed}")
-            subprocess.run(
+            r = subprocess.run(
                 [a.vibmode, "simulate", a.params, "--records", str(n), "--fs", str(a.fs),
                  "--seed", str(seed), "--format", "f32", "--effects", "in-service", "-o", d],
-                check=True, stdout=subprocess.DEVNULL)
+                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+            if r.returncode != 0:
+                sys.exit(f"vibmode simulate failed (exit {r.returncode}): {r.stderr.strip()}")
             for k in range(1, n + 1):
                 path = os.path.join(d, f"record_{k:02d}.f32")
                 if sidecar is None:
