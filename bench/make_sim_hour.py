@@ -20,8 +20,9 @@ import tempfile
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("out")
-    ap.add_argument("--vibmode", default="target/release/vibmode")
-    ap.add_argument("--params", default="examples/city_bus.toml")
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    ap.add_argument("--vibmode", default=os.path.join(root, "target/release/vibmode"))
+    ap.add_argument("--params", default=os.path.join(root, "examples/city_bus.toml"))
     ap.add_argument("--minutes", type=float, default=60.0)
     ap.add_argument("--fs", type=int, default=20000)
     ap.add_argument("--seed", type=int, default=1)
@@ -41,6 +42,8 @@ def main():
                  "--seed", str(seed), "--format", "f32", "--effects", "in-service", "-o", d],
                 stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
             if r.returncode != 0:
+                out.close()
+                os.remove(a.out)
                 sys.exit(f"vibmode simulate failed (exit {r.returncode}): {r.stderr.strip()}")
             for k in range(1, n + 1):
                 path = os.path.join(d, f"record_{k:02d}.f32")
