@@ -60,15 +60,22 @@ FAULTS = [
 ]
 
 
-def conditions(bus_seed: int, rng: random.Random) -> List[Dict]:
-    """The drives to check on one bus, with their busgen options and expectation."""
-    out = []
+def healthy_drive(rng: random.Random):
+    """A healthy drive on another day: `(busgen options, load, road class, speed or None)`, the
+    speed 20-40 km/h or busgen's 25-35 km/h per record, the load -15..+20 %, the road A-C."""
     speed = rng.choice([None, round(rng.uniform(20.0, 40.0), 1)])
     load = round(rng.uniform(0.85, 1.20), 3)
     road = rng.choice("ABC")
     extra = ["--load", str(load), "--road-class", road]
     if speed is not None:
         extra += ["--speed-kmh", str(speed)]
+    return extra, load, road, speed
+
+
+def conditions(bus_seed: int, rng: random.Random) -> List[Dict]:
+    """The drives to check on one bus, with their busgen options and expectation."""
+    out = []
+    extra, load, road, speed = healthy_drive(rng)
     out.append({"name": "healthy", "extra": extra, "expect": "normal", "corner": None,
                 "detail": f"load {load}, road {road}, "
                           + (f"{speed} km/h" if speed else "25-35 km/h")})

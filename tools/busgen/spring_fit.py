@@ -59,15 +59,8 @@ CORNERS = ("FL", "FR", "RL", "RR")
 
 
 def drawn_conditions(rng: random.Random) -> List[str]:
-    """busgen options of a drive on another day: speed, load and road class drawn as fleet.py's
-    healthy drive."""
-    speed = rng.choice([None, round(rng.uniform(20.0, 40.0), 1)])
-    load = round(rng.uniform(0.85, 1.20), 3)
-    road = rng.choice("ABC")
-    extra = ["--load", str(load), "--road-class", road]
-    if speed is not None:
-        extra += ["--speed-kmh", str(speed)]
-    return extra
+    """busgen options of a drive on another day, drawn as fleet.py's healthy drive."""
+    return fleet.healthy_drive(rng)[0]
 
 
 def fit(folders: List[Path], vehicle: Path, out: Path, config: Optional[Path] = None) -> Dict:
