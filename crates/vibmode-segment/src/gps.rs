@@ -30,11 +30,11 @@
 //! degrees is left out (the heading is then measured from the positions). Times must not go
 //! backwards ([`crate::SegmentError::TimeBackwards`]); repeated times keep the first fix.
 
-use crate::{parse_rfc3339, SegmentError};
+use crate::{parse_rfc3339, SegmentError, TrackProblem};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
-use vibmode_core::{quoted, Num};
+use vibmode_core::Num;
 
 /// Highest speed accepted from a GPS track, km/h: above any ground vehicle (the maglev speed
 /// record is 603 km/h); a larger value is a broken fix or a speed in the wrong unit.
@@ -183,10 +183,10 @@ pub fn check_fixes(fixes: Vec<GpsFix>) -> (Vec<GpsFix>, Vec<usize>, BTreeMap<Str
     (kept, idx, dropped)
 }
 
-fn track_err(path: &str, reason: String) -> SegmentError {
+fn track_err(path: &str, problem: TrackProblem) -> SegmentError {
     SegmentError::Track {
         path: path.to_string(),
-        reason,
+        problem,
     }
 }
 
@@ -346,20 +346,18 @@ fn read_gpx(text: &str, p: &str) -> Result<Raw, SegmentError> {
     let doc = roxmltree::Document::parse(text).map_err(|e| {
         track_err(
             p,
-            format!(
-                "{}; check that it is a valid GPX file",
-                short(&e.to_string())
-            ),
+            TrackProblem::NotXml {
+                message: short(&e.to_string()),
+            },
         )
     })?;
     let root = doc.root_element();
     if root.tag_name().name() != "gpx" {
         return Err(track_err(
             p,
-            format!(
-                "the root element is <{}>, not <gpx>; check that it is a valid GPX file",
-                short(root.tag_name().name())
-            ),
+            TrackProblem::NotGpx {
+                root: root.tag_name().name().to_string(),
+            },
         ));
     }
     // Track points of every track and segment; else route points; else waypoints.
@@ -378,31 +376,35 @@ fn read_gpx(text: &str, p: &str) -> Result<Raw, SegmentError> {
     let mut fixes = Vec::with_capacity(points.len());
     let mut places = Vec::with_capacity(points.len());
     for (k, w) in points.into_iter().enumerate() {
-        let place = format!("point {}", k + 1);
+        let point = k + 1;
+        let place = format!("point {point}");
         // A coordinate out of range, or not a number, makes the file invalid GPX: refused as a
         // whole, the value named, short.
-        let coord = |name: &str, limit: f64| -> Result<f64, SegmentError> {
+        let coord = |name: &'static str, limit: f64| -> Result<f64, SegmentError> {
             let Some(cell) = w.attribute(name) else {
                 return Err(track_err(
                     p,
-                    format!("{place} has no {name} attribute, which makes the file invalid GPX; fix or delete that point"),
+                    TrackProblem::MissingCoordinate { point, name },
                 ));
             };
             match cell.trim().parse::<f64>() {
                 Ok(v) if (-limit..=limit).contains(&v) => Ok(v),
-                Ok(v) => Err(track_err(
+                Ok(value) => Err(track_err(
                     p,
-                    format!(
-                        "{place}: {name} {} is outside -{limit}..{limit} degrees, which makes the file invalid GPX; fix or delete that point",
-                        Num(v)
-                    ),
+                    TrackProblem::CoordinateOutOfRange {
+                        point,
+                        name,
+                        value,
+                        limit_deg: limit,
+                    },
                 )),
                 Err(_) => Err(track_err(
                     p,
-                    format!(
-                        "{place}: {name} {} is not a number, which makes the file invalid GPX; fix or delete that point",
-                        quoted(cell)
-                    ),
+                    TrackProblem::PointNotANumber {
+                        point,
+                        name,
+                        text: cell.to_string(),
+                    },
                 )),
             }
         };
@@ -417,10 +419,10 @@ fn read_gpx(text: &str, p: &str) -> Result<Raw, SegmentError> {
         let Some(t_s) = parse_rfc3339(&time_text) else {
             return Err(track_err(
                 p,
-                format!(
-                    "{place}: time {} is not an RFC 3339 time (2024-05-02T07:31:00Z), which makes the file invalid GPX; fix or delete that point",
-                    quoted(&time_text)
-                ),
+                TrackProblem::PointTime {
+                    point,
+                    text: time_text,
+                },
             ));
         };
         // GPX 1.0's `<speed>`, m/s; a speed that is not finite is dropped by the common check.
@@ -431,10 +433,11 @@ fn read_gpx(text: &str, p: &str) -> Result<Raw, SegmentError> {
                 Err(_) => {
                     return Err(track_err(
                         p,
-                        format!(
-                            "{place}: speed {} is not a number, which makes the file invalid GPX; fix or delete that point",
-                            quoted(&v)
-                        ),
+                        TrackProblem::PointNotANumber {
+                            point,
+                            name: "speed",
+                            text: v,
+                        },
                     ))
                 }
             },
@@ -627,7 +630,7 @@ fn find_pattern_col(
     header: &[String],
     exact: &[&str],
     words_any: &[&str],
-    what: &str,
+    what: &'static str,
     p: &str,
 ) -> Result<Option<usize>, SegmentError> {
     let pick = |cands: Vec<usize>| -> Result<Option<usize>, SegmentError> {
@@ -636,11 +639,11 @@ fn find_pattern_col(
             [i] => Ok(Some(*i)),
             [a, b, ..] => Err(track_err(
                 p,
-                format!(
-                    "two {what} columns, '{}' and '{}'; keep one, or rename the other so that it does not read as {what}",
-                    quoted(&header[*a]),
-                    quoted(&header[*b])
-                ),
+                TrackProblem::TwoColumns {
+                    what,
+                    first: header[*a].clone(),
+                    second: header[*b].clone(),
+                },
             )),
         }
     };
@@ -699,23 +702,22 @@ fn read_csv(text: &str, p: &str) -> Result<Raw, SegmentError> {
         .map_err(|e| {
             track_err(
                 p,
-                format!(
-                    "{}; expected a header row like time,lat,lon,speed",
-                    short(&e.to_string())
-                ),
+                TrackProblem::CsvHeader {
+                    message: short(&e.to_string()),
+                },
             )
         })?
         .iter()
         .map(str::to_string)
         .collect();
-    let need = |names: &[&str], what: &str| {
+    let need = |names: &[&str], what: &'static str| {
         find_col(&header, names).ok_or_else(|| {
             track_err(
                 p,
-                format!(
-                    "no {what} column in the header [{}]; name the columns time, lat, lon and (optionally) speed",
-                    quoted(&header.join(", "))
-                ),
+                TrackProblem::NoColumn {
+                    what,
+                    header: header.clone(),
+                },
             )
         })
     };
@@ -786,10 +788,10 @@ fn read_csv(text: &str, p: &str) -> Result<Raw, SegmentError> {
         let rec = rec.map_err(|e| {
             track_err(
                 p,
-                format!(
-                    "line {line}: {}; check the CSV quoting",
-                    short(&e.to_string())
-                ),
+                TrackProblem::CsvRow {
+                    line,
+                    message: short(&e.to_string()),
+                },
             )
         })?;
         let cell = |i: usize| rec.get(i).unwrap_or("");
@@ -798,14 +800,15 @@ fn read_csv(text: &str, p: &str) -> Result<Raw, SegmentError> {
         }
         // A number that is not finite (nan, inf) or out of range is checked with the other
         // formats' fixes (dropped and counted); text that is no number at all is refused.
-        let num = |i: usize, what: &str| -> Result<f64, SegmentError> {
+        let num = |i: usize, what: &'static str| -> Result<f64, SegmentError> {
             cell(i).parse::<f64>().map_err(|_| {
                 track_err(
                     p,
-                    format!(
-                        "line {line}: {what} '{}' is not a number; fix the cell or delete the row",
-                        quoted(cell(i))
-                    ),
+                    TrackProblem::CellNotANumber {
+                        line,
+                        what,
+                        text: cell(i).to_string(),
+                    },
                 )
             })
         };
@@ -822,10 +825,10 @@ fn read_csv(text: &str, p: &str) -> Result<Raw, SegmentError> {
                 None => {
                     return Err(track_err(
                         p,
-                        format!(
-                            "line {line}: time '{}' is neither seconds nor an RFC 3339 time such as 2024-05-02T07:31:00Z",
-                            quoted(cell(tc))
-                        ),
+                        TrackProblem::CellTime {
+                            line,
+                            text: cell(tc).to_string(),
+                        },
                     ))
                 }
             },

@@ -442,12 +442,12 @@ pub enum SegmentError {
         message: String,
     },
     /// A GPS track in a format that cannot be parsed.
-    #[error("GPS track {path}: {reason}")]
+    #[error("GPS track {path}: {problem}")]
     Track {
         /// The file.
         path: String,
-        /// What is wrong and how to fix it.
-        reason: String,
+        /// What is wrong, with the values, and how to fix it.
+        problem: TrackProblem,
     },
     /// A track without usable fixes.
     #[error("GPS track {path} has no usable fix (with time, latitude and longitude){detail}; check the file and its format")]
@@ -527,6 +527,113 @@ pub enum SegmentError {
     /// Reading the recording or cutting its records failed.
     #[error(transparent)]
     Signal(#[from] vibmode_signal::SignalError),
+}
+
+/// What makes a GPS track file unreadable (the detail of [`SegmentError::Track`]); points
+/// and lines are 1-based. The XML and CSV parsers' own messages are kept as their text, shortened.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum TrackProblem {
+    /// Not well-formed XML.
+    #[error("{message}; check that it is a valid GPX file")]
+    NotXml {
+        /// The XML parser's message.
+        message: String,
+    },
+    /// XML whose root is not `<gpx>`.
+    #[error("the root element is <{}>, not <gpx>; check that it is a valid GPX file", quoted(.root))]
+    NotGpx {
+        /// The root element's name.
+        root: String,
+    },
+    /// A GPX point without `lat` or `lon`.
+    #[error("point {point} has no {name} attribute, which makes the file invalid GPX; fix or delete that point")]
+    MissingCoordinate {
+        /// The point.
+        point: usize,
+        /// `lat` or `lon`.
+        name: &'static str,
+    },
+    /// A GPX coordinate outside its range.
+    #[error("point {point}: {name} {} is outside -{limit_deg}..{limit_deg} degrees, which makes the file invalid GPX; fix or delete that point", Num(*.value))]
+    CoordinateOutOfRange {
+        /// The point.
+        point: usize,
+        /// `lat` or `lon`.
+        name: &'static str,
+        /// The value, degrees.
+        value: f64,
+        /// The range's bound, degrees.
+        limit_deg: f64,
+    },
+    /// A GPX coordinate or speed that is not a number.
+    #[error("point {point}: {name} {} is not a number, which makes the file invalid GPX; fix or delete that point", quoted(.text))]
+    PointNotANumber {
+        /// The point.
+        point: usize,
+        /// `lat`, `lon` or `speed`.
+        name: &'static str,
+        /// The text.
+        text: String,
+    },
+    /// A GPX time that is not RFC 3339.
+    #[error("point {point}: time {} is not an RFC 3339 time (2024-05-02T07:31:00Z), which makes the file invalid GPX; fix or delete that point", quoted(.text))]
+    PointTime {
+        /// The point.
+        point: usize,
+        /// The text.
+        text: String,
+    },
+    /// Two CSV columns that both read as one quantity.
+    #[error("two {what} columns, '{}' and '{}'; keep one, or rename the other so that it does not read as {what}", quoted(.first), quoted(.second))]
+    TwoColumns {
+        /// time, latitude, longitude or speed.
+        what: &'static str,
+        /// The first column's name.
+        first: String,
+        /// The second's.
+        second: String,
+    },
+    /// A CSV header that cannot be read.
+    #[error("{message}; expected a header row like time,lat,lon,speed")]
+    CsvHeader {
+        /// The CSV parser's message.
+        message: String,
+    },
+    /// A CSV header without a column the track needs.
+    #[error("no {what} column in the header [{}]; name the columns time, lat, lon and (optionally) speed", quoted(&.header.join(", ")))]
+    NoColumn {
+        /// time, latitude or longitude.
+        what: &'static str,
+        /// The header's names.
+        header: Vec<String>,
+    },
+    /// A CSV row that cannot be read.
+    #[error("line {line}: {message}; check the CSV quoting")]
+    CsvRow {
+        /// The line.
+        line: usize,
+        /// The CSV parser's message.
+        message: String,
+    },
+    /// A CSV cell that is not a number.
+    #[error("line {line}: {what} '{}' is not a number; fix the cell or delete the row", quoted(.text))]
+    CellNotANumber {
+        /// The line.
+        line: usize,
+        /// latitude, longitude or speed.
+        what: &'static str,
+        /// The cell.
+        text: String,
+    },
+    /// A CSV time cell that is neither seconds nor RFC 3339.
+    #[error("line {line}: time '{}' is neither seconds nor an RFC 3339 time such as 2024-05-02T07:31:00Z", quoted(.text))]
+    CellTime {
+        /// The line.
+        line: usize,
+        /// The cell.
+        text: String,
+    },
 }
 
 /// Unix seconds of an RFC 3339 time (`2024-05-02T07:31:00Z`, `2024-05-02T09:31:00.25+02:00`).

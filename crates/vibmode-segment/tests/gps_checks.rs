@@ -628,6 +628,23 @@ fn a_gpx_point_with_a_malformed_value_is_refused_naming_it() {
             "{e}"
         );
     }
+    let text = r#"<gpx><trk><trkseg><trkpt lat="45" lon="9"/><trkpt lat="95" lon="9"/></trkseg></trk></gpx>"#;
+    let e = read_track(&write(dir.path(), "r.gpx", text)).unwrap_err();
+    assert!(
+        matches!(
+            &e,
+            vibmode_segment::SegmentError::Track {
+                problem: vibmode_segment::TrackProblem::CoordinateOutOfRange {
+                    point: 2,
+                    name: "lat",
+                    value,
+                    limit_deg,
+                },
+                ..
+            } if *value == 95.0 && *limit_deg == 90.0
+        ),
+        "{e:?}"
+    );
     let e = read_track(&write(dir.path(), "k.gpx", "<kml></kml>"))
         .unwrap_err()
         .to_string();
