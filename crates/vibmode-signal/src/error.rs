@@ -154,13 +154,13 @@ pub enum SignalError {
         /// The file.
         path: String,
     },
-    /// A missing or malformed JSON sidecar of a raw binary file.
-    #[error("sidecar {path_q}: {reason}", path_q = vibmode_core::quoted(.path))]
+    /// A missing or malformed JSON sidecar of a raw binary or WAV file.
+    #[error("sidecar {path_q}: {problem}", path_q = vibmode_core::quoted(.path))]
     Sidecar {
         /// The sidecar file (or the expected names).
         path: String,
-        /// What is wrong and how to fix it.
-        reason: String,
+        /// What is wrong, with the values, and how to fix it.
+        problem: SidecarProblem,
     },
     /// A binary (raw) file whose size does not fit the sidecar.
     #[error("{path_q} has {bytes} bytes, not a multiple of {frame_bytes} (= {channels} channels x {dtype_bytes} bytes); check dtype and channels in the sidecar", path_q = vibmode_core::quoted(.path))]
@@ -194,12 +194,12 @@ pub enum SignalError {
         whole_bytes: u64,
     },
     /// A WAV file that cannot be used.
-    #[error("WAV {path_q}: {reason}", path_q = vibmode_core::quoted(.path))]
+    #[error("WAV {path_q}: {problem}", path_q = vibmode_core::quoted(.path))]
     Wav {
         /// The file.
         path: String,
-        /// What is wrong and how to fix it.
-        reason: String,
+        /// What is wrong, with the values, and how to fix it.
+        problem: WavProblem,
     },
     /// A file extension or format name that is not known.
     #[error("unknown format '{given_q}'; valid formats: delimited (.csv/.txt/.tsv/.dat), wav (.wav), raw (.f32/.f64/.bin/.raw + .json sidecar)", given_q = vibmode_core::quoted(.given))]
@@ -226,6 +226,134 @@ pub enum SignalError {
         n: usize,
         /// What is needed.
         fix: String,
+    },
+}
+
+/// What makes a WAV file unusable (the detail of [`SignalError::Wav`]). The WAV library's own
+/// messages are kept as their text.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum WavProblem {
+    /// A header with no channel.
+    #[error("the header declares 0 channels; re-export the file")]
+    NoChannels,
+    /// Float samples of another width than 32 bits.
+    #[error("{bits}-bit float samples are not supported; convert to 32-bit float or PCM")]
+    FloatBits {
+        /// Bits per sample.
+        bits: u16,
+    },
+    /// Integer samples wider than 32 bits (or of 0 bits).
+    #[error("{bits}-bit integer samples are not supported; use 8, 16, 24 or 32 bits")]
+    IntBits {
+        /// Bits per sample.
+        bits: u16,
+    },
+    /// Not a WAV file the reader understands.
+    #[error("{message}; check that it is a valid WAV file")]
+    Unreadable {
+        /// The WAV reader's message.
+        message: String,
+    },
+    /// Samples that cannot be read (whole-file reader).
+    #[error("{message}; the file may be truncated")]
+    Truncated {
+        /// The WAV reader's message.
+        message: String,
+    },
+    /// No sample at all.
+    #[error("it contains zero samples; check the recording")]
+    NoSamples,
+    /// A sample that cannot be read at a frame (streamed reader).
+    #[error("{message} at frame {frame} of the {announced} its header announces: the file is cut off (a recording stopped mid-write?); re-export it, or cut the header's data size to the frames present")]
+    CutOffAt {
+        /// The WAV reader's message.
+        message: String,
+        /// The frame.
+        frame: u64,
+        /// The frames the header announces.
+        announced: u64,
+    },
+    /// Fewer frames than the header announces (streamed reader).
+    #[error("it ends after frame {frame} of the {announced} its header announces: the file is cut off (a recording stopped mid-write?); re-export it")]
+    EndsEarly {
+        /// The last frame present.
+        frame: u64,
+        /// The frames the header announces.
+        announced: u64,
+    },
+    /// Writing failed.
+    #[error("{message}; check the path and free space")]
+    NotWritten {
+        /// The WAV writer's message.
+        message: String,
+    },
+}
+
+/// What is wrong with a JSON sidecar (the detail of [`SignalError::Sidecar`]). The JSON
+/// parser's own messages are kept as their text.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SidecarProblem {
+    /// A WAV file's sidecar that is not the expected JSON.
+    #[error("{message}; expected {{\"channels\": [\"FL\", ...]}} (or delete it to name the channels ch0, ch1, ...)")]
+    WavJson {
+        /// The JSON parser's message.
+        message: String,
+    },
+    /// A WAV file's sidecar naming another number of channels.
+    #[error("names {names} channels but the WAV has {channels}; fix the channel list or delete the file")]
+    WavChannels {
+        /// Names in the sidecar.
+        names: usize,
+        /// Channels in the WAV.
+        channels: usize,
+    },
+    /// A WAV file's sidecar with another number of units.
+    #[error("has {units} units for {channels} channels; give one unit per channel")]
+    WavUnits {
+        /// Units in the sidecar.
+        units: usize,
+        /// Channels in the WAV.
+        channels: usize,
+    },
+    /// A raw file without its sidecar.
+    #[error("not found; a raw file needs a JSON sidecar like {{\"fs_hz\": 20000, \"dtype\": \"f32\", \"channels\": [\"FL\"]}}")]
+    NotFound,
+    /// A raw file's sidecar that is not the expected JSON.
+    #[error("{message}; expected {{\"fs_hz\": 20000, \"dtype\": \"f32\"|\"f64\", \"channels\": [\"FL\", ...], \"units\": [\"m/s^2\", ...]}}")]
+    RawJson {
+        /// The JSON parser's message.
+        message: String,
+    },
+    /// A sample type other than f32 and f64.
+    #[error("dtype '{}' is not supported; use \"f32\" or \"f64\"", vibmode_core::quoted(.dtype))]
+    Dtype {
+        /// The type given.
+        dtype: String,
+    },
+    /// No channel name.
+    #[error("\"channels\" is empty; list one name per interleaved channel")]
+    NoChannels,
+    /// Another number of units than channels.
+    #[error("\"units\" has {units} entries but \"channels\" has {channels}; give one unit per channel or omit \"units\"")]
+    Units {
+        /// Units given.
+        units: usize,
+        /// Channels named.
+        channels: usize,
+    },
+    /// A rate that is not a positive finite number.
+    #[error("fs_hz {fs_hz} must be a positive finite number, e.g. 20000")]
+    Rate {
+        /// The rate given.
+        fs_hz: f64,
+    },
+    /// A sidecar that cannot be written.
+    #[error("cannot serialise: {message}")]
+    NotSerialised {
+        /// The JSON writer's message.
+        message: String,
     },
 }
 

@@ -1,7 +1,7 @@
 //! Reading recordings from delimited text, WAV and raw binary files.
 
 use crate::delimited::{Block, ColumnInfo, DelimitedReader};
-use crate::error::{io_err, Result, SignalError};
+use crate::error::{io_err, Result, SidecarProblem, SignalError, WavProblem};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::io::BufRead;
@@ -210,13 +210,11 @@ pub(crate) fn reconcile_fs(
 pub(crate) fn wav_layout(
     spec: &hound::WavSpec,
     opts: &ReadOptions,
-    wav_err: &dyn Fn(String) -> SignalError,
+    wav_err: &dyn Fn(WavProblem) -> SignalError,
 ) -> Result<(usize, bool, f64)> {
     let nch = spec.channels as usize;
     if nch == 0 {
-        return Err(wav_err(
-            "the header declares 0 channels; re-export the file".into(),
-        ));
+        return Err(wav_err(WavProblem::NoChannels));
     }
     if !(opts.scale.is_finite() && opts.scale != 0.0) {
         return Err(SignalError::InvalidParam {
@@ -230,19 +228,16 @@ pub(crate) fn wav_layout(
     match spec.sample_format {
         hound::SampleFormat::Float => {
             if spec.bits_per_sample != 32 {
-                return Err(wav_err(format!(
-                    "{}-bit float samples are not supported; convert to 32-bit float or PCM",
-                    spec.bits_per_sample
-                )));
+                return Err(wav_err(WavProblem::FloatBits {
+                    bits: spec.bits_per_sample,
+                }));
             }
             Ok((nch, true, opts.scale))
         }
         hound::SampleFormat::Int => {
             let bits = spec.bits_per_sample;
             if !(1..=32).contains(&bits) {
-                return Err(wav_err(format!(
-                    "{bits}-bit integer samples are not supported; use 8, 16, 24 or 32 bits"
-                )));
+                return Err(wav_err(WavProblem::IntBits { bits }));
             }
             Ok((nch, false, opts.scale / f64::powi(2.0, bits as i32 - 1)))
         }
@@ -422,9 +417,9 @@ pub(crate) fn interp_uniform(t: &[f64], y: &[f64], t0: f64, dt: f64) -> Vec<f64>
 
 fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Recording> {
     let p = path.display().to_string();
-    let wav_err = |reason: String| SignalError::Wav {
+    let wav_err = |problem: WavProblem| SignalError::Wav {
         path: p.clone(),
-        reason,
+        problem,
     };
     if !path.exists() {
         return Err(io_err(
@@ -433,8 +428,11 @@ fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Recording> {
             &std::io::Error::from(std::io::ErrorKind::NotFound),
         ));
     }
-    let reader = hound::WavReader::open(path)
-        .map_err(|e| wav_err(format!("{e}; check that it is a valid WAV file")))?;
+    let reader = hound::WavReader::open(path).map_err(|e| {
+        wav_err(WavProblem::Unreadable {
+            message: e.to_string(),
+        })
+    })?;
     let spec = reader.spec();
     let (nch, float, k) = wav_layout(&spec, opts, &wav_err)?;
     let interleaved: Vec<f64> = if float {
@@ -442,19 +440,25 @@ fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Recording> {
             .into_samples::<f32>()
             .map(|s| s.map(|v| v as f64 * k))
             .collect::<std::result::Result<_, _>>()
-            .map_err(|e| wav_err(format!("{e}; the file may be truncated")))?
+            .map_err(|e| {
+                wav_err(WavProblem::Truncated {
+                    message: e.to_string(),
+                })
+            })?
     } else {
         reader
             .into_samples::<i32>()
             .map(|s| s.map(|v| v as f64 * k))
             .collect::<std::result::Result<_, _>>()
-            .map_err(|e| wav_err(format!("{e}; the file may be truncated")))?
+            .map_err(|e| {
+                wav_err(WavProblem::Truncated {
+                    message: e.to_string(),
+                })
+            })?
     };
     let n = interleaved.len() / nch;
     if n == 0 {
-        return Err(wav_err(
-            "it contains zero samples; check the recording".into(),
-        ));
+        return Err(wav_err(WavProblem::NoSamples));
     }
     let fs = reconcile_fs(
         &p,
@@ -510,28 +514,28 @@ pub(crate) fn wav_names(path: &Path, nch: usize) -> Result<(Vec<String>, Vec<Str
     let sp = side.display().to_string();
     let text =
         vibmode_core::files::read_text_capped(&side).map_err(|e| io_err("read", &side, &e))?;
-    let bad = |reason: String| SignalError::Sidecar {
+    let bad = |problem: SidecarProblem| SignalError::Sidecar {
         path: sp.clone(),
-        reason,
+        problem,
     };
     let w: WavSidecar = serde_json::from_str(&text).map_err(|e| {
-        bad(format!(
-            "{e}; expected {{\"channels\": [\"FL\", ...]}} (or delete it to name the channels ch0, ch1, ...)"
-        ))
+        bad(SidecarProblem::WavJson {
+            message: e.to_string(),
+        })
     })?;
     if w.channels.len() != nch {
-        return Err(bad(format!(
-            "names {} channels but the WAV has {nch}; fix the channel list or delete the file",
-            w.channels.len()
-        )));
+        return Err(bad(SidecarProblem::WavChannels {
+            names: w.channels.len(),
+            channels: nch,
+        }));
     }
     let units = match w.units {
         Some(u) if u.len() == nch => u,
         Some(u) => {
-            return Err(bad(format!(
-                "has {} units for {nch} channels; give one unit per channel",
-                u.len()
-            )))
+            return Err(bad(SidecarProblem::WavUnits {
+                units: u.len(),
+                channels: nch,
+            }))
         }
         None => vec![String::new(); nch],
     };
@@ -576,55 +580,53 @@ pub(crate) struct RawLayout {
 /// Finds, reads and checks the sidecar of the raw file `path`.
 pub(crate) fn raw_layout(path: &Path) -> Result<RawLayout> {
     let cands = sidecar_candidates(path);
-    let side_path = cands.iter().find(|c| c.is_file()).ok_or_else(|| SignalError::Sidecar {
-        path: cands
-            .iter()
-            .map(|c| c.display().to_string())
-            .collect::<Vec<_>>()
-            .join(" or "),
-        reason: "not found; a raw file needs a JSON sidecar like {\"fs_hz\": 20000, \"dtype\": \"f32\", \"channels\": [\"FL\"]}".into(),
-    })?;
+    let side_path = cands
+        .iter()
+        .find(|c| c.is_file())
+        .ok_or_else(|| SignalError::Sidecar {
+            path: cands
+                .iter()
+                .map(|c| c.display().to_string())
+                .collect::<Vec<_>>()
+                .join(" or "),
+            problem: SidecarProblem::NotFound,
+        })?;
     let sp = side_path.display().to_string();
     let text = vibmode_core::files::read_text_capped(side_path)
         .map_err(|e| io_err("read", side_path, &e))?;
     let side: Sidecar = serde_json::from_str(&text).map_err(|e| SignalError::Sidecar {
         path: sp.clone(),
-        reason: format!(
-            "{e}; expected {{\"fs_hz\": 20000, \"dtype\": \"f32\"|\"f64\", \"channels\": [\"FL\", ...], \"units\": [\"m/s^2\", ...]}}"
-        ),
+        problem: SidecarProblem::RawJson {
+            message: e.to_string(),
+        },
     })?;
-    let side_err = |reason: String| SignalError::Sidecar {
+    let side_err = |problem: SidecarProblem| SignalError::Sidecar {
         path: sp.clone(),
-        reason,
+        problem,
     };
     let width = match side.dtype.as_str() {
         "f32" | "float32" => 4,
         "f64" | "float64" => 8,
         other => {
-            return Err(side_err(format!(
-                "dtype '{other}' is not supported; use \"f32\" or \"f64\""
-            )))
+            return Err(side_err(SidecarProblem::Dtype {
+                dtype: other.to_string(),
+            }))
         }
     };
     let nch = side.channels.len();
     if nch == 0 {
-        return Err(side_err(
-            "\"channels\" is empty; list one name per interleaved channel".into(),
-        ));
+        return Err(side_err(SidecarProblem::NoChannels));
     }
     if let Some(u) = &side.units {
         if u.len() != nch {
-            return Err(side_err(format!(
-                "\"units\" has {} entries but \"channels\" has {nch}; give one unit per channel or omit \"units\"",
-                u.len()
-            )));
+            return Err(side_err(SidecarProblem::Units {
+                units: u.len(),
+                channels: nch,
+            }));
         }
     }
     if !(side.fs_hz.is_finite() && side.fs_hz > 0.0) {
-        return Err(side_err(format!(
-            "fs_hz {} must be a positive finite number, e.g. 20000",
-            side.fs_hz
-        )));
+        return Err(side_err(SidecarProblem::Rate { fs_hz: side.fs_hz }));
     }
     Ok(RawLayout {
         sidecar_path: sp,

@@ -19,7 +19,7 @@
 //! Every sample is checked to be finite, naming the channel and the sample's index in the file.
 
 use crate::delimited::{Block, DelimitedReader};
-use crate::error::{io_err, Result, SignalError};
+use crate::error::{io_err, Result, SignalError, WavProblem};
 use crate::read::{raw_layout, reconcile_fs, wav_names, Format, ReadOptions};
 use std::fs::File;
 use std::io::{BufReader, Read};
@@ -238,20 +238,21 @@ fn open_raw(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
 
 fn open_wav(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
     let p = path.display().to_string();
-    let wav_err = |reason: String| SignalError::Wav {
+    let wav_err = |problem: WavProblem| SignalError::Wav {
         path: p.clone(),
-        reason,
+        problem,
     };
     let file = open_file(path)?;
-    let reader = hound::WavReader::new(BufReader::with_capacity(1 << 20, file))
-        .map_err(|e| wav_err(format!("{e}; check that it is a valid WAV file")))?;
+    let reader = hound::WavReader::new(BufReader::with_capacity(1 << 20, file)).map_err(|e| {
+        wav_err(WavProblem::Unreadable {
+            message: e.to_string(),
+        })
+    })?;
     let spec = reader.spec();
     let (nch, float, scale) = crate::read::wav_layout(&spec, opts, &wav_err)?;
     let n = u64::from(reader.duration());
     if n == 0 {
-        return Err(wav_err(
-            "it contains zero samples; check the recording".into(),
-        ));
+        return Err(wav_err(WavProblem::NoSamples));
     }
     let fs = reconcile_fs(
         &p,
@@ -594,14 +595,13 @@ impl FrameStream {
                 let nch = self.file_names.len();
                 let n = (*remaining).min(max_frames as u64) as usize;
                 let mut out = vec![Vec::with_capacity(n); nch];
-                let truncated = |e: hound::Error, frame: u64| {
-                    SignalError::Wav {
+                let truncated = |e: hound::Error, frame: u64| SignalError::Wav {
                     path: self.info.path.clone(),
-                    reason: format!(
-                        "{e} at frame {frame} of the {} its header announces: the file is cut off (a recording stopped mid-write?); re-export it, or cut the header's data size to the frames present",
-                        self.next_frame + *remaining
-                    ),
-                }
+                    problem: WavProblem::CutOffAt {
+                        message: e.to_string(),
+                        frame,
+                        announced: self.next_frame + *remaining,
+                    },
                 };
                 let mut k = 0usize;
                 if *float {
@@ -620,11 +620,10 @@ impl FrameStream {
                 if k < n * nch {
                     return Err(SignalError::Wav {
                         path: self.info.path.clone(),
-                        reason: format!(
-                            "it ends after frame {} of the {} its header announces: the file is cut off (a recording stopped mid-write?); re-export it",
-                            self.next_frame + (k / nch) as u64,
-                            self.next_frame + *remaining
-                        ),
+                        problem: WavProblem::EndsEarly {
+                            frame: self.next_frame + (k / nch) as u64,
+                            announced: self.next_frame + *remaining,
+                        },
                     });
                 }
                 *remaining -= n as u64;

@@ -6,7 +6,7 @@
 //! [`StreamWriter::finish`] renames into place; a writer dropped without `finish` (an error on
 //! the way) removes them.
 
-use crate::error::{io_err, Result, SignalError};
+use crate::error::{io_err, Result, SidecarProblem, SignalError, WavProblem};
 use crate::read::{Format, Sidecar, WavSidecar};
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -125,7 +125,9 @@ impl StreamWriter {
                 };
                 let w = hound::WavWriter::new(open()?, spec).map_err(|e| SignalError::Wav {
                     path: path.display().to_string(),
-                    reason: format!("{e}; check the path and free space"),
+                    problem: WavProblem::NotWritten {
+                        message: e.to_string(),
+                    },
                 })?;
                 let side = WavSidecar {
                     channels: names.to_vec(),
@@ -134,7 +136,9 @@ impl StreamWriter {
                 let text =
                     serde_json::to_string_pretty(&side).map_err(|e| SignalError::Sidecar {
                         path: with_suffix(path, ".json").display().to_string(),
-                        reason: e.to_string(),
+                        problem: SidecarProblem::NotSerialised {
+                            message: e.to_string(),
+                        },
                     })?;
                 (
                     Sink::Wav { w: Some(w) },
@@ -152,7 +156,9 @@ impl StreamWriter {
                 let text =
                     serde_json::to_string_pretty(&side).map_err(|e| SignalError::Sidecar {
                         path: with_suffix(path, ".json").display().to_string(),
-                        reason: format!("cannot serialise: {e}"),
+                        problem: SidecarProblem::NotSerialised {
+                            message: e.to_string(),
+                        },
                     })?;
                 (
                     Sink::Raw {
@@ -229,7 +235,9 @@ impl StreamWriter {
                         for c in block {
                             w.write_sample(c[i] as f32).map_err(|e| SignalError::Wav {
                                 path: path.display().to_string(),
-                                reason: format!("{e}; check the path and free space"),
+                                problem: WavProblem::NotWritten {
+                                    message: e.to_string(),
+                                },
                             })?;
                         }
                     }
@@ -273,7 +281,9 @@ impl StreamWriter {
                 if let Some(w) = w.take() {
                     w.finalize().map_err(|e| SignalError::Wav {
                         path: path.display().to_string(),
-                        reason: format!("{e}; check the path and free space"),
+                        problem: WavProblem::NotWritten {
+                            message: e.to_string(),
+                        },
                     })?;
                 }
             }

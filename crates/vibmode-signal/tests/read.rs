@@ -697,3 +697,47 @@ fn channels_of_one_name_are_refused() {
     assert!(e.contains("channels 2 and 3 are both named 'b'"), "{e}");
     assert!(Recording::new(100.0, vec![ch("a"), ch("b")]).is_ok());
 }
+
+/// A WAV without frames and a raw sidecar with an unknown sample type are refused with their
+/// problem typed (the values in its fields) and the same one-line message through both readers.
+#[test]
+fn wav_and_sidecar_problems_are_typed() {
+    use vibmode_signal::{SidecarProblem, SignalError, WavProblem};
+    let d = tempfile::tempdir().unwrap();
+    let w = d.path().join("empty.wav");
+    write_wav_int(&w, 16, 1000, &[]);
+    for e in [
+        read_path(&w, &ReadOptions::default()).unwrap_err(),
+        vibmode_signal::open_stream(&w, &ReadOptions::default())
+            .map(|_| ())
+            .unwrap_err(),
+    ] {
+        assert!(
+            matches!(
+                &e,
+                SignalError::Wav {
+                    problem: WavProblem::NoSamples,
+                    ..
+                }
+            ),
+            "{e:?}"
+        );
+        assert!(e.to_string().contains("zero samples"), "{e}");
+    }
+    let p = d.path().join("c.f32");
+    std::fs::write(&p, [0u8; 8]).unwrap();
+    write(
+        d.path(),
+        "c.f32.json",
+        r#"{"fs_hz": 100, "dtype": "i16", "channels": ["FL"]}"#,
+    );
+    let e = read_path(&p, &ReadOptions::default()).unwrap_err();
+    assert!(
+        matches!(&e, SignalError::Sidecar { problem: SidecarProblem::Dtype { dtype }, .. } if dtype == "i16"),
+        "{e:?}"
+    );
+    assert!(
+        e.to_string().contains("dtype 'i16' is not supported"),
+        "{e}"
+    );
+}
