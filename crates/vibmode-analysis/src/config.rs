@@ -195,6 +195,9 @@ fn migrate_legacy(value: &mut toml::Value) {
 /// Longest record cut from a long recording, s (one day).
 pub const RECORD_LENGTH_S_MAX: f64 = 86_400.0;
 
+/// The rule of `record_length_s`, as its error states it ([`RECORD_LENGTH_S_MAX`]).
+const RECORD_LENGTH_S_RULE: &str = "must be in (0, 86400] s";
+
 impl AnalysisConfig {
     /// The defaults of a preset.
     pub fn preset(p: Preset) -> Self {
@@ -292,13 +295,9 @@ impl AnalysisConfig {
         };
         let preset = match (given, in_file) {
             (Some(g), Some(f)) if g != f => {
-                return Err(AnalysisError::Config {
-                    key: Some("preset"),
-                    message: format!(
-                        "the config sets preset = \"{}\" but preset {} was given; give one of them",
-                        f.name(),
-                        g.name()
-                    ),
+                return Err(AnalysisError::PresetConflict {
+                    in_file: f.name(),
+                    given: g.name(),
                 })
             }
             (g, f) => g.or(f).unwrap_or_default(),
@@ -348,13 +347,12 @@ impl AnalysisConfig {
             && self.record_length_s > 0.0
             && self.record_length_s <= RECORD_LENGTH_S_MAX)
         {
-            return Err(AnalysisError::Config {
-                key: Some("record_length_s"),
-                message: format!(
-                    "record_length_s = {} must be in (0, {RECORD_LENGTH_S_MAX}] s; use e.g. record_length_s = 10.24",
-                    vibmode_core::Num(self.record_length_s)
-                ),
-            });
+            return Err(AnalysisError::Param(vibmode_core::ParamError::OutOfRange {
+                name: "record_length_s",
+                value: vibmode_core::Num(self.record_length_s).to_string(),
+                requirement: RECORD_LENGTH_S_RULE,
+                suggestion: "10.24".into(),
+            }));
         }
         self.preprocess.validate()?;
         self.spectra.validate()?;
@@ -419,6 +417,22 @@ fn merge(base: &mut toml::Value, over: toml::Value) {
 
 #[cfg(test)]
 mod tests {
+    /// The rule stated in `record_length_s`'s error is the bound the check uses.
+    #[test]
+    fn record_length_rule_states_the_bound() {
+        use super::*;
+        assert!(RECORD_LENGTH_S_RULE.ends_with(&format!(", {}] s", RECORD_LENGTH_S_MAX)));
+        let cfg = AnalysisConfig {
+            record_length_s: 2.0 * RECORD_LENGTH_S_MAX,
+            ..AnalysisConfig::default()
+        };
+        let e = cfg.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("record_length_s = 172800 must be in (0, 86400] s"),
+            "{e}"
+        );
+    }
+
     use super::*;
 
     /// `load`: the preset is the base the TOML's keys override; a TOML `preset` key that differs

@@ -92,6 +92,14 @@ pub enum AnalysisError {
         /// What is wrong and how to fix it.
         message: String,
     },
+    /// A preset in the config file other than the one given beside it.
+    #[error("analysis config: the config sets preset = \"{in_file}\" but preset {given} was given; give one of them")]
+    PresetConflict {
+        /// The config file's preset.
+        in_file: &'static str,
+        /// The preset given.
+        given: &'static str,
+    },
     /// A config file cannot be read or parsed.
     #[error("config {path}: {message}")]
     ConfigFile {
