@@ -650,7 +650,17 @@ impl FigureWriter<'_> {
             self.files.push(path);
         }
         self.html.heading(2, &format!("Figure {n}: {title}"));
-        self.html.figure(fig, caption)
+        let folder = self
+            .dir
+            .file_name()
+            .map(|f| f.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        self.html.figure_or_image(
+            fig,
+            caption,
+            &format!("{folder}/fig{n:02}_{file}.png"),
+            crate::html::INLINE_SVG_MAX_BYTES,
+        )
     }
 }
 

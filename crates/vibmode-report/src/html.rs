@@ -58,6 +58,10 @@ pub struct HtmlReport {
     n_tables: usize,
 }
 
+/// Largest SVG the analysis report inlines in its page ([`HtmlReport::figure_or_image`]),
+/// bytes: the demo's largest figure is 1.5 MB, an hour's frequency-damping figure 33 MB.
+pub const INLINE_SVG_MAX_BYTES: usize = 8_000_000;
+
 impl HtmlReport {
     /// A new, empty report; `title` goes into `<title>` and a top-level `<h1>`.
     pub fn new(title: &str) -> Self {
@@ -82,10 +86,43 @@ impl HtmlReport {
     /// Add a figure as inline SVG with a numbered caption ("Figure N. caption").
     pub fn figure(&mut self, fig: &Figure, caption: &str) -> Result<(), ReportError> {
         let svg = fig.to_svg_string()?;
+        self.inline_svg(&svg, caption);
+        Ok(())
+    }
+
+    /// [`HtmlReport::figure`], except that a figure whose SVG exceeds `max_inline_bytes`
+    /// ([`INLINE_SVG_MAX_BYTES`] in the analysis report: every pole of an hour of records is
+    /// tens of MB) is shown as the image `image_href` (a PNG of it the caller wrote, relative to
+    /// the page) so that the page stays light; the caption says so.
+    pub fn figure_or_image(
+        &mut self,
+        fig: &Figure,
+        caption: &str,
+        image_href: &str,
+        max_inline_bytes: usize,
+    ) -> Result<(), ReportError> {
+        let svg = fig.to_svg_string()?;
+        if svg.len() <= max_inline_bytes {
+            self.inline_svg(&svg, caption);
+            return Ok(());
+        }
+        self.n_figures += 1;
+        let href = escape_html(image_href);
+        let _ = writeln!(
+            self.body,
+            "<figure>\n<a href=\"{href}\"><img src=\"{href}\" alt=\"Figure {n}\" style=\"max-width:100%\"></a>\n<figcaption>Figure {n}. {} (Drawn as an image: its SVG has {:.1} MB, too much for the page; the SVG is beside the image.)</figcaption>\n</figure>",
+            escape_html(caption),
+            svg.len() as f64 / 1e6,
+            n = self.n_figures,
+        );
+        Ok(())
+    }
+
+    fn inline_svg(&mut self, svg: &str, caption: &str) {
         // Drop any XML prolog so the SVG is a plain inline element.
         let svg = match svg.find("<svg") {
             Some(i) => &svg[i..],
-            None => svg.as_str(),
+            None => svg,
         };
         self.n_figures += 1;
         let _ = writeln!(
@@ -95,7 +132,6 @@ impl HtmlReport {
             self.n_figures,
             escape_html(caption)
         );
-        Ok(())
     }
 
     /// Add a table. Rows shorter than `headers` are padded with empty cells; longer rows are kept
@@ -159,6 +195,30 @@ impl HtmlReport {
 #[cfg(test)]
 mod tests {
     use super::is_numeric_cell;
+
+    /// A figure whose SVG is above the limit is an image link (numbered like the others); at or
+    /// below it, inline SVG.
+    #[test]
+    fn a_figure_too_large_to_inline_is_an_image() {
+        use crate::{Figure, HtmlReport, Panel, Series};
+        let x: Vec<f64> = (0..200).map(f64::from).collect();
+        let fig = Figure::single(Panel::new("p", "x", "y").with_series(Series::line(x.clone(), x)));
+        let size = fig.to_svg_string().unwrap().len();
+        let mut r = HtmlReport::new("t");
+        r.figure_or_image(&fig, "small", "figures/a.png", size)
+            .unwrap();
+        r.figure_or_image(&fig, "large & dense", "figures/b<1>.png", size - 1)
+            .unwrap();
+        let html = r.to_html();
+        assert_eq!(html.matches("<figure>").count(), 2);
+        assert_eq!(html.matches("<svg").count(), 1);
+        assert!(
+            html.contains("<img src=\"figures/b&lt;1&gt;.png\""),
+            "{html}"
+        );
+        assert!(html.contains("Figure 2. large &amp; dense (Drawn as an image"));
+        assert!(!html.contains("figures/a.png"));
+    }
 
     #[test]
     fn numeric_cells_are_recognised() {

@@ -75,7 +75,7 @@ pub mod spectrum_figures;
 pub use analysis::{modes_csv, modes_table_text, write_analysis_report, ReportFiles, TruthRow};
 pub use error::ReportError;
 pub use font::{ensure_font, DEJAVU_SANS_TTF, FONT_FAMILY};
-pub use html::{escape_html, is_numeric_cell, HtmlReport};
+pub use html::{escape_html, is_numeric_cell, HtmlReport, INLINE_SVG_MAX_BYTES};
 pub use model::{Figure, Marker, Panel, Rgb, Scale, Series, SeriesStyle, PALETTE};
 pub use render::{
     MAX_POINTS_PER_SERIES, MAX_SIDE_PX, MIN_CELL_HEIGHT_PX, MIN_CELL_WIDTH_PX, MIN_SIDE_PX,
