@@ -149,8 +149,6 @@ fn fft_err(e: realfft::FftError) -> SignalError {
     }
 }
 
-/// How a record of `n_in` samples at `fs_hz` is resampled to `p.fs_out_hz`: the method, the
-/// decimation factor (integer ratios), the number of output samples and the output rate.
 /// The output rate, Hz, of a [`Resampler`] planned for `n_in` samples at `fs_hz` with `p` (its
 /// [`Resampler::fs_out_hz`]), without planning it: with a non-integer rate ratio it is
 /// `n_out / duration`, which can fall a hair below `p.fs_out_hz`. It does not depend on
@@ -159,6 +157,8 @@ pub fn planned_fs_out_hz(n_in: usize, fs_hz: f64, p: &ResampleParams) -> f64 {
     plan_kind(n_in, fs_hz, p).3
 }
 
+/// How a record of `n_in` samples at `fs_hz` is resampled to `p.fs_out_hz`: the method, the
+/// decimation factor (integer ratios), the number of output samples and the output rate.
 fn plan_kind(n_in: usize, fs_hz: f64, p: &ResampleParams) -> (Kind, usize, usize, f64) {
     let ratio = fs_hz / p.fs_out_hz;
     let d = ratio.round();
