@@ -535,28 +535,21 @@ fn channel_modes(
                 .map(|(ch, s)| (Pool::Channel(&ch.name), s.poles.len())),
         )
         .collect();
-    let mut by_size: Vec<usize> = (0..tasks.len()).collect();
-    by_size.sort_by_key(|&k| std::cmp::Reverse(tasks[k].1));
     let store: &PoleStore = store;
     let mut slots: Vec<Option<Result<Vec<InvariantMode>, AnalysisError>>> =
         (0..tasks.len()).map(|_| None).collect();
-    {
-        let mut slot_of: Vec<Option<&mut Option<_>>> = slots.iter_mut().map(Some).collect();
-        rayon::scope_fifo(|scope| {
-            for &k in &by_size {
-                let Some(slot) = slot_of[k].take() else {
-                    continue;
-                };
-                let task = &tasks[k].0;
-                scope.spawn_fifo(move |_| {
-                    *slot = Some(match *task {
-                        Pool::Role(role) => support.cluster(store, |_, r| r == role),
-                        Pool::Channel(name) => support.cluster(store, |n, _| n == name),
-                    });
+    let mut jobs: Vec<_> = slots.iter_mut().zip(&tasks).collect();
+    jobs.sort_by_key(|(_, (_, n_poles))| std::cmp::Reverse(*n_poles));
+    rayon::scope_fifo(|scope| {
+        for (slot, (task, _)) in jobs {
+            scope.spawn_fifo(move |_| {
+                *slot = Some(match *task {
+                    Pool::Role(role) => support.cluster(store, |_, r| r == role),
+                    Pool::Channel(name) => support.cluster(store, |n, _| n == name),
                 });
-            }
-        });
-    }
+            });
+        }
+    });
     // Every slot is filled once the scope ends.
     let mut clustered: Vec<Result<Vec<InvariantMode>, AnalysisError>> =
         slots.into_iter().flatten().collect();
