@@ -29,7 +29,7 @@ use crate::model::{FullCar, ModeInfo, ModeLabel};
 use crate::params::{CornerCondition, VehicleParams};
 use nalgebra::{DMatrix, DVector};
 use realfft::RealFftPlanner;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use vibmode_core::{Channel, Corner, Direction, Placement, Recording, Role};
 
 pub use vibmode_core::BodyFitParams;
@@ -86,6 +86,23 @@ pub struct BodyFit {
     noise: Vec<(String, f64)>,
     equations: usize,
     records: usize,
+}
+
+/// One record's body equations, summed ([`BodyFit::record_equations`]): enough to fit
+/// records together later without reading them again ([`BodyFit::add_equations`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
+pub struct RecordEquations {
+    /// Unknowns of the fit (pitch and roll inertias, four springs, four dampers, the bars).
+    pub unknowns: usize,
+    /// `Z^T Z` of the record's equations, `Z = [X | y]`, column-major, `(unknowns + 1)^2`.
+    pub gram: Vec<f64>,
+    /// The share its sensors' white noise is expected to add to `gram`, same layout.
+    pub noise_gram: Vec<f64>,
+    /// Each used channel's noise density from its spectrum above the band, (m/s^2)^2/Hz.
+    pub noise: Vec<(String, f64)>,
+    /// Equations (instants x 3 body rows).
+    pub equations: usize,
 }
 
 /// One fitted parameter beside the vehicle file's value.
@@ -195,6 +212,18 @@ impl BodyFitResult {
     /// The updated model's mode with this label, if any.
     pub fn mode(&self, label: ModeLabel) -> Option<&ModeInfo> {
         self.modes.iter().find(|m| m.label == label)
+    }
+
+    /// The fitted spring of a corner, N/m, with its standard deviation.
+    pub fn spring(&self, corner: Corner) -> Option<&FittedParameter> {
+        let name = format!("spring {corner}");
+        self.parameters.iter().find(|p| p.name == name)
+    }
+
+    /// The fitted damper of a corner, N s/m, with its standard deviation.
+    pub fn damper(&self, corner: Corner) -> Option<&FittedParameter> {
+        let name = format!("damper {corner}");
+        self.parameters.iter().find(|p| p.name == name)
     }
 
     /// The standard deviations of the updated mode with this label (frequency Hz, damping ratio).
@@ -581,6 +610,53 @@ impl BodyFit {
         rec: &Recording,
         placement: impl Fn(&Channel) -> Option<Placement>,
     ) -> Result<()> {
+        let eq = self.record_equations_placed(rec, placement)?;
+        self.add_equations(&eq)
+    }
+
+    /// One record's equations, not added: what [`BodyFit::add_record`] would add, to be kept
+    /// (e.g. by the fleet store, per record) and added later with [`BodyFit::add_equations`]
+    /// to a fit of the same vehicle file and parameters.
+    pub fn record_equations(&self, rec: &Recording) -> Result<RecordEquations> {
+        self.record_equations_placed(rec, |c| Some(c.placement))
+    }
+
+    /// Adds one record's equations made by [`BodyFit::record_equations`] of a fit of the same
+    /// vehicle file and parameters. An error if their number of unknowns differs from this
+    /// fit's (another vehicle file's anti-roll bars) or their matrices are not square of that
+    /// size or hold a non-finite value.
+    pub fn add_equations(&mut self, eq: &RecordEquations) -> Result<()> {
+        let size = self.gram.nrows();
+        let ok_len = |v: &[f64]| v.len() == size * size && v.iter().all(|x| x.is_finite());
+        if eq.unknowns + 1 != size || !ok_len(&eq.gram) || !ok_len(&eq.noise_gram) {
+            return Err(fit_error(
+                format!(
+                    "a record's equations have {} unknowns ({} and {} matrix entries), this fit {}",
+                    eq.unknowns,
+                    eq.gram.len(),
+                    eq.noise_gram.len(),
+                    size - 1
+                ),
+                "make the record's equations with the same vehicle file and band",
+            ));
+        }
+        let gram = DMatrix::from_column_slice(size, size, &eq.gram);
+        let noise_gram = DMatrix::from_column_slice(size, size, &eq.noise_gram);
+        self.gram += &gram;
+        self.per_record.push((gram, noise_gram));
+        self.noise.extend(eq.noise.iter().cloned());
+        self.equations += eq.equations;
+        self.records += 1;
+        Ok(())
+    }
+
+    /// As [`BodyFit::record_equations`], with each channel's placement given by `placement`
+    /// (see [`BodyFit::add_record_placed`]).
+    pub fn record_equations_placed(
+        &self,
+        rec: &Recording,
+        placement: impl Fn(&Channel) -> Option<Placement>,
+    ) -> Result<RecordEquations> {
         let fs = rec.fs_hz;
         if !(fs.is_finite() && fs > 0.0) {
             return Err(fit_error(
@@ -667,6 +743,8 @@ impl BodyFit {
             }
         };
         let ns = layout.sprung.len();
+        let mut equations = 0usize;
+        let mut noise = Vec::with_capacity(4 + ns);
         let mut wv = [[0.0; 3]; 4];
         let mut sv = vec![[0.0; 3]; ns];
         for t in 0..instants.len() {
@@ -678,7 +756,7 @@ impl BodyFit {
             }
             self.rows(&layout, &wv, &sv, &mut z);
             add(&z, 1.0, &mut gram);
-            self.equations += 3;
+            equations += 3;
         }
         // The noise's expected share of the gram: the rows are linear in each channel's a, a',
         // a''; white noise of variance s^2 per sample adds s^2 times the kernels' sums
@@ -698,7 +776,7 @@ impl BodyFit {
                 layout.sprung[ch - 4]
             }]
             .name;
-            self.noise.push((name.clone(), density));
+            noise.push((name.clone(), density));
             if density <= 0.0 {
                 continue;
             }
@@ -733,10 +811,13 @@ impl BodyFit {
                 }
             }
         }
-        self.gram += &gram;
-        self.per_record.push((gram, noise_gram));
-        self.records += 1;
-        Ok(())
+        Ok(RecordEquations {
+            unknowns: n,
+            gram: gram.as_slice().to_vec(),
+            noise_gram: noise_gram.as_slice().to_vec(),
+            noise,
+            equations,
+        })
     }
 
     /// The three body rows `[x | y]` (regressors, then the right side) at one instant from the
