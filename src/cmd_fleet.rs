@@ -32,6 +32,19 @@ pub enum FleetCommand {
     /// Analyse records and store their features (the same file twice is a no-op).
     #[command(allow_negative_numbers = true)]
     Ingest(IngestArgs),
+    /// Register a vehicle's full-car model file (docs/vehicle.md): records ingested or checked
+    /// afterwards keep their body equations, and the baseline and each checked drive fit the
+    /// suspension (springs and dampers per corner) to them (docs/fleet.md).
+    Register {
+        /// The store file.
+        #[arg(long)]
+        db: PathBuf,
+        /// Vehicle id (created if new).
+        #[arg(long)]
+        vehicle: String,
+        /// The vehicle's model file (TOML: geometry, masses, tyres, suspension, sensors).
+        model: PathBuf,
+    },
     /// Build a new nominal model-set version from a vehicle's nominal records.
     Baseline {
         /// The store file.
@@ -134,6 +147,7 @@ pub fn run(a: &FleetArgs) -> Result<()> {
             Ok(())
         }
         FleetCommand::Ingest(i) => ingest(i),
+        FleetCommand::Register { db, vehicle, model } => register(db, vehicle, model),
         FleetCommand::Baseline { db, vehicle } => baseline(db, vehicle),
         FleetCommand::Check(c) => check(c),
         FleetCommand::Status { db } => status(db),
@@ -195,6 +209,30 @@ fn ingest(a: &IngestArgs) -> Result<()> {
     Ok(())
 }
 
+fn register(db: &std::path::Path, vehicle: &str, model: &std::path::Path) -> Result<()> {
+    let mut store = Store::open(db)?;
+    let text = vibmode_core::files::read_text_capped(model)
+        .map_err(|e| anyhow::anyhow!("vehicle model {}: {e}", model.display()))?;
+    let changed = vibmode_fleet::register_vehicle_model(
+        &mut store,
+        vehicle,
+        &text,
+        &model.display().to_string(),
+    )?;
+    let text = if changed {
+        format!(
+            "vehicle {vehicle}: model file {} registered; records ingested from now on keep their body equations for the suspension fit (ingest nominal records, then build the baseline)\n",
+            model.display()
+        )
+    } else {
+        format!(
+            "vehicle {vehicle}: model file {} already registered (unchanged)\n",
+            model.display()
+        )
+    };
+    crate::output::print_stdout(&text)
+}
+
 fn baseline(db: &std::path::Path, vehicle: &str) -> Result<()> {
     let mut store = Store::open(db)?;
     let cfg = store.config()?;
@@ -216,6 +254,18 @@ fn baseline(db: &std::path::Path, vehicle: &str) -> Result<()> {
             l.bonferroni,
             l.loo_max_abs_z,
             l.limit
+        ));
+    }
+    if let Some(s) = &set.suspension {
+        text.push_str(&format!(
+            "suspension fitted to {} nominal records: springs and dampers per corner scored per drive, one-sided limit {:.2}{}\n",
+            s.fit.records,
+            s.limit,
+            if s.fit.supported {
+                ""
+            } else {
+                " (the fit's standard deviations exceed the model update's support limits: the scores use them as they are)"
+            }
         ));
     }
     for n in &set.notes {

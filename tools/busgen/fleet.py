@@ -48,6 +48,7 @@ from typing import Dict, List, Optional
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import harness as h  # noqa: E402
+import update  # noqa: E402
 
 CORNERS = ["fl", "fr", "rl", "rr"]
 
@@ -102,8 +103,29 @@ def verdict_ok(cls: str, corner: Optional[str], cond: Dict) -> bool:
     return cls == cond["expect"]
 
 
+def more_drives(bus_seed: int, n_healthy: int) -> List[Dict]:
+    """`n_healthy` more healthy drives (drawn as the first) and a spring at 80 % at each corner
+    on such drawn conditions (`--more`), from their own random stream: the drives of
+    `conditions` stay the same."""
+    more = random.Random(bus_seed * 104729 + 31)
+    out = []
+    for k in range(n_healthy):
+        extra, load, road, speed = healthy_drive(more)
+        out.append({"name": "healthy", "extra": extra, "expect": "normal", "corner": None,
+                    "detail": f"load {load}, road {road}, "
+                              f"{'25-35' if speed is None else speed} km/h", "seed": 500000 + 1000 * k})
+    for i, c in enumerate(CORNERS):
+        extra, load, road, speed = healthy_drive(more)
+        out.append({"name": "spring80", "extra": ["--spring", f"{c}=0.8", *extra],
+                    "expect": "vehicle", "corner": c.upper(), "component": "spring",
+                    "detail": f"spring {c.upper()} 0.8, load {load}, road {road}",
+                    "seed": 600000 + 1000 * i})
+    return out
+
+
 def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
-            test_extra: Optional[List[str]] = None, keep: bool = False) -> Dict:
+            test_extra: Optional[List[str]] = None, keep: bool = False,
+            model: bool = False, n_more: int = 0) -> Dict:
     """Simulates, ingests, baselines and checks one bus; returns its rows.
 
     The store is deleted unless `keep` (then it stays in `work` as fleet-SEED.db, beside each
@@ -118,11 +140,19 @@ def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
     for d in range(2):
         folder = h.simulate(bus_seed, base_seed + 1000 * d, records=n_records)
         base += h.records(folder)
+        if model and d == 0:
+            toml = work / f"bus{bus_seed}.toml"
+            toml.write_text(update.vehicle_toml(h.truth(folder), True))
+            h.run_vibmode(["fleet", "register", "--db", db, "--vehicle", vehicle, toml])
     h.run_vibmode(["fleet", "ingest", "--db", db, "--vehicle", vehicle, "-q", *base])
     h.run_vibmode(["fleet", "baseline", "--db", db, "--vehicle", vehicle])
     rows = []
-    for i, cond in enumerate(conditions(bus_seed, rng)):
-        seed = base_seed + 10000 * (i + 1)
+    drives = conditions(bus_seed, rng)
+    n_first = len(drives)
+    if n_more:
+        drives += more_drives(bus_seed, n_more)
+    for i, cond in enumerate(drives):
+        seed = base_seed + (10000 * (i + 1) if i < n_first else cond["seed"])
         folder = h.simulate(bus_seed, seed, *cond["extra"], *(test_extra or []),
                             records=n_records)
         r = h.run_vibmode(["fleet", "check", "--db", db, "--vehicle", vehicle, "-q",
@@ -191,6 +221,12 @@ def main(argv: Optional[List[str]] = None) -> int:
     p.add_argument("--json", type=Path, help="write the rows and the summary here")
     p.add_argument("--keep", type=Path,
                    help="keep each bus's store and checks' JSON in this folder (made if absent)")
+    p.add_argument("--model", action="store_true",
+                   help="register each bus's vehicle model file (its true geometry, masses and "
+                        "tyres, generic suspension: tools/busgen/update.py) before the baseline, "
+                        "for the suspension fitted per drive")
+    p.add_argument("--more", type=int, default=0, metavar="K",
+                   help="K more healthy drives per bus and a spring at 80 %% at each corner")
     p.add_argument("--test-extra", default="",
                    help="busgen options added to every checked drive, "
                         "e.g. --test-extra=--no-periodic")
@@ -201,7 +237,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         print(f"skipped: {e}")
         return 0
     seeds = h.draw_bus_seeds(a.buses, "fleet")
-    buses = measure(seeds, a.records, a.test_extra.split(), a.keep)
+    buses = measure(seeds, a.records, a.test_extra.split(), a.keep, a.model, a.more)
     summary = summarise(buses)
     print_summary(summary)
     if a.json:
@@ -210,7 +246,8 @@ def main(argv: Optional[List[str]] = None) -> int:
 
 
 def measure(seeds: List[int], n_records: int = h.RECORDS,
-            test_extra: Optional[List[str]] = None, keep: Optional[Path] = None) -> List[Dict]:
+            test_extra: Optional[List[str]] = None, keep: Optional[Path] = None,
+            model: bool = False, n_more: int = 0) -> List[Dict]:
     """Runs the buses of `seeds`; with `keep`, their stores and checks stay in that folder."""
     if keep is not None:
         keep.mkdir(parents=True, exist_ok=True)
@@ -219,7 +256,7 @@ def measure(seeds: List[int], n_records: int = h.RECORDS,
     try:
         for s in seeds:
             rng = random.Random(s * 7919 + n_records)
-            b = run_bus(s, n_records, work, rng, test_extra, keep is not None)
+            b = run_bus(s, n_records, work, rng, test_extra, keep is not None, model, n_more)
             for r in b["rows"]:
                 print_row(r)
             buses.append(b)

@@ -6,6 +6,10 @@ use vibmode_core::Num;
 
 use crate::error::{FleetError, Result};
 
+/// The band of the suspension fitted per drive, Hz: the fleet's default `[analysis.model_update]
+/// band_hz`.
+pub const SUSPENSION_BAND_HZ: [f64; 2] = [0.7, 5.0];
+
 /// Periods of the lowest band edge a record must span (4 periods of 0.5 Hz: 8 s).
 pub const MIN_PERIODS: f64 = 4.0;
 
@@ -78,6 +82,13 @@ impl Default for FleetConfig {
             // The features use the per-channel modes only: no multichannel identification.
             analysis: AnalysisConfig {
                 method: vibmode_core::IdentMethod::Arma.into(),
+                // The suspension fitted per drive (a registered vehicle model file): the body
+                // still rigid, the manoeuvres below (docs/fleet.md, "The suspension fitted per
+                // drive": healthy drives scattered least with 0.7-5 Hz on busgen's buses).
+                model_update: vibmode_core::BodyFitParams {
+                    band_hz: Some(SUSPENSION_BAND_HZ),
+                    ..vibmode_core::BodyFitParams::default()
+                },
                 ..AnalysisConfig::default()
             },
             bands_hz: vec![

@@ -205,6 +205,14 @@ pub enum FleetError {
         /// The baseline's channels, comma-separated.
         baseline: String,
     },
+    /// A vehicle model file that cannot be read or fitted.
+    #[error("vehicle model {}: {reason}; give a full-car model file as docs/vehicle.md describes (e.g. examples/city_bus.toml)", vibmode_core::quoted(source_name))]
+    VehicleModel {
+        /// The file (or where the text came from).
+        source_name: String,
+        /// What the parser or the fit said.
+        reason: String,
+    },
     /// A drive with too few records for its statistic.
     #[error("drive '{}' has {found} record(s); a drive's statistic (the median over its records) needs at least {needed}: give more records of the drive, or leave out --drive to check records one by one", vibmode_core::quoted(drive))]
     DriveTooShort {

@@ -95,6 +95,12 @@ pub struct RecordFeatures {
     /// before it existed (a model set is line-free only when all its nominal records are).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub line_free: Option<LineFree>,
+    /// The record's body equations for the suspension fitted per drive, made with the
+    /// vehicle's registered model file ([`crate::suspension`]); absent without one, in records
+    /// stored before it existed or registered, and when the record cannot give them (`notes`
+    /// says why).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub suspension: Option<crate::suspension::StoredEquations>,
 }
 
 /// A record's transmissibility with the bins of its periodic lines left out of the band sums
@@ -345,6 +351,7 @@ pub fn compute_features(name: &str, rec: &Recording, cfg: &FleetConfig) -> Resul
         body_spectra: None,
         sensor_faults: faults.clone(),
         line_free: Some(LineFree::default()),
+        suspension: None,
     };
     if healthy.channels.is_empty() {
         return Ok(only_faults("no working sensor: no feature".into()));
@@ -664,6 +671,7 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
         body_spectra: body,
         sensor_faults: Vec::new(),
         line_free: Some(line_free),
+        suspension: None,
     })
 }
 

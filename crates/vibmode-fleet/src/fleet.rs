@@ -11,9 +11,10 @@ use crate::config::FleetConfig;
 use crate::error::{FleetError, Result};
 use crate::features::{compute_features, RecordFeatures};
 use crate::model::{
-    assess, assess_drive, build_model_set, Assessment, Drive, ModelSet, MIN_DRIVE_RECORDS,
+    assess, assess_drive_fitted, build_model_set, Assessment, Drive, ModelSet, MIN_DRIVE_RECORDS,
 };
 use crate::store::{BatchItem, Condition, NewRecord, Store, Stored};
+use crate::suspension::{corner_scores, suspension_limit, SuspensionReference, VehicleModel};
 
 /// SHA-256 of bytes, lower-case hex.
 pub fn sha256_hex(bytes: &[u8]) -> String {
@@ -106,6 +107,61 @@ fn check_nominal_sensors(condition: Condition, name: &str, f: &RecordFeatures) -
     })
 }
 
+/// The vehicle's registered model file, parsed (none registered: `None`).
+pub fn registered_model(store: &Store, vehicle: &str) -> Result<Option<VehicleModel>> {
+    match store.vehicle_model(vehicle)? {
+        Some((_, text)) => Ok(Some(VehicleModel::from_toml(
+            &text,
+            &format!("registered for vehicle '{}'", vibmode_core::quoted(vehicle)),
+        )?)),
+        None => Ok(None),
+    }
+}
+
+/// Registers a vehicle's full-car model file (docs/vehicle.md), the vehicle created if new:
+/// records ingested or checked from now on carry their body equations, and the baseline and each
+/// drive fit the suspension to them ([`crate::suspension`]). The text is parsed and a fit of it
+/// made with the store's settings first; nothing is stored if either fails. Returns true when
+/// the file differs from the one registered before (a new baseline is then needed for the fit
+/// per drive).
+pub fn register_vehicle_model(
+    store: &mut Store,
+    vehicle: &str,
+    text: &str,
+    source: &str,
+) -> Result<bool> {
+    check_vehicle_id(vehicle)?;
+    let model = VehicleModel::from_toml(text, source)?;
+    let cfg = store.config()?;
+    model.check(&cfg.analysis, source)?;
+    store.register_vehicle_model(vehicle, text, &model.sha256)
+}
+
+/// Adds the record's body equations for the suspension fit to its features (or a note why not).
+fn add_equations(
+    features: &mut RecordFeatures,
+    rec: &Recording,
+    model: Option<&VehicleModel>,
+    cfg: &FleetConfig,
+) {
+    let Some(model) = model else {
+        return;
+    };
+    if !features.sensor_faults.is_empty() {
+        features
+            .notes
+            .push("suspension fit: no body equations from a record with a failed sensor".into());
+        return;
+    }
+    match model.record_equations(rec, &cfg.analysis) {
+        Ok(e) => features.suspension = Some(e),
+        Err(why) => features.notes.push(format!(
+            "suspension fit: no body equations ({})",
+            vibmode_core::cap_message(&why, 200)
+        )),
+    }
+}
+
 /// Features of a recording to be stored under `labels` (from the store when the vehicle
 /// already has its content).
 fn prepare_recording(
@@ -125,8 +181,14 @@ fn prepare_recording(
             known: true,
         });
     }
-    let features = compute_features(name, rec, cfg)?;
+    let mut features = compute_features(name, rec, cfg)?;
     check_nominal_sensors(labels.condition, name, &features)?;
+    add_equations(
+        &mut features,
+        rec,
+        registered_model(store, labels.vehicle)?.as_ref(),
+        cfg,
+    );
     Ok(Prepared {
         file: name.to_string(),
         sha256: sha256.to_string(),
@@ -239,6 +301,7 @@ fn prepare_files(
     layout: &dyn Fn(&str, &Recording) -> Result<()>,
     progress: &dyn Fn(usize),
 ) -> Result<Vec<Prepared>> {
+    let model = registered_model(store, labels.vehicle)?;
     let mut out: Vec<Prepared> = Vec::with_capacity(paths.len());
     for path in paths {
         if !out.is_empty() {
@@ -269,8 +332,9 @@ fn prepare_files(
         }
         let rec = vibmode_signal::read_path(path, opts)?;
         layout(&name, &rec)?;
-        let features = compute_features(&name, &rec, cfg)?;
+        let mut features = compute_features(&name, &rec, cfg)?;
         check_nominal_sensors(labels.condition, &name, &features)?;
+        add_equations(&mut features, &rec, model.as_ref(), cfg);
         out.push(Prepared {
             file: name,
             sha256: sha,
@@ -379,6 +443,27 @@ pub fn build_baseline(store: &mut Store, vehicle: &str, cfg: &FleetConfig) -> Re
     }
     let mut set = build_model_set(vehicle, &names, &feats, cfg)?;
     set.notes.extend(notes);
+    if let Some(model) = registered_model(store, vehicle)? {
+        let eqs: Vec<&vibmode_vehicle::update::RecordEquations> = feats
+            .iter()
+            .filter_map(|f| f.suspension.as_ref())
+            .filter(|e| e.model_sha256 == model.sha256)
+            .map(|e| &e.equations)
+            .collect();
+        match model.fit_corners(&cfg.analysis, &eqs) {
+            Ok(fit) => {
+                set.suspension = Some(SuspensionReference {
+                    model_sha256: model.sha256.clone(),
+                    fit,
+                    limit: suspension_limit(cfg.false_alarm_rate),
+                })
+            }
+            Err(why) => set.notes.push(format!(
+                "no suspension fit per drive: the nominal records' fit failed: {} (ingest nominal records after registering the vehicle model file)",
+                vibmode_core::cap_message(&why, 200)
+            )),
+        }
+    }
     store.save_model_set(&mut set)?;
     Ok(set)
 }
@@ -594,9 +679,17 @@ pub fn check_drive_files_progress(
             }
         }
     }
+    let suspension = if drive.is_some() || prepared.len() >= MIN_DRIVE_RECORDS {
+        drive_suspension(store, set, &prepared)?
+    } else {
+        (Vec::new(), None)
+    };
     let drive = (drive.is_some() || prepared.len() >= MIN_DRIVE_RECORDS).then(|| {
         let feats: Vec<&RecordFeatures> = prepared.iter().map(|p| &p.features).collect();
-        let assessment = assess_drive(set, &feats);
+        let mut assessment = assess_drive_fitted(set, &feats, &suspension.0);
+        if let Some(why) = &suspension.1 {
+            assessment.missing.push(why.clone());
+        }
         Drive {
             drive: drive.unwrap_or(DEFAULT_DRIVE_ID).to_string(),
             model_version: set.version,
@@ -612,6 +705,62 @@ pub fn check_drive_files_progress(
     });
     let checked = check_prepared_drive(store, set, prepared, drive.as_ref())?;
     Ok((checked, drive))
+}
+
+/// The suspension fitted to a drive's records and scored against the model set's, or why not
+/// (`None` and no scores when the vehicle has no registered model file and the model set no
+/// fitted suspension: nothing to say).
+fn drive_suspension(
+    store: &Store,
+    set: &ModelSet,
+    prepared: &[Prepared],
+) -> Result<(Vec<crate::suspension::CornerScore>, Option<String>)> {
+    let model = registered_model(store, &set.vehicle)?;
+    let (model, reference) = match (model, &set.suspension) {
+        (None, None) => return Ok((Vec::new(), None)),
+        (None, Some(_)) => {
+            return Ok((
+                Vec::new(),
+                Some("suspension fit: the vehicle has no registered model file".into()),
+            ))
+        }
+        (Some(_), None) => {
+            return Ok((
+                Vec::new(),
+                Some(format!(
+                    "suspension fit: model set version {} has no fitted suspension (build a baseline from nominal records ingested after registering the model file)",
+                    set.version
+                )),
+            ))
+        }
+        (Some(m), Some(r)) => (m, r),
+    };
+    if model.sha256 != reference.model_sha256 {
+        return Ok((
+            Vec::new(),
+            Some(format!(
+                "suspension fit: the vehicle's model file changed after model set version {} was built (build a new baseline)",
+                set.version
+            )),
+        ));
+    }
+    let eqs: Vec<&vibmode_vehicle::update::RecordEquations> = prepared
+        .iter()
+        .filter(|p| p.features.sensor_faults.is_empty())
+        .filter_map(|p| p.features.suspension.as_ref())
+        .filter(|e| e.model_sha256 == model.sha256)
+        .map(|e| &e.equations)
+        .collect();
+    match model.fit_corners(&set.config.analysis, &eqs) {
+        Ok(fit) => Ok((corner_scores(&reference.fit, &fit), None)),
+        Err(why) => Ok((
+            Vec::new(),
+            Some(format!(
+                "suspension fit: {}",
+                vibmode_core::cap_message(&why, 200)
+            )),
+        )),
+    }
 }
 
 /// Checks a file against `set` (stored as a test record unless already stored).

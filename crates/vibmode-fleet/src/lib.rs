@@ -18,6 +18,7 @@ pub mod model;
 pub mod report;
 pub mod stats;
 pub mod store;
+pub mod suspension;
 
 pub use body::{fit_body_model, BodyModel, BodySpectra};
 pub use config::FleetConfig;
@@ -29,13 +30,13 @@ pub use features::{
 pub use fleet::{
     build_baseline, check_drive_files_progress, check_file, check_files, check_files_progress,
     check_recording, check_vehicle_id, ingest_file, ingest_files, ingest_files_progress,
-    ingest_recording, record_file_name, recording_hash, require_baseline, sha256_hex, Checked,
-    IngestLabels, Ingested, DEFAULT_DRIVE_ID,
+    ingest_recording, record_file_name, recording_hash, register_vehicle_model, registered_model,
+    require_baseline, sha256_hex, Checked, IngestLabels, Ingested, DEFAULT_DRIVE_ID,
 };
 pub use model::{
-    assess, assess_drive, build_model_set, Assessment, Classification, Component, Drive, Evidence,
-    FeatureMeta, FeatureStat, Group, Kind, KindLimit, ModeSlot, ModelSet, Scores, LOO_MARGIN,
-    MIN_DRIVE_RECORDS,
+    assess, assess_drive, assess_drive_fitted, build_model_set, Assessment, Classification,
+    Component, Drive, Evidence, FeatureMeta, FeatureStat, Group, Kind, KindLimit, ModeSlot,
+    ModelSet, Scores, LOO_MARGIN, MIN_DRIVE_RECORDS,
 };
 #[cfg(feature = "report")]
 pub use report::write_fleet_report;

@@ -45,6 +45,11 @@ pub enum Kind {
     /// A sprung channel's measured power in a band over the power its record's own wheel
     /// motions predict through the nominal body response `H(f)`.
     BodyResponse,
+    /// A corner's spring fitted to a drive's records, relative to the other corners'
+    /// ([`crate::suspension`]; drives only).
+    SpringFit,
+    /// A corner's damper fitted to a drive's records, relative to the other corners'.
+    DamperFit,
 }
 
 /// Every kind, in the order of the model set's limits.
@@ -202,6 +207,11 @@ pub struct ModelSet {
     /// ([`FleetError::StaleBaseline`]).
     #[serde(default)]
     pub line_free: bool,
+    /// The suspension fitted to the nominal records together, when the vehicle has a
+    /// registered model file and at least three nominal records carry its equations
+    /// ([`crate::suspension`]); else absent and `notes` says why.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub suspension: Option<crate::suspension::SuspensionReference>,
 }
 
 impl ModelSet {
@@ -717,6 +727,8 @@ fn floor_of(kind: Kind, cfg: &FleetConfig) -> f64 {
         Kind::SideRatio => cfg.floor_side_ratio,
         Kind::TrackRatio => cfg.floor_track_ratio,
         Kind::BodyResponse => cfg.floor_body_response,
+        // Scored from the fits' own standard deviations, never from a spread.
+        Kind::SpringFit | Kind::DamperFit => 0.0,
     }
 }
 
@@ -941,6 +953,7 @@ pub fn build_model_set(
         body: body.map(|b| b.0),
         notes,
         line_free,
+        suspension: None,
     })
 }
 
@@ -973,7 +986,7 @@ pub fn assess(set: &ModelSet, rf: &RecordFeatures) -> Assessment {
         &set.config,
         set.line_free,
     );
-    let mut a = score_values(set, &values);
+    let mut a = score_values(set, &values, &[]);
     if !rf.sensor_faults.is_empty() {
         a.classification = Classification::Sensor;
         let faults: Vec<String> = rf.sensor_faults.iter().map(|f| f.to_string()).collect();
@@ -1007,6 +1020,17 @@ pub const MIN_DRIVE_RECORDS: usize = 3;
 /// fewer than [`MIN_DRIVE_RECORDS`] records left the drive is classed
 /// [`Classification::Sensor`].
 pub fn assess_drive(set: &ModelSet, records: &[&RecordFeatures]) -> Assessment {
+    assess_drive_fitted(set, records, &[])
+}
+
+/// As [`assess_drive`], with the drive's suspension scores against the model set's fitted
+/// suspension ([`crate::suspension::corner_scores`]): a score below minus the model set's
+/// suspension limit is vehicle evidence at its corner, naming the spring or the damper.
+pub fn assess_drive_fitted(
+    set: &ModelSet,
+    records: &[&RecordFeatures],
+    fitted: &[crate::suspension::CornerScore],
+) -> Assessment {
     let usable: Vec<&RecordFeatures> = records
         .iter()
         .copied()
@@ -1034,7 +1058,7 @@ pub fn assess_drive(set: &ModelSet, records: &[&RecordFeatures]) -> Assessment {
         .filter(|(_, xs)| xs.len() >= need)
         .filter_map(|(m, xs)| median(&xs).map(|x| (m, x)))
         .collect();
-    let mut a = score_values(set, &values);
+    let mut a = score_values(set, &values, fitted);
     let left_out = records.len() - usable.len();
     if left_out > 0 {
         let mut faults: Vec<String> = records
@@ -1069,7 +1093,51 @@ pub fn assess_drive(set: &ModelSet, records: &[&RecordFeatures]) -> Assessment {
     a
 }
 
-fn score_values(set: &ModelSet, values: &[(FeatureMeta, f64)]) -> Assessment {
+/// The evidence of a drive's suspension scores: every corner's spring and damper scored, those
+/// below minus the limit flagged.
+fn fitted_evidence(
+    set: &ModelSet,
+    fitted: &[crate::suspension::CornerScore],
+    scores: &mut Scores,
+) -> Vec<Evidence> {
+    let Some(reference) = &set.suspension else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for f in fitted {
+        let (kind, what) = match f.part {
+            crate::suspension::Part::Spring => (Kind::SpringFit, "spring"),
+            crate::suspension::Part::Damper => (Kind::DamperFit, "damper"),
+        };
+        scores.n_vehicle += 1;
+        scores.vehicle_max_abs_z = scores.vehicle_max_abs_z.max(f.z.abs());
+        if f.z < -reference.limit {
+            out.push(Evidence {
+                meta: FeatureMeta {
+                    key: format!("fit:{what}:{}", f.corner),
+                    group: Group::Vehicle,
+                    kind,
+                    corner: Some(f.corner),
+                    channel: String::new(),
+                    label: format!("{what} (fitted) vs the other corners"),
+                },
+                value: f.value,
+                centre: f.centre,
+                z: f.z,
+                change_pct: 100.0 * (f.value / f.centre - 1.0),
+                limit: reference.limit,
+                flagged: true,
+            });
+        }
+    }
+    out
+}
+
+fn score_values(
+    set: &ModelSet,
+    values: &[(FeatureMeta, f64)],
+    fitted: &[crate::suspension::CornerScore],
+) -> Assessment {
     let by_key: BTreeMap<&str, f64> = values.iter().map(|(m, v)| (m.key.as_str(), *v)).collect();
     let mut evidence = Vec::new();
     let mut missing = Vec::new();
@@ -1109,6 +1177,7 @@ fn score_values(set: &ModelSet, values: &[(FeatureMeta, f64)]) -> Assessment {
         }
     }
     attribute_ratios(set, values, &mut evidence);
+    evidence.extend(fitted_evidence(set, fitted, &mut scores));
     evidence.sort_by(|a, b| b.z.abs().total_cmp(&a.z.abs()));
     let vehicle = evidence.iter().any(|e| e.meta.group == Group::Vehicle);
     let road = evidence.iter().any(|e| e.meta.group == Group::Excitation);
@@ -1149,6 +1218,8 @@ fn corner_ratio_z(
 /// The component of the corner named first (that of the strongest flagged vehicle feature),
 /// from the flagged vehicle features of that corner:
 ///
+/// - the drive's fitted spring lowered (and no raised level ratio): the spring; its fitted
+///   damper lowered (and no lowered level ratio or wheel hop): the damper;
 /// - a level ratio at and above wheel hop read from the corner (after [`attribute_ratios`]):
 ///   lowered is the tyre (a softer tyre lowers the wheel hop and the wheel's response above
 ///   it), raised is the damper (a weaker damper lets the wheel move more at and above wheel
@@ -1188,6 +1259,14 @@ fn component(
     let body_lowered = at
         .iter()
         .any(|e| e.meta.kind == Kind::BodyResponse && e.z < 0.0);
+    // The suspension fitted to the drive names its part directly.
+    let fit_spring = at.iter().any(|e| e.meta.kind == Kind::SpringFit);
+    let fit_damper = at.iter().any(|e| e.meta.kind == Kind::DamperFit);
+    match (fit_spring, fit_damper) {
+        (true, false) if !damper => return Some(Component::Spring),
+        (false, true) if !tyre => return Some(Component::Damper),
+        _ => {}
+    }
     Some(match (tyre, damper) {
         (true, false) => Component::Tyre,
         (false, true) => Component::Damper,
@@ -1440,6 +1519,7 @@ mod tests {
             body_spectra: None,
             sensor_faults: Vec::new(),
             line_free: None,
+            suspension: None,
         }
     }
 
@@ -1746,6 +1826,7 @@ mod tests {
             body_spectra: Some(s),
             sensor_faults: Vec::new(),
             line_free: None,
+            suspension: None,
         }
     }
 
@@ -1848,6 +1929,7 @@ mod tests {
             body_spectra: None,
             sensor_faults: Vec::new(),
             line_free: None,
+            suspension: None,
         }
     }
 

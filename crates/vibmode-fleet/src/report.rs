@@ -305,6 +305,8 @@ fn trend_figure(html: &mut HtmlReport, set: &ModelSet, records: &[RecordEntry]) 
                 crate::model::Kind::SideRatio => "left / right unsprung RMS",
                 crate::model::Kind::TrackRatio => "front / rear unsprung RMS",
                 crate::model::Kind::BodyResponse => "measured / predicted sprung power",
+                crate::model::Kind::SpringFit => "fitted spring / other corners'",
+                crate::model::Kind::DamperFit => "fitted damper / other corners'",
             };
             Panel::new(title, "record (ingest order)", unit)
                 .with_series(band(1.0))

@@ -64,6 +64,13 @@ const MIGRATIONS: &[&str] = &[
         drive_id INTEGER NOT NULL REFERENCES drives(id) ON DELETE CASCADE,
         record_id INTEGER NOT NULL REFERENCES records(id) ON DELETE CASCADE,
         PRIMARY KEY (drive_id, record_id));",
+    // 3: a vehicle's full-car model file (`fleet register`), for the suspension fitted per
+    // drive; the text as given and its SHA-256, which each record's stored equations name.
+    "CREATE TABLE vehicle_models (
+        vehicle_id INTEGER PRIMARY KEY REFERENCES vehicles(id),
+        sha256 TEXT NOT NULL,
+        registered TEXT NOT NULL,
+        toml TEXT NOT NULL);",
 ];
 
 /// How long a write waits for another process's transaction before giving up.
@@ -546,6 +553,73 @@ impl Store {
                 })
             }
         }
+    }
+
+    /// Registers (or replaces) the full-car model file of a vehicle, created if new: its text
+    /// and SHA-256. Returns true when it differs from the one registered before (or there was
+    /// none).
+    pub fn register_vehicle_model(
+        &mut self,
+        vehicle: &str,
+        toml: &str,
+        sha256: &str,
+    ) -> Result<bool> {
+        let now = now_utc();
+        let path = self.path.clone();
+        let err = |e: rusqlite::Error| FleetError::Sql {
+            path: path.clone(),
+            operation: "registering a vehicle model",
+            reason: e.to_string(),
+        };
+        let tx = self
+            .conn
+            .transaction_with_behavior(TransactionBehavior::Immediate)
+            .map_err(err)?;
+        tx.execute(
+            "INSERT OR IGNORE INTO vehicles (name, created) VALUES (?1, ?2)",
+            params![vehicle, now],
+        )
+        .map_err(err)?;
+        let vid: i64 = tx
+            .query_row("SELECT id FROM vehicles WHERE name = ?1", [vehicle], |r| {
+                r.get(0)
+            })
+            .map_err(err)?;
+        let before: Option<String> = tx
+            .query_row(
+                "SELECT sha256 FROM vehicle_models WHERE vehicle_id = ?1",
+                [vid],
+                |r| r.get(0),
+            )
+            .optional()
+            .map_err(err)?;
+        let changed = before.as_deref() != Some(sha256);
+        if changed {
+            tx.execute(
+                "INSERT INTO vehicle_models (vehicle_id, sha256, registered, toml)
+                 VALUES (?1, ?2, ?3, ?4)
+                 ON CONFLICT (vehicle_id) DO UPDATE SET
+                    sha256 = excluded.sha256, registered = excluded.registered,
+                    toml = excluded.toml",
+                params![vid, sha256, now, toml],
+            )
+            .map_err(err)?;
+        }
+        tx.commit().map_err(err)?;
+        Ok(changed)
+    }
+
+    /// The registered full-car model file of a vehicle: (SHA-256, TOML text), if any.
+    pub fn vehicle_model(&self, vehicle: &str) -> Result<Option<(String, String)>> {
+        self.conn
+            .query_row(
+                "SELECT m.sha256, m.toml FROM vehicle_models m
+                 JOIN vehicles v ON v.id = m.vehicle_id WHERE v.name = ?1",
+                [vehicle],
+                |r| Ok((r.get(0)?, r.get(1)?)),
+            )
+            .optional()
+            .map_err(self.sql("reading a vehicle model"))
     }
 
     /// The vehicles other than `vehicle` that have a record with this content hash.
@@ -1203,6 +1277,7 @@ mod tests {
             body_spectra: None,
             sensor_faults: Vec::new(),
             line_free: None,
+            suspension: None,
         }
     }
 

@@ -1,0 +1,322 @@
+//! The suspension fitted per drive (docs/fleet.md, "The suspension fitted per drive").
+//!
+//! A vehicle with a registered full-car model file ([`crate::Store::register_vehicle_model`])
+//! gets, at ingest, each record's body equations ([`RecordEquations`], the model update of
+//! `vibmode analyze --vehicle`: generalized total least squares of the body's heave, pitch and
+//! roll rows, docs/model_update.md) kept with its features. The baseline fits its nominal
+//! records' equations together, a checked drive fits its own records', and per corner the
+//! fitted spring and damper relative to the other three corners, `ln k_c - mean_{j != c} ln
+//! k_j` (a change of load scales every corner alike and cancels), is compared with the
+//! baseline's. The score divides the change by the two fits' jackknife standard deviations (the
+//! corners taken as independent): `z = (r_drive - r_baseline) / sqrt(var_drive + var_baseline)`.
+//! A spring or damper that lost stiffness lowers its corner's `r`, so only a low score is an
+//! alarm; the limit is one-sided, Bonferroni over the 4 corners and the 2 components:
+//! `Phi^-1(1 - false_alarm_rate / 8)` (3.02 at 1 %). On busgen's buses the healthy drives'
+//! spring scores have an rms of 0.98-1.01 (roads B-C; tools/busgen/spring_fit.py), so the
+//! stated rate holds where the jackknife does.
+
+use serde::{Deserialize, Serialize};
+use vibmode_analysis::{AnalysisConfig, Corner};
+use vibmode_core::Recording;
+use vibmode_vehicle::update::{BodyFit, BodyFitResult, RecordEquations};
+use vibmode_vehicle::VehicleParams;
+
+use crate::error::{FleetError, Result};
+use crate::stats::normal_quantile;
+
+/// The corners in the order of the arrays of [`CornerFit`].
+pub const CORNERS: [Corner; 4] = [Corner::FL, Corner::FR, Corner::RL, Corner::RR];
+
+/// Fewest records a fit needs: the jackknife's standard deviations need three.
+pub const MIN_FIT_RECORDS: usize = 3;
+
+/// One-sided tests per fit: a spring and a damper at each of the four corners.
+pub const TESTS_PER_FIT: usize = 8;
+
+/// A vehicle's registered full-car model.
+#[derive(Clone, Debug)]
+pub struct VehicleModel {
+    /// SHA-256 of the file's text, which each record's equations name.
+    pub sha256: String,
+    /// The model.
+    pub params: VehicleParams,
+}
+
+impl VehicleModel {
+    /// Parses and validates a model file's text (`source` names it in errors).
+    pub fn from_toml(text: &str, source: &str) -> Result<Self> {
+        let params = VehicleParams::from_toml_str(text).map_err(|e| FleetError::VehicleModel {
+            source_name: source.to_string(),
+            reason: vibmode_core::cap_message(&e.to_string(), 240),
+        })?;
+        Ok(VehicleModel {
+            sha256: crate::fleet::sha256_hex(text.as_bytes()),
+            params,
+        })
+    }
+
+    /// A fit of this model with the analysis' `[model_update]` settings.
+    fn fit(&self, analysis: &AnalysisConfig) -> std::result::Result<BodyFit, String> {
+        BodyFit::new(&self.params, analysis.model_update.clone()).map_err(|e| e.to_string())
+    }
+
+    /// Checks that a fit of this model can be made with these settings (the band below the
+    /// records' Nyquist frequency is checked per record).
+    pub fn check(&self, analysis: &AnalysisConfig, source: &str) -> Result<()> {
+        self.fit(analysis)
+            .map(|_| ())
+            .map_err(|reason| FleetError::VehicleModel {
+                source_name: source.to_string(),
+                reason: vibmode_core::cap_message(&reason, 240),
+            })
+    }
+
+    /// A record's body equations, its channels placed as the analysis places them; the reason
+    /// as text when the record cannot give them (it is then kept as a note of the record).
+    pub fn record_equations(
+        &self,
+        rec: &Recording,
+        analysis: &AnalysisConfig,
+    ) -> std::result::Result<StoredEquations, String> {
+        let fit = self.fit(analysis)?;
+        let equations = fit
+            .record_equations_placed(rec, |c| analysis.placement_for_update(c))
+            .map_err(|e| e.to_string())?;
+        Ok(StoredEquations {
+            model_sha256: self.sha256.clone(),
+            equations,
+        })
+    }
+
+    /// The fit of records' equations together; the reason as text when it fails or has fewer
+    /// than [`MIN_FIT_RECORDS`] records.
+    pub fn fit_corners(
+        &self,
+        analysis: &AnalysisConfig,
+        equations: &[&RecordEquations],
+    ) -> std::result::Result<CornerFit, String> {
+        if equations.len() < MIN_FIT_RECORDS {
+            return Err(format!(
+                "{} record(s) with body equations of this model file, {MIN_FIT_RECORDS} needed",
+                equations.len()
+            ));
+        }
+        let mut fit = self.fit(analysis)?;
+        for e in equations {
+            fit.add_equations(e).map_err(|e| e.to_string())?;
+        }
+        let r = fit.solve().map_err(|e| e.to_string())?;
+        CornerFit::from_result(&r)
+    }
+}
+
+/// A record's body equations with the model file they were made with.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StoredEquations {
+    /// SHA-256 of the vehicle model file's text.
+    pub model_sha256: String,
+    /// The equations.
+    pub equations: RecordEquations,
+}
+
+/// The springs and dampers of one fit, per corner in the order of [`CORNERS`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CornerFit {
+    /// Records fitted.
+    pub records: usize,
+    /// Springs, N/m.
+    pub spring_n_per_m: [f64; 4],
+    /// Their relative standard deviations (jackknife over the records).
+    pub spring_rel_sd: [f64; 4],
+    /// Dampers, N s/m.
+    pub damper_n_s_per_m: [f64; 4],
+    /// Their relative standard deviations.
+    pub damper_rel_sd: [f64; 4],
+    /// Whether the model update calls the records' support of the whole fit sufficient (modes
+    /// to 1.5 %, springs and dampers to 5 %); the scores use the standard deviations either way.
+    pub supported: bool,
+}
+
+/// Spring or damper.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Part {
+    /// The corner's spring.
+    Spring,
+    /// The corner's damper.
+    Damper,
+}
+
+impl CornerFit {
+    fn from_result(r: &BodyFitResult) -> std::result::Result<Self, String> {
+        let mut out = CornerFit {
+            records: r.records,
+            spring_n_per_m: [0.0; 4],
+            spring_rel_sd: [0.0; 4],
+            damper_n_s_per_m: [0.0; 4],
+            damper_rel_sd: [0.0; 4],
+            supported: r.supported,
+        };
+        for (i, c) in CORNERS.iter().enumerate() {
+            for (p, value, sd) in [
+                (
+                    r.spring(*c),
+                    &mut out.spring_n_per_m[i],
+                    &mut out.spring_rel_sd[i],
+                ),
+                (
+                    r.damper(*c),
+                    &mut out.damper_n_s_per_m[i],
+                    &mut out.damper_rel_sd[i],
+                ),
+            ] {
+                let Some(p) = p else {
+                    return Err(format!("the fit has no {c} spring or damper"));
+                };
+                let Some(s) = p.sd.filter(|s| s.is_finite()) else {
+                    return Err(format!(
+                        "the fit's {} has no standard deviation (the fit fails without one of its records)",
+                        p.name
+                    ));
+                };
+                if !(p.value.is_finite() && p.value > 0.0) {
+                    return Err(format!("the fit's {} is {:.4e}", p.name, p.value));
+                }
+                *value = p.value;
+                *sd = s / p.value;
+            }
+        }
+        Ok(out)
+    }
+
+    fn values(&self, part: Part) -> (&[f64; 4], &[f64; 4]) {
+        match part {
+            Part::Spring => (&self.spring_n_per_m, &self.spring_rel_sd),
+            Part::Damper => (&self.damper_n_s_per_m, &self.damper_rel_sd),
+        }
+    }
+
+    /// Per corner `ln v_c - mean_{j != c} ln v_j` and its variance from the relative standard
+    /// deviations, the corners taken as independent.
+    pub fn relative(&self, part: Part) -> [(f64, f64); 4] {
+        let (v, sd) = self.values(part);
+        let ln: Vec<f64> = v.iter().map(|x| x.ln()).collect();
+        std::array::from_fn(|c| {
+            let others: f64 = (0..4).filter(|&j| j != c).map(|j| ln[j]).sum::<f64>() / 3.0;
+            let var = sd[c].powi(2)
+                + (0..4)
+                    .filter(|&j| j != c)
+                    .map(|j| sd[j].powi(2))
+                    .sum::<f64>()
+                    / 9.0;
+            (ln[c] - others, var)
+        })
+    }
+}
+
+/// The baseline's fit, kept in the model set.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SuspensionReference {
+    /// SHA-256 of the vehicle model file the fit used.
+    pub model_sha256: String,
+    /// The fit of the nominal records together.
+    pub fit: CornerFit,
+    /// The one-sided limit of the scores: `Phi^-1(1 - false_alarm_rate / 8)`.
+    pub limit: f64,
+}
+
+/// The limit of the suspension scores at this false-alarm rate per drive.
+pub fn suspension_limit(false_alarm_rate: f64) -> f64 {
+    -normal_quantile(false_alarm_rate / TESTS_PER_FIT as f64)
+}
+
+/// One corner's score of a drive's fit against the reference.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CornerScore {
+    /// The corner.
+    pub corner: Corner,
+    /// Spring or damper.
+    pub part: Part,
+    /// The drive's value relative to the other corners, `exp(r)`.
+    pub value: f64,
+    /// The baseline's.
+    pub centre: f64,
+    /// The score (negative: lower than at the baseline).
+    pub z: f64,
+}
+
+/// Every corner's spring and damper score of `drive` against `reference`.
+pub fn corner_scores(reference: &CornerFit, drive: &CornerFit) -> Vec<CornerScore> {
+    let mut out = Vec::with_capacity(TESTS_PER_FIT);
+    for part in [Part::Spring, Part::Damper] {
+        let (r, d) = (reference.relative(part), drive.relative(part));
+        for (i, corner) in CORNERS.iter().enumerate() {
+            let var = r[i].1 + d[i].1;
+            let z = if var > 0.0 {
+                (d[i].0 - r[i].0) / var.sqrt()
+            } else {
+                0.0
+            };
+            out.push(CornerScore {
+                corner: *corner,
+                part,
+                value: d[i].0.exp(),
+                centre: r[i].0.exp(),
+                z,
+            });
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fit(springs: [f64; 4], sd: f64) -> CornerFit {
+        CornerFit {
+            records: 8,
+            spring_n_per_m: springs,
+            spring_rel_sd: [sd; 4],
+            damper_n_s_per_m: [1.0e4; 4],
+            damper_rel_sd: [sd; 4],
+            supported: true,
+        }
+    }
+
+    #[test]
+    fn a_spring_at_80_percent_moves_its_corner_by_ln_08_and_the_others_by_a_third_less() {
+        // By hand: ln 0.8 = -0.2231 at RL; each other corner's mean of the others includes RL's
+        // -0.2231 / 3 = -0.0744, so theirs rises by 0.0744.
+        let base = fit([2.0e5; 4], 0.02);
+        let drive = fit([2.0e5, 2.0e5, 1.6e5, 2.0e5], 0.02);
+        let s = corner_scores(&base, &drive);
+        let rl = s
+            .iter()
+            .find(|x| x.corner == Corner::RL && x.part == Part::Spring)
+            .map(|x| x.value.ln());
+        assert!((rl.unwrap_or(0.0) - 0.8f64.ln()).abs() < 1e-12);
+        let fl = s
+            .iter()
+            .find(|x| x.corner == Corner::FL && x.part == Part::Spring)
+            .map(|x| x.value.ln());
+        assert!((fl.unwrap_or(0.0) + 0.8f64.ln() / 3.0).abs() < 1e-12);
+        // The variance: 0.02^2 (1 + 3/9) per fit, two fits: z = -0.2231 / sqrt(2 * 0.000533).
+        let z = s
+            .iter()
+            .find(|x| x.corner == Corner::RL && x.part == Part::Spring)
+            .map_or(0.0, |x| x.z);
+        let expect = 0.8f64.ln() / (2.0f64 * 0.0004 * (1.0 + 3.0 / 9.0)).sqrt();
+        assert!((z - expect).abs() < 1e-9, "{z} vs {expect}");
+        // A load change (every spring alike) moves no score.
+        let loaded = fit([2.3e5; 4], 0.02);
+        assert!(corner_scores(&base, &loaded)
+            .iter()
+            .all(|x| x.z.abs() < 1e-9));
+    }
+
+    #[test]
+    fn the_limit_is_one_sided_bonferroni_over_eight_tests() {
+        // Phi^-1(1 - 0.01 / 8) = 3.023 (scipy.stats.norm.isf(0.00125)).
+        assert!((suspension_limit(0.01) - 3.023_341_1).abs() < 1e-6);
+    }
+}
