@@ -371,3 +371,49 @@ fn a_bar_the_bus_does_not_have_comes_out_as_zero() {
     }
     eprintln!("front bar held at 0 on {held} of 6 seeds");
 }
+
+/// A record's equations kept (through JSON, as the fleet store keeps them) and added later give
+/// the very fit of the records added directly; equations of another vehicle file's unknowns
+/// (one anti-roll bar fewer) are refused.
+#[test]
+fn equations_kept_and_added_later_give_the_same_fit() {
+    let truth = changed(VehicleParams::city_bus());
+    let sp = SimParams {
+        road: RoadClass::C,
+        speed_kmh: 40.0,
+        fs_hz: 200.0,
+        records: 4,
+        seed: 11,
+        ..SimParams::default()
+    };
+    let sim = simulate(&truth, &sp).unwrap();
+    let file = VehicleParams::city_bus();
+    let mut direct = BodyFit::new(&file, BodyFitParams::default()).unwrap();
+    let mut later = BodyFit::new(&file, BodyFitParams::default()).unwrap();
+    for r in &sim.records {
+        direct.add_record(&r.recording).unwrap();
+        let eq = later.record_equations(&r.recording).unwrap();
+        let text = serde_json::to_string(&eq).unwrap();
+        let back: vibmode_vehicle::update::RecordEquations = serde_json::from_str(&text).unwrap();
+        later.add_equations(&back).unwrap();
+    }
+    assert_eq!(later.records(), 4);
+    let (a, b) = (direct.solve().unwrap(), later.solve().unwrap());
+    assert_eq!(a.parameters, b.parameters);
+    assert_eq!(a.equations, b.equations);
+    assert_eq!(a.noise_density, b.noise_density);
+    for c in Corner::ALL {
+        let (sa, sb) = (a.spring(c).unwrap(), b.spring(c).unwrap());
+        assert_eq!(sa, sb);
+        assert!(sa.sd.is_some(), "{c}: a spring's sd from 4 records");
+        assert!(a.damper(c).is_some());
+    }
+    // One bar fewer: one unknown fewer.
+    let mut no_front = file.clone();
+    no_front.front.anti_roll_stiffness_nm_per_rad = 0.0;
+    let mut other = BodyFit::new(&no_front, BodyFitParams::default()).unwrap();
+    let eq = direct.record_equations(&sim.records[0].recording).unwrap();
+    let e = other.add_equations(&eq).unwrap_err().to_string();
+    assert!(e.contains("unknowns"), "{e}");
+    assert_eq!(other.records(), 0);
+}
