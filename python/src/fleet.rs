@@ -20,6 +20,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fleet_init, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_settings, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_ingest, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet_register, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_baseline, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_check, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_status, m)?)?;
@@ -104,6 +105,24 @@ fn fleet_ingest(
         })
         .map_err(fleet_err)?;
     serde_json::to_string(&out).map_err(json_err)
+}
+
+/// Registers the vehicle's full-car model file (`vibmode fleet register`); returns whether it
+/// differs from the one registered before.
+#[pyfunction]
+fn fleet_register(py: Python<'_>, db: PathBuf, vehicle: &str, model: PathBuf) -> PyResult<bool> {
+    py.detach(|| {
+        let mut store = Store::open(&db)?;
+        let shown = model.display().to_string();
+        let text = vibmode_core::files::read_text_capped(&model).map_err(|e| {
+            FleetError::VehicleModel {
+                source_name: shown.clone(),
+                reason: e.to_string(),
+            }
+        })?;
+        vibmode_fleet::register_vehicle_model(&mut store, vehicle, &text, &shown)
+    })
+    .map_err(fleet_err)
 }
 
 /// Builds the vehicle's nominal model set; JSON of the `ModelSet`.

@@ -64,7 +64,9 @@ def measured():
 
     n = int(os.environ.get("VIBMODE_FLEET_BUSES", "1"))
     seeds = fleet.h.draw_bus_seeds(n, "fleet acceptance")
-    buses = fleet.measure(seeds)
+    # Each bus's model file registered (its true geometry, masses and tyres, generic
+    # suspension): the suspension fitted per drive is part of what is accepted.
+    buses = fleet.measure(seeds, model=True)
     summary = fleet.summarise(buses)
     fleet.print_summary(summary)
     summary["replay"] = "VIBMODE_BUS_SEEDS=" + ",".join(str(b) for b in seeds)

@@ -67,6 +67,15 @@ def ingest(
     )
 
 
+def register(db: PathLike, vehicle: str, model: PathLike) -> bool:
+    """Registers the vehicle's full-car model file (TOML, docs/vehicle.md), as `vibmode fleet
+    register`: records ingested or checked afterwards keep their body equations, and the
+    baseline and each checked drive fit the springs and dampers per corner to them
+    (docs/fleet.md, "The suspension fitted per drive"). Returns True when the file differs from
+    the one registered before (a new baseline is then needed)."""
+    return _native.fleet_register(os.fspath(db), vehicle, os.fspath(model))
+
+
 def baseline(db: PathLike, vehicle: str) -> Dict[str, Any]:
     """Builds the vehicle's nominal model set from its nominal records (at least 5); returns it."""
     return json.loads(_native.fleet_baseline(os.fspath(db), vehicle))
