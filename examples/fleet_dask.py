@@ -121,10 +121,12 @@ def analyze_record(
     with_features: bool = False,
     storage_options: Optional[Dict[str, Any]] = None,
     settings: Optional[Dict[str, Any]] = None,
+    model: Optional[str] = None,
 ) -> Dict[str, Any]:
     """The per-record task: analyse one recording, write OUT/modes/<record>.parquet, return its
     summary row (and its fleet-store features when asked, computed with the store's `settings`,
-    vibmode.fleet.settings(db))."""
+    vibmode.fleet.settings(db), and the vehicle's registered model file, vibmode.fleet.model(db,
+    vehicle), whose body equations `fleet ingest` keeps too)."""
     so = storage_options or {}
     t0 = time.perf_counter()
     # The record is named by its path or URL as listed (as `vibmode analyze` and `vibmode fleet
@@ -133,7 +135,11 @@ def analyze_record(
     name = url
     with local_copy(url, so) as path:
         res = vibmode.analyze(path, fs=fs_hz, as_frames=False, **analysis)
-        feats = vibmode.fleet.features(path, fs=fs_hz, settings=settings) if with_features else None
+        feats = (
+            vibmode.fleet.features(path, fs=fs_hz, settings=settings, model=model)
+            if with_features
+            else None
+        )
     if feats is not None:
         # Stored under the record as the user named it (as `vibmode fleet ingest` does), not
         # under the temporary copy of a remote file.
@@ -188,17 +194,19 @@ def run(
         raise ValueError("--store needs --vehicle ID")
     feats = store is not None
     settings = None
+    model = None
     if store is not None:
         # The store's settings (`vibmode fleet init --config`, or the defaults), read once here and
         # shipped to every task: the workers' features are then the ones `fleet ingest` stores.
         vibmode.fleet.init(store)
         settings = vibmode.fleet.settings(store)
+        model = vibmode.fleet.model(store, vehicle)
     if client is None:
-        results = [analyze_record(f, out, analysis, fs_hz, feats, so, settings) for f in files]
+        results = [analyze_record(f, out, analysis, fs_hz, feats, so, settings, model) for f in files]
     else:
         # A lambda is shipped by value (cloudpickle), with analyze_record inside it: the workers
         # need vibmode installed, not this script.
-        task = lambda url: analyze_record(url, out, analysis, fs_hz, feats, so, settings)  # noqa: E731
+        task = lambda url: analyze_record(url, out, analysis, fs_hz, feats, so, settings, model)  # noqa: E731
         futures = client.map(task, files, pure=False)
         results = client.gather(futures)
     records = pd.DataFrame([r["summary"] for r in results])

@@ -21,6 +21,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fleet_settings, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_ingest, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_register, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet_model, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_baseline, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_check, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_status, m)?)?;
@@ -125,6 +126,16 @@ fn fleet_register(py: Python<'_>, db: PathBuf, vehicle: &str, model: PathBuf) ->
     .map_err(fleet_err)
 }
 
+/// The vehicle's registered model file's text, if any (for the workers' [`fleet_features`]).
+#[pyfunction]
+fn fleet_model(py: Python<'_>, db: PathBuf, vehicle: &str) -> PyResult<Option<String>> {
+    py.detach(|| {
+        let store = Store::open(&db)?;
+        Ok::<_, FleetError>(store.vehicle_model(vehicle)?.map(|(_, text)| text))
+    })
+    .map_err(fleet_err)
+}
+
 /// Builds the vehicle's nominal model set; JSON of the `ModelSet`.
 #[pyfunction]
 fn fleet_baseline(py: Python<'_>, db: PathBuf, vehicle: &str) -> PyResult<String> {
@@ -206,7 +217,7 @@ struct FeaturesOut {
 /// without touching a store, with the settings `settings_json` (from [`fleet_settings`]; `None`:
 /// the defaults); JSON for [`fleet_store_features`].
 #[pyfunction]
-#[pyo3(signature = (path, fs=None, scale=1.0, unit=None, settings_json=None, allow_nonuniform=false, time_unit=None))]
+#[pyo3(signature = (path, fs=None, scale=1.0, unit=None, settings_json=None, allow_nonuniform=false, time_unit=None, model_toml=None))]
 #[allow(clippy::too_many_arguments)]
 fn fleet_features(
     py: Python<'_>,
@@ -217,8 +228,13 @@ fn fleet_features(
     settings_json: Option<&str>,
     allow_nonuniform: bool,
     time_unit: Option<&str>,
+    model_toml: Option<&str>,
 ) -> PyResult<String> {
     let cfg = settings_from_json(settings_json)?;
+    let model = model_toml
+        .map(|t| vibmode_fleet::suspension::VehicleModel::from_toml(t, "model"))
+        .transpose()
+        .map_err(fleet_err)?;
     let opts = read_options(fs, scale, unit, allow_nonuniform, time_unit)?;
     let out = py
         .detach(|| {
@@ -229,7 +245,8 @@ fn fleet_features(
             let sha256 = sha256_hex(&bytes);
             let rec = vibmode_signal::read_path(&path, &opts)?;
             let file = vibmode_fleet::record_file_name(&path);
-            let features = compute_features(&file, &rec, &cfg)?;
+            let mut features = compute_features(&file, &rec, &cfg)?;
+            vibmode_fleet::add_body_equations(&mut features, &rec, model.as_ref(), &cfg);
             Ok::<_, FleetError>(FeaturesOut {
                 file,
                 sha256,

@@ -13,6 +13,7 @@ import pytest
 import vibmode
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "fleet_dask.py"
+CITY_BUS = Path(__file__).resolve().parents[2] / "examples" / "city_bus.toml"
 
 distributed = pytest.importorskip("dask.distributed")
 pytest.importorskip("pyarrow")
@@ -46,8 +47,11 @@ def test_two_workers_equal_single_process(tmp_path):
     vibmode.simulate("city_bus", records=4, fs=200.0, effects="none", seed=11, out_dir=rec_dir)
     settings = {"order_max": 8}
     # Both stores with non-default settings: the workers must use them, not the defaults.
+    # And the vehicle's model file registered: the workers keep each record's body equations
+    # (the suspension fitted per drive) as `ingest` does.
     for db in ("single.db", "dask.db", "ingest.db"):
         vibmode.fleet.init(tmp_path / db, config=CONFIG_TOML)
+        assert vibmode.fleet.register(tmp_path / db, "bus-9", CITY_BUS)
 
     single = fd.run(str(rec_dir), str(tmp_path / "single"), None, settings,
                     store=str(tmp_path / "single.db"), vehicle="bus-9")
@@ -82,6 +86,7 @@ def test_two_workers_equal_single_process(tmp_path):
     by_ingest = stored_features(tmp_path / "ingest.db")
     by_workers = stored_features(tmp_path / "dask.db")
     assert len(by_ingest) == 4 and by_workers == by_ingest
+    assert all("suspension" in f for f in by_ingest.values()), by_ingest
     default = vibmode.fleet.features(files[0])["features"]
     # Records are stored under the path as given (run1/record_01.wav and run2/record_01.wav
     # stay apart), by the workers as by `ingest`.

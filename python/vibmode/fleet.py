@@ -76,6 +76,13 @@ def register(db: PathLike, vehicle: str, model: PathLike) -> bool:
     return _native.fleet_register(os.fspath(db), vehicle, os.fspath(model))
 
 
+def model(db: PathLike, vehicle: str) -> Optional[str]:
+    """The vehicle's registered model file's text (:func:`register`), or None: read once by the
+    client and passed to every worker's :func:`features` so that they keep the body equations
+    `fleet ingest` keeps."""
+    return _native.fleet_model(os.fspath(db), vehicle)
+
+
 def baseline(db: PathLike, vehicle: str) -> Dict[str, Any]:
     """Builds the vehicle's nominal model set from its nominal records (at least 5); returns it."""
     return json.loads(_native.fleet_baseline(os.fspath(db), vehicle))
@@ -120,6 +127,7 @@ def features(
     settings: Optional[Dict[str, Any]] = None,
     allow_nonuniform: bool = False,
     time_unit: Optional[str] = None,
+    model: Optional[str] = None,
 ) -> Dict[str, Any]:
     """What the store keeps of one file (band levels, transmissibility, modes), computed without
     a store: the expensive part of :func:`ingest`, to run on many workers (e.g. Dask). Returns a
@@ -130,14 +138,18 @@ def features(
 
     ``settings``: the store's settings, :func:`settings` ``(db)`` (read once, passed to every
     worker); None computes with the default settings, which differ from a store initialised
-    with other ones."""
+    with other ones. ``model``: the vehicle's registered model file's text, :func:`model`
+    ``(db, vehicle)``; with it the record's body equations for the suspension fitted per drive
+    are kept, as `fleet ingest` keeps them."""
     if settings is not None and not isinstance(settings, dict):
         raise ValueError(
             f"settings of type {type(settings).__name__}: pass the dict vibmode.fleet.settings(db) returns, or None"
         )
     text = None if settings is None else json.dumps(settings)
     return json.loads(
-        _native.fleet_features(os.fspath(path), fs, float(scale), unit, text, bool(allow_nonuniform), time_unit)
+        _native.fleet_features(
+            os.fspath(path), fs, float(scale), unit, text, bool(allow_nonuniform), time_unit, model
+        )
     )
 
 

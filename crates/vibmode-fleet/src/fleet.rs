@@ -137,8 +137,10 @@ pub fn register_vehicle_model(
     store.register_vehicle_model(vehicle, text, &model.sha256)
 }
 
-/// Adds the record's body equations for the suspension fit to its features (or a note why not).
-fn add_equations(
+/// Adds the record's body equations for the suspension fit to its features (or a note why not):
+/// what `ingest` adds when the vehicle has a registered model file ([`registered_model`]); the
+/// Python workers call it with the model the client read from the store.
+pub fn add_body_equations(
     features: &mut RecordFeatures,
     rec: &Recording,
     model: Option<&VehicleModel>,
@@ -183,7 +185,7 @@ fn prepare_recording(
     }
     let mut features = compute_features(name, rec, cfg)?;
     check_nominal_sensors(labels.condition, name, &features)?;
-    add_equations(
+    add_body_equations(
         &mut features,
         rec,
         registered_model(store, labels.vehicle)?.as_ref(),
@@ -334,7 +336,7 @@ fn prepare_files(
         layout(&name, &rec)?;
         let mut features = compute_features(&name, &rec, cfg)?;
         check_nominal_sensors(labels.condition, &name, &features)?;
-        add_equations(&mut features, &rec, model.as_ref(), cfg);
+        add_body_equations(&mut features, &rec, model.as_ref(), cfg);
         out.push(Prepared {
             file: name,
             sha256: sha,
