@@ -89,27 +89,39 @@ pub const QUOTE_CHARS_MAX: usize = 60;
 pub const MESSAGE_BYTES_MAX: usize = 400;
 
 /// User input (a cell, a name, an id, a path) for messages: at most [`QUOTE_CHARS_MAX`]
-/// characters, every control character, escape sequence or replacement character shown as `?`,
-/// and `...` where it was cut. A 2 MB cell or a terminal escape sequence never reaches the
+/// characters (a longer one: its first and last halves, so a path keeps its file name), every
+/// control character, escape sequence or replacement character shown as `?`, and `...` where it
+/// was cut. A 2 MB cell or a terminal escape sequence never reaches the
 /// terminal through an error.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Quoted<'a>(pub &'a str);
 
 impl fmt::Display for Quoted<'_> {
+    /// Longer than [`QUOTE_CHARS_MAX`]: its first and last characters (half each) around
+    /// `...`, so a long path keeps its file name.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let mut chars = self.0.chars();
-        for c in chars.by_ref().take(QUOTE_CHARS_MAX) {
-            let shown = if c.is_control() || c == char::REPLACEMENT_CHARACTER {
+        let shown = |c: char| {
+            if c.is_control() || c == char::REPLACEMENT_CHARACTER {
                 '?'
             } else {
                 c
-            };
-            write!(f, "{shown}")?;
+            }
+        };
+        let n = self.0.chars().count();
+        if n <= QUOTE_CHARS_MAX {
+            return self.0.chars().try_for_each(|c| write!(f, "{}", shown(c)));
         }
-        if chars.next().is_some() {
-            f.write_str("...")?;
-        }
-        Ok(())
+        let head = QUOTE_CHARS_MAX / 2;
+        let tail = QUOTE_CHARS_MAX - head;
+        self.0
+            .chars()
+            .take(head)
+            .try_for_each(|c| write!(f, "{}", shown(c)))?;
+        f.write_str("...")?;
+        self.0
+            .chars()
+            .skip(n - tail)
+            .try_for_each(|c| write!(f, "{}", shown(c)))
     }
 }
 
@@ -154,7 +166,16 @@ mod tests {
         assert_eq!(Quoted("bus-017").to_string(), "bus-017");
         assert_eq!(Quoted("a\u{1b}[31mb\n").to_string(), "a?[31mb?");
         let long = "x".repeat(10_000);
-        assert_eq!(Quoted(&long).to_string(), format!("{}...", "x".repeat(60)));
+        assert_eq!(
+            Quoted(&long).to_string(),
+            format!("{}...{}", "x".repeat(30), "x".repeat(30))
+        );
+        // A long path keeps its file name: 30 characters, `...`, the last 30.
+        let path = format!("/tmp/{}/record_01.wav", "d".repeat(80));
+        assert_eq!(
+            Quoted(&path).to_string(),
+            format!("/tmp/{}...{}/record_01.wav", "d".repeat(25), "d".repeat(16))
+        );
         assert_eq!(Quoted("\u{fffd}\u{fffd}").to_string(), "??");
     }
 
