@@ -211,24 +211,18 @@ fn ingest(a: &IngestArgs) -> Result<()> {
 
 fn register(db: &std::path::Path, vehicle: &str, model: &std::path::Path) -> Result<()> {
     let mut store = Store::open(db)?;
-    let text = vibmode_core::files::read_text_capped(model)
-        .map_err(|e| anyhow::anyhow!("vehicle model {}: {e}", model.display()))?;
-    let changed = vibmode_fleet::register_vehicle_model(
-        &mut store,
-        vehicle,
-        &text,
-        &model.display().to_string(),
-    )?;
-    let text = if changed {
-        format!(
-            "vehicle {vehicle}: model file {} registered; records ingested from now on keep their body equations for the suspension fit (ingest nominal records, then build the baseline)\n",
-            model.display()
-        )
-    } else {
-        format!(
-            "vehicle {vehicle}: model file {} already registered (unchanged)\n",
-            model.display()
-        )
+    let done = vibmode_fleet::register_vehicle_model_file(&mut store, vehicle, model)?;
+    let file = model.display();
+    let text = match done {
+        vibmode_fleet::Registered::New => format!(
+            "vehicle {vehicle}: model file {file} registered; records ingested or checked from now on keep their body equations for the suspension fitted per drive (ingest nominal records, then build the baseline)\n"
+        ),
+        vibmode_fleet::Registered::Unchanged => {
+            format!("vehicle {vehicle}: model file {file} already registered (unchanged)\n")
+        }
+        vibmode_fleet::Registered::Replaced => format!(
+            "vehicle {vehicle}: model file {file} registered in place of the one before; records' body equations made with the old file no longer count: ingest nominal records and build a new baseline for the suspension fitted per drive\n"
+        ),
     };
     crate::output::print_stdout(&text)
 }
@@ -344,6 +338,16 @@ fn check(a: &CheckArgs) -> Result<()> {
                 &d.assessment.summary
             }
         ));
+        // Why the suspension was not fitted to the drive, when the vehicle has a model file or
+        // the model set a fitted suspension: not a silent absence.
+        for m in d
+            .assessment
+            .missing
+            .iter()
+            .filter(|m| m.starts_with("suspension fit:"))
+        {
+            text.push_str(&format!("  note: {m}\n"));
+        }
     }
     match a.json.as_deref() {
         Some("-") => {

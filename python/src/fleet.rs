@@ -108,22 +108,22 @@ fn fleet_ingest(
     serde_json::to_string(&out).map_err(json_err)
 }
 
-/// Registers the vehicle's full-car model file (`vibmode fleet register`); returns whether it
-/// differs from the one registered before.
+/// Registers the vehicle's full-car model file (`vibmode fleet register`): "new", "unchanged"
+/// or "replaced".
 #[pyfunction]
-fn fleet_register(py: Python<'_>, db: PathBuf, vehicle: &str, model: PathBuf) -> PyResult<bool> {
-    py.detach(|| {
-        let mut store = Store::open(&db)?;
-        let shown = model.display().to_string();
-        let text = vibmode_core::files::read_text_capped(&model).map_err(|e| {
-            FleetError::VehicleModel {
-                source_name: shown.clone(),
-                reason: e.to_string(),
-            }
-        })?;
-        vibmode_fleet::register_vehicle_model(&mut store, vehicle, &text, &shown)
-    })
-    .map_err(fleet_err)
+fn fleet_register(py: Python<'_>, db: PathBuf, vehicle: &str, model: PathBuf) -> PyResult<String> {
+    let done = py
+        .detach(|| {
+            let mut store = Store::open(&db)?;
+            vibmode_fleet::register_vehicle_model_file(&mut store, vehicle, &model)
+        })
+        .map_err(fleet_err)?;
+    Ok(match done {
+        vibmode_fleet::Registered::New => "new",
+        vibmode_fleet::Registered::Unchanged => "unchanged",
+        _ => "replaced",
+    }
+    .to_string())
 }
 
 /// The vehicle's registered model file's text, if any (for the workers' [`fleet_features`]).

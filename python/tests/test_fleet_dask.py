@@ -51,7 +51,7 @@ def test_two_workers_equal_single_process(tmp_path):
     # (the suspension fitted per drive) as `ingest` does.
     for db in ("single.db", "dask.db", "ingest.db"):
         vibmode.fleet.init(tmp_path / db, config=CONFIG_TOML)
-        assert vibmode.fleet.register(tmp_path / db, "bus-9", CITY_BUS)
+        assert vibmode.fleet.register(tmp_path / db, "bus-9", CITY_BUS) == "new"
 
     single = fd.run(str(rec_dir), str(tmp_path / "single"), None, settings,
                     store=str(tmp_path / "single.db"), vehicle="bus-9")

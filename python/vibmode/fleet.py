@@ -67,12 +67,13 @@ def ingest(
     )
 
 
-def register(db: PathLike, vehicle: str, model: PathLike) -> bool:
+def register(db: PathLike, vehicle: str, model: PathLike) -> str:
     """Registers the vehicle's full-car model file (TOML, docs/vehicle.md), as `vibmode fleet
     register`: records ingested or checked afterwards keep their body equations, and the
     baseline and each checked drive fit the springs and dampers per corner to them
-    (docs/fleet.md, "The suspension fitted per drive"). Returns True when the file differs from
-    the one registered before (a new baseline is then needed)."""
+    (docs/fleet.md, "The suspension fitted per drive"). Returns ``"new"``, ``"unchanged"`` (the
+    same text was registered) or ``"replaced"`` (another file was: records' equations made with
+    it no longer count, and a new baseline is needed for the fit per drive)."""
     return _native.fleet_register(os.fspath(db), vehicle, os.fspath(model))
 
 

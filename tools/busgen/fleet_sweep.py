@@ -43,6 +43,7 @@ from typing import Dict, List, Optional, Tuple
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import fleet  # noqa: E402
 import harness as h  # noqa: E402
+import update  # noqa: E402
 
 #: fault -> (busgen option, the fleet.py condition whose corner and seed it takes, scales).
 FAULTS = {
@@ -106,7 +107,7 @@ def plan(bus_seed: int, n_records: int, scales: Dict[str, List[float]],
 
 
 def run_bus(bus_seed: int, n_records: int, work: Path, scales: Dict[str, List[float]],
-            n_healthy: int, simulate_only: bool = False) -> List[Dict]:
+            n_healthy: int, simulate_only: bool = False, model: bool = False) -> List[Dict]:
     """Baseline and every drive of one bus; one row per drive (none with `simulate_only`,
     which only fills the simulation cache)."""
     base_seed, drives = plan(bus_seed, n_records, scales, n_healthy)
@@ -123,6 +124,12 @@ def run_bus(bus_seed: int, n_records: int, work: Path, scales: Dict[str, List[fl
         db.unlink()
     vehicle = f"bus{bus_seed}"
     h.run_vibmode(["fleet", "init", "--db", db])
+    if model:
+        # The bus's model file (fleet.py --model): the suspension fitted per drive.
+        toml = work / f"bus{bus_seed}.toml"
+        toml.write_text(update.vehicle_toml(h.truth(h.simulate(bus_seed, base_seed,
+                                                               records=n_records)), True))
+        h.run_vibmode(["fleet", "register", "--db", db, "--vehicle", vehicle, toml])
     h.run_vibmode(["fleet", "ingest", "--db", db, "--vehicle", vehicle, "-q", *base])
     h.run_vibmode(["fleet", "baseline", "--db", db, "--vehicle", vehicle])
     rows = []
@@ -221,6 +228,9 @@ def main(argv: Optional[List[str]] = None) -> int:
     p.add_argument("--healthy", type=int, default=0,
                    help="healthy drives per bus beside fleet.py's")
     p.add_argument("--goal", type=float, default=0.9, help="share of drives found")
+    p.add_argument("--model", action="store_true",
+                   help="register each bus's model file first (fleet.py --model): the "
+                        "suspension fitted per drive")
     for fault, (_, _, sc) in FAULTS.items():
         p.add_argument(f"--scales-{fault}", type=scales_arg,
                        default=sc, help=f"{fault} scales (default {','.join(map(str, sc))})")
@@ -237,7 +247,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     rows: List[Dict] = []
     try:
         for s in seeds:
-            rows += run_bus(s, a.records, work, scales, a.healthy, a.simulate_only)
+            rows += run_bus(s, a.records, work, scales, a.healthy, a.simulate_only, a.model)
     finally:
         shutil.rmtree(work, ignore_errors=True)
     if a.simulate_only:

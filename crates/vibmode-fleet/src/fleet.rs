@@ -121,20 +121,52 @@ pub fn registered_model(store: &Store, vehicle: &str) -> Result<Option<VehicleMo
 /// Registers a vehicle's full-car model file (docs/vehicle.md), the vehicle created if new:
 /// records ingested or checked from now on carry their body equations, and the baseline and each
 /// drive fit the suspension to them ([`crate::suspension`]). The text is parsed and a fit of it
-/// made with the store's settings first; nothing is stored if either fails. Returns true when
-/// the file differs from the one registered before (a new baseline is then needed for the fit
-/// per drive).
+/// made with the store's settings first; nothing is stored if either fails.
 pub fn register_vehicle_model(
     store: &mut Store,
     vehicle: &str,
     text: &str,
     source: &str,
-) -> Result<bool> {
+) -> Result<Registered> {
     check_vehicle_id(vehicle)?;
     let model = VehicleModel::from_toml(text, source)?;
     let cfg = store.config()?;
     model.check(&cfg.analysis, source)?;
-    store.register_vehicle_model(vehicle, text, &model.sha256)
+    let before = store.vehicle_model(vehicle)?.is_some();
+    Ok(
+        match store.register_vehicle_model(vehicle, text, &model.sha256)? {
+            false => Registered::Unchanged,
+            true if before => Registered::Replaced,
+            true => Registered::New,
+        },
+    )
+}
+
+/// What registering a model file did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Registered {
+    /// The vehicle had no model file.
+    New,
+    /// The same text was registered before: nothing changed.
+    Unchanged,
+    /// Another file was registered before and is replaced: records' equations made with it no
+    /// longer count, and the model set's fitted suspension needs a new baseline.
+    Replaced,
+}
+
+/// [`register_vehicle_model`] of a file (at most 1 MiB of text).
+pub fn register_vehicle_model_file(
+    store: &mut Store,
+    vehicle: &str,
+    path: &Path,
+) -> Result<Registered> {
+    let shown = path.display().to_string();
+    let text =
+        vibmode_core::files::read_text_capped(path).map_err(|e| FleetError::VehicleModel {
+            source_name: shown.clone(),
+            reason: vibmode_core::cap_message(&e.to_string(), 160),
+        })?;
+    register_vehicle_model(store, vehicle, &text, &shown)
 }
 
 /// Adds the record's body equations for the suspension fit to its features (or a note why not):

@@ -31,8 +31,8 @@ pub use fleet::{
     add_body_equations, build_baseline, check_drive_files_progress, check_file, check_files,
     check_files_progress, check_recording, check_vehicle_id, ingest_file, ingest_files,
     ingest_files_progress, ingest_recording, record_file_name, recording_hash,
-    register_vehicle_model, registered_model, require_baseline, sha256_hex, Checked, IngestLabels,
-    Ingested, DEFAULT_DRIVE_ID,
+    register_vehicle_model, register_vehicle_model_file, registered_model, require_baseline,
+    sha256_hex, Checked, IngestLabels, Ingested, Registered, DEFAULT_DRIVE_ID,
 };
 pub use model::{
     assess, assess_drive, assess_drive_fitted, build_model_set, Assessment, Classification,
