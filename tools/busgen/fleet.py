@@ -168,7 +168,9 @@ def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
             dv = drives[0]
             drive = (dv["classification"], dv.get("corner") or first_corner(dv.get("evidence", [])),
                      dv.get("summary", ""), dv.get("component"))
+        susp = (drives[0].get("suspension") if drives else None)
         rows.append({"bus": bus_seed, "cond": cond["name"], "detail": cond["detail"],
+                     "suspension": susp,
                      "expect": cond["expect"], "corner": cond["corner"], "records": recs,
                      "drive": drive,
                      "record_ok": sum(verdict_ok(c, k, cond) for c, k, _ in recs),

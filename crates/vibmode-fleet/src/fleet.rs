@@ -716,11 +716,12 @@ pub fn check_drive_files_progress(
     let suspension = if drive.is_some() || prepared.len() >= MIN_DRIVE_RECORDS {
         drive_suspension(store, set, &prepared)?
     } else {
-        (Vec::new(), None)
+        (None, None)
     };
     let drive = (drive.is_some() || prepared.len() >= MIN_DRIVE_RECORDS).then(|| {
         let feats: Vec<&RecordFeatures> = prepared.iter().map(|p| &p.features).collect();
-        let mut assessment = assess_drive_fitted(set, &feats, &suspension.0);
+        let scores = suspension.0.as_ref().map_or(&[][..], |d| &d.scores[..]);
+        let mut assessment = assess_drive_fitted(set, &feats, scores);
         if let Some(why) = &suspension.1 {
             assessment.missing.push(why.clone());
         }
@@ -735,6 +736,7 @@ pub fn check_drive_files_progress(
                 .and_then(|e| e.meta.corner),
             false_alarm_rate: set.config.false_alarm_rate,
             assessment,
+            suspension: suspension.0.clone(),
         }
     });
     let checked = check_prepared_drive(store, set, prepared, drive.as_ref())?;
@@ -748,19 +750,19 @@ fn drive_suspension(
     store: &Store,
     set: &ModelSet,
     prepared: &[Prepared],
-) -> Result<(Vec<crate::suspension::CornerScore>, Option<String>)> {
+) -> Result<(Option<crate::suspension::DriveSuspension>, Option<String>)> {
     let model = registered_model(store, &set.vehicle)?;
     let (model, reference) = match (model, &set.suspension) {
-        (None, None) => return Ok((Vec::new(), None)),
+        (None, None) => return Ok((None, None)),
         (None, Some(_)) => {
             return Ok((
-                Vec::new(),
+                None,
                 Some("suspension fit: the vehicle has no registered model file".into()),
             ))
         }
         (Some(_), None) => {
             return Ok((
-                Vec::new(),
+                None,
                 Some(format!(
                     "suspension fit: model set version {} has no fitted suspension (build a baseline from nominal records ingested after registering the model file)",
                     set.version
@@ -771,7 +773,7 @@ fn drive_suspension(
     };
     if model.sha256 != reference.model_sha256 {
         return Ok((
-            Vec::new(),
+            None,
             Some(format!(
                 "suspension fit: the vehicle's model file changed after model set version {} was built (build a new baseline)",
                 set.version
@@ -786,9 +788,16 @@ fn drive_suspension(
         .map(|e| &e.equations)
         .collect();
     match model.fit_corners(&set.config.analysis, &eqs) {
-        Ok(fit) => Ok((corner_scores(&reference.fit, &fit), None)),
+        Ok(fit) => Ok((
+            Some(crate::suspension::DriveSuspension {
+                scores: corner_scores(&reference.fit, &fit),
+                fit,
+                limit: reference.limit,
+            }),
+            None,
+        )),
         Err(why) => Ok((
-            Vec::new(),
+            None,
             Some(format!(
                 "suspension fit: {}",
                 vibmode_core::cap_message(&why, 200)

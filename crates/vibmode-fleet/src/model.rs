@@ -1485,6 +1485,10 @@ pub struct Drive {
     /// The verdict from the medians of the features over the records.
     #[serde(flatten)]
     pub assessment: Assessment,
+    /// The suspension fitted to the drive's records and every corner's score, when the vehicle
+    /// has a registered model file and the model set a fitted suspension.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub suspension: Option<crate::suspension::DriveSuspension>,
 }
 
 #[cfg(test)]

@@ -138,7 +138,8 @@ pub struct CornerFit {
 }
 
 /// Spring or damper.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Part {
     /// The corner's spring.
     Spring,
@@ -230,7 +231,7 @@ pub fn suspension_limit(false_alarm_rate: f64) -> f64 {
 }
 
 /// One corner's score of a drive's fit against the reference.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CornerScore {
     /// The corner.
     pub corner: Corner,
@@ -242,6 +243,17 @@ pub struct CornerScore {
     pub centre: f64,
     /// The score (negative: lower than at the baseline).
     pub z: f64,
+}
+
+/// A drive's fitted suspension and every corner's score (kept with the drive's verdict).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DriveSuspension {
+    /// The fit of the drive's records.
+    pub fit: CornerFit,
+    /// Every corner's spring and damper score against the model set's fit.
+    pub scores: Vec<CornerScore>,
+    /// The limit the scores are compared with (flagged below minus it).
+    pub limit: f64,
 }
 
 /// Every corner's spring and damper score of `drive` against `reference`.
