@@ -100,6 +100,11 @@ fn a_spring_at_80_percent_is_named_by_the_fit_per_drive() {
     let healthy = simulate_csv(&d.path().join("healthy"), "B", "30", "21", "4");
     let dr = check_drive(db, &healthy);
     assert!(fit_evidence(&dr).is_empty(), "{dr}");
+    // Every corner's spring and damper score is kept, flagged or not.
+    let scores = dr["suspension"]["scores"].as_array().unwrap();
+    assert_eq!(scores.len(), 8, "{dr}");
+    assert!(scores.iter().all(|x| x["z"].as_f64().unwrap() > -3.02), "{dr}");
+    assert_eq!(dr["suspension"]["fit"]["records"], 4, "{dr}");
     assert!(
         dr["missing"]
             .as_array()
