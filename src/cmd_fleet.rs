@@ -261,6 +261,15 @@ fn baseline(db: &std::path::Path, vehicle: &str) -> Result<()> {
                 " (the fit's standard deviations exceed the model update's support limits: the scores use them as they are)"
             }
         ));
+        for (i, c) in vibmode_fleet::suspension::CORNERS.iter().enumerate() {
+            text.push_str(&format!(
+                "  {c}: spring {:.1} kN/m (sd {:.1} %), damper {:.2} kN s/m (sd {:.1} %)\n",
+                s.fit.spring_n_per_m[i] / 1e3,
+                100.0 * s.fit.spring_rel_sd[i],
+                s.fit.damper_n_s_per_m[i] / 1e3,
+                100.0 * s.fit.damper_rel_sd[i]
+            ));
+        }
     }
     for n in &set.notes {
         text.push_str(&format!("note: {n}\n"));

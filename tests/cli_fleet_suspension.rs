@@ -103,7 +103,10 @@ fn a_spring_at_80_percent_is_named_by_the_fit_per_drive() {
     // Every corner's spring and damper score is kept, flagged or not.
     let scores = dr["suspension"]["scores"].as_array().unwrap();
     assert_eq!(scores.len(), 8, "{dr}");
-    assert!(scores.iter().all(|x| x["z"].as_f64().unwrap() > -3.02), "{dr}");
+    assert!(
+        scores.iter().all(|x| x["z"].as_f64().unwrap() > -3.02),
+        "{dr}"
+    );
     assert_eq!(dr["suspension"]["fit"]["records"], 4, "{dr}");
     assert!(
         dr["missing"]
