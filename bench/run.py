@@ -228,6 +228,10 @@ def main():
             ls = py[case].get("_lambda_statsmodels")
             if lr is not None and ls is not None:
                 print(f"\n{case}: lambda vibmode {lr:.6e}, statsmodels (evaluated by the same predictor) {ls:.6e}, ratio {lr / ls:.5f}")
+    for case in rust:
+        if case.startswith("ssi_cov") and "_n_modes" in rust[case]:
+            print(f"\n{case}: {rust[case]['_n_modes']} modes (vibmode), "
+                  f"{py.get(case, {}).get('_n_modes_pyoma2', 'n/a')} (pyOMA2, its own correlation estimator)")
     cl = rust.get("cluster_poles", {})
     if "_n_poles" in cl:
         print(f"\ncluster_poles: {cl['_n_poles']} poles, {cl['_invariant_modes']} invariant modes (vibmode)")
