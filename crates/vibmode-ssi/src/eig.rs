@@ -390,22 +390,27 @@ fn blocks(t: &[f64], n: usize) -> Vec<(usize, usize)> {
     out
 }
 
+/// `|Re z| + |Im z|`: LAPACK's `cabs1`, the modulus within a factor sqrt(2) without `hypot`.
+fn cabs1(z: Complex64) -> f64 {
+    z.re.abs() + z.im.abs()
+}
+
 /// `m x = r` for a complex 2x2 `m` by Gaussian elimination with complete pivoting, a pivot
-/// below `small` in modulus replaced by `small` (as LAPACK's `dlaln2`): the solution of a
+/// below `small` in [`cabs1`] replaced by `small` (as LAPACK's `dlaln2`): the solution of a
 /// nearby system even when `m` is (nearly) singular, as it is at a (nearly) repeated
 /// eigenvalue. (Cramer's rule loses the direction there: its determinant cancels.)
 fn solve_2x2(m: [[Complex64; 2]; 2], r: [Complex64; 2], small: f64) -> [Complex64; 2] {
     let (mut pi, mut pj) = (0, 0);
     for (i, row) in m.iter().enumerate() {
         for (j, v) in row.iter().enumerate() {
-            if v.norm() > m[pi][pj].norm() {
+            if cabs1(*v) > cabs1(m[pi][pj]) {
                 (pi, pj) = (i, j);
             }
         }
     }
     let (oi, oj) = (1 - pi, 1 - pj);
     let floor = |z: Complex64| {
-        if z.norm() < small {
+        if cabs1(z) < small {
             Complex64::new(small, 0.0)
         } else {
             z
@@ -469,6 +474,8 @@ fn shaped_eigenvalues(
             x[k] = -dm;
             x[k + 1] = Complex64::new(c, 0.0);
         }
+        // The largest |re| + |im| of the entries solved so far.
+        let mut big = cabs1(x[k]).max(cabs1(x[k + 1]));
         // rhs = -T[..k, k..k+2] x[k..k+2]; then up through the blocks above, column by column.
         let rhs = &mut rhs[..k];
         for (i, e) in rhs.iter_mut().enumerate() {
@@ -477,7 +484,7 @@ fn shaped_eigenvalues(
         for &(j, sj) in blocks[..bi].iter().rev() {
             if sj == 1 {
                 let mut den = Complex64::new(tt(j, j), 0.0) - lambda;
-                if den.norm() < small {
+                if cabs1(den) < small {
                     den = Complex64::new(small, 0.0);
                 }
                 x[j] = rhs[j] / den;
@@ -504,11 +511,12 @@ fn shaped_eigenvalues(
                 }
             }
             // Keep the partial vector representable.
-            let big = x[j..].iter().fold(0.0f64, |m, v| m.max(v.norm()));
+            big = x[j..j + sj].iter().fold(big, |m, &v| m.max(cabs1(v)));
             if big > 1e100 {
                 for v in x[j..].iter_mut().chain(rhs[..j].iter_mut()) {
                     *v /= big;
                 }
+                big = 1.0;
             }
         }
         // C psi = G y.
