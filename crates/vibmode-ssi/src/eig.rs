@@ -38,6 +38,7 @@ pub(crate) fn kept_eigenvalues(
 ) -> Result<Vec<ShapedEigenvalue>, SsiError> {
     let n = a.nrows();
     let l = c.nrows();
+    debug_assert_eq!(c.ncols(), n, "C needs one column per state");
     let iterations = schur_iterations(n);
     let not_converged = SsiError::NotConverged {
         what: "Schur form of the state matrix A",
@@ -125,7 +126,8 @@ fn apply_right(x: &mut [f64], rows: usize, c0: usize, v: &[f64], tau: f64, w: &m
 
 /// Francis double-shift QR on the Hessenberg `t` (`n x n`, column-major) to real Schur form,
 /// the transformations also applied to the columns of `g` (`l x n`). On return the
-/// subdiagonal of `t` is nonzero exactly at the 2x2 blocks of complex conjugate eigenvalues.
+/// subdiagonal of `t` is nonzero exactly at the 2x2 blocks of complex conjugate eigenvalues;
+/// the entries below the subdiagonal are left as the sweeps left them (never read after).
 /// `false` when `max_sweeps` sweeps did not converge.
 fn francis(t: &mut [f64], nn: usize, g: &mut [f64], l: usize, max_sweeps: usize) -> bool {
     macro_rules! h {
@@ -155,7 +157,8 @@ fn francis(t: &mut [f64], nn: usize, g: &mut [f64], l: usize, max_sweeps: usize)
             if s == 0.0 {
                 s = norm;
             }
-            if h!(lo, lo - 1).abs() < eps * s {
+            // `<=` (as LAPACK): an exact zero deflates even where the diagonal is zero too.
+            if h!(lo, lo - 1).abs() <= eps * s {
                 h!(lo, lo - 1) = 0.0;
                 break;
             }
@@ -727,6 +730,43 @@ mod tests {
             }
             Err(e) => panic!("unexpected error {e}"),
             Ok(p) => panic!("NaN matrix gave {} eigenpairs", p.len()),
+        }
+    }
+
+    /// Matrices with exact zeros where the sweeps test for them: the zero matrix and a strictly
+    /// upper triangular one (every eigenvalue 0: nothing returned), and a matrix already in
+    /// real Schur form (rotation blocks on the diagonal, zeros between them, a zero block among
+    /// them): its pairs, exactly as its blocks give them, each shape `C` times the block's
+    /// eigenvector.
+    #[test]
+    fn exact_zeros_deflate() {
+        for n in [1, 2, 5] {
+            let c = DMatrix::identity(n, n);
+            assert!(kept_eigenvalues(&DMatrix::zeros(n, n), &c, all)
+                .unwrap()
+                .is_empty());
+            let upper =
+                DMatrix::from_fn(n, n, |r, k| if k > r { 1.0 + (r + k) as f64 } else { 0.0 });
+            assert!(kept_eigenvalues(&upper, &c, all).unwrap().is_empty());
+        }
+        let mut t = DMatrix::zeros(6, 6);
+        for (k, (re, im)) in [(0, (0.5, 0.25)), (4, (-0.25, 0.75))] {
+            t[(k, k)] = re;
+            t[(k, k + 1)] = -im;
+            t[(k + 1, k)] = im;
+            t[(k + 1, k + 1)] = re;
+        }
+        let got = kept_eigenvalues(&t, &DMatrix::identity(6, 6), all).unwrap();
+        let lambdas: Vec<Complex64> = got.iter().map(|p| p.lambda).collect();
+        assert_eq!(
+            lambdas,
+            vec![Complex64::new(0.5, 0.25), Complex64::new(-0.25, 0.75)]
+        );
+        for (p, k) in got.iter().zip([0, 4]) {
+            let mut want = vec![Complex64::new(0.0, 0.0); 6];
+            want[k] = Complex64::new(1.0, 0.0);
+            want[k + 1] = Complex64::new(0.0, -1.0);
+            assert!(shape_distance(&p.shape, &want) < 1e-15, "{:?}", p.shape);
         }
     }
 
