@@ -3,12 +3,13 @@
 
 Usage (from the repository root):
     python3 -m pip install -r tools/reference/requirements.txt
-    python3 bench/run.py [--quick] [--out bench-results.json]
+    python3 bench/run.py [--quick] [--out bench-results.json] [--only ssi_cov] [--ssi-demo]
 
 What it does, in one run:
 1. builds `vibmode-bench` in release mode;
 2. `vibmode-bench gen DIR` writes the shared inputs (a 7-channel 204 800-row CSV, the ARMA data);
 3. `vibmode-bench run DIR` times vibmode's kernels and prints medians as JSON;
+   (with --ssi-demo, SSI-cov also on `vibmode demo`'s 8 records brought to 50 Hz, see demo_ssi_input);
 4. times the Python peers on the same inputs in this process;
 5. prints a Markdown table (median seconds and vibmode/peer ratios) for BENCHMARKS.md.
 Medians over repeated runs; wall-clock time on whatever machine runs it.
@@ -40,6 +41,36 @@ def median_time(fn, repeat, min_time=0.0):
     return statistics.median(times)
 
 
+# SSI inputs (file in the data folder, case name), as bench/src/main.rs's SSI_CASES: the generated
+# case, and the demo's records at 50 Hz when --ssi-demo wrote them.
+SSI_CASES = [("ssi_8x7x512.f64", "ssi_cov_8x7x512_br20_orders2-60"),
+             ("ssi_demo50_8x7x512.f64", "ssi_cov_demo50_8x7x512_br20_orders2-60")]
+
+
+def demo_ssi_input(root, target, data_dir):
+    """The 8 records of `vibmode demo` (7 channels, 10.24 s at 20 kHz) brought to 50 Hz by
+    `vibmode resample --fs-out 50` (the ideal DFT low-pass, as the analysis does): 512 samples each,
+    written record-major, channel-major as data_dir/ssi_demo50_8x7x512.f64 (the layout of the
+    generated SSI case)."""
+    subprocess.run(["cargo", "build", "--release", "-q", "--bin", "vibmode"], cwd=root, check=True)
+    exe = os.path.join(target, "release", "vibmode")
+    demo = os.path.join(data_dir, "demo")
+    subprocess.run([exe, "demo", "-q", "--keep-records", "-o", demo], check=True, capture_output=True)
+    recs = sorted(f for f in os.listdir(os.path.join(demo, "records")) if f.endswith(".wav"))
+    out = []
+    for f in recs:
+        dst = os.path.join(demo, f[:-4] + "_50hz.f64")
+        subprocess.run([exe, "resample", "-q", os.path.join(demo, "records", f), "--fs-out", "50", "-o", dst],
+                       check=True, capture_output=True)
+        x = np.fromfile(dst, dtype="<f8").reshape(-1, 7)  # interleaved frames
+        if x.shape != (512, 7):
+            raise SystemExit(f"{f} at 50 Hz has shape {x.shape}, expected (512, 7)")
+        out.append(x.T)
+    if len(out) != 8:
+        raise SystemExit(f"vibmode demo wrote {len(out)} records, expected 8")
+    np.ascontiguousarray(np.stack(out)).astype("<f8").tofile(os.path.join(data_dir, SSI_CASES[1][0]))
+
+
 def ssi_peer(data_dir, meta, quick):
     res = {}
     # SSI-cov: pyOMA2's functions (as its SSI class with method "cov" calls them) on the same
@@ -51,22 +82,24 @@ def ssi_peer(data_dir, meta, quick):
         from pyoma2.functions import ssi as pyssi
         logging.disable(logging.CRITICAL)
         m = meta["ssi"]
-        data = np.fromfile(os.path.join(data_dir, "ssi_8x7x512.f64"), dtype="<f8").reshape(
-            m["records"], m["channels"], m["samples"])
         br, om, st, dt = m["block_rows"], m["order_max"], m["order_step"], 1.0 / m["fs_hz"]
+        for file, case in SSI_CASES:
+            path = os.path.join(data_dir, file)
+            if not os.path.exists(path):
+                continue
+            data = np.fromfile(path, dtype="<f8").reshape(m["records"], m["channels"], m["samples"])
 
-        def pyoma2_ssi():
-            n = 0
-            for y in data:
-                h, _ = pyssi.build_hank(y, y, br, "cov")
-                obs, a, c, _ = pyssi.SSI_fast(h, br, om, step=st)
-                fn, *_ = pyssi.SSI_poles(obs, a, c, om, dt, step=st, HC=True, xi_max=1.0)
-                n += int(np.sum(~np.isnan(fn)))
-            return n
+            def pyoma2_ssi():
+                n = 0
+                for y in data:
+                    h, _ = pyssi.build_hank(y, y, br, "cov")
+                    obs, a, c, _ = pyssi.SSI_fast(h, br, om, step=st)
+                    fn, *_ = pyssi.SSI_poles(obs, a, c, om, dt, step=st, HC=True, xi_max=1.0)
+                    n += int(np.sum(~np.isnan(fn)))
+                return n
 
-        case = "ssi_cov_8x7x512_br20_orders2-60"
-        res[case] = {"pyOMA2 1.4 SSI-cov (build_hank cov + SSI_fast + SSI_poles)": median_time(pyoma2_ssi, 1 if quick else 3),
-                     "_n_modes_pyoma2": pyoma2_ssi()}
+            res[case] = {"pyOMA2 1.4 SSI-cov (build_hank cov + SSI_fast + SSI_poles)": median_time(pyoma2_ssi, 1 if quick else 3),
+                         "_n_modes_pyoma2": pyoma2_ssi()}
         import importlib.metadata
         res.setdefault("_versions", {})["pyoma2"] = importlib.metadata.version("pyoma-2")
     except ImportError as e:
@@ -157,6 +190,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="fewer repetitions")
     ap.add_argument("--out", default=None, help="also write all figures to this JSON file")
+    ap.add_argument("--ssi-demo", action="store_true",
+                    help="also time SSI-cov on the 8 records of `vibmode demo` brought to 50 Hz (builds the vibmode binary)")
     ap.add_argument("--only", default=None,
                     help="only the cases whose name starts with this (e.g. ssi_cov): other peers are not run")
     args = ap.parse_args()
@@ -166,6 +201,8 @@ def main():
     exe = os.path.join(target, "release", "vibmode-bench")
     with tempfile.TemporaryDirectory() as d:
         subprocess.run([exe, "gen", d], check=True)
+        if args.ssi_demo:
+            demo_ssi_input(root, target, d)
         out = subprocess.run([exe, "run", d] + (["--quick"] if args.quick else []), check=True, capture_output=True, text=True)
         rust = json.loads(out.stdout)
         py = peers(d, args.quick, args.only)
@@ -191,6 +228,10 @@ def main():
             ls = py[case].get("_lambda_statsmodels")
             if lr is not None and ls is not None:
                 print(f"\n{case}: lambda vibmode {lr:.6e}, statsmodels (evaluated by the same predictor) {ls:.6e}, ratio {lr / ls:.5f}")
+    for case in rust:
+        if case.startswith("ssi_cov") and "_n_modes" in rust[case]:
+            print(f"\n{case}: {rust[case]['_n_modes']} modes (vibmode), "
+                  f"{py.get(case, {}).get('_n_modes_pyoma2', 'n/a')} (pyOMA2, its own correlation estimator)")
     cl = rust.get("cluster_poles", {})
     if "_n_poles" in cl:
         print(f"\ncluster_poles: {cl['_n_poles']} poles, {cl['_invariant_modes']} invariant modes (vibmode)")

@@ -242,6 +242,47 @@ fn median_time<F: FnMut() -> Result<()>>(repeat: usize, mut f: F) -> Result<f64>
     Ok(vibmode_core::stats::median_high_in_place(&mut t))
 }
 
+/// The SSI inputs (file in the data folder, case name): the generated one (always written by
+/// `gen`), then the demo's 8 records at 50 Hz (written by `bench/run.py --ssi-demo` only).
+const SSI_CASES: [(&str, &str); 2] = [
+    ("ssi_8x7x512.f64", "ssi_cov_8x7x512_br20_orders2-60"),
+    (
+        "ssi_demo50_8x7x512.f64",
+        "ssi_cov_demo50_8x7x512_br20_orders2-60",
+    ),
+];
+
+/// Median time of `vibmode_ssi::ssi_cov` over the 8 records of `ssi` (record-major, each
+/// channel-major, 7 x 512 at 50 Hz), block rows 20, orders 2..=60 step 2; and the modes found.
+fn time_ssi(ssi: &[f64], quick: bool) -> Result<(f64, usize)> {
+    if ssi.len() != SSI_RECORDS * SSI_CHANNELS * SSI_SAMPLES {
+        bail!(
+            "SSI input has {} values, expected {SSI_RECORDS} x {SSI_CHANNELS} x {SSI_SAMPLES}",
+            ssi.len()
+        );
+    }
+    let ssi_params = vibmode_ssi::SsiParams {
+        block_rows: SSI_BLOCK_ROWS,
+        order_min: 2,
+        order_max: SSI_ORDER_MAX,
+        order_step: 2,
+        reference_channels: None,
+        pool_records: false,
+        first_lag: 1,
+    };
+    let mut n_ssi_modes = 0;
+    let t_ssi = median_time(if quick { 3 } else { 11 }, || {
+        n_ssi_modes = 0;
+        for record in ssi.chunks_exact(SSI_CHANNELS * SSI_SAMPLES) {
+            let ch: Vec<&[f64]> = record.chunks_exact(SSI_SAMPLES).collect();
+            let res = vibmode_ssi::ssi_cov(&ch, SSI_FS_HZ, &ssi_params)?;
+            n_ssi_modes += res.orders.iter().map(|o| o.modes.len()).sum::<usize>();
+        }
+        Ok(())
+    })?;
+    Ok((t_ssi, n_ssi_modes))
+}
+
 fn run(dir: &Path, quick: bool) -> Result<Value> {
     let r = if quick { 3 } else { 15 };
     let mut out = Map::new();
@@ -329,31 +370,20 @@ fn run(dir: &Path, quick: bool) -> Result<Value> {
         "cluster_poles".into(),
         json!({"vibmode_modal::analyse_poles": t_cl, "_n_poles": poles.len(), "_invariant_modes": n_modes}),
     );
-    // SSI-cov of 8 records x 7 channels x 512 samples, block rows 20, orders 2..=60 step 2.
-    let ssi = read_f64(&dir.join("ssi_8x7x512.f64"))?;
-    let ssi_params = vibmode_ssi::SsiParams {
-        block_rows: SSI_BLOCK_ROWS,
-        order_min: 2,
-        order_max: SSI_ORDER_MAX,
-        order_step: 2,
-        reference_channels: None,
-        pool_records: false,
-        first_lag: 1,
-    };
-    let mut n_ssi_modes = 0;
-    let t_ssi = median_time(if quick { 3 } else { 11 }, || {
-        n_ssi_modes = 0;
-        for record in ssi.chunks_exact(SSI_CHANNELS * SSI_SAMPLES) {
-            let ch: Vec<&[f64]> = record.chunks_exact(SSI_SAMPLES).collect();
-            let res = vibmode_ssi::ssi_cov(&ch, SSI_FS_HZ, &ssi_params)?;
-            n_ssi_modes += res.orders.iter().map(|o| o.modes.len()).sum::<usize>();
+    // SSI-cov of 8 records x 7 channels x 512 samples, block rows 20, orders 2..=60 step 2: the
+    // generated case, and the demo's records brought to 50 Hz when `bench/run.py --ssi-demo`
+    // has written them.
+    for (file, case) in SSI_CASES {
+        let path = dir.join(file);
+        if case != SSI_CASES[0].1 && !path.exists() {
+            continue;
         }
-        Ok(())
-    })?;
-    out.insert(
-        "ssi_cov_8x7x512_br20_orders2-60".into(),
-        json!({"vibmode_ssi::ssi_cov": t_ssi, "_n_modes": n_ssi_modes}),
-    );
+        let (t_ssi, n_ssi_modes) = time_ssi(&read_f64(&path)?, quick)?;
+        out.insert(
+            case.into(),
+            json!({"vibmode_ssi::ssi_cov": t_ssi, "_n_modes": n_ssi_modes}),
+        );
+    }
     // ARMA fits, quadratic criterion (as statsmodels), N = 2048.
     for p in ARMA_ORDERS {
         let y = read_f64(&dir.join(format!("arma{p}.f64")))?;

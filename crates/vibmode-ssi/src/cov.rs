@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use vibmode_core::limits::{SSI_SAMPLES_PER_LAG_MIN, SSI_TOEPLITZ_ROWS_MAX};
 use vibmode_core::SsiParams;
 
-use crate::eig::complex_eigenpairs;
+use crate::eig::kept_eigenvalues;
 use crate::error::SsiError;
 use crate::shape::mpc;
 
@@ -502,11 +502,31 @@ fn lag_sums(
             for (b, &rb) in refs.iter().enumerate() {
                 let fut = &ya[ts.start + k..t1 + k];
                 let past = &y[rb][ts.start..t1];
-                sum[(a, b)] += fut.iter().zip(past).map(|(x, v)| x * v).sum::<f64>();
+                sum[(a, b)] += dot(fut, past);
             }
         }
     }
     (sums, counts)
+}
+
+/// Dot product with four accumulators (accumulator k sums the products at indices `4 i + k`;
+/// the chunks of four share SIMD registers), as `vibmode-ident`'s: about 4x faster than one
+/// running sum, whose every addition waits for the previous one.
+fn dot(x: &[f64], z: &[f64]) -> f64 {
+    let n = x.len().min(z.len());
+    let (xc, zc) = (x[..n].chunks_exact(4), z[..n].chunks_exact(4));
+    let (xr, zr) = (xc.remainder(), zc.remainder());
+    let mut s = [0.0f64; 4];
+    for (a, b) in xc.zip(zc) {
+        for k in 0..4 {
+            s[k] += a[k] * b[k];
+        }
+    }
+    let mut tail = 0.0;
+    for (a, b) in xr.iter().zip(zr) {
+        tail += a * b;
+    }
+    (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
 /// The jackknife standard deviation of an estimate from its leave-one-out values `theta`
@@ -704,33 +724,37 @@ impl SsiCov {
             });
         }
         let dim = i * l;
-        let o = observability(&self.u, &self.singular_values, dim, order);
         let a = match self.shift_from_full_qr(order) {
             Some(a) => a,
             None => {
+                let o = observability(&self.u, &self.singular_values, dim, order);
                 let rows = dim - l;
                 least_squares(o.rows(0, rows).into_owned(), &o.rows(l, rows).into_owned())?
             }
         };
-        let c = o.rows(0, l).into_owned();
-        let pairs = complex_eigenpairs(a)?;
-        let mut modes: Vec<SsiMode> = pairs
+        let c = observability(&self.u, &self.singular_values, l, order);
+        let fs_hz = self.fs_hz;
+        let pole = |lambda: Complex64| {
+            let s = lambda.ln() * fs_hz;
+            let abs = s.norm();
+            (abs, -s.re / abs)
+        };
+        let kept = kept_eigenvalues(&a, &c, |lambda| {
+            let (abs, damping_ratio) = pole(lambda);
+            abs.is_finite() && abs > 0.0 && damping_ratio > 0.0
+        })?;
+        let mut modes: Vec<SsiMode> = kept
             .into_iter()
-            .filter_map(|p| {
-                let s = p.lambda.ln() * self.fs_hz;
-                let abs = s.norm();
-                let damping_ratio = -s.re / abs;
-                if !(abs.is_finite() && abs > 0.0 && damping_ratio > 0.0) {
-                    return None;
-                }
-                let shape = normalised_shape(&c, &p.vector);
+            .map(|k| {
+                let (abs, damping_ratio) = pole(k.lambda);
+                let shape = normalised_shape(&k.shape);
                 let mpc = mpc(&shape);
-                Some(SsiMode {
+                SsiMode {
                     frequency_hz: abs / (2.0 * std::f64::consts::PI),
                     damping_ratio,
                     shape,
                     mpc,
-                })
+                }
             })
             .collect();
         modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
@@ -782,15 +806,7 @@ fn observability(u: &DMatrix<f64>, singular_values: &[f64], rows: usize, n: usiz
 }
 
 /// `C psi`, scaled so that its entry of largest modulus is `1 + 0i` (left as is when zero).
-fn normalised_shape(c: &DMatrix<f64>, psi: &[Complex64]) -> Vec<[f64; 2]> {
-    let phi: Vec<Complex64> = (0..c.nrows())
-        .map(|r| {
-            psi.iter()
-                .enumerate()
-                .map(|(m, v)| *v * c[(r, m)])
-                .sum::<Complex64>()
-        })
-        .collect();
+fn normalised_shape(phi: &[Complex64]) -> Vec<[f64; 2]> {
     let pivot = phi
         .iter()
         .copied()
