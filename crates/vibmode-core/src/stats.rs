@@ -1,6 +1,7 @@
 //! The one median every layer uses (spectra, identification, clustering, lines, segmentation,
 //! fleet): mean of the two middle values for an even count, NaN for no value; and the high
-//! median (the larger middle value) where the level must be an observed value.
+//! median (the larger middle value) where the level must be an observed value; and the dot
+//! product the fits' inner loops share ([`dot`]).
 //!
 //! Values are ordered by [`f64::total_cmp`]; callers pass NaN-free values (every input is checked
 //! to be finite where it is read) or filter them first.
@@ -37,6 +38,28 @@ pub fn median_high_in_place(v: &mut [f64]) -> f64 {
         return f64::NAN;
     }
     *v.select_nth_unstable_by(n / 2, f64::total_cmp).1
+}
+
+/// Dot product of the common length of `x` and `z`, with four accumulators (accumulator k sums
+/// the products at indices `4 i + k`; the chunks of four share SIMD registers): about 4x faster
+/// than one running sum, whose every addition waits for the previous one, and no less accurate.
+/// The ARMA fits' filters and SSI-cov's lag sums use it.
+#[inline]
+pub fn dot(x: &[f64], z: &[f64]) -> f64 {
+    let n = x.len().min(z.len());
+    let (xc, zc) = (x[..n].chunks_exact(4), z[..n].chunks_exact(4));
+    let (xr, zr) = (xc.remainder(), zc.remainder());
+    let mut s = [0.0f64; 4];
+    for (a, b) in xc.zip(zc) {
+        for k in 0..4 {
+            s[k] += a[k] * b[k];
+        }
+    }
+    let mut tail = 0.0;
+    for (a, b) in xr.iter().zip(zr) {
+        tail += a * b;
+    }
+    (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
 #[cfg(test)]
@@ -80,6 +103,30 @@ mod tests {
                 assert_eq!(median(&v), want, "{v:?}");
                 assert_eq!(median_high_in_place(&mut v.clone()), s[n / 2], "{v:?}");
             }
+        }
+    }
+
+    #[test]
+    fn dot_by_hand_and_against_one_running_sum() {
+        // 1 + 2 + 3 + 4 + 5 * 2 = 20; the shorter length counts.
+        assert_eq!(
+            dot(&[1.0, 2.0, 3.0, 4.0, 5.0], &[1.0, 1.0, 1.0, 1.0, 2.0, 9.0]),
+            20.0
+        );
+        assert_eq!(dot(&[], &[1.0]), 0.0);
+        let mut state = 12345u64;
+        for n in 0..40 {
+            let mut next = || {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            };
+            let x: Vec<f64> = (0..n).map(|_| next()).collect();
+            let z: Vec<f64> = (0..n).map(|_| next()).collect();
+            let naive: f64 = x.iter().zip(&z).map(|(a, b)| a * b).sum();
+            let scale: f64 = x.iter().zip(&z).map(|(a, b)| (a * b).abs()).sum();
+            assert!((dot(&x, &z) - naive).abs() <= 1e-15 * scale.max(1e-300) * n as f64);
         }
     }
 }

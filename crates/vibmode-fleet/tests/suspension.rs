@@ -51,6 +51,9 @@ fn with(bus: &VehicleParams, corner: Corner, spring: f64, damper: f64) -> Vehicl
     v
 }
 
+/// A checked drive: the vehicle, its road and speed, and the fault (corner and part) if any.
+type DrivePlan = (VehicleParams, RoadClass, f64, Option<(Corner, Part)>);
+
 /// P(X >= k) for X ~ Binomial(n, p).
 fn tail(k: usize, n: usize, p: f64) -> f64 {
     let comb = |n: usize, k: usize| -> f64 {
@@ -86,7 +89,7 @@ fn springs_and_dampers_fitted_per_drive_over_seeds() {
     let (mut faults, mut found) = (0usize, 0usize);
     for b in 0..4u64 {
         let base = fit(&records(&bus, RoadClass::B, 30.0, 100 + b, 8));
-        let drives: Vec<(VehicleParams, RoadClass, f64, Option<(Corner, Part)>)> = vec![
+        let drives: Vec<DrivePlan> = vec![
             (bus.clone(), RoadClass::B, 20.0, None),
             (bus.clone(), RoadClass::C, 40.0, None),
             (bus.with_passenger_load(0.15), RoadClass::B, 30.0, None),

@@ -19,27 +19,7 @@ pub(crate) fn check_signal(y: &[f64], min_len: usize) -> Result<f64, IdentError>
     Ok(y.iter().sum::<f64>() / y.len() as f64)
 }
 
-/// Dot product.
-#[inline]
-pub(crate) fn dot(x: &[f64], z: &[f64]) -> f64 {
-    // Four accumulators: faster and slightly more accurate than a single running sum. Accumulator
-    // k sums the products at indices 4 i + k; the chunks of four (no bounds checks) let them
-    // share SIMD registers without changing any rounding.
-    let n = x.len().min(z.len());
-    let (xc, zc) = (x[..n].chunks_exact(4), z[..n].chunks_exact(4));
-    let (xr, zr) = (xc.remainder(), zc.remainder());
-    let mut s = [0.0f64; 4];
-    for (a, b) in xc.zip(zc) {
-        for k in 0..4 {
-            s[k] += a[k] * b[k];
-        }
-    }
-    let mut tail = 0.0;
-    for (a, b) in xr.iter().zip(zr) {
-        tail += a * b;
-    }
-    (s[0] + s[1]) + (s[2] + s[3]) + tail
-}
+pub(crate) use vibmode_core::stats::dot;
 
 /// `sum_{t=t0}^{N-1} x[t-i] * z[t-j]` with zero for negative indices (i, j >= 0).
 #[inline]

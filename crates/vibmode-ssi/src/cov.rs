@@ -502,31 +502,11 @@ fn lag_sums(
             for (b, &rb) in refs.iter().enumerate() {
                 let fut = &ya[ts.start + k..t1 + k];
                 let past = &y[rb][ts.start..t1];
-                sum[(a, b)] += dot(fut, past);
+                sum[(a, b)] += vibmode_core::stats::dot(fut, past);
             }
         }
     }
     (sums, counts)
-}
-
-/// Dot product with four accumulators (accumulator k sums the products at indices `4 i + k`;
-/// the chunks of four share SIMD registers), as `vibmode-ident`'s: about 4x faster than one
-/// running sum, whose every addition waits for the previous one.
-fn dot(x: &[f64], z: &[f64]) -> f64 {
-    let n = x.len().min(z.len());
-    let (xc, zc) = (x[..n].chunks_exact(4), z[..n].chunks_exact(4));
-    let (xr, zr) = (xc.remainder(), zc.remainder());
-    let mut s = [0.0f64; 4];
-    for (a, b) in xc.zip(zc) {
-        for k in 0..4 {
-            s[k] += a[k] * b[k];
-        }
-    }
-    let mut tail = 0.0;
-    for (a, b) in xr.iter().zip(zr) {
-        tail += a * b;
-    }
-    (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
 /// The jackknife standard deviation of an estimate from its leave-one-out values `theta`
