@@ -418,6 +418,9 @@ fn status(db: &std::path::Path) -> Result<()> {
             v.baseline_version
                 .map_or("none".to_string(), |n| format!("version {n}"))
         ));
+        if let Some(s) = &v.suspension {
+            text.push_str(&format!("  {s}\n"));
+        }
         if !v.drives.is_empty() {
             text.push_str("  drives, newest first:\n");
             for d in &v.drives {

@@ -84,6 +84,11 @@ fn a_spring_at_80_percent_is_named_by_the_fit_per_drive() {
         CITY_BUS,
     ]);
     assert!(again.contains("unchanged"), "{again}");
+    let status = stdout(&["fleet", "status", "--db", db]);
+    assert!(
+        status.contains("model file registered; no baseline yet"),
+        "{status}"
+    );
 
     let nominal = simulate_csv(&d.path().join("nominal"), "B", "30", "11", "6");
     let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1", "-q"];
@@ -96,6 +101,11 @@ fn a_spring_at_80_percent_is_named_by_the_fit_per_drive() {
     );
     // The limit: Phi^-1(1 - 0.01 / 8).
     assert!(base.contains("limit 3.02"), "{base}");
+    let status = stdout(&["fleet", "status", "--db", db]);
+    assert!(
+        status.contains("baseline version 1 fits the suspension (6 nominal records)"),
+        "{status}"
+    );
 
     let healthy = simulate_csv(&d.path().join("healthy"), "B", "30", "21", "4");
     let dr = check_drive(db, &healthy);

@@ -164,6 +164,10 @@ pub struct VehicleStatus {
     /// The latest drive verdicts, newest first (at most the `last` asked for).
     #[serde(default)]
     pub drives: Vec<DriveStatus>,
+    /// The suspension fitted per drive: whether the vehicle has a registered model file and
+    /// whether its latest model set fits it (one line); absent without a model file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub suspension: Option<String>,
 }
 
 /// One drive verdict as the status shows it.
@@ -1129,6 +1133,22 @@ impl Store {
                 last_checks.push((file, a.classification, a.summary));
             }
             let drives = self.drive_statuses(vid, &v)?;
+            let suspension = match self.vehicle_model(&v)? {
+                None => None,
+                Some((sha, _)) => Some(match self.latest_model_set(&v)? {
+                    None => "model file registered; no baseline yet".to_string(),
+                    Some(set) => match &set.suspension {
+                        Some(r) if r.model_sha256 == sha => format!(
+                            "model file registered; baseline version {} fits the suspension ({} nominal records): springs and dampers scored per drive",
+                            set.version, r.fit.records
+                        ),
+                        _ => format!(
+                            "model file registered, but baseline version {} has no fit of it: drives are checked without the suspension fit until nominal records ingested since and a new baseline",
+                            set.version
+                        ),
+                    },
+                }),
+            };
             out.push(VehicleStatus {
                 vehicle: v,
                 n_nominal: count("nominal")?,
@@ -1137,6 +1157,7 @@ impl Store {
                 last_checks,
                 latest_drive: drives.first().cloned(),
                 drives: drives.into_iter().take(last).collect(),
+                suspension,
             });
         }
         Ok(out)
