@@ -123,6 +123,9 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
                 count(Classification::Vehicle),
                 count(Classification::Both),
                 count(Classification::Sensor),
+                s.suspension
+                    .clone()
+                    .unwrap_or_else(|| "no model file registered".into()),
             ]
         })
         .collect();
@@ -138,6 +141,7 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
             "vehicle",
             "both",
             "sensor",
+            "suspension fitted per drive",
         ],
         &rows,
     );
