@@ -1321,6 +1321,8 @@ mod tests {
         assert_eq!(s.schema_version().expect("version"), SCHEMA_VERSION);
         assert_eq!(s.vehicles().expect("vehicles"), vec!["bus-1".to_string()]);
         assert!(s.drives("bus-1").expect("drives").is_empty());
+        // Migration 3: the vehicle model table exists, empty.
+        assert!(s.vehicle_model("bus-1").expect("model").is_none());
     }
 
     #[test]
