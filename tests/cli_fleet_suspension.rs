@@ -118,6 +118,8 @@ fn a_spring_at_80_percent_is_named_by_the_fit_per_drive() {
         "{dr}"
     );
     assert_eq!(dr["suspension"]["fit"]["records"], 4, "{dr}");
+    // The bound per drive: the features' 1 % and the fit's own 1 %.
+    assert_eq!(dr["false_alarm_rate"], 0.02, "{dr}");
     assert!(
         dr["missing"]
             .as_array()

@@ -734,7 +734,11 @@ pub fn check_drive_files_progress(
                 .iter()
                 .find(|e| e.meta.group == crate::model::Group::Vehicle)
                 .and_then(|e| e.meta.corner),
-            false_alarm_rate: set.config.false_alarm_rate,
+            false_alarm_rate: if suspension.0.is_some() {
+                2.0 * set.config.false_alarm_rate
+            } else {
+                set.config.false_alarm_rate
+            },
             assessment,
             suspension: suspension.0.clone(),
         }

@@ -1480,7 +1480,8 @@ pub struct Drive {
     /// The corner of the strongest flagged vehicle feature (the one named first), if any.
     pub corner: Option<vibmode_analysis::Corner>,
     /// Upper bound of the false-alarm rate per drive and feature group: the model set's
-    /// `false_alarm_rate` per record (docs/fleet.md, "Drives").
+    /// `false_alarm_rate` per record (docs/fleet.md, "Drives"), twice it when the drive's
+    /// suspension fit is scored too (its tests have the same rate of their own).
     pub false_alarm_rate: f64,
     /// The verdict from the medians of the features over the records.
     #[serde(flatten)]
