@@ -191,7 +191,15 @@ fn ingest(a: &IngestArgs) -> Result<()> {
     pb.finish_and_clear();
     let done = done?;
     for r in &done {
-        if r.already_stored {
+        if r.already_stored && !r.notes.is_empty() {
+            eprintln!(
+                "{}: already stored for vehicle {} (record {})",
+                r.file, a.vehicle, r.record_id
+            );
+            for n in &r.notes {
+                eprintln!("  note: {n}");
+            }
+        } else if r.already_stored {
             eprintln!(
                 "{}: already stored for vehicle {} (record {}), nothing to do",
                 r.file, a.vehicle, r.record_id

@@ -243,3 +243,47 @@ fn bad_model_files_are_refused_and_nothing_is_stored() {
     assert!(store.vehicles().unwrap().is_empty());
     assert!(store.vehicle_model("bus-1").unwrap().is_none());
 }
+
+/// Records ingested before the model file was registered carry no body equations; ingesting the
+/// same files again after registering adds them (the features are updated, no record is added),
+/// and the baseline then fits the suspension.
+#[test]
+fn records_stored_before_registering_get_their_equations_when_ingested_again() {
+    let d = tempfile::tempdir().unwrap();
+    let db = d.path().join("fleet.db");
+    let db = db.to_str().unwrap();
+    ok(&["fleet", "init", "--db", db]);
+    let nominal = simulate_csv(&d.path().join("nominal"), "B", "30", "12", "5");
+    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1", "-q"];
+    args.extend(nominal.iter().map(String::as_str));
+    ok(&args);
+    stdout(&[
+        "fleet",
+        "register",
+        "--db",
+        db,
+        "--vehicle",
+        "bus-1",
+        CITY_BUS,
+    ]);
+    let base = stdout(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
+    assert!(
+        base.contains("no suspension fit per drive") && base.contains("0 record(s)"),
+        "{base}"
+    );
+    let again = common::vibmode(&args);
+    let err = String::from_utf8_lossy(&again.stderr).to_string();
+    assert_eq!(again.status.code(), Some(0), "{err}");
+    assert_eq!(err.matches("body equations added").count(), 5, "{err}");
+    let base = stdout(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
+    assert!(
+        base.contains("suspension fitted to 5 nominal records"),
+        "{base}"
+    );
+    // A third time: nothing to do.
+    let third = common::vibmode(&args);
+    let err = String::from_utf8_lossy(&third.stderr).to_string();
+    assert_eq!(err.matches("nothing to do").count(), 5, "{err}");
+    let status = stdout(&["fleet", "status", "--db", db]);
+    assert!(status.contains("5 nominal, 0 test records"), "{status}");
+}

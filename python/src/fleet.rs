@@ -296,6 +296,7 @@ fn fleet_store_features(
                     },
                     features: &it.features,
                     check: None,
+                    refresh_features: false,
                 })
                 .collect();
             let stored = store.store_batch(&batch)?;

@@ -85,6 +85,9 @@ struct Prepared {
     features: RecordFeatures,
     /// The vehicle already had this content when it was read.
     known: bool,
+    /// Known, and its stored features get the body equations of the vehicle's model file,
+    /// registered after the record was stored.
+    refreshed: bool,
 }
 
 fn metadata_of(rec: &Recording) -> serde_json::Value {
@@ -213,6 +216,7 @@ fn prepare_recording(
             metadata: metadata_of(rec),
             features: store.features(row.id)?,
             known: true,
+            refreshed: false,
         });
     }
     let mut features = compute_features(name, rec, cfg)?;
@@ -229,6 +233,7 @@ fn prepare_recording(
         metadata: metadata_of(rec),
         features,
         known: false,
+        refreshed: false,
     })
 }
 
@@ -264,6 +269,7 @@ fn store_prepared_drive(
             },
             features: &p.features,
             check: c.as_ref().map(|(v, a)| (*v, a)),
+            refresh_features: p.refreshed,
         })
         .collect();
     store.store_batch_with_drive(&items, drive)
@@ -276,10 +282,46 @@ fn ingested(p: Prepared, s: Stored) -> Ingested {
         already_stored: p.known || !s.inserted,
         notes: if s.inserted {
             p.features.notes
+        } else if p.refreshed {
+            vec![REFRESHED_NOTE.to_string()]
         } else {
             Vec::new()
         },
     }
+}
+
+/// The note of a stored record whose body equations were added.
+pub const REFRESHED_NOTE: &str =
+    "body equations added for the suspension fit (the record was stored before the vehicle's model file was registered)";
+
+/// A stored record's features with the body equations of `model` added, when they lack them
+/// (stored before the file was registered, or with another file) and the record can give them;
+/// `None` otherwise. The file is read again for it.
+fn with_equations(
+    features: &RecordFeatures,
+    model: Option<&VehicleModel>,
+    path: &Path,
+    opts: &ReadOptions,
+    cfg: &FleetConfig,
+) -> Result<Option<RecordFeatures>> {
+    let Some(model) = model else {
+        return Ok(None);
+    };
+    let current = features
+        .suspension
+        .as_ref()
+        .is_some_and(|e| e.model_sha256 == model.sha256);
+    if current || !features.sensor_faults.is_empty() {
+        return Ok(None);
+    }
+    let rec = vibmode_signal::read_path(path, opts)?;
+    Ok(model
+        .record_equations(&rec, &cfg.analysis)
+        .ok()
+        .map(|e| RecordFeatures {
+            suspension: Some(e),
+            ..features.clone()
+        }))
 }
 
 /// Ingests a recording with a known content hash: a no-op if the vehicle already has it.
@@ -344,11 +386,14 @@ fn prepare_files(
         let name = file_name(path);
         let sha = hash_file(path)?;
         if let Some(row) = store.find_record(labels.vehicle, &sha)? {
+            let stored = store.features(row.id)?;
+            let fresh = with_equations(&stored, model.as_ref(), path, opts, cfg)?;
             out.push(Prepared {
                 file: name,
                 sha256: sha,
                 metadata: serde_json::json!({}),
-                features: store.features(row.id)?,
+                refreshed: fresh.is_some(),
+                features: fresh.unwrap_or(stored),
                 known: true,
             });
             continue;
@@ -361,6 +406,7 @@ fn prepare_files(
                 metadata: serde_json::json!({}),
                 features,
                 known: false,
+                refreshed: false,
             });
             continue;
         }
@@ -375,6 +421,7 @@ fn prepare_files(
             metadata: metadata_of(&rec),
             features,
             known: false,
+            refreshed: false,
         });
     }
     progress(out.len());

@@ -676,6 +676,7 @@ impl Store {
             record: rec.clone(),
             features,
             check: None,
+            refresh_features: false,
         }])?;
         Ok(out.first().map_or(0, |o| o.record_id))
     }
@@ -782,12 +783,21 @@ impl Store {
                 .map_err(err)?;
                 id
             } else {
-                tx.query_row(
-                    "SELECT id FROM records WHERE vehicle_id = ?1 AND sha256 = ?2",
-                    params![vid, rec.sha256],
-                    |r| r.get(0),
-                )
-                .map_err(err)?
+                let id: i64 = tx
+                    .query_row(
+                        "SELECT id FROM records WHERE vehicle_id = ?1 AND sha256 = ?2",
+                        params![vid, rec.sha256],
+                        |r| r.get(0),
+                    )
+                    .map_err(err)?;
+                if it.refresh_features {
+                    tx.execute(
+                        "UPDATE features SET json = ?1 WHERE record_id = ?2",
+                        params![features, id],
+                    )
+                    .map_err(err)?;
+                }
+                id
             };
             if let Some((version, class, json)) = check {
                 tx.execute(
@@ -1232,6 +1242,9 @@ pub struct BatchItem<'a> {
     pub features: &'a RecordFeatures,
     /// A check to store with it: the model-set version and the verdict.
     pub check: Option<(i64, &'a Assessment)>,
+    /// When the vehicle already has the record: replace its stored features with `features`
+    /// (its body equations added after the model file was registered).
+    pub refresh_features: bool,
 }
 
 /// Where [`Store::store_batch`] put a record.
@@ -1556,6 +1569,7 @@ mod tests {
                 record: rec,
                 features: &f,
                 check: Some((1, &a)),
+                refresh_features: false,
             }])
             .expect_err("NaN score");
         assert!(matches!(e, FleetError::NotStorable { .. }), "{e}");
