@@ -281,11 +281,36 @@ fn fleet_store_features(
         .detach(|| {
             vibmode_fleet::check_vehicle_id(vehicle)?;
             let mut store = Store::open(&db)?;
+            // A record the vehicle already has, stored without the body equations the worker
+            // made (before the model file was registered): its stored features get them, as
+            // `fleet ingest` of the same file does.
+            let mut refreshed: Vec<Option<RecordFeatures>> = Vec::with_capacity(items.len());
+            for it in &items {
+                let fresh = match (
+                    &it.features.suspension,
+                    store.find_record(vehicle, &it.sha256)?,
+                ) {
+                    (Some(e), Some(row)) => {
+                        let stored = store.features(row.id)?;
+                        let current = stored
+                            .suspension
+                            .as_ref()
+                            .is_some_and(|x| x.model_sha256 == e.model_sha256);
+                        (!current && stored.sensor_faults.is_empty()).then(|| RecordFeatures {
+                            suspension: Some(e.clone()),
+                            ..stored
+                        })
+                    }
+                    _ => None,
+                };
+                refreshed.push(fresh);
+            }
             // All or nothing, in one transaction; content the vehicle already has (stored by
-            // another process meanwhile, too) is left alone.
+            // another process meanwhile, too) is left alone (but for the equations above).
             let batch: Vec<BatchItem<'_>> = items
                 .iter()
-                .map(|it| BatchItem {
+                .zip(&refreshed)
+                .map(|(it, fresh)| BatchItem {
                     record: NewRecord {
                         vehicle,
                         sha256: &it.sha256,
@@ -294,21 +319,24 @@ fn fleet_store_features(
                         road,
                         metadata: it.metadata.clone(),
                     },
-                    features: &it.features,
+                    features: fresh.as_ref().unwrap_or(&it.features),
                     check: None,
-                    refresh_features: false,
+                    refresh_features: fresh.is_some(),
                 })
                 .collect();
             let stored = store.store_batch(&batch)?;
             let out: Vec<Ingested> = items
                 .iter()
                 .zip(stored)
-                .map(|(it, s)| Ingested {
+                .zip(&refreshed)
+                .map(|((it, s), fresh)| Ingested {
                     file: it.file.clone(),
                     record_id: s.record_id,
                     already_stored: !s.inserted,
                     notes: if s.inserted {
                         it.features.notes.clone()
+                    } else if fresh.is_some() {
+                        vec![vibmode_fleet::fleet::REFRESHED_NOTE.to_string()]
                     } else {
                         Vec::new()
                     },

@@ -1,6 +1,7 @@
 """vibmode.fleet.register: a vehicle's model file for the suspension fitted per drive, as
 `vibmode fleet register` (the CLI test tests/cli_fleet_suspension.rs checks the fit itself)."""
 
+import contextlib
 import sqlite3
 from pathlib import Path
 
@@ -21,7 +22,7 @@ def test_register_stores_the_file_once(tmp_path):
     assert vibmode.fleet.register(db, "bus-1", other) == "replaced"
     assert vibmode.fleet.model(db, "bus-1") == other.read_text()
     assert vibmode.fleet.register(db, "bus-1", CITY_BUS) == "replaced"
-    with sqlite3.connect(str(db)) as c:
+    with contextlib.closing(sqlite3.connect(str(db))) as c:
         rows = c.execute(
             "SELECT v.name, m.toml FROM vehicle_models m JOIN vehicles v ON v.id = m.vehicle_id"
         ).fetchall()
@@ -39,6 +40,49 @@ def test_a_bad_model_file_raises_and_stores_nothing(tmp_path):
         vibmode.fleet.register(db, "bus-1", junk)
     with pytest.raises(ValueError, match="missing.toml"):
         vibmode.fleet.register(db, "bus-1", tmp_path / "missing.toml")
-    with sqlite3.connect(str(db)) as c:
+    with contextlib.closing(sqlite3.connect(str(db))) as c:
         assert c.execute("SELECT COUNT(*) FROM vehicle_models").fetchone()[0] == 0
         assert c.execute("SELECT COUNT(*) FROM vehicles").fetchone()[0] == 0
+
+
+def _stored(db):
+    """{file name: features} as the store keeps them. The connection is closed before vibmode
+    writes again: Python's sqlite3 and vibmode's own SQLite are two copies of the library in one
+    process, and a connection of one left open across the other's writes and checkpoints reads a
+    stale WAL index ("database disk image is malformed"; docs/fleet.md, "Store")."""
+    import contextlib
+    import json
+
+    with contextlib.closing(sqlite3.connect(str(db))) as c:
+        rows = c.execute(
+            "SELECT r.file_name, f.json FROM records r JOIN features f ON f.record_id = r.id"
+        ).fetchall()
+    return {name: json.loads(j) for name, j in rows}
+
+
+def test_workers_add_equations_to_records_stored_before_registering(tmp_path):
+    rec_dir = tmp_path / "records"
+    vibmode.simulate("city_bus", records=3, fs=200.0, effects="none", seed=13, out_dir=rec_dir)
+    files = sorted(rec_dir.glob("record_*.wav"))
+    db = tmp_path / "workers.db"
+    vibmode.fleet.init(db)
+    settings = vibmode.fleet.settings(db)
+    items = [vibmode.fleet.features(f, settings=settings) for f in files]
+    out = vibmode.fleet.store_features(db, "bus-1", items)
+    assert not any(o["already_stored"] for o in out)
+    assert not any("suspension" in f for f in _stored(db).values())
+    assert vibmode.fleet.register(db, "bus-1", CITY_BUS) == "new"
+    model = vibmode.fleet.model(db, "bus-1")
+    items = [vibmode.fleet.features(f, settings=settings, model=model) for f in files]
+    out = vibmode.fleet.store_features(db, "bus-1", items)
+    assert all(o["already_stored"] for o in out)
+    assert all(any("body equations added" in n for n in o["notes"]) for o in out), out
+    # The same as `ingest` into a store whose model file was registered first.
+    first = tmp_path / "first.db"
+    vibmode.fleet.init(first)
+    vibmode.fleet.register(first, "bus-1", CITY_BUS)
+    vibmode.fleet.ingest(first, "bus-1", files)
+    assert _stored(db) == _stored(first)
+    # Again: nothing to do.
+    out = vibmode.fleet.store_features(db, "bus-1", items)
+    assert all(o["already_stored"] and not o["notes"] for o in out), out
