@@ -5,12 +5,17 @@
 
 mod common;
 
-use common::{fails_with, ok, simulate_csv};
+use common::{fails_with, ok, simulate_csv, simulate_csv_of};
 
 const CITY_BUS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/city_bus.toml");
 
 fn stdout(args: &[&str]) -> String {
     String::from_utf8_lossy(&ok(args).stdout).to_string()
+}
+
+/// `fleet register` of `model` for bus-1: its standard output.
+fn register(db: &str, model: &str) -> String {
+    stdout(&["fleet", "register", "--db", db, "--vehicle", "bus-1", model])
 }
 
 fn check_drive(db: &str, files: &[String]) -> serde_json::Value {
@@ -64,25 +69,9 @@ fn a_spring_at_80_percent_is_named_by_the_fit_per_drive() {
     let db = d.path().join("fleet.db");
     let db = db.to_str().unwrap();
     ok(&["fleet", "init", "--db", db]);
-    let out = stdout(&[
-        "fleet",
-        "register",
-        "--db",
-        db,
-        "--vehicle",
-        "bus-1",
-        CITY_BUS,
-    ]);
+    let out = register(db, CITY_BUS);
     assert!(out.contains("registered"), "{out}");
-    let again = stdout(&[
-        "fleet",
-        "register",
-        "--db",
-        db,
-        "--vehicle",
-        "bus-1",
-        CITY_BUS,
-    ]);
+    let again = register(db, CITY_BUS);
     assert!(again.contains("unchanged"), "{again}");
     let status = stdout(&["fleet", "status", "--db", db]);
     assert!(
@@ -133,34 +122,14 @@ fn a_spring_at_80_percent_is_named_by_the_fit_per_drive() {
     let text = std::fs::read_to_string(CITY_BUS).unwrap()
         + "\n[[corner_condition]]\ncorner = \"RL\"\nspring_factor = 0.8\n";
     std::fs::write(&soft, text).unwrap();
-    let dir = d.path().join("soft");
-    ok(&[
-        "simulate",
+    let files = simulate_csv_of(
         soft.to_str().unwrap(),
-        "--road",
+        &d.path().join("soft"),
         "B",
-        "--speed-kmh",
         "30",
-        "--duration-s",
-        "10.24",
-        "--records",
-        "4",
-        "--seed",
         "31",
-        "--fs",
-        "200",
-        "--format",
-        "csv",
-        "-o",
-        dir.to_str().unwrap(),
-    ]);
-    let mut files: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .map(|e| e.path().to_string_lossy().to_string())
-        .filter(|p| p.ends_with(".csv"))
-        .collect();
-    files.sort();
+        "4",
+    );
     let dr = check_drive(db, &files);
     assert!(
         dr["classification"] == "vehicle" || dr["classification"] == "both",
@@ -257,15 +226,7 @@ fn records_stored_before_registering_get_their_equations_when_ingested_again() {
     let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1", "-q"];
     args.extend(nominal.iter().map(String::as_str));
     ok(&args);
-    stdout(&[
-        "fleet",
-        "register",
-        "--db",
-        db,
-        "--vehicle",
-        "bus-1",
-        CITY_BUS,
-    ]);
+    register(db, CITY_BUS);
     let base = stdout(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
     assert!(
         base.contains("no suspension fit per drive") && base.contains("0 record(s)"),

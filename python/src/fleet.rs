@@ -292,14 +292,12 @@ fn fleet_store_features(
                 ) {
                     (Some(e), Some(row)) => {
                         let stored = store.features(row.id)?;
-                        let current = stored
-                            .suspension
-                            .as_ref()
-                            .is_some_and(|x| x.model_sha256 == e.model_sha256);
-                        (!current && stored.sensor_faults.is_empty()).then(|| RecordFeatures {
-                            suspension: Some(e.clone()),
-                            ..stored
-                        })
+                        stored
+                            .lacks_equations_of(&e.model_sha256)
+                            .then(|| RecordFeatures {
+                                suspension: Some(e.clone()),
+                                ..stored
+                            })
                     }
                     _ => None,
                 };

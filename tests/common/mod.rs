@@ -95,6 +95,18 @@ pub fn simulate_csv(
     records: &str,
 ) -> Vec<String> {
     let params = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/city_bus.toml");
+    simulate_csv_of(params, dir, road, speed, seed, records)
+}
+
+/// As [`simulate_csv`], of the vehicle file `params`.
+pub fn simulate_csv_of(
+    params: &str,
+    dir: &std::path::Path,
+    road: &str,
+    speed: &str,
+    seed: &str,
+    records: &str,
+) -> Vec<String> {
     ok(&[
         "simulate",
         params,

@@ -103,6 +103,19 @@ pub struct RecordFeatures {
     pub suspension: Option<crate::suspension::StoredEquations>,
 }
 
+impl RecordFeatures {
+    /// True when the record lacks the body equations of the model file with this SHA-256 (none,
+    /// or another file's) and could have them (no failed sensor): a stored record that gets them
+    /// when it is ingested or checked again.
+    pub fn lacks_equations_of(&self, model_sha256: &str) -> bool {
+        let current = self
+            .suspension
+            .as_ref()
+            .is_some_and(|e| e.model_sha256 == model_sha256);
+        !current && self.sensor_faults.is_empty()
+    }
+}
+
 /// A record's transmissibility with the bins of its periodic lines left out of the band sums
 /// (and its unsprung levels with them replaced by the continuum under them): a line
 /// (an engine or driveline order entering at the engine mounts or the axle) moves the body and,

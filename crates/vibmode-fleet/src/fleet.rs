@@ -307,11 +307,7 @@ fn with_equations(
     let Some(model) = model else {
         return Ok(None);
     };
-    let current = features
-        .suspension
-        .as_ref()
-        .is_some_and(|e| e.model_sha256 == model.sha256);
-    if current || !features.sensor_faults.is_empty() {
+    if !features.lacks_equations_of(&model.sha256) {
         return Ok(None);
     }
     let rec = vibmode_signal::read_path(path, opts)?;

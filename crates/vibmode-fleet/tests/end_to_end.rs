@@ -6,35 +6,12 @@ use std::collections::BTreeMap;
 
 mod common;
 
-use common::config;
+use common::{config, records};
 use vibmode_fleet::{
     build_baseline, check_recording, ingest_recording, recording_hash, Classification, Condition,
     IngestLabels, Store,
 };
-use vibmode_vehicle::{simulate, RoadClass, SimParams, VehicleParams};
-
-fn runs(
-    v: &VehicleParams,
-    road: RoadClass,
-    kmh: f64,
-    seed: u64,
-    n: usize,
-) -> Vec<vibmode_core::Recording> {
-    let p = SimParams {
-        road,
-        speed_kmh: kmh,
-        fs_hz: 200.0,
-        records: n,
-        seed,
-        ..SimParams::default()
-    };
-    simulate(v, &p)
-        .expect("simulate")
-        .records
-        .into_iter()
-        .map(|r| r.recording)
-        .collect()
-}
+use vibmode_vehicle::{Disturbances, RoadClass, VehicleParams};
 
 #[test]
 fn classification_over_seeds() {
@@ -64,9 +41,16 @@ fn classification_over_seeds() {
             (RoadClass::C, 50.0),
         ];
         for (i, (road, kmh)) in conditions.into_iter().enumerate() {
-            for (j, rec) in runs(&bus, road, kmh, seed * 100 + i as u64, 2)
-                .iter()
-                .enumerate()
+            for (j, rec) in records(
+                &bus,
+                road,
+                kmh,
+                seed * 100 + i as u64,
+                2,
+                Disturbances::default(),
+            )
+            .iter()
+            .enumerate()
             {
                 let name = format!("nominal-{i}-{j}");
                 ingest_recording(&mut store, &nominal, &name, &recording_hash(rec), rec, &cfg)
@@ -82,9 +66,16 @@ fn classification_over_seeds() {
             ("d both", &weak, RoadClass::E, 40.0),
         ];
         for (k, (label, v, road, kmh)) in scenarios.into_iter().enumerate() {
-            for (j, rec) in runs(v, road, kmh, seed * 1000 + k as u64, 2)
-                .iter()
-                .enumerate()
+            for (j, rec) in records(
+                v,
+                road,
+                kmh,
+                seed * 1000 + k as u64,
+                2,
+                Disturbances::default(),
+            )
+            .iter()
+            .enumerate()
             {
                 let c = check_recording(
                     &mut store,

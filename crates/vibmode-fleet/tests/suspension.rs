@@ -8,37 +8,14 @@
 //! Phi^-1(0.01 / 8)), so 2 or more flagged of the healthy drives would be improbable (< 5 %) if
 //! the rate held; a fault is found with its corner and part lowest in at least 90 % of drives.
 
+mod common;
+
+use common::records;
 use vibmode_fleet::suspension::{corner_scores, suspension_limit, Part, VehicleModel};
 use vibmode_fleet::FleetConfig;
-use vibmode_vehicle::{
-    simulate, Corner, CornerCondition, Disturbances, RoadClass, SimParams, VehicleParams,
-};
+use vibmode_vehicle::{Corner, CornerCondition, Disturbances, RoadClass, VehicleParams};
 
 const CITY_BUS: &str = include_str!("../../../examples/city_bus.toml");
-
-fn records(
-    v: &VehicleParams,
-    road: RoadClass,
-    kmh: f64,
-    seed: u64,
-    n: usize,
-) -> Vec<vibmode_core::Recording> {
-    let p = SimParams {
-        road,
-        speed_kmh: kmh,
-        fs_hz: 200.0,
-        records: n,
-        seed,
-        disturbances: Disturbances::in_service(),
-        ..SimParams::default()
-    };
-    simulate(v, &p)
-        .unwrap()
-        .records
-        .into_iter()
-        .map(|r| r.recording)
-        .collect()
-}
 
 fn with(bus: &VehicleParams, corner: Corner, spring: f64, damper: f64) -> VehicleParams {
     let mut v = bus.clone();
@@ -88,7 +65,14 @@ fn springs_and_dampers_fitted_per_drive_over_seeds() {
     let (mut healthy, mut flagged) = (0usize, 0usize);
     let (mut faults, mut found) = (0usize, 0usize);
     for b in 0..4u64 {
-        let base = fit(&records(&bus, RoadClass::B, 30.0, 100 + b, 8));
+        let base = fit(&records(
+            &bus,
+            RoadClass::B,
+            30.0,
+            100 + b,
+            8,
+            Disturbances::in_service(),
+        ));
         let drives: Vec<DrivePlan> = vec![
             (bus.clone(), RoadClass::B, 20.0, None),
             (bus.clone(), RoadClass::C, 40.0, None),
@@ -120,7 +104,14 @@ fn springs_and_dampers_fitted_per_drive_over_seeds() {
             ),
         ];
         for (k, (v, road, kmh, fault)) in drives.into_iter().enumerate() {
-            let drive = fit(&records(&v, road, kmh, 1000 * (b + 1) + k as u64, 4));
+            let drive = fit(&records(
+                &v,
+                road,
+                kmh,
+                1000 * (b + 1) + k as u64,
+                4,
+                Disturbances::in_service(),
+            ));
             let scores = corner_scores(&base, &drive);
             let lowest = scores.iter().min_by(|a, c| a.z.total_cmp(&c.z)).unwrap();
             println!(

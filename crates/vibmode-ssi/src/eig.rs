@@ -570,23 +570,6 @@ mod reference {
         Ok(quasi_triangular_eigenpairs(&q, &t))
     }
 
-    /// Blocks `(start, size)` of a quasi-triangular matrix: a nonzero subdiagonal entry opens a 2x2.
-    fn blocks(t: &DMatrix<f64>) -> Vec<(usize, usize)> {
-        let n = t.nrows();
-        let mut out = Vec::new();
-        let mut j = 0;
-        while j < n {
-            if j + 1 < n && t[(j + 1, j)] != 0.0 {
-                out.push((j, 2));
-                j += 2;
-            } else {
-                out.push((j, 1));
-                j += 1;
-            }
-        }
-        out
-    }
-
     fn quasi_triangular_eigenpairs(q: &DMatrix<f64>, t: &DMatrix<f64>) -> Vec<EigenPair> {
         let n = t.nrows();
         let norm = t.amax();
@@ -597,7 +580,8 @@ mod reference {
         } else {
             f64::MIN_POSITIVE
         };
-        let blocks = blocks(t);
+        // nalgebra's matrices are column-major, as the path's own.
+        let blocks = super::blocks(t.as_slice(), t.nrows());
         let mut out = Vec::new();
         for (bi, &(k, size)) in blocks.iter().enumerate() {
             if size != 2 {

@@ -103,23 +103,32 @@ fn body_modes_of_the_measured_vehicle_over_seeds() {
     );
 }
 
-/// Noise-free records of the rigid bus (no bending, lines, misalignment or manoeuvres; steady
-/// speed): the fitted springs, dampers and inertias are the changed bus's within 1 %.
-#[test]
-fn clean_records_give_the_parameters() {
-    let truth = changed(VehicleParams::city_bus());
+/// 4 noise-free records of `truth` at 200 Hz on a class C road at 40 km/h.
+fn rigid_records(truth: &VehicleParams, seed: u64) -> Vec<Recording> {
     let sp = SimParams {
         road: RoadClass::C,
         speed_kmh: 40.0,
         fs_hz: 200.0,
         records: 4,
-        seed: 7,
+        seed,
         ..SimParams::default()
     };
-    let sim = simulate(&truth, &sp).unwrap();
+    simulate(truth, &sp)
+        .unwrap()
+        .records
+        .into_iter()
+        .map(|r| r.recording)
+        .collect()
+}
+
+/// Noise-free records of the rigid bus (no bending, lines, misalignment or manoeuvres; steady
+/// speed): the fitted springs, dampers and inertias are the changed bus's within 1 %.
+#[test]
+fn clean_records_give_the_parameters() {
+    let truth = changed(VehicleParams::city_bus());
     let mut fit = BodyFit::new(&VehicleParams::city_bus(), BodyFitParams::default()).unwrap();
-    for r in &sim.records {
-        fit.add_record(&r.recording).unwrap();
+    for r in &rigid_records(&truth, 7) {
+        fit.add_record(r).unwrap();
     }
     let res = fit.solve().unwrap();
     let close = |what: &str, got: f64, want: f64, tol: f64| {
@@ -378,21 +387,13 @@ fn a_bar_the_bus_does_not_have_comes_out_as_zero() {
 #[test]
 fn equations_kept_and_added_later_give_the_same_fit() {
     let truth = changed(VehicleParams::city_bus());
-    let sp = SimParams {
-        road: RoadClass::C,
-        speed_kmh: 40.0,
-        fs_hz: 200.0,
-        records: 4,
-        seed: 11,
-        ..SimParams::default()
-    };
-    let sim = simulate(&truth, &sp).unwrap();
+    let records = rigid_records(&truth, 11);
     let file = VehicleParams::city_bus();
     let mut direct = BodyFit::new(&file, BodyFitParams::default()).unwrap();
     let mut later = BodyFit::new(&file, BodyFitParams::default()).unwrap();
-    for r in &sim.records {
-        direct.add_record(&r.recording).unwrap();
-        let eq = later.record_equations(&r.recording).unwrap();
+    for r in &records {
+        direct.add_record(r).unwrap();
+        let eq = later.record_equations(r).unwrap();
         let text = serde_json::to_string(&eq).unwrap();
         let back: vibmode_vehicle::update::RecordEquations = serde_json::from_str(&text).unwrap();
         later.add_equations(&back).unwrap();
@@ -412,7 +413,7 @@ fn equations_kept_and_added_later_give_the_same_fit() {
     let mut no_front = file.clone();
     no_front.front.anti_roll_stiffness_nm_per_rad = 0.0;
     let mut other = BodyFit::new(&no_front, BodyFitParams::default()).unwrap();
-    let eq = direct.record_equations(&sim.records[0].recording).unwrap();
+    let eq = direct.record_equations(&records[0]).unwrap();
     let e = other.add_equations(&eq).unwrap_err().to_string();
     assert!(e.contains("unknowns"), "{e}");
     assert_eq!(other.records(), 0);

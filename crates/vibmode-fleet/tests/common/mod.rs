@@ -2,23 +2,38 @@
 #![allow(dead_code)]
 
 use vibmode_fleet::FleetConfig;
-use vibmode_vehicle::{simulate, RoadClass, SimParams, VehicleParams};
+use vibmode_vehicle::{simulate, Disturbances, RoadClass, SimParams, VehicleParams};
 
-/// One simulated 10.24 s record at 200 Hz of `v` on `road` at `kmh`.
-pub fn record(v: &VehicleParams, road: RoadClass, kmh: f64, seed: u64) -> vibmode_core::Recording {
+/// `n` simulated 10.24 s records at 200 Hz of `v` on `road` at `kmh`, with `disturbances`
+/// (sensor noise, engine lines, ...; `Disturbances::default()`: none).
+pub fn records(
+    v: &VehicleParams,
+    road: RoadClass,
+    kmh: f64,
+    seed: u64,
+    n: usize,
+    disturbances: Disturbances,
+) -> Vec<vibmode_core::Recording> {
     let p = SimParams {
         road,
         speed_kmh: kmh,
         fs_hz: 200.0,
-        records: 1,
+        records: n,
         seed,
+        disturbances,
         ..SimParams::default()
     };
     simulate(v, &p)
         .expect("simulate")
         .records
-        .remove(0)
-        .recording
+        .into_iter()
+        .map(|r| r.recording)
+        .collect()
+}
+
+/// One simulated 10.24 s record at 200 Hz of `v` on `road` at `kmh`.
+pub fn record(v: &VehicleParams, road: RoadClass, kmh: f64, seed: u64) -> vibmode_core::Recording {
+    records(v, road, kmh, seed, 1, Disturbances::default()).remove(0)
 }
 
 /// A faster analysis than the default (AR sweep to order 16) so several seeds run in seconds.
