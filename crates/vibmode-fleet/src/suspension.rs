@@ -7,13 +7,14 @@
 //! records' equations together, a checked drive fits its own records', and per corner the
 //! fitted spring and damper relative to the other three corners, `ln k_c - mean_{j != c} ln
 //! k_j` (a change of load scales every corner alike and cancels), is compared with the
-//! baseline's. The score divides the change by the two fits' jackknife standard deviations (the
-//! corners taken as independent): `z = (r_drive - r_baseline) / sqrt(var_drive + var_baseline)`.
+//! baseline's. The score divides the change by the two fits' jackknife standard deviations of
+//! `r` itself (over each fit's replicates, each record left out in turn: the corners' errors
+//! are correlated): `z = (r_drive - r_baseline) / sqrt(var_drive + var_baseline)`.
 //! A spring or damper that lost stiffness lowers its corner's `r`, so only a low score is an
 //! alarm; the limit is one-sided, Bonferroni over the 4 corners and the 2 components:
 //! `Phi^-1(1 - false_alarm_rate / 8)` (3.02 at 1 %). On busgen's buses the healthy drives'
-//! spring scores have an rms of 0.98-1.01 (roads B-C; tools/busgen/spring_fit.py), so the
-//! stated rate holds where the jackknife does.
+//! scores have an rms of about 1 (docs/fleet.md), so the stated rate holds where the jackknife
+//! does.
 
 use serde::{Deserialize, Serialize};
 use vibmode_analysis::{AnalysisConfig, Corner};
@@ -135,6 +136,11 @@ pub struct CornerFit {
     /// Whether the model update calls the records' support of the whole fit sufficient (modes
     /// to 1.5 %, springs and dampers to 5 %); the scores use the standard deviations either way.
     pub supported: bool,
+    /// Standard deviations of [`CornerFit::relative`]'s statistics, springs then dampers, from
+    /// the jackknife's replicates of the whole fit (the corners' errors are correlated); absent
+    /// in model sets stored before they were kept.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub relative_sd: Option<[[f64; 4]; 2]>,
 }
 
 /// Spring or damper.
@@ -156,6 +162,7 @@ impl CornerFit {
             damper_n_s_per_m: [0.0; 4],
             damper_rel_sd: [0.0; 4],
             supported: r.supported,
+            relative_sd: None,
         };
         for (i, c) in CORNERS.iter().enumerate() {
             for (p, value, sd) in [
@@ -186,6 +193,32 @@ impl CornerFit {
                 *sd = s / p.value;
             }
         }
+        let index = |name: &str| r.parameters.iter().position(|p| p.name == name);
+        // The relative statistics of each replicate, and their jackknife spread.
+        let cols: Option<Vec<[usize; 4]>> = ["spring", "damper"]
+            .iter()
+            .map(|what| {
+                let v: Option<Vec<usize>> = CORNERS
+                    .iter()
+                    .map(|c| index(&format!("{what} {c}")))
+                    .collect();
+                v.map(|v| [v[0], v[1], v[2], v[3]])
+            })
+            .collect();
+        if let Some(cols) = cols {
+            let sd: Option<Vec<[f64; 4]>> = cols
+                .iter()
+                .map(|idx| {
+                    let reps: Vec<[f64; 4]> = r
+                        .replicates
+                        .iter()
+                        .map(|rep| idx.map(|i| rep.get(i).copied().unwrap_or(f64::NAN)))
+                        .collect();
+                    jackknife_relative_sd(&reps)
+                })
+                .collect();
+            out.relative_sd = sd.map(|v| [v[0], v[1]]);
+        }
         Ok(out)
     }
 
@@ -196,22 +229,58 @@ impl CornerFit {
         }
     }
 
-    /// Per corner `ln v_c - mean_{j != c} ln v_j` and its variance from the relative standard
-    /// deviations, the corners taken as independent.
+    /// Per corner `ln v_c - mean_{j != c} ln v_j` and its variance: the square of its own
+    /// jackknife spread over the fit's replicates where the fit kept them
+    /// ([`CornerFit::relative_sd`]: the corners' errors are correlated, e.g. all move with the
+    /// noise share), else from the relative standard deviations with the corners taken as
+    /// independent (model sets stored before).
     pub fn relative(&self, part: Part) -> [(f64, f64); 4] {
         let (v, sd) = self.values(part);
-        let ln: Vec<f64> = v.iter().map(|x| x.ln()).collect();
+        let stat = relative_of(v);
+        if let Some(rsd) = self.relative_sd {
+            let p = match part {
+                Part::Spring => 0,
+                Part::Damper => 1,
+            };
+            return std::array::from_fn(|c| (stat[c], rsd[p][c].powi(2)));
+        }
         std::array::from_fn(|c| {
-            let others: f64 = (0..4).filter(|&j| j != c).map(|j| ln[j]).sum::<f64>() / 3.0;
-            let var = sd[c].powi(2)
-                + (0..4)
-                    .filter(|&j| j != c)
-                    .map(|j| sd[j].powi(2))
-                    .sum::<f64>()
-                    / 9.0;
-            (ln[c] - others, var)
+            let others = (0..4)
+                .filter(|&j| j != c)
+                .map(|j| sd[j].powi(2))
+                .sum::<f64>();
+            (stat[c], sd[c].powi(2) + others / 9.0)
         })
     }
+}
+
+/// Per corner `ln v_c - mean_{j != c} ln v_j`.
+fn relative_of(v: &[f64; 4]) -> [f64; 4] {
+    let ln = v.map(f64::ln);
+    std::array::from_fn(|c| {
+        let others: f64 = (0..4).filter(|&j| j != c).map(|j| ln[j]).sum::<f64>() / 3.0;
+        ln[c] - others
+    })
+}
+
+/// The jackknife standard deviation of [`relative_of`] per corner from the replicates of a fit
+/// (the values with each record left out in turn): `sqrt((k - 1) / k sum (x_i - mean)^2)`.
+/// `None` with fewer than [`MIN_FIT_RECORDS`] replicates or a value that is not positive.
+fn jackknife_relative_sd(replicates: &[[f64; 4]]) -> Option<[f64; 4]> {
+    if replicates.len() < MIN_FIT_RECORDS
+        || replicates
+            .iter()
+            .flatten()
+            .any(|v| !(v.is_finite() && *v > 0.0))
+    {
+        return None;
+    }
+    let stats: Vec<[f64; 4]> = replicates.iter().map(relative_of).collect();
+    let k = stats.len() as f64;
+    Some(std::array::from_fn(|c| {
+        let mean = stats.iter().map(|s| s[c]).sum::<f64>() / k;
+        ((k - 1.0) / k * stats.iter().map(|s| (s[c] - mean).powi(2)).sum::<f64>()).sqrt()
+    }))
 }
 
 /// The baseline's fit, kept in the model set.
@@ -292,6 +361,7 @@ mod tests {
             damper_n_s_per_m: [1.0e4; 4],
             damper_rel_sd: [sd; 4],
             supported: true,
+            relative_sd: None,
         }
     }
 
@@ -330,5 +400,42 @@ mod tests {
     fn the_limit_is_one_sided_bonferroni_over_eight_tests() {
         // Phi^-1(1 - 0.01 / 8) = 3.023 (scipy.stats.norm.isf(0.00125)).
         assert!((suspension_limit(0.01) - 3.023_341_1).abs() < 1e-6);
+    }
+
+    /// By hand: replicates whose four values move together (a common factor, e.g. the noise
+    /// share or the sprung mass) leave every corner's relative statistic unchanged, so its
+    /// jackknife spread is 0, where corners taken as independent would add their spreads.
+    /// Replicates moving corner FL alone by ln -a, 0, +a: FL's statistic spreads by
+    /// sqrt(2/3 * 2 a^2), each other corner's by a third of it. Fewer than three replicates, or a
+    /// value that is not positive: none.
+    #[test]
+    fn relative_spread_from_the_replicates_by_hand() {
+        let common: Vec<[f64; 4]> = [0.9, 1.0, 1.2, 0.95]
+            .iter()
+            .map(|s| [1.4e5 * s, 1.3e5 * s, 2.5e5 * s, 2.6e5 * s])
+            .collect();
+        let sd = jackknife_relative_sd(&common).unwrap();
+        assert!(sd.iter().all(|v| v.abs() < 1e-12), "{sd:?}");
+        let a = 0.05_f64;
+        let one: Vec<[f64; 4]> = [-a, 0.0, a]
+            .iter()
+            .map(|x| [2.0 * x.exp(), 2.0, 2.0, 2.0])
+            .collect();
+        let sd = jackknife_relative_sd(&one).unwrap();
+        let want = (2.0 / 3.0 * 2.0 * a * a).sqrt();
+        assert!((sd[0] - want).abs() < 1e-12, "{} vs {want}", sd[0]);
+        for (c, v) in sd.iter().enumerate().skip(1) {
+            assert!((v - want / 3.0).abs() < 1e-12, "{c}: {v}");
+        }
+        assert!(jackknife_relative_sd(&one[..2]).is_none());
+        let mut bad = one.clone();
+        bad[1][2] = 0.0;
+        assert!(jackknife_relative_sd(&bad).is_none());
+        // The statistic's variance is then the square of that spread, not the independent sum.
+        let mut f = fit([1.0e5; 4], 0.03);
+        f.relative_sd = Some([sd, [0.01; 4]]);
+        let rel = f.relative(Part::Spring);
+        assert!((rel[0].1 - want * want).abs() < 1e-15);
+        assert!((f.relative(Part::Damper)[3].1 - 1e-4).abs() < 1e-15);
     }
 }

@@ -149,6 +149,11 @@ pub struct BodyFitResult {
     /// Every fitted parameter in SI units with its standard deviation (jackknife over the
     /// records; `None` with fewer than three records).
     pub parameters: Vec<FittedParameter>,
+    /// The jackknife's replicates: per record left out, every parameter's value in the order of
+    /// `parameters` (empty with fewer than three records or when a replicate fails). For the
+    /// standard deviation of a function of several parameters, whose errors are correlated.
+    #[serde(skip)]
+    pub replicates: Vec<Vec<f64>>,
     /// The standard deviations of the updated body modes' frequency and damping (jackknife over
     /// the records; empty with fewer than three records).
     pub mode_sd: Vec<ModeSpread>,
@@ -1025,6 +1030,7 @@ impl BodyFit {
             explained,
             absent,
             parameters,
+            replicates: if have_sd { loo_values } else { Vec::new() },
             mode_sd,
             supported: not_supported.is_none(),
             not_supported,

@@ -401,6 +401,20 @@ fn equations_kept_and_added_later_give_the_same_fit() {
     assert_eq!(later.records(), 4);
     let (a, b) = (direct.solve().unwrap(), later.solve().unwrap());
     assert_eq!(a.parameters, b.parameters);
+    assert_eq!(a.replicates, b.replicates);
+    // One replicate per record left out, each parameter's jackknife sd their spread.
+    assert_eq!(a.replicates.len(), 4);
+    for (i, p) in a.parameters.iter().enumerate() {
+        let xs: Vec<f64> = a.replicates.iter().map(|r| r[i]).collect();
+        let mean = xs.iter().sum::<f64>() / 4.0;
+        let sd = (0.75 * xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>()).sqrt();
+        let want = p.sd.unwrap();
+        assert!(
+            (sd - want).abs() <= 1e-9 * want.max(1.0),
+            "{}: {sd} vs {want}",
+            p.name
+        );
+    }
     assert_eq!(a.equations, b.equations);
     assert_eq!(a.noise_density, b.noise_density);
     for c in Corner::ALL {
