@@ -363,62 +363,123 @@ fn hash_file(path: &Path) -> Result<String> {
 
 /// Reads and analyses every file (a file whose bytes the vehicle already has is not read
 /// again; the same bytes twice in `paths` are analysed once). `layout` checks each read
-/// recording first. `progress(n)` is called after the first `n` files are done.
+/// recording first. `progress(n)` is called as each of the `n` first finished files is done.
+///
+/// The files are hashed and looked up in the store in order, then read and analysed in
+/// parallel (rayon's pool; at most one recording per thread in memory); the results keep the
+/// order of `paths`, and the first error in that order is returned.
 fn prepare_files(
     store: &Store,
     labels: &IngestLabels<'_>,
     paths: &[&Path],
     opts: &ReadOptions,
     cfg: &FleetConfig,
-    layout: &dyn Fn(&str, &Recording) -> Result<()>,
+    layout: &(dyn Fn(&str, &Recording) -> Result<()> + Sync),
     progress: &dyn Fn(usize),
 ) -> Result<Vec<Prepared>> {
+    use rayon::prelude::*;
+    /// What each path needs.
+    enum Plan {
+        /// Stored before for the vehicle: its features (the equations added if they lack them).
+        Known(Box<RecordFeatures>),
+        /// The same bytes as the earlier path at this index.
+        Same(usize),
+        /// To be read and analysed.
+        New,
+    }
     let model = registered_model(store, labels.vehicle)?;
-    let mut out: Vec<Prepared> = Vec::with_capacity(paths.len());
+    let mut plans: Vec<(String, String, Plan)> = Vec::with_capacity(paths.len());
     for path in paths {
-        if !out.is_empty() {
-            progress(out.len());
-        }
         let name = file_name(path);
         let sha = hash_file(path)?;
-        if let Some(row) = store.find_record(labels.vehicle, &sha)? {
-            let stored = store.features(row.id)?;
-            let fresh = with_equations(&stored, model.as_ref(), path, opts, cfg)?;
-            out.push(Prepared {
-                file: name,
-                sha256: sha,
+        let plan = if let Some(row) = store.find_record(labels.vehicle, &sha)? {
+            Plan::Known(Box::new(store.features(row.id)?))
+        } else if let Some(k) = plans.iter().position(|p| p.1 == sha) {
+            Plan::Same(k)
+        } else {
+            Plan::New
+        };
+        plans.push((name, sha, plan));
+    }
+    let model = model.as_ref();
+    let work = |i: usize| -> Result<Prepared> {
+        let (name, sha, plan) = &plans[i];
+        let path = paths[i];
+        if let Plan::Known(stored) = plan {
+            let fresh = with_equations(stored, model, path, opts, cfg)?;
+            return Ok(Prepared {
+                file: name.clone(),
+                sha256: sha.clone(),
                 metadata: serde_json::json!({}),
                 refreshed: fresh.is_some(),
-                features: fresh.unwrap_or(stored),
+                features: fresh.unwrap_or_else(|| (**stored).clone()),
                 known: true,
             });
-            continue;
         }
-        if let Some(same) = out.iter().find(|p| p.sha256 == sha) {
-            let features = same.features.clone();
+        let rec = vibmode_signal::read_path(path, opts)?;
+        layout(name, &rec)?;
+        let mut features = compute_features(name, &rec, cfg)?;
+        check_nominal_sensors(labels.condition, name, &features)?;
+        add_body_equations(&mut features, &rec, model, cfg);
+        Ok(Prepared {
+            file: name.clone(),
+            sha256: sha.clone(),
+            metadata: metadata_of(&rec),
+            features,
+            known: false,
+            refreshed: false,
+        })
+    };
+    // Every path but the repeated ones, analysed in parallel; this thread reports progress.
+    let todo: Vec<usize> = (0..plans.len())
+        .filter(|&i| !matches!(plans[i].2, Plan::Same(_)))
+        .collect();
+    let (tx, rx) = std::sync::mpsc::channel::<()>();
+    let (todo_ref, work) = (&todo, &work);
+    let results: Vec<Result<Prepared>> = std::thread::scope(|scope| {
+        let worker = scope.spawn(move || {
+            // A chunk of as many files as threads at a time: a thread waiting inside one
+            // file's analysis could otherwise steal and start another file, and hold more
+            // recordings in memory than there are threads.
+            let mut all: Vec<Result<Prepared>> = Vec::with_capacity(todo_ref.len());
+            for chunk in todo_ref.chunks(rayon::current_num_threads().max(1)) {
+                let part: Vec<Result<Prepared>> = chunk
+                    .par_iter()
+                    .map_with(tx.clone(), |tx, &i| {
+                        let r = work(i);
+                        // The receiver outlives every sender (drained below).
+                        let _ = tx.send(());
+                        r
+                    })
+                    .collect();
+                all.extend(part);
+            }
+            all
+        });
+        for (n, ()) in rx.iter().enumerate() {
+            progress(n + 1);
+        }
+        worker
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+    });
+    // In the order of `paths`: `todo` holds every index but the repeated ones, in order.
+    let mut results = todo.iter().copied().zip(results).peekable();
+    let mut out: Vec<Prepared> = Vec::with_capacity(paths.len());
+    for (i, (name, sha, plan)) in plans.iter().enumerate() {
+        if let Plan::Same(k) = plan {
+            let features = out[*k].features.clone();
             out.push(Prepared {
-                file: name,
-                sha256: sha,
+                file: name.clone(),
+                sha256: sha.clone(),
                 metadata: serde_json::json!({}),
                 features,
                 known: false,
                 refreshed: false,
             });
-            continue;
+        } else if let Some((_, r)) = results.next_if(|(j, _)| *j == i) {
+            out.push(r?);
         }
-        let rec = vibmode_signal::read_path(path, opts)?;
-        layout(&name, &rec)?;
-        let mut features = compute_features(&name, &rec, cfg)?;
-        check_nominal_sensors(labels.condition, &name, &features)?;
-        add_body_equations(&mut features, &rec, model.as_ref(), cfg);
-        out.push(Prepared {
-            file: name,
-            sha256: sha,
-            metadata: metadata_of(&rec),
-            features,
-            known: false,
-            refreshed: false,
-        });
     }
     progress(out.len());
     Ok(out)
