@@ -93,7 +93,7 @@ fn hessenberg(t: &mut [f64], n: usize, g: &mut [f64], l: usize) {
         // From the left, columns k+1..n, rows k+1..n.
         for j in k + 1..n {
             let col = &mut t[j * n + k + 1..(j + 1) * n];
-            let d = tau * col.iter().zip(v.iter()).map(|(a, b)| a * b).sum::<f64>();
+            let d = tau * vibmode_core::stats::dot(col, v);
             for (e, vi) in col.iter_mut().zip(v.iter()) {
                 *e -= d * vi;
             }
