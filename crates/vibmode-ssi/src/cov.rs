@@ -10,6 +10,7 @@ use vibmode_core::SsiParams;
 use crate::eig::kept_eigenvalues;
 use crate::error::SsiError;
 use crate::shape::mpc;
+use crate::svd::leading_svd;
 
 /// One identified mode: one pole of a conjugate pair (`Im > 0`) of the identified state matrix.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -71,7 +72,12 @@ pub struct SsiCov {
     n_channels: usize,
     n_references: usize,
     n_samples: usize,
+    /// The first `min(order_max, i r)` left singular vectors of `T` (`il` rows).
     u: DMatrix<f64>,
+    /// The block Toeplitz matrix, kept for an order above `u`'s columns ([`SsiCov::full_u`]).
+    toeplitz: DMatrix<f64>,
+    /// All of `T`'s left singular vectors, computed when an order above `u`'s columns is asked.
+    u_full: std::sync::OnceLock<Option<DMatrix<f64>>>,
     singular_values: Vec<f64>,
     rank: usize,
     rank_tolerance: f64,
@@ -95,6 +101,11 @@ pub struct SsiCov {
 /// iteration stops with inaccurate singular vectors when several singular values are zero
 /// (seen on the rank-2 Toeplitz matrix of one exact mode: the column space off by 5e-3).
 const SVD_EPS: f64 = 5.0 * f64::EPSILON;
+
+/// Iteration cap of the Toeplitz matrix's SVD (`dim` its larger side).
+fn svd_iterations(dim: usize) -> usize {
+    60 * dim.max(1) + 100
+}
 
 /// Checks the channels: at least one, each with >= 2 samples, equal lengths, finite samples.
 /// Returns the common length.
@@ -585,19 +596,16 @@ impl SsiCov {
             r[i + a - b - 1][(ra, cb)]
         });
         let dim = i * l.max(n_refs);
-        let iterations = 60 * dim.max(1) + 100;
+        let iterations = svd_iterations(dim);
+        // Only the left singular vectors the orders up to `order_max` use.
+        let k_u = order_max.min(i * n_refs);
         let svd =
-            SVD::try_new(t, true, false, SVD_EPS, iterations).ok_or(SsiError::NotConverged {
+            leading_svd(t.clone(), k_u, SVD_EPS, iterations).ok_or(SsiError::NotConverged {
                 what: "SVD of the block Toeplitz matrix",
                 size: dim,
                 iterations,
             })?;
-        let singular_values: Vec<f64> = svd.singular_values.iter().copied().collect();
-        let u = svd.u.ok_or(SsiError::NotConverged {
-            what: "SVD of the block Toeplitz matrix",
-            size: dim,
-            iterations,
-        })?;
+        let (singular_values, u) = (svd.singular_values, svd.u);
         let smax = singular_values.first().copied().unwrap_or(0.0);
         let rank_tolerance = smax * dim as f64 * f64::EPSILON;
         let rank = singular_values
@@ -639,6 +647,8 @@ impl SsiCov {
             rank_tolerance,
             m_shift,
             c_shift,
+            toeplitz: t,
+            u_full: std::sync::OnceLock::new(),
         })
     }
 
@@ -742,7 +752,11 @@ impl SsiCov {
             )?
         } else {
             let dim = i * l;
-            let o = observability(&self.u, &self.singular_values, dim, order);
+            let o = if order <= self.u.ncols() {
+                observability(&self.u, &self.singular_values, dim, order)
+            } else {
+                observability(self.full_u()?, &self.singular_values, dim, order)
+            };
             let rows = dim - l;
             let a = least_squares(o.rows(0, rows).into_owned(), &o.rows(l, rows).into_owned())?;
             kept_eigenvalues(&a, o.rows(0, l), keep)?
@@ -763,6 +777,24 @@ impl SsiCov {
             .collect();
         modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
         Ok(modes)
+    }
+
+    /// All the left singular vectors of `T` (nalgebra's SVD, computed once, on the first order
+    /// above the columns kept by [`SsiCov::from_correlations`]).
+    fn full_u(&self) -> Result<&DMatrix<f64>, SsiError> {
+        let dim = self.toeplitz.nrows().max(self.toeplitz.ncols());
+        let iterations = svd_iterations(dim);
+        self.u_full
+            .get_or_init(|| {
+                SVD::try_new(self.toeplitz.clone(), true, false, SVD_EPS, iterations)
+                    .and_then(|svd| svd.u)
+            })
+            .as_ref()
+            .ok_or(SsiError::NotConverged {
+                what: "SVD of the block Toeplitz matrix",
+                size: dim,
+                iterations,
+            })
     }
 
     /// [`SsiCov::poles_at`] for every order of `orders`, the orders on all of rayon's threads
@@ -946,6 +978,81 @@ mod tests {
         );
     }
 
+    /// The correlations `R_1 ..= R_{2i-1}` of a seeded random record: three damped modes
+    /// (1.3, 4.1 and 9.7 Hz at 50 Hz) driven by white noise, mixed into `l` channels, plus
+    /// white noise, `n` samples.
+    fn three_mode_correlations(seed: u64, l: usize, n: usize, i: usize) -> Vec<DMatrix<f64>> {
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, StandardNormal};
+        let fs = 50.0;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let mut noise = || -> f64 { StandardNormal.sample(&mut rng) };
+        let mut y = vec![vec![0.0; n]; l];
+        for (m, &(f, z)) in [(1.3, 0.02), (4.1, 0.05), (9.7, 0.03)].iter().enumerate() {
+            let w = 2.0 * PI * f / fs;
+            let r = (-z * w).exp();
+            let (a1, a2) = (2.0 * r * (w * (1.0 - z * z).sqrt()).cos(), -r * r);
+            let (mut x1, mut x2) = (0.0, 0.0);
+            let gains: Vec<f64> = (0..l)
+                .map(|c| ((c + 1) * (m + 2)) as f64 % 3.0 - 1.1)
+                .collect();
+            let xs: Vec<f64> = (0..n)
+                .map(|_| {
+                    let x = a1 * x1 + a2 * x2 + noise();
+                    (x2, x1) = (x1, x);
+                    x
+                })
+                .collect();
+            for (ch, g) in y.iter_mut().zip(&gains) {
+                for (v, x) in ch.iter_mut().zip(&xs) {
+                    *v += g * x;
+                }
+            }
+        }
+        for ch in &mut y {
+            for v in ch.iter_mut() {
+                *v += 0.3 * noise();
+            }
+        }
+        let r: Vec<DMatrix<f64>> = (1..2 * i)
+            .map(|k| {
+                DMatrix::from_fn(l, l, |a, b| {
+                    (0..n - k).map(|t| y[a][t + k] * y[b][t]).sum::<f64>() / (n - k) as f64
+                })
+            })
+            .collect();
+        r
+    }
+
+    /// An order above `order_max` (above the singular vectors kept) takes all of `T`'s left
+    /// singular vectors from nalgebra's SVD: the same modes as from a plan for that order, to
+    /// rounding (1e-9 relative in frequency and damping, 1e-7 in the shapes).
+    #[test]
+    fn orders_above_order_max_are_still_served() {
+        let (l, n, i) = (5, 1200, 8);
+        let r = three_mode_correlations(1, l, n, i);
+        let small = SsiCov::from_correlations(&r, 50.0, i, 6).unwrap();
+        let large = SsiCov::from_correlations(&r, 50.0, i, 20).unwrap();
+        assert_eq!(small.u.ncols(), 6);
+        for order in [8, 14, 20] {
+            let (a, b) = (
+                small.poles_at(order).unwrap(),
+                large.poles_at(order).unwrap(),
+            );
+            assert_eq!(a.len(), b.len(), "order {order}");
+            for (x, y) in a.iter().zip(&b) {
+                assert!((x.frequency_hz - y.frequency_hz).abs() < 1e-9 * y.frequency_hz);
+                assert!((x.damping_ratio - y.damping_ratio).abs() < 1e-9 * y.damping_ratio);
+                for (p, q) in x.shape.iter().zip(&y.shape) {
+                    assert!(
+                        (p[0] - q[0]).abs().max((p[1] - q[1]).abs()) < 1e-7,
+                        "{p:?} {q:?}"
+                    );
+                }
+            }
+        }
+    }
+
     /// The modes of order `n` from the leading block of `M = B R^-1` against the definition:
     /// `A_n` as the least-squares solution of `O_up A = O_down` of that order alone (its own QR)
     /// and `C` the first block row of `O`, on the correlations of seeded random records (three
@@ -955,47 +1062,10 @@ mod tests {
     /// (scaled to their largest entry) to 1e-7.
     #[test]
     fn leading_blocks_of_the_shared_state_matrix_give_each_orders_least_squares_modes() {
-        use rand::SeedableRng;
-        use rand_distr::{Distribution, StandardNormal};
         let (fs, l, n, i) = (50.0, 5, 1200, 8);
         let mut checked = 0;
         for seed in 0..12u64 {
-            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-            let mut noise = || -> f64 { StandardNormal.sample(&mut rng) };
-            let mut y = vec![vec![0.0; n]; l];
-            for (m, &(f, z)) in [(1.3, 0.02), (4.1, 0.05), (9.7, 0.03)].iter().enumerate() {
-                let w = 2.0 * PI * f / fs;
-                let r = (-z * w).exp();
-                let (a1, a2) = (2.0 * r * (w * (1.0 - z * z).sqrt()).cos(), -r * r);
-                let (mut x1, mut x2) = (0.0, 0.0);
-                let gains: Vec<f64> = (0..l)
-                    .map(|c| ((c + 1) * (m + 2)) as f64 % 3.0 - 1.1)
-                    .collect();
-                let xs: Vec<f64> = (0..n)
-                    .map(|_| {
-                        let x = a1 * x1 + a2 * x2 + noise();
-                        (x2, x1) = (x1, x);
-                        x
-                    })
-                    .collect();
-                for (ch, g) in y.iter_mut().zip(&gains) {
-                    for (v, x) in ch.iter_mut().zip(&xs) {
-                        *v += g * x;
-                    }
-                }
-            }
-            for ch in &mut y {
-                for v in ch.iter_mut() {
-                    *v += 0.3 * noise();
-                }
-            }
-            let r: Vec<DMatrix<f64>> = (1..2 * i)
-                .map(|k| {
-                    DMatrix::from_fn(l, l, |a, b| {
-                        (0..n - k).map(|t| y[a][t + k] * y[b][t]).sum::<f64>() / (n - k) as f64
-                    })
-                })
-                .collect();
+            let r = three_mode_correlations(seed, l, n, i);
             let cov = SsiCov::from_correlations(&r, fs, i, 30).unwrap();
             assert_eq!(cov.m_shift.nrows(), 30, "seed {seed}: every order from M");
             for order in (2..=30).step_by(2) {
