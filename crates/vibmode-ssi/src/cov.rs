@@ -590,11 +590,13 @@ impl SsiCov {
         let i = block_rows;
         let l = r.first().map_or(0, DMatrix::nrows);
         let n_refs = r.first().map_or(0, DMatrix::ncols);
-        let t = DMatrix::from_fn(i * l, i * n_refs, |row, col| {
-            let (a, ra) = (row / l, row % l);
-            let (b, cb) = (col / n_refs, col % n_refs);
-            r[i + a - b - 1][(ra, cb)]
-        });
+        let mut t = DMatrix::zeros(i * l, i * n_refs);
+        for a in 0..i {
+            for b in 0..i {
+                t.view_mut((a * l, b * n_refs), (l, n_refs))
+                    .copy_from(&r[i + a - b - 1]);
+            }
+        }
         let dim = i * l.max(n_refs);
         let iterations = svd_iterations(dim);
         // Only the left singular vectors the orders up to `order_max` use.
