@@ -90,7 +90,7 @@ pub struct SsiCov {
     /// `c`). So `M` is formed once and order `n` takes its leading block: the same eigenvalues,
     /// and for an eigenvector `phi` of `M_n` the eigenvector of `A_n` is `R_n^-1 phi`, whose
     /// `C` image is `(C R^-1)[.., ..n] phi` (`c_shift`). Kept to the orders `n <= K` whose
-    /// pivots `R_jj`, `j < n`, all pass [`SsiCov::shift_pivots_ok`]; others (rank-deficient
+    /// pivots `R_jj`, `j < n`, all pass [`shift_pivots_ok`]; others (rank-deficient
     /// `O_up`) get their own least squares.
     m_shift: DMatrix<f64>,
     /// `C R^-1` (`l x K`), `C` the first block row of `O`.
