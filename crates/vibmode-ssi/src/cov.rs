@@ -10,6 +10,7 @@ use vibmode_core::SsiParams;
 use crate::eig::kept_eigenvalues;
 use crate::error::SsiError;
 use crate::shape::mpc;
+use crate::svd::leading_svd;
 
 /// One identified mode: one pole of a conjugate pair (`Im > 0`) of the identified state matrix.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -71,22 +72,40 @@ pub struct SsiCov {
     n_channels: usize,
     n_references: usize,
     n_samples: usize,
+    /// The first `min(order_max, i r)` left singular vectors of `T` (`il` rows).
     u: DMatrix<f64>,
+    /// The block Toeplitz matrix, kept for an order above `u`'s columns ([`SsiCov::full_u`]).
+    toeplitz: DMatrix<f64>,
+    /// All of `T`'s left singular vectors, computed when an order above `u`'s columns is asked.
+    u_full: std::sync::OnceLock<Option<DMatrix<f64>>>,
     singular_values: Vec<f64>,
     rank: usize,
     rank_tolerance: f64,
-    /// QR of `O_up` at the order `K = min(order_max, max_order())`: `O_up = Q R`. At order `n <= K` the
-    /// least-squares `A` is `R[..n, ..n]^-1 (Q^T O_down)[..n, ..n]` (the first `n` columns of
-    /// `O_up` are `Q[.., ..n] R[..n, ..n]`), so one QR serves every order.
-    r_full: DMatrix<f64>,
-    /// `Q^T O_down` at order `K`.
-    qt_down_full: DMatrix<f64>,
+    /// The state matrix of every order up to `K` at once. With the QR `O_up = Q R` of the shifted
+    /// observability matrix at order `K = min(order_max, max_order())` (the first `n` columns of
+    /// `O_up` are `Q[.., ..n] R[..n, ..n]`) and `B = Q^T O_down`, the least-squares `A` of order
+    /// `n <= K` is `A_n = R_n^-1 B_n` (`R_n`, `B_n` the leading `n x n` blocks). It is similar
+    /// to `M_n = R_n A_n R_n^-1 = B_n R_n^-1`, and `M_n` is the leading `n x n` block of
+    /// `M = B R^-1` (`R^-1` is upper triangular: column `c < n` of `R^-1` is zero below row
+    /// `c`). So `M` is formed once and order `n` takes its leading block: the same eigenvalues,
+    /// and for an eigenvector `phi` of `M_n` the eigenvector of `A_n` is `R_n^-1 phi`, whose
+    /// `C` image is `(C R^-1)[.., ..n] phi` (`c_shift`). Kept to the orders `n <= K` whose
+    /// pivots `R_jj`, `j < n`, all pass [`shift_pivots_ok`]; others (rank-deficient
+    /// `O_up`) get their own least squares.
+    m_shift: DMatrix<f64>,
+    /// `C R^-1` (`l x K`), `C` the first block row of `O`.
+    c_shift: DMatrix<f64>,
 }
 
 /// Convergence tolerance of nalgebra's SVD: its own default (`5 eps`). With `eps` alone the
 /// iteration stops with inaccurate singular vectors when several singular values are zero
 /// (seen on the rank-2 Toeplitz matrix of one exact mode: the column space off by 5e-3).
 const SVD_EPS: f64 = 5.0 * f64::EPSILON;
+
+/// Iteration cap of the Toeplitz matrix's SVD (`dim` its larger side).
+fn svd_iterations(dim: usize) -> usize {
+    60 * dim.max(1) + 100
+}
 
 /// Checks the channels: at least one, each with >= 2 samples, equal lengths, finite samples.
 /// Returns the common length.
@@ -571,25 +590,24 @@ impl SsiCov {
         let i = block_rows;
         let l = r.first().map_or(0, DMatrix::nrows);
         let n_refs = r.first().map_or(0, DMatrix::ncols);
-        let t = DMatrix::from_fn(i * l, i * n_refs, |row, col| {
-            let (a, ra) = (row / l, row % l);
-            let (b, cb) = (col / n_refs, col % n_refs);
-            r[i + a - b - 1][(ra, cb)]
-        });
+        let mut t = DMatrix::zeros(i * l, i * n_refs);
+        for a in 0..i {
+            for b in 0..i {
+                t.view_mut((a * l, b * n_refs), (l, n_refs))
+                    .copy_from(&r[i + a - b - 1]);
+            }
+        }
         let dim = i * l.max(n_refs);
-        let iterations = 60 * dim.max(1) + 100;
+        let iterations = svd_iterations(dim);
+        // Only the left singular vectors the orders up to `order_max` use.
+        let k_u = order_max.min(i * n_refs);
         let svd =
-            SVD::try_new(t, true, false, SVD_EPS, iterations).ok_or(SsiError::NotConverged {
+            leading_svd(t.clone(), k_u, SVD_EPS, iterations).ok_or(SsiError::NotConverged {
                 what: "SVD of the block Toeplitz matrix",
                 size: dim,
                 iterations,
             })?;
-        let singular_values: Vec<f64> = svd.singular_values.iter().copied().collect();
-        let u = svd.u.ok_or(SsiError::NotConverged {
-            what: "SVD of the block Toeplitz matrix",
-            size: dim,
-            iterations,
-        })?;
+        let (singular_values, u) = (svd.singular_values, svd.u);
         let smax = singular_values.first().copied().unwrap_or(0.0);
         let rank_tolerance = smax * dim as f64 * f64::EPSILON;
         let rank = singular_values
@@ -597,14 +615,27 @@ impl SsiCov {
             .filter(|&&s| s > rank_tolerance)
             .count();
         let k_max = ((i - 1) * l).min(i * n_refs).min(rank).min(order_max);
-        let (r_full, qt_down_full) = if k_max == 0 {
-            (DMatrix::zeros(0, 0), DMatrix::zeros(0, 0))
+        let rows = (i - 1) * l;
+        let (m_shift, c_shift) = if k_max == 0 {
+            (DMatrix::zeros(0, 0), DMatrix::zeros(l, 0))
         } else {
             let o = observability(&u, &singular_values, i * l, k_max);
-            let rows = (i - 1) * l;
             let qr = o.rows(0, rows).into_owned().qr();
-            let qt_down = qr.q().tr_mul(&o.rows(l, rows));
-            (qr.r(), qt_down)
+            let r = qr.r();
+            // The orders whose leading pivots all pass: a prefix (see `shift_pivots_ok`).
+            let k = (1..=k_max)
+                .take_while(|&n| shift_pivots_ok(&r, n, rows))
+                .last()
+                .unwrap_or(0);
+            let r = r.view((0, 0), (k, k));
+            // M = B R^-1 and C R^-1, as R^T M^T = B^T and R^T (C R^-1)^T = C^T.
+            let b = qr.q().columns(0, k).tr_mul(&o.rows(l, rows).columns(0, k));
+            let m_t = r.tr_solve_upper_triangular(&b.transpose());
+            let c_t = r.tr_solve_upper_triangular(&o.view((0, 0), (l, k)).transpose());
+            match (m_t, c_t) {
+                (Some(m_t), Some(c_t)) => (m_t.transpose(), c_t.transpose()),
+                _ => (DMatrix::zeros(0, 0), DMatrix::zeros(l, 0)),
+            }
         };
         Ok(SsiCov {
             fs_hz,
@@ -616,8 +647,10 @@ impl SsiCov {
             singular_values,
             rank,
             rank_tolerance,
-            r_full,
-            qt_down_full,
+            m_shift,
+            c_shift,
+            toeplitz: t,
+            u_full: std::sync::OnceLock::new(),
         })
     }
 
@@ -703,26 +736,33 @@ impl SsiCov {
                 tolerance: self.rank_tolerance,
             });
         }
-        let dim = i * l;
-        let a = match self.shift_from_full_qr(order) {
-            Some(a) => a,
-            None => {
-                let o = observability(&self.u, &self.singular_values, dim, order);
-                let rows = dim - l;
-                least_squares(o.rows(0, rows).into_owned(), &o.rows(l, rows).into_owned())?
-            }
-        };
-        let c = observability(&self.u, &self.singular_values, l, order);
         let fs_hz = self.fs_hz;
         let pole = |lambda: Complex64| {
             let s = lambda.ln() * fs_hz;
             let abs = s.norm();
             (abs, -s.re / abs)
         };
-        let kept = kept_eigenvalues(&a, &c, |lambda| {
+        let keep = |lambda| {
             let (abs, damping_ratio) = pole(lambda);
             abs.is_finite() && abs > 0.0 && damping_ratio > 0.0
-        })?;
+        };
+        let kept = if order <= self.m_shift.nrows() {
+            kept_eigenvalues(
+                self.m_shift.view((0, 0), (order, order)),
+                self.c_shift.columns(0, order),
+                keep,
+            )?
+        } else {
+            let dim = i * l;
+            let o = if order <= self.u.ncols() {
+                observability(&self.u, &self.singular_values, dim, order)
+            } else {
+                observability(self.full_u()?, &self.singular_values, dim, order)
+            };
+            let rows = dim - l;
+            let a = least_squares(o.rows(0, rows).into_owned(), &o.rows(l, rows).into_owned())?;
+            kept_eigenvalues(&a, o.rows(0, l), keep)?
+        };
         let mut modes: Vec<SsiMode> = kept
             .into_iter()
             .map(|k| {
@@ -741,22 +781,22 @@ impl SsiCov {
         Ok(modes)
     }
 
-    /// `A` at `order` from the QR computed once, or `None` when `R[..n, ..n]` has a pivot at
-    /// or below `max |R_jj| * rows * eps` (then the caller solves by SVD).
-    fn shift_from_full_qr(&self, order: usize) -> Option<DMatrix<f64>> {
-        if order > self.r_full.nrows() {
-            return None;
-        }
-        let r = self.r_full.view((0, 0), (order, order));
-        let diag = r.diagonal();
-        let rmax = diag.amax();
-        let rows = (self.block_rows - 1) * self.n_channels;
-        let tiny = rmax * rows.max(order) as f64 * f64::EPSILON;
-        if rmax.is_nan() || rmax <= 0.0 || diag.iter().any(|d| d.abs() <= tiny) {
-            return None;
-        }
-        let b = self.qt_down_full.view((0, 0), (order, order)).into_owned();
-        r.solve_upper_triangular(&b)
+    /// All the left singular vectors of `T` (nalgebra's SVD, computed once, on the first order
+    /// above the columns kept by [`SsiCov::from_correlations`]).
+    fn full_u(&self) -> Result<&DMatrix<f64>, SsiError> {
+        let dim = self.toeplitz.nrows().max(self.toeplitz.ncols());
+        let iterations = svd_iterations(dim);
+        self.u_full
+            .get_or_init(|| {
+                SVD::try_new(self.toeplitz.clone(), true, false, SVD_EPS, iterations)
+                    .and_then(|svd| svd.u)
+            })
+            .as_ref()
+            .ok_or(SsiError::NotConverged {
+                what: "SVD of the block Toeplitz matrix",
+                size: dim,
+                iterations,
+            })
     }
 
     /// [`SsiCov::poles_at`] for every order of `orders`, the orders on all of rayon's threads
@@ -778,6 +818,17 @@ impl SsiCov {
             singular_values: self.singular_values.clone(),
         })
     }
+}
+
+/// Whether the leading `n x n` block of the triangular `r` (of the QR of `O_up`, `rows` rows)
+/// is safely invertible: every pivot `|R_jj|`, `j < n`, above `max_j |R_jj| max(rows, n) eps`
+/// (over `j < n`); false for a non-finite pivot. True for `n` implies true for every smaller
+/// `n` (the bound only grows with `n`), so the orders that pass are a prefix.
+fn shift_pivots_ok(r: &DMatrix<f64>, n: usize, rows: usize) -> bool {
+    let diag = r.view((0, 0), (n, n)).diagonal();
+    let rmax = diag.amax();
+    let tiny = rmax * rows.max(n) as f64 * f64::EPSILON;
+    rmax > 0.0 && diag.iter().all(|d| d.abs() > tiny)
 }
 
 /// `O = U[.., ..n] S[..n]^{1/2}` (`rows x n`).
@@ -927,6 +978,144 @@ mod tests {
             m.contains("order 4") && m.contains("rank 2") && m.contains("<= 2"),
             "{m}"
         );
+    }
+
+    /// The correlations `R_1 ..= R_{2i-1}` of a seeded random record: three damped modes
+    /// (1.3, 4.1 and 9.7 Hz at 50 Hz) driven by white noise, mixed into `l` channels, plus
+    /// white noise, `n` samples.
+    fn three_mode_correlations(seed: u64, l: usize, n: usize, i: usize) -> Vec<DMatrix<f64>> {
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, StandardNormal};
+        let fs = 50.0;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let mut noise = || -> f64 { StandardNormal.sample(&mut rng) };
+        let mut y = vec![vec![0.0; n]; l];
+        for (m, &(f, z)) in [(1.3, 0.02), (4.1, 0.05), (9.7, 0.03)].iter().enumerate() {
+            let w = 2.0 * PI * f / fs;
+            let r = (-z * w).exp();
+            let (a1, a2) = (2.0 * r * (w * (1.0 - z * z).sqrt()).cos(), -r * r);
+            let (mut x1, mut x2) = (0.0, 0.0);
+            let gains: Vec<f64> = (0..l)
+                .map(|c| ((c + 1) * (m + 2)) as f64 % 3.0 - 1.1)
+                .collect();
+            let xs: Vec<f64> = (0..n)
+                .map(|_| {
+                    let x = a1 * x1 + a2 * x2 + noise();
+                    (x2, x1) = (x1, x);
+                    x
+                })
+                .collect();
+            for (ch, g) in y.iter_mut().zip(&gains) {
+                for (v, x) in ch.iter_mut().zip(&xs) {
+                    *v += g * x;
+                }
+            }
+        }
+        for ch in &mut y {
+            for v in ch.iter_mut() {
+                *v += 0.3 * noise();
+            }
+        }
+        let r: Vec<DMatrix<f64>> = (1..2 * i)
+            .map(|k| {
+                DMatrix::from_fn(l, l, |a, b| {
+                    (0..n - k).map(|t| y[a][t + k] * y[b][t]).sum::<f64>() / (n - k) as f64
+                })
+            })
+            .collect();
+        r
+    }
+
+    /// An order above `order_max` (above the singular vectors kept) takes all of `T`'s left
+    /// singular vectors from nalgebra's SVD: the same modes as from a plan for that order, to
+    /// rounding (1e-9 relative in frequency and damping, 1e-7 in the shapes).
+    #[test]
+    fn orders_above_order_max_are_still_served() {
+        let (l, n, i) = (5, 1200, 8);
+        let r = three_mode_correlations(1, l, n, i);
+        let small = SsiCov::from_correlations(&r, 50.0, i, 6).unwrap();
+        let large = SsiCov::from_correlations(&r, 50.0, i, 20).unwrap();
+        assert_eq!(small.u.ncols(), 6);
+        for order in [8, 14, 20] {
+            let (a, b) = (
+                small.poles_at(order).unwrap(),
+                large.poles_at(order).unwrap(),
+            );
+            assert_eq!(a.len(), b.len(), "order {order}");
+            for (x, y) in a.iter().zip(&b) {
+                assert!((x.frequency_hz - y.frequency_hz).abs() < 1e-9 * y.frequency_hz);
+                assert!((x.damping_ratio - y.damping_ratio).abs() < 1e-9 * y.damping_ratio);
+                for (p, q) in x.shape.iter().zip(&y.shape) {
+                    assert!(
+                        (p[0] - q[0]).abs().max((p[1] - q[1]).abs()) < 1e-7,
+                        "{p:?} {q:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// The modes of order `n` from the leading block of `M = B R^-1` against the definition:
+    /// `A_n` as the least-squares solution of `O_up A = O_down` of that order alone (its own QR)
+    /// and `C` the first block row of `O`, on the correlations of seeded random records (three
+    /// damped modes plus white noise, 5 channels, 1200 samples), every even order up to 30 (the
+    /// noise poles included). The same eigenproblem up to a similarity, so the poles agree to
+    /// rounding times their condition: frequencies and damping ratios to 1e-9 relative, shapes
+    /// (scaled to their largest entry) to 1e-7.
+    #[test]
+    fn leading_blocks_of_the_shared_state_matrix_give_each_orders_least_squares_modes() {
+        let (fs, l, n, i) = (50.0, 5, 1200, 8);
+        let mut checked = 0;
+        for seed in 0..12u64 {
+            let r = three_mode_correlations(seed, l, n, i);
+            let cov = SsiCov::from_correlations(&r, fs, i, 30).unwrap();
+            assert_eq!(cov.m_shift.nrows(), 30, "seed {seed}: every order from M");
+            for order in (2..=30).step_by(2) {
+                let got = cov.poles_at(order).unwrap();
+                let o = observability(&cov.u, &cov.singular_values, i * l, order);
+                let rows = (i - 1) * l;
+                let a = least_squares(o.rows(0, rows).into_owned(), &o.rows(l, rows).into_owned())
+                    .unwrap();
+                let want = kept_eigenvalues(&a, o.rows(0, l), |lambda| {
+                    let s = lambda.ln() * fs;
+                    s.norm() > 0.0 && -s.re / s.norm() > 0.0
+                })
+                .unwrap();
+                assert_eq!(got.len(), want.len(), "seed {seed} order {order}");
+                for k in want {
+                    let s = k.lambda.ln() * fs;
+                    let f = s.norm() / (2.0 * PI);
+                    let z = -s.re / s.norm();
+                    let m = got
+                        .iter()
+                        .min_by(|a, b| {
+                            (a.frequency_hz - f)
+                                .abs()
+                                .total_cmp(&(b.frequency_hz - f).abs())
+                        })
+                        .unwrap();
+                    assert!(
+                        (m.frequency_hz - f).abs() < 1e-9 * f,
+                        "seed {seed} order {order}: {} vs {f}",
+                        m.frequency_hz
+                    );
+                    assert!(
+                        (m.damping_ratio - z).abs() < 1e-9 * z,
+                        "seed {seed} order {order}: {} vs {z}",
+                        m.damping_ratio
+                    );
+                    let shape = normalised_shape(&k.shape);
+                    for (p, q) in m.shape.iter().zip(&shape) {
+                        assert!(
+                            (p[0] - q[0]).abs().max((p[1] - q[1]).abs()) < 1e-7,
+                            "seed {seed} order {order}: {p:?} vs {q:?}"
+                        );
+                    }
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 1000, "{checked} poles compared");
     }
 
     /// `R_1` and `R_5` only, i = 3: the Toeplitz matrix `[[0,0,R1],[0,0,0],[R5,0,0]]` has rank 2

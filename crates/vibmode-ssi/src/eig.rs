@@ -12,7 +12,7 @@
 //! eigenvalues is split into two 1x1 blocks) are skipped, and an eigenvector is computed only
 //! for an eigenvalue the caller keeps.
 
-use nalgebra::DMatrix;
+use nalgebra::DMatrixView;
 use num_complex::Complex64;
 
 use crate::error::SsiError;
@@ -31,11 +31,12 @@ fn schur_iterations(n: usize) -> usize {
 /// The eigenvalues of `a` with `Im > 0` that `keep` accepts, each with `C psi` for its right
 /// eigenvector `psi` (`c` has `a`'s column count), in the order of the Schur form.
 /// Errors: a non-finite entry, or no convergence within [`schur_iterations`] sweeps.
-pub(crate) fn kept_eigenvalues(
-    a: &DMatrix<f64>,
-    c: &DMatrix<f64>,
+pub(crate) fn kept_eigenvalues<'a>(
+    a: impl Into<DMatrixView<'a, f64>>,
+    c: impl Into<DMatrixView<'a, f64>>,
     keep: impl Fn(Complex64) -> bool,
 ) -> Result<Vec<ShapedEigenvalue>, SsiError> {
+    let (a, c) = (a.into(), c.into());
     let n = a.nrows();
     let l = c.nrows();
     debug_assert_eq!(c.ncols(), n, "C needs one column per state");
@@ -52,8 +53,8 @@ pub(crate) fn kept_eigenvalues(
         return Err(not_converged);
     }
     // Column-major copies: t[i + j n] = T[i, j], g[i + j l] = G[i, j].
-    let mut t = a.as_slice().to_vec();
-    let mut g = c.as_slice().to_vec();
+    let mut t: Vec<f64> = a.iter().copied().collect();
+    let mut g: Vec<f64> = c.iter().copied().collect();
     hessenberg(&mut t, n, &mut g, l);
     if !francis(&mut t, n, &mut g, l, iterations) {
         return Err(not_converged);
@@ -92,7 +93,7 @@ fn hessenberg(t: &mut [f64], n: usize, g: &mut [f64], l: usize) {
         // From the left, columns k+1..n, rows k+1..n.
         for j in k + 1..n {
             let col = &mut t[j * n + k + 1..(j + 1) * n];
-            let d = tau * col.iter().zip(v.iter()).map(|(a, b)| a * b).sum::<f64>();
+            let d = tau * vibmode_core::stats::dot(col, v);
             for (e, vi) in col.iter_mut().zip(v.iter()) {
                 *e -= d * vi;
             }
@@ -665,6 +666,7 @@ mod reference {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::DMatrix;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
     use rand_distr::{Distribution, StandardNormal};

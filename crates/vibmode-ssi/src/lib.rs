@@ -24,6 +24,7 @@ mod perturb;
 mod record;
 mod shape;
 mod stability;
+mod svd;
 
 pub use cov::{
     jackknife_std, samples_needed, ssi_cov, SsiCorrelations, SsiCov, SsiMode, SsiOrder, SsiResult,
