@@ -7,9 +7,11 @@
 //! records' equations together, a checked drive fits its own records', and per corner the
 //! fitted spring and damper relative to the other three corners, `ln k_c - mean_{j != c} ln
 //! k_j` (a change of load scales every corner alike and cancels), is compared with the
-//! baseline's. The score divides the change by the two fits' jackknife standard deviations of
-//! `r` itself (over each fit's replicates, each record left out in turn: the corners' errors
-//! are correlated): `z = (r_drive - r_baseline) / sqrt(var_drive + var_baseline)`.
+//! baseline's. The score divides the change by the two fits' jackknife standard deviations
+//! (each record left out in turn): for a spring those of `r` itself over the replicates (the
+//! corners' errors are correlated), for a damper its corners' added as independent, which is
+//! what covers the dampers' drive-to-drive scatter on busgen:
+//! `z = (r_drive - r_baseline) / sqrt(var_drive + var_baseline)`.
 //! A spring or damper that lost stiffness lowers its corner's `r`, so only a low score is an
 //! alarm; the limit is one-sided, Bonferroni over the 4 corners and the 2 components:
 //! `Phi^-1(1 - false_alarm_rate / 8)` (3.02 at 1 %). On busgen's buses the healthy drives'
@@ -136,11 +138,11 @@ pub struct CornerFit {
     /// Whether the model update calls the records' support of the whole fit sufficient (modes
     /// to 1.5 %, springs and dampers to 5 %); the scores use the standard deviations either way.
     pub supported: bool,
-    /// Standard deviations of [`CornerFit::relative`]'s statistics, springs then dampers, from
-    /// the jackknife's replicates of the whole fit (the corners' errors are correlated); absent
-    /// in model sets stored before they were kept.
+    /// Standard deviations of [`CornerFit::relative`]'s spring statistics from the jackknife's
+    /// replicates of the whole fit (the corners' errors are correlated); absent in model sets
+    /// stored before they were kept.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub relative_sd: Option<[[f64; 4]; 2]>,
+    pub spring_relative_sd: Option<[f64; 4]>,
 }
 
 /// Spring or damper.
@@ -162,7 +164,7 @@ impl CornerFit {
             damper_n_s_per_m: [0.0; 4],
             damper_rel_sd: [0.0; 4],
             supported: r.supported,
-            relative_sd: None,
+            spring_relative_sd: None,
         };
         for (i, c) in CORNERS.iter().enumerate() {
             for (p, value, sd) in [
@@ -194,30 +196,18 @@ impl CornerFit {
             }
         }
         let index = |name: &str| r.parameters.iter().position(|p| p.name == name);
-        // The relative statistics of each replicate, and their jackknife spread.
-        let cols: Option<Vec<[usize; 4]>> = ["spring", "damper"]
+        // The springs' relative statistics of each replicate, and their jackknife spread.
+        let cols: Option<Vec<usize>> = CORNERS
             .iter()
-            .map(|what| {
-                let v: Option<Vec<usize>> = CORNERS
-                    .iter()
-                    .map(|c| index(&format!("{what} {c}")))
-                    .collect();
-                v.map(|v| [v[0], v[1], v[2], v[3]])
-            })
+            .map(|c| index(&format!("spring {c}")))
             .collect();
         if let Some(cols) = cols {
-            let sd: Option<Vec<[f64; 4]>> = cols
+            let reps: Vec<[f64; 4]> = r
+                .replicates
                 .iter()
-                .map(|idx| {
-                    let reps: Vec<[f64; 4]> = r
-                        .replicates
-                        .iter()
-                        .map(|rep| idx.map(|i| rep.get(i).copied().unwrap_or(f64::NAN)))
-                        .collect();
-                    jackknife_relative_sd(&reps)
-                })
+                .map(|rep| std::array::from_fn(|c| rep.get(cols[c]).copied().unwrap_or(f64::NAN)))
                 .collect();
-            out.relative_sd = sd.map(|v| [v[0], v[1]]);
+            out.spring_relative_sd = jackknife_relative_sd(&reps);
         }
         Ok(out)
     }
@@ -229,20 +219,17 @@ impl CornerFit {
         }
     }
 
-    /// Per corner `ln v_c - mean_{j != c} ln v_j` and its variance: the square of its own
-    /// jackknife spread over the fit's replicates where the fit kept them
-    /// ([`CornerFit::relative_sd`]: the corners' errors are correlated, e.g. all move with the
-    /// noise share), else from the relative standard deviations with the corners taken as
-    /// independent (model sets stored before).
+    /// Per corner `ln v_c - mean_{j != c} ln v_j` and its variance. For the springs, where the
+    /// fit kept it ([`CornerFit::spring_relative_sd`]), the square of the statistic's own
+    /// jackknife spread over the fit's replicates (the corners' errors are correlated, e.g. all
+    /// move with the noise share, which cancels); else, and for the dampers, from the relative
+    /// standard deviations with the corners taken as independent, which on busgen is what
+    /// covers the dampers' drive-to-drive scatter (docs/fleet.md).
     pub fn relative(&self, part: Part) -> [(f64, f64); 4] {
         let (v, sd) = self.values(part);
         let stat = relative_of(v);
-        if let Some(rsd) = self.relative_sd {
-            let p = match part {
-                Part::Spring => 0,
-                Part::Damper => 1,
-            };
-            return std::array::from_fn(|c| (stat[c], rsd[p][c].powi(2)));
+        if let (Part::Spring, Some(rsd)) = (part, self.spring_relative_sd) {
+            return std::array::from_fn(|c| (stat[c], rsd[c].powi(2)));
         }
         std::array::from_fn(|c| {
             let others = (0..4)
@@ -361,7 +348,7 @@ mod tests {
             damper_n_s_per_m: [1.0e4; 4],
             damper_rel_sd: [sd; 4],
             supported: true,
-            relative_sd: None,
+            spring_relative_sd: None,
         }
     }
 
@@ -431,11 +418,16 @@ mod tests {
         let mut bad = one.clone();
         bad[1][2] = 0.0;
         assert!(jackknife_relative_sd(&bad).is_none());
-        // The statistic's variance is then the square of that spread, not the independent sum.
+        // The springs' variance is then the square of that spread, not the independent sum.
+        // The dampers keep the corners' spreads added as independent: 0.03^2 (1 + 3 / 9).
         let mut f = fit([1.0e5; 4], 0.03);
-        f.relative_sd = Some([sd, [0.01; 4]]);
+        f.spring_relative_sd = Some(sd);
         let rel = f.relative(Part::Spring);
         assert!((rel[0].1 - want * want).abs() < 1e-15);
-        assert!((f.relative(Part::Damper)[3].1 - 1e-4).abs() < 1e-15);
+        let damper = f.relative(Part::Damper)[3].1;
+        assert!(
+            (damper - 0.03_f64.powi(2) * (4.0 / 3.0)).abs() < 1e-15,
+            "{damper}"
+        );
     }
 }
