@@ -363,11 +363,12 @@ fn hash_file(path: &Path) -> Result<String> {
 
 /// Reads and analyses every file (a file whose bytes the vehicle already has is not read
 /// again; the same bytes twice in `paths` are analysed once). `layout` checks each read
-/// recording first. `progress(n)` is called as each of the `n` first finished files is done.
+/// recording first. `progress(n)` is called as the first `n` files are done.
 ///
-/// The files are hashed and looked up in the store in order, then read and analysed in
-/// parallel (rayon's pool; at most one recording per thread in memory); the results keep the
-/// order of `paths`, and the first error in that order is returned.
+/// The files go in chunks of as many as rayon's pool has threads: each chunk's files are hashed
+/// and looked up in the store in order, then read and analysed in parallel (so at most one
+/// recording per thread is in memory, and a file is read again soon after it was hashed). The
+/// results keep the order of `paths`; the first error in that order is returned.
 fn prepare_files(
     store: &Store,
     labels: &IngestLabels<'_>,
@@ -378,110 +379,88 @@ fn prepare_files(
     progress: &dyn Fn(usize),
 ) -> Result<Vec<Prepared>> {
     use rayon::prelude::*;
-    /// What each path needs.
+    /// What a path needs.
     enum Plan {
         /// Stored before for the vehicle: its features (the equations added if they lack them).
         Known(Box<RecordFeatures>),
-        /// The same bytes as the earlier path at this index.
+        /// The same bytes as the path at this index, read before in this call.
         Same(usize),
         /// To be read and analysed.
         New,
     }
     let model = registered_model(store, labels.vehicle)?;
-    let mut plans: Vec<(String, String, Plan)> = Vec::with_capacity(paths.len());
-    for path in paths {
-        let name = file_name(path);
-        let sha = hash_file(path)?;
-        let plan = if let Some(row) = store.find_record(labels.vehicle, &sha)? {
-            Plan::Known(Box::new(store.features(row.id)?))
-        } else if let Some(k) = plans.iter().position(|p| p.1 == sha) {
-            Plan::Same(k)
-        } else {
-            Plan::New
-        };
-        plans.push((name, sha, plan));
-    }
     let model = model.as_ref();
-    let work = |i: usize| -> Result<Prepared> {
-        let (name, sha, plan) = &plans[i];
-        let path = paths[i];
-        if let Plan::Known(stored) = plan {
-            let fresh = with_equations(stored, model, path, opts, cfg)?;
-            return Ok(Prepared {
-                file: name.clone(),
-                sha256: sha.clone(),
-                metadata: serde_json::json!({}),
-                refreshed: fresh.is_some(),
-                features: fresh.unwrap_or_else(|| (**stored).clone()),
-                known: true,
-            });
-        }
-        let rec = vibmode_signal::read_path(path, opts)?;
-        layout(name, &rec)?;
-        let mut features = compute_features(name, &rec, cfg)?;
-        check_nominal_sensors(labels.condition, name, &features)?;
-        add_body_equations(&mut features, &rec, model, cfg);
-        Ok(Prepared {
-            file: name.clone(),
-            sha256: sha.clone(),
-            metadata: metadata_of(&rec),
-            features,
-            known: false,
-            refreshed: false,
-        })
-    };
-    // Every path but the repeated ones, analysed in parallel; this thread reports progress.
-    let todo: Vec<usize> = (0..plans.len())
-        .filter(|&i| !matches!(plans[i].2, Plan::Same(_)))
-        .collect();
-    let (tx, rx) = std::sync::mpsc::channel::<()>();
-    let (todo_ref, work) = (&todo, &work);
-    let results: Vec<Result<Prepared>> = std::thread::scope(|scope| {
-        let worker = scope.spawn(move || {
-            // A chunk of as many files as threads at a time: a thread waiting inside one
-            // file's analysis could otherwise steal and start another file, and hold more
-            // recordings in memory than there are threads.
-            let mut all: Vec<Result<Prepared>> = Vec::with_capacity(todo_ref.len());
-            for chunk in todo_ref.chunks(rayon::current_num_threads().max(1)) {
-                let part: Vec<Result<Prepared>> = chunk
-                    .par_iter()
-                    .map_with(tx.clone(), |tx, &i| {
-                        let r = work(i);
-                        // The receiver outlives every sender (drained below).
-                        let _ = tx.send(());
-                        r
-                    })
-                    .collect();
-                all.extend(part);
+    // A path's prepared record, or `None` for a repeat (taken from the first).
+    let work = |path: &Path, name: &str, sha: &str, plan: &Plan| -> Result<Option<Prepared>> {
+        match plan {
+            Plan::Same(_) => Ok(None),
+            Plan::Known(stored) => {
+                let fresh = with_equations(stored, model, path, opts, cfg)?;
+                Ok(Some(Prepared {
+                    file: name.to_string(),
+                    sha256: sha.to_string(),
+                    metadata: serde_json::json!({}),
+                    refreshed: fresh.is_some(),
+                    features: fresh.unwrap_or_else(|| (**stored).clone()),
+                    known: true,
+                }))
             }
-            all
-        });
-        for (n, ()) in rx.iter().enumerate() {
-            progress(n + 1);
+            Plan::New => {
+                let rec = vibmode_signal::read_path(path, opts)?;
+                layout(name, &rec)?;
+                let mut features = compute_features(name, &rec, cfg)?;
+                check_nominal_sensors(labels.condition, name, &features)?;
+                add_body_equations(&mut features, &rec, model, cfg);
+                Ok(Some(Prepared {
+                    file: name.to_string(),
+                    sha256: sha.to_string(),
+                    metadata: metadata_of(&rec),
+                    features,
+                    known: false,
+                    refreshed: false,
+                }))
+            }
         }
-        worker
-            .join()
-            .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
-    });
-    // In the order of `paths`: `todo` holds every index but the repeated ones, in order.
-    let mut results = todo.iter().copied().zip(results).peekable();
+    };
+    let mut first_of: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
     let mut out: Vec<Prepared> = Vec::with_capacity(paths.len());
-    for (i, (name, sha, plan)) in plans.iter().enumerate() {
-        if let Plan::Same(k) = plan {
-            let features = out[*k].features.clone();
-            out.push(Prepared {
-                file: name.clone(),
-                sha256: sha.clone(),
-                metadata: serde_json::json!({}),
-                features,
-                known: false,
-                refreshed: false,
-            });
-        } else if let Some((_, r)) = results.next_if(|(j, _)| *j == i) {
-            out.push(r?);
+    for chunk in paths.chunks(rayon::current_num_threads().max(1)) {
+        let mut plans: Vec<(String, String, Plan)> = Vec::with_capacity(chunk.len());
+        for path in chunk {
+            let name = file_name(path);
+            let sha = hash_file(path)?;
+            let plan = if let Some(row) = store.find_record(labels.vehicle, &sha)? {
+                Plan::Known(Box::new(store.features(row.id)?))
+            } else if let Some(&k) = first_of.get(&sha) {
+                Plan::Same(k)
+            } else {
+                first_of.insert(sha.clone(), out.len() + plans.len());
+                Plan::New
+            };
+            plans.push((name, sha, plan));
         }
+        let results: Vec<Result<Option<Prepared>>> = chunk
+            .par_iter()
+            .zip(plans.par_iter())
+            .map(|(path, (name, sha, plan))| work(path, name, sha, plan))
+            .collect();
+        for (r, (name, sha, plan)) in results.into_iter().zip(plans) {
+            if let Some(p) = r? {
+                out.push(p);
+            } else if let Plan::Same(k) = plan {
+                let features = out[k].features.clone();
+                out.push(Prepared {
+                    file: name,
+                    sha256: sha,
+                    metadata: serde_json::json!({}),
+                    features,
+                    known: false,
+                    refreshed: false,
+                });
+            }
+        }
+        progress(out.len());
     }
-    progress(out.len());
     Ok(out)
 }
 

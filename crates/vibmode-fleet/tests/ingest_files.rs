@@ -36,16 +36,30 @@ fn files(dir: &Path) -> Vec<PathBuf> {
         .collect()
 }
 
+/// On pools of 1 to 4 threads: the files go in chunks of that many, so a repeat and a bad file
+/// fall in the same chunk as the first copy or the good files before them, or in a later one.
 #[test]
 fn order_duplicates_and_the_first_error_in_order() {
     let dir = tempfile::tempdir().unwrap();
     let f = files(dir.path());
+    for threads in 1..=4 {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let run = dir.path().join(format!("t{threads}"));
+        std::fs::create_dir(&run).unwrap();
+        pool.install(|| ingest_in(&run, &f));
+    }
+}
+
+fn ingest_in(dir: &Path, f: &[PathBuf]) {
     let cfg = common::config();
-    let (mut store, _) = Store::init(&dir.path().join("f.db")).unwrap();
+    let (mut store, _) = Store::init(&dir.join("f.db")).unwrap();
     store.set_config(&cfg).unwrap();
     // A bad file third and another last: the third is named, nothing is stored.
-    let bad1 = dir.path().join("bad_1.csv");
-    let bad2 = dir.path().join("bad_2.csv");
+    let bad1 = dir.join("bad_1.csv");
+    let bad2 = dir.join("bad_2.csv");
     std::fs::write(&bad1, "a,b\n1,x\n").unwrap();
     std::fs::write(&bad2, "nonsense").unwrap();
     let given: Vec<&Path> = vec![&f[0], &f[1], &bad1, &f[2], &bad2];
@@ -74,7 +88,7 @@ fn order_duplicates_and_the_first_error_in_order() {
     ids.dedup();
     assert_eq!(ids.len(), 5);
     // Each record's stored features are its own file's: the same as ingesting it alone.
-    let (mut alone, _) = Store::init(&dir.path().join("g.db")).unwrap();
+    let (mut alone, _) = Store::init(&dir.join("g.db")).unwrap();
     alone.set_config(&cfg).unwrap();
     for (k, p) in given.iter().enumerate() {
         let one = ingest_files(&mut alone, &labels(), &[p], &ReadOptions::default(), &cfg)
