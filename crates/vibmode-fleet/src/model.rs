@@ -1111,7 +1111,7 @@ fn fitted_evidence(
         };
         scores.n_vehicle += 1;
         scores.vehicle_max_abs_z = scores.vehicle_max_abs_z.max(f.z.abs());
-        if f.z < -reference.limit {
+        if f.flagged(reference.limit) {
             out.push(Evidence {
                 meta: FeatureMeta {
                     key: format!("fit:{what}:{}", f.corner),
@@ -1124,7 +1124,7 @@ fn fitted_evidence(
                 value: f.value,
                 centre: f.centre,
                 z: f.z,
-                change_pct: 100.0 * (f.value / f.centre - 1.0),
+                change_pct: 100.0 * f.change(),
                 limit: reference.limit,
                 flagged: true,
             });
