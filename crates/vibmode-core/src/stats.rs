@@ -62,6 +62,19 @@ pub fn dot(x: &[f64], z: &[f64]) -> f64 {
     (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
+/// The jackknife standard deviation of an estimate from its leave-one-out values `theta`
+/// (`m >= 2` of them): `sqrt((m - 1) / m * sum (theta_s - mean)^2)`. 0 for fewer than two.
+/// SSI-cov's modes, the model update's parameters and the fleet's suspension scores use it.
+pub fn jackknife_std(theta: &[f64]) -> f64 {
+    let m = theta.len();
+    if m < 2 {
+        return 0.0;
+    }
+    let mean = theta.iter().sum::<f64>() / m as f64;
+    let ss: f64 = theta.iter().map(|t| (t - mean) * (t - mean)).sum();
+    ((m as f64 - 1.0) / m as f64 * ss).sqrt()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -251,7 +251,7 @@ fn relative_of(v: &[f64; 4]) -> [f64; 4] {
 }
 
 /// The jackknife standard deviation of [`relative_of`] per corner from the replicates of a fit
-/// (the values with each record left out in turn): `sqrt((k - 1) / k sum (x_i - mean)^2)`.
+/// (the values with each record left out in turn; [`vibmode_core::stats::jackknife_std`]).
 /// `None` with fewer than [`MIN_FIT_RECORDS`] replicates or a value that is not positive.
 fn jackknife_relative_sd(replicates: &[[f64; 4]]) -> Option<[f64; 4]> {
     if replicates.len() < MIN_FIT_RECORDS
@@ -263,10 +263,8 @@ fn jackknife_relative_sd(replicates: &[[f64; 4]]) -> Option<[f64; 4]> {
         return None;
     }
     let stats: Vec<[f64; 4]> = replicates.iter().map(relative_of).collect();
-    let k = stats.len() as f64;
     Some(std::array::from_fn(|c| {
-        let mean = stats.iter().map(|s| s[c]).sum::<f64>() / k;
-        ((k - 1.0) / k * stats.iter().map(|s| (s[c] - mean).powi(2)).sum::<f64>()).sqrt()
+        vibmode_core::stats::jackknife_std(&stats.iter().map(|s| s[c]).collect::<Vec<_>>())
     }))
 }
 

@@ -7,6 +7,8 @@ use serde::{Deserialize, Serialize};
 use vibmode_core::limits::{SSI_SAMPLES_PER_LAG_MIN, SSI_TOEPLITZ_ROWS_MAX};
 use vibmode_core::SsiParams;
 
+pub use vibmode_core::stats::jackknife_std;
+
 use crate::eig::kept_eigenvalues;
 use crate::error::SsiError;
 use crate::shape::mpc;
@@ -526,18 +528,6 @@ fn lag_sums(
         }
     }
     (sums, counts)
-}
-
-/// The jackknife standard deviation of an estimate from its leave-one-out values `theta`
-/// (`m >= 2` of them): `sqrt((m - 1) / m * sum (theta_s - mean)^2)`. 0 for fewer than two.
-pub fn jackknife_std(theta: &[f64]) -> f64 {
-    let m = theta.len();
-    if m < 2 {
-        return 0.0;
-    }
-    let mean = theta.iter().sum::<f64>() / m as f64;
-    let ss: f64 = theta.iter().map(|t| (t - mean) * (t - mean)).sum();
-    ((m as f64 - 1.0) / m as f64 * ss).sqrt()
 }
 
 impl SsiCov {

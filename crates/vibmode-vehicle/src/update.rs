@@ -944,11 +944,7 @@ impl BodyFit {
                 }
             }
         }
-        let jack = |xs: &[f64]| -> f64 {
-            let k = xs.len() as f64;
-            let mean = xs.iter().sum::<f64>() / k;
-            ((k - 1.0) / k * xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>()).sqrt()
-        };
+        let jack = vibmode_core::stats::jackknife_std;
         let have_sd = not_supported.is_none() && loo_values.len() >= 3;
         let parameters: Vec<FittedParameter> = values
             .iter()
