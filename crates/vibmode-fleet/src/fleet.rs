@@ -301,6 +301,7 @@ fn with_equations(
     features: &RecordFeatures,
     model: Option<&VehicleModel>,
     path: &Path,
+    bytes: &[u8],
     opts: &ReadOptions,
     cfg: &FleetConfig,
 ) -> Result<Option<RecordFeatures>> {
@@ -310,7 +311,7 @@ fn with_equations(
     if !features.lacks_equations_of(&model.sha256) {
         return Ok(None);
     }
-    let rec = vibmode_signal::read_path(path, opts)?;
+    let rec = vibmode_signal::read_path_bytes(path, bytes, opts)?;
     Ok(model
         .record_equations(&rec, &cfg.analysis)
         .ok()
@@ -353,22 +354,25 @@ fn file_name(path: &Path) -> String {
     record_file_name(path)
 }
 
-fn hash_file(path: &Path) -> Result<String> {
+/// A file's bytes and their SHA-256.
+fn read_and_hash(path: &Path) -> Result<(Vec<u8>, String)> {
     let bytes = std::fs::read(path).map_err(|e| FleetError::Io {
         path: path.display().to_string(),
         reason: e.to_string(),
     })?;
-    Ok(sha256_hex(&bytes))
+    let sha = sha256_hex(&bytes);
+    Ok((bytes, sha))
 }
 
-/// Reads and analyses every file (a file whose bytes the vehicle already has is not read
+/// Reads and analyses every file (a file whose bytes the vehicle already has is not analysed
 /// again; the same bytes twice in `paths` are analysed once). `layout` checks each read
 /// recording first. `progress(n)` is called as the first `n` files are done.
 ///
-/// The files go in chunks of as many as rayon's pool has threads: each chunk's files are hashed
-/// and looked up in the store in order, then read and analysed in parallel (so at most one
-/// recording per thread is in memory, and a file is read again soon after it was hashed). The
-/// results keep the order of `paths`; the first error in that order is returned.
+/// The files go in chunks of as many as rayon's pool has threads: each chunk's files are read
+/// and hashed in parallel, looked up in the store in order, then parsed from the bytes read
+/// and analysed in parallel (so at most one recording per thread is in memory, and each file
+/// is read from disk once). The results keep the order of `paths`; the first error in that
+/// order is returned.
 fn prepare_files(
     store: &Store,
     labels: &IngestLabels<'_>,
@@ -391,11 +395,16 @@ fn prepare_files(
     let model = registered_model(store, labels.vehicle)?;
     let model = model.as_ref();
     // A path's prepared record, or `None` for a repeat (taken from the first).
-    let work = |path: &Path, name: &str, sha: &str, plan: &Plan| -> Result<Option<Prepared>> {
+    let work = |path: &Path,
+                bytes: Vec<u8>,
+                name: &str,
+                sha: &str,
+                plan: &Plan|
+     -> Result<Option<Prepared>> {
         match plan {
             Plan::Same(_) => Ok(None),
             Plan::Known(stored) => {
-                let fresh = with_equations(stored, model, path, opts, cfg)?;
+                let fresh = with_equations(stored, model, path, &bytes, opts, cfg)?;
                 Ok(Some(Prepared {
                     file: name.to_string(),
                     sha256: sha.to_string(),
@@ -406,7 +415,8 @@ fn prepare_files(
                 }))
             }
             Plan::New => {
-                let rec = vibmode_signal::read_path(path, opts)?;
+                let rec = vibmode_signal::read_path_bytes(path, &bytes, opts)?;
+                drop(bytes);
                 layout(name, &rec)?;
                 let mut features = compute_features(name, &rec, cfg)?;
                 check_nominal_sensors(labels.condition, name, &features)?;
@@ -425,10 +435,14 @@ fn prepare_files(
     let mut first_of: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
     let mut out: Vec<Prepared> = Vec::with_capacity(paths.len());
     for chunk in paths.chunks(rayon::current_num_threads().max(1)) {
+        // Each file is read once: hashed here (in parallel), parsed from the same bytes below.
+        let read: Vec<Result<(Vec<u8>, String)>> =
+            chunk.par_iter().map(|p| read_and_hash(p)).collect();
         let mut plans: Vec<(String, String, Plan)> = Vec::with_capacity(chunk.len());
-        for path in chunk {
+        let mut contents: Vec<Vec<u8>> = Vec::with_capacity(chunk.len());
+        for (path, r) in chunk.iter().zip(read) {
             let name = file_name(path);
-            let sha = hash_file(path)?;
+            let (bytes, sha) = r?;
             let plan = if let Some(row) = store.find_record(labels.vehicle, &sha)? {
                 Plan::Known(Box::new(store.features(row.id)?))
             } else if let Some(&k) = first_of.get(&sha) {
@@ -437,12 +451,17 @@ fn prepare_files(
                 first_of.insert(sha.clone(), out.len() + plans.len());
                 Plan::New
             };
+            contents.push(match plan {
+                Plan::Same(_) => Vec::new(),
+                _ => bytes,
+            });
             plans.push((name, sha, plan));
         }
         let results: Vec<Result<Option<Prepared>>> = chunk
             .par_iter()
+            .zip(contents.into_par_iter())
             .zip(plans.par_iter())
-            .map(|(path, (name, sha, plan))| work(path, name, sha, plan))
+            .map(|((path, bytes), (name, sha, plan))| work(path, bytes, name, sha, plan))
             .collect();
         for (r, (name, sha, plan)) in results.into_iter().zip(plans) {
             if let Some(p) = r? {

@@ -54,8 +54,8 @@ pub use delimited::{Block, ColumnInfo, DelimitedReader, Separator};
 pub use error::{SidecarProblem, SignalError, WavProblem};
 pub use preprocess::{preprocess, Preprocessed};
 pub use read::{
-    read_delimited, read_delimited_bytes, read_path, sidecar_candidates, time_unit_scale, Format,
-    ReadOptions, Sidecar, WavSidecar,
+    read_delimited, read_delimited_bytes, read_path, read_path_bytes, sidecar_candidates,
+    time_unit_scale, Format, ReadOptions, Sidecar, WavSidecar,
 };
 pub use records::{ChainedRecords, StreamRecords};
 pub use resample::ResampleRecording;

@@ -159,15 +159,30 @@ impl ReadOptions {
 ///
 /// All samples are checked to be finite; channel order is file order (time column removed).
 pub fn read_path(path: &Path, opts: &ReadOptions) -> Result<Recording> {
+    read_path_or_bytes(path, None, opts)
+}
+
+/// Reads a recording from the bytes of the file at `path`, already read (for example to hash
+/// them): the same result as [`read_path`] without reading the file again. `path` gives the
+/// format (unless `opts.format` does), names the file in messages and finds a WAV's sidecar;
+/// a raw file is read from `path` with its sidecar as by [`read_path`].
+pub fn read_path_bytes(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Recording> {
+    read_path_or_bytes(path, Some(bytes), opts)
+}
+
+fn read_path_or_bytes(path: &Path, bytes: Option<&[u8]>, opts: &ReadOptions) -> Result<Recording> {
     opts.check()?;
     let format = opts.format.unwrap_or_else(|| Format::from_path(path));
-    let mut rec = match format {
-        Format::Delimited => {
+    let mut rec = match (format, bytes) {
+        (Format::Delimited, Some(bytes)) => {
+            read_delimited_bytes(bytes, &path.display().to_string(), opts)?
+        }
+        (Format::Delimited, None) => {
             let bytes = std::fs::read(path).map_err(|e| io_err("read", path, &e))?;
             read_delimited_bytes(&bytes, &path.display().to_string(), opts)?
         }
-        Format::Wav => read_wav(path, opts)?,
-        Format::Raw => read_raw(path, opts)?,
+        (Format::Wav, bytes) => read_wav(path, bytes, opts)?,
+        (Format::Raw, _) => read_raw(path, opts)?,
     };
     crate::error::check_names_of(path, rec.channels.iter().map(|c| c.name.as_str()))?;
     if let Some(u) = &opts.unit {
@@ -415,24 +430,50 @@ pub(crate) fn interp_uniform(t: &[f64], y: &[f64], t0: f64, dt: f64) -> Vec<f64>
     out
 }
 
-fn read_wav(path: &Path, opts: &ReadOptions) -> Result<Recording> {
+fn read_wav(path: &Path, bytes: Option<&[u8]>, opts: &ReadOptions) -> Result<Recording> {
     let p = path.display().to_string();
     let wav_err = |problem: WavProblem| SignalError::Wav {
         path: p.clone(),
         problem,
     };
-    if !path.exists() {
-        return Err(io_err(
-            "read",
-            path,
-            &std::io::Error::from(std::io::ErrorKind::NotFound),
-        ));
-    }
-    let reader = hound::WavReader::open(path).map_err(|e| {
+    let unreadable = |e: hound::Error| {
         wav_err(WavProblem::Unreadable {
             message: e.to_string(),
         })
-    })?;
+    };
+    match bytes {
+        Some(b) => read_wav_from(
+            path,
+            hound::WavReader::new(std::io::Cursor::new(b)).map_err(unreadable)?,
+            opts,
+        ),
+        None => {
+            if !path.exists() {
+                return Err(io_err(
+                    "read",
+                    path,
+                    &std::io::Error::from(std::io::ErrorKind::NotFound),
+                ));
+            }
+            read_wav_from(
+                path,
+                hound::WavReader::open(path).map_err(unreadable)?,
+                opts,
+            )
+        }
+    }
+}
+
+fn read_wav_from<R: std::io::Read>(
+    path: &Path,
+    reader: hound::WavReader<R>,
+    opts: &ReadOptions,
+) -> Result<Recording> {
+    let p = path.display().to_string();
+    let wav_err = |problem: WavProblem| SignalError::Wav {
+        path: p.clone(),
+        problem,
+    };
     let spec = reader.spec();
     let (nch, float, k) = wav_layout(&spec, opts, &wav_err)?;
     let interleaved: Vec<f64> = if float {

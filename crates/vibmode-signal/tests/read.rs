@@ -5,8 +5,8 @@ use rand_chacha::ChaCha8Rng;
 use std::path::{Path, PathBuf};
 use vibmode_signal::ResampleRecording;
 use vibmode_signal::{
-    read_delimited, read_path, write_path, Channel, ChannelSelector, DelimitedReader, Format,
-    ReadOptions, Recording,
+    read_delimited, read_path, read_path_bytes, write_path, Channel, ChannelSelector,
+    DelimitedReader, Format, ReadOptions, Recording,
 };
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
@@ -494,6 +494,37 @@ fn write_read_roundtrip_identity() {
     assert_eq!(Format::Raw.to_string(), "raw");
     let e = err_of("mat".parse::<Format>());
     assert!(e.contains("'mat'") && e.contains("delimited"), "{e}");
+}
+
+/// Reading from the file's bytes in memory gives what reading the file gives, for every
+/// format (names, units from a WAV's sidecar, rate, samples bit for bit), and the same errors.
+#[test]
+fn bytes_in_memory_read_as_the_file() {
+    let d = tempfile::tempdir().unwrap();
+    for (seed, name) in [(3u64, "r.csv"), (4, "r.wav"), (5, "r.f32"), (6, "r.txt")] {
+        let rec = random_recording(seed, 700, 7, 2_000.0);
+        let p = d.path().join(name);
+        write_path(&p, &rec).unwrap();
+        let bytes = std::fs::read(&p).unwrap();
+        let a = read_path(&p, &ReadOptions::default()).unwrap();
+        let b = read_path_bytes(&p, &bytes, &ReadOptions::default()).unwrap();
+        assert_eq!(a.fs_hz, b.fs_hz, "{name}");
+        assert_eq!(a.names(), b.names(), "{name}");
+        for (x, y) in a.channels.iter().zip(&b.channels) {
+            assert_eq!(x.unit, y.unit, "{name}");
+            assert_eq!(x.samples, y.samples, "{name}");
+        }
+    }
+    // Bad bytes: the same one-line errors as the file's.
+    for (name, text) in [
+        ("bad.csv", "a,b\n1,2\n3,x\n"),
+        ("bad.wav", "RIFF....not a wav"),
+    ] {
+        let p = write(d.path(), name, text);
+        let a = err_of(read_path(&p, &opts_fs(100.0)));
+        let b = err_of(read_path_bytes(&p, text.as_bytes(), &opts_fs(100.0)));
+        assert_eq!(a, b, "{name}");
+    }
 }
 
 #[test]

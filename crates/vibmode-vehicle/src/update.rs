@@ -1283,7 +1283,24 @@ struct Derivatives {
     len: usize,
     fs_hz: f64,
     band_hz: [f64; 2],
-    planner: RealFftPlanner<f64>,
+    /// The record's Hann window and the sum of its squares, made on first use and shared by
+    /// the channels.
+    hann: Option<(Vec<f64>, f64)>,
+}
+
+thread_local! {
+    /// FFT plans shared by every record a thread works on (their twiddle factors are the
+    /// costly part of a plan at a record's length).
+    static PLANNER: std::cell::RefCell<RealFftPlanner<f64>> =
+        std::cell::RefCell::new(RealFftPlanner::new());
+}
+
+fn plan_forward(n: usize) -> std::sync::Arc<dyn realfft::RealToComplex<f64>> {
+    PLANNER.with(|p| p.borrow_mut().plan_fft_forward(n))
+}
+
+fn plan_inverse(n: usize) -> std::sync::Arc<dyn realfft::ComplexToReal<f64>> {
+    PLANNER.with(|p| p.borrow_mut().plan_fft_inverse(n))
 }
 
 impl Derivatives {
@@ -1292,8 +1309,27 @@ impl Derivatives {
             len,
             fs_hz,
             band_hz,
-            planner: RealFftPlanner::new(),
+            hann: None,
         }
+    }
+
+    /// The Hann window of `n` samples and the sum of its squares.
+    fn hann(&mut self, n: usize) -> &(Vec<f64>, f64) {
+        let make = || {
+            let mut wsum = 0.0;
+            let w: Vec<f64> = (0..n)
+                .map(|k| {
+                    let w = 0.5 - 0.5 * (2.0 * std::f64::consts::PI * k as f64 / n as f64).cos();
+                    wsum += w * w;
+                    w
+                })
+                .collect();
+            (w, wsum)
+        };
+        if self.hann.as_ref().is_some_and(|(w, _)| w.len() != n) {
+            self.hann = None;
+        }
+        self.hann.get_or_insert_with(make)
     }
 
     /// The band-pass gain at `f` Hz.
@@ -1319,9 +1355,39 @@ impl Derivatives {
     /// over the record's samples, `h_k` the circular kernel of the band-pass times `(i w)^k`),
     /// so the samples near the record's ends, whose kernels reach past it, count less.
     fn noise_cov(&mut self, keep: &[usize]) -> Result<[[f64; 3]; 3]> {
+        // They depend on the record's length, rate, band and instants only, so the records of
+        // a drive (equal lengths) share them: kept per thread for the last few such keys.
+        type Key = (usize, u64, [u64; 2], Vec<usize>);
+        thread_local! {
+            static SUMS: std::cell::RefCell<Vec<(Key, [[f64; 3]; 3])>> =
+                const { std::cell::RefCell::new(Vec::new()) };
+        }
+        let key: Key = (
+            self.len,
+            self.fs_hz.to_bits(),
+            self.band_hz.map(f64::to_bits),
+            keep.to_vec(),
+        );
+        if let Some(sums) =
+            SUMS.with(|c| c.borrow().iter().find(|(k, _)| *k == key).map(|(_, v)| *v))
+        {
+            return Ok(sums);
+        }
+        let sums = self.noise_cov_sums(keep)?;
+        SUMS.with(|c| {
+            let mut c = c.borrow_mut();
+            if c.len() >= 4 {
+                c.remove(0);
+            }
+            c.push((key, sums));
+        });
+        Ok(sums)
+    }
+
+    fn noise_cov_sums(&mut self, keep: &[usize]) -> Result<[[f64; 3]; 3]> {
         use num_complex::Complex64;
         let (n, m) = (self.len, 2 * self.len);
-        let inv = self.planner.plan_fft_inverse(m);
+        let inv = plan_inverse(m);
         let df = self.fs_hz / m as f64;
         let mut h: Vec<Vec<f64>> = Vec::with_capacity(3);
         for k in 0..3 {
@@ -1376,7 +1442,7 @@ impl Derivatives {
     fn apply(&mut self, x: &[f64], keep: &[usize]) -> Result<([Vec<f64>; 3], f64)> {
         use num_complex::Complex64;
         let m = 2 * self.len;
-        let fwd = self.planner.plan_fft_forward(m);
+        let fwd = plan_forward(m);
         let mean = x.iter().sum::<f64>() / x.len().max(1) as f64;
         let mut buf = fwd.make_input_vec();
         buf.iter_mut().zip(x).for_each(|(b, v)| *b = v - mean);
@@ -1390,13 +1456,12 @@ impl Derivatives {
                 // A Hann-windowed periodogram of the record (its sidelobes fall fast, so a
                 // strong tone does not spread over the range).
                 let n = x.len();
-                let plan = self.planner.plan_fft_forward(n);
+                let plan = plan_forward(n);
                 let mut hb = plan.make_input_vec();
-                let mut wsum = 0.0;
-                for (k, (b, v)) in hb.iter_mut().zip(x).enumerate() {
-                    let w = 0.5 - 0.5 * (2.0 * std::f64::consts::PI * k as f64 / n as f64).cos();
+                let (window, wsum) = self.hann(n);
+                let wsum = *wsum;
+                for ((b, v), w) in hb.iter_mut().zip(x).zip(window) {
                     *b = w * (v - mean);
-                    wsum += w * w;
                 }
                 let mut spec = plan.make_output_vec();
                 plan.process(&mut hb, &mut spec)
@@ -1471,6 +1536,28 @@ impl Derivatives {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The kept noise sums are those of their own key: records of other lengths, rates, bands
+    /// and instants, taken in turn, each get the sums computed afresh for them, bit for bit.
+    #[test]
+    fn shared_noise_sums_follow_their_key() {
+        let cases = [
+            (400usize, 50.0, [0.5, 2.0], 20usize),
+            (600, 50.0, [0.5, 2.0], 20),
+            (400, 60.0, [0.5, 2.0], 20),
+            (400, 50.0, [0.6, 2.0], 20),
+            (400, 50.0, [0.5, 2.0], 30),
+            (400, 50.0, [0.5, 2.0], 20),
+        ];
+        for _ in 0..2 {
+            for &(n, fs, band, edge) in &cases {
+                let keep: Vec<usize> = (edge..n - edge).step_by(3).collect();
+                let shared = Derivatives::new(n, fs, band).noise_cov(&keep).unwrap();
+                let own = Derivatives::new(n, fs, band).noise_cov_sums(&keep).unwrap();
+                assert_eq!(shared, own, "n {n} fs {fs} band {band:?} edge {edge}");
+            }
+        }
+    }
 
     /// By hand: x = sin(2 pi f t) at f = 1 Hz inside the flat part of the band has
     /// x' = 2 pi cos(2 pi f t) and x'' = -(2 pi)^2 sin(2 pi f t); away from the record ends the
