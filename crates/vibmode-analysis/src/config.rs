@@ -284,6 +284,18 @@ impl AnalysisConfig {
 
     /// As [`AnalysisConfig::from_toml_str`], with `preset` (when given) as the base.
     fn from_toml_with_preset(text: &str, given: Option<Preset>) -> Result<Self, AnalysisError> {
+        Self::from_toml_over(text, given, &AnalysisConfig::preset)
+    }
+
+    /// Reads a TOML config over the defaults `base(preset)` instead of the preset's own: for a
+    /// caller whose defaults differ from the presets' (the fleet runs ARMA only, with its own
+    /// model-update band), so that a file giving one key keeps the caller's other defaults.
+    /// The preset is `given`, else the TOML's `preset` key, else vibmode's; validated.
+    pub fn from_toml_over(
+        text: &str,
+        given: Option<Preset>,
+        base: &dyn Fn(Preset) -> AnalysisConfig,
+    ) -> Result<Self, AnalysisError> {
         let mut value: toml::Value = toml::from_str(text).map_err(|e| AnalysisError::Config {
             key: None,
             message: e.to_string().replace('\n', " "),
@@ -303,11 +315,9 @@ impl AnalysisConfig {
             (g, f) => g.or(f).unwrap_or_default(),
         };
         // Merge the file over the preset's defaults.
-        let mut base = toml::Value::try_from(AnalysisConfig::preset(preset)).map_err(|e| {
-            AnalysisError::Config {
-                key: None,
-                message: e.to_string(),
-            }
+        let mut base = toml::Value::try_from(base(preset)).map_err(|e| AnalysisError::Config {
+            key: None,
+            message: e.to_string(),
         })?;
         merge(&mut base, value);
         let cfg: AnalysisConfig =

@@ -76,21 +76,27 @@ pub struct FleetConfig {
     pub floor_body_response: f64,
 }
 
+/// The fleet's per-record analysis: the `preset`'s, with ARMA only and the fleet's model-update
+/// band. An `[analysis]` table in the fleet's settings overrides these, key by key.
+pub fn fleet_analysis(preset: vibmode_analysis::Preset) -> AnalysisConfig {
+    AnalysisConfig {
+        // The features use the per-channel modes only: no multichannel identification.
+        method: vibmode_core::IdentMethod::Arma.into(),
+        // The suspension fitted per drive (a registered vehicle model file): the body
+        // still rigid, the manoeuvres below (docs/fleet.md, "The suspension fitted per
+        // drive": healthy drives scattered least with 0.7-5 Hz on busgen's buses).
+        model_update: vibmode_core::BodyFitParams {
+            band_hz: Some(SUSPENSION_BAND_HZ),
+            ..vibmode_core::BodyFitParams::default()
+        },
+        ..AnalysisConfig::preset(preset)
+    }
+}
+
 impl Default for FleetConfig {
     fn default() -> Self {
         FleetConfig {
-            // The features use the per-channel modes only: no multichannel identification.
-            analysis: AnalysisConfig {
-                method: vibmode_core::IdentMethod::Arma.into(),
-                // The suspension fitted per drive (a registered vehicle model file): the body
-                // still rigid, the manoeuvres below (docs/fleet.md, "The suspension fitted per
-                // drive": healthy drives scattered least with 0.7-5 Hz on busgen's buses).
-                model_update: vibmode_core::BodyFitParams {
-                    band_hz: Some(SUSPENSION_BAND_HZ),
-                    ..vibmode_core::BodyFitParams::default()
-                },
-                ..AnalysisConfig::default()
-            },
+            analysis: fleet_analysis(vibmode_analysis::Preset::default()),
             bands_hz: vec![
                 [0.5, 2.0],
                 [2.0, 5.0],
@@ -156,11 +162,35 @@ fn short_reason(message: &str) -> String {
 impl FleetConfig {
     /// Parses and validates TOML settings (every key optional: the defaults above; the
     /// per-record analysis under `[analysis]`, with the keys of docs/analysis.md).
+    ///
+    /// Keys missing from `[analysis]` take the fleet's defaults ([`fleet_analysis`]), not a
+    /// standalone analysis's: a table that only sets `[analysis.sweep] order_max` keeps ARMA
+    /// only and the fleet's model-update band.
     pub fn from_toml_str(text: &str, path: &str) -> Result<Self> {
-        let cfg: FleetConfig = toml::from_str(text).map_err(|e| FleetError::ConfigFile {
+        let file_err = |reason: String| FleetError::ConfigFile {
             path: path.to_string(),
-            reason: short_reason(e.message()),
-        })?;
+            reason,
+        };
+        let mut value: toml::Value =
+            toml::from_str(text).map_err(|e| file_err(short_reason(e.message())))?;
+        let analysis = value.as_table_mut().and_then(|t| t.remove("analysis"));
+        let mut cfg: FleetConfig = value
+            .try_into()
+            .map_err(|e: toml::de::Error| file_err(short_reason(e.message())))?;
+        if let Some(table) = analysis {
+            let text = match table {
+                toml::Value::Table(t) => {
+                    toml::to_string(&t).map_err(|e| file_err(format!("[analysis]: {e}")))?
+                }
+                other => {
+                    return Err(file_err(format!(
+                        "analysis = {other} is not a table; give the analysis keys under [analysis]"
+                    )))
+                }
+            };
+            cfg.analysis = AnalysisConfig::from_toml_over(&text, None, &fleet_analysis)
+                .map_err(|e| file_err(format!("[analysis]: {}", short_reason(&e.to_string()))))?;
+        }
         cfg.validate()?;
         Ok(cfg)
     }

@@ -21,7 +21,7 @@ pub mod store;
 pub mod suspension;
 
 pub use body::{fit_body_model, BodyModel, BodySpectra};
-pub use config::FleetConfig;
+pub use config::{fleet_analysis, FleetConfig, SUSPENSION_BAND_HZ};
 pub use error::{FleetError, Result};
 pub use features::{
     check_sampling, compute_features, sensor_faults, ChannelFeatures, CornerTransmissibility,

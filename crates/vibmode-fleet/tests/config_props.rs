@@ -161,3 +161,44 @@ fn the_settings_of_the_issue_are_refused() {
     let ok = FleetConfig::from_toml_str("false_alarm_rate = 1e-9", "fleet.toml").expect("1e-9");
     assert!(bonferroni_limit(ok.false_alarm_rate, 100).is_finite());
 }
+
+/// An `[analysis]` table overrides the fleet's analysis key by key: one sweep key leaves the
+/// fleet's ARMA-only method and model-update band (before, any `[analysis]` key brought back a
+/// standalone analysis's defaults: SSI-cov too and no band). A preset key takes that preset
+/// under the fleet's own choices; a misspelt key is refused, naming it.
+#[test]
+fn an_analysis_table_keeps_the_fleets_other_defaults() {
+    use vibmode_analysis::Preset;
+    use vibmode_fleet::fleet_analysis;
+    let cfg =
+        FleetConfig::from_toml_str("[analysis.sweep]\norder_max = 20\n", "fleet.toml").unwrap();
+    let want = {
+        let mut a = fleet_analysis(Preset::Vibmode);
+        a.sweep.order_max = 20;
+        a
+    };
+    assert_eq!(cfg.analysis, want);
+    assert_eq!(cfg.analysis.method, vibmode_core::IdentMethod::Arma.into());
+    assert_eq!(
+        cfg.analysis.model_update.band_hz,
+        Some(vibmode_fleet::SUSPENSION_BAND_HZ)
+    );
+    assert_eq!(cfg, {
+        let mut d = FleetConfig::default();
+        d.analysis.sweep.order_max = 20;
+        d
+    });
+    let paper =
+        FleetConfig::from_toml_str("[analysis]\npreset = \"paper\"\n", "fleet.toml").unwrap();
+    assert_eq!(paper.analysis, fleet_analysis(Preset::Paper));
+    assert_ne!(paper.analysis.preprocess, cfg.analysis.preprocess);
+    for (text, key) in [
+        ("[analysis.sweep]\norder_maxx = 20\n", "order_maxx"),
+        ("analysis = 3\n", "analysis"),
+        ("[analysis.sweep]\norder_max = 0\n", "order_max"),
+    ] {
+        let e = FleetConfig::from_toml_str(text, "fleet.toml").expect_err(text);
+        let msg = e.to_string();
+        assert!(msg.contains(key) && !msg.contains('\n'), "{text}: {msg}");
+    }
+}
