@@ -29,7 +29,7 @@ every checked drive (not the baseline), e.g. to see what the driveline lines or 
 noise do to a verdict.
 
 Usage: python3 tools/busgen/fleet.py [--buses N] [--records 8] [--json OUT] [--keep DIR]
-       [--test-extra OPTS]
+       [--test-extra OPTS] [--config FLEET.toml]
 Needs VIBMODE_BIN (else target/release/vibmode) and a Python with numpy+scipy for busgen
 (BUSGEN_PYTHON).
 """
@@ -125,7 +125,8 @@ def more_drives(bus_seed: int, n_healthy: int) -> List[Dict]:
 
 def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
             test_extra: Optional[List[str]] = None, keep: bool = False,
-            model: bool = False, n_more: int = 0) -> Dict:
+            model: bool = False, n_more: int = 0,
+            config: Optional[Path] = None) -> Dict:
     """Simulates, ingests, baselines and checks one bus; returns its rows.
 
     The store is deleted unless `keep` (then it stays in `work` as fleet-SEED.db, beside each
@@ -135,7 +136,7 @@ def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
         db.unlink()
     vehicle = f"bus{bus_seed}"
     base_seed = rng.randrange(1, 10**6)
-    h.run_vibmode(["fleet", "init", "--db", db])
+    h.run_vibmode(["fleet", "init", "--db", db, *(["--config", config] if config else [])])
     base = []
     for d in range(2):
         folder = h.simulate(bus_seed, base_seed + 1000 * d, records=n_records)
@@ -229,6 +230,8 @@ def main(argv: Optional[List[str]] = None) -> int:
                         "for the suspension fitted per drive")
     p.add_argument("--more", type=int, default=0, metavar="K",
                    help="K more healthy drives per bus and a spring at 80 %% at each corner")
+    p.add_argument("--config", type=Path,
+                   help="fleet settings (TOML) given to `fleet init --config`")
     p.add_argument("--test-extra", default="",
                    help="busgen options added to every checked drive, "
                         "e.g. --test-extra=--no-periodic")
@@ -239,7 +242,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         print(f"skipped: {e}")
         return 0
     seeds = h.draw_bus_seeds(a.buses, "fleet")
-    buses = measure(seeds, a.records, a.test_extra.split(), a.keep, a.model, a.more)
+    buses = measure(seeds, a.records, a.test_extra.split(), a.keep, a.model, a.more, a.config)
     summary = summarise(buses)
     print_summary(summary)
     if a.json:
@@ -249,7 +252,8 @@ def main(argv: Optional[List[str]] = None) -> int:
 
 def measure(seeds: List[int], n_records: int = h.RECORDS,
             test_extra: Optional[List[str]] = None, keep: Optional[Path] = None,
-            model: bool = False, n_more: int = 0) -> List[Dict]:
+            model: bool = False, n_more: int = 0,
+            config: Optional[Path] = None) -> List[Dict]:
     """Runs the buses of `seeds`; with `keep`, their stores and checks stay in that folder."""
     if keep is not None:
         keep.mkdir(parents=True, exist_ok=True)
@@ -258,7 +262,8 @@ def measure(seeds: List[int], n_records: int = h.RECORDS,
     try:
         for s in seeds:
             rng = random.Random(s * 7919 + n_records)
-            b = run_bus(s, n_records, work, rng, test_extra, keep is not None, model, n_more)
+            b = run_bus(s, n_records, work, rng, test_extra, keep is not None, model, n_more,
+                        config)
             for r in b["rows"]:
                 print_row(r)
             buses.append(b)

@@ -442,11 +442,15 @@ fn read_wav(path: &Path, bytes: Option<&[u8]>, opts: &ReadOptions) -> Result<Rec
         })
     };
     match bytes {
-        Some(b) => read_wav_from(
-            path,
-            hound::WavReader::new(std::io::Cursor::new(b)).map_err(unreadable)?,
-            opts,
-        ),
+        Some(b) => {
+            let reader = hound::WavReader::new(std::io::Cursor::new(b)).map_err(unreadable)?;
+            let spec = reader.spec();
+            if spec.sample_format == hound::SampleFormat::Float && spec.bits_per_sample == 32 {
+                float_wav_from_bytes(path, reader, opts)
+            } else {
+                read_wav_from(path, reader, opts)
+            }
+        }
         None => {
             if !path.exists() {
                 return Err(io_err(
@@ -462,6 +466,68 @@ fn read_wav(path: &Path, bytes: Option<&[u8]>, opts: &ReadOptions) -> Result<Rec
             )
         }
     }
+}
+
+/// A 32-bit float WAV in memory: its data chunk decoded straight into the channels (the same
+/// values as hound's sample iterator, `f32 as f64 * scale`, without an interleaved copy).
+fn float_wav_from_bytes(
+    path: &Path,
+    reader: hound::WavReader<std::io::Cursor<&[u8]>>,
+    opts: &ReadOptions,
+) -> Result<Recording> {
+    let p = path.display().to_string();
+    let wav_err = |problem: WavProblem| SignalError::Wav {
+        path: p.clone(),
+        problem,
+    };
+    let spec = reader.spec();
+    let (nch, _, k) = wav_layout(&spec, opts, &wav_err)?;
+    let declared = reader.len() as usize;
+    let cursor = reader.into_inner();
+    let start = (cursor.position() as usize).min(cursor.get_ref().len());
+    let data = &cursor.get_ref()[start..];
+    if data.len() / 4 < declared {
+        return Err(wav_err(WavProblem::Truncated {
+            message: format!(
+                "the data chunk declares {declared} samples, the file holds {}",
+                data.len() / 4
+            ),
+        }));
+    }
+    let n = declared / nch;
+    if n == 0 {
+        return Err(wav_err(WavProblem::NoSamples));
+    }
+    let fs = reconcile_fs(
+        &p,
+        "the WAV header".into(),
+        spec.sample_rate as f64,
+        opts.fs_hz,
+    )?;
+    let (names, units) = wav_names(path, nch)?;
+    let mut samples: Vec<Vec<f64>> = (0..nch).map(|_| Vec::with_capacity(n)).collect();
+    for frame in data[..4 * nch * n].chunks_exact(4 * nch) {
+        for (ch, v) in samples.iter_mut().zip(frame.chunks_exact(4)) {
+            let v = f32::from_le_bytes([v[0], v[1], v[2], v[3]]);
+            ch.push(v as f64 * k);
+        }
+    }
+    let channels: Vec<Channel> = samples
+        .into_iter()
+        .enumerate()
+        .map(|(c, samples)| Channel {
+            placement: Default::default(),
+            name: names[c].clone(),
+            unit: units[c].clone(),
+            samples,
+        })
+        .collect();
+    check_finite(&channels)?;
+    Ok(Recording {
+        fs_hz: fs,
+        channels,
+        time_axis: None,
+    })
 }
 
 fn read_wav_from<R: std::io::Read>(

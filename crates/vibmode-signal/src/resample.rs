@@ -237,9 +237,17 @@ struct Ffts {
     scratch_len: usize,
 }
 
+/// FFT plans shared by every resampler of the process: a plan's twiddle factors cost about as
+/// much as one transform of its length, and the records of a run have a few lengths only. The
+/// same planner gives the same algorithm for a length, so the results are the same bits.
+static PLANNER: std::sync::LazyLock<std::sync::Mutex<RealFftPlanner<f64>>> =
+    std::sync::LazyLock::new(|| std::sync::Mutex::new(RealFftPlanner::new()));
+
 impl Ffts {
     fn plan(kind: Kind, n_in: usize, n_out: usize) -> Ffts {
-        let mut planner = RealFftPlanner::<f64>::new();
+        // A poisoned lock only means another thread panicked while planning; the planner's
+        // cache is still a valid cache.
+        let mut planner = PLANNER.lock().unwrap_or_else(|e| e.into_inner());
         let (fwd, inv) = match kind {
             Kind::Pick | Kind::Linear => (None, None),
             Kind::Fold => (

@@ -515,6 +515,18 @@ fn bytes_in_memory_read_as_the_file() {
             assert_eq!(x.samples, y.samples, "{name}");
         }
     }
+    // A float WAV cut short: both refuse it as truncated.
+    let rec = random_recording(8, 300, 3, 1_000.0);
+    let p = d.path().join("cut.wav");
+    write_path(&p, &rec).unwrap();
+    let mut bytes = std::fs::read(&p).unwrap();
+    bytes.truncate(bytes.len() - 10);
+    std::fs::write(&p, &bytes).unwrap();
+    let a = err_of(read_path(&p, &ReadOptions::default()));
+    let b = err_of(read_path_bytes(&p, &bytes, &ReadOptions::default()));
+    for e in [&a, &b] {
+        assert!(e.contains("may be truncated") && !e.contains('\n'), "{e}");
+    }
     // Bad bytes: the same one-line errors as the file's.
     for (name, text) in [
         ("bad.csv", "a,b\n1,2\n3,x\n"),

@@ -1288,19 +1288,22 @@ struct Derivatives {
     hann: Option<(Vec<f64>, f64)>,
 }
 
-thread_local! {
-    /// FFT plans shared by every record a thread works on (their twiddle factors are the
-    /// costly part of a plan at a record's length).
-    static PLANNER: std::cell::RefCell<RealFftPlanner<f64>> =
-        std::cell::RefCell::new(RealFftPlanner::new());
+/// FFT plans shared by every record of the process (their twiddle factors are the costly part
+/// of a plan at a record's length; one planner gives the same algorithm, so the same bits).
+static PLANNER: std::sync::LazyLock<std::sync::Mutex<RealFftPlanner<f64>>> =
+    std::sync::LazyLock::new(|| std::sync::Mutex::new(RealFftPlanner::new()));
+
+fn planner() -> std::sync::MutexGuard<'static, RealFftPlanner<f64>> {
+    // A poisoned lock only means another thread panicked while planning; the cache is valid.
+    PLANNER.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 fn plan_forward(n: usize) -> std::sync::Arc<dyn realfft::RealToComplex<f64>> {
-    PLANNER.with(|p| p.borrow_mut().plan_fft_forward(n))
+    planner().plan_fft_forward(n)
 }
 
 fn plan_inverse(n: usize) -> std::sync::Arc<dyn realfft::ComplexToReal<f64>> {
-    PLANNER.with(|p| p.borrow_mut().plan_fft_inverse(n))
+    planner().plan_fft_inverse(n)
 }
 
 impl Derivatives {
