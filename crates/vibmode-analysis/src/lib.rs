@@ -156,6 +156,26 @@ pub enum AnalysisError {
         /// Duration needed, s.
         needed_s: f64,
     },
+    /// The sweep's highest order needs more samples than the longest record has.
+    #[error("sweep order_max = {order_max} needs at least {needed} samples per record at the analysis rate {} Hz ({needed_s:.3} s), the longest record '{record}' has {n_samples} ({duration_s:.3} s): lower order_max to {highest} or less, or give longer records", short(*fs_hz))]
+    OrderMaxTooHigh {
+        /// The sweep's highest order.
+        order_max: usize,
+        /// Samples it needs.
+        needed: usize,
+        /// Duration it needs, s.
+        needed_s: f64,
+        /// The longest record.
+        record: String,
+        /// Its samples after pre-processing.
+        n_samples: usize,
+        /// The analysis rate reached, Hz.
+        fs_hz: f64,
+        /// Its duration, s.
+        duration_s: f64,
+        /// The highest order its samples support.
+        highest: usize,
+    },
     /// A recording breaks its invariants.
     #[error(transparent)]
     Recording(#[from] vibmode_core::RecordingError),

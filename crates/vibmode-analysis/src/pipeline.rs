@@ -81,12 +81,13 @@ fn check_lengths_named<'n>(
     pre: &[Preprocessed],
     cfg: &AnalysisConfig,
 ) -> Result<(), AnalysisError> {
-    let params = match cfg.sweep.model {
-        vibmode_core::SweepModel::Arma => 2 * cfg.sweep.order_min,
-        vibmode_core::SweepModel::Ar => cfg.sweep.order_min,
+    let per_order = match cfg.sweep.model {
+        vibmode_core::SweepModel::Arma => 2,
+        vibmode_core::SweepModel::Ar => 1,
     };
-    let needed = (SAMPLES_PER_PARAMETER * params).max(8);
-    for (name, p) in names.zip(pre) {
+    let needed = (SAMPLES_PER_PARAMETER * per_order * cfg.sweep.order_min).max(8);
+    let names: Vec<&str> = names.collect();
+    for (name, p) in names.iter().zip(pre) {
         let n = p.recording.len();
         if n < needed {
             return Err(AnalysisError::RecordTooShort {
@@ -97,6 +98,25 @@ fn check_lengths_named<'n>(
                 order_min: cfg.sweep.order_min,
                 needed,
                 needed_s: needed as f64 / p.band.fs_hz,
+            });
+        }
+    }
+    // The highest order must be within reach of the longest record (a short last record only
+    // fits the orders it can; orders no record can fit would make every fit above them fail and
+    // no cluster reach its share of the orders).
+    if let Some((name, p)) = names.iter().zip(pre).max_by_key(|(_, p)| p.recording.len()) {
+        let n = p.recording.len();
+        let needed_max = SAMPLES_PER_PARAMETER * per_order * cfg.sweep.order_max;
+        if n < needed_max {
+            return Err(AnalysisError::OrderMaxTooHigh {
+                order_max: cfg.sweep.order_max,
+                needed: needed_max,
+                needed_s: needed_max as f64 / p.band.fs_hz,
+                record: name.to_string(),
+                n_samples: n,
+                fs_hz: p.band.fs_hz,
+                duration_s: n as f64 / p.band.fs_hz,
+                highest: n / (SAMPLES_PER_PARAMETER * per_order),
             });
         }
     }
