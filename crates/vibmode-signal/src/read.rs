@@ -439,11 +439,7 @@ pub(crate) fn interp_uniform(t: &[f64], y: &[f64], t0: f64, dt: f64) -> Vec<f64>
 }
 
 fn read_wav(path: &Path, bytes: Option<&[u8]>, opts: &ReadOptions) -> Result<Recording> {
-    let p = path.display().to_string();
-    let wav_err = |problem: WavProblem| SignalError::Wav {
-        path: p.clone(),
-        problem,
-    };
+    let wav_err = wav_error(path);
     let unreadable = |e: hound::Error| {
         wav_err(WavProblem::Unreadable {
             message: e.to_string(),
@@ -476,6 +472,14 @@ fn read_wav(path: &Path, bytes: Option<&[u8]>, opts: &ReadOptions) -> Result<Rec
     }
 }
 
+/// The error of a WAV file at `path`.
+fn wav_error(path: &Path) -> impl Fn(WavProblem) -> SignalError + '_ {
+    move |problem| SignalError::Wav {
+        path: path.display().to_string(),
+        problem,
+    }
+}
+
 /// A 32-bit float WAV in memory: its data chunk decoded straight into the channels (the same
 /// values as hound's sample iterator, `f32 as f64 * scale`, without an interleaved copy).
 fn float_wav_from_bytes(
@@ -483,11 +487,7 @@ fn float_wav_from_bytes(
     reader: hound::WavReader<std::io::Cursor<&[u8]>>,
     opts: &ReadOptions,
 ) -> Result<Recording> {
-    let p = path.display().to_string();
-    let wav_err = |problem: WavProblem| SignalError::Wav {
-        path: p.clone(),
-        problem,
-    };
+    let wav_err = wav_error(path);
     let spec = reader.spec();
     let (nch, _, k) = wav_layout(&spec, opts, &wav_err)?;
     let declared = reader.len() as usize;
@@ -503,16 +503,6 @@ fn float_wav_from_bytes(
         }));
     }
     let n = declared / nch;
-    if n == 0 {
-        return Err(wav_err(WavProblem::NoSamples));
-    }
-    let fs = reconcile_fs(
-        &p,
-        "the WAV header".into(),
-        spec.sample_rate as f64,
-        opts.fs_hz,
-    )?;
-    let (names, units) = wav_names(path, nch)?;
     let mut samples: Vec<Vec<f64>> = (0..nch).map(|_| Vec::with_capacity(n)).collect();
     for frame in data[..4 * nch * n].chunks_exact(4 * nch) {
         for (ch, v) in samples.iter_mut().zip(frame.chunks_exact(4)) {
@@ -520,22 +510,7 @@ fn float_wav_from_bytes(
             ch.push(v as f64 * k);
         }
     }
-    let channels: Vec<Channel> = samples
-        .into_iter()
-        .enumerate()
-        .map(|(c, samples)| Channel {
-            placement: Default::default(),
-            name: names[c].clone(),
-            unit: units[c].clone(),
-            samples,
-        })
-        .collect();
-    check_finite(&channels)?;
-    Ok(Recording {
-        fs_hz: fs,
-        channels,
-        time_axis: None,
-    })
+    wav_recording(path, &spec, opts, samples)
 }
 
 fn read_wav_from<R: std::io::Read>(
@@ -543,57 +518,68 @@ fn read_wav_from<R: std::io::Read>(
     reader: hound::WavReader<R>,
     opts: &ReadOptions,
 ) -> Result<Recording> {
-    let p = path.display().to_string();
-    let wav_err = |problem: WavProblem| SignalError::Wav {
-        path: p.clone(),
-        problem,
-    };
+    let wav_err = wav_error(path);
     let spec = reader.spec();
     let (nch, float, k) = wav_layout(&spec, opts, &wav_err)?;
+    let truncated = |e: hound::Error| {
+        wav_err(WavProblem::Truncated {
+            message: e.to_string(),
+        })
+    };
     let interleaved: Vec<f64> = if float {
         reader
             .into_samples::<f32>()
             .map(|s| s.map(|v| v as f64 * k))
             .collect::<std::result::Result<_, _>>()
-            .map_err(|e| {
-                wav_err(WavProblem::Truncated {
-                    message: e.to_string(),
-                })
-            })?
+            .map_err(truncated)?
     } else {
         reader
             .into_samples::<i32>()
             .map(|s| s.map(|v| v as f64 * k))
             .collect::<std::result::Result<_, _>>()
-            .map_err(|e| {
-                wav_err(WavProblem::Truncated {
-                    message: e.to_string(),
-                })
-            })?
+            .map_err(truncated)?
     };
     let n = interleaved.len() / nch;
-    if n == 0 {
-        return Err(wav_err(WavProblem::NoSamples));
-    }
-    let fs = reconcile_fs(
-        &p,
-        "the WAV header".into(),
-        spec.sample_rate as f64,
-        opts.fs_hz,
-    )?;
-    let (names, units) = wav_names(path, nch)?;
-    let channels: Vec<Channel> = (0..nch)
-        .map(|c| Channel {
-            placement: Default::default(),
-            name: names[c].clone(),
-            unit: units[c].clone(),
-            samples: interleaved
+    let samples = (0..nch)
+        .map(|c| {
+            interleaved
                 .iter()
                 .skip(c)
                 .step_by(nch)
                 .take(n)
                 .copied()
-                .collect(),
+                .collect()
+        })
+        .collect();
+    wav_recording(path, &spec, opts, samples)
+}
+
+/// The recording of a WAV's decoded channels: refused without samples; its rate checked
+/// against `opts.fs_hz`, names and units from its sidecar, every sample finite.
+fn wav_recording(
+    path: &Path,
+    spec: &hound::WavSpec,
+    opts: &ReadOptions,
+    samples: Vec<Vec<f64>>,
+) -> Result<Recording> {
+    if samples.first().map_or(true, |s| s.is_empty()) {
+        return Err(wav_error(path)(WavProblem::NoSamples));
+    }
+    let fs = reconcile_fs(
+        &path.display().to_string(),
+        "the WAV header".into(),
+        spec.sample_rate as f64,
+        opts.fs_hz,
+    )?;
+    let (names, units) = wav_names(path, samples.len())?;
+    let channels: Vec<Channel> = samples
+        .into_iter()
+        .zip(names.into_iter().zip(units))
+        .map(|(samples, (name, unit))| Channel {
+            placement: Default::default(),
+            name,
+            unit,
+            samples,
         })
         .collect();
     check_finite(&channels)?;
