@@ -39,12 +39,12 @@ DAY_RECORDS_8H = int(8 * 3600 / RECORD_S)
 CORNERS = ["fl", "fr", "rl", "rr"]
 
 
-def features_task(path, settings):
+def features_task(path, settings, content_hash):
     # One core per task: the worker's parallelism is the cluster's, not rayon's.
     os.environ.setdefault("RAYON_NUM_THREADS", "1")
     import vibmode
 
-    return vibmode.fleet.features(path, settings=settings)
+    return vibmode.fleet.features(path, settings=settings, content_hash=content_hash)
 
 
 def simulate_fleet(seeds, records, fs, damper_bus, damper_corner, road_bus):
@@ -76,13 +76,15 @@ def run(fleet, seeds, n_workers, workdir):
     db = os.path.join(workdir, f"fleet-{n_workers}.db")
     vibmode.fleet.init(db)
     settings = vibmode.fleet.settings(db)
+    content_hash = vibmode.fleet.content_hash(db)
     paths = [(i, kind, p) for i in sorted(fleet) for kind in ("baseline", "day") for p in fleet[i][kind]]
     os.environ["RAYON_NUM_THREADS"] = "1"
     with dd.LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
                          dashboard_address=None) as cluster, dd.Client(cluster) as client:
         client.run(lambda: os.environ.__setitem__("RAYON_NUM_THREADS", "1"))
         t0 = time.perf_counter()
-        futures = client.map(features_task, [p for _, _, p in paths], settings=settings, pure=False)
+        futures = client.map(features_task, [p for _, _, p in paths], settings=settings,
+                             content_hash=content_hash, pure=False)
         items = client.gather(futures)
         t_features = time.perf_counter() - t0
     by = collections.defaultdict(list)

@@ -122,11 +122,13 @@ def analyze_record(
     storage_options: Optional[Dict[str, Any]] = None,
     settings: Optional[Dict[str, Any]] = None,
     model: Optional[str] = None,
+    content_hash: str = "blake3",
 ) -> Dict[str, Any]:
     """The per-record task: analyse one recording, write OUT/modes/<record>.parquet, return its
     summary row (and its fleet-store features when asked, computed with the store's `settings`,
     vibmode.fleet.settings(db), and the vehicle's registered model file, vibmode.fleet.model(db,
-    vehicle), whose body equations `fleet ingest` keeps too)."""
+    vehicle), whose body equations `fleet ingest` keeps too, keyed by the store's content hash,
+    vibmode.fleet.content_hash(db))."""
     so = storage_options or {}
     t0 = time.perf_counter()
     # The record is named by its path or URL as listed (as `vibmode analyze` and `vibmode fleet
@@ -136,7 +138,8 @@ def analyze_record(
     with local_copy(url, so) as path:
         res = vibmode.analyze(path, fs=fs_hz, as_frames=False, **analysis)
         feats = (
-            vibmode.fleet.features(path, fs=fs_hz, settings=settings, model=model)
+            vibmode.fleet.features(path, fs=fs_hz, settings=settings, model=model,
+                                   content_hash=content_hash)
             if with_features
             else None
         )
@@ -195,18 +198,22 @@ def run(
     feats = store is not None
     settings = None
     model = None
+    content_hash = "blake3"
     if store is not None:
         # The store's settings (`vibmode fleet init --config`, or the defaults), read once here and
         # shipped to every task: the workers' features are then the ones `fleet ingest` stores.
         vibmode.fleet.init(store)
         settings = vibmode.fleet.settings(store)
         model = vibmode.fleet.model(store, vehicle)
+        content_hash = vibmode.fleet.content_hash(store)
     if client is None:
-        results = [analyze_record(f, out, analysis, fs_hz, feats, so, settings, model) for f in files]
+        results = [analyze_record(f, out, analysis, fs_hz, feats, so, settings, model, content_hash)
+                   for f in files]
     else:
         # A lambda is shipped by value (cloudpickle), with analyze_record inside it: the workers
         # need vibmode installed, not this script.
-        task = lambda url: analyze_record(url, out, analysis, fs_hz, feats, so, settings, model)  # noqa: E731
+        task = lambda url: analyze_record(  # noqa: E731
+            url, out, analysis, fs_hz, feats, so, settings, model, content_hash)
         futures = client.map(task, files, pure=False)
         results = client.gather(futures)
     records = pd.DataFrame([r["summary"] for r in results])

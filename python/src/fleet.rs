@@ -11,7 +11,7 @@ use vibmode_fleet::{
     build_baseline, check_drive_files_progress, ingest_files, require_baseline, Condition,
     FleetConfig, IngestLabels, Store,
 };
-use vibmode_fleet::{compute_features, sha256_hex, FleetError, Ingested, RecordFeatures};
+use vibmode_fleet::{compute_features, ContentHash, FleetError, Ingested, RecordFeatures};
 
 use crate::errors::{fleet_err, json_err};
 
@@ -22,6 +22,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fleet_ingest, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_register, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_model, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet_content_hash, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_baseline, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_check, m)?)?;
     m.add_function(wrap_pyfunction!(fleet_status, m)?)?;
@@ -126,6 +127,14 @@ fn fleet_register(py: Python<'_>, db: PathBuf, vehicle: &str, model: PathBuf) ->
     .to_string())
 }
 
+/// The hash function the store keys its records by (`sha256` or `blake3`), for the workers'
+/// [`fleet_features`].
+#[pyfunction]
+fn fleet_content_hash(py: Python<'_>, db: PathBuf) -> PyResult<String> {
+    py.detach(|| Ok::<_, FleetError>(Store::open(&db)?.content_hash()?.as_str().to_string()))
+        .map_err(fleet_err)
+}
+
 /// The vehicle's registered model file's text, if any (for the workers' [`fleet_features`]).
 #[pyfunction]
 fn fleet_model(py: Python<'_>, db: PathBuf, vehicle: &str) -> PyResult<Option<String>> {
@@ -208,7 +217,9 @@ fn fleet_status(py: Python<'_>, db: PathBuf, last: usize) -> PyResult<String> {
 #[derive(Serialize, serde::Deserialize)]
 struct FeaturesOut {
     file: String,
-    sha256: String,
+    /// The file's content hash (hex) and the function that made it (the store's).
+    content_hash: String,
+    content_hash_kind: ContentHash,
     metadata: serde_json::Value,
     features: RecordFeatures,
 }
@@ -217,7 +228,7 @@ struct FeaturesOut {
 /// without touching a store, with the settings `settings_json` (from [`fleet_settings`]; `None`:
 /// the defaults); JSON for [`fleet_store_features`].
 #[pyfunction]
-#[pyo3(signature = (path, fs=None, scale=1.0, unit=None, settings_json=None, allow_nonuniform=false, time_unit=None, model_toml=None))]
+#[pyo3(signature = (path, fs=None, scale=1.0, unit=None, settings_json=None, allow_nonuniform=false, time_unit=None, model_toml=None, content_hash="blake3"))]
 #[allow(clippy::too_many_arguments)]
 fn fleet_features(
     py: Python<'_>,
@@ -229,7 +240,9 @@ fn fleet_features(
     allow_nonuniform: bool,
     time_unit: Option<&str>,
     model_toml: Option<&str>,
+    content_hash: &str,
 ) -> PyResult<String> {
+    let kind: ContentHash = content_hash.parse().map_err(fleet_err)?;
     let cfg = settings_from_json(settings_json)?;
     let model = model_toml
         .map(|t| vibmode_fleet::suspension::VehicleModel::from_toml(t, "model"))
@@ -242,14 +255,16 @@ fn fleet_features(
                 path: path.display().to_string(),
                 reason: e.to_string(),
             })?;
-            let sha256 = sha256_hex(&bytes);
-            let rec = vibmode_signal::read_path(&path, &opts)?;
+            let key = kind.hex(&bytes);
+            let rec = vibmode_signal::read_path_bytes(&path, &bytes, &opts)?;
+            drop(bytes);
             let file = vibmode_fleet::record_file_name(&path);
             let mut features = compute_features(&file, &rec, &cfg)?;
             vibmode_fleet::add_body_equations(&mut features, &rec, model.as_ref(), &cfg);
             Ok::<_, FleetError>(FeaturesOut {
                 file,
-                sha256,
+                content_hash: key,
+                content_hash_kind: kind,
                 metadata: serde_json::json!({
                     "fs_hz": rec.fs_hz,
                     "n_samples": rec.len(),
@@ -281,6 +296,15 @@ fn fleet_store_features(
         .detach(|| {
             vibmode_fleet::check_vehicle_id(vehicle)?;
             let mut store = Store::open(&db)?;
+            let kind = store.content_hash()?;
+            if let Some(it) = items.iter().find(|it| it.content_hash_kind != kind) {
+                return Err(FleetError::ContentHashMismatch {
+                    path: db.display().to_string(),
+                    file: it.file.clone(),
+                    given: it.content_hash_kind,
+                    store: kind,
+                });
+            }
             // A record the vehicle already has, stored without the body equations the worker
             // made (before the model file was registered): its stored features get them, as
             // `fleet ingest` of the same file does.
@@ -288,7 +312,7 @@ fn fleet_store_features(
             for it in &items {
                 let fresh = match (
                     &it.features.suspension,
-                    store.find_record(vehicle, &it.sha256)?,
+                    store.find_record(vehicle, &it.content_hash)?,
                 ) {
                     (Some(e), Some(row)) => {
                         let stored = store.features(row.id)?;
@@ -311,7 +335,7 @@ fn fleet_store_features(
                 .map(|(it, fresh)| BatchItem {
                     record: NewRecord {
                         vehicle,
-                        sha256: &it.sha256,
+                        content_hash: &it.content_hash,
                         file_name: &it.file,
                         condition,
                         road,

@@ -149,3 +149,26 @@ def test_bad_settings_raise(tmp_path):
     assert not (tmp_path / "bad.db").exists()  # checked before the store is created
     with pytest.raises(OSError):
         vibmode.fleet.settings(tmp_path / "missing.db")
+
+
+def test_features_carry_the_stores_content_hash(tmp_path):
+    """A store made now keys records by BLAKE3; features hashed with another function are
+    refused by store_features with one line naming both, and nothing is stored."""
+    vibmode.simulate("city_bus", records=1, fs=200.0, effects="none", seed=15, out_dir=tmp_path / "r")
+    path = tmp_path / "r" / "record_01.wav"
+    db = tmp_path / "h.db"
+    vibmode.fleet.init(db)
+    assert vibmode.fleet.content_hash(db) == "blake3"
+    item = vibmode.fleet.features(path, content_hash=vibmode.fleet.content_hash(db))
+    assert item["content_hash_kind"] == "blake3" and len(item["content_hash"]) == 64
+    other = vibmode.fleet.features(path, content_hash="sha256")
+    assert other["content_hash"] != item["content_hash"]
+    with pytest.raises(ValueError, match="hashed with sha256, the store keys records by blake3") as e:
+        vibmode.fleet.store_features(db, "bus-1", [other])
+    assert "\n" not in str(e.value)
+    assert stored_features(db) == {}
+    with pytest.raises(ValueError, match="'md5' is not one of sha256, blake3"):
+        vibmode.fleet.features(path, content_hash="md5")
+    assert vibmode.fleet.store_features(db, "bus-1", [item])[0]["already_stored"] is False
+    # The CLI's ingest of the same file keys it the same way: a no-op.
+    assert vibmode.fleet.ingest(db, "bus-1", [path])[0]["already_stored"] is True

@@ -77,6 +77,13 @@ def register(db: PathLike, vehicle: str, model: PathLike) -> str:
     return _native.fleet_register(os.fspath(db), vehicle, os.fspath(model))
 
 
+def content_hash(db: PathLike) -> str:
+    """The hash function the store keys its records by, ``'blake3'`` (stores made since schema 4)
+    or ``'sha256'`` (stores that held records before): pass it to every worker's
+    :func:`features` (:func:`store_features` refuses features hashed with the other)."""
+    return _native.fleet_content_hash(os.fspath(db))
+
+
 def model(db: PathLike, vehicle: str) -> Optional[str]:
     """The vehicle's registered model file's text (:func:`register`), or None: read once by the
     client and passed to every worker's :func:`features` so that they keep the body equations
@@ -131,10 +138,12 @@ def features(
     allow_nonuniform: bool = False,
     time_unit: Optional[str] = None,
     model: Optional[str] = None,
+    content_hash: str = "blake3",
 ) -> Dict[str, Any]:
     """What the store keeps of one file (band levels, transmissibility, modes), computed without
     a store: the expensive part of :func:`ingest`, to run on many workers (e.g. Dask). Returns a
-    JSON-ready dict ``{'file', 'sha256', 'metadata', 'features'}`` for :func:`store_features`;
+    JSON-ready dict ``{'file', 'content_hash', 'content_hash_kind', 'metadata', 'features'}`` for
+    :func:`store_features`;
     ``file`` is ``path`` as given (as :func:`ingest` names records: ``run1/record_01.wav`` and
     ``run2/record_01.wav`` stay apart). A worker that reads a temporary copy of a remote file
     sets ``file`` back to the file's URL before storing.
@@ -143,7 +152,8 @@ def features(
     worker); None computes with the default settings, which differ from a store initialised
     with other ones. ``model``: the vehicle's registered model file's text, :func:`model`
     ``(db, vehicle)``; with it the record's body equations for the suspension fitted per drive
-    are kept, as `fleet ingest` keeps them."""
+    are kept, as `fleet ingest` keeps them. ``content_hash``: the store's, :func:`content_hash`
+    ``(db)`` (the default, ``'blake3'``, is that of every store made since schema 4)."""
     if settings is not None and not isinstance(settings, dict):
         raise ValueError(
             f"settings of type {type(settings).__name__}: pass the dict vibmode.fleet.settings(db) returns, or None"
@@ -151,7 +161,8 @@ def features(
     text = None if settings is None else json.dumps(settings)
     return json.loads(
         _native.fleet_features(
-            os.fspath(path), fs, float(scale), unit, text, bool(allow_nonuniform), time_unit, model
+            os.fspath(path), fs, float(scale), unit, text, bool(allow_nonuniform), time_unit, model,
+            content_hash,
         )
     )
 

@@ -131,10 +131,10 @@ def score(truth: Dict, res: Dict) -> Dict:
     }
 
 
-def run_bus(bus: int, seed: int, keep: bool) -> Tuple[int, Dict, Dict]:
+def run_bus(bus: int, seed: int, keep: bool, extra: Tuple[str, ...] = ()) -> Tuple[int, Dict, Dict]:
     folder = harness.simulate(bus, seed)
     out = Path(tempfile.mkdtemp(prefix=f"vibmode-lines-bus{bus}-"))
-    res = harness.analyze(folder, out=out)
+    res = harness.analyze(folder, *extra, out=out)
     if not keep:
         import shutil
         shutil.rmtree(out, ignore_errors=True)
@@ -189,10 +189,12 @@ def print_summary(sm: Dict) -> None:
           f"{r(sm['bending_structural'], sm['bending_seen'])}")
 
 
-def measure(n_buses: int, seed: int = 1, jobs: int = 2, keep: bool = False) -> Dict:
+def measure(n_buses: int, seed: int = 1, jobs: int = 2, keep: bool = False,
+            extra: Tuple[str, ...] = ()) -> Dict:
+    """`extra`: further `vibmode analyze` arguments, e.g. `("--config", "sweep.toml")`."""
     buses = harness.draw_bus_seeds(n_buses, "lines")
     with ThreadPoolExecutor(max_workers=max(1, jobs)) as ex:
-        results = list(ex.map(lambda b: run_bus(b, seed, keep), buses))
+        results = list(ex.map(lambda b: run_bus(b, seed, keep, extra), buses))
     for bus, t, s in results:
         print(row(bus, t, s), flush=True)
     sm = summary(results)
@@ -207,9 +209,15 @@ def main() -> int:
     ap.add_argument("--seed", type=int, default=1, help="busgen record seed (default 1)")
     ap.add_argument("--jobs", type=int, default=2, help="buses analysed at once (default 2)")
     ap.add_argument("--keep", action="store_true", help="keep the analysis folders")
+    ap.add_argument("--config", help="an analysis settings file passed to `vibmode analyze --config`")
+    ap.add_argument("--json", help="write the summary and the per-bus scores to this file")
     a = ap.parse_args()
     try:
-        measure(a.buses, a.seed, a.jobs, a.keep)
+        sm = measure(a.buses, a.seed, a.jobs, a.keep,
+                     ("--config", a.config) if a.config else ())
+        if a.json:
+            with open(a.json, "w") as f:
+                json.dump(sm, f, indent=1, default=str)
     except harness.Skip as e:
         print(f"skipped: {e}", file=sys.stderr)
         return 2

@@ -323,6 +323,27 @@ pub enum FleetError {
         /// The text given.
         value: String,
     },
+    /// A content-hash name that is not `sha256` or `blake3`.
+    #[error(
+        "content hash '{}' is not one of sha256, blake3; use the store's own (vibmode.fleet.content_hash(db))",
+        vibmode_core::quoted(value)
+    )]
+    BadContentHash {
+        /// The text given.
+        value: String,
+    },
+    /// Features hashed with another function than the store keys its records by.
+    #[error("fleet store {}: record {} was hashed with {given}, the store keys records by {store}; compute its features with content_hash = '{store}'", vibmode_core::quoted(path), vibmode_core::quoted(file))]
+    ContentHashMismatch {
+        /// Store path.
+        path: String,
+        /// The record's file name.
+        file: String,
+        /// The hash the features carry.
+        given: crate::hash::ContentHash,
+        /// The store's.
+        store: crate::hash::ContentHash,
+    },
     /// Stored content that does not parse (edited or foreign rows).
     #[error("fleet store {}: {} cannot be read ({}); the row was not written by this vibmode: restore the store or re-ingest the record", vibmode_core::quoted(path), vibmode_core::cap_message(what, 80), vibmode_core::cap_message(reason, 100))]
     CorruptRow {

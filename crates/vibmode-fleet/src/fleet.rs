@@ -3,38 +3,22 @@
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
-use sha2::{Digest, Sha256};
 use vibmode_core::Recording;
 use vibmode_signal::ReadOptions;
 
 use crate::config::FleetConfig;
 use crate::error::{FleetError, Result};
 use crate::features::{compute_features, RecordFeatures};
+use crate::hash::ContentHash;
 use crate::model::{
     assess, assess_drive_fitted, build_model_set, Assessment, Drive, ModelSet, MIN_DRIVE_RECORDS,
 };
 use crate::store::{BatchItem, Condition, NewRecord, Store, Stored};
 use crate::suspension::{corner_scores, suspension_limit, SuspensionReference, VehicleModel};
 
-/// SHA-256 of bytes, lower-case hex.
+/// SHA-256 of bytes, lower-case hex (a vehicle model file's key).
 pub fn sha256_hex(bytes: &[u8]) -> String {
-    let digest = Sha256::digest(bytes);
-    digest.iter().map(|b| format!("{b:02x}")).collect()
-}
-
-/// SHA-256 of a recording's content (rate, channel names and samples), for records that are
-/// not files.
-pub fn recording_hash(rec: &Recording) -> String {
-    let mut h = Sha256::new();
-    h.update(rec.fs_hz.to_le_bytes());
-    for c in &rec.channels {
-        h.update(c.name.as_bytes());
-        h.update([0u8]);
-        for s in &c.samples {
-            h.update(s.to_le_bytes());
-        }
-    }
-    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+    ContentHash::Sha256.hex(bytes)
 }
 
 /// Checks a vehicle id: 1 to 64 printable characters without spaces.
@@ -80,7 +64,7 @@ pub struct IngestLabels<'a> {
 /// A record read and analysed (or found in the store), not yet stored.
 struct Prepared {
     file: String,
-    sha256: String,
+    content_hash: String,
     metadata: serde_json::Value,
     features: RecordFeatures,
     /// The vehicle already had this content when it was read.
@@ -205,14 +189,14 @@ fn prepare_recording(
     store: &Store,
     labels: &IngestLabels<'_>,
     name: &str,
-    sha256: &str,
+    content_hash: &str,
     rec: &Recording,
     cfg: &FleetConfig,
 ) -> Result<Prepared> {
-    if let Some(row) = store.find_record(labels.vehicle, sha256)? {
+    if let Some(row) = store.find_record(labels.vehicle, content_hash)? {
         return Ok(Prepared {
             file: name.to_string(),
-            sha256: sha256.to_string(),
+            content_hash: content_hash.to_string(),
             metadata: metadata_of(rec),
             features: store.features(row.id)?,
             known: true,
@@ -229,7 +213,7 @@ fn prepare_recording(
     );
     Ok(Prepared {
         file: name.to_string(),
-        sha256: sha256.to_string(),
+        content_hash: content_hash.to_string(),
         metadata: metadata_of(rec),
         features,
         known: false,
@@ -261,7 +245,7 @@ fn store_prepared_drive(
         .map(|(p, c)| BatchItem {
             record: NewRecord {
                 vehicle: labels.vehicle,
-                sha256: &p.sha256,
+                content_hash: &p.content_hash,
                 file_name: &p.file,
                 condition: labels.condition,
                 road: labels.road,
@@ -321,17 +305,18 @@ fn with_equations(
         }))
 }
 
-/// Ingests a recording with a known content hash: a no-op if the vehicle already has it.
+/// Ingests a recording with a known content hash (made with [`Store::content_hash`], e.g.
+/// [`ContentHash::of_recording`]): a no-op if the vehicle already has it.
 pub fn ingest_recording(
     store: &mut Store,
     labels: &IngestLabels<'_>,
     name: &str,
-    sha256: &str,
+    content_hash: &str,
     rec: &Recording,
     cfg: &FleetConfig,
 ) -> Result<Ingested> {
     check_vehicle_id(labels.vehicle)?;
-    let p = prepare_recording(store, labels, name, sha256, rec, cfg)?;
+    let p = prepare_recording(store, labels, name, content_hash, rec, cfg)?;
     let stored = store_prepared(store, labels, std::slice::from_ref(&p), &[None])?;
     let s = stored
         .first()
@@ -354,14 +339,14 @@ fn file_name(path: &Path) -> String {
     record_file_name(path)
 }
 
-/// A file's bytes and their SHA-256.
-fn read_and_hash(path: &Path) -> Result<(Vec<u8>, String)> {
+/// A file's bytes and their content hash.
+fn read_and_hash(path: &Path, hash: ContentHash) -> Result<(Vec<u8>, String)> {
     let bytes = std::fs::read(path).map_err(|e| FleetError::Io {
         path: path.display().to_string(),
         reason: e.to_string(),
     })?;
-    let sha = sha256_hex(&bytes);
-    Ok((bytes, sha))
+    let key = hash.hex(&bytes);
+    Ok((bytes, key))
 }
 
 /// Reads and analyses every file (a file whose bytes the vehicle already has is not analysed
@@ -394,6 +379,7 @@ fn prepare_files(
     }
     let model = registered_model(store, labels.vehicle)?;
     let model = model.as_ref();
+    let hash = store.content_hash()?;
     // A path's prepared record, or `None` for a repeat (taken from the first).
     let work = |path: &Path,
                 bytes: Vec<u8>,
@@ -407,7 +393,7 @@ fn prepare_files(
                 let fresh = with_equations(stored, model, path, &bytes, opts, cfg)?;
                 Ok(Some(Prepared {
                     file: name.to_string(),
-                    sha256: sha.to_string(),
+                    content_hash: sha.to_string(),
                     metadata: serde_json::json!({}),
                     refreshed: fresh.is_some(),
                     features: fresh.unwrap_or_else(|| (**stored).clone()),
@@ -423,7 +409,7 @@ fn prepare_files(
                 add_body_equations(&mut features, &rec, model, cfg);
                 Ok(Some(Prepared {
                     file: name.to_string(),
-                    sha256: sha.to_string(),
+                    content_hash: sha.to_string(),
                     metadata: metadata_of(&rec),
                     features,
                     known: false,
@@ -437,7 +423,7 @@ fn prepare_files(
     for chunk in paths.chunks(rayon::current_num_threads().max(1)) {
         // Each file is read once: hashed here (in parallel), parsed from the same bytes below.
         let read: Vec<Result<(Vec<u8>, String)>> =
-            chunk.par_iter().map(|p| read_and_hash(p)).collect();
+            chunk.par_iter().map(|p| read_and_hash(p, hash)).collect();
         let mut plans: Vec<(String, String, Plan)> = Vec::with_capacity(chunk.len());
         let mut contents: Vec<Vec<u8>> = Vec::with_capacity(chunk.len());
         for (path, r) in chunk.iter().zip(read) {
@@ -470,7 +456,7 @@ fn prepare_files(
                 let features = out[k].features.clone();
                 out.push(Prepared {
                     file: name,
-                    sha256: sha,
+                    content_hash: sha,
                     metadata: serde_json::json!({}),
                     features,
                     known: false,
@@ -693,12 +679,19 @@ pub fn check_recording(
     store: &mut Store,
     set: &ModelSet,
     name: &str,
-    sha256: &str,
+    content_hash: &str,
     rec: &Recording,
 ) -> Result<Checked> {
     check_vehicle_id(&set.vehicle)?;
     check_layout(set, name, rec)?;
-    let p = prepare_recording(store, &test_labels(set), name, sha256, rec, &set.config)?;
+    let p = prepare_recording(
+        store,
+        &test_labels(set),
+        name,
+        content_hash,
+        rec,
+        &set.config,
+    )?;
     let mut out = check_prepared(store, set, vec![p])?;
     out.pop().ok_or_else(|| FleetError::NotStorable {
         what: format!("the check of '{}'", vibmode_core::quoted(name)),
@@ -802,7 +795,7 @@ pub fn check_drive_files_progress(
     if let Some(id) = drive {
         for p in prepared.iter().filter(|p| !p.known) {
             if let Some(other) = store
-                .other_vehicles_with(&set.vehicle, &p.sha256)?
+                .other_vehicles_with(&set.vehicle, &p.content_hash)?
                 .into_iter()
                 .next()
             {

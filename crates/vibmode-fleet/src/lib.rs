@@ -13,6 +13,7 @@ pub mod config;
 pub mod error;
 pub mod features;
 pub mod fleet;
+pub mod hash;
 pub mod model;
 #[cfg(feature = "report")]
 pub mod report;
@@ -30,10 +31,11 @@ pub use features::{
 pub use fleet::{
     add_body_equations, build_baseline, check_drive_files_progress, check_file, check_files,
     check_files_progress, check_recording, check_vehicle_id, ingest_file, ingest_files,
-    ingest_files_progress, ingest_recording, record_file_name, recording_hash,
-    register_vehicle_model, register_vehicle_model_file, registered_model, require_baseline,
-    sha256_hex, Checked, IngestLabels, Ingested, Registered, DEFAULT_DRIVE_ID,
+    ingest_files_progress, ingest_recording, record_file_name, register_vehicle_model,
+    register_vehicle_model_file, registered_model, require_baseline, sha256_hex, Checked,
+    IngestLabels, Ingested, Registered, DEFAULT_DRIVE_ID,
 };
+pub use hash::ContentHash;
 pub use model::{
     assess, assess_drive, assess_drive_fitted, build_model_set, Assessment, Classification,
     Component, Drive, Evidence, FeatureMeta, FeatureStat, Group, Kind, KindLimit, ModeSlot,

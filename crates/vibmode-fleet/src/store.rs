@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 use crate::config::FleetConfig;
 use crate::error::{FleetError, Result};
 use crate::features::RecordFeatures;
+use crate::hash::ContentHash;
 use crate::model::{Assessment, Classification, ModelSet};
 
 /// The application id kept in the `meta` table.
@@ -71,6 +72,11 @@ const MIGRATIONS: &[&str] = &[
         sha256 TEXT NOT NULL,
         registered TEXT NOT NULL,
         toml TEXT NOT NULL);",
+    // 4: the records' content hash (crate::hash): BLAKE3 for a store without records, SHA-256
+    // kept by a store that holds some (their hashes cannot be recomputed without the files).
+    "ALTER TABLE records RENAME COLUMN sha256 TO content_hash;
+     INSERT INTO meta (key, value) SELECT 'content_hash',
+        CASE WHEN EXISTS (SELECT 1 FROM records) THEN 'sha256' ELSE 'blake3' END;",
 ];
 
 /// How long a write waits for another process's transaction before giving up.
@@ -116,8 +122,8 @@ impl std::str::FromStr for Condition {
 pub struct NewRecord<'a> {
     /// Vehicle id.
     pub vehicle: &'a str,
-    /// SHA-256 of the file's bytes, hex.
-    pub sha256: &'a str,
+    /// The file's content hash, hex, made with the store's [`Store::content_hash`].
+    pub content_hash: &'a str,
     /// File name.
     pub file_name: &'a str,
     /// Nominal or test.
@@ -135,8 +141,8 @@ pub struct RecordRow {
     pub id: i64,
     /// File name.
     pub file_name: String,
-    /// SHA-256, hex.
-    pub sha256: String,
+    /// Content hash, hex ([`Store::content_hash`]).
+    pub content_hash: String,
     /// Ingest time, UTC, RFC 3339.
     pub ingested: String,
     /// Nominal or test.
@@ -499,6 +505,31 @@ impl Store {
         }
     }
 
+    /// The hash function this store keys its records by (`meta.content_hash`, set by
+    /// migration 4): every record hash given to [`Store::find_record`], [`NewRecord`] and
+    /// [`Store::other_vehicles_with`] must be made with it.
+    pub fn content_hash(&self) -> Result<ContentHash> {
+        let name: Option<String> = self
+            .conn
+            .query_row(
+                "SELECT value FROM meta WHERE key = 'content_hash'",
+                [],
+                |r| r.get(0),
+            )
+            .optional()
+            .map_err(self.sql("reading the content hash"))?;
+        let name = name.ok_or_else(|| FleetError::CorruptRow {
+            path: self.path.clone(),
+            what: "meta content_hash".into(),
+            reason: "missing".into(),
+        })?;
+        name.parse().map_err(|_| FleetError::CorruptRow {
+            path: self.path.clone(),
+            what: "meta content_hash".into(),
+            reason: format!("'{}' is not sha256 or blake3", vibmode_core::quoted(&name)),
+        })
+    }
+
     /// The schema version (`user_version`).
     pub fn schema_version(&self) -> Result<i64> {
         self.conn
@@ -627,31 +658,31 @@ impl Store {
     }
 
     /// The vehicles other than `vehicle` that have a record with this content hash.
-    pub fn other_vehicles_with(&self, vehicle: &str, sha256: &str) -> Result<Vec<String>> {
+    pub fn other_vehicles_with(&self, vehicle: &str, content_hash: &str) -> Result<Vec<String>> {
         let mut st = self
             .conn
             .prepare(
                 "SELECT DISTINCT v.name FROM records r JOIN vehicles v ON v.id = r.vehicle_id
-                 WHERE r.sha256 = ?1 AND v.name <> ?2 ORDER BY v.name",
+                 WHERE r.content_hash = ?1 AND v.name <> ?2 ORDER BY v.name",
             )
             .map_err(self.sql("looking up a record's vehicles"))?;
         let rows = st
-            .query_map(params![sha256, vehicle], |r| r.get::<_, String>(0))
+            .query_map(params![content_hash, vehicle], |r| r.get::<_, String>(0))
             .map_err(self.sql("looking up a record's vehicles"))?;
         rows.collect::<std::result::Result<Vec<_>, _>>()
             .map_err(self.sql("looking up a record's vehicles"))
     }
 
     /// The record of `vehicle` with this content hash, if stored.
-    pub fn find_record(&self, vehicle: &str, sha256: &str) -> Result<Option<RecordRow>> {
+    pub fn find_record(&self, vehicle: &str, content_hash: &str) -> Result<Option<RecordRow>> {
         let Some(vid) = self.vehicle_id(vehicle)? else {
             return Ok(None);
         };
         self.conn
             .query_row(
-                "SELECT id, file_name, sha256, ingested, condition, road FROM records
-                 WHERE vehicle_id = ?1 AND sha256 = ?2",
-                params![vid, sha256],
+                "SELECT id, file_name, content_hash, ingested, condition, road FROM records
+                 WHERE vehicle_id = ?1 AND content_hash = ?2",
+                params![vid, content_hash],
                 row_to_record,
             )
             .optional()
@@ -759,12 +790,12 @@ impl Store {
             let changed = tx
                 .execute(
                     "INSERT INTO records
-                        (vehicle_id, sha256, file_name, ingested, condition, road, metadata)
+                        (vehicle_id, content_hash, file_name, ingested, condition, road, metadata)
                      VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)
-                     ON CONFLICT (vehicle_id, sha256) DO NOTHING",
+                     ON CONFLICT (vehicle_id, content_hash) DO NOTHING",
                     params![
                         vid,
-                        rec.sha256,
+                        rec.content_hash,
                         rec.file_name,
                         now,
                         rec.condition.as_str(),
@@ -785,8 +816,8 @@ impl Store {
             } else {
                 let id: i64 = tx
                     .query_row(
-                        "SELECT id FROM records WHERE vehicle_id = ?1 AND sha256 = ?2",
-                        params![vid, rec.sha256],
+                        "SELECT id FROM records WHERE vehicle_id = ?1 AND content_hash = ?2",
+                        params![vid, rec.content_hash],
                         |r| r.get(0),
                     )
                     .map_err(err)?;
@@ -879,7 +910,7 @@ impl Store {
         let mut st = self
             .conn
             .prepare(
-                "SELECT r.id, r.file_name, r.sha256, r.ingested, r.condition, r.road, f.json
+                "SELECT r.id, r.file_name, r.content_hash, r.ingested, r.condition, r.road, f.json
                  FROM records r JOIN features f ON f.record_id = r.id
                  WHERE r.vehicle_id = ?1 AND r.condition = 'nominal' ORDER BY r.id",
             )
@@ -910,7 +941,7 @@ impl Store {
         let mut st = self
             .conn
             .prepare(
-                "SELECT r.id, r.file_name, r.sha256, r.ingested, r.condition, r.road, f.json,
+                "SELECT r.id, r.file_name, r.content_hash, r.ingested, r.condition, r.road, f.json,
                         (SELECT c.json FROM checks c WHERE c.record_id = r.id
                          ORDER BY c.id DESC LIMIT 1)
                  FROM records r JOIN features f ON f.record_id = r.id
@@ -1279,7 +1310,7 @@ fn row_to_record(r: &rusqlite::Row<'_>) -> rusqlite::Result<RowResult> {
     Ok(Ok(RecordRow {
         id: r.get(0)?,
         file_name: r.get(1)?,
-        sha256: r.get(2)?,
+        content_hash: r.get(2)?,
         ingested: r.get(3)?,
         condition,
         road: r.get(5)?,
@@ -1336,6 +1367,50 @@ mod tests {
         assert!(s.drives("bus-1").expect("drives").is_empty());
         // Migration 3: the vehicle model table exists, empty.
         assert!(s.vehicle_model("bus-1").expect("model").is_none());
+    }
+
+    /// Migration 4: a store that held records keeps SHA-256 as its records' key (their hashes
+    /// cannot be recomputed), and its records are still found by it; a store made now, or one
+    /// migrated without records, keys by BLAKE3.
+    #[test]
+    fn the_content_hash_is_kept_by_a_store_with_records_and_blake3_otherwise() {
+        let d = tempfile::tempdir().expect("tmp");
+        let bytes = b"time,z\n0,1\n";
+        let sha = ContentHash::Sha256.hex(bytes);
+        for (name, with_record) in [("old.db", true), ("empty.db", false)] {
+            let path = d.path().join(name);
+            {
+                let c = Connection::open(&path).expect("create");
+                for m in &MIGRATIONS[..3] {
+                    c.execute_batch(m).expect("schema 3");
+                }
+                c.execute_batch(
+                    "PRAGMA user_version = 3;
+                     INSERT INTO vehicles (name, created) VALUES ('bus-1', 'then');",
+                )
+                .expect("v3");
+                if with_record {
+                    c.execute(
+                        "INSERT INTO records (vehicle_id, sha256, file_name, ingested, condition,
+                         metadata) VALUES (1, ?1, 'r.csv', 'then', 'nominal', '{}')",
+                        params![sha],
+                    )
+                    .expect("record");
+                }
+            }
+            let s = Store::open(&path).expect("open");
+            assert_eq!(s.schema_version().expect("version"), SCHEMA_VERSION);
+            let kind = s.content_hash().expect("hash");
+            if with_record {
+                assert_eq!(kind, ContentHash::Sha256);
+                let row = s.find_record("bus-1", &kind.hex(bytes)).expect("find");
+                assert_eq!(row.map(|r| r.file_name), Some("r.csv".to_string()));
+            } else {
+                assert_eq!(kind, ContentHash::Blake3);
+            }
+        }
+        let (s, _) = Store::init(&d.path().join("new.db")).expect("init");
+        assert_eq!(s.content_hash().expect("hash"), ContentHash::Blake3);
     }
 
     #[test]
@@ -1427,7 +1502,7 @@ mod tests {
             let name = format!("r{i}.csv");
             let rec = NewRecord {
                 vehicle: "bus-1",
-                sha256: &sha,
+                content_hash: &sha,
                 file_name: &name,
                 condition: Condition::Nominal,
                 road: Some("B"),
@@ -1494,7 +1569,7 @@ mod tests {
         let (mut s, _) = Store::init(&d.path().join("f.db")).expect("init");
         let rec = NewRecord {
             vehicle: "bus-1",
-            sha256: "abc",
+            content_hash: "abc",
             file_name: "a.csv",
             condition: Condition::Nominal,
             road: Some("B"),
@@ -1543,7 +1618,7 @@ mod tests {
         // A check with a NaN score is refused (it would be stored as null and never read).
         let rec = NewRecord {
             vehicle: "bus-1",
-            sha256: "abc",
+            content_hash: "abc",
             file_name: "a.csv",
             condition: Condition::Test,
             road: None,

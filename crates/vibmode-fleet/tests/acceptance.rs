@@ -22,7 +22,7 @@ mod common;
 
 use common::{config, record};
 use vibmode_fleet::{
-    build_baseline, check_recording, ingest_recording, recording_hash, Classification, Condition,
+    build_baseline, check_recording, ingest_recording, Classification, Condition, ContentHash,
     IngestLabels, Store,
 };
 use vibmode_vehicle::{Corner, CornerCondition, RoadClass, VehicleParams};
@@ -105,7 +105,7 @@ fn issue_scenarios_over_three_baselines() {
                 &mut store,
                 &labels,
                 &format!("n{i}"),
-                &recording_hash(&rec),
+                &ContentHash::Blake3.of_recording(&rec),
                 &rec,
                 &cfg,
             )
@@ -209,7 +209,7 @@ fn issue_scenarios_over_three_baselines() {
                     &mut store,
                     &set,
                     &format!("{label}-{j}"),
-                    &recording_hash(&rec),
+                    &ContentHash::Blake3.of_recording(&rec),
                     &rec,
                 )
                 .expect("check");

@@ -8,7 +8,7 @@ mod common;
 
 use common::{config, records};
 use vibmode_fleet::{
-    build_baseline, check_recording, ingest_recording, recording_hash, Classification, Condition,
+    build_baseline, check_recording, ingest_recording, Classification, Condition, ContentHash,
     IngestLabels, Store,
 };
 use vibmode_vehicle::{Disturbances, RoadClass, VehicleParams};
@@ -53,8 +53,15 @@ fn classification_over_seeds() {
             .enumerate()
             {
                 let name = format!("nominal-{i}-{j}");
-                ingest_recording(&mut store, &nominal, &name, &recording_hash(rec), rec, &cfg)
-                    .expect("ingest");
+                ingest_recording(
+                    &mut store,
+                    &nominal,
+                    &name,
+                    &ContentHash::Blake3.of_recording(rec),
+                    rec,
+                    &cfg,
+                )
+                .expect("ingest");
             }
         }
         let set = build_baseline(&mut store, "bus-1", &cfg).expect("baseline");
@@ -81,7 +88,7 @@ fn classification_over_seeds() {
                     &mut store,
                     &set,
                     &format!("{label}-{j}"),
-                    &recording_hash(rec),
+                    &ContentHash::Blake3.of_recording(rec),
                     rec,
                 )
                 .expect("check");
