@@ -122,7 +122,7 @@ def analyze_record(
     storage_options: Optional[Dict[str, Any]] = None,
     settings: Optional[Dict[str, Any]] = None,
     model: Optional[str] = None,
-    content_hash: str = "blake3",
+    content_hash: Optional[str] = None,
 ) -> Dict[str, Any]:
     """The per-record task: analyse one recording, write OUT/modes/<record>.parquet, return its
     summary row (and its fleet-store features when asked, computed with the store's `settings`,
@@ -198,7 +198,7 @@ def run(
     feats = store is not None
     settings = None
     model = None
-    content_hash = "blake3"
+    content_hash = None
     if store is not None:
         # The store's settings (`vibmode fleet init --config`, or the defaults), read once here and
         # shipped to every task: the workers' features are then the ones `fleet ingest` stores.

@@ -228,7 +228,7 @@ struct FeaturesOut {
 /// without touching a store, with the settings `settings_json` (from [`fleet_settings`]; `None`:
 /// the defaults); JSON for [`fleet_store_features`].
 #[pyfunction]
-#[pyo3(signature = (path, fs=None, scale=1.0, unit=None, settings_json=None, allow_nonuniform=false, time_unit=None, model_toml=None, content_hash="blake3"))]
+#[pyo3(signature = (path, fs=None, scale=1.0, unit=None, settings_json=None, allow_nonuniform=false, time_unit=None, model_toml=None, content_hash=None))]
 #[allow(clippy::too_many_arguments)]
 fn fleet_features(
     py: Python<'_>,
@@ -240,9 +240,14 @@ fn fleet_features(
     allow_nonuniform: bool,
     time_unit: Option<&str>,
     model_toml: Option<&str>,
-    content_hash: &str,
+    content_hash: Option<&str>,
 ) -> PyResult<String> {
-    let kind: ContentHash = content_hash.parse().map_err(fleet_err)?;
+    // `None`: the hash of a store made now (`ContentHash::default`).
+    let kind: ContentHash = content_hash
+        .map(str::parse)
+        .transpose()
+        .map_err(fleet_err)?
+        .unwrap_or_default();
     let cfg = settings_from_json(settings_json)?;
     let model = model_toml
         .map(|t| vibmode_fleet::suspension::VehicleModel::from_toml(t, "model"))

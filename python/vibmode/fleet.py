@@ -138,7 +138,7 @@ def features(
     allow_nonuniform: bool = False,
     time_unit: Optional[str] = None,
     model: Optional[str] = None,
-    content_hash: str = "blake3",
+    content_hash: Optional[str] = None,
 ) -> Dict[str, Any]:
     """What the store keeps of one file (band levels, transmissibility, modes), computed without
     a store: the expensive part of :func:`ingest`, to run on many workers (e.g. Dask). Returns a
@@ -153,7 +153,7 @@ def features(
     with other ones. ``model``: the vehicle's registered model file's text, :func:`model`
     ``(db, vehicle)``; with it the record's body equations for the suspension fitted per drive
     are kept, as `fleet ingest` keeps them. ``content_hash``: the store's, :func:`content_hash`
-    ``(db)`` (the default, ``'blake3'``, is that of every store made since schema 4)."""
+    ``(db)`` (None: that of every store made since schema 4, ``'blake3'``)."""
     if settings is not None and not isinstance(settings, dict):
         raise ValueError(
             f"settings of type {type(settings).__name__}: pass the dict vibmode.fleet.settings(db) returns, or None"

@@ -24,6 +24,13 @@ pub enum ContentHash {
     Blake3,
 }
 
+impl Default for ContentHash {
+    /// The hash of a store made now ([`ContentHash::Blake3`]; migration 4 writes the same).
+    fn default() -> Self {
+        ContentHash::Blake3
+    }
+}
+
 impl ContentHash {
     /// The name kept in the store's `meta` table and accepted by [`std::str::FromStr`].
     pub fn as_str(self) -> &'static str {

@@ -509,25 +509,23 @@ impl Store {
     /// migration 4): every record hash given to [`Store::find_record`], [`NewRecord`] and
     /// [`Store::other_vehicles_with`] must be made with it.
     pub fn content_hash(&self) -> Result<ContentHash> {
-        let name: Option<String> = self
-            .conn
-            .query_row(
-                "SELECT value FROM meta WHERE key = 'content_hash'",
-                [],
-                |r| r.get(0),
+        let name = self
+            .meta_value("content_hash", "reading the content hash")?
+            .ok_or_else(|| self.corrupt("meta content_hash", "missing"))?;
+        name.parse().map_err(|_| {
+            self.corrupt(
+                "meta content_hash",
+                format!("'{}' is not sha256 or blake3", vibmode_core::quoted(&name)),
             )
-            .optional()
-            .map_err(self.sql("reading the content hash"))?;
-        let name = name.ok_or_else(|| FleetError::CorruptRow {
-            path: self.path.clone(),
-            what: "meta content_hash".into(),
-            reason: "missing".into(),
-        })?;
-        name.parse().map_err(|_| FleetError::CorruptRow {
-            path: self.path.clone(),
-            what: "meta content_hash".into(),
-            reason: format!("'{}' is not sha256 or blake3", vibmode_core::quoted(&name)),
         })
+    }
+
+    /// The `meta` table's value of `key`, if any.
+    fn meta_value(&self, key: &str, operation: &'static str) -> Result<Option<String>> {
+        self.conn
+            .query_row("SELECT value FROM meta WHERE key = ?1", [key], |r| r.get(0))
+            .optional()
+            .map_err(self.sql(operation))
     }
 
     /// The schema version (`user_version`).
@@ -1013,15 +1011,7 @@ impl Store {
     /// The settings new records are analysed with: those given to `fleet init --config`, or
     /// the defaults.
     pub fn config(&self) -> Result<FleetConfig> {
-        let json: Option<String> = self
-            .conn
-            .query_row(
-                "SELECT value FROM meta WHERE key = 'fleet_config'",
-                [],
-                |r| r.get(0),
-            )
-            .optional()
-            .map_err(self.sql("reading the settings"))?;
+        let json = self.meta_value("fleet_config", "reading the settings")?;
         match json {
             None => Ok(FleetConfig::default()),
             Some(j) => {
