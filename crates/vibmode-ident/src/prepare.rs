@@ -55,8 +55,7 @@ fn has_empty_band(y: &[f64]) -> bool {
     if n < EMPTY_BAND_MIN_LEN {
         return false;
     }
-    let mut planner = realfft::RealFftPlanner::<f64>::new();
-    let fft = planner.plan_fft_forward(n);
+    let fft = vibmode_fft::forward(n);
     let mut input = y.to_vec();
     let mut spec = fft.make_output_vec();
     if fft.process(&mut input, &mut spec).is_err() {

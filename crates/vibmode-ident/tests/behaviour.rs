@@ -164,9 +164,8 @@ fn robust_fit_resists_innovation_spikes() {
 /// The paper's ideal DFT low-pass: zero every bin above `cutoff_hz`, inverse FFT.
 fn ideal_lowpass(x: &[f64], fs_hz: f64, cutoff_hz: f64) -> Vec<f64> {
     let n = x.len();
-    let mut planner = realfft::RealFftPlanner::<f64>::new();
-    let fwd = planner.plan_fft_forward(n);
-    let inv = planner.plan_fft_inverse(n);
+    let fwd = vibmode_fft::forward(n);
+    let inv = vibmode_fft::inverse(n);
     let mut input = x.to_vec();
     let mut spec = fwd.make_output_vec();
     fwd.process(&mut input, &mut spec).unwrap();

@@ -39,11 +39,11 @@
 
 use crate::error::{Result, SignalError};
 use num_complex::Complex;
-use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 use vibmode_core::limits::{SAMPLES_OUT_MAX, UPSAMPLE_RATIO_MAX};
 use vibmode_core::{check_fs, Channel, Num, Recording, RecordingError, TimeAxis};
+use vibmode_fft::{ComplexToReal, RealToComplex};
 
 /// Parameters of [`resample`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -141,7 +141,7 @@ fn invalid(name: &'static str, value: f64, fix: String) -> SignalError {
     }
 }
 
-fn fft_err(e: realfft::FftError) -> SignalError {
+fn fft_err(e: vibmode_fft::FftError) -> SignalError {
     SignalError::InvalidParam {
         name: "fft",
         value: e.to_string(),
@@ -237,31 +237,15 @@ struct Ffts {
     scratch_len: usize,
 }
 
-/// FFT plans shared by every resampler of the process: a plan's twiddle factors cost about as
-/// much as one transform of its length, and the records of a run have a few lengths only. The
-/// same planner gives the same algorithm for a length, so the results are the same bits.
-static PLANNER: std::sync::LazyLock<std::sync::Mutex<RealFftPlanner<f64>>> =
-    std::sync::LazyLock::new(|| std::sync::Mutex::new(RealFftPlanner::new()));
-
 impl Ffts {
     fn plan(kind: Kind, n_in: usize, n_out: usize) -> Ffts {
-        // A poisoned lock only means another thread panicked while planning; the planner's
-        // cache is still a valid cache.
-        let mut planner = PLANNER.lock().unwrap_or_else(|e| e.into_inner());
+        // The plans are shared by every resampler of the process (vibmode_fft caches them).
+        use vibmode_fft::{forward, inverse};
         let (fwd, inv) = match kind {
             Kind::Pick | Kind::Linear => (None, None),
-            Kind::Fold => (
-                Some(planner.plan_fft_forward(n_in)),
-                Some(planner.plan_fft_inverse(n_out)),
-            ),
-            Kind::Full => (
-                Some(planner.plan_fft_forward(n_in)),
-                Some(planner.plan_fft_inverse(n_in)),
-            ),
-            Kind::Fourier => (
-                Some(planner.plan_fft_forward(n_in)),
-                Some(planner.plan_fft_inverse(n_out)),
-            ),
+            Kind::Fold => (Some(forward(n_in)), Some(inverse(n_out))),
+            Kind::Full => (Some(forward(n_in)), Some(inverse(n_in))),
+            Kind::Fourier => (Some(forward(n_in)), Some(inverse(n_out))),
         };
         let scratch_len = fwd
             .as_ref()
@@ -440,7 +424,7 @@ impl Resampler {
 
     fn process_fft(&mut self, x: &[f64], out: &mut [f64]) -> Result<()> {
         let (Some(fwd), Some(inv)) = (self.fwd.clone(), self.inv.clone()) else {
-            return Err(fft_err(realfft::FftError::InputBuffer(0, 0)));
+            return Err(fft_err(vibmode_fft::FftError::InputBuffer(0, 0)));
         };
         let n = self.n_in;
         self.buf_in.copy_from_slice(x);

@@ -20,8 +20,8 @@
 
 use crate::error::SpectraError;
 use crate::welch::{check_fs, check_samples};
-use realfft::{RealFftPlanner, RealToComplex};
 use std::sync::Arc;
+use vibmode_fft::RealToComplex;
 
 /// Discrete prolate spheroidal sequences: the `k` tapers of length `n` with time-half-bandwidth
 /// product `nw`, each of unit energy, in order of decreasing concentration in `[-nw/n, nw/n]`,
@@ -246,7 +246,7 @@ impl HarmonicPlan {
         let tapers = dpss(n, nw, k)?;
         let sums = tapers.iter().map(|v| v.iter().sum()).collect();
         let nfft = n * pad.max(1);
-        let fft = RealFftPlanner::<f64>::new().plan_fft_forward(nfft);
+        let fft = vibmode_fft::forward(nfft);
         Ok(HarmonicPlan {
             n,
             nfft,

@@ -2,9 +2,9 @@
 
 use crate::{Average, Detrend, Scaling, ShortRecord, SpectraError, WelchParams, WindowSpec};
 use num_complex::Complex64;
-use realfft::{RealFftPlanner, RealToComplex};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
+use vibmode_fft::RealToComplex;
 
 /// One-sided auto-spectrum (power spectral density or power spectrum) of a real signal.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -342,7 +342,7 @@ impl WelchPlan {
         let nfreq = nfft / 2 + 1;
         let df = 1.0 / (nfft as f64 * (1.0 / fs_hz));
         let freq_hz = (0..nfreq).map(|k| k as f64 * df).collect();
-        let fft = RealFftPlanner::<f64>::new().plan_fft_forward(nfft);
+        let fft = vibmode_fft::forward(nfft);
         let seg = fft.make_input_vec();
         let spec_x = fft.make_output_vec();
         let spec_y = fft.make_output_vec();

@@ -4,10 +4,10 @@ use crate::error::{invalid, Result, VehicleError};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
-use realfft::num_complex::Complex;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
+use vibmode_fft::Complex;
 
 /// Reference spatial frequency of ISO 8608, cycles/m.
 pub const N0_CYCLES_PER_M: f64 = 0.1;
@@ -291,8 +291,7 @@ impl RoadProfile {
         let nfft = npts.next_power_of_two().max(16);
         let dn = 1.0 / (nfft as f64 * dx_m);
         let half = nfft / 2;
-        let mut planner = realfft::RealFftPlanner::<f64>::new();
-        let inv = planner.plan_fft_inverse(nfft);
+        let inv = vibmode_fft::inverse(nfft);
         let mut left = vec![Complex::new(0.0, 0.0); half + 1];
         let mut right = vec![Complex::new(0.0, 0.0); half + 1];
         for (k, (l, r)) in left

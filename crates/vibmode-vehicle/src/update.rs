@@ -28,9 +28,11 @@ use crate::error::{Result, VehicleError};
 use crate::model::{FullCar, ModeInfo, ModeLabel};
 use crate::params::{CornerCondition, VehicleParams};
 use nalgebra::{DMatrix, DVector};
-use realfft::RealFftPlanner;
 use serde::{Deserialize, Serialize};
 use vibmode_core::{Channel, Corner, Direction, Placement, Recording, Role};
+// FFT plans are shared by every record of the process (vibmode_fft caches them: their twiddle
+// factors are the costly part of a plan at a record's length).
+use vibmode_fft::{forward as plan_forward, inverse as plan_inverse};
 
 pub use vibmode_core::BodyFitParams;
 
@@ -1288,24 +1290,6 @@ struct Derivatives {
     hann: Option<(Vec<f64>, f64)>,
 }
 
-/// FFT plans shared by every record of the process (their twiddle factors are the costly part
-/// of a plan at a record's length; one planner gives the same algorithm, so the same bits).
-static PLANNER: std::sync::LazyLock<std::sync::Mutex<RealFftPlanner<f64>>> =
-    std::sync::LazyLock::new(|| std::sync::Mutex::new(RealFftPlanner::new()));
-
-fn planner() -> std::sync::MutexGuard<'static, RealFftPlanner<f64>> {
-    // A poisoned lock only means another thread panicked while planning; the cache is valid.
-    PLANNER.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-fn plan_forward(n: usize) -> std::sync::Arc<dyn realfft::RealToComplex<f64>> {
-    planner().plan_fft_forward(n)
-}
-
-fn plan_inverse(n: usize) -> std::sync::Arc<dyn realfft::ComplexToReal<f64>> {
-    planner().plan_fft_inverse(n)
-}
-
 impl Derivatives {
     fn new(len: usize, fs_hz: f64, band_hz: [f64; 2]) -> Self {
         Derivatives {
@@ -1625,8 +1609,7 @@ mod tests {
             let (got, _) = d.apply(&x, &keep).unwrap();
             // The whole inverse FFTs.
             let m = 2 * n;
-            let mut planner = RealFftPlanner::<f64>::new();
-            let (fwd, inv) = (planner.plan_fft_forward(m), planner.plan_fft_inverse(m));
+            let (fwd, inv) = (vibmode_fft::forward(m), vibmode_fft::inverse(m));
             let mean = x.iter().sum::<f64>() / n as f64;
             let mut buf = fwd.make_input_vec();
             buf.iter_mut().zip(&x).for_each(|(b, v)| *b = v - mean);

@@ -2,7 +2,6 @@
 //! The simulator's in-service effects, each checked against what it must do physically, over
 //! several seeds: lines that move from record to record and follow the speed, wander and
 //! amplitude modulation, misaligned sensors, speed variation, bending shapes at the sensors.
-use realfft::RealFftPlanner;
 use vibmode_vehicle::*;
 
 const SEEDS: [u64; 5] = [1, 2, 3, 4, 5];
@@ -16,7 +15,7 @@ fn peak_hz(x: &[f64], fs: f64, lo: f64, hi: f64) -> f64 {
         let w = 0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / x.len() as f64).cos();
         buf[i] = (v - mean) * w;
     }
-    let fft = RealFftPlanner::<f64>::new().plan_fft_forward(n);
+    let fft = vibmode_fft::forward(n);
     let mut spec = fft.make_output_vec();
     fft.process(&mut buf, &mut spec).unwrap();
     let df = fs / n as f64;

@@ -3,7 +3,6 @@
 //! disturbances, FOH discretisation vs the frequency response, error paths.
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use realfft::RealFftPlanner;
 use vibmode_vehicle::*;
 
 /// Hann-windowed periodogram, one-sided density (m^2/s^4/Hz), averaged over `segs`.
@@ -13,7 +12,7 @@ fn avg_periodogram(segs: &[&[f64]], fs: f64) -> (Vec<f64>, Vec<f64>) {
         .map(|i| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / n as f64).cos())
         .collect();
     let u: f64 = w.iter().map(|x| x * x).sum();
-    let fft = RealFftPlanner::<f64>::new().plan_fft_forward(n);
+    let fft = vibmode_fft::forward(n);
     let mut p = vec![0.0; n / 2 + 1];
     for s in segs {
         let mean = s.iter().sum::<f64>() / n as f64;
