@@ -1,5 +1,5 @@
 """vibmode.fleet.register: a vehicle's model file for the suspension fitted per drive, as
-`vibmode fleet register` (the CLI test tests/cli_fleet_suspension.rs checks the fit itself)."""
+`vibmode fleet register` (the CLI test tests/integration/cli_fleet_suspension.rs checks the fit itself)."""
 
 import contextlib
 import sqlite3

@@ -36,7 +36,7 @@ The fit (the algorithm of crates/vibmode-vehicle/src/update.rs, written again he
 * The updated model (file masses and tyres, fitted springs, dampers, bars, inertias times the
   sprung mass): scipy.linalg.eigvals of its state matrix; the three lowest modes.
 
-Rust tolerance (crates/vibmode-vehicle/tests/reference.rs): parameters and mode frequencies and
+Rust tolerance (crates/vibmode-vehicle/tests/integration/reference.rs): parameters and mode frequencies and
 damping ratios relative 1e-6 (same algorithm, different FFT and solver); and both within 1 % of
 the changed bus's true parameters and modes (the physics).
 """

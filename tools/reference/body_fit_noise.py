@@ -32,7 +32,7 @@ The fit (the algorithm of crates/vibmode-vehicle/src/update.rs, written again he
   mean)^2) for every parameter and for the three body modes' frequency and damping
   (scipy.linalg.eigvals).
 
-Rust tolerance (crates/vibmode-vehicle/tests/reference.rs): densities, parameters, modes and
+Rust tolerance (crates/vibmode-vehicle/tests/integration/reference.rs): densities, parameters, modes and
 their standard deviations relative 1e-6 (same algorithm; different FFT, median selection and
 linear solver).
 """

@@ -15,7 +15,7 @@ raw = X^T X + s E^T E, noise = c s E^T E. scipy.linalg.eigh(noise, raw) gives th
 eigenvalues mu of noise v = mu raw v; the share is 1 / max(mu) when max(mu) > 1, else 1 (the
 smallest lambda that makes raw - lambda noise singular, capped at 1).
 
-Rust tolerance (crates/vibmode-vehicle/tests/reference.rs): 1e-8 relative (Cholesky and a symmetric
+Rust tolerance (crates/vibmode-vehicle/tests/integration/reference.rs): 1e-8 relative (Cholesky and a symmetric
 eigensolver against LAPACK's generalized symmetric eigensolver, on matrices whose conditioning
 reaches 1e8).
 """

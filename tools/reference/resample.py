@@ -1,4 +1,4 @@
-"""Reference values for vibmode-signal's resampling (crates/vibmode-signal/tests/resample.rs).
+"""Reference values for vibmode-signal's resampling (crates/vibmode-signal/tests/integration/resample.rs).
 
 Writes tools/reference/data/resample.json. Run from the repository root:
     python3 tools/reference/resample.py

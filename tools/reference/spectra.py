@@ -20,7 +20,7 @@ Contents
   noverlap 0 and non-default, a short record (nperseg clamped), periodograms
   with and without window and with nfft larger and smaller than the record.
 
-Tolerance used by the Rust tests (tests/scipy_reference.rs): on every bin,
+Tolerance used by the Rust tests (tests/integration/scipy_reference.rs): on every bin,
 |rust - scipy| <= 1e-9 * max(|scipy bin|, 1e-12 * max_bins |scipy|);
 frequencies to 1e-12 relative; windows to 1e-12 absolute.
 """

@@ -44,7 +44,7 @@ Two cases are stored, at orders 2, 4, ..., 20 with br = 10:
 * "toeplitz": pyOMA2's SSI_fast + SSI_poles applied to the block Hankel matrix built here in
   numpy from vibmode's estimator (means removed, R_k = 1/(Ndat-k) ..., lags 1..2br-1). Same
   definitions end to end. Rust tolerance: 1e-9 relative on frequency and damping, 1 - MAC < 1e-9
-  on shapes (achieved 4e-13, 2e-12 and 6e-16: crates/vibmode-ssi/tests/reference.rs).
+  on shapes (achieved 4e-13, 2e-12 and 6e-16: crates/vibmode-ssi/tests/integration/reference.rs).
 * "toeplitz_refs": the same with channels 0 and 2 as the references (reference-based SSI-cov;
   pyOMA2's build_hank(Y, Yref, ...) correlates every channel with Yref = Y[ref_ind]): the block
   Hankel matrix is (br l) x (br r), r = 2. Same tolerance.

@@ -33,7 +33,7 @@ H and T are built here from vibmode's estimator and handed to pyOMA2:
 pyOMA2 is run with step = 1: with step = 2 its loop over the singular vectors (`for ii in
 trange(1, ordmax + 1, step)`) fills the sensitivities of every other singular vector only and
 leaves the rest zero, which underestimates the standard deviations. br = 10, orders 2, 4, ...,
-12 are stored. Rust tolerance (crates/vibmode-ssi/tests/reference.rs): poles 1e-9 relative,
+12 are stored. Rust tolerance (crates/vibmode-ssi/tests/integration/reference.rs): poles 1e-9 relative,
 standard deviations 1e-4 relative (finite differences against closed form).
 """
 

@@ -10,7 +10,7 @@ Builds the 7-DOF (8 with bending) full-car model directly from the TOML files wi
     wheels (scipy.signal.lsim, state x = [q, q'], input u = [r, r'] with analytic r').
 
 Versions: Python 3.11, numpy 2.1.3, scipy 1.14.1 (tools/reference/requirements.txt).
-Tolerances used by crates/vibmode-vehicle/tests/reference.rs: modes and PSD relative 1e-6;
+Tolerances used by crates/vibmode-vehicle/tests/integration/reference.rs: modes and PSD relative 1e-6;
 bump response max |error| <= 2e-3 * max |response| per channel (first-order-hold vs lsim's
 linear interpolation and central-difference road velocity differ at O(dt^2)).
 

@@ -80,7 +80,7 @@ pub struct FleetConfig {
 /// analysis sweeps 2..30). Measured (docs/fleet.md, "The fleet's order sweep"): on 26 busgen
 /// buses, 416 drives of 8 records (healthy, dampers at 60 and 70 %, springs at 80 %, tyres at
 /// 75 %, class D roads), every drive's verdict, corner and component was the same with orders
-/// up to 8, 10, 12 and 30; on vibmode's own simulator (`tests/acceptance.rs` with ARMA) every
+/// up to 8, 10, 12 and 30; on vibmode's own simulator (`tests/integration/acceptance.rs` with ARMA) every
 /// figure was the same at 8 and 30 (10 to 20 lost 1-2 of 24 records of the -20 % damper).
 /// The verdicts rest on the fitted suspension, the transmissibility and the levels; the low
 /// orders give more modes that recur in 60 % of the records (7 against 3 on the demo bus). The

@@ -10,7 +10,7 @@
 //! sensitivities; here `J d_s` is the directional derivative computed by central differences,
 //! `(theta(T + e d_s) - theta(T - e d_s)) / 2e`, one pair of plans per block serving every order.
 //! Both are the same first-order quantity (checked against pyOMA2's implementation of
-//! Döhler's formulas in `tests/reference.rs`).
+//! Döhler's formulas in `tests/integration/reference.rs`).
 
 use nalgebra::DMatrix;
 use num_complex::Complex64;

@@ -1,0 +1,220 @@
+//! `vibmode fleet check` per drive: the given records of a vehicle classified together (the
+//! median of every feature over them), the JSON's `drives` beside its `records`, and the drive's
+//! bad input (too few records, records of another vehicle, another channel layout): one line,
+//! exit code 2, nothing stored.
+
+use crate::common;
+
+use common::{fails_with, ok, simulate_csv};
+
+fn check_json(args: &[&str]) -> serde_json::Value {
+    let o = ok(args);
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+/// Test records the store holds for `vehicle` (from `fleet status`).
+fn n_test(db: &str, vehicle: &str) -> usize {
+    let o = ok(&["fleet", "status", "--db", db]);
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    let line = text
+        .lines()
+        .find(|l| l.starts_with(&format!("vehicle {vehicle}:")))
+        .unwrap_or_else(|| panic!("no {vehicle} in {text}"));
+    let n = line
+        .split(", ")
+        .find(|p| p.ends_with("test records"))
+        .and_then(|p| p.split_whitespace().next())
+        .and_then(|n| n.parse().ok());
+    n.unwrap_or_else(|| panic!("no test count in {line}"))
+}
+
+#[test]
+fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let db = d.path().join("fleet.db");
+    let db = db.to_str().unwrap();
+    ok(&["fleet", "init", "--db", db]);
+    let nominal = simulate_csv(&d.path().join("nominal"), "B", "30", "11", "6");
+    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1", "-q"];
+    args.extend(nominal.iter().map(String::as_str));
+    ok(&args);
+    ok(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
+
+    // A healthy drive of 4 records: one drive, its records listed, the per-record verdicts kept.
+    let test = simulate_csv(&d.path().join("test"), "B", "30", "21", "4");
+    let mut args = vec![
+        "fleet",
+        "check",
+        "--db",
+        db,
+        "--vehicle",
+        "bus-1",
+        "-q",
+        "--drive",
+        "2026-11-25",
+        "--json",
+        "-",
+    ];
+    args.extend(test.iter().map(String::as_str));
+    let v = check_json(&args);
+    assert_eq!(v["records"].as_array().unwrap().len(), 4, "{v}");
+    let drives = v["drives"].as_array().unwrap();
+    assert_eq!(drives.len(), 1, "{v}");
+    let dr = &drives[0];
+    assert_eq!(dr["drive"], "2026-11-25");
+    assert_eq!(dr["records"].as_array().unwrap().len(), 4);
+    assert_eq!(dr["false_alarm_rate"], 0.01);
+    assert_eq!(dr["classification"], "normal", "{dr}");
+    // No vehicle evidence: no component named.
+    assert!(dr.get("component").is_none(), "{dr}");
+    assert_eq!(n_test(db, "bus-1"), 4);
+    let drives = || {
+        vibmode_fleet::Store::open(std::path::Path::new(db))
+            .unwrap()
+            .drives("bus-1")
+            .unwrap()
+    };
+    assert_eq!(
+        drives(),
+        vec![("2026-11-25".to_string(), "normal".to_string(), 4)]
+    );
+
+    // Without --drive: 3 or more records are the drive "all given records"; fewer, no drive.
+    let mut args = vec![
+        "fleet",
+        "check",
+        "--db",
+        db,
+        "--vehicle",
+        "bus-1",
+        "-q",
+        "--json",
+        "-",
+    ];
+    args.extend(test.iter().take(3).map(String::as_str));
+    let v = check_json(&args);
+    assert_eq!(v["drives"][0]["drive"], "all given records", "{v}");
+    let v = check_json(&[
+        "fleet",
+        "check",
+        "--db",
+        db,
+        "--vehicle",
+        "bus-1",
+        "-q",
+        "--json",
+        "-",
+        &test[0],
+    ]);
+    assert_eq!(v["drives"].as_array().unwrap().len(), 0, "{v}");
+    assert_eq!(drives().len(), 2);
+    assert_eq!(drives()[1].0, "all given records");
+
+    // The status leads with each vehicle's latest drive verdict and since when (the first
+    // drive of the latest run of equal verdicts: both drives are normal).
+    let st = vibmode_fleet::Store::open(std::path::Path::new(db))
+        .unwrap()
+        .status(10)
+        .unwrap();
+    let v1 = st.iter().find(|v| v.vehicle == "bus-1").unwrap();
+    let latest = v1.latest_drive.as_ref().unwrap();
+    assert_eq!(latest.drive, "all given records");
+    assert_eq!(latest.classification.to_string(), "normal");
+    assert_eq!(latest.n_records, 3);
+    assert_eq!(v1.drives.len(), 2);
+    assert_eq!(v1.drives[1].drive, "2026-11-25");
+    assert_eq!(
+        latest.since, v1.drives[1].checked,
+        "since the first normal drive"
+    );
+    let o = ok(&["fleet", "status", "--db", db]);
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    let row = text.lines().nth(1).unwrap_or("");
+    assert!(
+        row.starts_with("bus-1") && row.contains("normal") && row.contains(&latest.since),
+        "{text}"
+    );
+
+    // Too few records for a named drive: refused before anything is read or stored.
+    let more = simulate_csv(&d.path().join("more"), "B", "30", "31", "3");
+    fails_with(
+        &[
+            "fleet",
+            "check",
+            "--db",
+            db,
+            "--vehicle",
+            "bus-1",
+            "--drive",
+            "day-2",
+            &more[0],
+            &more[1],
+        ],
+        &["drive 'day-2'", "2 record(s)", "at least 3"],
+    );
+    assert_eq!(n_test(db, "bus-1"), 4);
+
+    // A record of another vehicle in the drive.
+    ok(&[
+        "fleet",
+        "ingest",
+        "--db",
+        db,
+        "--vehicle",
+        "bus-2",
+        "-q",
+        &more[2],
+    ]);
+    fails_with(
+        &[
+            "fleet",
+            "check",
+            "--db",
+            db,
+            "--vehicle",
+            "bus-1",
+            "--drive",
+            "day-2",
+            &more[0],
+            &more[1],
+            &more[2],
+        ],
+        &["drive 'day-2'", "vehicle 'bus-2'", "record_"],
+    );
+    assert_eq!(n_test(db, "bus-1"), 4);
+
+    // A record with another channel layout (a sprung channel missing) in the drive.
+    let text = std::fs::read_to_string(&more[1]).unwrap();
+    let cut: String = text
+        .lines()
+        .map(|l| {
+            let mut cols: Vec<&str> = l.split(',').collect();
+            cols.pop();
+            cols.join(",") + "\n"
+        })
+        .collect();
+    let other = d.path().join("other_layout.csv");
+    std::fs::write(&other, cut).unwrap();
+    fails_with(
+        &[
+            "fleet",
+            "check",
+            "--db",
+            db,
+            "--vehicle",
+            "bus-1",
+            "--drive",
+            "day-2",
+            &more[0],
+            other.to_str().unwrap(),
+            &more[1],
+        ],
+        &[
+            "other_layout.csv",
+            "has channels",
+            "baseline of vehicle 'bus-1'",
+        ],
+    );
+    assert_eq!(n_test(db, "bus-1"), 4);
+    assert_eq!(drives().len(), 2, "no drive stored by a refused check");
+}

@@ -1,0 +1,250 @@
+//! `vibmode fleet register`: a vehicle's model file, and the suspension fitted per drive from it
+//! (docs/fleet.md, "The suspension fitted per drive"): the baseline fits its nominal records
+//! together, each drive its own, and a corner's spring lowered against the other corners is
+//! named; bad model files are refused in one line with exit code 2, nothing stored.
+
+use crate::common;
+
+use common::{fails_with, ok, simulate_csv, simulate_csv_of};
+
+const CITY_BUS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/city_bus.toml");
+
+fn stdout(args: &[&str]) -> String {
+    String::from_utf8_lossy(&ok(args).stdout).to_string()
+}
+
+/// `fleet register` of `model` for bus-1: its standard output.
+fn register(db: &str, model: &str) -> String {
+    stdout(&["fleet", "register", "--db", db, "--vehicle", "bus-1", model])
+}
+
+fn check_drive(db: &str, files: &[String]) -> serde_json::Value {
+    let mut args = vec![
+        "fleet",
+        "check",
+        "--db",
+        db,
+        "--vehicle",
+        "bus-1",
+        "-q",
+        "--drive",
+        "d",
+        "--json",
+        "-",
+    ];
+    args.extend(files.iter().map(String::as_str));
+    let o = ok(&args);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    v["drives"][0].clone()
+}
+
+/// The fit's evidence of a drive: (kind, corner, z).
+fn fit_evidence(drive: &serde_json::Value) -> Vec<(String, String, f64)> {
+    drive["evidence"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| {
+            e["kind"]
+                .as_str()
+                .is_some_and(|k| k == "spring-fit" || k == "damper-fit")
+        })
+        .map(|e| {
+            (
+                e["kind"].as_str().unwrap().to_string(),
+                e["corner"].as_str().unwrap_or("").to_string(),
+                e["z"].as_f64().unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// vibmode's own simulator (city bus, class B at 30 km/h, 200 Hz): 6 nominal records with the
+/// model file registered; a healthy drive of 4 records on other seeds gives no fit evidence, a
+/// drive of the same bus with the RL spring at 80 % (a `[[corner_condition]]` the registered file
+/// does not have) is `vehicle`, RL named first, the spring.
+#[test]
+fn a_spring_at_80_percent_is_named_by_the_fit_per_drive() {
+    let d = tempfile::tempdir().unwrap();
+    let db = d.path().join("fleet.db");
+    let db = db.to_str().unwrap();
+    ok(&["fleet", "init", "--db", db]);
+    let out = register(db, CITY_BUS);
+    assert!(out.contains("registered"), "{out}");
+    let again = register(db, CITY_BUS);
+    assert!(again.contains("unchanged"), "{again}");
+    let status = stdout(&["fleet", "status", "--db", db]);
+    assert!(
+        status.contains("model file registered; no baseline yet"),
+        "{status}"
+    );
+
+    let nominal = simulate_csv(&d.path().join("nominal"), "B", "30", "11", "6");
+    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1", "-q"];
+    args.extend(nominal.iter().map(String::as_str));
+    ok(&args);
+    let base = stdout(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
+    assert!(
+        base.contains("suspension fitted to 6 nominal records"),
+        "{base}"
+    );
+    // The limit: Phi^-1(1 - 0.01 / 8).
+    assert!(base.contains("limit 3.02"), "{base}");
+    let status = stdout(&["fleet", "status", "--db", db]);
+    assert!(
+        status.contains("baseline version 1 fits the suspension (6 nominal records)"),
+        "{status}"
+    );
+
+    let healthy = simulate_csv(&d.path().join("healthy"), "B", "30", "21", "4");
+    let dr = check_drive(db, &healthy);
+    assert!(fit_evidence(&dr).is_empty(), "{dr}");
+    // Every corner's spring and damper score is kept, flagged or not.
+    let scores = dr["suspension"]["scores"].as_array().unwrap();
+    assert_eq!(scores.len(), 8, "{dr}");
+    assert!(
+        scores.iter().all(|x| x["z"].as_f64().unwrap() > -3.02),
+        "{dr}"
+    );
+    assert_eq!(dr["suspension"]["fit"]["records"], 4, "{dr}");
+    // The bound per drive: the features' 1 % and the fit's own 1 %.
+    assert_eq!(dr["false_alarm_rate"], 0.02, "{dr}");
+    assert!(
+        dr["missing"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|m| !m.as_str().unwrap_or("").contains("suspension")),
+        "{dr}"
+    );
+
+    let soft = d.path().join("soft_rl.toml");
+    let text = std::fs::read_to_string(CITY_BUS).unwrap()
+        + "\n[[corner_condition]]\ncorner = \"RL\"\nspring_factor = 0.8\n";
+    std::fs::write(&soft, text).unwrap();
+    let files = simulate_csv_of(
+        soft.to_str().unwrap(),
+        &d.path().join("soft"),
+        "B",
+        "30",
+        "31",
+        "4",
+    );
+    let dr = check_drive(db, &files);
+    assert!(
+        dr["classification"] == "vehicle" || dr["classification"] == "both",
+        "{dr}"
+    );
+    assert_eq!(dr["corner"], "RL", "{dr}");
+    assert_eq!(dr["component"], "spring", "{dr}");
+    let fit = fit_evidence(&dr);
+    assert!(
+        fit.iter()
+            .any(|(k, c, z)| k == "spring-fit" && c == "RL" && *z < -3.02),
+        "{fit:?}"
+    );
+}
+
+/// A model file that is not one, or that gives no fit, is refused before anything is stored;
+/// without a registered file a baseline has no fitted suspension and says nothing of it.
+#[test]
+fn bad_model_files_are_refused_and_nothing_is_stored() {
+    let d = tempfile::tempdir().unwrap();
+    let db = d.path().join("fleet.db");
+    let db = db.to_str().unwrap();
+    ok(&["fleet", "init", "--db", db]);
+    let junk = d.path().join("junk.toml");
+    std::fs::write(&junk, "this is = not [ a vehicle").unwrap();
+    fails_with(
+        &[
+            "fleet",
+            "register",
+            "--db",
+            db,
+            "--vehicle",
+            "bus-1",
+            junk.to_str().unwrap(),
+        ],
+        &["vehicle model", "junk.toml"],
+    );
+    let binary = d.path().join("binary.toml");
+    std::fs::write(&binary, [0u8, 159, 146, 150, 0, 1]).unwrap();
+    fails_with(
+        &[
+            "fleet",
+            "register",
+            "--db",
+            db,
+            "--vehicle",
+            "bus-1",
+            binary.to_str().unwrap(),
+        ],
+        &["binary.toml"],
+    );
+    let missing = d.path().join("missing.toml");
+    fails_with(
+        &[
+            "fleet",
+            "register",
+            "--db",
+            db,
+            "--vehicle",
+            "bus-1",
+            missing.to_str().unwrap(),
+        ],
+        &["missing.toml"],
+    );
+    // A body-fit band above what a bus's body modes allow still parses; a vehicle id with a
+    // space is refused.
+    fails_with(
+        &[
+            "fleet",
+            "register",
+            "--db",
+            db,
+            "--vehicle",
+            "bus 1",
+            CITY_BUS,
+        ],
+        &["bus 1"],
+    );
+    let store = vibmode_fleet::Store::open(std::path::Path::new(db)).unwrap();
+    assert!(store.vehicles().unwrap().is_empty());
+    assert!(store.vehicle_model("bus-1").unwrap().is_none());
+}
+
+/// Records ingested before the model file was registered carry no body equations; ingesting the
+/// same files again after registering adds them (the features are updated, no record is added),
+/// and the baseline then fits the suspension.
+#[test]
+fn records_stored_before_registering_get_their_equations_when_ingested_again() {
+    let d = tempfile::tempdir().unwrap();
+    let db = d.path().join("fleet.db");
+    let db = db.to_str().unwrap();
+    ok(&["fleet", "init", "--db", db]);
+    let nominal = simulate_csv(&d.path().join("nominal"), "B", "30", "12", "5");
+    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1", "-q"];
+    args.extend(nominal.iter().map(String::as_str));
+    ok(&args);
+    register(db, CITY_BUS);
+    let base = stdout(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
+    assert!(
+        base.contains("no suspension fit per drive") && base.contains("0 record(s)"),
+        "{base}"
+    );
+    let again = common::vibmode(&args);
+    let err = String::from_utf8_lossy(&again.stderr).to_string();
+    assert_eq!(again.status.code(), Some(0), "{err}");
+    assert_eq!(err.matches("body equations added").count(), 5, "{err}");
+    let base = stdout(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
+    assert!(
+        base.contains("suspension fitted to 5 nominal records"),
+        "{base}"
+    );
+    // A third time: nothing to do.
+    let third = common::vibmode(&args);
+    let err = String::from_utf8_lossy(&third.stderr).to_string();
+    assert_eq!(err.matches("nothing to do").count(), 5, "{err}");
+    let status = stdout(&["fleet", "status", "--db", db]);
+    assert!(status.contains("5 nominal, 0 test records"), "{status}");
+}

@@ -1,0 +1,212 @@
+//! Issue 29 item 5: every command that reads recordings reads them the same way. A text export
+//! with Excel's `sep=,` line and a jittery millisecond time column (as a published FSAE car IMU
+//! export) is refused by `analyze`, `segment` and `fleet ingest` with the hint
+//! `--resample-nonuniform`, and read by each of them once that flag is given; a `Timestamp`
+//! column in milliseconds is read with `--time-unit ms`.
+
+use std::path::Path;
+
+use crate::common;
+
+use common::{fails_with, ok, stderr};
+
+/// A small deterministic generator (no dependency): uniform in [-1, 1).
+struct Lcg(u64);
+
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+}
+
+/// 100 Hz, `seconds` long, three channels named by corner and role (a sine each plus noise), the time column `time_name`
+/// in milliseconds with +-0.3 ms jitter, after Excel's `sep=,` line.
+fn jittery_csv(path: &Path, time_name: &str, seconds: f64) {
+    let fs = 100.0;
+    let n = (fs * seconds) as usize;
+    let mut rng = Lcg(7);
+    let mut text = format!("sep=,\n{time_name},FL_sprung,FL_unsprung,FR_unsprung\n");
+    for i in 0..n {
+        let t = i as f64 / fs;
+        let t_ms = 1000.0 * t + 0.3 * rng.next();
+        let mut row = format!("{t_ms:.3}");
+        for f in [1.3, 11.0, 12.0] {
+            let v = (2.0 * std::f64::consts::PI * f * t).sin() + 0.5 * rng.next();
+            row.push_str(&format!(",{v:.6}"));
+        }
+        text.push_str(&row);
+        text.push('\n');
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap()
+}
+
+#[test]
+fn analyze_segment_and_fleet_ingest_read_a_jittery_time_column() {
+    let d = tempfile::tempdir().unwrap();
+    let f = d.path().join("imu.csv");
+    jittery_csv(&f, "Time_ms", 60.0);
+    let db = d.path().join("fleet.db");
+    ok(&["fleet", "init", "--db", s(&db)]);
+    let report = d.path().join("report");
+    let segs = d.path().join("segs");
+
+    // Without the flag: refused, one line naming the fix each command accepts.
+    for args in [
+        vec!["analyze", s(&f), "-q", "-o", s(&report)],
+        vec!["segment", s(&f), "-o", s(&segs)],
+        vec!["fleet", "ingest", "--db", s(&db), "--vehicle", "car", s(&f)],
+    ] {
+        fails_with(&args, &["not uniform", "--resample-nonuniform"]);
+    }
+
+    // With it: each command reads the file at the mean rate, 100 Hz.
+    ok(&[
+        "analyze",
+        s(&f),
+        "--resample-nonuniform",
+        "-q",
+        "-o",
+        s(&report),
+    ]);
+    let r = json(&report.join("results.json"));
+    let records = r["records"].as_array().expect("records");
+    // 60 s in records of 10.24 s.
+    assert_eq!(records.len(), 5, "{records:?}");
+    let fs = records[0]["fs_hz"].as_f64().unwrap();
+    assert!((fs - 50.0).abs() < 1e-9 || (fs - 100.0).abs() < 0.1, "{fs}");
+    let channels: Vec<&str> = r["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|c| c["name"].as_str())
+        .collect();
+    assert_eq!(
+        channels,
+        ["FL_sprung", "FL_unsprung", "FR_unsprung"],
+        "time column taken as a channel"
+    );
+
+    ok(&["segment", s(&f), "--resample-nonuniform", "-o", s(&segs)]);
+    let sj = json(&segs.join("segments.json"));
+    assert_eq!(sj["records"].as_array().map(Vec::len), Some(5), "{sj}");
+    let fs = sj["fs_hz"].as_f64().unwrap();
+    assert!((fs - 100.0).abs() < 0.05, "mean rate {fs}");
+    assert!(
+        (sj["duration_s"].as_f64().unwrap() - 60.0).abs() < 0.05,
+        "{sj}"
+    );
+
+    let o = ok(&[
+        "fleet",
+        "ingest",
+        "--db",
+        s(&db),
+        "--vehicle",
+        "car",
+        "--resample-nonuniform",
+        s(&f),
+    ]);
+    let err = stderr(&o);
+    assert!(err.contains("stored as nominal record"), "{err}");
+}
+
+/// A `Timestamp` column says no unit: seconds, unless `--time-unit ms`; a `Time_ms` column is
+/// milliseconds by its name. The rate read shows which.
+#[test]
+fn time_column_units_by_name_and_by_option() {
+    let d = tempfile::tempdir().unwrap();
+    let fs_of = |args: &[&str]| -> f64 {
+        let o = ok(args);
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v["parameters"]["fs_hz"].as_f64().unwrap()
+    };
+    let ms = d.path().join("ms.csv");
+    jittery_csv(&ms, "Time_ms", 20.0);
+    let fs = fs_of(&["psd", s(&ms), "--resample-nonuniform", "--json", "-"]);
+    assert!((fs - 100.0).abs() < 0.05, "{fs}");
+
+    let stamp = d.path().join("stamp.csv");
+    jittery_csv(&stamp, "Timestamp", 20.0);
+    let fs = fs_of(&["psd", s(&stamp), "--resample-nonuniform", "--json", "-"]);
+    assert!((fs - 0.1).abs() < 1e-4, "read as seconds: {fs}");
+    let fs = fs_of(&[
+        "psd",
+        s(&stamp),
+        "--resample-nonuniform",
+        "--time-unit",
+        "ms",
+        "--json",
+        "-",
+    ]);
+    assert!((fs - 100.0).abs() < 0.05, "{fs}");
+    fails_with(
+        &["psd", s(&stamp), "--time-unit", "fortnights"],
+        &["time_unit", "fortnights", "ms"],
+    );
+}
+
+/// A car dataset's GPS track `Timestamp,Lat_GNSS,Long_GNSS` (Unix ms, no speed column) is read
+/// by `segment --gps`: the speed comes from the positions and the records are cut where the car
+/// drives (the command refused the file before: "no latitude column").
+#[test]
+fn segment_reads_a_gps_csv_with_gnss_column_names() {
+    use vibmode_signal::{write_path, Channel, Recording};
+    let d = tempfile::tempdir().unwrap();
+    let fs = 100.0;
+    let n = 6_000;
+    let mut rng = Lcg(3);
+    let rec = Recording {
+        fs_hz: fs,
+        channels: vec![Channel::new(
+            "z".to_string(),
+            "m/s^2".to_string(),
+            (0..n).map(|_| rng.next()).collect(),
+        )],
+        time_axis: None,
+    };
+    let r = d.path().join("r.f32");
+    write_path(&r, &rec).unwrap();
+    let side = d.path().join("r.f32.json");
+    let text = std::fs::read_to_string(&side).unwrap();
+    let text = text.replacen('{', "{\n  \"start_time\": \"2024-05-02T07:31:00Z\",", 1);
+    std::fs::write(&side, text).unwrap();
+    // 10 m/s due north for 38 s, then standing.
+    let mut track = String::from("Timestamp,Lat_GNSS,Long_GNSS\n");
+    for i in 0..=60u64 {
+        let north = 10.0 * (i as f64).min(38.0);
+        let ms = (1_714_635_060 + i) * 1000;
+        track.push_str(&format!("{ms},{},17.0\n", 48.0 + north / 111_195.08));
+    }
+    let g = d.path().join("gnss.csv");
+    std::fs::write(&g, track).unwrap();
+    let out = d.path().join("segs");
+    ok(&[
+        "segment",
+        s(&r),
+        "--gps",
+        s(&g),
+        "--plan-only",
+        "-o",
+        s(&out),
+    ]);
+    let sj = json(&out.join("segments.json"));
+    let records = sj["records"].as_array().expect("records");
+    assert_eq!(records.len(), 3, "{sj}");
+    for rec in records {
+        let v = rec["mean_speed_kmh"].as_f64().expect("speed");
+        assert!((v - 36.0).abs() < 1.0, "{v}");
+    }
+}
