@@ -1,5 +1,5 @@
 //! The planner's transforms: a case by hand and the inverse identity on random inputs.
-use vibmode_fft::{forward, inverse, Complex};
+use vibmode_fft::{forward, inverse, Complex, Planner};
 
 /// A small case by hand: x = [1, 2, 3, 4] has X0 = 10, X1 = -2 + 2i, X2 = -2.
 #[test]
@@ -42,4 +42,21 @@ fn inverse_undoes_forward_times_n() {
             assert!((a * n as f64 - b).abs() < 1e-9 * n as f64, "n = {n}");
         }
     }
+}
+
+/// A planner of one's own gives the same bits as the shared one.
+#[test]
+fn an_own_planner_gives_the_shared_planners_bits() {
+    let x: Vec<f64> = (0..1000).map(|i| ((i * i) % 97) as f64 - 48.0).collect();
+    let mut own = Planner::new();
+    let (a, b) = (own.forward(1000), forward(1000));
+    let (mut xa, mut xb) = (x.clone(), x);
+    let (mut sa, mut sb) = (a.make_output_vec(), b.make_output_vec());
+    a.process(&mut xa, &mut sa).unwrap();
+    b.process(&mut xb, &mut sb).unwrap();
+    assert_eq!(sa, sb);
+    let inv = own.inverse(1000);
+    let mut back = inv.make_output_vec();
+    inv.process(&mut sa, &mut back).unwrap();
+    assert!((back[1] / 1000.0 - (1.0 - 48.0)).abs() < 1e-9);
 }

@@ -55,7 +55,8 @@ fn has_empty_band(y: &[f64]) -> bool {
     if n < EMPTY_BAND_MIN_LEN {
         return false;
     }
-    let fft = vibmode_fft::forward(n);
+    let mut planner = vibmode_fft::Planner::new();
+    let fft = planner.forward(n);
     let mut input = y.to_vec();
     let mut spec = fft.make_output_vec();
     if fft.process(&mut input, &mut spec).is_err() {

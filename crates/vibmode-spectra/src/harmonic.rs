@@ -246,7 +246,7 @@ impl HarmonicPlan {
         let tapers = dpss(n, nw, k)?;
         let sums = tapers.iter().map(|v| v.iter().sum()).collect();
         let nfft = n * pad.max(1);
-        let fft = vibmode_fft::forward(nfft);
+        let fft = vibmode_fft::Planner::new().forward(nfft);
         Ok(HarmonicPlan {
             n,
             nfft,

@@ -68,11 +68,24 @@ pub fn narrowband_moments(
 ) -> Result<(f64, f64), SpectraError> {
     check_fs(fs_hz)?;
     check_samples(x, "x")?;
-    Ok(band_moments(x, fs_hz, center_hz, half_width_hz))
+    let mut planner = vibmode_fft::Planner::new();
+    Ok(band_moments(
+        &mut planner,
+        x,
+        fs_hz,
+        center_hz,
+        half_width_hz,
+    ))
 }
 
-fn band_kurtosis(x: &[f64], fs_hz: f64, center_hz: f64, half_width_hz: f64) -> f64 {
-    let (m2, m4) = band_moments(x, fs_hz, center_hz, half_width_hz);
+fn band_kurtosis(
+    planner: &mut vibmode_fft::Planner,
+    x: &[f64],
+    fs_hz: f64,
+    center_hz: f64,
+    half_width_hz: f64,
+) -> f64 {
+    let (m2, m4) = band_moments(planner, x, fs_hz, center_hz, half_width_hz);
     if m2 > 0.0 {
         m4 / (m2 * m2)
     } else {
@@ -80,13 +93,19 @@ fn band_kurtosis(x: &[f64], fs_hz: f64, center_hz: f64, half_width_hz: f64) -> f
     }
 }
 
-fn band_moments(x: &[f64], fs_hz: f64, center_hz: f64, half_width_hz: f64) -> (f64, f64) {
+fn band_moments(
+    planner: &mut vibmode_fft::Planner,
+    x: &[f64],
+    fs_hz: f64,
+    center_hz: f64,
+    half_width_hz: f64,
+) -> (f64, f64) {
     let n = x.len();
     let mean = x.iter().sum::<f64>() / n as f64;
     let mut buf: Vec<f64> = x.iter().map(|v| v - mean).collect();
     let var = buf.iter().map(|v| v * v).sum::<f64>() / n as f64;
-    let fwd = vibmode_fft::forward(n);
-    let inv = vibmode_fft::inverse(n);
+    let fwd = planner.forward(n);
+    let inv = planner.inverse(n);
     let mut spec = fwd.make_output_vec();
     if fwd.process(&mut buf, &mut spec).is_err() {
         return (0.0, 0.0);
@@ -177,6 +196,7 @@ pub fn line_candidates(
     if n < 8 {
         return Ok(Vec::new());
     }
+    let mut planner = vibmode_fft::Planner::new();
     let nfft = 4 * n;
     let mean = x.iter().sum::<f64>() / n as f64;
     let mut buf = vec![0.0; nfft];
@@ -184,7 +204,7 @@ pub fn line_candidates(
         let w = 0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / n as f64).cos();
         buf[i] = (v - mean) * w;
     }
-    let fwd = vibmode_fft::forward(nfft);
+    let fwd = planner.forward(nfft);
     let mut spec = fwd.make_output_vec();
     if fwd.process(&mut buf, &mut spec).is_err() {
         return Ok(Vec::new());
@@ -211,7 +231,7 @@ pub fn line_candidates(
         .into_iter()
         .map(|(k, prominence_db)| {
             let frequency_hz = peak_bin(&pw, k) * df;
-            let kurtosis = band_kurtosis(x, fs_hz, frequency_hz, p.half_width_hz);
+            let kurtosis = band_kurtosis(&mut planner, x, fs_hz, frequency_hz, p.half_width_hz);
             LineCandidate {
                 frequency_hz,
                 kurtosis,
@@ -240,6 +260,7 @@ pub fn f_test_line_candidates(
     p: &LineParams,
 ) -> Vec<LineCandidate> {
     let w = h.half_bandwidth_hz;
+    let mut planner = vibmode_fft::Planner::new();
     let dof_num = h.dof / 2.0; // K - 1
     let df = h.freq_hz.get(1).copied().unwrap_or(f64::NAN);
     f_test_peaks(
@@ -254,7 +275,7 @@ pub fn f_test_line_candidates(
         let fstat = h.f_stat.get(j).copied().unwrap_or(f64::NAN);
         LineCandidate {
             frequency_hz: f,
-            kurtosis: band_kurtosis(x, fs_hz, f, p.half_width_hz),
+            kurtosis: band_kurtosis(&mut planner, x, fs_hz, f, p.half_width_hz),
             prominence_db: 10.0 * (fstat / dof_num).log10(),
             periodic: true,
             p_value: pv,
@@ -499,8 +520,9 @@ pub fn tracked_kurtosis(
         im.push(-(v - mean) * phase.sin());
         phase = (phase + 2.0 * std::f64::consts::PI * f * dt) % (2.0 * std::f64::consts::PI);
     }
-    lowpass(&mut re, fs_hz, half_width_hz);
-    lowpass(&mut im, fs_hz, half_width_hz);
+    let mut planner = vibmode_fft::Planner::new();
+    lowpass(&mut planner, &mut re, fs_hz, half_width_hz);
+    lowpass(&mut planner, &mut im, fs_hz, half_width_hz);
     let lo = (((t0 - half_segment_s) * fs_hz).floor().max(0.0)) as usize;
     let hi = ((((t1 + half_segment_s) * fs_hz).ceil()) as usize).min(n);
     let (mut m2, mut m4, mut k) = (0.0, 0.0, 0usize);
@@ -518,10 +540,10 @@ pub fn tracked_kurtosis(
 }
 
 /// Ideal DFT low-pass of `y` to `cut_hz` (DC kept), in place.
-fn lowpass(y: &mut [f64], fs_hz: f64, cut_hz: f64) {
+fn lowpass(planner: &mut vibmode_fft::Planner, y: &mut [f64], fs_hz: f64, cut_hz: f64) {
     let n = y.len();
-    let fwd = vibmode_fft::forward(n);
-    let inv = vibmode_fft::inverse(n);
+    let fwd = planner.forward(n);
+    let inv = planner.inverse(n);
     let mut spec = fwd.make_output_vec();
     if fwd.process(y, &mut spec).is_err() {
         return;

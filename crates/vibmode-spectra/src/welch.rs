@@ -342,7 +342,7 @@ impl WelchPlan {
         let nfreq = nfft / 2 + 1;
         let df = 1.0 / (nfft as f64 * (1.0 / fs_hz));
         let freq_hz = (0..nfreq).map(|k| k as f64 * df).collect();
-        let fft = vibmode_fft::forward(nfft);
+        let fft = vibmode_fft::Planner::new().forward(nfft);
         let seg = fft.make_input_vec();
         let spec_x = fft.make_output_vec();
         let spec_y = fft.make_output_vec();

@@ -291,7 +291,8 @@ impl RoadProfile {
         let nfft = npts.next_power_of_two().max(16);
         let dn = 1.0 / (nfft as f64 * dx_m);
         let half = nfft / 2;
-        let inv = vibmode_fft::inverse(nfft);
+        let mut planner = vibmode_fft::Planner::new();
+        let inv = planner.inverse(nfft);
         let mut left = vec![Complex::new(0.0, 0.0); half + 1];
         let mut right = vec![Complex::new(0.0, 0.0); half + 1];
         for (k, (l, r)) in left
