@@ -108,9 +108,13 @@ def simulate(bus_seed: int, seed: int, *extra: str, records: int = RECORDS,
     """A folder of busgen records (`recNN.csv` + truth.json) for these arguments, made once.
 
     `extra` are busgen options as given on its command line, e.g. `"--damper", "rl=0.6"`.
+    `VIBMODE_BUSGEN_EXTRA` (whitespace-separated busgen options, e.g. `--no-noise`) is added to
+    every simulation, the baselines' too: what a figure depends on, measured by any of these
+    scripts with one switch of the simulator off (part of the cache key).
     """
     args = ["--bus-seed", str(bus_seed), "--records", str(records), "--seed", str(seed),
-            "--fs", repr(float(fs_hz)), "--csv-only", *extra]
+            "--fs", repr(float(fs_hz)), "--csv-only", *extra,
+            *os.environ.get("VIBMODE_BUSGEN_EXTRA", "").split()]
     key = hashlib.sha256(json.dumps(args).encode()).hexdigest()[:16]
     out = cache_dir() / f"bus{bus_seed}-{key}"
     if (out / "truth.json").is_file():
