@@ -222,6 +222,18 @@ pub struct Store {
     path: String,
 }
 
+/// `map_err`'s conversion of an SQLite error met while doing `operation` on the store at `path`.
+fn sql_error<'a>(
+    path: &'a str,
+    operation: &'static str,
+) -> impl Fn(rusqlite::Error) -> FleetError + Copy + 'a {
+    move |e| FleetError::Sql {
+        path: path.to_string(),
+        operation,
+        reason: e.to_string(),
+    }
+}
+
 /// Now as UTC RFC 3339 (seconds).
 pub fn now_utc() -> String {
     let secs = std::time::SystemTime::now()
@@ -477,11 +489,7 @@ impl Store {
     /// `user_version` (another process may have applied it meanwhile).
     fn migrate(&mut self) -> Result<()> {
         let path = self.path.clone();
-        let err = |e: rusqlite::Error| FleetError::Sql {
-            path: path.clone(),
-            operation: "schema migration",
-            reason: e.to_string(),
-        };
+        let err = sql_error(&path, "schema migration");
         let current: i64 = self
             .conn
             .query_row("PRAGMA user_version", [], |r| r.get(0))
@@ -599,11 +607,7 @@ impl Store {
     ) -> Result<bool> {
         let now = now_utc();
         let path = self.path.clone();
-        let err = |e: rusqlite::Error| FleetError::Sql {
-            path: path.clone(),
-            operation: "registering a vehicle model",
-            reason: e.to_string(),
-        };
+        let err = sql_error(&path, "registering a vehicle model");
         let tx = self
             .conn
             .transaction_with_behavior(TransactionBehavior::Immediate)
@@ -761,11 +765,7 @@ impl Store {
         }
         let now = now_utc();
         let path = self.path.clone();
-        let err = |e: rusqlite::Error| FleetError::Sql {
-            path: path.clone(),
-            operation: "storing records",
-            reason: e.to_string(),
-        };
+        let err = sql_error(&path, "storing records");
         let tx = self
             .conn
             .transaction_with_behavior(TransactionBehavior::Immediate)
@@ -978,11 +978,7 @@ impl Store {
     pub fn save_model_set(&mut self, set: &mut ModelSet) -> Result<i64> {
         let vid = self.require_vehicle(&set.vehicle)?;
         let path = self.path.clone();
-        let err = |e: rusqlite::Error| FleetError::Sql {
-            path: path.clone(),
-            operation: "storing a model set",
-            reason: e.to_string(),
-        };
+        let err = sql_error(&path, "storing a model set");
         let tx = self
             .conn
             .transaction_with_behavior(rusqlite::TransactionBehavior::Immediate)
@@ -1045,11 +1041,7 @@ impl Store {
             return Ok(());
         }
         let path = self.path.clone();
-        let err = |e: rusqlite::Error| FleetError::Sql {
-            path: path.clone(),
-            operation: "storing the settings",
-            reason: e.to_string(),
-        };
+        let err = sql_error(&path, "storing the settings");
         let tx = self
             .conn
             .transaction_with_behavior(rusqlite::TransactionBehavior::Immediate)
@@ -1095,11 +1087,7 @@ impl Store {
     pub fn save_check(&mut self, record_id: i64, version: i64, a: &Assessment) -> Result<()> {
         let json = to_json_checked(a, "the check")?;
         let path = self.path.clone();
-        let err = |e: rusqlite::Error| FleetError::Sql {
-            path: path.clone(),
-            operation: "storing a check",
-            reason: e.to_string(),
-        };
+        let err = sql_error(&path, "storing a check");
         let tx = self
             .conn
             .transaction_with_behavior(rusqlite::TransactionBehavior::Immediate)
