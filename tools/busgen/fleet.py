@@ -172,7 +172,6 @@ def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
         susp = (drives[0].get("suspension") if drives else None)
         rows.append({"bus": bus_seed, "cond": cond["name"], "detail": cond["detail"],
                      "suspension": susp,
-                     "scores": drives[0].get("scores") if drives else None,
                      "expect": cond["expect"], "corner": cond["corner"], "records": recs,
                      "drive": drive,
                      "record_ok": sum(verdict_ok(c, k, cond) for c, k, _ in recs),
