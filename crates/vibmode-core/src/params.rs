@@ -1004,16 +1004,16 @@ pub struct LineParams {
     /// channel: a line where F peaks with `P(F > F_obs) < f_test_alpha` under F(2, 2K - 2), the
     /// distribution of F without a line over a spectrum smooth within the tapers' band
     /// (docs/analysis.md, "Lines"). Default 1e-4: the false-alarm probability per record,
-    /// channel and independent frequency (a 10.24 s record has 10.24 of them per Hz), so at most
-    /// 0.18 false detections per record over 0-25 Hz on one channel; a track needs detections in
-    /// `min_record_share` of the records. In (0, 0.1].
+    /// channel and frequency of the search grid (4 per `1 / T`), so over 3-24 Hz a record of
+    /// white noise on one channel has a false detection with probability about 8 %; a track
+    /// needs detections in `min_record_share` of the records and in two at least. In (0, 0.1].
     pub f_test_alpha: f64,
     /// False-alarm probability of the F-test combined over the records (Fisher over the records
     /// per channel, Bonferroni over the pool's channels) per pool and analysis, over the whole
     /// band searched: the combined p-value at one frequency must be below this divided by the
-    /// number of independent frequencies searched, `(band width Hz) x (record length s)`
-    /// (Bonferroni over the frequencies). Default 0.01: 4.5e-5 per frequency for 10.24 s records
-    /// over 3-24.6 Hz (docs/analysis.md, "Periodic lines"). In (0, 0.1].
+    /// number of frequencies searched, the points of the F-test's 4x zero-padded grid in the
+    /// band (Bonferroni over them). Default 0.01: 1.1e-5 per frequency for 10.24 s records over
+    /// 3-24.6 Hz (docs/analysis.md, "Periodic lines"). In (0, 0.1].
     pub f_test_combined_alpha: f64,
     /// Time-half-bandwidth product `NW` of the F-test's Slepian tapers (default 4: a 10.24 s
     /// record's tapers are concentrated in +-0.39 Hz). In [1, 20].
