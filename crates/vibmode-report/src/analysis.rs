@@ -420,7 +420,7 @@ pub fn lines_text(
     if lines.is_empty() {
         let _ = writeln!(
             s,
-            "{indent}No periodic lines (no harmonic F-test peak at p < {:e} per record and channel, none over the pooled records at a false-alarm rate of {} for the band, no prominent peak with a narrow-band kurtosis below {} in {:.0} % of the records, no swept ridge).",
+            "{indent}No periodic lines (no harmonic F-test peak at p < {:e} per record and channel in two records or more, none over the pooled records at a false-alarm rate of {} for the band, no prominent peak with a narrow-band kurtosis below {} in {:.0} % of the records and two at least, no swept ridge).",
             r.config.lines.f_test_alpha,
             r.config.lines.f_test_combined_alpha,
             r.config.lines.max_kurtosis,
