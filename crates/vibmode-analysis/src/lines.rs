@@ -470,16 +470,12 @@ impl<'a> LineStage<'a> {
         let mut out: Vec<LineTrack> = track(&per_record, &sweeps, self.params, n_used)
             .into_iter()
             .filter_map(|mut t| {
-                // A sweep is reported only on a line seen steady in other records (it carries
-                // that line from one engine speed to another): in at least
-                // MIN_STEADY_RECORDS_OF_A_SWEEP of them. A ridge alone (busgen: 7.6 -> 9.7 Hz in
-                // one record, along the wheel hop's flank), or with one steady peak after it, is
-                // no evidence of a line.
-                let n_steady = t.record_hz.iter().flatten().count();
-                let has_sweep = t.record_sweep.iter().any(Option::is_some);
-                if n_steady < MIN_TRACK_RECORDS
-                    || (has_sweep && n_steady < MIN_STEADY_RECORDS_OF_A_SWEEP)
-                {
+                // Every track is seen steady in MIN_TRACK_RECORDS records, so a sweep is reported
+                // only on a line seen steady in other records (it carries that line from one
+                // engine speed to another; MIN_STEADY_RECORDS_OF_A_SWEEP). A ridge alone (busgen:
+                // 7.6 -> 9.7 Hz in one record, along the wheel hop's flank), or with one steady
+                // peak after it, is no evidence of a line.
+                if t.record_hz.iter().flatten().count() < MIN_TRACK_RECORDS {
                     return None;
                 }
                 // A track with F-test lines (false-alarm probability f_test_alpha per record and
@@ -756,8 +752,9 @@ pub const ORDER_MATCH_REL_TOL: f64 = 0.01;
 pub const ENGINE_SPEED_CHANGE_MAX: f64 = 0.15;
 /// A track holding a sweep is reported only when its line is steady in at least this many
 /// records (one steady peak after a ridge can be noise: about 8 % of records of white noise hold
-/// a false F-test line in 3-24 Hz on the 4x grid).
-pub const MIN_STEADY_RECORDS_OF_A_SWEEP: usize = 2;
+/// a false F-test line in 3-24 Hz on the 4x grid). Every track needs as many since
+/// `MIN_TRACK_RECORDS`.
+pub const MIN_STEADY_RECORDS_OF_A_SWEEP: usize = MIN_TRACK_RECORDS;
 /// A track classes a cluster periodic only at a frequency it holds (within `half_width_hz`) in
 /// at least this many records (or in all its records when it has fewer, or when it holds a
 /// sweep): in one record a track can take a peak of another line or of a mode (busgen buses 30411, 22764, 94423: one record's
@@ -1236,7 +1233,7 @@ mod tests {
     /// anywhere in the band in at most `f_test_combined_alpha` (1 %) of the analyses. 400
     /// analyses each: 4 expected at 1 %, at most 10 allowed (Poisson(4) exceeds 10 with
     /// probability 0.3 %); the Bonferroni count of before (band x record length, 221
-    /// frequencies, where the 4x grid searches 884) gave about 3.9 % (16 expected).
+    /// frequencies, where the 4x grid searches 884) gave 18 of 400 with one record.
     /// A 7 Hz sine of amplitude 1.5 in the unit noise is found in every analysis of one record.
     #[test]
     fn the_combined_test_keeps_its_stated_false_alarm_rate_over_white_noise() {

@@ -261,11 +261,7 @@ pub fn now_utc() -> String {
 
 impl Store {
     fn sql(&self, operation: &'static str) -> impl Fn(rusqlite::Error) -> FleetError + '_ {
-        move |e| FleetError::Sql {
-            path: self.path.clone(),
-            operation,
-            reason: e.to_string(),
-        }
+        sql_error(&self.path, operation)
     }
 
     fn not_a_store(path: &str, reason: impl ToString) -> FleetError {
