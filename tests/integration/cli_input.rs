@@ -210,3 +210,41 @@ fn segment_reads_a_gps_csv_with_gnss_column_names() {
         assert!((v - 36.0).abs() < 1.0, "{v}");
     }
 }
+
+/// A CSV written by pandas' `DataFrame.to_csv` (its row index as an unnamed first column): the
+/// index is not a channel for `psd` and `analyze`; a broken count is refused in one line.
+#[test]
+fn a_pandas_index_column_is_not_analysed() {
+    let d = tempfile::tempdir().unwrap();
+    let f = d.path().join("frame.csv");
+    let mut rng = Lcg(11);
+    let mut text = String::from(",time,acc_front,acc_rear\n");
+    for i in 0..3000 {
+        let t = i as f64 / 100.0;
+        let a = (2.0 * std::f64::consts::PI * 1.3 * t).sin() + 0.5 * rng.next();
+        let b = (2.0 * std::f64::consts::PI * 9.0 * t).sin() + 0.5 * rng.next();
+        text.push_str(&format!("{i},{t:.2},{a:.6},{b:.6}\n"));
+    }
+    std::fs::write(&f, &text).unwrap();
+    let o = ok(&["psd", s(&f)]);
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        out.contains("acc_front") && out.contains("acc_rear"),
+        "{out}"
+    );
+    assert!(!out.contains("ch0"), "the index read as a channel: {out}");
+    let r = d.path().join("report");
+    ok(&["analyze", "-q", "--method", "arma", s(&f), "-o", s(&r)]);
+    let names: Vec<String> = json(&r.join("results.json"))["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(names, ["acc_front", "acc_rear"]);
+    std::fs::write(&f, text.replacen("\n17,", "\n18,", 1)).unwrap();
+    fails_with(
+        &["psd", s(&f)],
+        &["pandas row index", "line 19", "index=False"],
+    );
+}

@@ -118,6 +118,45 @@ pub struct ColumnInfo {
     /// `Some(seconds per unit)` if this is recognised as the time column (name `time`, `t`,
     /// `time_s`, `t_s`, `time_ms`, `t_ms`, `timestamp`, case-insensitive; unit s, ms, us, ns, min, h).
     pub time_scale_s: Option<f64>,
+    /// True for a row counter as pandas' `DataFrame.to_csv` writes its index: the first column of
+    /// a header whose cell is empty or `Unnamed: 0` (every other column named), its first value
+    /// 0 or 1. It is not a channel; its values must count up by one
+    /// ([`check_row_index`]).
+    #[serde(default)]
+    pub row_index: bool,
+}
+
+impl ColumnInfo {
+    /// True for a column that holds samples of a channel (neither time nor a row counter).
+    pub fn is_channel(&self) -> bool {
+        self.time_scale_s.is_none() && !self.row_index
+    }
+}
+
+/// Checks that a row-index column ([`ColumnInfo::row_index`]) counts up by one from `first`
+/// (the value expected at `values[0]`); `lines[k]` (when given) is the file line of row `k`.
+/// Returns the next value expected after `values`.
+pub fn check_row_index(
+    path: &str,
+    column: &ColumnInfo,
+    first: f64,
+    values: &[f64],
+    lines: &[usize],
+) -> Result<f64> {
+    let mut expected = first;
+    for (k, &v) in values.iter().enumerate() {
+        if v != expected {
+            return Err(SignalError::NotARowIndex {
+                path: path.to_string(),
+                column: column.name.clone(),
+                line: lines.get(k).copied().unwrap_or(0),
+                value: v,
+                expected,
+            });
+        }
+        expected += 1.0;
+    }
+    Ok(expected)
 }
 
 /// A block of consecutive data rows, stored column by column.
@@ -339,9 +378,38 @@ fn header_columns(line: &[u8], spans: &[(usize, usize)]) -> Vec<ColumnInfo> {
                 name,
                 unit,
                 time_scale_s,
+                row_index: false,
             }
         })
         .collect()
+}
+
+/// Marks the first column as a row index when it looks like pandas' `DataFrame.to_csv` index:
+/// its header cell is empty (named `ch0` here) or `Unnamed: 0`, every other column is named, it is
+/// not the time column, and the first data row holds 0 or 1 there.
+fn mark_row_index(
+    columns: &mut [ColumnInfo],
+    header: &[u8],
+    spans: &[(usize, usize)],
+    first_value: Option<f64>,
+) {
+    if columns.len() < 2 || spans.len() != columns.len() {
+        return;
+    }
+    let cell = |i: usize| {
+        let (a, b) = spans[i];
+        trim_cell(&header[a..b])
+    };
+    let first = cell(0);
+    let unnamed = first.is_empty() || first.eq_ignore_ascii_case(b"Unnamed: 0");
+    let others_named = (1..columns.len()).all(|i| !cell(i).is_empty());
+    if unnamed
+        && others_named
+        && columns[0].time_scale_s.is_none()
+        && matches!(first_value, Some(v) if v == 0.0 || v == 1.0)
+    {
+        columns[0].row_index = true;
+    }
 }
 
 impl<R: BufRead> DelimitedReader<R> {
@@ -443,6 +511,12 @@ impl<R: BufRead> DelimitedReader<R> {
                             split_spans(&first.1, r.sep, &mut spans);
                             r.columns = header_columns(&first.1, &spans);
                         }
+                        let mut row_spans = Vec::new();
+                        split_spans(&r.buf, r.sep, &mut row_spans);
+                        let first_value = row_spans.first().and_then(|&(a, b)| {
+                            parse_slow(&r.buf[a..b], r.sep != Separator::Comma, &mut scratch)
+                        });
+                        mark_row_index(&mut r.columns, &first.1, &spans, first_value);
                         r.pending = Some((n, r.buf.clone()));
                         break;
                     }
@@ -455,6 +529,7 @@ impl<R: BufRead> DelimitedReader<R> {
                     name: format!("ch{i}"),
                     unit: String::new(),
                     time_scale_s: None,
+                    row_index: false,
                 })
                 .collect();
             r.pending = Some(first);
@@ -1131,6 +1206,7 @@ mod tests {
                 name: ["a", "b", "c", "d"][i % 4].to_string(),
                 unit: String::new(),
                 time_scale_s: None,
+                row_index: false,
             })
             .collect()
     }

@@ -148,6 +148,21 @@ pub enum SignalError {
         /// This time value, s.
         value: f64,
     },
+    /// A first column without a name that starts at 0 or 1, read as pandas' row index, does not
+    /// count up by one.
+    #[error("the unnamed first column of {path_q} starts like a pandas row index but holds {} at line {line}, not {}; give it a name in the header to read it as a channel, or write the file with index=False", vibmode_core::num(.value), vibmode_core::num(.expected), path_q = vibmode_core::quoted(.path))]
+    NotARowIndex {
+        /// The file.
+        path: String,
+        /// The column's name as read (`ch0` or `Unnamed: 0`).
+        column: String,
+        /// 1-based line number (0 when unknown).
+        line: usize,
+        /// The value found.
+        value: f64,
+        /// The row counter's value expected there.
+        expected: f64,
+    },
     /// The file has no data channel (e.g. only a time column).
     #[error("{path_q} has no data channels (only a time column?); check the file", path_q = vibmode_core::quoted(.path))]
     NoChannels {

@@ -1,6 +1,6 @@
 //! Reading recordings from delimited text, WAV and raw binary files.
 
-use crate::delimited::{Block, ColumnInfo, DelimitedReader};
+use crate::delimited::{check_row_index, Block, ColumnInfo, DelimitedReader};
 use crate::error::{io_err, Result, SidecarProblem, SignalError, WavProblem};
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -274,7 +274,7 @@ pub fn read_delimited<R: BufRead>(reader: R, path: &str, opts: &ReadOptions) -> 
     let mut r = DelimitedReader::new(reader, path)?;
     let mut data: Vec<Vec<f64>> = vec![Vec::new(); r.columns().len()];
     let mut lines: Vec<usize> = Vec::new();
-    let keep_lines = r.time_column().is_some();
+    let keep_lines = r.time_column().is_some() || r.columns().iter().any(|c| c.row_index);
     while let Some(block) = r.next_block(1 << 16)? {
         append_block(&mut data, &mut lines, block, keep_lines);
     }
@@ -287,7 +287,7 @@ pub fn read_delimited_bytes(bytes: &[u8], path: &str, opts: &ReadOptions) -> Res
     let mut r = DelimitedReader::new(bytes, path)?;
     let mut data: Vec<Vec<f64>> = vec![Vec::new(); r.columns().len()];
     let mut lines: Vec<usize> = Vec::new();
-    let keep_lines = r.time_column().is_some();
+    let keep_lines = r.time_column().is_some() || r.columns().iter().any(|c| c.row_index);
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get().min(8));
     if let Some(block) = r.read_all_parallel(threads)? {
         append_block(&mut data, &mut lines, block, keep_lines);
@@ -328,6 +328,8 @@ fn finish_delimited(
         if Some(i) == tcol {
             let scale = opts.time_scale_s.or(c.time_scale_s).unwrap_or(1.0);
             time = Some(d.into_iter().map(|v| v * scale).collect());
+        } else if c.row_index {
+            check_row_index(path, c, d.first().copied().unwrap_or(0.0), &d, &lines)?;
         } else {
             channels.push(Channel::new(c.name.clone(), c.unit.clone(), d));
         }

@@ -18,7 +18,7 @@
 //!
 //! Every sample is checked to be finite, naming the channel and the sample's index in the file.
 
-use crate::delimited::{Block, DelimitedReader};
+use crate::delimited::{check_row_index, Block, ColumnInfo, DelimitedReader};
 use crate::error::{io_err, Result, SignalError, WavProblem};
 use crate::read::{raw_layout, reconcile_fs, wav_names, Format, ReadOptions};
 use std::fs::File;
@@ -95,6 +95,11 @@ enum Inner {
     Delimited {
         reader: Box<DelimitedReader<BufReader<File>>>,
         time_col: Option<(usize, f64)>,
+        /// The columns that are channels, in order.
+        channel_cols: Vec<usize>,
+        /// A pandas row index: its column and the value expected next (`None` before the first
+        /// row).
+        row_index: Option<(ColumnInfo, usize, Option<f64>)>,
         interp: Option<Interp>,
         /// Frames parsed but not yet handed out (channel-major).
         pending: Vec<Vec<f64>>,
@@ -350,18 +355,13 @@ fn open_delimited(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
     let reader = delimited_reader(path)?;
     let cols = reader.columns().to_vec();
     let tcol = cols.iter().position(|c| c.time_scale_s.is_some());
-    let names: Vec<String> = cols
+    let channel_cols: Vec<usize> = (0..cols.len()).filter(|&i| cols[i].is_channel()).collect();
+    let names: Vec<String> = channel_cols.iter().map(|&i| cols[i].name.clone()).collect();
+    let units: Vec<String> = channel_cols.iter().map(|&i| cols[i].unit.clone()).collect();
+    let row_index = cols
         .iter()
-        .enumerate()
-        .filter(|(i, _)| Some(*i) != tcol)
-        .map(|(_, c)| c.name.clone())
-        .collect();
-    let units: Vec<String> = cols
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| Some(*i) != tcol)
-        .map(|(_, c)| c.unit.clone())
-        .collect();
+        .position(|c| c.row_index)
+        .map(|i| (cols[i].clone(), i, None));
     if names.is_empty() {
         return Err(SignalError::NoChannels { path: p });
     }
@@ -430,6 +430,8 @@ fn open_delimited(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
         Inner::Delimited {
             reader: Box::new(reader),
             time_col,
+            channel_cols,
+            row_index,
             interp,
             pending: vec![Vec::new(); nch],
             eof: false,
@@ -437,16 +439,10 @@ fn open_delimited(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
     ))
 }
 
-/// Appends a parsed block's rows (time column removed) to `pending`.
-fn push_rows(block: Block, time_col: Option<(usize, f64)>, pending: &mut [Vec<f64>]) {
-    let data = block
-        .columns
-        .into_iter()
-        .enumerate()
-        .filter(|(i, _)| time_col.map(|(t, _)| t) != Some(*i))
-        .map(|(_, c)| c);
-    for (p, d) in pending.iter_mut().zip(data) {
-        p.extend_from_slice(&d);
+/// Appends a parsed block's channel columns to `pending`.
+fn push_rows(block: &Block, channel_cols: &[usize], pending: &mut [Vec<f64>]) {
+    for (p, &c) in pending.iter_mut().zip(channel_cols) {
+        p.extend_from_slice(&block.columns[c]);
     }
 }
 
@@ -632,27 +628,41 @@ impl FrameStream {
             Inner::Delimited {
                 reader,
                 time_col,
+                channel_cols,
+                row_index,
                 interp,
                 pending,
                 eof,
             } => {
                 while !*eof && pending.first().map_or(0, |p| p.len()) < max_frames {
                     match reader.next_block(max_frames)? {
-                        Some(block) => match interp.as_mut() {
-                            Some(ip) => {
-                                let (ti, scale) = time_col.unwrap_or((0, 1.0));
-                                let nc = block.columns.len();
-                                let mut row = Vec::with_capacity(nc.saturating_sub(1));
-                                for r in 0..block.n_rows() {
-                                    row.clear();
-                                    row.extend(
-                                        (0..nc).filter(|&c| c != ti).map(|c| block.columns[c][r]),
-                                    );
-                                    ip.feed(block.columns[ti][r] * scale, &row, pending);
-                                }
+                        Some(block) => {
+                            if let Some((info, col, next)) = row_index.as_mut() {
+                                let values = &block.columns[*col];
+                                let first = next.or(values.first().copied()).unwrap_or(0.0);
+                                *next = Some(check_row_index(
+                                    reader.path(),
+                                    info,
+                                    first,
+                                    values,
+                                    &block.lines,
+                                )?);
                             }
-                            None => push_rows(block, *time_col, pending),
-                        },
+                            match interp.as_mut() {
+                                Some(ip) => {
+                                    let (ti, scale) = time_col.unwrap_or((0, 1.0));
+                                    let mut row = Vec::with_capacity(channel_cols.len());
+                                    for r in 0..block.n_rows() {
+                                        row.clear();
+                                        row.extend(
+                                            channel_cols.iter().map(|&c| block.columns[c][r]),
+                                        );
+                                        ip.feed(block.columns[ti][r] * scale, &row, pending);
+                                    }
+                                }
+                                None => push_rows(&block, channel_cols, pending),
+                            }
+                        }
                         None => {
                             *eof = true;
                             if let Some(ip) = interp.as_mut() {

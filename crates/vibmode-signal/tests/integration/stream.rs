@@ -137,6 +137,103 @@ fn delimited_time_column_rate_and_nonuniform_interpolation_match_read_path() {
     }
 }
 
+/// pandas' `DataFrame.to_csv` writes its row index as an unnamed first column (`Unnamed: 0` once
+/// read and written again): not a channel, in the whole-file reader and the stream alike, with or
+/// without a time column and a jittery one; a first column that does not count up by one is an
+/// error naming its line; a named first column, or one starting elsewhere, stays a channel.
+#[test]
+fn a_pandas_row_index_is_not_a_channel() {
+    let dir = tmp();
+    let mut r = ChaCha8Rng::seed_from_u64(31);
+    let opts = ReadOptions {
+        fs_hz: Some(100.0),
+        allow_nonuniform: true,
+        ..ReadOptions::default()
+    };
+    for (case, (head, start, time)) in [
+        ("", 0, true),
+        ("Unnamed: 0", 0, false),
+        ("\"\"", 1, true),
+        ("", 0, false),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut text = format!("{head},{}a [m/s^2],b\n", if time { "time," } else { "" });
+        let n = 2500;
+        let mut plain = String::from(if time {
+            "time,a [m/s^2],b\n"
+        } else {
+            "a [m/s^2],b\n"
+        });
+        for i in 0..n {
+            let t = if time {
+                let jitter = if case == 2 {
+                    r.gen_range(-1e-4..1e-4)
+                } else {
+                    0.0
+                };
+                format!("{},", i as f64 * 0.01 + jitter)
+            } else {
+                String::new()
+            };
+            let row = format!("{t}{},{}\n", r.gen_range(-1.0..1.0), r.gen_range(-1.0..1.0));
+            text.push_str(&format!("{},{row}", i + start));
+            plain.push_str(&row);
+        }
+        let p = dir.path().join(format!("pandas{case}.csv"));
+        let q = dir.path().join(format!("plain{case}.csv"));
+        std::fs::write(&p, &text).unwrap();
+        std::fs::write(&q, &plain).unwrap();
+        let expected = read_path(&q, &opts).unwrap();
+        let whole = read_path(&p, &opts).unwrap();
+        assert_eq!(whole.names(), vec!["a", "b"], "case {case}");
+        assert_eq!(whole.channels, expected.channels, "case {case}");
+        assert_eq!(whole.fs_hz, expected.fs_hz);
+        for block in [1, 7, 1000, 5000] {
+            let s = stream_all(&p, &opts, block);
+            assert_eq!(s.names(), vec!["a", "b"]);
+            assert_eq!(s.channels, expected.channels, "case {case}, block {block}");
+        }
+        // A skipped count: the error names the line (row 1234 is line 1236) in both readers.
+        let broken = text.replacen(&format!("\n{},", 1234 + start), "\n99999,", 1);
+        assert_ne!(broken, text);
+        std::fs::write(&p, &broken).unwrap();
+        let e = read_path(&p, &opts).unwrap_err().to_string();
+        assert!(
+            e.contains("pandas row index") && e.contains("line 1236"),
+            "{e}"
+        );
+        assert!(e.contains(&format!("not {}", 1234 + start)), "{e}");
+        let mut st = open_stream(&p, &opts).unwrap();
+        let e = loop {
+            match st.next_block(100) {
+                Ok(Some(_)) => {}
+                Ok(None) => panic!("the stream read a broken row index"),
+                Err(e) => break e.to_string(),
+            }
+        };
+        assert!(
+            e.contains("pandas row index") && e.contains("line 1236"),
+            "{e}"
+        );
+    }
+    // Not a row index: the first column named, or starting at 5, or the only column named.
+    for (name, text) in [
+        ("named", "idx,a\n0,0.5\n1,0.25\n2,0.125\n"),
+        ("five", ",a\n5,0.5\n6,0.25\n7,0.125\n"),
+        ("headerless", "0,0.5\n1,0.25\n2,0.125\n"),
+        ("others unnamed", ",\"\",a\n0,1,0.5\n1,2,0.25\n2,3,0.125\n"),
+    ] {
+        let p = dir.path().join(format!("{name}.csv"));
+        std::fs::write(&p, text).unwrap();
+        let whole = read_path(&p, &opts).unwrap();
+        assert_eq!(whole.channels[0].samples.len(), 3, "{name}");
+        assert!(whole.channels.len() >= 2, "{name}: {:?}", whole.names());
+        assert_eq!(stream_all(&p, &opts, 2).names(), whole.names(), "{name}");
+    }
+}
+
 #[test]
 fn channel_selection_and_start_time_from_the_sidecar() {
     let dir = tmp();
