@@ -384,6 +384,24 @@ fn header_columns(line: &[u8], spans: &[(usize, usize)]) -> Vec<ColumnInfo> {
         .collect()
 }
 
+/// The columns named by a comment line (numpy's `savetxt(..., header="time,a,b")` writes
+/// `# time,a,b`): when it splits into `n` cells with the data's separator and one of them at
+/// least is not a number.
+fn comment_header(
+    text: &[u8],
+    sep: Separator,
+    n: usize,
+    allow_comma: bool,
+) -> Option<Vec<ColumnInfo>> {
+    let mut spans = Vec::new();
+    split_spans(text, sep, &mut spans);
+    let mut scratch = Vec::new();
+    let named = spans
+        .iter()
+        .any(|&(a, b)| parse_slow(&text[a..b], allow_comma, &mut scratch).is_none());
+    (spans.len() == n && named).then(|| header_columns(text, &spans))
+}
+
 /// Marks the first column as a row index when it looks like pandas' `DataFrame.to_csv` index:
 /// its header cell is empty (named `ch0` here) or `Unnamed: 0`, every other column is named, it is
 /// not the time column, and the first data row holds 0 or 1 there.
@@ -434,6 +452,9 @@ impl<R: BufRead> DelimitedReader<R> {
         };
         // Excel's `sep=X` first line, when present.
         let mut forced_sep: Option<Separator> = None;
+        // The last comment line (its number and text after the comment marks), which may be
+        // numpy's `savetxt(..., header=...)` header: `# time,a,b`.
+        let mut last_comment: Option<(usize, Vec<u8>)> = None;
         // First content line (skipping blanks and comment lines).
         let first = loop {
             match r.next_line()? {
@@ -451,7 +472,15 @@ impl<R: BufRead> DelimitedReader<R> {
                     };
                     check_text(l, &r.path, n)?;
                     let t = trim_cell(l);
-                    if t.is_empty() || t[0] == b'#' || t[0] == b'%' {
+                    if t.is_empty() {
+                        continue;
+                    }
+                    if t[0] == b'#' || t[0] == b'%' {
+                        let body = t
+                            .iter()
+                            .position(|&b| b != b'#' && b != b'%')
+                            .unwrap_or(t.len());
+                        last_comment = Some((n, t[body..].to_vec()));
                         continue;
                     }
                     if forced_sep.is_none() {
@@ -522,6 +551,16 @@ impl<R: BufRead> DelimitedReader<R> {
                     }
                 }
             }
+        } else if let Some(columns) = last_comment
+            .filter(|(n, _)| *n + 1 == first.0)
+            .and_then(|(_, text)| comment_header(&text, r.sep, spans.len(), allow_comma))
+        {
+            // numpy's `savetxt` header: the comment line just above the first row names its
+            // columns.
+            r.has_header = true;
+            r.reference_line = first.0;
+            r.columns = columns;
+            r.pending = Some(first);
         } else {
             r.reference_line = first.0;
             r.columns = (0..spans.len())

@@ -129,6 +129,37 @@ fn tab_whitespace_headerless_and_comments() {
     assert_eq!(rec.channels[1].samples, vec![2.0, 4.0]);
 }
 
+/// numpy's `savetxt(..., header="time,a,b")` writes the header as a comment (`# time,a,b`): the
+/// comment line just above the first row names the columns when it has as many cells as the rows
+/// and one of them is not a number (before, its time column was read as a channel).
+#[test]
+fn numpy_savetxt_header_names_the_columns() {
+    let comma = "# time,acc_a [m/s^2],acc_b\n0.0,1,2\n0.5,3,4\n1.0,5,6\n";
+    let ws = "# time acc_a acc_b\n0.000000000000000000e+00 1 2\n5.0e-01 3 4\n1.0 5 6\n";
+    for (name, text) in [("c.csv", comma), ("w.txt", ws)] {
+        let rec = read_delimited(text.as_bytes(), name, &ReadOptions::default()).unwrap();
+        assert_eq!(rec.names(), vec!["acc_a", "acc_b"], "{name}");
+        assert_eq!(rec.fs_hz, 2.0);
+        assert_eq!(rec.channels[1].samples, vec![2.0, 4.0, 6.0]);
+    }
+    assert_eq!(
+        read_delimited(comma.as_bytes(), "c.csv", &ReadOptions::default())
+            .unwrap()
+            .channels[0]
+            .unit,
+        "m/s^2"
+    );
+    // Not a header: another cell count, all numbers, or a blank line before the rows.
+    for text in [
+        "# exported by logger, v2\n1,2,3\n4,5,6\n",
+        "# 1,2,3\n1,2,3\n4,5,6\n",
+        "# time,a,b\n\n1,2,3\n4,5,6\n",
+    ] {
+        let rec = read_delimited(text.as_bytes(), "n.csv", &opts_fs(1.0)).unwrap();
+        assert_eq!(rec.names(), vec!["ch0", "ch1", "ch2"], "{text}");
+    }
+}
+
 #[test]
 fn rate_from_time_and_fs_option_must_agree() {
     let text = "time,x\n0,1\n0.002,2\n0.004,3\n";
