@@ -124,6 +124,11 @@ pub struct ColumnInfo {
     /// ([`check_row_index`]).
     #[serde(default)]
     pub row_index: bool,
+    /// For a time column of date-times (`2026-11-27 05:00:00.000050`, pandas' `DatetimeIndex`):
+    /// the first row's instant as Unix seconds and nanoseconds; the column's values are then
+    /// seconds since it ([`parse_datetime`]).
+    #[serde(default)]
+    pub datetime_base: Option<(i64, u32)>,
 }
 
 impl ColumnInfo {
@@ -131,6 +136,45 @@ impl ColumnInfo {
     pub fn is_channel(&self) -> bool {
         self.time_scale_s.is_none() && !self.row_index
     }
+
+    /// Seconds per unit of this time column's values: `override_s` (a user's time unit) unless
+    /// the column holds date-times, whose values are seconds.
+    pub fn time_scale(&self, override_s: Option<f64>) -> f64 {
+        if self.datetime_base.is_some() {
+            1.0
+        } else {
+            override_s.or(self.time_scale_s).unwrap_or(1.0)
+        }
+    }
+}
+
+/// The instant of a date-time cell as Unix seconds and nanoseconds: ISO 8601 / RFC 3339 with `T`
+/// or a space between date and time, optional fraction of a second, and an optional `Z` or
+/// `+hh:mm` offset (without one the time is taken as UTC; only differences are used):
+/// `2026-11-27 05:00:00`, `2026-11-27T05:00:00.000050`, `2026-11-27 05:00:00.25+01:00`.
+pub fn parse_datetime(cell: &[u8]) -> Option<(i64, u32)> {
+    let text = std::str::from_utf8(trim_cell(cell)).ok()?;
+    // The shortest form is `YYYY-MM-DD HH:MM:SS`; a plain number is never a date-time.
+    if text.len() < 19 || text.as_bytes().get(4) != Some(&b'-') {
+        return None;
+    }
+    if let Ok(t) = chrono::DateTime::parse_from_rfc3339(text) {
+        return Some((t.timestamp(), t.timestamp_subsec_nanos()));
+    }
+    for format in ["%Y-%m-%d %H:%M:%S%.f", "%Y-%m-%dT%H:%M:%S%.f"] {
+        if let Ok(t) = chrono::NaiveDateTime::parse_from_str(text, format) {
+            let t = t.and_utc();
+            return Some((t.timestamp(), t.timestamp_subsec_nanos()));
+        }
+    }
+    None
+}
+
+/// Seconds from `base` to `t` (both Unix seconds and nanoseconds), exact to the nanosecond for
+/// spans of up to about 100 days.
+fn seconds_since(t: (i64, u32), base: (i64, u32)) -> f64 {
+    let ns = i128::from(t.0 - base.0) * 1_000_000_000 + i128::from(t.1) - i128::from(base.1);
+    ns as f64 * 1e-9
 }
 
 /// Checks that a row-index column ([`ColumnInfo::row_index`]) counts up by one from `first`
@@ -379,6 +423,7 @@ fn header_columns(line: &[u8], spans: &[(usize, usize)]) -> Vec<ColumnInfo> {
                 unit,
                 time_scale_s,
                 row_index: false,
+                datetime_base: None,
             }
         })
         .collect()
@@ -400,6 +445,41 @@ fn comment_header(
         .iter()
         .any(|&(a, b)| parse_slow(&text[a..b], allow_comma, &mut scratch).is_none());
     (spans.len() == n && named).then(|| header_columns(text, &spans))
+}
+
+/// Marks the time column of date-times: a column named as a time column (or `datetime`,
+/// `date_time`, `date`), or an unnamed first column (pandas' `DatetimeIndex`), whose first data
+/// cell is a date-time ([`parse_datetime`]); the first such column only.
+fn mark_datetime_time(
+    columns: &mut [ColumnInfo],
+    header: &[u8],
+    spans: &[(usize, usize)],
+    row: &[u8],
+    row_spans: &[(usize, usize)],
+) {
+    if spans.len() != columns.len() || row_spans.len() != columns.len() {
+        return;
+    }
+    for (c, col) in columns.iter_mut().enumerate() {
+        let (a, b) = spans[c];
+        let head = trim_cell(&header[a..b]);
+        let lower = col.name.to_ascii_lowercase();
+        let named = col.time_scale_s.is_some()
+            || matches!(lower.as_str(), "datetime" | "date_time" | "date")
+            || (c == 0 && (head.is_empty() || head.eq_ignore_ascii_case(b"Unnamed: 0")));
+        if !named {
+            continue;
+        }
+        let (ra, rb) = row_spans[c];
+        if let Some(base) = parse_datetime(&row[ra..rb]) {
+            col.datetime_base = Some(base);
+            col.time_scale_s = Some(1.0);
+            if head.is_empty() {
+                col.name = "time".to_string();
+            }
+            return;
+        }
+    }
 }
 
 /// Marks the first column as a row index when it looks like pandas' `DataFrame.to_csv` index:
@@ -545,6 +625,7 @@ impl<R: BufRead> DelimitedReader<R> {
                         let first_value = row_spans.first().and_then(|&(a, b)| {
                             parse_slow(&r.buf[a..b], r.sep != Separator::Comma, &mut scratch)
                         });
+                        mark_datetime_time(&mut r.columns, &first.1, &spans, &r.buf, &row_spans);
                         mark_row_index(&mut r.columns, &first.1, &spans, first_value);
                         r.pending = Some((n, r.buf.clone()));
                         break;
@@ -569,6 +650,7 @@ impl<R: BufRead> DelimitedReader<R> {
                     unit: String::new(),
                     time_scale_s: None,
                     row_index: false,
+                    datetime_base: None,
                 })
                 .collect();
             r.pending = Some(first);
@@ -1049,8 +1131,12 @@ impl RowCtx<'_> {
         let text = std::str::from_utf8(line).ok();
         for (c, &(a, b)) in self.spans.iter().enumerate() {
             let cell = &line[a..b];
-            let parsed = match text.and_then(|t| t.get(a..b)) {
-                Some(t) if !self.decimal_comma => t.parse::<f64>().ok(),
+            let parsed = match (
+                self.columns[c].datetime_base,
+                text.and_then(|t| t.get(a..b)),
+            ) {
+                (Some(base), _) => parse_datetime(cell).map(|t| seconds_since(t, base)),
+                (None, Some(t)) if !self.decimal_comma => t.parse::<f64>().ok(),
                 _ => parse_slow(cell, self.decimal_comma, self.scratch),
             };
             match parsed {
@@ -1097,6 +1183,33 @@ mod tests {
         assert_eq!(spans_of("\"a\";\"b\"", Separator::Semicolon), ["a", "b"]);
         assert_eq!(spans_of("1\t2\t", Separator::Tab), ["1", "2"]);
         assert!(spans_of("   ", Separator::Whitespace).is_empty());
+    }
+
+    /// By hand: 2026-11-27 is day 20784 after 1970-01-01, so 04:00:00.25 UTC is
+    /// 20784 * 86400 + 4 * 3600 + 0.25 = 1795752000.25 s.
+    #[test]
+    fn date_times_by_hand() {
+        let t = (1_795_752_000, 250_000_000);
+        assert_eq!(20784 * 86400 + 4 * 3600, t.0);
+        for cell in [
+            "2026-11-27 04:00:00.25",
+            "2026-11-27T04:00:00.250000",
+            "2026-11-27T05:00:00.25+01:00",
+            " 2026-11-27 04:00:00.250Z ",
+            "\"2026-11-27 04:00:00.25\"",
+        ] {
+            assert_eq!(parse_datetime(cell.as_bytes()), Some(t), "{cell}");
+        }
+        for cell in [
+            "1795752000.25",
+            "2026-11-27",
+            "27.11.2026 04:00:00",
+            "2026-11-31 04:00:00",
+        ] {
+            assert_eq!(parse_datetime(cell.as_bytes()), None, "{cell}");
+        }
+        // 10 s + 100 ns after 9 s + 999 999 900 ns: 200 ns.
+        assert!((seconds_since((10, 100), (9, 999_999_900)) - 200e-9).abs() < 1e-22);
     }
 
     #[test]
@@ -1246,6 +1359,7 @@ mod tests {
                 unit: String::new(),
                 time_scale_s: None,
                 row_index: false,
+                datetime_base: None,
             })
             .collect()
     }

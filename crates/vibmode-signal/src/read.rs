@@ -326,7 +326,7 @@ fn finish_delimited(
     let mut channels = Vec::with_capacity(cols.len());
     for (i, (c, d)) in cols.iter().zip(data).enumerate() {
         if Some(i) == tcol {
-            let scale = opts.time_scale_s.or(c.time_scale_s).unwrap_or(1.0);
+            let scale = c.time_scale(opts.time_scale_s);
             time = Some(d.into_iter().map(|v| v * scale).collect());
         } else if c.row_index {
             check_row_index(path, c, d.first().copied().unwrap_or(0.0), &d, &lines)?;

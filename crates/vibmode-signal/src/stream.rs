@@ -368,7 +368,7 @@ fn open_delimited(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
     let (fs_hz, n_frames, start_s, time_col, interp) = match tcol {
         Some(ti) => {
             let name = cols[ti].name.clone();
-            let scale = opts.time_scale_s.or(cols[ti].time_scale_s).unwrap_or(1.0);
+            let scale = cols[ti].time_scale(opts.time_scale_s);
             let scan = scan_time(path, ti, scale, &name)?;
             if scan.n == 0 {
                 return Err(SignalError::NoDataRows { path: p });

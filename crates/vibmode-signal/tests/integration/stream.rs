@@ -234,6 +234,80 @@ fn a_pandas_row_index_is_not_a_channel() {
     }
 }
 
+/// A time column of date-times (pandas' `DatetimeIndex`, written as an unnamed first column, or a
+/// `timestamp` column with an offset): read as seconds from the first row, by the whole-file
+/// reader and the stream alike, as the same file with seconds; `--time-unit` does not scale it;
+/// a cell that is not a date-time is an error naming its line.
+#[test]
+fn a_date_time_column_is_the_time() {
+    let dir = tmp();
+    let mut r = ChaCha8Rng::seed_from_u64(5);
+    let n = 4000;
+    let rows: Vec<(f64, f64)> = (0..n)
+        .map(|_| (r.gen_range(-1.0..1.0), r.gen_range(-1.0..1.0)))
+        .collect();
+    let mut plain = String::from("time,a,b\n");
+    for (i, (a, b)) in rows.iter().enumerate() {
+        plain.push_str(&format!("{},{a},{b}\n", i as f64 / 200.0));
+    }
+    let q = dir.path().join("plain.csv");
+    std::fs::write(&q, &plain).unwrap();
+    let expected = read_path(&q, &ReadOptions::default()).unwrap();
+    // 2026-11-27 23:59:58 plus 5 ms steps: the date changes within the file.
+    for (case, head, sep_t, zone) in [
+        (0, "", ' ', ""),
+        (1, "timestamp", 'T', "+01:00"),
+        (2, "Date", ' ', "Z"),
+    ] {
+        let mut text = format!("{head},a,b\n");
+        for (i, (a, b)) in rows.iter().enumerate() {
+            let us = i as u64 * 5000;
+            let s = 58 + us / 1_000_000;
+            let (day, h, m, s) = if s >= 60 {
+                (28, 0, 0, s - 60)
+            } else {
+                (27, 23, 59, s)
+            };
+            text.push_str(&format!(
+                "2026-11-{day}{sep_t}{h:02}:{m:02}:{s:02}.{:06}{zone},{a},{b}\n",
+                us % 1_000_000
+            ));
+        }
+        let p = dir.path().join(format!("dt{case}.csv"));
+        std::fs::write(&p, &text).unwrap();
+        for opts in [
+            ReadOptions::default(),
+            ReadOptions {
+                time_scale_s: Some(1e-3),
+                ..ReadOptions::default()
+            },
+        ] {
+            let whole = read_path(&p, &opts).unwrap();
+            assert_eq!(whole.names(), vec!["a", "b"], "case {case}");
+            assert!(
+                (whole.fs_hz - 200.0).abs() < 1e-9,
+                "case {case}: {}",
+                whole.fs_hz
+            );
+            assert_eq!(whole.channels, expected.channels);
+            assert_eq!(whole.time_axis.as_ref().unwrap().start_s, 0.0);
+            for block in [3, 1000] {
+                let s = stream_all(&p, &opts, block);
+                assert_eq!(s.fs_hz, whole.fs_hz);
+                assert_eq!(s.channels, expected.channels, "case {case}, block {block}");
+            }
+        }
+        let broken = text.replacen("\n2026-11-28", "\n2026-13-28", 1);
+        assert_ne!(broken, text);
+        std::fs::write(&p, &broken).unwrap();
+        let e = read_path(&p, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        // Row 400 (2 s after 23:59:58) is line 402.
+        assert!(e.contains("line 402") && e.contains("2026-13-28"), "{e}");
+    }
+}
+
 #[test]
 fn channel_selection_and_start_time_from_the_sidecar() {
     let dir = tmp();
