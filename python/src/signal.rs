@@ -15,6 +15,7 @@ use crate::errors::{json_err, signal_err, value_err};
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read, m)?)?;
     m.add_function(wrap_pyfunction!(write, m)?)?;
+    m.add_function(wrap_pyfunction!(time_column_scale, m)?)?;
     m.add_function(wrap_pyfunction!(resample_rows, m)?)?;
     Ok(())
 }
@@ -154,6 +155,12 @@ pub fn select(rec: Recording, sel: Option<&[String]>) -> Result<Recording, Signa
         }
         _ => Ok(rec),
     }
+}
+
+/// Seconds per unit of the time column a column name names (the file reader's rule), or None.
+#[pyfunction]
+fn time_column_scale(name: &str) -> Option<f64> {
+    vibmode_signal::delimited::time_column_scale(name)
 }
 
 /// Writes a recording; the format follows the extension (.csv, .wav, .f32/.f64 + sidecar).

@@ -135,18 +135,98 @@ def write(path: PathLike, recording: Any, fs: Optional[float] = None, channels=N
     _native.write(os.fspath(path), rec.data, rec.fs, rec.channels, rec.units, placements)
 
 
+#: Largest relative deviation of a DataFrame's time steps from their mean (the file reader's
+#: ``max_jitter_rel`` default).
+MAX_JITTER_REL = 0.01
+
+
+def _frame_time(df: Any):
+    """The DataFrame's time in seconds (from its first sample) and its column, or (None, None): a
+    column named as the file reader names a time column (``time``, ``t``, ``timestamp``, ``Time
+    (ms)``, ``t_s``, ...) or of a datetime/timedelta dtype, else the index when it is a
+    ``DatetimeIndex``/``TimedeltaIndex`` or a numeric index so named (``read(..., as_frame=True)``'s
+    ``time_s``)."""
+    import pandas as pd
+    from pandas.api import types
+
+    def clock(values: Any) -> bool:
+        return types.is_datetime64_any_dtype(values) or types.is_timedelta64_dtype(values)
+
+    def seconds(values: Any, label: str):
+        if clock(values):
+            first = values[0] if isinstance(values, pd.Index) else values.iloc[0]
+            ns = np.asarray(values - first, dtype="timedelta64[ns]").astype(np.int64)
+            return ns.astype(np.float64) * 1e-9
+        scale = _native.time_column_scale(label)
+        v = np.asarray(values, dtype=np.float64)
+        return (v - v[0]) * (1.0 if scale is None else scale)
+
+    def is_time(values: Any, label: str) -> bool:
+        return clock(values) or (types.is_numeric_dtype(values) and _native.time_column_scale(label) is not None)
+
+    if len(df) == 0:
+        return None, None
+    for c in df.columns:
+        if is_time(df[c], str(c)):
+            return seconds(df[c], str(c)), c
+    idx = df.index
+    label = "" if idx.name is None else str(idx.name)
+    if clock(idx) or (label and is_time(idx, label)):
+        return seconds(idx, label), None
+    return None, None
+
+
+def frame_channels(df: Any, fs: Optional[float]):
+    """A DataFrame's channels as an array (n_channels, n_samples), its rate (Hz) and the channel
+    names. The rate is ``fs``, else ``attrs['fs']``, else its time (see :func:`_frame_time`:
+    a time column, or a datetime/timedelta or time-named index), which must then be uniform
+    within 1 % and agree with a given rate within 1 %; a time column is not a channel."""
+    t, time_col = _frame_time(df)
+    cols = [c for c in df.columns if time_col is None or c != time_col]
+    from pandas.api import types
+
+    bad = [str(c) for c in cols if not types.is_numeric_dtype(df[c]) or types.is_bool_dtype(df[c])]
+    if bad:
+        raise ValueError(
+            f"DataFrame column(s) {', '.join(repr(b) for b in bad[:5])} are not numbers; "
+            "drop them or make the time the index"
+        )
+    given = fs if fs is not None else df.attrs.get("fs")
+    measured = None
+    if t is not None and len(t) >= 2:
+        what = f"the DataFrame's time ({'index' if time_col is None else repr(str(time_col))})"
+        dt = np.diff(t)
+        if not np.all(dt > 0):
+            k = int(np.argmin(dt > 0)) + 1
+            raise ValueError(f"{what} does not increase at row {k}; sort the rows (df.sort_index()) or drop duplicates")
+        mean_dt = (t[-1] - t[0]) / (len(t) - 1)
+        jitter = float(np.max(np.abs(dt - mean_dt)) / mean_dt)
+        measured = 1.0 / mean_dt
+        if jitter > MAX_JITTER_REL and given is None:
+            raise ValueError(
+                f"{what} is not uniform: its steps deviate by up to {jitter:.3g} of their mean "
+                f"(limit {MAX_JITTER_REL}); resample it onto a uniform grid (df.resample) or give fs (Hz)"
+            )
+        if given is not None and abs(measured - float(given)) > 0.01 * float(given):
+            raise ValueError(f"{what} gives {measured:.6g} Hz but fs is {float(given):.6g} Hz; they must agree within 1 %")
+    rate = given if given is not None else measured
+    if rate is None:
+        raise ValueError(
+            "the DataFrame has no time (a time column, or a DatetimeIndex/TimedeltaIndex) and no attrs['fs']; give fs (Hz)"
+        )
+    data = df[cols].to_numpy(dtype=np.float64).T if cols else np.zeros((0, len(df)))
+    return data, float(rate), [str(c) for c in cols]
+
+
 def _as_recording(x: Any, fs: Optional[float], channels=None, units=None, name: str = "record") -> Recording:
     if isinstance(x, Recording):
         return x
     if isinstance(x, tuple) and len(x) == 2 and fs is None:  # (data, fs)
         return Recording(x[0], x[1], channels, units, name=name)
     if hasattr(x, "to_numpy") and hasattr(x, "columns"):  # a DataFrame
-        rate = fs if fs is not None else x.attrs.get("fs")
-        if rate is None:
-            raise ValueError("the DataFrame has no attrs['fs']; give fs (Hz)")
+        data, rate, cols = frame_channels(x, fs)
         u = x.attrs.get("units", {})
-        cols = [str(c) for c in x.columns]
-        return Recording(x.to_numpy().T, rate, cols, [u.get(c, "") for c in cols], name=x.attrs.get("name", name))
+        return Recording(data, rate, cols, [u.get(c, "") for c in cols], name=x.attrs.get("name", name))
     if fs is None:
         raise ValueError("an array needs its sampling rate: give fs (Hz)")
     return Recording(x, fs, channels, units, name=name)

@@ -9,7 +9,7 @@ from typing import Any, Dict, List, Optional, Sequence
 import numpy as np
 
 from . import _native
-from ._io import Recording
+from ._io import Recording, frame_channels
 from ._models import _num, _order
 from ._spectral import _check_fs, _real_input
 from ._tables import columns
@@ -168,7 +168,8 @@ def ssi_cov(
     the stabilisation labels, and the poles clustered over the orders (docs/ssi.md).
 
     ``data``: a :class:`Recording`, a pandas DataFrame (one column per channel, rows are
-    samples; ``fs`` from ``attrs['fs']`` when not given), or an array with time along ``axis``
+    samples; ``fs`` from ``attrs['fs']`` or the frame's time when not given, a time column not a
+    channel: see :func:`vibmode.analyze`), or an array with time along ``axis``
     (default the last: ``(n_channels, n_samples)``; pyOMA2's ``(n_samples, n_channels)`` is
     ``axis=0``). ``fs``: sampling rate, Hz. ``orders``: a range of model orders (state
     dimensions, 2 per mode; default ``range(2, 61, 2)``). ``references``: 0-based channel
@@ -186,10 +187,8 @@ def ssi_cov(
         arr, fs_given, names = data.data, data.fs, list(data.channels)
         fs = fs_given if fs is None else fs
     elif hasattr(data, "columns") and hasattr(data, "to_numpy"):  # pandas DataFrame
-        arr = _real_input(data.to_numpy(), "data").T
-        names = [str(c) for c in data.columns]
-        if fs is None:
-            fs = getattr(data, "attrs", {}).get("fs")
+        arr, fs, names = frame_channels(data, fs)
+        arr = _real_input(arr, "data")
     else:
         a = _real_input(data, "data")
         if a.ndim == 1:

@@ -361,6 +361,13 @@ pub fn split_name_unit(header: &str) -> (String, String) {
     (h.to_string(), String::new())
 }
 
+/// Seconds per unit of the time column a header cell names (`time`, `Time (ms)`, `t_s`,
+/// `timestamp_ms`: the rule of [`ColumnInfo::time_scale_s`]); `None` when it names no time column.
+pub fn time_column_scale(header: &str) -> Option<f64> {
+    let (name, unit) = split_name_unit(header);
+    time_scale(&name, &unit)
+}
+
 /// Seconds per unit of a time unit's name (`s`, `ms`, `us`/`µs`, `ns`, `min`, `h` and their
 /// spellings), case-insensitive; `None` for anything else.
 pub fn time_unit_seconds(unit: &str) -> Option<f64> {
