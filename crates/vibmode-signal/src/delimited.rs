@@ -124,11 +124,53 @@ pub struct ColumnInfo {
     /// ([`check_row_index`]).
     #[serde(default)]
     pub row_index: bool,
-    /// For a time column of date-times (`2026-11-27 05:00:00.000050`, pandas' `DatetimeIndex`):
-    /// the first row's instant as Unix seconds and nanoseconds; the column's values are then
-    /// seconds since it ([`parse_datetime`]).
+    /// For a time column written as text rather than numbers: how its cells are read (their
+    /// values are then seconds).
     #[serde(default)]
-    pub datetime_base: Option<(i64, u32)>,
+    pub time_text: Option<TimeText>,
+}
+
+/// How a time column's text cells are read as seconds.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
+pub enum TimeText {
+    /// Date-times (`2026-11-27 05:00:00.000050`, pandas' `DatetimeIndex`): seconds since the
+    /// first row's instant, given as Unix seconds and nanoseconds ([`parse_datetime`]).
+    DateTime {
+        /// The first row's instant: Unix seconds and nanoseconds.
+        base: (i64, u32),
+    },
+    /// A number and a time unit (`0.005 sec`, MATLAB's `writetable` of a timetable whose row
+    /// times are `seconds(...)`): the number times the unit's seconds ([`parse_with_unit`]).
+    WithUnit,
+}
+
+impl TimeText {
+    /// Seconds of a cell; `None` when it is not of this kind.
+    fn seconds(&self, cell: &[u8]) -> Option<f64> {
+        match *self {
+            TimeText::DateTime { base } => parse_datetime(cell).map(|t| seconds_since(t, base)),
+            TimeText::WithUnit => parse_with_unit(cell),
+        }
+    }
+
+    /// The kind of a time column's first cell, when it is text of a known kind.
+    fn of_cell(cell: &[u8]) -> Option<TimeText> {
+        if let Some(base) = parse_datetime(cell) {
+            return Some(TimeText::DateTime { base });
+        }
+        parse_with_unit(cell).map(|_| TimeText::WithUnit)
+    }
+}
+
+/// Seconds of a number followed by a time unit (`0.005 sec`, `1.5 s`, `20 ms`, `2 min`, `1 hr`:
+/// the units of [`time_unit_seconds`]); `None` for anything else.
+pub fn parse_with_unit(cell: &[u8]) -> Option<f64> {
+    let text = std::str::from_utf8(trim_cell(cell)).ok()?;
+    let (number, unit) = text.split_once(|c: char| c.is_ascii_whitespace())?;
+    let v: f64 = number.parse().ok()?;
+    let scale = time_unit_seconds(unit.trim())?;
+    v.is_finite().then_some(v * scale)
 }
 
 impl ColumnInfo {
@@ -140,7 +182,7 @@ impl ColumnInfo {
     /// Seconds per unit of this time column's values: `override_s` (a user's time unit) unless
     /// the column holds date-times, whose values are seconds.
     pub fn time_scale(&self, override_s: Option<f64>) -> f64 {
-        if self.datetime_base.is_some() {
+        if self.time_text.is_some() {
             1.0
         } else {
             override_s.or(self.time_scale_s).unwrap_or(1.0)
@@ -430,7 +472,7 @@ fn header_columns(line: &[u8], spans: &[(usize, usize)]) -> Vec<ColumnInfo> {
                 unit,
                 time_scale_s,
                 row_index: false,
-                datetime_base: None,
+                time_text: None,
             }
         })
         .collect()
@@ -454,10 +496,11 @@ fn comment_header(
     (spans.len() == n && named).then(|| header_columns(text, &spans))
 }
 
-/// Marks the time column of date-times: a column named as a time column (or `datetime`,
-/// `date_time`, `date`), or an unnamed first column (pandas' `DatetimeIndex`), whose first data
-/// cell is a date-time ([`parse_datetime`]); the first such column only.
-fn mark_datetime_time(
+/// Marks the time column written as text ([`TimeText`]): a column named as a time column (or
+/// `datetime`, `date_time`, `date`), or an unnamed first column (pandas' `DatetimeIndex`), whose
+/// first data cell is a date-time ([`parse_datetime`]), or, named as a time column, a number
+/// and a time unit ([`parse_with_unit`]); the first such column only.
+fn mark_text_time(
     columns: &mut [ColumnInfo],
     header: &[u8],
     spans: &[(usize, usize)],
@@ -478,8 +521,11 @@ fn mark_datetime_time(
             continue;
         }
         let (ra, rb) = row_spans[c];
-        if let Some(base) = parse_datetime(&row[ra..rb]) {
-            col.datetime_base = Some(base);
+        // A number and a unit only in a column named as a time column.
+        let kind = TimeText::of_cell(&row[ra..rb])
+            .filter(|k| matches!(k, TimeText::DateTime { .. }) || col.time_scale_s.is_some());
+        if let Some(kind) = kind {
+            col.time_text = Some(kind);
             col.time_scale_s = Some(1.0);
             if head.is_empty() {
                 col.name = "time".to_string();
@@ -632,7 +678,7 @@ impl<R: BufRead> DelimitedReader<R> {
                         let first_value = row_spans.first().and_then(|&(a, b)| {
                             parse_slow(&r.buf[a..b], r.sep != Separator::Comma, &mut scratch)
                         });
-                        mark_datetime_time(&mut r.columns, &first.1, &spans, &r.buf, &row_spans);
+                        mark_text_time(&mut r.columns, &first.1, &spans, &r.buf, &row_spans);
                         mark_row_index(&mut r.columns, &first.1, &spans, first_value);
                         r.pending = Some((n, r.buf.clone()));
                         break;
@@ -657,7 +703,7 @@ impl<R: BufRead> DelimitedReader<R> {
                     unit: String::new(),
                     time_scale_s: None,
                     row_index: false,
-                    datetime_base: None,
+                    time_text: None,
                 })
                 .collect();
             r.pending = Some(first);
@@ -1138,11 +1184,8 @@ impl RowCtx<'_> {
         let text = std::str::from_utf8(line).ok();
         for (c, &(a, b)) in self.spans.iter().enumerate() {
             let cell = &line[a..b];
-            let parsed = match (
-                self.columns[c].datetime_base,
-                text.and_then(|t| t.get(a..b)),
-            ) {
-                (Some(base), _) => parse_datetime(cell).map(|t| seconds_since(t, base)),
+            let parsed = match (self.columns[c].time_text, text.and_then(|t| t.get(a..b))) {
+                (Some(kind), _) => kind.seconds(cell),
                 (None, Some(t)) if !self.decimal_comma => t.parse::<f64>().ok(),
                 _ => parse_slow(cell, self.decimal_comma, self.scratch),
             };
@@ -1214,6 +1257,19 @@ mod tests {
             "2026-11-31 04:00:00",
         ] {
             assert_eq!(parse_datetime(cell.as_bytes()), None, "{cell}");
+        }
+        for (cell, seconds) in [
+            ("0 sec", 0.0),
+            ("0.005 sec", 0.005),
+            ("1.5 s", 1.5),
+            ("20 ms", 0.02),
+            ("2 min", 120.0),
+            ("1 hr", 3600.0),
+        ] {
+            assert_eq!(parse_with_unit(cell.as_bytes()), Some(seconds), "{cell}");
+        }
+        for cell in ["0.005", "sec", "0.005 parsecs", "NaN sec", "1e400 s"] {
+            assert_eq!(parse_with_unit(cell.as_bytes()), None, "{cell}");
         }
         // 10 s + 100 ns after 9 s + 999 999 900 ns: 200 ns.
         assert!((seconds_since((10, 100), (9, 999_999_900)) - 200e-9).abs() < 1e-22);
@@ -1366,7 +1422,7 @@ mod tests {
                 unit: String::new(),
                 time_scale_s: None,
                 row_index: false,
-                datetime_base: None,
+                time_text: None,
             })
             .collect()
     }

@@ -306,6 +306,30 @@ fn a_date_time_column_is_the_time() {
         // Row 400 (2 s after 23:59:58) is line 402.
         assert!(e.contains("line 402") && e.contains("2026-13-28"), "{e}");
     }
+    // MATLAB's writetable of a timetable with row times seconds(...): `0.005 sec`; and in ms.
+    for (case, unit, per_s) in [(0, "sec", 1.0), (1, "ms", 1e3)] {
+        let mut text = String::from("Time,a,b\n");
+        for (i, (a, b)) in rows.iter().enumerate() {
+            text.push_str(&format!("{} {unit},{a},{b}\n", i as f64 / 200.0 * per_s));
+        }
+        let p = dir.path().join(format!("matlab{case}.csv"));
+        std::fs::write(&p, &text).unwrap();
+        let whole = read_path(&p, &ReadOptions::default()).unwrap();
+        assert_eq!(whole.names(), vec!["a", "b"]);
+        assert!((whole.fs_hz - 200.0).abs() < 1e-9, "{}", whole.fs_hz);
+        assert_eq!(whole.channels, expected.channels);
+        let s = stream_all(&p, &ReadOptions::default(), 777);
+        assert_eq!(s.channels, expected.channels);
+        // Row 10 is line 12.
+        let row10 = format!("\n{} {unit},", 10.0 / 200.0 * per_s);
+        let broken = text.replacen(&row10, &format!("\nten {unit},"), 1);
+        assert_ne!(broken, text);
+        std::fs::write(&p, &broken).unwrap();
+        let e = read_path(&p, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("line 12") && e.contains("ten"), "{e}");
+    }
 }
 
 #[test]
