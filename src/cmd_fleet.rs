@@ -114,8 +114,9 @@ pub struct CheckArgs {
     #[arg(long)]
     pub json: Option<String>,
     /// The given records are one drive with this id (at least 3 records), classified from the
-    /// medians of their features; without it, 3 or more records are the drive `all given
-    /// records` (docs/fleet.md, "Drives").
+    /// medians of their features; without it, records whose time column holds date-times form
+    /// one drive per UTC day (named `YYYY-MM-DD`, 3 records or more), and other records, 3 or
+    /// more, the drive `all given records` (docs/fleet.md, "Drives").
     #[arg(long)]
     pub drive: Option<String>,
     #[command(flatten)]
@@ -318,7 +319,7 @@ fn check(a: &CheckArgs) -> Result<()> {
         &|n| pb.set_position(n as u64),
     );
     pb.finish_and_clear();
-    let (out, drive) = out?;
+    let (out, drives) = out?;
     let mut text = format!(
         "vehicle {} against model set version {}\nfile                            class     vehicle |z|  road score  evidence\n",
         a.vehicle, set.version
@@ -337,7 +338,7 @@ fn check(a: &CheckArgs) -> Result<()> {
             }
         ));
     }
-    if let Some(d) = &drive {
+    for d in &drives {
         text.push_str(&format!(
             "drive {} ({} records, median of each feature; false alarms per drive at most {} %): {}{}  {}\n",
             d.drive,
@@ -379,7 +380,7 @@ fn check(a: &CheckArgs) -> Result<()> {
                 vehicle: &a.vehicle,
                 model_version: set.version,
                 records: &out,
-                drives: drive.iter().collect(),
+                drives: drives.iter().collect(),
             },
         )?;
     }

@@ -190,13 +190,13 @@ fn fleet_check(
             let set = require_baseline(&store, vehicle)?;
             // All or nothing, as `vibmode fleet check`.
             let paths: Vec<&std::path::Path> = files.iter().map(|f| f.as_path()).collect();
-            let (records, drive) =
+            let (records, drives) =
                 check_drive_files_progress(&mut store, &set, &paths, &opts, drive, &|_| ())?;
             Ok::<_, vibmode_fleet::FleetError>(CheckOut {
                 vehicle: vehicle.to_string(),
                 model_version: set.version,
                 records,
-                drives: drive.into_iter().collect(),
+                drives,
             })
         })
         .map_err(fleet_err)?;

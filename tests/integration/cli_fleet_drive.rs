@@ -218,3 +218,121 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
     assert_eq!(n_test(db, "bus-1"), 4);
     assert_eq!(drives().len(), 2, "no drive stored by a refused check");
 }
+
+/// `path`'s time column (seconds from 0) rewritten as date-times from `day` `hh:mm:00` (UTC), as
+/// pandas writes a `DatetimeIndex`.
+fn dated(path: &str, day: &str, hh: u32, mm: u32) -> String {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    assert!(header.starts_with("time"), "{header}");
+    let mut out = format!("{header}\n");
+    for l in lines {
+        let (t, rest) = l.split_once(',').unwrap();
+        let us = (t.parse::<f64>().unwrap() * 1e6).round() as u64;
+        out.push_str(&format!(
+            "{day} {hh:02}:{mm:02}:{:02}.{:06},{rest}\n",
+            us / 1_000_000,
+            us % 1_000_000
+        ));
+    }
+    let p = format!("{path}.{day}.csv");
+    std::fs::write(&p, out).unwrap();
+    p
+}
+
+/// Without `--drive`, records whose time column holds date-times are grouped by their UTC day:
+/// one drive per day with 3 records or more (named by the date), a day with fewer checked
+/// record by record only; where a record's start is unknown, all are the one drive `all given
+/// records`.
+#[test]
+fn records_with_dates_form_one_drive_per_day() {
+    let d = tempfile::tempdir().unwrap();
+    let db = d.path().join("fleet.db");
+    let db = db.to_str().unwrap();
+    ok(&["fleet", "init", "--db", db]);
+    let nominal = simulate_csv(&d.path().join("nominal"), "B", "30", "11", "6");
+    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1", "-q"];
+    args.extend(nominal.iter().map(String::as_str));
+    ok(&args);
+    ok(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
+    let test = simulate_csv(&d.path().join("test"), "B", "30", "21", "7");
+    // Given out of order: 26th, 25th, 26th, 27th (alone), 25th, 26th, 25th (23:59 UTC).
+    let days = [
+        ("2026-11-26", 7),
+        ("2026-11-25", 8),
+        ("2026-11-26", 9),
+        ("2026-11-27", 6),
+        ("2026-11-25", 10),
+        ("2026-11-26", 11),
+        ("2026-11-25", 23),
+    ];
+    let files: Vec<String> = test
+        .iter()
+        .zip(days)
+        .enumerate()
+        .map(|(i, (f, (day, hh)))| dated(f, day, hh, 59 * (i as u32 % 2)))
+        .collect();
+    let mut args = vec![
+        "fleet",
+        "check",
+        "--db",
+        db,
+        "--vehicle",
+        "bus-1",
+        "-q",
+        "--json",
+        "-",
+    ];
+    args.extend(files.iter().map(String::as_str));
+    let v = check_json(&args);
+    assert_eq!(v["records"].as_array().unwrap().len(), 7, "{v}");
+    let drives: Vec<(String, Vec<String>)> = v["drives"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| {
+            let recs = d["records"].as_array().unwrap();
+            let recs = recs.iter().map(|r| r.as_str().unwrap().to_string());
+            (d["drive"].as_str().unwrap().to_string(), recs.collect())
+        })
+        .collect();
+    let names = |idx: &[usize]| idx.iter().map(|&i| files[i].clone()).collect::<Vec<_>>();
+    assert_eq!(
+        drives,
+        vec![
+            ("2026-11-25".to_string(), names(&[1, 4, 6])),
+            ("2026-11-26".to_string(), names(&[0, 2, 5])),
+        ]
+    );
+    let stored = vibmode_fleet::Store::open(std::path::Path::new(db))
+        .unwrap()
+        .drives("bus-1")
+        .unwrap();
+    let mut ids: Vec<(String, usize)> = stored.into_iter().map(|(d, _, n)| (d, n)).collect();
+    ids.sort();
+    assert_eq!(
+        ids,
+        vec![("2026-11-25".to_string(), 3), ("2026-11-26".to_string(), 3)]
+    );
+    // One record without dates among them: the start of every record is not known.
+    let mut mixed: Vec<&str> = files[..3].iter().map(String::as_str).collect();
+    mixed.push(&test[3]);
+    let mut args = vec![
+        "fleet",
+        "check",
+        "--db",
+        db,
+        "--vehicle",
+        "bus-1",
+        "-q",
+        "--json",
+        "-",
+    ];
+    args.extend(mixed);
+    let v = check_json(&args);
+    let drives = v["drives"].as_array().unwrap();
+    assert_eq!(drives.len(), 1, "{v}");
+    assert_eq!(drives[0]["drive"], "all given records");
+    assert_eq!(drives[0]["records"].as_array().unwrap().len(), 4);
+}

@@ -49,6 +49,17 @@ pub struct TimeAxis {
     pub jitter_rel: f64,
     /// Time of the first sample, s.
     pub start_s: f64,
+    /// When the time column holds date-times: the Unix time (s, UTC) of its zero, so the first
+    /// sample was taken at `origin_unix_s + start_s`. `None` for a time column of numbers.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub origin_unix_s: Option<f64>,
+}
+
+impl TimeAxis {
+    /// Unix time (s, UTC) of the first sample, when the time column told it.
+    pub fn start_unix_s(&self) -> Option<f64> {
+        self.origin_unix_s.map(|o| o + self.start_s)
+    }
 }
 
 /// Checks that no two channel names are equal ([`RecordingError::SameName`] names the first

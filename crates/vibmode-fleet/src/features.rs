@@ -101,6 +101,11 @@ pub struct RecordFeatures {
     /// says why).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub suspension: Option<crate::suspension::StoredEquations>,
+    /// When the record started: Unix time (s, UTC), where the file tells it (a time column of
+    /// date-times); it puts the record into the drive of its day ([`crate::drive_of_day`]).
+    /// Absent in records stored before it existed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start_unix_s: Option<f64>,
 }
 
 impl RecordFeatures {
@@ -343,6 +348,12 @@ fn finite(x: f64) -> Option<f64> {
 /// feature can be computed (no channel with a role: name channels like `FL_unsprung`,
 /// `RR_sprung`).
 pub fn compute_features(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordFeatures> {
+    let mut features = compute_features_of(name, rec, cfg)?;
+    features.start_unix_s = rec.time_axis.as_ref().and_then(|t| t.start_unix_s());
+    Ok(features)
+}
+
+fn compute_features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordFeatures> {
     cfg.validate()?;
     check_sampling(name, rec, cfg)?;
     let faults = sensor_faults(rec, &cfg.analysis);
@@ -365,6 +376,7 @@ pub fn compute_features(name: &str, rec: &Recording, cfg: &FleetConfig) -> Resul
         sensor_faults: faults.clone(),
         line_free: Some(LineFree::default()),
         suspension: None,
+        start_unix_s: None,
     };
     if healthy.channels.is_empty() {
         return Ok(only_faults("no working sensor: no feature".into()));
@@ -685,6 +697,7 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
         sensor_faults: Vec::new(),
         line_free: Some(line_free),
         suspension: None,
+        start_unix_s: None,
     })
 }
 

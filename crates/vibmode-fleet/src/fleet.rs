@@ -228,7 +228,7 @@ fn store_prepared(
     prepared: &[Prepared],
     checks: &[Option<(i64, Assessment)>],
 ) -> Result<Vec<Stored>> {
-    store_prepared_drive(store, labels, prepared, checks, None)
+    store_prepared_drive(store, labels, prepared, checks, &[])
 }
 
 /// As [`store_prepared`], with a drive's verdict over the records in the same transaction.
@@ -237,7 +237,7 @@ fn store_prepared_drive(
     labels: &IngestLabels<'_>,
     prepared: &[Prepared],
     checks: &[Option<(i64, Assessment)>],
-    drive: Option<&Drive>,
+    drives: &[(Drive, Vec<usize>)],
 ) -> Result<Vec<Stored>> {
     let items: Vec<BatchItem<'_>> = prepared
         .iter()
@@ -256,7 +256,7 @@ fn store_prepared_drive(
             refresh_features: p.refreshed,
         })
         .collect();
-    store.store_batch_with_drive(&items, drive)
+    store.store_batch_with_drives(&items, drives)
 }
 
 fn ingested(p: Prepared, s: Stored) -> Ingested {
@@ -643,7 +643,7 @@ fn check_prepared(
     set: &ModelSet,
     prepared: Vec<Prepared>,
 ) -> Result<Vec<Checked>> {
-    check_prepared_drive(store, set, prepared, None)
+    check_prepared_drive(store, set, prepared, &[])
 }
 
 /// As [`check_prepared`], storing a drive's verdict in the same transaction.
@@ -651,14 +651,14 @@ fn check_prepared_drive(
     store: &mut Store,
     set: &ModelSet,
     prepared: Vec<Prepared>,
-    drive: Option<&Drive>,
+    drives: &[(Drive, Vec<usize>)],
 ) -> Result<Vec<Checked>> {
     require_line_free(set)?;
     let checks: Vec<Option<(i64, Assessment)>> = prepared
         .iter()
         .map(|p| Some((set.version, assess(set, &p.features))))
         .collect();
-    let stored = store_prepared_drive(store, &test_labels(set), &prepared, &checks, drive)?;
+    let stored = store_prepared_drive(store, &test_labels(set), &prepared, &checks, drives)?;
     Ok(prepared
         .into_iter()
         .zip(checks)
@@ -758,12 +758,49 @@ pub fn check_files_progress(
 /// The id of a drive when none is given.
 pub const DEFAULT_DRIVE_ID: &str = "all given records";
 
-/// As [`check_files_progress`], and the given files as one drive of the vehicle: with `drive`
-/// given, at least [`MIN_DRIVE_RECORDS`] files are needed (else an error before anything is
-/// read or stored); without it, the files form the drive [`DEFAULT_DRIVE_ID`] when there are
-/// at least that many, and no drive otherwise. Every record must have the baseline's channels
-/// (one layout per drive), and with `drive` given no record may be one stored for another
-/// vehicle (one vehicle per drive); else an error, and nothing is stored.
+/// The drive (its id, `YYYY-MM-DD`) of a record that started at this Unix time (s): its day
+/// in UTC. `None` outside the years chrono can represent.
+pub fn drive_of_day(start_unix_s: f64) -> Option<String> {
+    if !start_unix_s.is_finite() || start_unix_s.abs() > 1e14 {
+        return None;
+    }
+    let t = chrono::DateTime::from_timestamp(start_unix_s.floor() as i64, 0)?;
+    Some(t.format("%Y-%m-%d").to_string())
+}
+
+/// The drives of records checked without a drive id, as (id, indices of the records): where
+/// every record's start is known (a time column of date-times), one drive per UTC day with at
+/// least [`MIN_DRIVE_RECORDS`] records (the records of a day with fewer are checked one by one
+/// only); else all the records as the drive [`DEFAULT_DRIVE_ID`] when there are that many.
+fn drives_of_records(starts: &[Option<f64>]) -> Vec<(String, Vec<usize>)> {
+    let days: Option<Vec<String>> = starts.iter().map(|s| s.and_then(drive_of_day)).collect();
+    match days {
+        Some(days) if !days.is_empty() => {
+            let mut out: Vec<(String, Vec<usize>)> = Vec::new();
+            for (i, day) in days.into_iter().enumerate() {
+                match out.iter_mut().find(|(d, _)| *d == day) {
+                    Some((_, members)) => members.push(i),
+                    None => out.push((day, vec![i])),
+                }
+            }
+            out.retain(|(_, members)| members.len() >= MIN_DRIVE_RECORDS);
+            out.sort_by(|a, b| a.0.cmp(&b.0));
+            out
+        }
+        _ if starts.len() >= MIN_DRIVE_RECORDS => {
+            vec![(DEFAULT_DRIVE_ID.to_string(), (0..starts.len()).collect())]
+        }
+        _ => Vec::new(),
+    }
+}
+
+/// As [`check_files_progress`], and the given files as drives of the vehicle: with `drive`
+/// given, all of them are that one drive, and at least [`MIN_DRIVE_RECORDS`] files are needed
+/// (else an error before anything is read or stored); without it, one drive per day where
+/// every record's start is known, else the drive [`DEFAULT_DRIVE_ID`]
+/// ([`drives_of_records`]). Every record must have the baseline's channels (one layout per
+/// drive), and with `drive` given no record may be one stored for another vehicle (one vehicle
+/// per drive); else an error, and nothing is stored. The drives come sorted by id.
 pub fn check_drive_files_progress(
     store: &mut Store,
     set: &ModelSet,
@@ -771,7 +808,7 @@ pub fn check_drive_files_progress(
     opts: &ReadOptions,
     drive: Option<&str>,
     progress: &dyn Fn(usize),
-) -> Result<(Vec<Checked>, Option<Drive>)> {
+) -> Result<(Vec<Checked>, Vec<Drive>)> {
     check_vehicle_id(&set.vehicle)?;
     if let Some(id) = drive {
         if paths.len() < MIN_DRIVE_RECORDS {
@@ -808,38 +845,49 @@ pub fn check_drive_files_progress(
             }
         }
     }
-    let suspension = if drive.is_some() || prepared.len() >= MIN_DRIVE_RECORDS {
-        drive_suspension(store, set, &prepared)?
-    } else {
-        (None, None)
+    let groups = match drive {
+        Some(id) => vec![(id.to_string(), (0..prepared.len()).collect())],
+        None => {
+            let starts: Vec<Option<f64>> =
+                prepared.iter().map(|p| p.features.start_unix_s).collect();
+            drives_of_records(&starts)
+        }
     };
-    let drive = (drive.is_some() || prepared.len() >= MIN_DRIVE_RECORDS).then(|| {
-        let feats: Vec<&RecordFeatures> = prepared.iter().map(|p| &p.features).collect();
-        let scores = suspension.0.as_ref().map_or(&[][..], |d| &d.scores[..]);
-        let mut assessment = assess_drive_fitted(set, &feats, scores);
-        if let Some(why) = &suspension.1 {
-            assessment.missing.push(why.clone());
-        }
-        Drive {
-            drive: drive.unwrap_or(DEFAULT_DRIVE_ID).to_string(),
-            model_version: set.version,
-            records: prepared.iter().map(|p| p.file.clone()).collect(),
-            corner: assessment
-                .evidence
-                .iter()
-                .find(|e| e.meta.group == crate::model::Group::Vehicle)
-                .and_then(|e| e.meta.corner),
-            false_alarm_rate: if suspension.0.is_some() {
-                2.0 * set.config.false_alarm_rate
-            } else {
-                set.config.false_alarm_rate
-            },
-            assessment,
-            suspension: suspension.0.clone(),
-        }
-    });
-    let checked = check_prepared_drive(store, set, prepared, drive.as_ref())?;
-    Ok((checked, drive))
+    let mut drives = Vec::with_capacity(groups.len());
+    for (id, members) in groups {
+        let group: Vec<&Prepared> = members.iter().map(|&i| &prepared[i]).collect();
+        drives.push((drive_verdict(store, set, &id, &group)?, members));
+    }
+    let checked = check_prepared_drive(store, set, prepared, &drives)?;
+    Ok((checked, drives.into_iter().map(|(d, _)| d).collect()))
+}
+
+/// The verdict of one drive of `records`.
+fn drive_verdict(store: &Store, set: &ModelSet, id: &str, records: &[&Prepared]) -> Result<Drive> {
+    let suspension = drive_suspension(store, set, records)?;
+    let feats: Vec<&RecordFeatures> = records.iter().map(|p| &p.features).collect();
+    let scores = suspension.0.as_ref().map_or(&[][..], |d| &d.scores[..]);
+    let mut assessment = assess_drive_fitted(set, &feats, scores);
+    if let Some(why) = &suspension.1 {
+        assessment.missing.push(why.clone());
+    }
+    Ok(Drive {
+        drive: id.to_string(),
+        model_version: set.version,
+        records: records.iter().map(|p| p.file.clone()).collect(),
+        corner: assessment
+            .evidence
+            .iter()
+            .find(|e| e.meta.group == crate::model::Group::Vehicle)
+            .and_then(|e| e.meta.corner),
+        false_alarm_rate: if suspension.0.is_some() {
+            2.0 * set.config.false_alarm_rate
+        } else {
+            set.config.false_alarm_rate
+        },
+        assessment,
+        suspension: suspension.0,
+    })
 }
 
 /// The suspension fitted to a drive's records and scored against the model set's, or why not
@@ -848,7 +896,7 @@ pub fn check_drive_files_progress(
 fn drive_suspension(
     store: &Store,
     set: &ModelSet,
-    prepared: &[Prepared],
+    prepared: &[&Prepared],
 ) -> Result<(Option<crate::suspension::DriveSuspension>, Option<String>)> {
     let model = registered_model(store, &set.vehicle)?;
     let (model, reference) = match (model, &set.suspension) {
@@ -917,4 +965,57 @@ pub fn check_file(
         what: format!("the check of '{}'", vibmode_core::quoted(&file_name(path))),
         reason: "the store returned no row".into(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// By hand: 2026-11-27 is day 20784 after 1970-01-01.
+    #[test]
+    fn the_day_of_a_start_by_hand() {
+        let midnight = 20784.0 * 86400.0;
+        assert_eq!(drive_of_day(midnight).as_deref(), Some("2026-11-27"));
+        assert_eq!(drive_of_day(midnight - 0.25).as_deref(), Some("2026-11-26"));
+        assert_eq!(
+            drive_of_day(midnight + 86399.9).as_deref(),
+            Some("2026-11-27")
+        );
+        assert_eq!(drive_of_day(0.0).as_deref(), Some("1970-01-01"));
+        assert_eq!(drive_of_day(f64::NAN), None);
+        assert_eq!(drive_of_day(1e300), None);
+    }
+
+    #[test]
+    fn records_are_grouped_by_day_where_every_start_is_known() {
+        let day = |d: f64, h: f64| Some((20784.0 + d) * 86400.0 + h * 3600.0);
+        let id = |s: &str| s.to_string();
+        // Two days of 3, one of 1 (left out), in the order of the dates.
+        let starts = [
+            day(1.0, 8.0),
+            day(0.0, 8.0),
+            day(1.0, 9.0),
+            day(2.0, 1.0),
+            day(0.0, 23.9),
+            day(1.0, 0.1),
+            day(0.0, 0.0),
+        ];
+        assert_eq!(
+            drives_of_records(&starts),
+            vec![
+                (id("2026-11-27"), vec![1, 4, 6]),
+                (id("2026-11-28"), vec![0, 2, 5])
+            ]
+        );
+        // One unknown start: all together, as without dates.
+        let mut some = starts.to_vec();
+        some[3] = None;
+        assert_eq!(
+            drives_of_records(&some),
+            vec![(id(DEFAULT_DRIVE_ID), (0..7).collect())]
+        );
+        assert_eq!(drives_of_records(&[None, None]), vec![]);
+        assert_eq!(drives_of_records(&[day(0.0, 1.0), day(0.0, 2.0)]), vec![]);
+        assert_eq!(drives_of_records(&[]), vec![]);
+    }
 }

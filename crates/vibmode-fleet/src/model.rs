@@ -1525,6 +1525,7 @@ mod tests {
             sensor_faults: Vec::new(),
             line_free: None,
             suspension: None,
+            start_unix_s: None,
         }
     }
 
@@ -1832,6 +1833,7 @@ mod tests {
             sensor_faults: Vec::new(),
             line_free: None,
             suspension: None,
+            start_unix_s: None,
         }
     }
 
@@ -1935,6 +1937,7 @@ mod tests {
             sensor_faults: Vec::new(),
             line_free: None,
             suspension: None,
+            start_unix_s: None,
         }
     }
 

@@ -717,23 +717,30 @@ impl Store {
     /// back before the transaction starts: a value that could not be read later (a non-finite
     /// number) is an error and nothing is written.
     pub fn store_batch(&mut self, items: &[BatchItem<'_>]) -> Result<Vec<Stored>> {
-        self.store_batch_with_drive(items, None)
+        self.store_batch_with_drives(items, &[])
     }
 
-    /// As [`Store::store_batch`], and in the same transaction the verdict of a drive over these
-    /// records (table `drives`, its records in `drive_records`) when `drive` is given.
-    pub fn store_batch_with_drive(
+    /// As [`Store::store_batch`], and in the same transaction the verdict of each drive over
+    /// some of these records (table `drives`, its records, given by their indices in `items`, in
+    /// `drive_records`).
+    pub fn store_batch_with_drives(
         &mut self,
         items: &[BatchItem<'_>],
-        drive: Option<&crate::model::Drive>,
+        drives: &[(crate::model::Drive, Vec<usize>)],
     ) -> Result<Vec<Stored>> {
-        let drive_json = match drive {
-            Some(d) => Some(to_json_checked(
+        let mut drive_json = Vec::with_capacity(drives.len());
+        for (d, members) in drives {
+            if let Some(&bad) = members.iter().find(|&&i| i >= items.len()) {
+                return Err(FleetError::NotStorable {
+                    what: format!("the verdict of drive '{}'", vibmode_core::quoted(&d.drive)),
+                    reason: format!("record index {bad} of {} records", items.len()),
+                });
+            }
+            drive_json.push(to_json_checked(
                 d,
                 &format!("the verdict of drive '{}'", vibmode_core::quoted(&d.drive)),
-            )?),
-            None => None,
-        };
+            )?);
+        }
         let mut prepared = Vec::with_capacity(items.len());
         for it in items {
             let features = to_json_checked(
@@ -837,7 +844,10 @@ impl Store {
                 inserted,
             });
         }
-        if let (Some(d), Some(json), Some(first)) = (drive, drive_json, items.first()) {
+        for ((d, members), json) in drives.iter().zip(drive_json) {
+            let Some(first) = members.first().map(|&i| &items[i]) else {
+                continue;
+            };
             let vid: i64 = tx
                 .query_row(
                     "SELECT id FROM vehicles WHERE name = ?1",
@@ -859,10 +869,10 @@ impl Store {
             )
             .map_err(err)?;
             let did = tx.last_insert_rowid();
-            for o in &out {
+            for &i in members {
                 tx.execute(
                     "INSERT OR IGNORE INTO drive_records (drive_id, record_id) VALUES (?1, ?2)",
-                    params![did, o.record_id],
+                    params![did, out[i].record_id],
                 )
                 .map_err(err)?;
             }
@@ -1317,6 +1327,7 @@ mod tests {
             sensor_faults: Vec::new(),
             line_free: None,
             suspension: None,
+            start_unix_s: None,
         }
     }
 

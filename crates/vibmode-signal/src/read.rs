@@ -404,6 +404,12 @@ fn finish_delimited(
                     fs_hz: mean_fs,
                     jitter_rel: jitter,
                     start_s: t[0],
+                    origin_unix_s: match cols[ti].time_text {
+                        Some(crate::delimited::TimeText::DateTime { base }) => {
+                            Some(base.0 as f64 + f64::from(base.1) * 1e-9)
+                        }
+                        _ => None,
+                    },
                 }),
             )
         }

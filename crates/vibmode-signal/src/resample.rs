@@ -578,6 +578,7 @@ impl ResampleRecording for Recording {
                 fs_hz: r.fs_out_hz(),
                 jitter_rel: 0.0,
                 start_s: t.start_s,
+                origin_unix_s: t.origin_unix_s,
             }),
         })
     }

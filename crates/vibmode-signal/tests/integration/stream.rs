@@ -290,7 +290,11 @@ fn a_date_time_column_is_the_time() {
                 whole.fs_hz
             );
             assert_eq!(whole.channels, expected.channels);
-            assert_eq!(whole.time_axis.as_ref().unwrap().start_s, 0.0);
+            let axis = whole.time_axis.as_ref().unwrap();
+            assert_eq!(axis.start_s, 0.0);
+            // 2026-11-27 is day 20784 after 1970-01-01; 23:59:58 UTC, or local at +01:00.
+            let start = 20784.0 * 86400.0 + 86398.0 - if case == 1 { 3600.0 } else { 0.0 };
+            assert_eq!(axis.start_unix_s(), Some(start), "case {case}");
             for block in [3, 1000] {
                 let s = stream_all(&p, &opts, block);
                 assert_eq!(s.fs_hz, whole.fs_hz);
