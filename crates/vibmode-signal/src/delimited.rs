@@ -598,6 +598,11 @@ impl<R: BufRead> DelimitedReader<R> {
                 }
                 Some(n) => {
                     let l = &r.buf;
+                    if n == 1 && (l.starts_with(&[0xFF, 0xFE]) || l.starts_with(&[0xFE, 0xFF])) {
+                        return Err(SignalError::Utf16Text {
+                            path: r.path.clone(),
+                        });
+                    }
                     let l = if n == 1 && l.starts_with(&[0xEF, 0xBB, 0xBF]) {
                         &l[3..]
                     } else {

@@ -58,6 +58,12 @@ pub enum SignalError {
         /// 1-based line number.
         line: usize,
     },
+    /// UTF-16 text (a byte-order mark `FF FE` or `FE FF`, as Excel's "Unicode Text" export).
+    #[error("{path_q} is UTF-16 text (as Excel's \"Unicode Text\" export); save it as \"CSV UTF-8\" or convert it (iconv -f UTF-16 -t UTF-8 IN > OUT)", path_q = vibmode_core::quoted(.path))]
+    Utf16Text {
+        /// The file.
+        path: String,
+    },
     /// Excel's `sep=X` directive names a separator vibmode does not read.
     #[error("{path_q}: the separator directive on line {line} names '{sep_q}'; vibmode reads comma, semicolon, tab or whitespace separators", path_q = vibmode_core::quoted(.path), sep_q = vibmode_core::quoted(.sep))]
     UnsupportedSeparator {

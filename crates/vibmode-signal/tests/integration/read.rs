@@ -160,6 +160,29 @@ fn numpy_savetxt_header_names_the_columns() {
     }
 }
 
+/// Excel's "Unicode Text" export is UTF-16 with a byte-order mark: refused in one line that
+/// says so and how to convert it (not "not a text file").
+#[test]
+fn utf16_text_is_named_with_the_fix() {
+    let text = "time\tacc\n0\t1\n0.01\t2\n";
+    for bom in [[0xFFu8, 0xFE], [0xFE, 0xFF]] {
+        let mut bytes = bom.to_vec();
+        for u in text.encode_utf16() {
+            let b = if bom[0] == 0xFF {
+                u.to_le_bytes()
+            } else {
+                u.to_be_bytes()
+            };
+            bytes.extend_from_slice(&b);
+        }
+        let e = err_of(read_delimited(&bytes[..], "u.txt", &ReadOptions::default()));
+        assert!(
+            e.contains("UTF-16") && e.contains("CSV UTF-8") && !e.contains('\n'),
+            "{e}"
+        );
+    }
+}
+
 #[test]
 fn rate_from_time_and_fs_option_must_agree() {
     let text = "time,x\n0,1\n0.002,2\n0.004,3\n";
