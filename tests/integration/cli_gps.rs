@@ -351,3 +351,43 @@ fn segment_config_errors_are_short() {
         assert!(!e.contains('\u{1b}'), "{e:?}");
     }
 }
+
+/// `segment` writes each WAV or raw record's absolute start into its sidecar (`start_time`, the
+/// recording's sidecar start plus the record's offset), and the readers give it back as the
+/// record's start (`TimeAxis::start_unix_s`), which `fleet check` groups into drives by day;
+/// a sidecar's `start_time` that is no time is refused in one line.
+#[test]
+fn segmented_records_carry_their_start_in_the_sidecar() {
+    let d = tempfile::tempdir().unwrap();
+    // 2024-05-02T07:31:00Z, by hand: 19845 days after 1970-01-01, plus 7 h 31 min.
+    let t0 = 19845.0 * 86400.0 + 7.0 * 3600.0 + 31.0 * 60.0;
+    for (name, ext) in [("r.wav", "wav"), ("r.f32", "f32")] {
+        let input = recording(d.path(), name, 100.0, 60.0);
+        let out = d.path().join(format!("seg-{ext}"));
+        ok(&["segment", s(&input), "-o", s(&out)]);
+        let third = out.join(format!("record_0003.{ext}"));
+        let side: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(out.join(format!("record_0003.{ext}.json"))).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(side["start_time"], "2024-05-02T07:31:20.48Z", "{side}");
+        let rec = vibmode_signal::read_path(&third, &Default::default()).unwrap();
+        let start = rec.time_axis.as_ref().and_then(|t| t.start_unix_s());
+        assert_eq!(start, Some(t0 + 20.48), "{ext}");
+        // The input's own start is read too, as a number of seconds since 1970 as well.
+        let rec = vibmode_signal::read_path(&input, &Default::default()).unwrap();
+        assert_eq!(rec.time_axis.and_then(|t| t.start_unix_s()), Some(t0));
+        let side_path = d.path().join(format!("{name}.json"));
+        let text = std::fs::read_to_string(&side_path).unwrap();
+        let numeric = text.replacen("\"2024-05-02T07:31:00Z\"", &format!("{t0}"), 1);
+        std::fs::write(&side_path, &numeric).unwrap();
+        let rec = vibmode_signal::read_path(&input, &Default::default()).unwrap();
+        assert_eq!(rec.time_axis.and_then(|t| t.start_unix_s()), Some(t0));
+        let bad = text.replacen("\"2024-05-02T07:31:00Z\"", "\"yesterday\"", 1);
+        std::fs::write(&side_path, bad).unwrap();
+        fails_with(
+            &["psd", s(&input)],
+            &["start_time \"yesterday\"", "ISO 8601", "fix or delete it"],
+        );
+    }
+}

@@ -38,7 +38,9 @@ impl Channel {
     }
 }
 
-/// Where the sampling rate of a delimited file came from, when it had a time column.
+/// Where the sampling rate of a delimited file came from, when it had a time column; for a WAV
+/// or raw file whose sidecar gives its `start_time`, that start (`column` `start_time`, the
+/// header's rate, `origin_unix_s`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TimeAxis {
     /// Name of the time column in the file (e.g. `Time`).

@@ -79,6 +79,13 @@ fn write_all(
             .collect();
         let start_s = seg.records.get(k).map_or(0.0, |s| s.meta.start_s);
         let mut w = StreamWriter::create(&path, &names, &units, r.recording.fs_hz, start_s)?;
+        // A WAV or raw record's sidecar carries its absolute start, when the recording's is
+        // known: `fleet check` groups records into drives by their day.
+        w.set_start_time(
+            seg.records
+                .get(k)
+                .and_then(|s| s.meta.start_time.as_deref()),
+        )?;
         let block: Vec<Vec<f64>> = r
             .recording
             .channels

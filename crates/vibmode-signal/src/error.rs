@@ -338,6 +338,12 @@ pub enum SidecarProblem {
         /// Channels in the WAV.
         channels: usize,
     },
+    /// A sidecar's `"start_time"` that is no time.
+    #[error("has start_time {value}, neither an ISO 8601 time such as \"2026-11-27T07:31:00Z\" nor seconds since 1970 (0 to 1e11); fix or delete it")]
+    StartTime {
+        /// The value as written (JSON text).
+        value: String,
+    },
     /// A raw file without its sidecar.
     #[error("not found; a raw file needs a JSON sidecar like {{\"fs_hz\": 20000, \"dtype\": \"f32\", \"channels\": [\"FL\"]}}")]
     NotFound,

@@ -591,11 +591,53 @@ fn wav_recording(
         })
         .collect();
     check_finite(&channels)?;
+    let mut side = path.as_os_str().to_owned();
+    side.push(".json");
     Ok(Recording {
         fs_hz: fs,
         channels,
-        time_axis: None,
+        time_axis: sidecar_time_axis(Path::new(&side), fs)?,
     })
+}
+
+/// The time axis of a WAV or raw recording whose sidecar gives its `"start_time"` (ISO 8601 /
+/// RFC 3339 text, or a number of seconds since 1970, 0 to 1e11; as `vibmode segment` reads
+/// it): column `start_time`, the header's rate, origin that time. `None` without a sidecar or
+/// without the key; an error naming the value when it is no time.
+fn sidecar_time_axis(sidecar: &Path, fs_hz: f64) -> Result<Option<TimeAxis>> {
+    if !sidecar.is_file() {
+        return Ok(None);
+    }
+    let text =
+        vibmode_core::files::read_text_capped(sidecar).map_err(|e| io_err("read", sidecar, &e))?;
+    // The sidecar's own reader reports malformed JSON; here only the key is read.
+    let Ok(v) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return Ok(None);
+    };
+    let origin = match v.get("start_time") {
+        None | Some(serde_json::Value::Null) => return Ok(None),
+        Some(serde_json::Value::String(s)) => crate::delimited::parse_datetime(s.as_bytes())
+            .map(|(s, ns)| s as f64 + f64::from(ns) * 1e-9)
+            .or_else(|| s.trim().parse::<f64>().ok()),
+        Some(serde_json::Value::Number(n)) => n.as_f64(),
+        Some(_) => None,
+    }
+    .filter(|u| u.is_finite() && (0.0..=1e11).contains(u));
+    match origin {
+        Some(u) => Ok(Some(TimeAxis {
+            column: "start_time".into(),
+            fs_hz,
+            jitter_rel: 0.0,
+            start_s: 0.0,
+            origin_unix_s: Some(u),
+        })),
+        None => Err(SignalError::Sidecar {
+            path: sidecar.display().to_string(),
+            problem: SidecarProblem::StartTime {
+                value: vibmode_core::cap_message(&v["start_time"].to_string(), 60),
+            },
+        }),
+    }
 }
 
 /// The optional JSON sidecar of a WAV file (`<path>.json`): channel names and units, which WAV
@@ -797,7 +839,7 @@ fn read_raw(path: &Path, opts: &ReadOptions) -> Result<Recording> {
     Ok(Recording {
         fs_hz: fs,
         channels,
-        time_axis: None,
+        time_axis: sidecar_time_axis(Path::new(&sp), fs)?,
     })
 }
 

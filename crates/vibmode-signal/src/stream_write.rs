@@ -191,6 +191,31 @@ impl StreamWriter {
         })
     }
 
+    /// Writes `start_time` (the absolute time of the first frame, RFC 3339 text as `vibmode
+    /// segment` gives it) into the sidecar of a WAV or raw file, where the readers find the
+    /// record's start (docs/formats.md); a CSV keeps its relative `time_s`. `None` leaves the
+    /// sidecar as it is.
+    pub fn set_start_time(&mut self, start_time: Option<&str>) -> Result<()> {
+        let (Some(t), Some((sp, text))) = (start_time, self.sidecar.as_mut()) else {
+            return Ok(());
+        };
+        let not_serialised = |e: serde_json::Error| SignalError::Sidecar {
+            path: sp.display().to_string(),
+            problem: SidecarProblem::NotSerialised {
+                message: e.to_string(),
+            },
+        };
+        let mut v: serde_json::Value = serde_json::from_str(text).map_err(not_serialised)?;
+        if let Some(map) = v.as_object_mut() {
+            map.insert(
+                "start_time".into(),
+                serde_json::Value::String(t.to_string()),
+            );
+        }
+        *text = serde_json::to_string_pretty(&v).map_err(not_serialised)? + "\n";
+        Ok(())
+    }
+
     /// Frames written so far.
     pub fn frames_written(&self) -> u64 {
         self.written
