@@ -74,6 +74,8 @@ def test_frames_with_a_bad_time_are_refused_in_one_line():
         vibmode.analyze(words)
     with pytest.raises(ValueError, match="give fs"):
         vibmode.analyze(pd.DataFrame({"acc_a": data[0]}))
+    with pytest.raises(ValueError, match="no channel besides its time column 'time'"):
+        vibmode.analyze(df[["time"]])
 
 
 def test_to_csv_files_read_as_their_frames(tmp_path):

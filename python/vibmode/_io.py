@@ -183,6 +183,9 @@ def frame_channels(df: Any, fs: Optional[float]):
     within 1 % and agree with a given rate within 1 %; a time column is not a channel."""
     t, time_col = _frame_time(df)
     cols = [c for c in df.columns if time_col is None or c != time_col]
+    if not cols:
+        only = "" if time_col is None else f" besides its time column {str(time_col)!r}"
+        raise ValueError(f"the DataFrame has no channel{only}; give it one column per channel")
     from pandas.api import types
 
     bad = [str(c) for c in cols if not types.is_numeric_dtype(df[c]) or types.is_bool_dtype(df[c])]
@@ -214,7 +217,7 @@ def frame_channels(df: Any, fs: Optional[float]):
         raise ValueError(
             "the DataFrame has no time (a time column, or a DatetimeIndex/TimedeltaIndex) and no attrs['fs']; give fs (Hz)"
         )
-    data = df[cols].to_numpy(dtype=np.float64).T if cols else np.zeros((0, len(df)))
+    data = df[cols].to_numpy(dtype=np.float64).T
     return data, float(rate), [str(c) for c in cols]
 
 
