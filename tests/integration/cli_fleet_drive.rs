@@ -28,17 +28,24 @@ fn n_test(db: &str, vehicle: &str) -> usize {
     n.unwrap_or_else(|| panic!("no test count in {line}"))
 }
 
+/// A store in `dir` with vehicle `bus-1`: 6 nominal records (road B, 30 km/h, seed 11) and
+/// its baseline. Returns the store's path.
+fn store_with_baseline(dir: &std::path::Path) -> String {
+    let db = dir.join("fleet.db").to_str().unwrap().to_string();
+    ok(&["fleet", "init", "--db", &db]);
+    let nominal = simulate_csv(&dir.join("nominal"), "B", "30", "11", "6");
+    let mut args = vec!["fleet", "ingest", "--db", &db, "--vehicle", "bus-1", "-q"];
+    args.extend(nominal.iter().map(String::as_str));
+    ok(&args);
+    ok(&["fleet", "baseline", "--db", &db, "--vehicle", "bus-1"]);
+    db
+}
+
 #[test]
 fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
     let d = tempfile::tempdir().unwrap();
-    let db = d.path().join("fleet.db");
-    let db = db.to_str().unwrap();
-    ok(&["fleet", "init", "--db", db]);
-    let nominal = simulate_csv(&d.path().join("nominal"), "B", "30", "11", "6");
-    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1", "-q"];
-    args.extend(nominal.iter().map(String::as_str));
-    ok(&args);
-    ok(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
+    let db = store_with_baseline(d.path());
+    let db = db.as_str();
 
     // A healthy drive of 4 records: one drive, its records listed, the per-record verdicts kept.
     let test = simulate_csv(&d.path().join("test"), "B", "30", "21", "4");
@@ -248,14 +255,8 @@ fn dated(path: &str, day: &str, hh: u32, mm: u32) -> String {
 #[test]
 fn records_with_dates_form_one_drive_per_day() {
     let d = tempfile::tempdir().unwrap();
-    let db = d.path().join("fleet.db");
-    let db = db.to_str().unwrap();
-    ok(&["fleet", "init", "--db", db]);
-    let nominal = simulate_csv(&d.path().join("nominal"), "B", "30", "11", "6");
-    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1", "-q"];
-    args.extend(nominal.iter().map(String::as_str));
-    ok(&args);
-    ok(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
+    let db = store_with_baseline(d.path());
+    let db = db.as_str();
     let test = simulate_csv(&d.path().join("test"), "B", "30", "21", "7");
     // Given out of order: 26th, 25th, 26th, 27th (alone), 25th, 26th, 25th (23:59 UTC).
     let days = [

@@ -767,6 +767,12 @@ impl<R: BufRead> DelimitedReader<R> {
         &self.path
     }
 
+    /// True when the rows' line numbers are needed to name a row in an error: a time column or a
+    /// row index is checked row by row after the read.
+    pub fn needs_lines(&self) -> bool {
+        self.time_column().is_some() || self.columns.iter().any(|c| c.row_index)
+    }
+
     /// Index of the first column recognised as time, if any.
     pub fn time_column(&self) -> Option<usize> {
         self.columns.iter().position(|c| c.time_scale_s.is_some())

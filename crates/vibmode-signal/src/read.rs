@@ -274,7 +274,7 @@ pub fn read_delimited<R: BufRead>(reader: R, path: &str, opts: &ReadOptions) -> 
     let mut r = DelimitedReader::new(reader, path)?;
     let mut data: Vec<Vec<f64>> = vec![Vec::new(); r.columns().len()];
     let mut lines: Vec<usize> = Vec::new();
-    let keep_lines = r.time_column().is_some() || r.columns().iter().any(|c| c.row_index);
+    let keep_lines = r.needs_lines();
     while let Some(block) = r.next_block(1 << 16)? {
         append_block(&mut data, &mut lines, block, keep_lines);
     }
@@ -287,7 +287,7 @@ pub fn read_delimited_bytes(bytes: &[u8], path: &str, opts: &ReadOptions) -> Res
     let mut r = DelimitedReader::new(bytes, path)?;
     let mut data: Vec<Vec<f64>> = vec![Vec::new(); r.columns().len()];
     let mut lines: Vec<usize> = Vec::new();
-    let keep_lines = r.time_column().is_some() || r.columns().iter().any(|c| c.row_index);
+    let keep_lines = r.needs_lines();
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get().min(8));
     if let Some(block) = r.read_all_parallel(threads)? {
         append_block(&mut data, &mut lines, block, keep_lines);
@@ -605,24 +605,14 @@ fn wav_recording(
 /// it): column `start_time`, the header's rate, origin that time. `None` without a sidecar or
 /// without the key; an error naming the value when it is no time.
 fn sidecar_time_axis(sidecar: &Path, fs_hz: f64) -> Result<Option<TimeAxis>> {
-    if !sidecar.is_file() {
-        return Ok(None);
-    }
-    let text =
-        vibmode_core::files::read_text_capped(sidecar).map_err(|e| io_err("read", sidecar, &e))?;
-    // The sidecar's own reader reports malformed JSON; here only the key is read.
-    let Ok(v) = serde_json::from_str::<serde_json::Value>(&text) else {
+    // A missing or malformed sidecar gives none here; the sidecar's own reader reports it.
+    let Some(text) = crate::stream::sidecar_start_time(sidecar) else {
         return Ok(None);
     };
-    let origin = match v.get("start_time") {
-        None | Some(serde_json::Value::Null) => return Ok(None),
-        Some(serde_json::Value::String(s)) => crate::delimited::parse_datetime(s.as_bytes())
-            .map(|(s, ns)| s as f64 + f64::from(ns) * 1e-9)
-            .or_else(|| s.trim().parse::<f64>().ok()),
-        Some(serde_json::Value::Number(n)) => n.as_f64(),
-        Some(_) => None,
-    }
-    .filter(|u| u.is_finite() && (0.0..=1e11).contains(u));
+    let origin = crate::delimited::parse_datetime(text.as_bytes())
+        .map(|(s, ns)| s as f64 + f64::from(ns) * 1e-9)
+        .or_else(|| text.trim().parse::<f64>().ok())
+        .filter(|u| u.is_finite() && (0.0..=1e11).contains(u));
     match origin {
         Some(u) => Ok(Some(TimeAxis {
             column: "start_time".into(),
@@ -634,7 +624,7 @@ fn sidecar_time_axis(sidecar: &Path, fs_hz: f64) -> Result<Option<TimeAxis>> {
         None => Err(SignalError::Sidecar {
             path: sidecar.display().to_string(),
             problem: SidecarProblem::StartTime {
-                value: vibmode_core::cap_message(&v["start_time"].to_string(), 60),
+                value: vibmode_core::cap_message(&format!("{text:?}"), 60),
             },
         }),
     }

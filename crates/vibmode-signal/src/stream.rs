@@ -179,7 +179,7 @@ fn stream(info: StreamInfo, inner: Inner) -> FrameStream {
 /// `"start_time"` of a JSON sidecar, if any: a string as written, a number (seconds since 1970)
 /// as its decimal text, anything else as its JSON text, so that the reader checks it and refuses
 /// what it cannot use instead of it being ignored.
-fn sidecar_start_time(sidecar: &Path) -> Option<String> {
+pub(crate) fn sidecar_start_time(sidecar: &Path) -> Option<String> {
     let text = std::fs::read_to_string(sidecar).ok()?;
     let v: serde_json::Value = serde_json::from_str(&text).ok()?;
     match v.get("start_time")? {
