@@ -431,11 +431,11 @@ fn status(db: &std::path::Path) -> Result<()> {
             text.push_str(&format!("  {s}\n"));
         }
         if !v.drives.is_empty() {
-            text.push_str("  drives, newest first:\n");
+            text.push_str("  drives, newest first (when driven; when checked where the records' times are unknown):\n");
             for d in &v.drives {
                 text.push_str(&format!(
-                    "    {} {:<8} {:<15} {} {}\n",
-                    d.checked,
+                    "    {:<28} {:<8} {:<15} {} {}\n",
+                    d.when(),
                     d.classification.to_string(),
                     d.place(),
                     d.drive,

@@ -316,6 +316,69 @@ fn records_with_dates_form_one_drive_per_day() {
         ids,
         vec![("2026-11-25".to_string(), 3), ("2026-11-26".to_string(), 3)]
     );
+    // The drives are ordered by when they were driven (their earliest record's start), and
+    // a drive of an earlier day checked later takes its place in the timeline: since when is
+    // the day driven, not the time checked.
+    let early: Vec<String> = test[..3]
+        .iter()
+        .enumerate()
+        .map(|(i, f)| dated(f, "2026-11-20", 14 - i as u32, 30))
+        .collect();
+    let mut args = vec![
+        "fleet",
+        "check",
+        "--db",
+        db,
+        "--vehicle",
+        "bus-1",
+        "-q",
+        "--json",
+        "-",
+    ];
+    args.extend(early.iter().map(String::as_str));
+    let v = check_json(&args);
+    assert_eq!(v["drives"][0]["drive"], "2026-11-20", "{v}");
+    let status = || {
+        let st = vibmode_fleet::Store::open(std::path::Path::new(db))
+            .unwrap()
+            .status(10)
+            .unwrap();
+        st.into_iter().find(|v| v.vehicle == "bus-1").unwrap()
+    };
+    let v1 = status();
+    let timeline: Vec<(&str, Option<&str>)> = v1
+        .drives
+        .iter()
+        .map(|d| (d.drive.as_str(), d.driven.as_deref()))
+        .collect();
+    assert_eq!(
+        timeline,
+        vec![
+            ("2026-11-26", Some("2026-11-26T07:00:00Z")),
+            ("2026-11-25", Some("2026-11-25T08:59:00Z")),
+            ("2026-11-20", Some("2026-11-20T12:30:00Z")),
+        ],
+        "newest driven first"
+    );
+    for d in &v1.drives {
+        assert_eq!(d.classification.to_string(), "normal", "{}", d.summary);
+    }
+    let latest = v1.latest_drive.as_ref().unwrap();
+    assert_eq!(latest.drive, "2026-11-26");
+    assert_eq!(
+        latest.since, "2026-11-20T12:30:00Z",
+        "normal since the 20th"
+    );
+    let o = ok(&["fleet", "status", "--db", db]);
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        text.lines()
+            .nth(1)
+            .unwrap_or("")
+            .contains("2026-11-20T12:30:00Z"),
+        "{text}"
+    );
+
     // One record without dates among them: the start of every record is not known.
     let mut mixed: Vec<&str> = files[..3].iter().map(String::as_str).collect();
     mixed.push(&test[3]);
@@ -336,4 +399,13 @@ fn records_with_dates_form_one_drive_per_day() {
     assert_eq!(drives.len(), 1, "{v}");
     assert_eq!(drives[0]["drive"], "all given records");
     assert_eq!(drives[0]["records"].as_array().unwrap().len(), 4);
+    // That drive has no time of its own: it is placed by when it was checked (now, after the
+    // dated ones), and shows that time.
+    let v1 = status();
+    let latest = v1.latest_drive.as_ref().unwrap();
+    assert_eq!(latest.drive, "all given records");
+    assert_eq!(latest.driven, None);
+    assert_eq!(latest.when(), format!("checked {}", latest.checked));
+    assert_eq!(v1.drives.len(), 4);
+    assert_eq!(v1.drives[1].drive, "2026-11-26");
 }

@@ -875,6 +875,11 @@ fn drive_verdict(store: &Store, set: &ModelSet, id: &str, records: &[&Prepared])
         drive: id.to_string(),
         model_version: set.version,
         records: records.iter().map(|p| p.file.clone()).collect(),
+        start_unix_s: records
+            .iter()
+            .map(|p| p.features.start_unix_s)
+            .collect::<Option<Vec<f64>>>()
+            .and_then(|s| s.into_iter().reduce(f64::min)),
         corner: assessment
             .evidence
             .iter()

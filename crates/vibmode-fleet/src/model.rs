@@ -1477,6 +1477,11 @@ pub struct Drive {
     pub model_version: i64,
     /// Its records (file names as given), whose own verdicts are in the check's `records`.
     pub records: Vec<String>,
+    /// When it was driven: the earliest start of its records (Unix time, s), where every
+    /// record's start is known (a time column of date-times, or a sidecar's `start_time`);
+    /// absent otherwise and in drives stored before it existed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start_unix_s: Option<f64>,
     /// The corner of the strongest flagged vehicle feature (the one named first), if any.
     pub corner: Option<vibmode_analysis::Corner>,
     /// Upper bound of the false-alarm rate per drive and feature group: the model set's

@@ -82,7 +82,7 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
             s.drives.iter().map(|d| {
                 vec![
                     s.vehicle.clone(),
-                    d.checked.clone(),
+                    d.when(),
                     d.drive.clone(),
                     d.classification.to_string(),
                     d.place(),
@@ -95,7 +95,7 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
         html.table(
             &[
                 "vehicle",
-                "checked",
+                "driven (or checked)",
                 "drive",
                 "verdict",
                 "corner, component",

@@ -199,11 +199,36 @@ pub struct DriveStatus {
     pub false_alarm_rate: f64,
     /// Records in the drive.
     pub n_records: usize,
-    /// The first check of the latest run of drives with this classification (since when).
+    /// When the drive was driven (UTC, RFC 3339 to the second): its earliest record's start,
+    /// where every record's start is known; else `None`.
+    #[serde(default)]
+    pub driven: Option<String>,
+    /// Since when the vehicle has had this verdict: the first drive of the latest run of
+    /// drives with this classification, by when it was driven (`driven`), or by when it was
+    /// checked where that is unknown.
     pub since: String,
 }
 
+/// A Unix time (s) as UTC RFC 3339 to the second, as [`now_utc`] writes it; `None` outside
+/// the years chrono can represent.
+pub fn utc_of_unix(unix_s: f64) -> Option<String> {
+    if !unix_s.is_finite() || unix_s.abs() > 1e14 {
+        return None;
+    }
+    let t = chrono::DateTime::from_timestamp(unix_s.floor() as i64, 0)?;
+    Some(t.format("%Y-%m-%dT%H:%M:%SZ").to_string())
+}
+
 impl DriveStatus {
+    /// When the drive was driven, or `checked <time>` where that is unknown: the time the
+    /// drives are ordered by.
+    pub fn when(&self) -> String {
+        match &self.driven {
+            Some(t) => t.clone(),
+            None => format!("checked {}", self.checked),
+        }
+    }
+
     /// The corner and its component as tables show them: `RL damper`, `RL` (no component
     /// named), `-` (no corner).
     pub fn place(&self) -> String {
@@ -1191,7 +1216,9 @@ impl Store {
 
 impl Store {
     /// Every drive verdict of the vehicle `vid`, newest first, each with the start of its run
-    /// of equal verdicts.
+    /// of equal verdicts. A drive's time is when it was driven where its records' starts are
+    /// known, else when it was checked (checked in the order stored where times are equal), so
+    /// a drive of last week checked today takes its place in last week.
     fn drive_statuses(&self, vid: i64, vehicle: &str) -> Result<Vec<DriveStatus>> {
         let mut st = self
             .conn
@@ -1213,14 +1240,25 @@ impl Store {
             .map_err(self.sql("reading drives"))?
             .collect::<rusqlite::Result<Vec<_>>>()
             .map_err(self.sql("reading drives"))?;
-        let mut out: Vec<DriveStatus> = Vec::with_capacity(rows.len());
+        let mut parsed = Vec::with_capacity(rows.len());
         for (drive, checked, json, n) in rows {
             let d: crate::model::Drive = serde_json::from_str(&json)
                 .map_err(|e| self.corrupt(&format!("drive {drive} of {vehicle}"), e))?;
+            let driven = d.start_unix_s.and_then(utc_of_unix);
+            parsed.push((drive, checked, d, n, driven));
+        }
+        // Stable: drives of equal time stay in the order they were stored.
+        parsed.sort_by(|a, b| {
+            let at = a.4.as_deref().unwrap_or(&a.1);
+            let bt = b.4.as_deref().unwrap_or(&b.1);
+            at.cmp(bt)
+        });
+        let mut out: Vec<DriveStatus> = Vec::with_capacity(parsed.len());
+        for (drive, checked, d, n, driven) in parsed {
             let class = d.assessment.classification;
             let since = match out.last() {
                 Some(prev) if prev.classification == class => prev.since.clone(),
-                _ => checked.clone(),
+                _ => driven.clone().unwrap_or_else(|| checked.clone()),
             };
             let limit = d
                 .assessment
@@ -1240,6 +1278,7 @@ impl Store {
                     .map(|l| d.assessment.scores.vehicle_max_abs_z / l),
                 false_alarm_rate: d.false_alarm_rate,
                 n_records: n.max(0) as usize,
+                driven,
                 since,
             });
         }
