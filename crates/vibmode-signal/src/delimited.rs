@@ -26,7 +26,7 @@
 //! [`DelimitedReader::read_all_parallel`] runs the same line parser on newline-aligned chunks
 //! in several threads.
 
-use crate::error::{Result, SignalError};
+use crate::error::{BinaryFormat, Result, SignalError};
 use crate::number::{parse_slow, scan_number, Scan};
 use serde::{Deserialize, Serialize};
 use std::io::BufRead;
@@ -95,6 +95,16 @@ fn sep_directive(t: &[u8]) -> Option<Option<Separator>> {
 }
 
 impl Separator {
+    /// The separating byte (`,`, `;`, tab; a space for whitespace runs).
+    fn byte(self) -> u8 {
+        match self {
+            Separator::Comma => b',',
+            Separator::Semicolon => b';',
+            Separator::Tab => b'\t',
+            Separator::Whitespace => b' ',
+        }
+    }
+
     fn sniff(line: &[u8]) -> Separator {
         if line.contains(&b'\t') && !mixed_whitespace_numbers(line) {
             Separator::Tab
@@ -583,6 +593,19 @@ impl<R: BufRead> DelimitedReader<R> {
             spans: Vec::new(),
             scratch: Vec::new(),
         };
+        // A binary format a user can export from, named by its first bytes (peeked: the
+        // buffer's first fill, before any line is read).
+        let head = r.reader.fill_buf().map_err(|e| SignalError::Io {
+            action: "read",
+            path: r.path.clone(),
+            message: e.to_string(),
+        })?;
+        if let Some(format) = BinaryFormat::sniff(&r.path, head) {
+            return Err(SignalError::BinaryFormat {
+                path: r.path.clone(),
+                format,
+            });
+        }
         // Excel's `sep=X` first line, when present.
         let mut forced_sep: Option<Separator> = None;
         // The last comment line (its number and text after the comment marks), which may be
@@ -1182,6 +1205,20 @@ impl RowCtx<'_> {
         if self.spans.is_empty() {
             return Ok(());
         }
+        // A row cut short by empty cells at its end (`1.5,2.0,` for three columns: a missing
+        // value, as pandas writes NaN) is a missing value, not a short row.
+        let cells_written = match self.sep {
+            Separator::Whitespace => self.spans.len(),
+            sep => line.iter().filter(|&&b| b == sep.byte()).count() + 1,
+        };
+        if self.spans.len() < nc && cells_written >= nc {
+            return Err(SignalError::EmptyCell {
+                path: self.path.to_string(),
+                line: line_no,
+                column: self.spans.len() + 1,
+                column_name: self.columns[self.spans.len()].name.clone(),
+            });
+        }
         if self.spans.len() != nc {
             return Err(SignalError::RaggedRow {
                 path: self.path.to_string(),
@@ -1202,6 +1239,14 @@ impl RowCtx<'_> {
             };
             match parsed {
                 Some(v) => block.columns[c].push(v),
+                None if cell.is_empty() => {
+                    return Err(SignalError::EmptyCell {
+                        path: self.path.to_string(),
+                        line: line_no,
+                        column: c + 1,
+                        column_name: self.columns[c].name.clone(),
+                    });
+                }
                 None => {
                     let text: String = String::from_utf8_lossy(cell).chars().take(40).collect();
                     return Err(SignalError::NotNumeric {

@@ -94,6 +94,27 @@ pub enum SignalError {
         /// 1-based line the expected count comes from.
         reference_line: usize,
     },
+    /// An empty cell in a data row: a missing value (pandas writes NaN as an empty cell).
+    #[error("line {line}, column {column} ('{column_name_q}') of {path_q} is empty (a missing value; pandas writes NaN as an empty cell); fill or interpolate the gap, or delete the row", path_q = vibmode_core::quoted(.path), column_name_q = vibmode_core::quoted(.column_name))]
+    EmptyCell {
+        /// The file.
+        path: String,
+        /// 1-based line number.
+        line: usize,
+        /// 1-based column number.
+        column: usize,
+        /// Column name (from the header or `chN`).
+        column_name: String,
+    },
+    /// A file in a binary format that vibmode does not read but that a user can export to one
+    /// it does (recognised by its first bytes).
+    #[error("{path_q} is {what}, not delimited text; {fix}", path_q = vibmode_core::quoted(.path), what = .format.description(), fix = .format.fix())]
+    BinaryFormat {
+        /// The file.
+        path: String,
+        /// The format recognised.
+        format: BinaryFormat,
+    },
     /// A cell that is not a number.
     #[error("line {line}, column {column} ('{column_name_q}') of {path_q}: '{text_q}' is not a number; fix the cell or delete the row", path_q = vibmode_core::quoted(.path), column_name_q = vibmode_core::quoted(.column_name), text_q = vibmode_core::quoted(.text))]
     NotNumeric {
@@ -417,4 +438,102 @@ pub(crate) fn check_names_of<'a>(
         },
         other => SignalError::Recording(other),
     })
+}
+
+/// Binary formats recognised by their first bytes where delimited text was expected, each with
+/// the way to export it to a format vibmode reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum BinaryFormat {
+    /// A spreadsheet workbook: Excel's `.xlsx`/`.xlsm` or LibreOffice's `.ods` (ZIP archives).
+    ExcelWorkbook,
+    /// A legacy Excel workbook (`.xls`: an OLE compound file).
+    ExcelLegacy,
+    /// A MATLAB MAT-file of version 5 to 7 (`MATLAB 5.0 MAT-file` header).
+    MatFile,
+    /// HDF5, as MATLAB's `-v7.3` MAT-files and `.h5` files.
+    Hdf5,
+    /// Apache Parquet (pandas' `to_parquet`).
+    Parquet,
+    /// National Instruments TDMS.
+    Tdms,
+    /// A gzip-compressed file.
+    Gzip,
+    /// Another ZIP archive.
+    Zip,
+}
+
+impl BinaryFormat {
+    /// The format recognised from the first bytes of the file at `path` (its extension tells a
+    /// workbook from another ZIP archive when the first entry does not), if any.
+    pub fn sniff(path: &str, head: &[u8]) -> Option<BinaryFormat> {
+        if head.starts_with(b"PK\x03\x04") {
+            // The first entry's name follows the 30-byte local header.
+            let name = head.get(30..head.len().min(30 + 64)).unwrap_or(&[]);
+            let ext = std::path::Path::new(path)
+                .extension()
+                .and_then(|e| e.to_str())
+                .map(str::to_ascii_lowercase);
+            let excel = name.starts_with(b"[Content_Types].xml")
+                || name.starts_with(b"xl/")
+                || name.starts_with(b"docProps/")
+                || name.starts_with(b"_rels/")
+                || name.starts_with(b"mimetype")
+                || matches!(ext.as_deref(), Some("xlsx" | "xlsm" | "ods"));
+            return Some(if excel {
+                BinaryFormat::ExcelWorkbook
+            } else {
+                BinaryFormat::Zip
+            });
+        }
+        let magic: [(&[u8], BinaryFormat); 6] = [
+            (
+                b"\xD0\xCF\x11\xE0\xA1\xB1\x1A\xE1",
+                BinaryFormat::ExcelLegacy,
+            ),
+            (b"MATLAB 5.0 MAT-file", BinaryFormat::MatFile),
+            (b"\x89HDF\r\n\x1a\n", BinaryFormat::Hdf5),
+            (b"PAR1", BinaryFormat::Parquet),
+            (b"TDSm", BinaryFormat::Tdms),
+            (b"\x1f\x8b", BinaryFormat::Gzip),
+        ];
+        magic
+            .iter()
+            .find(|(m, _)| head.starts_with(m))
+            .map(|&(_, f)| f)
+    }
+
+    /// What the file is, for messages (`an Excel workbook`).
+    pub fn description(self) -> &'static str {
+        match self {
+            BinaryFormat::ExcelWorkbook => "a spreadsheet workbook (.xlsx, .ods)",
+            BinaryFormat::ExcelLegacy => "an Excel 97-2003 workbook (.xls)",
+            BinaryFormat::MatFile => "a MATLAB MAT-file",
+            BinaryFormat::Hdf5 => "an HDF5 file (a MATLAB -v7.3 MAT-file or .h5)",
+            BinaryFormat::Parquet => "an Apache Parquet file",
+            BinaryFormat::Tdms => "an NI TDMS file",
+            BinaryFormat::Gzip => "gzip-compressed",
+            BinaryFormat::Zip => "a ZIP archive",
+        }
+    }
+
+    /// How to export it to a format vibmode reads.
+    pub fn fix(self) -> &'static str {
+        match self {
+            BinaryFormat::ExcelWorkbook | BinaryFormat::ExcelLegacy => {
+                "save the sheet as \"CSV UTF-8\" (Excel) or \"Text CSV\" (LibreOffice), or in Python: pandas.read_excel(IN).to_csv(OUT, index=False)"
+            }
+            BinaryFormat::MatFile | BinaryFormat::Hdf5 => {
+                "export the channels in MATLAB with writetable(T, 'OUT.csv') or writematrix(A, 'OUT.csv'), or write them as a WAV (audiowrite)"
+            }
+            BinaryFormat::Parquet => {
+                "convert it in Python: pandas.read_parquet(IN).to_csv(OUT, index=False)"
+            }
+            BinaryFormat::Tdms => {
+                "export it to CSV (NI DIAdem or LabVIEW, or in Python: nptdms.TdmsFile.read(IN).as_dataframe().to_csv(OUT, index=False))"
+            }
+            BinaryFormat::Gzip => "decompress it first (gunzip)",
+            BinaryFormat::Zip => "extract the recordings from it first (unzip)",
+        }
+    }
 }

@@ -51,7 +51,7 @@ pub mod stream_write;
 pub mod write;
 
 pub use delimited::{Block, ColumnInfo, DelimitedReader, Separator, TimeText};
-pub use error::{SidecarProblem, SignalError, WavProblem};
+pub use error::{BinaryFormat, SidecarProblem, SignalError, WavProblem};
 pub use preprocess::{preprocess, Preprocessed};
 pub use read::{
     read_delimited, read_delimited_bytes, read_path, read_path_bytes, sidecar_candidates,

@@ -638,3 +638,164 @@ fn resampler_kind_auto_streams_only_large_filtered_inputs() {
         "{e}"
     );
 }
+
+/// The first error of reading `p` by the whole-file reader and by the stream (blocks of 100
+/// rows), which must agree.
+fn errors_of_both_readers(p: &Path, opts: &ReadOptions) -> String {
+    let whole = read_path(p, opts).unwrap_err().to_string();
+    let streamed = match open_stream(p, opts) {
+        Err(e) => e.to_string(),
+        Ok(mut st) => loop {
+            match st.next_block(100) {
+                Ok(Some(_)) => {}
+                Ok(None) => panic!("{}: the stream read it", p.display()),
+                Err(e) => break e.to_string(),
+            }
+        },
+    };
+    assert_eq!(whole, streamed, "{}", p.display());
+    assert!(!whole.contains('\n'), "{whole}");
+    whole
+}
+
+/// A missing value (an empty cell: pandas writes NaN so) is named as one, with its line and
+/// column, wherever it is in the row, with each separator; not as a short row or as "'' is
+/// not a number". A trailing separator on every row is still no missing value.
+#[test]
+fn a_missing_value_is_named_as_an_empty_cell() {
+    let dir = tmp();
+    let opts = ReadOptions::default();
+    for (sep, name) in [(",", "comma"), (";", "semicolon"), ("\t", "tab")] {
+        for (col, colname) in [(1, "time"), (2, "a"), (3, "b")] {
+            let mut text = format!("time{sep}a{sep}b\n");
+            for i in 0..300 {
+                let mut cells: [String; 3] =
+                    [format!("{}", i as f64 / 100.0), "1".into(), "2".into()];
+                if i == 250 {
+                    cells[col - 1].clear();
+                }
+                text.push_str(&cells.join(sep));
+                text.push('\n');
+            }
+            let p = dir.path().join(format!("{name}{col}.csv"));
+            std::fs::write(&p, &text).unwrap();
+            let e = errors_of_both_readers(&p, &opts);
+            // Row 250 is line 252.
+            assert!(
+                e.contains(&format!("line 252, column {col} ('{colname}')"))
+                    && e.contains("is empty")
+                    && e.contains("missing value"),
+                "{name} {col}: {e}"
+            );
+        }
+    }
+    // pandas' own NaN, written by `to_csv(index=False)`: `0.03,,2.5` and `0.04,1.5,`.
+    let p = dir.path().join("pandas.csv");
+    std::fs::write(&p, "time,a,b\n0.0,1.0,2.0\n0.01,1.5,2.5\n0.02,,2.5\n").unwrap();
+    let e = errors_of_both_readers(&p, &opts);
+    assert!(e.contains("line 4, column 2 ('a')"), "{e}");
+    // A trailing separator on every row: three columns, no missing value.
+    let p = dir.path().join("trailing.csv");
+    std::fs::write(&p, "time,a,b,\n0,1,2,\n0.01,1,2,\n0.02,1,2,\n").unwrap();
+    let rec = read_path(&p, &opts).unwrap();
+    assert_eq!(rec.names(), vec!["a", "b"]);
+    // A row that is short without empty cells stays a short row.
+    let p = dir.path().join("short.csv");
+    std::fs::write(&p, "time,a,b\n0,1,2\n0.01,1\n0.02,1,2\n").unwrap();
+    let e = errors_of_both_readers(&p, &opts);
+    assert!(
+        e.contains("line 3 of") && e.contains("has 2 columns but 3"),
+        "{e}"
+    );
+}
+
+/// Binary formats users have (workbooks, MAT-files, HDF5, Parquet, TDMS, compressed files) are
+/// named by what they are, with the export that makes them readable, in one line; other binary
+/// bytes keep the generic message.
+#[test]
+fn binary_formats_are_named_with_their_export() {
+    let dir = tmp();
+    // A ZIP local header (30 bytes) whose first entry is `name`.
+    let zip = |name: &str| {
+        let mut b = b"PK\x03\x04".to_vec();
+        b.extend_from_slice(&[0u8; 22]);
+        b.extend_from_slice(&(name.len() as u16).to_le_bytes());
+        b.extend_from_slice(&[0, 0]);
+        b.extend_from_slice(name.as_bytes());
+        b.extend_from_slice(&[0u8; 40]);
+        b
+    };
+    let mut mat = b"MATLAB 5.0 MAT-file, Platform: GLNXA64, Created on: Fri Nov 27 2026".to_vec();
+    mat.extend_from_slice(&[0u8; 60]);
+    let cases: [(&str, Vec<u8>, &str, &str); 11] = [
+        (
+            "book.xlsx",
+            zip("[Content_Types].xml"),
+            "spreadsheet workbook",
+            "CSV UTF-8",
+        ),
+        (
+            "book.txt",
+            zip("xl/workbook.xml"),
+            "spreadsheet workbook",
+            "read_excel",
+        ),
+        (
+            "sheet.ods",
+            zip("mimetype"),
+            "spreadsheet workbook",
+            "Text CSV",
+        ),
+        (
+            "renamed.xlsx",
+            zip("a.txt"),
+            "spreadsheet workbook",
+            "CSV UTF-8",
+        ),
+        ("records.zip", zip("rec01.csv"), "ZIP archive", "unzip"),
+        (
+            "old.xls",
+            b"\xD0\xCF\x11\xE0\xA1\xB1\x1A\xE1\0\0\0\0".to_vec(),
+            "97-2003",
+            "CSV UTF-8",
+        ),
+        ("run.mat", mat, "MATLAB MAT-file", "writetable"),
+        (
+            "run73.mat",
+            b"\x89HDF\r\n\x1a\n\0\0\0\0".to_vec(),
+            "HDF5",
+            "writetable",
+        ),
+        (
+            "df.parquet",
+            b"PAR1\x15\x04\x15".to_vec(),
+            "Parquet",
+            "read_parquet",
+        ),
+        ("log.tdms", b"TDSm\x0e\0\0\0".to_vec(), "TDMS", "CSV"),
+        (
+            "rec.csv.gz",
+            b"\x1f\x8b\x08\0\0\0\0\0".to_vec(),
+            "gzip",
+            "gunzip",
+        ),
+    ];
+    let opts = ReadOptions::default();
+    for (name, bytes, what, fix) in cases {
+        let p = dir.path().join(name);
+        std::fs::write(&p, &bytes).unwrap();
+        let e = errors_of_both_readers(&p, &opts);
+        assert!(
+            e.contains(name)
+                && e.contains(what)
+                && e.contains(fix)
+                && e.contains("not delimited text"),
+            "{name}: {e}"
+        );
+    }
+    // Unknown binary bytes: the generic message.
+    let p = dir.path().join("noise.dat");
+    std::fs::write(&p, b"\x00\x01\x02\x03binary").unwrap();
+    let e = errors_of_both_readers(&p, &opts);
+    assert!(e.contains("is not a text file"), "{e}");
+}
