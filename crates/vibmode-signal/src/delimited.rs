@@ -488,6 +488,76 @@ fn header_columns(line: &[u8], spans: &[(usize, usize)]) -> Vec<ColumnInfo> {
         .collect()
 }
 
+/// Longest cell of a units row, in bytes.
+const UNIT_CELL_MAX: usize = 24;
+
+/// Reads `line` as a units row below the header (`s,m/s^2,m/s^2`, as data loggers export;
+/// cells may be bracketed, `[s]`, `(g)`) and gives each column whose header named no unit its
+/// unit, when the row has a cell per column, none of them a number or a date-time or longer than
+/// [`UNIT_CELL_MAX`], and every time column's unit is a time unit (or empty); `false` (columns
+/// untouched) otherwise.
+fn apply_units_row(columns: &mut [ColumnInfo], line: &[u8], sep: Separator) -> bool {
+    let mut spans = Vec::new();
+    split_spans(line, sep, &mut spans);
+    if spans.len() != columns.len() {
+        return false;
+    }
+    let mut scratch = Vec::new();
+    let mut units = Vec::with_capacity(spans.len());
+    for &(a, b) in &spans {
+        let cell = &line[a..b];
+        if cell.len() > UNIT_CELL_MAX
+            || parse_slow(cell, sep != Separator::Comma, &mut scratch).is_some()
+            || parse_datetime(cell).is_some()
+        {
+            return false;
+        }
+        let Ok(text) = std::str::from_utf8(cell) else {
+            return false;
+        };
+        let text = text.trim();
+        let bare = text
+            .strip_prefix('[')
+            .and_then(|t| t.strip_suffix(']'))
+            .or_else(|| text.strip_prefix('(').and_then(|t| t.strip_suffix(')')))
+            .unwrap_or(text)
+            .trim();
+        units.push(bare.to_string());
+    }
+    if units.iter().all(String::is_empty) {
+        return false;
+    }
+    let merged: Vec<String> = columns
+        .iter()
+        .zip(&units)
+        .map(|(c, u)| {
+            if c.unit.is_empty() {
+                u.clone()
+            } else {
+                c.unit.clone()
+            }
+        })
+        .collect();
+    let scales: Vec<Option<f64>> = columns
+        .iter()
+        .zip(&merged)
+        .map(|(c, u)| time_scale(&c.name, u))
+        .collect();
+    // A time column must stay one: its unit cell names a time unit.
+    if columns
+        .iter()
+        .zip(&scales)
+        .any(|(c, s)| c.time_scale_s.is_some() && s.is_none())
+    {
+        return false;
+    }
+    for ((c, u), s) in columns.iter_mut().zip(merged).zip(scales) {
+        c.unit = u;
+        c.time_scale_s = s;
+    }
+    true
+}
+
 /// The columns named by a comment line (numpy's `savetxt(..., header="time,a,b")` writes
 /// `# time,a,b`): when it splits into `n` cells with the data's separator and one of them at
 /// least is not a number.
@@ -679,6 +749,8 @@ impl<R: BufRead> DelimitedReader<R> {
             r.has_header = true;
             r.reference_line = first.0;
             r.columns = header_columns(&first.1, &spans);
+            // A units row may follow the header (data loggers' exports: `s,m/s^2,m/s^2`).
+            let mut units_checked = false;
             // Peek the first data row for decimal commas.
             loop {
                 match r.next_line()? {
@@ -691,6 +763,12 @@ impl<R: BufRead> DelimitedReader<R> {
                         check_text(&r.buf, &r.path, n)?;
                         if trim_cell(&r.buf).is_empty() {
                             continue;
+                        }
+                        if !units_checked {
+                            units_checked = true;
+                            if apply_units_row(&mut r.columns, &r.buf, r.sep) {
+                                continue;
+                            }
                         }
                         if forced_sep.is_none()
                             && r.sep == Separator::Tab

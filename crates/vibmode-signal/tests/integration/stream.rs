@@ -799,3 +799,80 @@ fn binary_formats_are_named_with_their_export() {
     let e = errors_of_both_readers(&p, &opts);
     assert!(e.contains("is not a text file"), "{e}");
 }
+
+/// A units row below the header (data loggers' exports: `s,m/s^2`, or `[ms];[g]`) gives the
+/// channels their units and the time column its unit; both readers read it as the same file
+/// with the units in the header. A units row whose time cell is not a time unit is data, and an
+/// error names it.
+#[test]
+fn a_units_row_below_the_header_gives_the_units() {
+    let dir = tmp();
+    let mut r = ChaCha8Rng::seed_from_u64(77);
+    let opts = ReadOptions::default();
+    let n = 1500;
+    let rows: Vec<(f64, f64)> = (0..n)
+        .map(|_| (r.gen_range(-1.0..1.0), r.gen_range(-1.0..1.0)))
+        .collect();
+    for (case, header, units, sep, step, unit_a, unit_b) in [
+        ("plain", "time,a,b", "s,m/s^2,g", ",", 0.005, "m/s^2", "g"),
+        (
+            "brackets",
+            "Time;a;b",
+            "[ms];[g];(m/s2)",
+            ";",
+            5.0,
+            "g",
+            "m/s2",
+        ),
+        (
+            "header wins",
+            "t,a [m/s^2],b",
+            "s,g,mg",
+            ",",
+            0.005,
+            "m/s^2",
+            "mg",
+        ),
+        ("empty cell", "time\ta\tb", "s\t\tg", "\t", 0.005, "", "g"),
+    ] {
+        let mut with_units = format!("{header}\n{units}\n");
+        let mut expected_text = String::from("time,a,b\n");
+        for (i, (a, b)) in rows.iter().enumerate() {
+            let t = i as f64 * step;
+            with_units.push_str(&format!("{t}{sep}{a}{sep}{b}\n"));
+            expected_text.push_str(&format!("{},{a},{b}\n", i as f64 * 0.005));
+        }
+        let p = dir.path().join(format!("{case}.csv"));
+        let q = dir.path().join(format!("{case}-expected.csv"));
+        std::fs::write(&p, &with_units).unwrap();
+        std::fs::write(&q, &expected_text).unwrap();
+        let expected = read_path(&q, &opts).unwrap();
+        let whole = read_path(&p, &opts).unwrap();
+        assert_eq!(whole.names(), vec!["a", "b"], "{case}");
+        assert!(
+            (whole.fs_hz - 200.0).abs() < 1e-9,
+            "{case}: {}",
+            whole.fs_hz
+        );
+        let units: Vec<&str> = whole.channels.iter().map(|c| c.unit.as_str()).collect();
+        assert_eq!(units, vec![unit_a, unit_b], "{case}");
+        let samples = |rec: &Recording| -> Vec<Vec<f64>> {
+            rec.channels.iter().map(|c| c.samples.clone()).collect()
+        };
+        assert_eq!(samples(&whole), samples(&expected), "{case}");
+        for block in [1, 64, 5000] {
+            let s = stream_all(&p, &opts, block);
+            assert_eq!(samples(&s), samples(&expected), "{case}, block {block}");
+            let su: Vec<&str> = s.channels.iter().map(|c| c.unit.as_str()).collect();
+            assert_eq!(su, units, "{case}, block {block}");
+        }
+    }
+    // Not a units row: `g` is no time unit, so the row is data and is refused as such.
+    let p = dir.path().join("not-units.csv");
+    std::fs::write(&p, "time,a\ng,g\n0,1\n0.01,2\n").unwrap();
+    let e = errors_of_both_readers(&p, &opts);
+    assert!(
+        e.contains("line 2, column 1 ('time')") && e.contains("'g'"),
+        "{e}"
+    );
+}
