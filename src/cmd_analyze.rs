@@ -12,7 +12,8 @@ use vibmode_run::{Demo, Progress, Run, RunInput, RunOutput};
 #[derive(Args, Debug)]
 pub struct AnalyzeArgs {
     /// Record files (one record each), or long recordings cut into records of
-    /// `record_length_s` (10.24 s by default).
+    /// `record_length_s` (10.24 s by default), or folders of them (each folder's recordings,
+    /// sorted by name).
     #[arg(required = true)]
     pub inputs: Vec<PathBuf>,
     /// Analysis settings (TOML); see docs/analysis.md. Keys not given take the preset's values.
@@ -101,8 +102,11 @@ fn load_config(config: Option<&Path>, preset: Option<&str>) -> Result<AnalysisCo
 /// Runs `vibmode analyze`.
 pub fn run(a: &AnalyzeArgs) -> Result<()> {
     let mut cfg = load_config(a.config.as_deref(), a.preset.as_deref())?;
-    // The output folder is checked and locked before any work, and written as a whole.
+    let files = vibmode_signal::expand_folders(&a.inputs)?;
+    // The output folder is checked and locked before any work, and written as a whole; it may
+    // neither be nor hold an input (a folder given or a file of it).
     let mut inputs = a.inputs.clone();
+    inputs.extend(files.iter().cloned());
     inputs.extend(a.seg.gps.iter().cloned());
     let out = crate::output::StagedDir::begin(&a.output, &inputs)?;
     apply_placements(&mut cfg, &a.roles, &a.corners)?;
@@ -126,12 +130,12 @@ pub fn run(a: &AnalyzeArgs) -> Result<()> {
     }
     let input = match &segmenting {
         Some(segmenting) => RunInput::Segmented {
-            paths: &a.inputs,
+            paths: &files,
             read: &opts,
             channels: &sel,
             segmenting,
         },
-        None => RunInput::files(&a.inputs, &opts, &sel),
+        None => RunInput::files(&files, &opts, &sel),
     };
     let output = with_progress(a.quiet, true, |progress| run.run(input, progress))?;
     output

@@ -93,7 +93,7 @@ pub struct IngestArgs {
     pub road: Option<String>,
     #[command(flatten)]
     pub read: crate::input::ReadArgs,
-    /// Record files.
+    /// Record files, or folders of them (each folder's recordings, sorted by name).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
     /// No progress bar.
@@ -121,7 +121,7 @@ pub struct CheckArgs {
     pub drive: Option<String>,
     #[command(flatten)]
     pub read: crate::input::ReadArgs,
-    /// Record files.
+    /// Record files, or folders of them (each folder's recordings, sorted by name).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
     /// No progress bar.
@@ -178,7 +178,8 @@ fn ingest(a: &IngestArgs) -> Result<()> {
     let cfg = store.config()?;
     // All or nothing: every file is read and analysed before any is stored, so nothing is
     // reported as stored unless all were.
-    let files: Vec<&std::path::Path> = a.files.iter().map(|f| f.as_path()).collect();
+    let expanded = vibmode_signal::expand_folders(&a.files)?;
+    let files: Vec<&std::path::Path> = expanded.iter().map(|f| f.as_path()).collect();
     let pb =
         crate::progress::records_bar(a.quiet, Some(files.len() as u64), "files analysed", "files");
     let done = ingest_files_progress(
@@ -295,25 +296,22 @@ struct CheckJson<'a> {
 }
 
 fn check(a: &CheckArgs) -> Result<()> {
+    let files = vibmode_signal::expand_folders(&a.files)?;
     // The store is an input too: JSON written over it would destroy it.
     let inputs: Vec<&std::path::Path> = std::iter::once(a.db.as_path())
-        .chain(a.files.iter().map(|f| f.as_path()))
+        .chain(files.iter().map(|f| f.as_path()))
         .collect();
     crate::output::check_json_dest(a.json.as_deref(), &inputs)?;
     let mut store = Store::open(&a.db)?;
     store.require_vehicle(&a.vehicle)?;
     let set = require_baseline(&store, &a.vehicle)?;
     // All or nothing: every file is read and scored before any record or check is stored.
-    let pb = crate::progress::records_bar(
-        a.quiet,
-        Some(a.files.len() as u64),
-        "files analysed",
-        "files",
-    );
+    let pb =
+        crate::progress::records_bar(a.quiet, Some(files.len() as u64), "files analysed", "files");
     let out = check_drive_files_progress(
         &mut store,
         &set,
-        &a.files.iter().map(|f| f.as_path()).collect::<Vec<_>>(),
+        &files.iter().map(|f| f.as_path()).collect::<Vec<_>>(),
         &a.read.options()?,
         a.drive.as_deref(),
         &|n| pb.set_position(n as u64),

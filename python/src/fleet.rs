@@ -101,7 +101,8 @@ fn fleet_ingest(
             };
             // The settings the store was initialised with (`fleet init --config`).
             let cfg = store.config()?;
-            // All or nothing, as `vibmode fleet ingest`.
+            // All or nothing, as `vibmode fleet ingest`; a folder stands for its recordings.
+            let files = vibmode_signal::expand_folders(&files)?;
             let paths: Vec<&std::path::Path> = files.iter().map(|f| f.as_path()).collect();
             ingest_files(&mut store, &labels, &paths, &opts, &cfg)
         })
@@ -188,7 +189,8 @@ fn fleet_check(
             let mut store = Store::open(&db)?;
             store.require_vehicle(vehicle)?;
             let set = require_baseline(&store, vehicle)?;
-            // All or nothing, as `vibmode fleet check`.
+            // All or nothing, as `vibmode fleet check`; a folder stands for its recordings.
+            let files = vibmode_signal::expand_folders(&files)?;
             let paths: Vec<&std::path::Path> = files.iter().map(|f| f.as_path()).collect();
             let (records, drives) =
                 check_drive_files_progress(&mut store, &set, &paths, &opts, drive, &|_| ())?;

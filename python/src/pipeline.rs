@@ -139,7 +139,12 @@ fn analyze(
         .map(|c| c.parse::<vibmode_signal::ChannelSelector>())
         .collect::<Result<_, _>>()
         .map_err(|e| signal_err(e.into()))?;
-    let paths = all_paths.filter(|p| !p.is_empty());
+    // A folder stands for its recordings, sorted by name (as `vibmode analyze DIR`).
+    let paths = all_paths
+        .filter(|p| !p.is_empty())
+        .map(|p| vibmode_signal::expand_folders(&p))
+        .transpose()
+        .map_err(signal_err)?;
     let mut records: Vec<RecordInput> = Vec::new();
     for item in inputs.iter().filter(|_| paths.is_none()) {
         if let Ok(t) = item.cast::<PyTuple>() {
@@ -153,16 +158,21 @@ fn analyze(
             let rec = select(rec, channels.as_deref()).map_err(signal_err)?;
             records.extend(cut_records(&name, &rec, cfg.record_length_s));
         } else {
-            let path: PathBuf = item.extract()?;
-            let rec = py
-                .detach(|| {
-                    let rec = vibmode_signal::read_path(&path, &opts)?;
-                    select(rec, channels.as_deref())
-                })
+            let given: PathBuf = item.extract()?;
+            let files = vibmode_signal::expand_folders(std::slice::from_ref(&given))
                 .map_err(signal_err)?;
-            // The path as given (as the CLI and vibmode.fleet name records), not its base name.
-            let name = vibmode_fleet::record_file_name(&path);
-            records.extend(cut_records(&name, &rec, cfg.record_length_s));
+            for path in files {
+                let rec = py
+                    .detach(|| {
+                        let rec = vibmode_signal::read_path(&path, &opts)?;
+                        select(rec, channels.as_deref())
+                    })
+                    .map_err(signal_err)?;
+                // The path as given (as the CLI and vibmode.fleet name records), not its base
+                // name.
+                let name = vibmode_fleet::record_file_name(&path);
+                records.extend(cut_records(&name, &rec, cfg.record_length_s));
+            }
         }
     }
     if records.is_empty() && paths.is_none() {

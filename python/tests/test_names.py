@@ -71,3 +71,25 @@ def test_dask_workers_name_records_as_one_process(tmp_path, monkeypatch):
     vibmode.fleet.init("ingest.db")
     vibmode.fleet.ingest("ingest.db", "bus-1", paths)
     assert stored_names("dask.db") == stored_names("single.db") == stored_names("ingest.db") == paths
+
+
+def test_a_folder_stands_for_its_recordings(tmp_path, monkeypatch):
+    """A folder given to analyze, fleet.ingest or fleet.check is its recordings sorted by name,
+    each named by its path (the folder joined with the file name), as `vibmode analyze DIR`."""
+    monkeypatch.chdir(tmp_path)
+    vibmode.simulate("city_bus", records=3, fs=200.0, effects="none", seed=5, out_dir="recs")
+    (tmp_path / "recs" / "notes.txt.json").write_text("{}")
+    files = sorted(os.path.join("recs", f) for f in os.listdir("recs") if f.endswith(".wav"))
+    assert len(files) == 3
+    by_folder = vibmode.analyze("recs", order_max=6, as_frames=False)
+    by_files = vibmode.analyze(files, order_max=6, as_frames=False)
+    assert [r["name"] for r in by_folder["records"]] == files
+    by_folder.pop("timing", None)
+    by_files.pop("timing", None)
+    assert by_folder == by_files
+    vibmode.fleet.init("fleet.db")
+    got = vibmode.fleet.ingest("fleet.db", "bus-1", "recs")
+    assert [g["file"] for g in got] == files
+    os.mkdir("empty")
+    with pytest.raises(ValueError, match="holds no recording"):
+        vibmode.analyze("empty")

@@ -124,7 +124,8 @@ def analyze(
     per role into invariant modes (frequency in Hz, damping ratio), lines tracked, optionally
     SSI-cov and the full-car model's modes matched.
 
-    ``inputs``: a file path, a :class:`Recording`, an array (n_channels, n_samples) with ``fs``
+    ``inputs``: a file path, a folder (its recordings, sorted by name, as ``vibmode analyze
+    DIR``), a :class:`Recording`, an array (n_channels, n_samples) with ``fs``
     (Hz), a ``(data, fs)`` tuple, a DataFrame from ``read(..., as_frame=True)``, or a list of these (one or more records
     each; long recordings are cut into records of ``record_length_s``).
     ``config``: a dict, a TOML file or TOML text (docs/analysis.md); ``preset``: 'vibmode'

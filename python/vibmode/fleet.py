@@ -55,7 +55,8 @@ def ingest(
     allow_nonuniform: bool = False,
     time_unit: Optional[str] = None,
 ) -> List[Dict[str, Any]]:
-    """Stores the features of ``files`` for ``vehicle`` (``condition`` 'nominal' or 'test');
+    """Stores the features of ``files`` (paths, or folders standing for their recordings,
+    sorted by name) for ``vehicle`` (``condition`` 'nominal' or 'test');
     a file already stored is not stored twice. All or nothing: every file is read and analysed
     first, then all are stored in one transaction; an error stores none. Returns one dict per
     file."""
@@ -107,7 +108,8 @@ def check(
     time_unit: Optional[str] = None,
     drive: Optional[str] = None,
 ) -> Dict[str, Any]:
-    """Classifies ``files`` against the vehicle's latest model set (``vibmode fleet check
+    """Classifies ``files`` (paths, or folders standing for their recordings) against the
+    vehicle's latest model set (``vibmode fleet check
     --json``): ``{'vehicle', 'model_version', 'records': [...], 'drives': [...]}``, each record
     with its ``assessment`` (classification: normal, road, vehicle, both, or sensor for a dead,
     stuck or clipped channel listed in ``sensor_faults``; scores, evidence). ``drive`` names the

@@ -248,3 +248,111 @@ fn a_pandas_index_column_is_not_analysed() {
         &["pandas row index", "line 19", "index=False"],
     );
 }
+
+/// A folder given as an input stands for its recordings (not its subfolders, not hidden files,
+/// not other files), sorted by name: `analyze DIR` gives the results of `analyze` of those files
+/// given one by one, and `fleet ingest DIR` stores each. A folder without recordings, or with a
+/// record in two formats, is refused in one line, exit code 2, before any output is made.
+#[test]
+fn a_folder_stands_for_its_recordings() {
+    let d = tempfile::tempdir().unwrap();
+    let recs = d.path().join("recs");
+    std::fs::create_dir_all(recs.join("sub")).unwrap();
+    let mut rng = Lcg(23);
+    let mut write = |path: &Path| {
+        let mut text = String::from("time,FL_sprung,FL_unsprung\n");
+        for i in 0..2000 {
+            let t = i as f64 / 100.0;
+            let a = (2.0 * std::f64::consts::PI * 1.3 * t).sin() + 0.5 * rng.next();
+            let b = (2.0 * std::f64::consts::PI * 9.0 * t).sin() + 0.5 * rng.next();
+            text.push_str(&format!("{t:.2},{a:.6},{b:.6}\n"));
+        }
+        std::fs::write(path, text).unwrap();
+    };
+    for name in [
+        "rec_b.csv",
+        "rec_a.csv",
+        "rec_c.csv",
+        ".rec_hidden.csv",
+        "sub/rec_d.csv",
+    ] {
+        write(&recs.join(name));
+    }
+    std::fs::write(recs.join("notes.json"), "{}").unwrap();
+    let by_folder = d.path().join("by-folder");
+    let by_files = d.path().join("by-files");
+    ok(&[
+        "analyze",
+        "-q",
+        "--method",
+        "arma",
+        s(&recs),
+        "-o",
+        s(&by_folder),
+    ]);
+    let files: Vec<String> = ["rec_a.csv", "rec_b.csv", "rec_c.csv"]
+        .iter()
+        .map(|n| s(&recs.join(n)).to_string())
+        .collect();
+    let mut args = vec!["analyze", "-q", "--method", "arma"];
+    args.extend(files.iter().map(String::as_str));
+    args.extend(["-o", s(&by_files)]);
+    ok(&args);
+    let strip = |mut v: serde_json::Value| {
+        v.as_object_mut().unwrap().remove("timing");
+        v
+    };
+    let a = strip(json(&by_folder.join("results.json")));
+    let b = strip(json(&by_files.join("results.json")));
+    assert_eq!(a, b, "a folder analysed as its files");
+    assert!(a.to_string().contains("rec_c.csv") && !a.to_string().contains("rec_d"));
+    assert!(!a.to_string().contains("rec_hidden"));
+    // The fleet stores each of them.
+    let db = d.path().join("f.db");
+    ok(&["fleet", "init", "--db", s(&db)]);
+    ok(&[
+        "fleet",
+        "ingest",
+        "-q",
+        "--db",
+        s(&db),
+        "--vehicle",
+        "b",
+        s(&recs),
+    ]);
+    let names: Vec<String> = vibmode_fleet::Store::open(&db)
+        .unwrap()
+        .nominal_records("b")
+        .unwrap()
+        .into_iter()
+        .map(|(r, _)| r.file_name)
+        .collect();
+    assert_eq!(names, files);
+    // Refused: a folder without recordings, and one holding a record twice.
+    let empty = d.path().join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    let out = d.path().join("never");
+    fails_with(
+        &["analyze", "-q", s(&empty), "-o", s(&out)],
+        &["holds no recording", "give the record files"],
+    );
+    std::fs::copy(recs.join("rec_a.csv"), recs.join("rec_a.txt")).unwrap();
+    fails_with(
+        &["analyze", "-q", s(&recs), "-o", s(&out)],
+        &["rec_a.csv and rec_a.txt", "two formats"],
+    );
+    fails_with(
+        &[
+            "fleet",
+            "ingest",
+            "-q",
+            "--db",
+            s(&db),
+            "--vehicle",
+            "b",
+            s(&recs),
+        ],
+        &["two formats"],
+    );
+    assert!(!out.exists(), "nothing written");
+}

@@ -43,6 +43,25 @@ pub enum SignalError {
         /// The operating system's message.
         message: String,
     },
+    /// A folder given as an input holds no recording.
+    #[error("the folder {path_q} holds no recording (.csv, .txt, .tsv, .dat, .asc, .wav, or raw .f32, .f64, .bin, .raw with a .json sidecar); give the record files or another folder", path_q = vibmode_core::quoted(.path))]
+    FolderWithoutRecordings {
+        /// The folder.
+        path: String,
+    },
+    /// A folder given as an input holds one record name in two formats (busgen's `--csv` writes
+    /// `rec01.f32` and `rec01.csv`): the same record twice.
+    #[error("the folder {path_q} holds {first_q} and {second_q}, the same record in two formats; give the files of one format (e.g. {path_q}/*.{ext})", path_q = vibmode_core::quoted(.path), first_q = vibmode_core::quoted(.first), second_q = vibmode_core::quoted(.second))]
+    FolderRecordTwice {
+        /// The folder.
+        path: String,
+        /// The first file name.
+        first: String,
+        /// The second file name, of the same stem.
+        second: String,
+        /// The first file's extension.
+        ext: String,
+    },
     /// The file has no content at all.
     #[error("{path_q} is empty; expected numeric rows (optionally after one header row)", path_q = vibmode_core::quoted(.path))]
     EmptyFile {

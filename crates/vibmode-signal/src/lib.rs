@@ -54,8 +54,9 @@ pub use delimited::{Block, ColumnInfo, DelimitedReader, Separator, TimeText};
 pub use error::{BinaryFormat, SidecarProblem, SignalError, WavProblem};
 pub use preprocess::{preprocess, Preprocessed};
 pub use read::{
-    read_delimited, read_delimited_bytes, read_path, read_path_bytes, sidecar_candidates,
-    time_unit_scale, Format, ReadOptions, Sidecar, WavSidecar,
+    expand_folders, read_delimited, read_delimited_bytes, read_path, read_path_bytes,
+    recordings_in_folder, sidecar_candidates, time_unit_scale, Format, ReadOptions, Sidecar,
+    WavSidecar,
 };
 pub use records::{ChainedRecords, StreamRecords};
 pub use resample::ResampleRecording;

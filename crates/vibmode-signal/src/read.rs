@@ -55,6 +55,68 @@ impl Format {
     }
 }
 
+/// The recordings of the folder `dir` (not its subfolders): its files with a known extension
+/// ([`Format::from_extension`]), hidden files left out, sorted by name. A folder with none, or
+/// with one record name in two formats (`rec01.csv` beside `rec01.f32`), is an error.
+pub fn recordings_in_folder(dir: &Path) -> Result<Vec<PathBuf>> {
+    let entries = std::fs::read_dir(dir).map_err(|e| io_err("read", dir, &e))?;
+    let mut files: Vec<PathBuf> = Vec::new();
+    for entry in entries {
+        let entry = entry.map_err(|e| io_err("read", dir, &e))?;
+        let path = entry.path();
+        let name = entry.file_name();
+        let hidden = name.to_str().map_or(true, |n| n.starts_with('.'));
+        let known = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .and_then(Format::from_extension)
+            .is_some();
+        if !hidden && known && path.is_file() {
+            files.push(path);
+        }
+    }
+    files.sort();
+    if files.is_empty() {
+        return Err(SignalError::FolderWithoutRecordings {
+            path: dir.display().to_string(),
+        });
+    }
+    let name = |p: &Path| {
+        p.file_name()
+            .map_or(String::new(), |n| n.to_string_lossy().into_owned())
+    };
+    let mut stems: std::collections::HashMap<std::ffi::OsString, &Path> =
+        std::collections::HashMap::new();
+    for f in &files {
+        let stem = f.file_stem().map(|s| s.to_os_string()).unwrap_or_default();
+        if let Some(first) = stems.insert(stem, f) {
+            return Err(SignalError::FolderRecordTwice {
+                path: dir.display().to_string(),
+                first: name(first),
+                second: name(f),
+                ext: first
+                    .extension()
+                    .map_or(String::new(), |e| e.to_string_lossy().into_owned()),
+            });
+        }
+    }
+    Ok(files)
+}
+
+/// `paths` with every folder among them replaced by its recordings ([`recordings_in_folder`]),
+/// in place; files are kept as given.
+pub fn expand_folders(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    let mut out = Vec::with_capacity(paths.len());
+    for p in paths {
+        if p.is_dir() {
+            out.extend(recordings_in_folder(p)?);
+        } else {
+            out.push(p.clone());
+        }
+    }
+    Ok(out)
+}
+
 impl FromStr for Format {
     type Err = SignalError;
     fn from_str(s: &str) -> Result<Format> {
