@@ -159,8 +159,8 @@ fn analyze(
             records.extend(cut_records(&name, &rec, cfg.record_length_s));
         } else {
             let given: PathBuf = item.extract()?;
-            let files = vibmode_signal::expand_folders(std::slice::from_ref(&given))
-                .map_err(signal_err)?;
+            let files =
+                vibmode_signal::expand_folders(std::slice::from_ref(&given)).map_err(signal_err)?;
             for path in files {
                 let rec = py
                     .detach(|| {

@@ -51,7 +51,7 @@ pub enum SignalError {
     },
     /// A folder given as an input holds one record name in two formats (busgen's `--csv` writes
     /// `rec01.f32` and `rec01.csv`): the same record twice.
-    #[error("the folder {path_q} holds {first_q} and {second_q}, the same record in two formats; give the files of one format (e.g. {path_q}/*.{ext})", path_q = vibmode_core::quoted(.path), first_q = vibmode_core::quoted(.first), second_q = vibmode_core::quoted(.second))]
+    #[error("the folder {path_q} holds {first_q} and {second_q}, the same record in two formats; give the files of one format (e.g. {path_q}/*.{ext})", path_q = vibmode_core::quoted(.path), first_q = vibmode_core::quoted(.first), second_q = vibmode_core::quoted(.second), ext = vibmode_core::quoted(.first.rsplit('.').next().unwrap_or_default()))]
     FolderRecordTwice {
         /// The folder.
         path: String,
@@ -59,8 +59,6 @@ pub enum SignalError {
         first: String,
         /// The second file name, of the same stem.
         second: String,
-        /// The first file's extension.
-        ext: String,
     },
     /// The file has no content at all.
     #[error("{path_q} is empty; expected numeric rows (optionally after one header row)", path_q = vibmode_core::quoted(.path))]

@@ -94,9 +94,6 @@ pub fn recordings_in_folder(dir: &Path) -> Result<Vec<PathBuf>> {
                 path: dir.display().to_string(),
                 first: name(first),
                 second: name(f),
-                ext: first
-                    .extension()
-                    .map_or(String::new(), |e| e.to_string_lossy().into_owned()),
             });
         }
     }
