@@ -160,6 +160,34 @@ pub fn channel_fit(
     }
 }
 
+/// Unstable poles `[re, im]` as the table lists them: each conjugate pair once (its `im > 0`
+/// member) as its frequency (Hz, `fs_hz` the sampling rate) and modulus, each real pole as its
+/// value, by frequency.
+fn unstable_text(poles: &[[f64; 2]], fs_hz: f64) -> String {
+    let mut items: Vec<(f64, String)> = poles
+        .iter()
+        .filter(|z| z[1] >= 0.0)
+        .map(|&[re, im]| {
+            let modulus = re.hypot(im);
+            if im == 0.0 {
+                (
+                    if re >= 0.0 { 0.0 } else { fs_hz / 2.0 },
+                    format!("real z = {re:.5}"),
+                )
+            } else {
+                let f = fs_hz * im.atan2(re) / std::f64::consts::TAU;
+                (f, format!("{f:.4} Hz (|z| = {modulus:.5})"))
+            }
+        })
+        .collect();
+    items.sort_by(|a, b| a.0.total_cmp(&b.0));
+    items
+        .into_iter()
+        .map(|(_, t)| t)
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// The terminal table: per channel a header line and the modes. Modes that pass the shared pole
 /// filters with a damping ratio below `zmax` are marked `*`; pole pairs the filters leave out
 /// say why; a legend explains the marks.
@@ -224,7 +252,11 @@ pub fn table_text(o: &FitOutput, zmax: f64) -> String {
             ));
         }
         if !c.unstable_poles.is_empty() {
-            s.push_str(&format!("  {} unstable pole(s)\n", c.unstable_poles.len()));
+            s.push_str(&format!(
+                "  {} unstable pole(s), left out: {}; a pole on or outside the unit circle is a pure tone (a periodic line) or a drift, not a damped mode\n",
+                c.unstable_poles.len(),
+                unstable_text(&c.unstable_poles, o.fs_hz)
+            ));
         }
     }
     s.push_str(&format!(
@@ -358,6 +390,20 @@ mod tests {
         assert!(
             t.lines().last().is_some_and(|l| l.starts_with("* mode:")),
             "{t}"
+        );
+    }
+
+    /// Unstable poles are listed by frequency, a conjugate pair once, by hand: at 200 Hz the
+    /// pair `1.0001 e^(+-i pi/10)` is 200 / 20 = 10 Hz with |z| = 1.0001; the real pole -1.2 is
+    /// listed as itself.
+    #[test]
+    fn unstable_poles_are_listed_by_frequency() {
+        let (s, c) = (std::f64::consts::PI / 10.0).sin_cos();
+        let r = 1.0001;
+        let poles = [[-1.2, 0.0], [r * c, -r * s], [r * c, r * s]];
+        assert_eq!(
+            unstable_text(&poles, 200.0),
+            "10.0000 Hz (|z| = 1.00010), real z = -1.20000"
         );
     }
 }
