@@ -93,3 +93,32 @@ def test_to_csv_files_read_as_their_frames(tmp_path):
     assert list(rec.channels) == ["acc_a", "acc_b"]
     assert rec.fs == pytest.approx(FS, rel=1e-9)
     np.testing.assert_allclose(rec.data, data, rtol=0, atol=1e-15)
+
+
+def test_a_units_row_read_by_pandas_gives_names_and_units(tmp_path):
+    """A file with a units row below its header, read as ``pandas.read_csv(path, header=[0,
+    1])``, has two-level columns (name, unit): the time column (in ms here) gives the rate and
+    is not a channel, the channels keep their names and units, and the analysis is that of the
+    plain arrays; the same file read by vibmode directly agrees. Two-level columns that are not
+    (name, unit), such as (sensor, axis), are joined."""
+    t, data = _signals()
+    expected = _analysis((data, FS), channels=None)
+    path = tmp_path / "logger.csv"
+    rows = "\n".join(f"{1e3 * ti:.3f},{float(a)!r},{float(b)!r}" for ti, a, b in zip(t, data[0], data[1]))
+    path.write_text("time,acc_a,acc_b\nms,m/s^2,g\n" + rows + "\n")
+    frame = pd.read_csv(path, header=[0, 1])
+    assert isinstance(frame.columns, pd.MultiIndex)
+    names, fs, psd = _analysis(frame)
+    assert (names, fs) == (["acc_a", "acc_b"], expected[1])
+    np.testing.assert_allclose(psd, expected[2], rtol=1e-9)
+    rec = vibmode.read(path)
+    assert rec.channels == ["acc_a", "acc_b"] and rec.units == ["m/s^2", "g"] and rec.fs == FS
+    from vibmode._io import _as_recording
+
+    assert _as_recording(frame, None).units == ["m/s^2", "g"]
+    # An empty unit cell (pandas' "Unnamed: 1_level_1"): no unit.
+    path.write_text("time,acc_a,acc_b\nms,,g\n" + rows + "\n")
+    assert _as_recording(pd.read_csv(path, header=[0, 1]), None).units == ["", "g"]
+    # (sensor, axis): not units; the names are joined.
+    sensors = pd.DataFrame({("FL", "x"): data[0], ("FL", "z"): data[1]})
+    assert _as_recording(sensors, FS).channels == ["FL_x", "FL_z"]

@@ -176,11 +176,55 @@ def _frame_time(df: Any):
     return None, None
 
 
+def _flat_columns(df: Any) -> Any:
+    """``df`` with two-level columns made flat, as ``pandas.read_csv(path, header=[0, 1])``
+    reads a file with a units row (``('time', 's'), ('acc', 'g')``): where the first level's
+    names are distinct, the second level is the units, kept in ``attrs['units']`` (pandas'
+    ``Unnamed: ...`` placeholders as no unit), and a time column keeps its unit in its name
+    (``time [ms]``) so that it scales the time; else the levels are joined (``FL_z``). Other
+    frames are returned as they are."""
+    import pandas as pd
+
+    cols = df.columns
+    if not isinstance(cols, pd.MultiIndex):
+        return df
+    if cols.nlevels != 2:
+        raise ValueError(
+            f"the DataFrame's columns have {cols.nlevels} levels; give one level of channel names "
+            "(and at most a second of units)"
+        )
+
+    def text(v: Any) -> str:
+        v = "" if v is None else str(v).strip()
+        return "" if v.startswith("Unnamed:") else v
+
+    names = [text(a) for a, _ in cols]
+    units = [text(b) for _, b in cols]
+    out = df.copy(deep=False)
+    if len(set(names)) == len(names) and all(names):
+        flat = []
+        for n, u in zip(names, units):
+            labelled = f"{n} [{u}]"
+            flat.append(labelled if u and _native.time_column_scale(labelled) is not None else n)
+        out.columns = flat
+        merged = dict(df.attrs.get("units", {}))
+        for n, u in zip(names, units):
+            if u:
+                merged.setdefault(n, u)
+        out.attrs = dict(df.attrs)
+        out.attrs["units"] = merged
+    else:
+        out.columns = ["_".join(p for p in (n, u) if p) for n, u in zip(names, units)]
+    return out
+
+
 def frame_channels(df: Any, fs: Optional[float]):
     """A DataFrame's channels as an array (n_channels, n_samples), its rate (Hz) and the channel
     names. The rate is ``fs``, else ``attrs['fs']``, else its time (see :func:`_frame_time`:
     a time column, or a datetime/timedelta or time-named index), which must then be uniform
-    within 1 % and agree with a given rate within 1 %; a time column is not a channel."""
+    within 1 % and agree with a given rate within 1 %; a time column is not a channel. Two-level
+    columns (name, unit) are read as :func:`_flat_columns` says."""
+    df = _flat_columns(df)
     t, time_col = _frame_time(df)
     cols = [c for c in df.columns if time_col is None or c != time_col]
     if not cols:
@@ -227,6 +271,7 @@ def _as_recording(x: Any, fs: Optional[float], channels=None, units=None, name: 
     if isinstance(x, tuple) and len(x) == 2 and fs is None:  # (data, fs)
         return Recording(x[0], x[1], channels, units, name=name)
     if hasattr(x, "to_numpy") and hasattr(x, "columns"):  # a DataFrame
+        x = _flat_columns(x)
         data, rate, cols = frame_channels(x, fs)
         u = x.attrs.get("units", {})
         return Recording(data, rate, cols, [u.get(c, "") for c in cols], name=x.attrs.get("name", name))
