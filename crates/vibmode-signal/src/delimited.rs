@@ -153,6 +153,17 @@ pub enum TimeText {
     /// A number and a time unit (`0.005 sec`, MATLAB's `writetable` of a timetable whose row
     /// times are `seconds(...)`): the number times the unit's seconds ([`parse_with_unit`]).
     WithUnit,
+    /// A time of day (`05:00:00.005`, as data loggers write): seconds since midnight
+    /// ([`parse_time_of_day`]); a later time earlier than the one before by more than 12 h
+    /// has passed midnight, unless a [`TimeText::Date`] column gives the day.
+    TimeOfDay,
+    /// The date of a split date and time (`Date,Time` columns: `2026-11-27,05:00:00.005`):
+    /// seconds from the first row's day to this row's (whole days, [`parse_date`]), added to the
+    /// time of day beside it. Not a channel and not the time column itself.
+    Date {
+        /// The first row's day, days since 1970-01-01.
+        base_day: i64,
+    },
 }
 
 impl TimeText {
@@ -161,6 +172,10 @@ impl TimeText {
         match *self {
             TimeText::DateTime { base } => parse_datetime(cell).map(|t| seconds_since(t, base)),
             TimeText::WithUnit => parse_with_unit(cell),
+            TimeText::TimeOfDay => parse_time_of_day(cell),
+            TimeText::Date { base_day } => {
+                parse_date(cell).map(|d| (d - base_day) as f64 * 86_400.0)
+            }
         }
     }
 
@@ -169,8 +184,38 @@ impl TimeText {
         if let Some(base) = parse_datetime(cell) {
             return Some(TimeText::DateTime { base });
         }
+        if parse_time_of_day(cell).is_some() {
+            return Some(TimeText::TimeOfDay);
+        }
         parse_with_unit(cell).map(|_| TimeText::WithUnit)
     }
+}
+
+/// Seconds since midnight of a time of day `HH:MM:SS` or `HH:MM:SS.fff` (24-hour clock, one or
+/// two digits for the hour); `None` for anything else.
+pub fn parse_time_of_day(cell: &[u8]) -> Option<f64> {
+    let text = std::str::from_utf8(trim_cell(cell)).ok()?;
+    if text.len() < 7 || text.bytes().filter(|&b| b == b':').count() != 2 {
+        return None;
+    }
+    let t = chrono::NaiveTime::parse_from_str(text, "%H:%M:%S%.f").ok()?;
+    let secs = chrono::Timelike::num_seconds_from_midnight(&t);
+    let nanos = chrono::Timelike::nanosecond(&t);
+    Some(f64::from(secs) + f64::from(nanos) * 1e-9)
+}
+
+/// Days since 1970-01-01 of a date `YYYY-MM-DD`, `YYYY/MM/DD` or `DD.MM.YYYY`; `None` for
+/// anything else (`MM/DD/YYYY` and `DD/MM/YYYY` are not read: they cannot be told apart).
+pub fn parse_date(cell: &[u8]) -> Option<i64> {
+    let text = std::str::from_utf8(trim_cell(cell)).ok()?;
+    if text.len() < 8 || text.len() > 10 {
+        return None;
+    }
+    let epoch = chrono::NaiveDate::from_ymd_opt(1970, 1, 1)?;
+    ["%Y-%m-%d", "%Y/%m/%d", "%d.%m.%Y"]
+        .iter()
+        .find_map(|f| chrono::NaiveDate::parse_from_str(text, f).ok())
+        .map(|d| (d - epoch).num_days())
 }
 
 /// Seconds of a number followed by a time unit (`0.005 sec`, `1.5 s`, `20 ms`, `2 min`, `1 hr`:
@@ -184,9 +229,12 @@ pub fn parse_with_unit(cell: &[u8]) -> Option<f64> {
 }
 
 impl ColumnInfo {
-    /// True for a column that holds samples of a channel (neither time nor a row counter).
+    /// True for a column that holds samples of a channel (neither time, nor the date of a split
+    /// date and time, nor a row counter).
     pub fn is_channel(&self) -> bool {
-        self.time_scale_s.is_none() && !self.row_index
+        self.time_scale_s.is_none()
+            && !self.row_index
+            && !matches!(self.time_text, Some(TimeText::Date { .. }))
     }
 
     /// Seconds per unit of this time column's values: `override_s` (a user's time unit) unless
@@ -307,6 +355,9 @@ pub struct DelimitedReader<R: BufRead> {
     buf: Vec<u8>,
     spans: Vec<(usize, usize)>,
     scratch: Vec<u8>,
+    /// Times of day without a date column: whole days passed (s) and the last time read.
+    day_offset_s: f64,
+    last_time_of_day_s: f64,
 }
 
 impl<R: BufRead> std::fmt::Debug for DelimitedReader<R> {
@@ -590,6 +641,23 @@ fn mark_text_time(
     if spans.len() != columns.len() || row_spans.len() != columns.len() {
         return;
     }
+    // A split date and time: a date column just before a time column holding times of day.
+    for c in 0..columns.len().saturating_sub(1) {
+        let lower = columns[c].name.to_ascii_lowercase();
+        let cell = |i: usize| &row[row_spans[i].0..row_spans[i].1];
+        if matches!(lower.as_str(), "date" | "datum" | "day")
+            && columns[c + 1].time_scale_s.is_some()
+            && parse_time_of_day(cell(c + 1)).is_some()
+        {
+            if let Some(base_day) = parse_date(cell(c)) {
+                columns[c].time_text = Some(TimeText::Date { base_day });
+                columns[c].time_scale_s = None;
+                columns[c + 1].time_text = Some(TimeText::TimeOfDay);
+                columns[c + 1].time_scale_s = Some(1.0);
+                return;
+            }
+        }
+    }
     for (c, col) in columns.iter_mut().enumerate() {
         let (a, b) = spans[c];
         let head = trim_cell(&header[a..b]);
@@ -662,6 +730,8 @@ impl<R: BufRead> DelimitedReader<R> {
             buf: Vec::new(),
             spans: Vec::new(),
             scratch: Vec::new(),
+            day_offset_s: 0.0,
+            last_time_of_day_s: f64::NEG_INFINITY,
         };
         // A binary format a user can export from, named by its first bytes (peeked: the
         // buffer's first fill, before any line is read).
@@ -950,7 +1020,42 @@ impl<R: BufRead> DelimitedReader<R> {
         if block.lines.is_empty() {
             Ok(None)
         } else {
+            self.finish_times(&mut block);
             Ok(Some(block))
+        }
+    }
+
+    /// Completes a block's times of day: the date column's days added where there is one, else
+    /// the days passed at each midnight (a time more than 12 h earlier than the one before).
+    fn finish_times(&mut self, block: &mut Block) {
+        let Some(t) = self
+            .columns
+            .iter()
+            .position(|c| c.time_text == Some(TimeText::TimeOfDay))
+        else {
+            return;
+        };
+        let date = self
+            .columns
+            .iter()
+            .position(|c| matches!(c.time_text, Some(TimeText::Date { .. })));
+        match date {
+            Some(d) => {
+                let days = std::mem::take(&mut block.columns[d]);
+                for (v, day) in block.columns[t].iter_mut().zip(&days) {
+                    *v += day;
+                }
+                block.columns[d] = days;
+            }
+            None => {
+                for v in block.columns[t].iter_mut() {
+                    if *v + self.day_offset_s < self.last_time_of_day_s - 43_200.0 {
+                        self.day_offset_s += 86_400.0;
+                    }
+                    *v += self.day_offset_s;
+                    self.last_time_of_day_s = *v;
+                }
+            }
         }
     }
 }
@@ -1089,6 +1194,7 @@ impl<'s> DelimitedReader<&'s [u8]> {
         if all.lines.is_empty() {
             Ok(None)
         } else {
+            self.finish_times(&mut all);
             Ok(Some(all))
         }
     }
@@ -1407,6 +1513,46 @@ mod tests {
         }
         // 10 s + 100 ns after 9 s + 999 999 900 ns: 200 ns.
         assert!((seconds_since((10, 100), (9, 999_999_900)) - 200e-9).abs() < 1e-22);
+    }
+
+    /// Times of day and dates worked out by hand: 23:59:59.5 is 23 h 59 min 59.5 s =
+    /// 86 399.5 s; 2026-11-27 is 20 784 days after 1970-01-01 (56 years of 365 days, 14 leap
+    /// days from 1972 to 2024, and 330 days from January 1 to November 27 of 2026).
+    #[test]
+    fn times_of_day_and_dates_by_hand() {
+        assert_eq!(56 * 365 + 14 + 330, 20784);
+        for (cell, seconds) in [
+            ("00:00:00", 0.0),
+            ("05:00:00.005", 18_000.005),
+            ("23:59:59.5", 86_399.5),
+            (" 7:30:00.25 ", 27_000.25),
+        ] {
+            let got = parse_time_of_day(cell.as_bytes()).unwrap_or(f64::NAN);
+            assert!((got - seconds).abs() < 1e-9, "{cell}: {got}");
+        }
+        for cell in [
+            "0.005",
+            "05:00",
+            "25:00:00",
+            "05:61:00",
+            "2026-11-27",
+            "05:00:00 pm",
+        ] {
+            assert_eq!(parse_time_of_day(cell.as_bytes()), None, "{cell}");
+        }
+        for cell in ["2026-11-27", "2026/11/27", "27.11.2026", "\"2026-11-27\""] {
+            assert_eq!(parse_date(cell.as_bytes()), Some(20784), "{cell}");
+        }
+        assert_eq!(parse_date(b"1970-01-01"), Some(0));
+        for cell in [
+            "11/27/2026",
+            "27/11/2026",
+            "2026-11-31",
+            "20261127",
+            "05:00:00",
+        ] {
+            assert_eq!(parse_date(cell.as_bytes()), None, "{cell}");
+        }
     }
 
     #[test]

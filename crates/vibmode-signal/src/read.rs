@@ -389,6 +389,8 @@ fn finish_delimited(
             time = Some(d.into_iter().map(|v| v * scale).collect());
         } else if c.row_index {
             check_row_index(path, c, d.first().copied().unwrap_or(0.0), &d, &lines)?;
+        } else if !c.is_channel() {
+            // The date of a split date and time: added to the time column by the reader.
         } else {
             channels.push(Channel::new(c.name.clone(), c.unit.clone(), d));
         }
@@ -466,6 +468,15 @@ fn finish_delimited(
                     origin_unix_s: match cols[ti].time_text {
                         Some(crate::delimited::TimeText::DateTime { base }) => {
                             Some(base.0 as f64 + f64::from(base.1) * 1e-9)
+                        }
+                        // Times of day beside a date column: from the first row's midnight.
+                        Some(crate::delimited::TimeText::TimeOfDay) => {
+                            cols.iter().find_map(|c| match c.time_text {
+                                Some(crate::delimited::TimeText::Date { base_day }) => {
+                                    Some(base_day as f64 * 86_400.0)
+                                }
+                                _ => None,
+                            })
                         }
                         _ => None,
                     },

@@ -876,3 +876,98 @@ fn a_units_row_below_the_header_gives_the_units() {
         "{e}"
     );
 }
+
+/// A split date and time (`Date,Time`, as data loggers and Excel write them) and a time of day
+/// alone (`Time` = `23:59:59.995`) are the time: read by both readers as the same samples at
+/// the same rate as a file with seconds, across midnight (the date changes, or the time of day
+/// starts again from 0); the date is no channel, and with it the first sample's absolute time is
+/// known.
+#[test]
+fn a_split_date_and_time_or_a_time_of_day_is_the_time() {
+    let dir = tmp();
+    let mut r = ChaCha8Rng::seed_from_u64(9);
+    let opts = ReadOptions::default();
+    let n = 3000;
+    let rows: Vec<(f64, f64)> = (0..n)
+        .map(|_| (r.gen_range(-1.0..1.0), r.gen_range(-1.0..1.0)))
+        .collect();
+    let mut plain = String::from("time,a,b\n");
+    for (i, (a, b)) in rows.iter().enumerate() {
+        plain.push_str(&format!("{},{a},{b}\n", i as f64 / 200.0));
+    }
+    let q = dir.path().join("plain.csv");
+    std::fs::write(&q, &plain).unwrap();
+    let expected = read_path(&q, &ReadOptions::default()).unwrap();
+    // From 2026-11-27 23:59:55 at 5 ms steps: midnight after 1000 rows.
+    let start_s = 86_395.0;
+    let clock = |i: usize| {
+        let ms = (start_s * 1000.0) as u64 + 5 * i as u64;
+        let (day, ms) = (ms / 86_400_000, ms % 86_400_000);
+        let s = format!(
+            "{:02}:{:02}:{:02}.{:03}",
+            ms / 3_600_000,
+            ms / 60_000 % 60,
+            ms / 1000 % 60,
+            ms % 1000
+        );
+        (day, s)
+    };
+    for (case, header, sep, date_of) in [
+        (
+            "iso",
+            "Date,Time,a,b",
+            ",",
+            Some(["2026-11-27", "2026-11-28"]),
+        ),
+        (
+            "european",
+            "Datum;Zeit;a;b",
+            ";",
+            Some(["27.11.2026", "28.11.2026"]),
+        ),
+        ("time of day", "Time,a,b", ",", None),
+    ] {
+        let mut text = format!("{header}\n");
+        for (i, (a, b)) in rows.iter().enumerate() {
+            let (day, hms) = clock(i);
+            let (a, b) = if sep == ";" {
+                (
+                    a.to_string().replace('.', ","),
+                    b.to_string().replace('.', ","),
+                )
+            } else {
+                (a.to_string(), b.to_string())
+            };
+            match date_of {
+                Some(dates) => text.push_str(&format!(
+                    "{}{sep}{hms}{sep}{a}{sep}{b}\n",
+                    dates[day as usize]
+                )),
+                None => text.push_str(&format!("{hms}{sep}{a}{sep}{b}\n")),
+            }
+        }
+        let p = dir.path().join(format!("{case}.csv"));
+        std::fs::write(&p, &text).unwrap();
+        let whole = read_path(&p, &opts).unwrap();
+        assert_eq!(whole.names(), vec!["a", "b"], "{case}");
+        assert_eq!(whole.channels, expected.channels, "{case}");
+        assert!(
+            (whole.fs_hz - 200.0).abs() < 1e-6,
+            "{case}: {}",
+            whole.fs_hz
+        );
+        let axis = whole.time_axis.clone().unwrap();
+        assert!((axis.start_s - start_s).abs() < 1e-9, "{case}");
+        let start = axis.start_unix_s();
+        match date_of {
+            // 2026-11-27 23:59:55 UTC: 20784 days and 86 395 s after 1970-01-01.
+            Some(_) => assert_eq!(start, Some(20784.0 * 86_400.0 + 86_395.0), "{case}"),
+            None => assert_eq!(start, None, "{case}"),
+        }
+        for block in [1, 7, 999, 1000, 5000] {
+            let s = stream_all(&p, &opts, block);
+            assert_eq!(s.names(), vec!["a", "b"], "{case}, block {block}");
+            assert_eq!(s.channels, expected.channels, "{case}, block {block}");
+        }
+    }
+}
