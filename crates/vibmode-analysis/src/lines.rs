@@ -805,8 +805,8 @@ struct Assignment {
 
 impl Assignment {
     fn better_than(&self, other: &Assignment) -> bool {
-        (self.pairs.len(), self.by_factor) > (other.pairs.len(), other.by_factor)
-            || ((self.pairs.len(), self.by_factor) == (other.pairs.len(), other.by_factor)
+        (self.by_factor, self.pairs.len()) > (other.by_factor, other.pairs.len())
+            || ((self.by_factor, self.pairs.len()) == (other.by_factor, other.pairs.len())
                 && self.distance < other.distance - 1e-12)
     }
 }
@@ -857,14 +857,18 @@ fn assign(lines: &[LineCandidate], tracks: &[Building], g: f64, tol: f64) -> Ass
 
 /// Links the lines of successive records into tracks. Engine and gear lines are orders of one
 /// shaft, so from one record to the next they move by a common factor: for each record the
-/// factor (within +-[`ENGINE_SPEED_CHANGE_MAX`]) is chosen that places the most lines: lines
-/// within [`ORDER_MATCH_REL_TOL`] of a track after dividing by the factor join it, then each
-/// line left (it drifts on its own) joins the nearest free track within `track_rel_tol` after
-/// the same division; ties go to the factor that placed more lines itself, then to the smaller
-/// total distance. A factor beyond `track_rel_tol` must place at least
-/// [`MIN_LINES_FOR_SPEED_CHANGE`] lines itself, or only F-test lines onto tracks whose latest line
-/// was an F-test line (a kurtosis-rule line alone does not move a track, nor join one). A line not placed starts a new track. Tracks found
-/// in fewer than `min_record_share` of the `n_used` records are dropped.
+/// factor (within +-[`ENGINE_SPEED_CHANGE_MAX`]) is chosen that places the most lines itself:
+/// lines within [`ORDER_MATCH_REL_TOL`] of a track after dividing by the factor join it; then
+/// each line left (it drifts on its own) joins the nearest free track within `track_rel_tol`
+/// after the same division; ties go to the factor that placed more lines in all, then to the
+/// smaller total distance. A factor other than 1 must place at least
+/// [`MIN_LINES_FOR_SPEED_CHANGE`] lines itself, or one or more F-test lines only, onto tracks
+/// whose latest line was an F-test line (a kurtosis-rule line alone does not move a track, nor
+/// join one; one line alone would define a factor that places itself exactly). A line not
+/// placed starts a new track. Tracks found in fewer than `min_record_share` of the `n_used`
+/// records are dropped. (Before 2026-11-27 the factor placing the most lines in all won, and a
+/// factor within `track_rel_tol` needed no support: two noise peaks agreeing on a factor, or one
+/// line alone, could drag steady lines onto other tracks; see the tests below.)
 ///
 /// Swept lines (`sweeps[r]`, empty or shorter for none) are placed first in their record: a
 /// sweep joins the track whose latest frequency is nearest its start (within `track_rel_tol`),
@@ -933,13 +937,14 @@ pub(crate) fn track(
             // places itself on any track within 15 %, and a kurtosis-rule line (no stated
             // false-alarm rate) may be a lightly damped mode's peak (busgen's bending joined to
             // an engine order, or an engine order to the bending's track).
-            let by_f_test = a.pairs[..a.by_factor]
-                .iter()
-                .all(|&(i, j)| lines[i].p_value.is_finite() && tracks[j].last_f);
-            if (g - 1.0).abs() > p.track_rel_tol
-                && a.by_factor < MIN_LINES_FOR_SPEED_CHANGE
-                && !by_f_test
-            {
+            // (A factor that places no line itself is no evidence of a speed change: without
+            // `by_factor > 0` the test held vacuously, and a factor up to 15 % away dragged lines
+            // onto tracks 20 % away within `track_rel_tol`.)
+            let by_f_test = a.by_factor > 0
+                && a.pairs[..a.by_factor]
+                    .iter()
+                    .all(|&(i, j)| lines[i].p_value.is_finite() && tracks[j].last_f);
+            if g != 1.0 && a.by_factor < MIN_LINES_FOR_SPEED_CHANGE && !by_f_test {
                 continue;
             }
             if best.as_ref().map_or(true, |b| a.better_than(b)) {
@@ -1043,6 +1048,76 @@ mod tests {
         assert!((t[0].frequency_hz - 11.0).abs() < 1e-12);
         assert_eq!(t[0].frequency_range_hz, (10.9, 11.2));
         assert!((t[1].record_share - 1.0).abs() < 1e-12);
+    }
+
+    /// busgen bus 99711's pooled SSI-cov channels, records 2-3 (the lines steady at 7.38, 10.87
+    /// and 11.66 Hz; kurtosis-rule peaks of noise at 19.88, 22.29 and 18.01, 20.03 Hz): the two
+    /// noise peaks agree on a factor 0.90 within 1 %, and that factor placed the 10.86 Hz line
+    /// on the 11.66 Hz track and a 6.45 Hz peak on the 7.38 Hz track (4 lines placed against 3
+    /// at factor 1), so two false "steady lines" at 6.45 and 11.26 Hz were reported. The factor
+    /// is now the one that places the most lines within 1 % itself: 1 here (three lines).
+    #[test]
+    fn a_factor_two_noise_peaks_agree_on_does_not_drag_steady_lines() {
+        let p = LineParams::default();
+        let k = |f: f64| LineCandidate {
+            p_value: f64::NAN,
+            ..line(f, 5.0)
+        };
+        let recs = vec![
+            Some(vec![
+                line(7.38, 20.0),
+                line(10.878, 20.0),
+                k(11.661),
+                k(19.877),
+                k(22.29),
+            ]),
+            Some(vec![
+                k(6.449),
+                line(10.861, 20.0),
+                k(11.679),
+                k(18.007),
+                k(20.029),
+            ]),
+        ];
+        let t = track(&recs, &[], &p, 2);
+        let by_start: Vec<(Option<f64>, Option<f64>)> =
+            t.iter().map(|x| (x.record_hz[0], x.record_hz[1])).collect();
+        assert!(
+            by_start.contains(&(Some(10.878), Some(10.861))),
+            "{by_start:?}"
+        );
+        assert!(
+            by_start.contains(&(Some(11.661), Some(11.679))),
+            "{by_start:?}"
+        );
+        assert!(
+            by_start.contains(&(Some(19.877), Some(20.029))),
+            "{by_start:?}"
+        );
+        assert!(
+            !by_start.contains(&(Some(7.38), Some(6.449))),
+            "a 12.6 % jump joined a track: {by_start:?}"
+        );
+    }
+
+    /// A factor within the tracking tolerance that one line alone defines places that line
+    /// exactly (distance 0) and so beat factor 1 on distance: a line of 10.88 Hz then went to
+    /// the 10.50 Hz track instead of the 10.86 Hz one (bus 99711, record 1).
+    #[test]
+    fn one_line_does_not_define_a_factor() {
+        let p = LineParams::default();
+        let k = |f: f64| LineCandidate {
+            p_value: f64::NAN,
+            ..line(f, 5.0)
+        };
+        let recs = vec![
+            Some(vec![k(10.502), line(10.864, 20.0), line(11.646, 20.0)]),
+            Some(vec![k(7.38), k(10.88)]),
+        ];
+        let t = track(&recs, &[], &p, 2);
+        let pairs: Vec<(Option<f64>, Option<f64>)> =
+            t.iter().map(|x| (x.record_hz[0], x.record_hz[1])).collect();
+        assert!(pairs.contains(&(Some(10.864), Some(10.88))), "{pairs:?}");
     }
 
     #[test]
