@@ -368,6 +368,10 @@ fn append_block(data: &mut [Vec<f64>], lines: &mut Vec<usize>, block: Block, kee
     }
 }
 
+/// The first value (s) of a numeric time column read as Unix time: 1e9 s (2001-09-09) to
+/// 4102444800 s (2100-01-01).
+pub const UNIX_TIME_RANGE_S: std::ops::Range<f64> = 1e9..4_102_444_800.0;
+
 fn finish_delimited(
     path: &str,
     opts: &ReadOptions,
@@ -478,6 +482,10 @@ fn finish_delimited(
                                 _ => None,
                             })
                         }
+                        // A number of seconds since 1970 (a logger's Unix timestamp, `timestamp`
+                        // or `timestamp_ms`): its first value is 2001-09-09 to 2100 as such, and no
+                        // recording's relative time is 31 years long.
+                        None if UNIX_TIME_RANGE_S.contains(&t[0]) => Some(0.0),
                         _ => None,
                     },
                 }),

@@ -842,3 +842,35 @@ fn wav_and_sidecar_problems_are_typed() {
         "{e}"
     );
 }
+
+/// A time column of Unix time (seconds since 1970, or milliseconds with its unit), as loggers
+/// and phones write a `timestamp`, gives the first sample's absolute time; a relative time
+/// column does not. 1795752000 s is 2026-11-27 04:00:00 UTC (20784 days of 86400 s and 4 h).
+#[test]
+fn a_unix_time_column_gives_the_start() {
+    assert_eq!(20784 * 86400 + 4 * 3600, 1_795_752_000);
+    let rows = |t0: f64, step: f64| -> String {
+        (0..400)
+            .map(|i| format!("{},{}\n", t0 + step * i as f64, (i % 7) as f64 / 7.0))
+            .collect()
+    };
+    for (header, t0, step) in [
+        ("timestamp,acc\n", 1_795_752_000.0, 0.005),
+        ("timestamp_ms,acc\n", 1_795_752_000_000.0, 5.0),
+        ("Time (ms),acc\n", 1_795_752_000_000.0, 5.0),
+    ] {
+        let text = format!("{header}{}", rows(t0, step));
+        let rec = read_delimited(text.as_bytes(), "u.csv", &ReadOptions::default()).unwrap();
+        // Seconds near 1.8e9 hold steps of 5 ms to a few 1e-7 s (f64): the rate to ~1e-7.
+        assert!((rec.fs_hz - 200.0).abs() < 1e-4, "{header}: {}", rec.fs_hz);
+        let start = rec.time_axis.unwrap().start_unix_s();
+        assert_eq!(start, Some(1_795_752_000.0), "{header}");
+    }
+    // Relative times, and a time column in ms read as seconds by its name (a relative 1.8e12 s
+    // is not a date either): no absolute start.
+    for (header, t0, step) in [("time,acc\n", 0.0, 0.005), ("time,acc\n", 5000.0, 0.005)] {
+        let text = format!("{header}{}", rows(t0, step));
+        let rec = read_delimited(text.as_bytes(), "r.csv", &ReadOptions::default()).unwrap();
+        assert_eq!(rec.time_axis.unwrap().start_unix_s(), None, "{t0}");
+    }
+}
