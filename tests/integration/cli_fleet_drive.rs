@@ -7,9 +7,16 @@ use crate::common;
 
 use common::{fails_with, ok, simulate_csv};
 
-fn check_json(args: &[&str]) -> serde_json::Value {
-    let o = ok(args);
-    serde_json::from_slice(&o.stdout).unwrap()
+/// `vibmode fleet check --json -` of `files` for `bus-1` in the store `db`, as one drive `drive`
+/// when given.
+fn check_json<S: AsRef<str>>(db: &str, drive: Option<&str>, files: &[S]) -> serde_json::Value {
+    let mut args = vec!["fleet", "check", "--db", db, "--vehicle", "bus-1", "-q"];
+    if let Some(id) = drive {
+        args.extend(["--drive", id]);
+    }
+    args.extend(["--json", "-"]);
+    args.extend(files.iter().map(AsRef::as_ref));
+    serde_json::from_slice(&ok(&args).stdout).unwrap()
 }
 
 /// Test records the store holds for `vehicle` (from `fleet status`).
@@ -49,21 +56,7 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
 
     // A healthy drive of 4 records: one drive, its records listed, the per-record verdicts kept.
     let test = simulate_csv(&d.path().join("test"), "B", "30", "21", "4");
-    let mut args = vec![
-        "fleet",
-        "check",
-        "--db",
-        db,
-        "--vehicle",
-        "bus-1",
-        "-q",
-        "--drive",
-        "2026-11-25",
-        "--json",
-        "-",
-    ];
-    args.extend(test.iter().map(String::as_str));
-    let v = check_json(&args);
+    let v = check_json(db, Some("2026-11-25"), &test);
     assert_eq!(v["records"].as_array().unwrap().len(), 4, "{v}");
     let drives = v["drives"].as_array().unwrap();
     assert_eq!(drives.len(), 1, "{v}");
@@ -87,32 +80,9 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
     );
 
     // Without --drive: 3 or more records are the drive "all given records"; fewer, no drive.
-    let mut args = vec![
-        "fleet",
-        "check",
-        "--db",
-        db,
-        "--vehicle",
-        "bus-1",
-        "-q",
-        "--json",
-        "-",
-    ];
-    args.extend(test.iter().take(3).map(String::as_str));
-    let v = check_json(&args);
+    let v = check_json(db, None, &test[..3]);
     assert_eq!(v["drives"][0]["drive"], "all given records", "{v}");
-    let v = check_json(&[
-        "fleet",
-        "check",
-        "--db",
-        db,
-        "--vehicle",
-        "bus-1",
-        "-q",
-        "--json",
-        "-",
-        &test[0],
-    ]);
+    let v = check_json(db, None, &test[..1]);
     assert_eq!(v["drives"].as_array().unwrap().len(), 0, "{v}");
     assert_eq!(drives().len(), 2);
     assert_eq!(drives()[1].0, "all given records");
@@ -274,19 +244,7 @@ fn records_with_dates_form_one_drive_per_day() {
         .enumerate()
         .map(|(i, (f, (day, hh)))| dated(f, day, hh, 59 * (i as u32 % 2)))
         .collect();
-    let mut args = vec![
-        "fleet",
-        "check",
-        "--db",
-        db,
-        "--vehicle",
-        "bus-1",
-        "-q",
-        "--json",
-        "-",
-    ];
-    args.extend(files.iter().map(String::as_str));
-    let v = check_json(&args);
+    let v = check_json(db, None, &files);
     assert_eq!(v["records"].as_array().unwrap().len(), 7, "{v}");
     let drives: Vec<(String, Vec<String>)> = v["drives"]
         .as_array()
@@ -324,19 +282,7 @@ fn records_with_dates_form_one_drive_per_day() {
         .enumerate()
         .map(|(i, f)| dated(f, "2026-11-20", 14 - i as u32, 30))
         .collect();
-    let mut args = vec![
-        "fleet",
-        "check",
-        "--db",
-        db,
-        "--vehicle",
-        "bus-1",
-        "-q",
-        "--json",
-        "-",
-    ];
-    args.extend(early.iter().map(String::as_str));
-    let v = check_json(&args);
+    let v = check_json(db, None, &early);
     assert_eq!(v["drives"][0]["drive"], "2026-11-20", "{v}");
     let status = || {
         let st = vibmode_fleet::Store::open(std::path::Path::new(db))
@@ -382,19 +328,7 @@ fn records_with_dates_form_one_drive_per_day() {
     // One record without dates among them: the start of every record is not known.
     let mut mixed: Vec<&str> = files[..3].iter().map(String::as_str).collect();
     mixed.push(&test[3]);
-    let mut args = vec![
-        "fleet",
-        "check",
-        "--db",
-        db,
-        "--vehicle",
-        "bus-1",
-        "-q",
-        "--json",
-        "-",
-    ];
-    args.extend(mixed);
-    let v = check_json(&args);
+    let v = check_json(db, None, &mixed);
     let drives = v["drives"].as_array().unwrap();
     assert_eq!(drives.len(), 1, "{v}");
     assert_eq!(drives[0]["drive"], "all given records");

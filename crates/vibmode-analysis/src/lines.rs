@@ -1059,24 +1059,20 @@ mod tests {
     #[test]
     fn a_factor_two_noise_peaks_agree_on_does_not_drag_steady_lines() {
         let p = LineParams::default();
-        let k = |f: f64| LineCandidate {
-            p_value: f64::NAN,
-            ..line(f, 5.0)
-        };
         let recs = vec![
             Some(vec![
                 line(7.38, 20.0),
                 line(10.878, 20.0),
-                k(11.661),
-                k(19.877),
-                k(22.29),
+                k_line(11.661),
+                k_line(19.877),
+                k_line(22.29),
             ]),
             Some(vec![
-                k(6.449),
+                k_line(6.449),
                 line(10.861, 20.0),
-                k(11.679),
-                k(18.007),
-                k(20.029),
+                k_line(11.679),
+                k_line(18.007),
+                k_line(20.029),
             ]),
         ];
         let t = track(&recs, &[], &p, 2);
@@ -1106,13 +1102,9 @@ mod tests {
     #[test]
     fn one_line_does_not_define_a_factor() {
         let p = LineParams::default();
-        let k = |f: f64| LineCandidate {
-            p_value: f64::NAN,
-            ..line(f, 5.0)
-        };
         let recs = vec![
-            Some(vec![k(10.502), line(10.864, 20.0), line(11.646, 20.0)]),
-            Some(vec![k(7.38), k(10.88)]),
+            Some(vec![k_line(10.502), line(10.864, 20.0), line(11.646, 20.0)]),
+            Some(vec![k_line(7.38), k_line(10.88)]),
         ];
         let t = track(&recs, &[], &p, 2);
         let pairs: Vec<(Option<f64>, Option<f64>)> =

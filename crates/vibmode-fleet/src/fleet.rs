@@ -761,11 +761,8 @@ pub const DEFAULT_DRIVE_ID: &str = "all given records";
 /// The drive (its id, `YYYY-MM-DD`) of a record that started at this Unix time (s): its day
 /// in UTC. `None` outside the years chrono can represent.
 pub fn drive_of_day(start_unix_s: f64) -> Option<String> {
-    if !start_unix_s.is_finite() || start_unix_s.abs() > 1e14 {
-        return None;
-    }
-    let t = chrono::DateTime::from_timestamp(start_unix_s.floor() as i64, 0)?;
-    Some(t.format("%Y-%m-%d").to_string())
+    // `YYYY-MM-DDTHH:MM:SSZ`: its date.
+    crate::store::utc_of_unix(start_unix_s).map(|t| t[..10].to_string())
 }
 
 /// The drives of records checked without a drive id, as (id, indices of the records): where
