@@ -34,9 +34,6 @@ pub struct AnalyzeArgs {
     /// Output folder for index.html, results.json and figures/.
     #[arg(short = 'o', long = "output", default_value = "vibmode-report")]
     pub output: PathBuf,
-    /// No progress bar.
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
     /// Role of a channel, `NAME=sprung|unsprung|other` (repeat for several); overrides the
     /// config's `[[channels]]` and the guess from the name.
     #[arg(long = "role", value_name = "NAME=ROLE")]
@@ -137,7 +134,7 @@ pub fn run(a: &AnalyzeArgs) -> Result<()> {
         },
         None => RunInput::files(&files, &opts, &sel),
     };
-    let output = with_progress(a.quiet, true, |progress| run.run(input, progress))?;
+    let output = with_progress(true, |progress| run.run(input, progress))?;
     output
         .write(out.path(), None)
         .with_context(|| format!("writing the report in {}", out.path().display()))?;
@@ -156,7 +153,6 @@ pub fn run(a: &AnalyzeArgs) -> Result<()> {
 /// Runs `f` with a progress bar on a terminal (records read when `streamed`, then records
 /// identified, per second, the time left), cleared at the end.
 fn with_progress<T>(
-    quiet: bool,
     streamed: bool,
     f: impl FnOnce(&Progress<'_>) -> Result<T, vibmode_run::RunError>,
 ) -> Result<T> {
@@ -165,7 +161,7 @@ fn with_progress<T>(
     } else {
         "records identified"
     };
-    let pb = crate::progress::records_bar(quiet, None, first_phase, "records");
+    let pb = crate::progress::records_bar(None, first_phase, "records");
     let on_record = |n: usize| pb.set_position(n as u64);
     let started = AtomicBool::new(false);
     let on_identified = |done: usize, total: usize| {
@@ -206,9 +202,6 @@ pub struct DemoArgs {
     /// Also write the simulated records (WAV) and truth.json into `OUTPUT/records/`.
     #[arg(long)]
     pub keep_records: bool,
-    /// No progress bar.
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
     /// Identification methods, a comma-separated list of arma and ssi-cov; `both` (the
     /// default) is both.
     #[arg(long)]
@@ -238,7 +231,7 @@ pub fn run_demo(a: &DemoArgs) -> Result<()> {
         write_simulation(&dir, &d.simulation, RecordFormat::Wav)?;
     }
     let run = Run::new(cfg).reference(d.reference).vehicle(d.vehicle)?;
-    let output: RunOutput = with_progress(a.quiet, false, |progress| {
+    let output: RunOutput = with_progress(false, |progress| {
         run.run(RunInput::Records(d.records), progress)
     })?;
     output

@@ -96,9 +96,6 @@ pub struct IngestArgs {
     /// Record files, or folders of them (each folder's recordings, sorted by name).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
-    /// No progress bar.
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
 }
 
 /// Arguments of `vibmode fleet check`.
@@ -124,9 +121,6 @@ pub struct CheckArgs {
     /// Record files, or folders of them (each folder's recordings, sorted by name).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
-    /// No progress bar.
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
 }
 
 /// Runs `vibmode fleet ...`.
@@ -180,8 +174,7 @@ fn ingest(a: &IngestArgs) -> Result<()> {
     // reported as stored unless all were.
     let expanded = vibmode_signal::expand_folders(&a.files)?;
     let files: Vec<&std::path::Path> = expanded.iter().map(|f| f.as_path()).collect();
-    let pb =
-        crate::progress::records_bar(a.quiet, Some(files.len() as u64), "files analysed", "files");
+    let pb = crate::progress::records_bar(Some(files.len() as u64), "files analysed", "files");
     let done = ingest_files_progress(
         &mut store,
         &labels,
@@ -306,8 +299,7 @@ fn check(a: &CheckArgs) -> Result<()> {
     store.require_vehicle(&a.vehicle)?;
     let set = require_baseline(&store, &a.vehicle)?;
     // All or nothing: every file is read and scored before any record or check is stored.
-    let pb =
-        crate::progress::records_bar(a.quiet, Some(files.len() as u64), "files analysed", "files");
+    let pb = crate::progress::records_bar(Some(files.len() as u64), "files analysed", "files");
     let out = check_drive_files_progress(
         &mut store,
         &set,

@@ -5,7 +5,6 @@ use anyhow::{bail, Context, Result};
 use clap::builder::TypedValueParser;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use vibmode_signal::ResampleRecording;
 use vibmode_signal::{ResampleParams, ResamplerKind, StreamResampleParams};
@@ -42,9 +41,6 @@ pub struct ResampleArgs {
     /// (`--method` is still accepted.)
     #[arg(long, alias = "method", default_value = "auto", value_parser = resampler_parser())]
     pub resampler: ResamplerKind,
-    /// No progress bar.
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
 }
 
 /// The values `--resampler` takes: the library's [`ResamplerKind`], by the names it parses.
@@ -124,7 +120,7 @@ fn run_streamed(a: &ResampleArgs, fs_out_hz: f64) -> Result<()> {
         cutoff_hz: a.input.cutoff_hz,
         ..StreamResampleParams::default()
     };
-    let show = !a.quiet && std::io::stderr().is_terminal();
+    let show = crate::progress::shown();
     let pb = ProgressBar::with_draw_target(
         info.n_frames,
         if show {

@@ -31,6 +31,10 @@ use vibmode_core::limits::MESSAGE_BYTES_MAX;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// No progress bar (any command; only `analyze`, `demo`, `resample` and `fleet ingest` and
+    /// `check` draw one, on a terminal). Before or after the command's name.
+    #[arg(long, short = 'q', global = true)]
+    quiet: bool,
 }
 
 #[derive(Subcommand, Debug)]
@@ -87,6 +91,7 @@ fn main() -> ExitCode {
         Ok(c) => c,
         Err(e) => return clap_failure(&e, &cli_cmd, &args),
     };
+    progress::set_quiet(cli.quiet);
     let result = match cli.command {
         Command::Psd(a) => cmd_psd::run(&a),
         Command::Resample(a) => cmd_resample::run(&a),

@@ -1,22 +1,32 @@
 //! The progress bar of the commands that work through many records (`analyze`, `demo`,
-//! `fleet ingest`, `fleet check`): records done, records per second and the time left. Drawn on
-//! standard error only when it is a terminal and `-q` was not given; otherwise nothing of it is
-//! written.
+//! `fleet ingest`, `fleet check`, `resample`): records done, records per second and the time
+//! left. Drawn on standard error only when it is a terminal and `-q` was not given; otherwise
+//! nothing of it is written.
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressState, ProgressStyle};
 use std::io::IsTerminal;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// `-q`: a global option (any command takes it, before or after the command's name), set once
+/// by `main` before the command runs.
+static QUIET: AtomicBool = AtomicBool::new(false);
+
+/// Records the global `-q`.
+pub fn set_quiet(quiet: bool) {
+    QUIET.store(quiet, Ordering::Relaxed);
+}
 
 /// Whether a bar is drawn: not with `-q`, and only on a terminal.
-pub fn shown(quiet: bool) -> bool {
-    !quiet && std::io::stderr().is_terminal()
+pub fn shown() -> bool {
+    !QUIET.load(Ordering::Relaxed) && std::io::stderr().is_terminal()
 }
 
 /// A bar counting records: with a known total (`len`), a bar, `done/total`, the rate and the
 /// time left; without, a spinner, the count and the rate. `what` says what is counted (e.g.
 /// "records identified"), `unit` its unit in the rate ("records", "files"): records (files or
 /// records cut from them), never channels.
-pub fn records_bar(quiet: bool, len: Option<u64>, what: &str, unit: &'static str) -> ProgressBar {
-    let target = if shown(quiet) {
+pub fn records_bar(len: Option<u64>, what: &str, unit: &'static str) -> ProgressBar {
+    let target = if shown() {
         ProgressDrawTarget::stderr()
     } else {
         ProgressDrawTarget::hidden()

@@ -72,6 +72,60 @@ fn no_bar_when_stderr_is_not_a_terminal_and_q_accepted() {
     assert_no_bar("analyze -q", &common::stderr(&ok(&a)));
 }
 
+/// `-q` is one option of the whole program: every command takes it, before or after the command's
+/// name (a script that passes it everywhere must not fail on the commands without a bar).
+#[test]
+fn every_command_takes_q_before_or_after_its_name() {
+    let d = tempfile::tempdir().unwrap();
+    let rec = simulate_csv(&d.path().join("r"), "C", "40", "7", "1");
+    let rec = rec[0].as_str();
+    let params = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/city_bus.toml");
+    // The commands, each writing its output under a name of its own per `tag`.
+    let commands = |tag: &str| -> Vec<Vec<String>> {
+        let out = |name: &str| s(&d.path().join(format!("{tag}-{name}"))).to_string();
+        let words = |w: &[&str]| w.iter().map(|x| x.to_string()).collect::<Vec<_>>();
+        vec![
+            words(&["psd", rec]),
+            words(&["fit", "--order", "4", rec]),
+            words(&[
+                "sweep",
+                "--orders",
+                "2:4",
+                rec,
+                "--json",
+                &out("sweep.json"),
+            ]),
+            words(&["ssi", rec, "--json", &out("ssi.json")]),
+            words(&["fullcar", params]),
+            words(&["resample", "--fs-out", "100", rec, "-o", &out("rs.csv")]),
+            words(&["segment", rec, "-o", &out("seg")]),
+            words(&[
+                "simulate",
+                params,
+                "--records",
+                "1",
+                "--duration-s",
+                "2",
+                "--fs",
+                "200",
+                "-o",
+                &out("sim"),
+            ]),
+            words(&["fleet", "init", "--db", &out("f.db")]),
+        ]
+    };
+    for cmd in commands("after") {
+        let mut args: Vec<&str> = cmd.iter().map(String::as_str).collect();
+        args.push("-q");
+        assert_no_bar(&args.join(" "), &common::stderr(&ok(&args)));
+    }
+    for cmd in commands("before") {
+        let mut args: Vec<&str> = vec!["--quiet"];
+        args.extend(cmd.iter().map(String::as_str));
+        assert_no_bar(&args.join(" "), &common::stderr(&ok(&args)));
+    }
+}
+
 /// `vibmode ARGS` on a pseudo-terminal (util-linux `script`): what the terminal received.
 /// None where `script` is missing.
 fn on_terminal(args: &[&str]) -> Option<String> {
