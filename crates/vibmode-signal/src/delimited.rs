@@ -163,7 +163,34 @@ pub enum TimeText {
     Date {
         /// The first row's day, days since 1970-01-01.
         base_day: i64,
+        /// How the column writes its dates.
+        order: DateOrder,
     },
+    /// The date of a split date and time whose order of day and month cannot be told from the
+    /// first row (`05/11/2026`: 5 November or May 11): not a channel, and not read; the times of
+    /// day beside it pass midnight as in [`TimeText::TimeOfDay`] and the absolute start is
+    /// unknown.
+    UndecidedDate,
+    /// A date with slashes and a time of day in one cell (`11/27/2026 08:00:00.005`,
+    /// `27/11/2026 8:00:00 AM`, as spreadsheets of US or UK locale write): the time of day,
+    /// passing midnight as in [`TimeText::TimeOfDay`]; the first row's day when the order of day
+    /// and month can be told from it (a part above 12, or both equal), else unknown.
+    SlashDateTime {
+        /// The first row's day, days since 1970-01-01, when its order is known.
+        first_day: Option<i64>,
+    },
+}
+
+/// How a date writes its year, month and day.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[non_exhaustive]
+pub enum DateOrder {
+    /// `2026-11-27`, `2026/11/27` (ISO 8601).
+    YearMonthDay,
+    /// `27.11.2026`, `27/11/2026`.
+    DayMonthYear,
+    /// `11/27/2026` (US).
+    MonthDayYear,
 }
 
 impl TimeText {
@@ -173,10 +200,18 @@ impl TimeText {
             TimeText::DateTime { base } => parse_datetime(cell).map(|t| seconds_since(t, base)),
             TimeText::WithUnit => parse_with_unit(cell),
             TimeText::TimeOfDay => parse_time_of_day(cell),
-            TimeText::Date { base_day } => {
-                parse_date(cell).map(|d| (d - base_day) as f64 * 86_400.0)
+            TimeText::Date { base_day, order } => {
+                parse_date_in(cell, order).map(|d| (d - base_day) as f64 * 86_400.0)
             }
+            TimeText::UndecidedDate => slash_date_parts(cell).map(|_| 0.0),
+            TimeText::SlashDateTime { .. } => parse_slash_datetime(cell).map(|(_, t)| t),
         }
+    }
+
+    /// True for a time of day that passes midnight when it steps back by more than 12 h (no
+    /// date column gives its days).
+    fn is_time_of_day(&self) -> bool {
+        matches!(self, TimeText::TimeOfDay | TimeText::SlashDateTime { .. })
     }
 
     /// The kind of a time column's first cell, when it is text of a known kind.
@@ -187,35 +222,117 @@ impl TimeText {
         if parse_time_of_day(cell).is_some() {
             return Some(TimeText::TimeOfDay);
         }
+        if let Some(((a, b, year), _)) = parse_slash_datetime(cell) {
+            let first_day = slash_order(a, b).and_then(|o| day_number(year, a, b, o));
+            return Some(TimeText::SlashDateTime { first_day });
+        }
         parse_with_unit(cell).map(|_| TimeText::WithUnit)
     }
 }
 
+/// The two leading numbers and the year of a date `NN/NN/YYYY` (one or two digits each part);
+/// `None` for anything else.
+fn slash_date_parts(cell: &[u8]) -> Option<(u32, u32, i32)> {
+    let text = std::str::from_utf8(trim_cell(cell)).ok()?;
+    let mut parts = text.split('/');
+    let (a, b, y) = (parts.next()?, parts.next()?, parts.next()?);
+    let short = |p: &str| (1..=2).contains(&p.len()) && p.bytes().all(|c| c.is_ascii_digit());
+    if parts.next().is_some() || !short(a) || !short(b) || y.len() != 4 {
+        return None;
+    }
+    Some((a.parse().ok()?, b.parse().ok()?, y.parse().ok()?))
+}
+
+/// The order of a slash date's first two numbers `a/b`: day first when `a` cannot be a month,
+/// month first when `b` cannot be (or when both are equal: the same day either way); `None`
+/// when both could be either (`05/11`).
+fn slash_order(a: u32, b: u32) -> Option<DateOrder> {
+    if a > 12 && b <= 12 {
+        Some(DateOrder::DayMonthYear)
+    } else if b > 12 && a <= 12 || a == b {
+        Some(DateOrder::MonthDayYear)
+    } else {
+        None
+    }
+}
+
+/// Days since 1970-01-01 of the slash date `a/b/year` read in `order`; `None` for no such day.
+fn day_number(year: i32, a: u32, b: u32, order: DateOrder) -> Option<i64> {
+    let (month, day) = match order {
+        DateOrder::MonthDayYear => (a, b),
+        _ => (b, a),
+    };
+    let epoch = chrono::NaiveDate::from_ymd_opt(1970, 1, 1)?;
+    Some((chrono::NaiveDate::from_ymd_opt(year, month, day)? - epoch).num_days())
+}
+
+/// A slash date and a time of day in one cell, `NN/NN/YYYY HH:MM:SS[.fff][ AM|PM]`: the date's
+/// parts ([`slash_date_parts`]) and the seconds since midnight ([`parse_time_of_day`]).
+fn parse_slash_datetime(cell: &[u8]) -> Option<((u32, u32, i32), f64)> {
+    let text = trim_cell(cell);
+    let gap = text.iter().position(u8::is_ascii_whitespace)?;
+    let date = slash_date_parts(&text[..gap])?;
+    Some((date, parse_time_of_day(&text[gap + 1..])?))
+}
+
 /// Seconds since midnight of a time of day `HH:MM:SS` or `HH:MM:SS.fff` (24-hour clock, one or
-/// two digits for the hour); `None` for anything else.
+/// two digits for the hour), or the same on a 12-hour clock followed by `AM` or `PM` (any case);
+/// `None` for anything else.
 pub fn parse_time_of_day(cell: &[u8]) -> Option<f64> {
     let text = std::str::from_utf8(trim_cell(cell)).ok()?;
     if text.len() < 7 || text.bytes().filter(|&b| b == b':').count() != 2 {
         return None;
     }
-    let t = chrono::NaiveTime::parse_from_str(text, "%H:%M:%S%.f").ok()?;
+    let upper = text.to_ascii_uppercase();
+    let t = match upper
+        .strip_suffix("AM")
+        .or_else(|| upper.strip_suffix("PM"))
+    {
+        Some(_) => chrono::NaiveTime::parse_from_str(&upper, "%I:%M:%S%.f %p").ok()?,
+        None => chrono::NaiveTime::parse_from_str(text, "%H:%M:%S%.f").ok()?,
+    };
     let secs = chrono::Timelike::num_seconds_from_midnight(&t);
     let nanos = chrono::Timelike::nanosecond(&t);
     Some(f64::from(secs) + f64::from(nanos) * 1e-9)
 }
 
 /// Days since 1970-01-01 of a date `YYYY-MM-DD`, `YYYY/MM/DD` or `DD.MM.YYYY`; `None` for
-/// anything else (`MM/DD/YYYY` and `DD/MM/YYYY` are not read: they cannot be told apart).
+/// anything else (`MM/DD/YYYY` and `DD/MM/YYYY` alone cannot be told apart: see
+/// [`parse_date_in`]).
 pub fn parse_date(cell: &[u8]) -> Option<i64> {
+    parse_date_order(cell).map(|(d, _)| d)
+}
+
+/// [`parse_date`]'s day and the order its text follows.
+fn parse_date_order(cell: &[u8]) -> Option<(i64, DateOrder)> {
     let text = std::str::from_utf8(trim_cell(cell)).ok()?;
     if text.len() < 8 || text.len() > 10 {
         return None;
     }
     let epoch = chrono::NaiveDate::from_ymd_opt(1970, 1, 1)?;
-    ["%Y-%m-%d", "%Y/%m/%d", "%d.%m.%Y"]
-        .iter()
-        .find_map(|f| chrono::NaiveDate::parse_from_str(text, f).ok())
-        .map(|d| (d - epoch).num_days())
+    [
+        ("%Y-%m-%d", DateOrder::YearMonthDay),
+        ("%Y/%m/%d", DateOrder::YearMonthDay),
+        ("%d.%m.%Y", DateOrder::DayMonthYear),
+    ]
+    .iter()
+    .find_map(|&(f, o)| {
+        chrono::NaiveDate::parse_from_str(text, f)
+            .ok()
+            .map(|d| ((d - epoch).num_days(), o))
+    })
+}
+
+/// Days since 1970-01-01 of a date written in `order`: as [`parse_date`], and `NN/NN/YYYY` read
+/// as month first ([`DateOrder::MonthDayYear`]) or day first ([`DateOrder::DayMonthYear`]).
+pub fn parse_date_in(cell: &[u8], order: DateOrder) -> Option<i64> {
+    if let Some((a, b, year)) = slash_date_parts(cell) {
+        return match order {
+            DateOrder::YearMonthDay => None,
+            _ => day_number(year, a, b, order),
+        };
+    }
+    parse_date_order(cell).and_then(|(d, o)| (o == order).then_some(d))
 }
 
 /// Seconds of a number followed by a time unit (`0.005 sec`, `1.5 s`, `20 ms`, `2 min`, `1 hr`:
@@ -234,7 +351,10 @@ impl ColumnInfo {
     pub fn is_channel(&self) -> bool {
         self.time_scale_s.is_none()
             && !self.row_index
-            && !matches!(self.time_text, Some(TimeText::Date { .. }))
+            && !matches!(
+                self.time_text,
+                Some(TimeText::Date { .. } | TimeText::UndecidedDate)
+            )
     }
 
     /// Seconds per unit of this time column's values: `override_s` (a user's time unit) unless
@@ -486,12 +606,26 @@ pub fn time_unit_seconds(unit: &str) -> Option<f64> {
 }
 
 /// Seconds per unit if `name`/`unit` denote a time column: a base name `time`, `t`,
-/// `timestamp` or `zeit`, optionally with a unit suffix `_s`, `_sec`, `_ms`, `_us` or `_ns`
+/// `timestamp`, `zeit`, or a Unix time's `epoch`, `epoch_time`, `unix`, `unixtime`, `unix_time`,
+/// optionally with a unit suffix `_s`, `_sec`, `_ms`, `_us` or `_ns`
 /// (`Time_ms`, `timestamp_ms`), case-insensitive. A unit in the header wins over the suffix; no
 /// unit at all means seconds.
 fn time_scale(name: &str, unit: &str) -> Option<f64> {
     let n = name.trim().to_ascii_lowercase();
-    let is_base = |b: &str| matches!(b, "time" | "t" | "timestamp" | "zeit");
+    let is_base = |b: &str| {
+        matches!(
+            b,
+            "time"
+                | "t"
+                | "timestamp"
+                | "zeit"
+                | "epoch"
+                | "epoch_time"
+                | "unix"
+                | "unixtime"
+                | "unix_time"
+        )
+    };
     let implied = if is_base(&n) {
         None
     } else {
@@ -649,8 +783,20 @@ fn mark_text_time(
             && columns[c + 1].time_scale_s.is_some()
             && parse_time_of_day(cell(c + 1)).is_some()
         {
-            if let Some(base_day) = parse_date(cell(c)) {
-                columns[c].time_text = Some(TimeText::Date { base_day });
+            let date = match (parse_date_order(cell(c)), slash_date_parts(cell(c))) {
+                (Some((base_day, order)), _) => Some(TimeText::Date { base_day, order }),
+                (None, Some((a, b, year))) => Some(
+                    slash_order(a, b)
+                        .and_then(|order| {
+                            let base_day = day_number(year, a, b, order)?;
+                            Some(TimeText::Date { base_day, order })
+                        })
+                        .unwrap_or(TimeText::UndecidedDate),
+                ),
+                (None, None) => None,
+            };
+            if let Some(date) = date {
+                columns[c].time_text = Some(date);
                 columns[c].time_scale_s = None;
                 columns[c + 1].time_text = Some(TimeText::TimeOfDay);
                 columns[c + 1].time_scale_s = Some(1.0);
@@ -670,8 +816,12 @@ fn mark_text_time(
         }
         let (ra, rb) = row_spans[c];
         // A number and a unit only in a column named as a time column.
-        let kind = TimeText::of_cell(&row[ra..rb])
-            .filter(|k| matches!(k, TimeText::DateTime { .. }) || col.time_scale_s.is_some());
+        let kind = TimeText::of_cell(&row[ra..rb]).filter(|k| {
+            matches!(
+                k,
+                TimeText::DateTime { .. } | TimeText::SlashDateTime { .. }
+            ) || col.time_scale_s.is_some()
+        });
         if let Some(kind) = kind {
             col.time_text = Some(kind);
             col.time_scale_s = Some(1.0);
@@ -1031,7 +1181,7 @@ impl<R: BufRead> DelimitedReader<R> {
         let Some(t) = self
             .columns
             .iter()
-            .position(|c| c.time_text == Some(TimeText::TimeOfDay))
+            .position(|c| c.time_text.is_some_and(|k| k.is_time_of_day()))
         else {
             return;
         };
@@ -1536,10 +1686,51 @@ mod tests {
             "25:00:00",
             "05:61:00",
             "2026-11-27",
-            "05:00:00 pm",
+            "13:00:00 PM",
+            "5:00 PM",
         ] {
             assert_eq!(parse_time_of_day(cell.as_bytes()), None, "{cell}");
         }
+        // A 12-hour clock: 12 AM is midnight, 12 PM noon.
+        for (cell, seconds) in [
+            ("12:00:00.25 AM", 0.25),
+            ("5:00:00 am", 18_000.0),
+            ("12:30:00 PM", 45_000.0),
+            ("11:59:59.5 pm", 86_399.5),
+        ] {
+            let got = parse_time_of_day(cell.as_bytes()).unwrap_or(f64::NAN);
+            assert!((got - seconds).abs() < 1e-9, "{cell}: {got}");
+        }
+        // Slash dates: the order from a part above 12 (or both equal); 05/11 is undecided.
+        assert_eq!(slash_order(27, 11), Some(DateOrder::DayMonthYear));
+        assert_eq!(slash_order(11, 27), Some(DateOrder::MonthDayYear));
+        assert_eq!(slash_order(11, 11), Some(DateOrder::MonthDayYear));
+        assert_eq!(slash_order(5, 11), None);
+        assert_eq!(slash_order(13, 14), None);
+        for (cell, order) in [
+            ("11/27/2026", DateOrder::MonthDayYear),
+            ("27/11/2026", DateOrder::DayMonthYear),
+            ("2026-11-27", DateOrder::YearMonthDay),
+            ("27.11.2026", DateOrder::DayMonthYear),
+        ] {
+            assert_eq!(parse_date_in(cell.as_bytes(), order), Some(20784), "{cell}");
+        }
+        // 1 February 2026: 56 x 365 + 14 + 31 days.
+        assert_eq!(56 * 365 + 14 + 31, 20485);
+        assert_eq!(
+            parse_date_in(b"1/2/2026", DateOrder::DayMonthYear),
+            Some(20485)
+        );
+        assert_eq!(
+            parse_date_in(b"2/1/2026", DateOrder::MonthDayYear),
+            Some(20485)
+        );
+        assert_eq!(parse_date_in(b"11/27/2026", DateOrder::DayMonthYear), None);
+        assert_eq!(parse_date_in(b"27.11.2026", DateOrder::MonthDayYear), None);
+        let t = parse_slash_datetime(b"11/27/2026 11:59:55.5 PM").unwrap();
+        assert_eq!(t, ((11, 27, 2026), 86_395.5));
+        assert_eq!(parse_slash_datetime(b"11/27/26 08:00:00"), None);
+        assert_eq!(parse_slash_datetime(b"2026/11/27 08:00:00"), None);
         for cell in ["2026-11-27", "2026/11/27", "27.11.2026", "\"2026-11-27\""] {
             assert_eq!(parse_date(cell.as_bytes()), Some(20784), "{cell}");
         }
@@ -1569,6 +1760,10 @@ mod tests {
         assert_eq!(time_scale("time_ms", ""), Some(1e-3));
         assert_eq!(time_scale("t", ""), Some(1.0));
         assert_eq!(time_scale("timestamp", ""), Some(1.0));
+        assert_eq!(time_scale("epoch_ms", ""), Some(1e-3));
+        assert_eq!(time_scale("unix_time", ""), Some(1.0));
+        assert_eq!(time_scale("Unix_Time_ms", ""), Some(1e-3));
+        assert_eq!(time_scale("epoch", "ms"), Some(1e-3));
         assert_eq!(time_scale("Time", "furlongs"), None);
         assert_eq!(time_scale("x", "s"), None);
         assert_eq!(time_scale("Time_ms", ""), Some(1e-3));

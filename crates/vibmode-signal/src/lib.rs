@@ -50,7 +50,7 @@ pub mod stream_resample;
 pub mod stream_write;
 pub mod write;
 
-pub use delimited::{Block, ColumnInfo, DelimitedReader, Separator, TimeText};
+pub use delimited::{Block, ColumnInfo, DateOrder, DelimitedReader, Separator, TimeText};
 pub use error::{BinaryFormat, SidecarProblem, SignalError, WavProblem};
 pub use preprocess::{preprocess, Preprocessed};
 pub use read::{

@@ -476,11 +476,16 @@ fn finish_delimited(
                         // Times of day beside a date column: from the first row's midnight.
                         Some(crate::delimited::TimeText::TimeOfDay) => {
                             cols.iter().find_map(|c| match c.time_text {
-                                Some(crate::delimited::TimeText::Date { base_day }) => {
+                                Some(crate::delimited::TimeText::Date { base_day, .. }) => {
                                     Some(base_day as f64 * 86_400.0)
                                 }
                                 _ => None,
                             })
+                        }
+                        // A slash date and a time of day: from the first row's midnight when
+                        // the order of its day and month is known.
+                        Some(crate::delimited::TimeText::SlashDateTime { first_day }) => {
+                            first_day.map(|d| d as f64 * 86_400.0)
                         }
                         // A number of seconds since 1970 (a logger's Unix timestamp, `timestamp`
                         // or `timestamp_ms`): its first value is 2001-09-09 to 2100 as such, and no

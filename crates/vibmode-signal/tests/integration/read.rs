@@ -857,6 +857,8 @@ fn a_unix_time_column_gives_the_start() {
     for (header, t0, step) in [
         ("timestamp,acc\n", 1_795_752_000.0, 0.005),
         ("timestamp_ms,acc\n", 1_795_752_000_000.0, 5.0),
+        ("epoch_ms,acc\n", 1_795_752_000_000.0, 5.0),
+        ("unix_time,acc\n", 1_795_752_000.0, 0.005),
         ("Time (ms),acc\n", 1_795_752_000_000.0, 5.0),
     ] {
         let text = format!("{header}{}", rows(t0, step));

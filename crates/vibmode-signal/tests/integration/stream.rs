@@ -912,24 +912,100 @@ fn a_split_date_and_time_or_a_time_of_day_is_the_time() {
         );
         (day, s)
     };
-    for (case, header, sep, date_of) in [
+    // A 24-hour time of day on a 12-hour clock: 23:59:55.000 -> 11:59:55.000 PM.
+    let twelve_hour = |hms: &str| {
+        let h: u32 = hms[..2].parse().unwrap();
+        let (h12, half) = match h {
+            0 => (12, "AM"),
+            1..=11 => (h, "AM"),
+            12 => (12, "PM"),
+            _ => (h - 12, "PM"),
+        };
+        format!("{h12}{} {half}", &hms[2..])
+    };
+    // (case, header, separator, the dates of the two days, what joins date and time, a 12-hour
+    // clock, whether the absolute start is known)
+    for (case, header, sep, date_of, glue, twelve, known) in [
         (
             "iso",
             "Date,Time,a,b",
             ",",
             Some(["2026-11-27", "2026-11-28"]),
+            ",",
+            false,
+            true,
         ),
         (
             "european",
             "Datum;Zeit;a;b",
             ";",
             Some(["27.11.2026", "28.11.2026"]),
+            ";",
+            false,
+            true,
         ),
-        ("time of day", "Time,a,b", ",", None),
+        ("time of day", "Time,a,b", ",", None, ",", false, false),
+        // Slash dates: the order of day and month from a part above 12.
+        (
+            "us split",
+            "Date,Time,a,b",
+            ",",
+            Some(["11/27/2026", "11/28/2026"]),
+            ",",
+            true,
+            true,
+        ),
+        (
+            "uk split",
+            "Date,Time,a,b",
+            ",",
+            Some(["27/11/2026", "28/11/2026"]),
+            ",",
+            false,
+            true,
+        ),
+        (
+            "us one cell",
+            "timestamp,a,b",
+            ",",
+            Some(["11/27/2026", "11/28/2026"]),
+            " ",
+            false,
+            true,
+        ),
+        (
+            "uk one cell 12 h",
+            "Timestamp,a,b",
+            ",",
+            Some(["27/11/2026", "28/11/2026"]),
+            " ",
+            true,
+            true,
+        ),
+        // 5 November or May 11: the times of day are read, the absolute start is unknown.
+        (
+            "undecided split",
+            "Date,Time,a,b",
+            ",",
+            Some(["05/11/2026", "06/11/2026"]),
+            ",",
+            false,
+            false,
+        ),
+        (
+            "undecided one cell",
+            "timestamp,a,b",
+            ",",
+            Some(["05/11/2026", "06/11/2026"]),
+            " ",
+            true,
+            false,
+        ),
     ] {
         let mut text = format!("{header}\n");
         for (i, (a, b)) in rows.iter().enumerate() {
             let (day, hms) = clock(i);
+            let hms = if twelve { twelve_hour(&hms) } else { hms };
             let (a, b) = if sep == ";" {
                 (
                     a.to_string().replace('.', ","),
@@ -940,13 +1016,13 @@ fn a_split_date_and_time_or_a_time_of_day_is_the_time() {
             };
             match date_of {
                 Some(dates) => text.push_str(&format!(
-                    "{}{sep}{hms}{sep}{a}{sep}{b}\n",
+                    "{}{glue}{hms}{sep}{a}{sep}{b}\n",
                     dates[day as usize]
                 )),
                 None => text.push_str(&format!("{hms}{sep}{a}{sep}{b}\n")),
             }
         }
-        let p = dir.path().join(format!("{case}.csv"));
+        let p = dir.path().join(format!("{}.csv", case.replace(' ', "_")));
         std::fs::write(&p, &text).unwrap();
         let whole = read_path(&p, &opts).unwrap();
         assert_eq!(whole.names(), vec!["a", "b"], "{case}");
@@ -959,10 +1035,11 @@ fn a_split_date_and_time_or_a_time_of_day_is_the_time() {
         let axis = whole.time_axis.clone().unwrap();
         assert!((axis.start_s - start_s).abs() < 1e-9, "{case}");
         let start = axis.start_unix_s();
-        match date_of {
+        if known {
             // 2026-11-27 23:59:55 UTC: 20784 days and 86 395 s after 1970-01-01.
-            Some(_) => assert_eq!(start, Some(20784.0 * 86_400.0 + 86_395.0), "{case}"),
-            None => assert_eq!(start, None, "{case}"),
+            assert_eq!(start, Some(20784.0 * 86_400.0 + 86_395.0), "{case}");
+        } else {
+            assert_eq!(start, None, "{case}");
         }
         for block in [1, 7, 999, 1000, 5000] {
             let s = stream_all(&p, &opts, block);
