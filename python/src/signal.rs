@@ -20,14 +20,15 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     Ok(())
 }
 
-/// A recording as Python sees it: data (channels, samples), rate (Hz), names, units and
-/// placements (JSON list).
+/// A recording as Python sees it: data (channels, samples), rate (Hz), names, units,
+/// placements (JSON list) and the first sample's Unix time (s, UTC) when the file told it.
 pub type PyRecording<'py> = (
     Bound<'py, PyArray2<f64>>,
     f64,
     Vec<String>,
     Vec<String>,
     String,
+    Option<f64>,
 );
 
 /// The Python form of a recording.
@@ -45,6 +46,7 @@ pub fn to_py<'py>(py: Python<'py>, rec: &Recording) -> PyResult<PyRecording<'py>
         rec.channels.iter().map(|c| c.name.clone()).collect(),
         rec.channels.iter().map(|c| c.unit.clone()).collect(),
         serde_json::to_string(&placements).map_err(json_err)?,
+        rec.time_axis.as_ref().and_then(|t| t.start_unix_s()),
     ))
 }
 

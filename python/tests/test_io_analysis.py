@@ -46,6 +46,40 @@ def test_read_as_frame_and_channel_selection(tmp_path):
     assert rec.channels == ["Z-Axis"]
 
 
+def test_the_first_samples_time_is_read_when_the_file_tells_it(tmp_path):
+    import datetime
+
+    # 2026-11-27 23:59:59 UTC (20784 days after 1970-01-01) at 200 Hz, across midnight, written as
+    # ISO date-times, as a US date with a 12-hour clock, and as Unix milliseconds.
+    t0 = 20784 * 86400 + 86399.0
+    rows = range(400)
+    stamp = lambda i: datetime.datetime.fromtimestamp(t0 + i / 200, tz=datetime.timezone.utc)
+    files = {
+        "iso.csv": ["time,z"] + [f"{stamp(i).strftime('%Y-%m-%d %H:%M:%S.%f')},{i % 5}" for i in rows],
+        "us.csv": ["timestamp,z"] + [f"{stamp(i).strftime('%m/%d/%Y %I:%M:%S.%f %p')},{i % 5}" for i in rows],
+        "epoch.csv": ["epoch_ms,z"] + [f"{round((t0 + i / 200) * 1000)},{i % 5}" for i in rows],
+    }
+    for name, lines in files.items():
+        p = tmp_path / name
+        p.write_text("\n".join(lines) + "\n")
+        rec = vibmode.read(p)
+        assert rec.fs == pytest.approx(200.0, rel=1e-6), name
+        assert rec.start_unix_s == pytest.approx(t0, abs=1e-6), name
+        assert rec.start == datetime.datetime(2026, 11, 27, 23, 59, 59, tzinfo=datetime.timezone.utc), name
+        assert vibmode.read(p, as_frame=True).attrs["start_unix_s"] == pytest.approx(t0, abs=1e-6), name
+    # Seconds from 0, and a slash date whose day and month cannot be told apart: no start.
+    p = tmp_path / "relative.csv"
+    p.write_text("\n".join(["time,z"] + [f"{i / 200},{i % 5}" for i in rows]) + "\n")
+    p2 = tmp_path / "undecided.csv"
+    p2.write_text("\n".join(["timestamp,z"] + [f"05/11/2026 08:00:{i / 200:06.3f},{i % 5}" for i in rows]) + "\n")
+    for q in (p, p2):
+        rec = vibmode.read(q)
+        assert rec.fs == pytest.approx(200.0, rel=1e-9)
+        assert rec.start_unix_s is None and rec.start is None
+    with pytest.raises(ValueError, match="start_unix_s"):
+        vibmode.Recording(np.zeros((1, 10)), 10.0, start_unix_s=float("nan"))
+
+
 def test_file_errors_are_os_errors(tmp_path):
     with pytest.raises(FileNotFoundError):
         vibmode.read(tmp_path / "missing.csv")

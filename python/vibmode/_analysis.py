@@ -219,7 +219,7 @@ def simulate(
         kind, value, str(road), float(speed_kmh), float(duration_s), int(records), _check_fs(fs), int(seed), str(effects),
     )
     out: List[SimRecord] = []
-    for i, ((data, rate, names, units, placements), t0, v) in enumerate(recs):
+    for i, ((data, rate, names, units, placements, _start), t0, v) in enumerate(recs):
         r = SimRecord(data, rate, names, units, json.loads(placements), name=f"record_{i + 1:02d}")
         r.start_time_s = t0
         r.mean_speed_kmh = v

@@ -26,6 +26,9 @@ class Recording:
     units : list of units (e.g. 'm/s^2'; '' when unknown).
     placements : list of dicts (role, corner, direction) per channel.
     name : display name (the file name for files read).
+    start_unix_s : the first sample's Unix time (s, UTC) when the file's time column told it
+        (date-times, a date beside times of day, Unix time; docs/formats.md), else None.
+        :attr:`start` gives it as a ``datetime``.
 
     ``data, fs, channels = recording`` unpacks the three main fields.
     """
@@ -38,6 +41,7 @@ class Recording:
         units: Optional[Sequence[str]] = None,
         placements: Optional[List[Dict[str, Any]]] = None,
         name: str = "record",
+        start_unix_s: Optional[float] = None,
     ):
         a = _real_input(data, "data")
         if a.ndim == 1:
@@ -56,6 +60,9 @@ class Recording:
             )
         self.placements = placements
         self.name = name
+        if start_unix_s is not None and not np.isfinite(start_unix_s):
+            raise ValueError(f"start_unix_s = {start_unix_s!r}; give a finite Unix time in s, or None")
+        self.start_unix_s = None if start_unix_s is None else float(start_unix_s)
 
     def __iter__(self) -> Iterator[Any]:
         return iter((self.data, self.fs, self.channels))
@@ -73,12 +80,24 @@ class Recording:
         """Sample times from 0, s."""
         return np.arange(self.data.shape[1]) / self.fs
 
+    @property
+    def start(self):
+        """The first sample's time as a timezone-aware ``datetime`` (UTC), or None when the file
+        did not tell it."""
+        if self.start_unix_s is None:
+            return None
+        import datetime
+
+        return datetime.datetime.fromtimestamp(self.start_unix_s, tz=datetime.timezone.utc)
+
     def to_frame(self):
         """A pandas DataFrame: one column per channel, index ``time_s`` (s); ``attrs`` holds
-        ``fs`` (Hz), ``units`` and ``name``."""
+        ``fs`` (Hz), ``units``, ``name`` and ``start_unix_s`` (None when unknown)."""
         pd = require_pandas("Recording.to_frame")
         df = pd.DataFrame(self.data.T, columns=self.channels, index=pd.Index(self.time_s, name="time_s"))
-        df.attrs.update(fs=self.fs, units=dict(zip(self.channels, self.units)), name=self.name)
+        df.attrs.update(
+            fs=self.fs, units=dict(zip(self.channels, self.units)), name=self.name, start_unix_s=self.start_unix_s
+        )
         return df
 
     def _native_tuple(self):
@@ -113,16 +132,18 @@ def read(
     the time column's unit (``s``, ``ms``, ``us``, ``ns``, ``min``, ``h``) when its name and header
     do not say (``--time-unit``); :func:`analyze` and the fleet functions take the same options.
 
-    Returns a :class:`Recording` (``data, fs, names = vibmode.read(path)`` unpacks it), or with
-    ``as_frame=True`` a pandas DataFrame (index ``time_s``, ``attrs['fs']`` in Hz).
+    Returns a :class:`Recording` (``data, fs, names = vibmode.read(path)`` unpacks it; its
+    ``start`` is the first sample's UTC time when the time column told it), or with
+    ``as_frame=True`` a pandas DataFrame (index ``time_s``, ``attrs['fs']`` in Hz,
+    ``attrs['start_unix_s']``).
     Raises OSError (FileNotFoundError) for files that cannot be read, ValueError for contents.
     """
     sel = None if channels is None else [str(c) for c in channels]
-    data, rate, names, units, placements = _native.read(
+    data, rate, names, units, placements, start = _native.read(
         os.fspath(path), None if fs is None else _check_fs(fs), float(scale), unit,
         bool(allow_nonuniform), format, sel, time_unit,
     )
-    rec = Recording(data, rate, names, units, json.loads(placements), name=os.fspath(path))
+    rec = Recording(data, rate, names, units, json.loads(placements), name=os.fspath(path), start_unix_s=start)
     return rec.to_frame() if as_frame else rec
 
 

@@ -10,7 +10,8 @@ __version__: str
 
 F64 = npt.NDArray[np.float64]
 C128 = npt.NDArray[np.complex128]
-_PyRecording = Tuple[F64, float, List[str], List[str], str]
+# data, rate (Hz), names, units, placements (JSON), the first sample's Unix time (s) or None
+_PyRecording = Tuple[F64, float, List[str], List[str], str, Optional[float]]
 
 class _SegmentArgs(TypedDict):
     """scipy's segment arguments as vibmode._spectral._segment_args gives them."""
@@ -46,6 +47,7 @@ def ssi_cov(
 def read(
     path: str, fs: Optional[float] = None, scale: float = 1.0, unit: Optional[str] = None,
     allow_nonuniform: bool = False, format: Optional[str] = None, channels: Optional[List[str]] = None,
+    time_unit: Optional[str] = None,
 ) -> _PyRecording: ...
 def write(
     path: str, data: F64, fs: float, names: List[str], units: List[str], placements: Optional[str] = None,
