@@ -283,14 +283,17 @@ pub fn parse_time_of_day(cell: &[u8]) -> Option<f64> {
     if text.len() < 7 || text.bytes().filter(|&b| b == b':').count() != 2 {
         return None;
     }
-    let upper = text.to_ascii_uppercase();
-    let t = match upper
-        .strip_suffix("AM")
-        .or_else(|| upper.strip_suffix("PM"))
-    {
-        Some(_) => chrono::NaiveTime::parse_from_str(&upper, "%I:%M:%S%.f %p").ok()?,
-        None => chrono::NaiveTime::parse_from_str(text, "%H:%M:%S%.f").ok()?,
+    // A 12-hour clock ends in AM or PM (chrono reads either case); no allocation per cell.
+    let twelve_hour = matches!(
+        text.as_bytes(),
+        [.., b'A' | b'a' | b'P' | b'p', b'M' | b'm']
+    );
+    let format = if twelve_hour {
+        "%I:%M:%S%.f %p"
+    } else {
+        "%H:%M:%S%.f"
     };
+    let t = chrono::NaiveTime::parse_from_str(text, format).ok()?;
     let secs = chrono::Timelike::num_seconds_from_midnight(&t);
     let nanos = chrono::Timelike::nanosecond(&t);
     Some(f64::from(secs) + f64::from(nanos) * 1e-9)
