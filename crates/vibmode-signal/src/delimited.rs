@@ -275,14 +275,16 @@ fn parse_slash_datetime(cell: &[u8]) -> Option<((u32, u32, i32), f64)> {
     Some((date, parse_time_of_day(&text[gap + 1..])?))
 }
 
-/// Seconds since midnight of a time of day `HH:MM:SS` or `HH:MM:SS.fff` (24-hour clock, one or
-/// two digits for the hour), or the same on a 12-hour clock followed by `AM` or `PM` (any case);
-/// `None` for anything else.
+/// Seconds since midnight of a time of day `HH:MM:SS` or `HH:MM:SS.fff` (or `,fff`; 24-hour
+/// clock, one or two digits for the hour), or the same on a 12-hour clock followed by `AM` or
+/// `PM` (any case); `None` for anything else.
 pub fn parse_time_of_day(cell: &[u8]) -> Option<f64> {
     let text = std::str::from_utf8(trim_cell(cell)).ok()?;
     if text.len() < 7 || text.bytes().filter(|&b| b == b':').count() != 2 {
         return None;
     }
+    let mut buf = [0u8; DATETIME_BYTES_MAX];
+    let text = decimal_point(text, &mut buf)?;
     // A 12-hour clock ends in AM or PM (chrono reads either case); no allocation per cell.
     let twelve_hour = matches!(
         text.as_bytes(),
@@ -374,23 +376,57 @@ impl ColumnInfo {
 /// The instant of a date-time cell as Unix seconds and nanoseconds: ISO 8601 / RFC 3339 with `T`
 /// or a space between date and time, optional fraction of a second, and an optional `Z` or
 /// `+hh:mm` offset (without one the time is taken as UTC; only differences are used):
-/// `2026-11-27 05:00:00`, `2026-11-27T05:00:00.000050`, `2026-11-27 05:00:00.25+01:00`.
+/// `2026-11-27 05:00:00`, `2026-11-27T05:00:00.000050`, `2026-11-27 05:00:00.25+01:00`; or a
+/// European `DD.MM.YYYY HH:MM:SS[.fff]` (`27.11.2026 05:00:00`). The fraction may follow a
+/// decimal comma (`05:00:00,25`, as ISO 8601 allows and European software writes).
 pub fn parse_datetime(cell: &[u8]) -> Option<(i64, u32)> {
     let text = std::str::from_utf8(trim_cell(cell)).ok()?;
-    // The shortest form is `YYYY-MM-DD HH:MM:SS`; a plain number is never a date-time.
-    if text.len() < 19 || text.as_bytes().get(4) != Some(&b'-') {
+    // The shortest form is `YYYY-MM-DD HH:MM:SS` (`D.M.YYYY HH:MM:SS`); a plain number is never a
+    // date-time.
+    if text.len() < 16 {
         return None;
+    }
+    let mut buf = [0u8; DATETIME_BYTES_MAX];
+    let text = decimal_point(text, &mut buf)?;
+    let utc = |t: chrono::NaiveDateTime| {
+        let t = t.and_utc();
+        (t.timestamp(), t.timestamp_subsec_nanos())
+    };
+    if text.as_bytes().get(4) != Some(&b'-') {
+        // `DD.MM.YYYY HH:MM:SS[.fff]`.
+        let (date, time) = text.split_once(|c: char| c.is_ascii_whitespace())?;
+        let date = chrono::NaiveDate::parse_from_str(date, "%d.%m.%Y").ok()?;
+        let time = chrono::NaiveTime::parse_from_str(time.trim_start(), "%H:%M:%S%.f").ok()?;
+        return Some(utc(date.and_time(time)));
     }
     if let Ok(t) = chrono::DateTime::parse_from_rfc3339(text) {
         return Some((t.timestamp(), t.timestamp_subsec_nanos()));
     }
-    for format in ["%Y-%m-%d %H:%M:%S%.f", "%Y-%m-%dT%H:%M:%S%.f"] {
-        if let Ok(t) = chrono::NaiveDateTime::parse_from_str(text, format) {
-            let t = t.and_utc();
-            return Some((t.timestamp(), t.timestamp_subsec_nanos()));
+    ["%Y-%m-%d %H:%M:%S%.f", "%Y-%m-%dT%H:%M:%S%.f"]
+        .iter()
+        .find_map(|f| chrono::NaiveDateTime::parse_from_str(text, f).ok())
+        .map(utc)
+}
+
+/// The longest date-time or time-of-day cell read ([`parse_datetime`]): an RFC 3339 instant
+/// with nanoseconds and an offset is 35 bytes.
+const DATETIME_BYTES_MAX: usize = 48;
+
+/// `text` with the decimal comma of its seconds (`05:00:00,005`) made a point, copied into `buf`;
+/// `text` itself when it has no comma; `None` when it has more than one, or is longer than `buf`.
+fn decimal_point<'b>(text: &'b str, buf: &'b mut [u8; DATETIME_BYTES_MAX]) -> Option<&'b str> {
+    match text.bytes().filter(|&b| b == b',').count() {
+        0 => Some(text),
+        1 if text.len() <= buf.len() => {
+            let out = &mut buf[..text.len()];
+            out.copy_from_slice(text.as_bytes());
+            for b in out.iter_mut().filter(|b| **b == b',') {
+                *b = b'.';
+            }
+            std::str::from_utf8(out).ok()
         }
+        _ => None,
     }
-    None
 }
 
 /// Seconds from `base` to `t` (both Unix seconds and nanoseconds), exact to the nanosecond for
@@ -622,6 +658,7 @@ fn time_scale(name: &str, unit: &str) -> Option<f64> {
                 | "t"
                 | "timestamp"
                 | "zeit"
+                | "zeitstempel"
                 | "epoch"
                 | "epoch_time"
                 | "unix"
@@ -765,7 +802,7 @@ fn comment_header(
 }
 
 /// Marks the time column written as text ([`TimeText`]): a column named as a time column (or
-/// `datetime`, `date_time`, `date`), or an unnamed first column (pandas' `DatetimeIndex`), whose
+/// `datetime`, `date_time`, `date`, `datum`), or an unnamed first column (pandas' `DatetimeIndex`), whose
 /// first data cell is a date-time ([`parse_datetime`]), or, named as a time column, a number
 /// and a time unit ([`parse_with_unit`]); the first such column only.
 fn mark_text_time(
@@ -812,7 +849,7 @@ fn mark_text_time(
         let head = trim_cell(&header[a..b]);
         let lower = col.name.to_ascii_lowercase();
         let named = col.time_scale_s.is_some()
-            || matches!(lower.as_str(), "datetime" | "date_time" | "date")
+            || matches!(lower.as_str(), "datetime" | "date_time" | "date" | "datum")
             || (c == 0 && (head.is_empty() || head.eq_ignore_ascii_case(b"Unnamed: 0")));
         if !named {
             continue;
@@ -1640,13 +1677,15 @@ mod tests {
             "2026-11-27T05:00:00.25+01:00",
             " 2026-11-27 04:00:00.250Z ",
             "\"2026-11-27 04:00:00.25\"",
+            "27.11.2026 04:00:00.25",
+            "27.11.2026 04:00:00,25",
         ] {
             assert_eq!(parse_datetime(cell.as_bytes()), Some(t), "{cell}");
         }
         for cell in [
             "1795752000.25",
             "2026-11-27",
-            "27.11.2026 04:00:00",
+            "31.11.2026 04:00:00",
             "2026-11-31 04:00:00",
         ] {
             assert_eq!(parse_datetime(cell.as_bytes()), None, "{cell}");
@@ -1730,6 +1769,30 @@ mod tests {
         );
         assert_eq!(parse_date_in(b"11/27/2026", DateOrder::DayMonthYear), None);
         assert_eq!(parse_date_in(b"27.11.2026", DateOrder::MonthDayYear), None);
+        // European date-times and decimal commas: 2026-11-27 05:00:00.25 UTC.
+        let at = (20784 * 86_400 + 18_000, 250_000_000);
+        for cell in [
+            "27.11.2026 05:00:00,25",
+            "27.11.2026 05:00:00.25",
+            "2026-11-27 05:00:00,25",
+            "2026-11-27T05:00:00,25Z",
+        ] {
+            assert_eq!(parse_datetime(cell.as_bytes()), Some(at), "{cell}");
+        }
+        assert_eq!(
+            parse_datetime(b"1.2.2026 00:00:00"),
+            Some((20485 * 86_400, 0))
+        );
+        for cell in [
+            "27.13.2026 05:00:00",
+            "27.11.2026 05:00:00,25,1",
+            "27.11.2026",
+            "1234567890123456",
+        ] {
+            assert_eq!(parse_datetime(cell.as_bytes()), None, "{cell}");
+        }
+        let got = parse_time_of_day(b"05:00:00,005").unwrap_or(f64::NAN);
+        assert!((got - 18_000.005).abs() < 1e-9, "{got}");
         let t = parse_slash_datetime(b"11/27/2026 11:59:55.5 PM").unwrap();
         assert_eq!(t, ((11, 27, 2026), 86_395.5));
         assert_eq!(parse_slash_datetime(b"11/27/26 08:00:00"), None);
@@ -1767,6 +1830,7 @@ mod tests {
         assert_eq!(time_scale("unix_time", ""), Some(1.0));
         assert_eq!(time_scale("Unix_Time_ms", ""), Some(1e-3));
         assert_eq!(time_scale("epoch", "ms"), Some(1e-3));
+        assert_eq!(time_scale("Zeitstempel", "ms"), Some(1e-3));
         assert_eq!(time_scale("Time", "furlongs"), None);
         assert_eq!(time_scale("x", "s"), None);
         assert_eq!(time_scale("Time_ms", ""), Some(1e-3));

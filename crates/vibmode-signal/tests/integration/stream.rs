@@ -944,6 +944,15 @@ fn a_split_date_and_time_or_a_time_of_day_is_the_time() {
             false,
             true,
         ),
+        (
+            "european one cell",
+            "Zeitstempel;a;b",
+            ";",
+            Some(["27.11.2026", "28.11.2026"]),
+            " ",
+            false,
+            true,
+        ),
         ("time of day", "Time,a,b", ",", None, ",", false, false),
         // Slash dates: the order of day and month from a part above 12.
         (
@@ -1006,6 +1015,12 @@ fn a_split_date_and_time_or_a_time_of_day_is_the_time() {
         for (i, (a, b)) in rows.iter().enumerate() {
             let (day, hms) = clock(i);
             let hms = if twelve { twelve_hour(&hms) } else { hms };
+            // Decimal commas in the times too where the separator is a semicolon.
+            let hms = if sep == ";" {
+                hms.replace('.', ",")
+            } else {
+                hms
+            };
             let (a, b) = if sep == ";" {
                 (
                     a.to_string().replace('.', ","),
@@ -1033,7 +1048,13 @@ fn a_split_date_and_time_or_a_time_of_day_is_the_time() {
             whole.fs_hz
         );
         let axis = whole.time_axis.clone().unwrap();
-        assert!((axis.start_s - start_s).abs() < 1e-9, "{case}");
+        // A date-time in one cell counts from its first row; times of day from midnight.
+        let first_s = if case == "european one cell" {
+            0.0
+        } else {
+            start_s
+        };
+        assert!((axis.start_s - first_s).abs() < 1e-9, "{case}");
         let start = axis.start_unix_s();
         if known {
             // 2026-11-27 23:59:55 UTC: 20784 days and 86 395 s after 1970-01-01.
