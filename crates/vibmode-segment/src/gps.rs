@@ -820,7 +820,7 @@ fn read_csv(text: &str, p: &str) -> Result<Raw, SegmentError> {
                 None if v.abs() > GPS_TIME_ABS_MAX_S => (v * 1e-3, true),
                 None => (v, v > 1e8),
             },
-            _ => match parse_rfc3339(cell(tc)) {
+            _ => match parse_rfc3339(cell(tc)).or_else(|| csv_datetime(cell(tc))) {
                 Some(v) => (v, true),
                 None => {
                     return Err(track_err(
@@ -873,4 +873,12 @@ pub fn bearing_deg(a: &GpsFix, b: &GpsFix) -> f64 {
     let y = dl.sin() * p2.cos();
     let x = p1.cos() * p2.sin() - p1.sin() * p2.cos() * dl.cos();
     (y.atan2(x).to_degrees() + 360.0) % 360.0
+}
+
+/// Unix seconds of a CSV time cell written as a date-time the recordings' reader takes
+/// ([`vibmode_signal::delimited::parse_datetime`]): `2024-05-02 07:31:00.25` (no offset: UTC),
+/// `02.05.2024 07:31:00,25`, an ISO 8601 time with a decimal comma.
+fn csv_datetime(text: &str) -> Option<f64> {
+    let (s, ns) = vibmode_signal::delimited::parse_datetime(text.as_bytes())?;
+    Some(s as f64 + f64::from(ns) * 1e-9)
 }

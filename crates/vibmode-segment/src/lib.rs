@@ -626,8 +626,8 @@ pub enum TrackProblem {
         /// The cell.
         text: String,
     },
-    /// A CSV time cell that is neither seconds nor RFC 3339.
-    #[error("line {line}: time '{}' is neither seconds nor an RFC 3339 time such as 2024-05-02T07:31:00Z", quoted(.text))]
+    /// A CSV time cell that is neither seconds nor a date-time.
+    #[error("line {line}: time '{}' is neither seconds nor a date-time such as 2024-05-02T07:31:00Z or 2024-05-02 07:31:00", quoted(.text))]
     CellTime {
         /// The line.
         line: usize,

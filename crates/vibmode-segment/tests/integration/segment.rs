@@ -178,6 +178,8 @@ fn gps_csv_columns_found_by_name_patterns() {
     let t0 = 1_714_635_060.0;
     let mut plain = String::from("time,lat,lon,speed\n");
     let mut car = String::from("Timestamp,Long_Acc,Lat_GNSS,Long_GNSS\n");
+    // A phone app's date-times: a space, no offset (UTC).
+    let mut phone = String::from("time,lat,lon\n");
     for i in 0..=60 {
         let t = i as f64;
         let north = 10.0 * t.min(38.0);
@@ -185,7 +187,16 @@ fn gps_csv_columns_found_by_name_patterns() {
         let lat = 48.0 + north / 111_195.08;
         plain.push_str(&format!("{},{lat},17.0,{v}\n", t0 + t));
         car.push_str(&format!("{},0.1,{lat},17.0\n", (t0 + t) as u64 * 1000));
+        phone.push_str(&format!(
+            "2024-05-02 07:{:02}:{:02}.000,{lat},17.0\n",
+            31 + i / 60,
+            i % 60
+        ));
     }
+    let phone_p = dir.path().join("phone.csv");
+    std::fs::write(&phone_p, phone).unwrap();
+    let c = read_track(&phone_p).unwrap();
+    assert!(c.absolute);
     let plain_p = dir.path().join("plain.csv");
     let car_p = dir.path().join("car.csv");
     std::fs::write(&plain_p, plain).unwrap();
@@ -205,9 +216,12 @@ fn gps_csv_columns_found_by_name_patterns() {
     let b = read_track(&car_p).unwrap();
     assert!(a.absolute && b.absolute);
     assert_eq!(a.fixes.len(), b.fixes.len());
-    for (x, y) in a.fixes.iter().zip(&b.fixes) {
+    assert_eq!(a.fixes.len(), c.fixes.len());
+    for ((x, y), z) in a.fixes.iter().zip(&b.fixes).zip(&c.fixes) {
         assert!((x.t_s - y.t_s).abs() < 1e-6, "{} {}", x.t_s, y.t_s);
+        assert!((x.t_s - z.t_s).abs() < 1e-6, "{} {}", x.t_s, z.t_s);
         assert_eq!((x.lat_deg, x.lon_deg), (y.lat_deg, y.lon_deg));
+        assert_eq!((x.lat_deg, x.lon_deg), (z.lat_deg, z.lon_deg));
         assert!(y.speed_kmh.is_none());
     }
     let p = SegmentParams::default();
