@@ -140,7 +140,33 @@ pub struct LineFree {
     /// continuum ([`continuum`]), for the unsprung level ratios.
     #[serde(default)]
     pub ratio_band_rms: Vec<Option<f64>>,
+    /// Per entry of [`RecordFeatures::channels`] (same order): the one-sided density (unit^2/Hz)
+    /// of the unsprung channel's white noise floor, measured at the file's own rate above the
+    /// ratio band ([`noise_range_hz`], [`vibmode_vehicle::update::noise_floor_density`]; the
+    /// median over the file's records), 0 where the rate leaves no such range, the floor is not flat (motion, not
+    /// noise) or the channel is not unsprung. Its power in the band is taken out of the band's
+    /// before the unsprung level ratios (by model sets built from records that have it,
+    /// [`crate::model::ModelSet::noise_free`]). Empty in records stored before it existed.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub noise_density: Vec<f64>,
 }
+
+/// Where an unsprung channel's spectrum is taken as its sensor's noise floor, Hz: from
+/// [`NOISE_FROM_BAND_EDGE`] times the band's upper edge (and at least 5 % of the rate) to 0.4
+/// times the rate, two octaves at least (so that a spectrum still falling there, the wheel's
+/// motion, is told from a flat floor: [`vibmode_vehicle::update::FLAT_FLOOR`]); `None` when the
+/// rate is too low (below 100 times the edge: 2 kHz for the 20 Hz of the ratio band).
+pub fn noise_range_hz(band_hz: [f64; 2], fs_hz: f64) -> Option<[f64; 2]> {
+    let lo = (NOISE_FROM_BAND_EDGE * band_hz[1]).max(0.05 * fs_hz);
+    let hi = 0.4 * fs_hz;
+    (hi >= 4.0 * lo).then_some([lo, hi])
+}
+
+/// How far above the ratio band's upper edge the noise floor is measured: a wheel's response
+/// above wheel hop falls at least as fast as `f^-2` in power, so at 10 times the edge it is a
+/// hundredth of its level there; busgen's unsprung channels are at their noise floor from about
+/// 40 Hz on.
+pub const NOISE_FROM_BAND_EDGE: f64 = 10.0;
 
 /// Half-width, in Welch bins, of the band left out around a detected periodic line: a Hann
 /// window spreads a line over its main lobe of +-2 bins, and at 1.5 bins off the line its power
@@ -642,6 +668,31 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
         .map(|l| l.frequency_range_hz)
         .collect();
     let unsprung_lines = line_bins(&freq, &unsprung_ranges);
+    // The unsprung sensors' noise floors, measured at the file's rate on each record (the median
+    // over the records: a record with a knock or a tone in the range counts once).
+    let noise_range = noise_range_hz(cfg.ratio_band_hz, rec.fs_hz);
+    let mut noise_density = Vec::with_capacity(channels.len());
+    for (c, ch) in channels.iter().enumerate() {
+        let Some(range) = noise_range.filter(|_| ch.role == Role::Unsprung) else {
+            noise_density.push(0.0);
+            continue;
+        };
+        let mut per: Vec<f64> = Vec::with_capacity(records.len());
+        for r in &records {
+            let Some(x) = r.recording.channels.get(c) else {
+                continue;
+            };
+            match vibmode_vehicle::update::noise_floor_density(&x.samples, r.recording.fs_hz, range)
+            {
+                Ok(d) if d.is_finite() && d >= 0.0 => per.push(d),
+                _ => notes.push(format!(
+                    "channel {}: the noise floor of {} could not be measured; its level ratios keep the noise",
+                    ch.name, r.name
+                )),
+            }
+        }
+        noise_density.push(crate::stats::median(&per).unwrap_or(0.0));
+    }
     let [rlo, rhi] = cfg.ratio_band_hz;
     let line_free = LineFree {
         line_bins_hz: freq
@@ -674,6 +725,7 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
             .take(channels.len())
             .map(|p| finite(band_rms(&freq, &continuum(p, &unsprung_lines), rlo, rhi)))
             .collect(),
+        noise_density,
     };
     if !channels.iter().any(|c| c.role == Role::Unsprung) {
         notes.push("no unsprung channel: no excitation levels".into());

@@ -86,6 +86,19 @@ fn ratio_key(kind: Kind, name: &str, band: &[f64; 2], line_free: bool) -> String
     format!("{prefix}:{name}:{}{lf}", band_key(band))
 }
 
+/// Largest share of a channel's band power that may be sensor noise for its level to enter a
+/// ratio: beyond it the band says more about the sensor than about the wheel, and the ratio is
+/// left out (`missing`) rather than computed from a small difference of two noisy powers.
+pub const NOISE_SHARE_MAX: f64 = 0.5;
+
+/// The band RMS `level` without the noise power `noise_power` (unit^2) in the band:
+/// `sqrt(level^2 - noise_power)`; `None` when the noise is more than [`NOISE_SHARE_MAX`] of the
+/// band's power.
+pub fn noise_free_level(level: f64, noise_power: f64) -> Option<f64> {
+    let power = level * level;
+    (noise_power <= NOISE_SHARE_MAX * power).then(|| (power - noise_power.max(0.0)).sqrt())
+}
+
 /// Where a feature comes from, and its name in tables.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FeatureMeta {
@@ -207,6 +220,13 @@ pub struct ModelSet {
     /// ([`FleetError::StaleBaseline`]).
     #[serde(default)]
     pub line_free: bool,
+    /// Built from unsprung level ratios with each channel's noise power in the band taken out
+    /// ([`crate::features::LineFree::noise_density`] of every nominal record): on a smooth road
+    /// the sensors' noise, alike in every channel, is a large share of the wheels' band power and
+    /// pulls every ratio towards 1. False in model sets stored before it existed and in those
+    /// built from records stored before it; their checks keep the ratios as they were.
+    #[serde(default)]
+    pub noise_free: bool,
     /// The suspension fitted to the nominal records together, when the vehicle has a
     /// registered model file and at least three nominal records carry its equations
     /// ([`crate::suspension`]); else absent and `notes` says why.
@@ -497,13 +517,16 @@ fn transmissibility_features(
 ///
 /// `line_free` (the model set's [`ModelSet::line_free`]): the transmissibility with the periodic
 /// lines left out and the level ratios with the unsprung lines replaced by their continuum,
-/// under their own keys.
+/// under their own keys. `noise_free` (the model set's [`ModelSet::noise_free`], with
+/// `line_free`): each unsprung channel's noise power in the band taken out of its band power
+/// before the level ratios ([`noise_free_level`]).
 pub fn scalar_features(
     rf: &RecordFeatures,
     slots: &[ModeSlot],
     body: Option<&BodyModel>,
     cfg: &FleetConfig,
     line_free: bool,
+    noise_free: bool,
 ) -> Vec<(FeatureMeta, f64)> {
     let mut out = body.map_or_else(Vec::new, |b| body_features(rf, b, cfg));
     // Road level per band: the mean of ln(band RMS) over the unsprung channels that have it.
@@ -540,12 +563,15 @@ pub fn scalar_features(
             .position(|c| c.role == Role::Unsprung && c.corner == Some(corner))?;
         let c = &rf.channels[i];
         let level = if line_free {
-            rf.line_free
-                .as_ref()?
-                .ratio_band_rms
-                .get(i)
-                .copied()
-                .flatten()
+            let lf = rf.line_free.as_ref()?;
+            let level = lf.ratio_band_rms.get(i).copied().flatten()?;
+            if noise_free {
+                let density = lf.noise_density.get(i).copied().unwrap_or(0.0);
+                let [lo, hi] = cfg.ratio_band_hz;
+                noise_free_level(level, density * (hi - lo))
+            } else {
+                Some(level)
+            }
         } else {
             c.ratio_band_rms
         };
@@ -863,13 +889,19 @@ pub fn build_model_set(
     }
     let slots = mode_slots(records, cfg);
     let line_free = records.iter().all(|r| r.line_free.is_some());
+    let noise_free = line_free
+        && records.iter().all(|r| {
+            r.line_free
+                .as_ref()
+                .is_some_and(|l| !l.noise_density.is_empty())
+        });
     let mut notes = Vec::new();
     let body = fit_body(records, cfg, &mut notes);
     let values: Vec<Vec<(FeatureMeta, f64)>> = records
         .iter()
         .enumerate()
         .map(|(i, r)| {
-            let mut v = scalar_features(r, &slots, None, cfg, line_free);
+            let mut v = scalar_features(r, &slots, None, cfg, line_free, noise_free);
             if let Some((_, loo)) = &body {
                 v.extend(loo[i].iter().cloned());
             }
@@ -953,6 +985,7 @@ pub fn build_model_set(
         body: body.map(|b| b.0),
         notes,
         line_free,
+        noise_free,
         suspension: None,
     })
 }
@@ -985,6 +1018,7 @@ pub fn assess(set: &ModelSet, rf: &RecordFeatures) -> Assessment {
         set.body.as_ref(),
         &set.config,
         set.line_free,
+        set.noise_free,
     );
     let mut a = score_values(set, &values, &[]);
     if !rf.sensor_faults.is_empty() {
@@ -1044,6 +1078,7 @@ pub fn assess_drive_fitted(
             set.body.as_ref(),
             &set.config,
             set.line_free,
+            set.noise_free,
         ) {
             by_key
                 .entry(m.key.clone())
@@ -1704,7 +1739,7 @@ mod tests {
         let z = slots[0].damping_ratio.expect("damping");
         assert!((z - 0.305).abs() < 1e-9, "{z}");
         let damping = |r: &RecordFeatures| {
-            scalar_features(r, &slots, None, &cfg, false)
+            scalar_features(r, &slots, None, &cfg, false, false)
                 .into_iter()
                 .find(|(m, _)| m.kind == Kind::ModeDamping)
                 .map(|(_, x)| x.exp())
@@ -1715,7 +1750,7 @@ mod tests {
         // A model set stored before the damping class matches any damping.
         let mut old = slots.clone();
         old[0].damping_ratio = None;
-        let any = scalar_features(&moded(9.1, 0.03), &old, None, &cfg, false);
+        let any = scalar_features(&moded(9.1, 0.03), &old, None, &cfg, false, false);
         assert!(any.iter().any(|(m, _)| m.kind == Kind::ModeDamping));
     }
 
@@ -1944,6 +1979,84 @@ mod tests {
             suspension: None,
             start_unix_s: None,
         }
+    }
+
+    /// Four wheels' line-free levels `l` and their noise densities `d` (unit^2/Hz).
+    fn noisy_wheels(l: [f64; 4], d: [f64; 4]) -> RecordFeatures {
+        let mut r = wheels([1.0; 4]);
+        r.line_free = Some(crate::features::LineFree {
+            line_bins_hz: Vec::new(),
+            h1: Vec::new(),
+            ratio_band_rms: l.iter().map(|v| Some(*v)).collect(),
+            noise_density: d.to_vec(),
+        });
+        r
+    }
+
+    /// By hand, the band 8-20 Hz (12 Hz wide): FL's level 2 with a density 1/12 (noise power 1)
+    /// becomes sqrt(4 - 1) = sqrt(3); RL's level 1 without noise stays 1; the left front/rear
+    /// ratio is then ln sqrt(3) = 0.549 instead of ln 2. FR's level 1 with a noise power of
+    /// 0.6 (> half its power) leaves the ratios with FR out.
+    #[test]
+    fn noise_power_comes_out_of_the_level_ratios_by_hand() {
+        let cfg = FleetConfig::default();
+        assert_eq!(cfg.ratio_band_hz, [8.0, 20.0]);
+        assert_eq!(noise_free_level(2.0, 1.0), Some(3f64.sqrt()));
+        assert_eq!(noise_free_level(2.0, 0.0), Some(2.0));
+        assert_eq!(noise_free_level(1.0, 0.5), Some(0.5f64.sqrt()));
+        assert_eq!(noise_free_level(1.0, 0.6), None);
+        let r = noisy_wheels([2.0, 1.0, 1.0, 1.0], [1.0 / 12.0, 0.6 / 12.0, 0.0, 0.0]);
+        let get = |noise_free: bool, key: &str| {
+            scalar_features(&r, &[], None, &cfg, true, noise_free)
+                .into_iter()
+                .find(|(m, _)| m.key == key)
+                .map(|(_, v)| v)
+        };
+        let left = ratio_key(Kind::TrackRatio, "left", &cfg.ratio_band_hz, true);
+        let right = ratio_key(Kind::TrackRatio, "right", &cfg.ratio_band_hz, true);
+        let front = ratio_key(Kind::SideRatio, "front", &cfg.ratio_band_hz, true);
+        let x = get(true, &left).unwrap_or(f64::NAN);
+        assert!((x - 0.5 * 3f64.ln()).abs() < 1e-12, "{x}");
+        assert_eq!(get(false, &left), Some(2f64.ln()));
+        assert_eq!(get(true, &right), None);
+        assert_eq!(get(true, &front), None);
+        assert_eq!(get(false, &right), Some(0.0));
+        // A record without densities (stored before them) keeps its levels.
+        let mut old = r.clone();
+        if let Some(lf) = old.line_free.as_mut() {
+            lf.noise_density.clear();
+        }
+        let x = scalar_features(&old, &[], None, &cfg, true, true)
+            .into_iter()
+            .find(|(m, _)| m.key == left)
+            .map(|(_, v)| v);
+        assert_eq!(x, Some(2f64.ln()));
+    }
+
+    /// A model set is noise-free when every nominal record has the densities; one record without
+    /// them (stored before) leaves the whole set as it was.
+    #[test]
+    fn a_model_set_takes_the_noise_out_only_when_every_record_has_it() {
+        let cfg = FleetConfig::default();
+        let recs: Vec<RecordFeatures> = (0..6)
+            .map(|i| noisy_wheels([1.0 + 0.01 * i as f64, 1.0, 1.0, 1.0], [0.01; 4]))
+            .collect();
+        let names: Vec<String> = (0..6).map(|i| format!("n{i}")).collect();
+        let set = build_model_set("v", &names, &recs, &cfg).expect("set");
+        assert!(set.line_free && set.noise_free);
+        let mut older = recs.clone();
+        if let Some(lf) = older[3].line_free.as_mut() {
+            lf.noise_density.clear();
+        }
+        let set = build_model_set("v", &names, &older, &cfg).expect("set");
+        assert!(set.line_free && !set.noise_free);
+        // A model set stored before the flag reads as not noise-free.
+        let mut json = serde_json::to_value(&set).expect("json");
+        if let Some(o) = json.as_object_mut() {
+            o.remove("noise_free");
+        }
+        let back: ModelSet = serde_json::from_value(json).expect("old set");
+        assert!(!back.noise_free);
     }
 
     #[test]
@@ -2226,8 +2339,16 @@ mod tests {
     fn a_lowered_body_response_is_the_spring_only_when_the_wheel_level_is_not_raised() {
         let set = wheel_set();
         let cfg = &set.config;
-        let values =
-            |l: [f64; 4]| scalar_features(&wheels(l), &set.slots, None, cfg, set.line_free);
+        let values = |l: [f64; 4]| {
+            scalar_features(
+                &wheels(l),
+                &set.slots,
+                None,
+                cfg,
+                set.line_free,
+                set.noise_free,
+            )
+        };
         let lowered = [body_evidence(Corner::RL, -6.0)];
         // The wheel levels as nominal: the spring.
         assert_eq!(

@@ -221,10 +221,17 @@ fn trend_figure(html: &mut HtmlReport, set: &ModelSet, records: &[RecordEntry]) 
     let values: Vec<Vec<(String, f64)>> = records
         .iter()
         .map(|(_, f, _)| {
-            scalar_features(f, &set.slots, set.body.as_ref(), &set.config, set.line_free)
-                .into_iter()
-                .map(|(m, v)| (m.key, v))
-                .collect()
+            scalar_features(
+                f,
+                &set.slots,
+                set.body.as_ref(),
+                &set.config,
+                set.line_free,
+                set.noise_free,
+            )
+            .into_iter()
+            .map(|(m, v)| (m.key, v))
+            .collect()
         })
         .collect();
     // Vehicle features, most-moved first (largest |z| seen in any record).

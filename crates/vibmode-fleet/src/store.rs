@@ -1508,6 +1508,7 @@ mod tests {
             line_bins_hz: Vec::new(),
             h1: vec![vec![Some(t)]],
             ratio_band_rms: vec![None],
+            noise_density: Vec::new(),
         });
         f
     }
