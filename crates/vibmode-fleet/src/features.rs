@@ -142,8 +142,8 @@ pub struct LineFree {
     pub ratio_band_rms: Vec<Option<f64>>,
     /// Per entry of [`RecordFeatures::channels`] (same order): the one-sided density (unit^2/Hz)
     /// of the unsprung channel's white noise floor, measured at the file's own rate above the
-    /// ratio band ([`noise_range_hz`], [`vibmode_vehicle::update::noise_floor_density`]; the
-    /// median over the file's records), 0 where the rate leaves no such range, the floor is not flat (motion, not
+    /// ratio band ([`noise_range_hz`], [`vibmode_vehicle::update::noise_floor_density`] of each
+    /// record's first [`NOISE_SAMPLES_MAX`] samples; the median over the file's records), 0 where the rate leaves no such range, the floor is not flat (motion, not
     /// noise) or the channel is not unsprung. Its power in the band is taken out of the band's
     /// before the unsprung level ratios (by model sets built from records that have it,
     /// [`crate::model::ModelSet::noise_free`]). Empty in records stored before it existed.
@@ -161,6 +161,11 @@ pub fn noise_range_hz(band_hz: [f64; 2], fs_hz: f64) -> Option<[f64; 2]> {
     let hi = 0.4 * fs_hz;
     (hi >= 4.0 * lo).then_some([lo, hi])
 }
+
+/// Most samples of a record the noise floor is measured from (its first ones): 16384 give
+/// thousands of periodogram bins in each half of the range at any rate that has one (2400 at
+/// 2 kHz over 200-800 Hz), so the medians scatter by about 2 %.
+pub const NOISE_SAMPLES_MAX: usize = 16_384;
 
 /// How far above the ratio band's upper edge the noise floor is measured: a wheel's response
 /// above wheel hop falls at least as fast as `f^-2` in power, so at 10 times the edge it is a
@@ -682,8 +687,10 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
             let Some(x) = r.recording.channels.get(c) else {
                 continue;
             };
-            match vibmode_vehicle::update::noise_floor_density(&x.samples, r.recording.fs_hz, range)
-            {
+            // The floor needs a few thousand bins, not the whole record (an FFT of 200 000
+            // samples per channel and record at 20 kHz would cost a fifth of the ingest).
+            let head = &x.samples[..x.samples.len().min(NOISE_SAMPLES_MAX)];
+            match vibmode_vehicle::update::noise_floor_density(head, r.recording.fs_hz, range) {
                 Ok(d) if d.is_finite() && d >= 0.0 => per.push(d),
                 _ => notes.push(format!(
                     "channel {}: the noise floor of {} could not be measured; its level ratios keep the noise",
