@@ -143,8 +143,9 @@ pub struct LineFree {
     /// Per entry of [`RecordFeatures::channels`] (same order): the one-sided density (unit^2/Hz)
     /// of the unsprung channel's white noise floor, measured at the file's own rate above the
     /// ratio band ([`noise_range_hz`], [`vibmode_vehicle::update::noise_floor_density`] of each
-    /// record's first [`NOISE_SAMPLES_MAX`] samples; the median over the file's records), 0 where the rate leaves no such range, the floor is not flat (motion, not
-    /// noise) or the channel is not unsprung. Its power in the band is taken out of the band's
+    /// record's first [`NOISE_SAMPLES_MAX`] samples; the median over the file's records), 0
+    /// where the rate leaves no such range, the floor is not flat (motion, not noise) or the
+    /// channel is not unsprung. Its power in the band is taken out of the band's
     /// before the unsprung level ratios (by model sets built from records that have it,
     /// [`crate::model::ModelSet::noise_free`]). Empty in records stored before it existed.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -157,9 +158,7 @@ pub struct LineFree {
 /// motion, is told from a flat floor: [`vibmode_vehicle::update::FLAT_FLOOR`]); `None` when the
 /// rate is too low (below 100 times the edge: 2 kHz for the 20 Hz of the ratio band).
 pub fn noise_range_hz(band_hz: [f64; 2], fs_hz: f64) -> Option<[f64; 2]> {
-    let lo = (NOISE_FROM_BAND_EDGE * band_hz[1]).max(0.05 * fs_hz);
-    let hi = 0.4 * fs_hz;
-    (hi >= 4.0 * lo).then_some([lo, hi])
+    vibmode_vehicle::update::noise_range_above(band_hz, fs_hz, NOISE_FROM_BAND_EDGE)
 }
 
 /// Most samples of a record the noise floor is measured from (its first ones): 16384 give

@@ -1249,9 +1249,27 @@ pub const FLAT_FLOOR: f64 = 1.5;
 /// times below the noise from 40 Hz on. `None` when the rate is too low (below about 60 times
 /// the band's upper edge, 130 Hz on the bus): then nothing is subtracted.
 pub fn noise_range_hz(band_hz: [f64; 2], fs_hz: f64) -> Option<[f64; 2]> {
-    let lo = (15.0 * band_hz[1]).max(0.05 * fs_hz);
+    noise_range_above(band_hz, fs_hz, 15.0)
+}
+
+/// A channel's noise-floor range above a band, Hz: from `factor` times the band's upper edge
+/// (and at least 5 % of the rate) to 0.4 times the rate, below any anti-alias roll-off; `None`
+/// unless it spans two octaves (so that a spectrum still falling there is told from a flat
+/// floor, [`FLAT_FLOOR`]). [`noise_range_hz`] is this with 15, the fleet's level ratios use 10.
+pub fn noise_range_above(band_hz: [f64; 2], fs_hz: f64, factor: f64) -> Option<[f64; 2]> {
+    let lo = (factor * band_hz[1]).max(0.05 * fs_hz);
     let hi = 0.4 * fs_hz;
     (hi >= 4.0 * lo).then_some([lo, hi])
+}
+
+/// The periodic Hann window of `n` samples (`0.5 - 0.5 cos(2 pi k / n)`) and the sum of its
+/// squares.
+pub fn hann_window(n: usize) -> (Vec<f64>, f64) {
+    let w: Vec<f64> = (0..n)
+        .map(|k| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * k as f64 / n as f64).cos())
+        .collect();
+    let wsum = w.iter().map(|v| v * v).sum();
+    (w, wsum)
 }
 
 /// The one-sided density (unit^2/Hz) of the white noise floor of `x` sampled at `fs_hz`, from its
@@ -1266,14 +1284,7 @@ pub fn noise_range_hz(band_hz: [f64; 2], fs_hz: f64) -> Option<[f64; 2]> {
 /// Errors: only an internal FFT failure ([`VehicleError::Numerical`]).
 pub fn noise_floor_density(x: &[f64], fs_hz: f64, range_hz: [f64; 2]) -> Result<f64> {
     let n = x.len();
-    let mut wsum = 0.0;
-    let window: Vec<f64> = (0..n)
-        .map(|k| {
-            let w = 0.5 - 0.5 * (2.0 * std::f64::consts::PI * k as f64 / n as f64).cos();
-            wsum += w * w;
-            w
-        })
-        .collect();
+    let (window, wsum) = hann_window(n);
     let mean = x.iter().sum::<f64>() / n.max(1) as f64;
     floor_density(x, mean, fs_hz, range_hz, &window, wsum)
 }
@@ -1377,21 +1388,10 @@ impl Derivatives {
 
     /// The Hann window of `n` samples and the sum of its squares.
     fn hann(&mut self, n: usize) -> &(Vec<f64>, f64) {
-        let make = || {
-            let mut wsum = 0.0;
-            let w: Vec<f64> = (0..n)
-                .map(|k| {
-                    let w = 0.5 - 0.5 * (2.0 * std::f64::consts::PI * k as f64 / n as f64).cos();
-                    wsum += w * w;
-                    w
-                })
-                .collect();
-            (w, wsum)
-        };
         if self.hann.as_ref().is_some_and(|(w, _)| w.len() != n) {
             self.hann = None;
         }
-        self.hann.get_or_insert_with(make)
+        self.hann.get_or_insert_with(|| hann_window(n))
     }
 
     /// The band-pass gain at `f` Hz.
