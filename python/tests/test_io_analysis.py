@@ -258,3 +258,17 @@ def test_fleet_features_then_store_equals_ingest(tmp_path):
     a = vibmode.fleet.status(db1)[0]
     b = vibmode.fleet.status(db2)[0]
     assert a == b
+
+
+def test_a_dead_or_stuck_channel_is_named_not_analysed(rng):
+    # Before: the stuck channel's rounding noise after resampling gave "modes" and lines.
+    fs = 100.0
+    x = np.stack([rng.standard_normal(2048), np.full(2048, 9.81), np.zeros(2048)])
+    with pytest.raises(ValueError, match=r"channel '1' is constant \(every sample is 9.81\)"):
+        vibmode.analyze(x, fs)
+    with pytest.raises(ValueError, match=r"channel '2' is constant \(every sample is 0\)"):
+        vibmode.analyze(x[[0, 2]], fs)
+    with pytest.raises(ValueError, match=r"constant \(every sample is 9.81\)"):
+        vibmode.ssi_cov(x[:2], fs, block_rows=10, orders=[2, 4, 6])
+    res = vibmode.analyze(x[:1], fs, as_frames=False)
+    assert res["records"]

@@ -299,6 +299,15 @@ fn messages_are_short_and_plain() {
     let f = d.path().join("a.csv");
     csv(&f, 200.0, 512, &[("a", &tone)]);
     fails_with(&["psd", s(&f), "--fs", "-1"], &["-1 Hz"]);
+    // A WAV cut inside its header: the reader's sentence ends before the fix ("bytes.; check"
+    // before).
+    let w = d.path().join("cut.wav");
+    std::fs::write(&w, b"RIFF\x24\x00\x00\x00WAVEfmt ").unwrap();
+    let line = fails_with(
+        &["psd", s(&w)],
+        &["cut.wav", "check that it is a valid WAV file"],
+    );
+    assert!(!line.contains(".;"), "{line}");
 }
 
 #[test]
@@ -342,16 +351,56 @@ fn excel_separator_directive_and_trailing_commas_are_read() {
 }
 
 #[test]
-fn an_analysis_whose_every_fit_failed_is_an_error_with_the_reason() {
+fn a_flat_record_is_an_error_with_the_reason() {
     let d = tempfile::tempdir().unwrap();
     let f = d.path().join("flat.csv");
     csv(&f, 50.0, 1024, &[("a", &|_| 1.0)]);
     let o = d.path().join("o");
     fails_with(
         &["analyze", s(&f), "-o", s(&o), "-q"],
-        &["every one of the", "fits failed", "constant"],
+        &["flat.csv", "channel 'a' is constant", "every sample is 1"],
     );
     assert!(!o.join("results.json").exists());
+}
+
+/// A dead (all 0) or stuck (one value) sensor used to be analysed after resampling: the
+/// pre-processing's rounding noise gave "modes" and 23 "periodic lines" with exit 0 (a stuck
+/// channel at 100 Hz). Now the record and channel are named, nothing is written, and the other
+/// channels are analysed when chosen.
+#[test]
+fn a_dead_or_stuck_sensor_is_named_not_analysed() {
+    let d = tempfile::tempdir().unwrap();
+    let stuck = d.path().join("stuck.csv");
+    csv(&stuck, 100.0, 2048, &[("a", &tone), ("stuck", &|_| 9.81)]);
+    let dead = d.path().join("dead.csv");
+    csv(&dead, 100.0, 2048, &[("a", &tone), ("stuck", &|_| 0.0)]);
+    let o = d.path().join("o");
+    for (f, value) in [(&stuck, "9.81"), (&dead, "0")] {
+        let every = format!("every sample is {value})");
+        fails_with(
+            &["analyze", s(f), "-o", s(&o), "-q"],
+            &["channel 'stuck' is constant", &every, "--channel NAME"],
+        );
+        assert!(!o.exists(), "an output folder for {f:?}");
+        // Among good records, and cut from a long file: the record is named.
+        fails_with(
+            &["analyze", s(f), "-o", s(&o), "-q", "--record-length-s", "5"],
+            &["[0.00-5.00 s]", "channel 'stuck' is constant"],
+        );
+        fails_with(
+            &["ssi", s(f), "--block-rows", "10", "--orders", "2:10:2"],
+            &["channel 'stuck' is constant", &every],
+        );
+        assert!(!o.exists());
+    }
+    let good = d.path().join("good.csv");
+    csv(&good, 100.0, 2048, &[("a", &tone), ("stuck", &noise)]);
+    fails_with(
+        &["analyze", s(&good), s(&stuck), "-o", s(&o), "-q"],
+        &["stuck.csv [0.00-10.24 s]'", "channel 'stuck'"],
+    );
+    ok(&["analyze", s(&stuck), "-c", "a", "-o", s(&o), "-q"]);
+    assert!(o.join("results.json").exists());
 }
 
 /// Sizes of the files under `dir` (for comparing whole outputs).

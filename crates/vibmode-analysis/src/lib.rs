@@ -43,8 +43,8 @@ pub use identify::SweepIdentifier;
 pub use lines::{LineSweep, LineTrack};
 pub use multichannel::{ShapedPole, SsiAnalysis};
 pub use pipeline::{
-    analyze, analyze_keeping_first, analyze_prepared, analyze_with, check_records,
-    preprocess_records, RecordFacts,
+    analyze, analyze_keeping_first, analyze_prepared, analyze_with, check_channels_vary,
+    check_records, preprocess_records, RecordFacts,
 };
 pub use results::{
     AnalysisResults, ChannelAnalysis, RecordSummary, RoleAnalysis, Timing, SCHEMA_VERSION,
@@ -125,6 +125,18 @@ pub enum AnalysisError {
         first: String,
         /// The first record's channels.
         first_channels: String,
+    },
+    /// A channel of a record that carries no vibration: every sample 0 (a dead sensor) or one
+    /// other value (a stuck one), [`vibmode_core::stats::constant_value`]. Its "modes" would be
+    /// those of the rounding noise of the pre-processing.
+    #[error("record '{record}': channel '{channel}' is constant (every sample is {}): a dead or stuck sensor has no vibration to identify; check the sensor, or analyse the record without this channel", vibmode_core::num(.value))]
+    ChannelConstant {
+        /// The record.
+        record: String,
+        /// The channel.
+        channel: String,
+        /// Its one value.
+        value: f64,
     },
     /// Records at different sampling rates.
     #[error("record '{record}' is sampled at {} Hz but '{first}' at {} Hz; resample them to one rate first", short(*fs_hz), short(*first_fs_hz))]

@@ -40,6 +40,22 @@ pub fn check_records(records: &[RecordInput]) -> Result<(), AnalysisError> {
     Ok(())
 }
 
+/// Checks that every channel of `r` varies: a dead or stuck sensor
+/// ([`AnalysisError::ChannelConstant`]) would give the modes of the pre-processing's rounding
+/// noise.
+pub fn check_channels_vary(r: &RecordInput) -> Result<(), AnalysisError> {
+    for ch in &r.recording.channels {
+        if let Some(value) = vibmode_core::stats::constant_value(&ch.samples) {
+            return Err(AnalysisError::ChannelConstant {
+                record: r.name.clone(),
+                channel: ch.name.clone(),
+                value,
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Checks that `r` has the channels and rate of `first`.
 pub fn check_same_layout(first: &RecordInput, r: &RecordInput) -> Result<(), AnalysisError> {
     let names = first.recording.names();
@@ -174,6 +190,9 @@ pub fn analyze_keeping_first(
     cfg.validate()?;
     check_records(records)?;
     let pre = preprocess_records(records, cfg)?;
+    // After the pre-processing's own checks (a rate or a length out of reach is the first thing
+    // to fix).
+    records.iter().try_for_each(check_channels_vary)?;
     let first = pre.first().cloned().ok_or(AnalysisError::NoRecords)?;
     let facts = records.iter().map(RecordFacts::of).collect();
     let results = analyze_prepared(facts, pre, cfg, identifier, reference, progress, t0)?;

@@ -11,7 +11,7 @@ use vibmode_core::{Identifier, RecordInput, RecordMeta, RecordSource, ReferenceM
 use vibmode_signal::{preprocess, Preprocessed};
 
 use crate::config::AnalysisConfig;
-use crate::pipeline::{analyze_prepared, check_same_layout, RecordFacts};
+use crate::pipeline::{analyze_prepared, check_channels_vary, check_same_layout, RecordFacts};
 use crate::results::AnalysisResults;
 use crate::{AnalysisError, FirstRecord};
 
@@ -62,6 +62,7 @@ where
                     preprocess(&r.recording, &cfg.preprocess).map_err(AnalysisError::Signal)
                 })
                 .collect::<Result<_, AnalysisError>>()?;
+            batch.iter().try_for_each(|(r, _)| check_channels_vary(r))?;
             pre.extend(done);
             for (r, meta) in batch {
                 let mut f = RecordFacts::of(&r);

@@ -62,6 +62,27 @@ pub fn dot(x: &[f64], z: &[f64]) -> f64 {
     (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
+/// The value of a channel that carries no vibration: `Some(0.0)` when every sample is 0 (a dead
+/// sensor: its peak magnitude at most [`crate::limits::SAMPLE_PEAK_MIN`]), `Some(v)` when every
+/// sample is `v` to within 1e-9 of the peak (a stuck sensor; rounding of a resampled constant
+/// stays far inside this), `None` otherwise (and for an empty slice). The analysis refuses such
+/// a channel, the fleet calls it `dead` or `flat`. `None` for fewer than 2 samples (too short
+/// is another fault).
+pub fn constant_value(x: &[f64]) -> Option<f64> {
+    if x.len() < 2 {
+        return None;
+    }
+    let first = x[0];
+    let (min, max) = x
+        .iter()
+        .fold((first, first), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    let peak = max.abs().max(min.abs());
+    if peak <= crate::limits::SAMPLE_PEAK_MIN {
+        return Some(0.0);
+    }
+    (max - min <= 1e-9 * peak).then_some(max)
+}
+
 /// The jackknife standard deviation of an estimate from its leave-one-out values `theta`
 /// (`m >= 2` of them): `sqrt((m - 1) / m * sum (theta_s - mean)^2)`. 0 for fewer than two.
 /// SSI-cov's modes, the model update's parameters and the fleet's suspension scores use it.
@@ -78,6 +99,24 @@ pub fn jackknife_std(theta: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_dead_or_stuck_channel_has_a_constant_value_and_a_moving_one_none() {
+        assert_eq!(constant_value(&[]), None);
+        assert_eq!(constant_value(&[1.0]), None);
+        assert_eq!(constant_value(&[0.0; 5]), Some(0.0));
+        assert_eq!(constant_value(&[1e-70, -1e-70]), Some(0.0));
+        assert_eq!(constant_value(&[9.81; 4]), Some(9.81));
+        // Rounding-level wobble of a resampled constant is still constant...
+        assert_eq!(
+            constant_value(&[1.0, 1.0 + 1e-15, 1.0 - 1e-15]),
+            Some(1.0 + 1e-15)
+        );
+        // ...a micro-g vibration on gravity is not, nor is one sign change.
+        assert_eq!(constant_value(&[9.81, 9.81 + 1e-6, 9.81]), None);
+        assert_eq!(constant_value(&[1.0, -1.0]), None);
+        assert_eq!(constant_value(&[0.0, 0.0, 1e-3]), None);
+    }
 
     #[test]
     fn by_hand() {

@@ -293,26 +293,28 @@ pub fn sensor_faults(rec: &Recording, acfg: &AnalysisConfig) -> Vec<SensorFault>
             continue;
         }
         let x = &ch.samples;
-        let max = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        let min = x.iter().copied().fold(f64::INFINITY, f64::min);
-        let peak = max.abs().max(min.abs());
         let fault = |fault, detail| SensorFault {
             channel: ch.name.clone(),
             fault,
             detail,
         };
-        if peak <= vibmode_core::limits::SAMPLE_PEAK_MIN {
-            out.push(fault(FaultKind::Dead, "every sample is 0".into()));
-            continue;
+        match vibmode_core::stats::constant_value(x) {
+            Some(0.0) => {
+                out.push(fault(FaultKind::Dead, "every sample is 0".into()));
+                continue;
+            }
+            Some(v) => {
+                out.push(fault(
+                    FaultKind::Flat,
+                    format!("every sample is {}", vibmode_core::Num(v)),
+                ));
+                continue;
+            }
+            None => {}
         }
+        let max = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let min = x.iter().copied().fold(f64::INFINITY, f64::min);
         let range = max - min;
-        if range <= 1e-9 * peak {
-            out.push(fault(
-                FaultKind::Flat,
-                format!("every sample is {}", vibmode_core::Num(max)),
-            ));
-            continue;
-        }
         let tol = 1e-9 * range;
         let at_max = x.iter().filter(|&&v| v >= max - tol).count();
         let at_min = x.iter().filter(|&&v| v <= min + tol).count();

@@ -188,6 +188,22 @@ pub fn psd(
     })
 }
 
+/// A rate for the terminal: ten significant digits, trailing zeros dropped (a time column of
+/// `i / 100` gives 100.00000000000001 Hz, shown as 100; 425.0796211146227 as 425.0796211). The
+/// JSON keeps every digit.
+fn rate_text(fs_hz: f64) -> String {
+    if !(fs_hz.is_finite() && fs_hz > 0.0) {
+        return format!("{fs_hz}");
+    }
+    let decimals = (9 - fs_hz.log10().floor() as i32).max(0) as usize;
+    let s = format!("{fs_hz:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
 impl PsdOutput {
     /// One line: the file, its rate and length, and the estimator's parameters.
     pub fn header_line(&self) -> String {
@@ -195,7 +211,7 @@ impl PsdOutput {
         format!(
             "{}: fs = {} Hz, {} samples, window {}, nfft {}{}",
             self.source,
-            p.fs_hz,
+            rate_text(p.fs_hz),
             p.n_samples,
             p.window,
             p.nfft,
@@ -319,5 +335,17 @@ impl PsdOutput {
             (xs, ys),
             (xmin, fmax_hz.unwrap_or(nyq).min(nyq)),
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn rates_are_shown_to_ten_digits() {
+        assert_eq!(super::rate_text(100.00000000000001), "100");
+        assert_eq!(super::rate_text(425.0796211146227), "425.0796211");
+        assert_eq!(super::rate_text(20000.0), "20000");
+        assert_eq!(super::rate_text(0.001), "0.001");
+        assert_eq!(super::rate_text(1e7), "10000000");
     }
 }

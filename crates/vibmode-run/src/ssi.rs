@@ -30,7 +30,22 @@ pub fn ssi(
     options: &RecordSsiOptions,
 ) -> Result<SsiOutput, RunError> {
     let chans: Vec<&[f64]> = rec.channels.iter().map(|c| c.samples.as_slice()).collect();
-    let found = vibmode_ssi::identify_record(&chans, rec.fs_hz, params, options)?;
+    let found = vibmode_ssi::identify_record(&chans, rec.fs_hz, params, options).map_err(|e| {
+        match e {
+            // Named as the analysis names it: the record and the channel by name.
+            vibmode_ssi::SsiError::ConstantChannel { channel, value } => {
+                RunError::Analysis(vibmode_analysis::AnalysisError::ChannelConstant {
+                    record: source.to_string(),
+                    channel: rec
+                        .channels
+                        .get(channel)
+                        .map_or_else(|| channel.to_string(), |c| c.name.clone()),
+                    value,
+                })
+            }
+            e => e.into(),
+        }
+    })?;
     Ok(SsiOutput {
         source: source.to_string(),
         channels: rec.channels.iter().map(|c| c.name.clone()).collect(),

@@ -309,13 +309,13 @@ pub enum WavProblem {
         bits: u16,
     },
     /// Not a WAV file the reader understands.
-    #[error("{message}; check that it is a valid WAV file")]
+    #[error("{}; check that it is a valid WAV file", .message.trim_end_matches('.'))]
     Unreadable {
         /// The WAV reader's message.
         message: String,
     },
     /// Samples that cannot be read (whole-file reader).
-    #[error("{message}; the file may be truncated")]
+    #[error("{}; the file may be truncated", .message.trim_end_matches('.'))]
     Truncated {
         /// The WAV reader's message.
         message: String,
@@ -324,7 +324,7 @@ pub enum WavProblem {
     #[error("it contains zero samples; check the recording")]
     NoSamples,
     /// A sample that cannot be read at a frame (streamed reader).
-    #[error("{message} at frame {frame} of the {announced} its header announces: the file is cut off (a recording stopped mid-write?); re-export it, or cut the header's data size to the frames present")]
+    #[error("{} at frame {frame} of the {announced} its header announces: the file is cut off (a recording stopped mid-write?); re-export it, or cut the header's data size to the frames present", .message.trim_end_matches('.'))]
     CutOffAt {
         /// The WAV reader's message.
         message: String,

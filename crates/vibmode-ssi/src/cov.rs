@@ -135,6 +135,9 @@ fn check_channels(channels: &[&[f64]]) -> Result<usize, SsiError> {
                 value,
             });
         }
+        if let Some(value) = vibmode_core::stats::constant_value(ch) {
+            return Err(SsiError::ConstantChannel { channel: c, value });
+        }
     }
     Ok(n)
 }

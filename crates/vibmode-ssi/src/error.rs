@@ -38,6 +38,15 @@ pub enum SsiError {
         /// The value.
         value: f64,
     },
+    /// A channel that carries no vibration: every sample 0 or one other value
+    /// ([`vibmode_core::stats::constant_value`]): a dead or stuck sensor.
+    #[error("channel {channel} is constant (every sample is {}): a dead or stuck sensor has no vibration to identify; check the sensor, or leave the channel out", vibmode_core::num(.value))]
+    ConstantChannel {
+        /// Index of the channel.
+        channel: usize,
+        /// Its one value.
+        value: f64,
+    },
     /// A sampling rate that is not a positive finite number.
     #[error("sampling rate {} Hz must be a positive finite number", vibmode_core::num(.fs_hz))]
     InvalidSampleRate {

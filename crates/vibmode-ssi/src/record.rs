@@ -133,6 +133,12 @@ pub fn identify_record(
         Some(list) => checked_orders(list)?,
         None => params.orders(),
     };
+    // Before the scaling, which would blow a constant channel's rounding up to unit RMS.
+    for (channel, ch) in channels.iter().enumerate() {
+        if let Some(value) = vibmode_core::stats::constant_value(ch) {
+            return Err(SsiError::ConstantChannel { channel, value });
+        }
+    }
     let scales = if options.normalise {
         rms_scales(channels)
     } else {

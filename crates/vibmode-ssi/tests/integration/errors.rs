@@ -247,21 +247,40 @@ fn order_too_high_for_the_block_rows() {
 
 #[test]
 fn order_above_the_rank() {
-    // A constant channel is zero once its mean is removed: rank 0.
-    let a = vec![3.5; 200];
+    // A tone at the Nyquist frequency (+1, -1, ...): every lag's correlation is +-1 times the
+    // same value, so the Toeplitz matrix has rank 1 and order 2 is above it.
+    let a: Vec<f64> = (0..200)
+        .map(|i| if i % 2 == 0 { 1.0 } else { -1.0 })
+        .collect();
     let (e, m) = msg(ssi_cov(&[&a], 50.0, &params(5)));
     assert!(
         matches!(
             e,
             SsiError::OrderAboveRank {
                 order: 2,
-                rank: 0,
+                rank: 1,
                 ..
             }
         ),
         "{e:?}"
     );
-    assert!(m.contains("order 2") && m.contains("rank 0"), "{m}");
+    assert!(m.contains("order 2") && m.contains("rank 1"), "{m}");
+}
+
+#[test]
+fn a_constant_channel_is_named() {
+    // A stuck sensor (or a dead one) carries no vibration; its mean removed it would be
+    // rank 0, and scaled to unit RMS it would be rounding noise.
+    let a = noise(200, 1);
+    for value in [3.5, 0.0] {
+        let b = vec![value; 200];
+        let (e, m) = msg(ssi_cov(&[&a, &b], 50.0, &params(5)));
+        assert_eq!(e, SsiError::ConstantChannel { channel: 1, value });
+        assert!(
+            m.contains("channel 1 is constant") && m.contains(&format!("every sample is {value}")),
+            "{m}"
+        );
+    }
 }
 
 #[test]
