@@ -403,6 +403,50 @@ fn a_dead_or_stuck_sensor_is_named_not_analysed() {
     assert!(o.join("results.json").exists());
 }
 
+/// A saturated sensor (a tone cut at 0.8) is analysed, and said so: the terminal and the
+/// report name the records and the channel, `results.json` lists them per record.
+#[test]
+fn a_clipped_channel_is_named_in_the_results() {
+    let d = tempfile::tempdir().unwrap();
+    let f = d.path().join("sat.csv");
+    csv(
+        &f,
+        100.0,
+        2048,
+        &[("a", &|i| tone(i).clamp(-2.0, 0.8)), ("b", &noise)],
+    );
+    let o = d.path().join("o");
+    let out = ok(&["analyze", s(&f), "-o", s(&o), "-q"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("Clipped: 2 of 2 records")
+            && text.contains("channel 'a'")
+            && !text.contains("channel 'b'"),
+        "{text}"
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(o.join("results.json")).unwrap()).unwrap();
+    for rec in v["records"].as_array().unwrap() {
+        let c = &rec["clipped"][0];
+        assert_eq!(c["channel"], "a");
+        assert_eq!(c["value"], 0.8);
+        let share = c["share"].as_f64().unwrap();
+        assert!(share > 0.05 && share < 0.5, "{share}");
+        assert_eq!(rec["clipped"].as_array().unwrap().len(), 1);
+    }
+    let html = std::fs::read_to_string(o.join("index.html")).unwrap();
+    assert!(html.contains("Clipped: 2 of 2 records"));
+    // Unclipped, nothing is said.
+    let g = d.path().join("fine.csv");
+    csv(&g, 100.0, 2048, &[("a", &tone), ("b", &noise)]);
+    let o2 = d.path().join("o2");
+    let out = ok(&["analyze", s(&g), "-o", s(&o2), "-q"]);
+    assert!(!String::from_utf8_lossy(&out.stdout).contains("Clipped"));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(o2.join("results.json")).unwrap()).unwrap();
+    assert!(v["records"][0].get("clipped").is_none());
+}
+
 /// Sizes of the files under `dir` (for comparing whole outputs).
 fn listing(dir: &Path) -> Vec<(PathBuf, u64)> {
     let mut out = Vec::new();

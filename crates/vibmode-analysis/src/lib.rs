@@ -47,7 +47,8 @@ pub use pipeline::{
     check_records, preprocess_records, RecordFacts,
 };
 pub use results::{
-    AnalysisResults, ChannelAnalysis, RecordSummary, RoleAnalysis, Timing, SCHEMA_VERSION,
+    AnalysisResults, ChannelAnalysis, ClippedChannel, RecordSummary, RoleAnalysis, Timing,
+    SCHEMA_VERSION,
 };
 pub use store::PoleStore;
 pub use stream::analyze_source;

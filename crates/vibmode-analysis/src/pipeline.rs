@@ -16,7 +16,8 @@ use crate::identify::SweepIdentifier;
 use crate::lines::LineStage;
 use crate::multichannel::SsiStage;
 use crate::results::{
-    AnalysisResults, ChannelAnalysis, RecordSummary, RoleAnalysis, Timing, SCHEMA_VERSION,
+    AnalysisResults, ChannelAnalysis, ClippedChannel, RecordSummary, RoleAnalysis, Timing,
+    SCHEMA_VERSION,
 };
 use crate::stops::{activity_ratios, band_rms, detect_stops};
 use crate::store::PoleStore;
@@ -210,6 +211,8 @@ pub struct RecordFacts {
     pub n_samples: usize,
     /// Where the record was cut from a long recording (segmentation), if it was.
     pub meta: Option<vibmode_core::RecordMeta>,
+    /// Its channels held at an extreme, as read.
+    pub clipped: Vec<ClippedChannel>,
 }
 
 impl RecordFacts {
@@ -220,6 +223,7 @@ impl RecordFacts {
             fs_hz: r.recording.fs_hz,
             n_samples: r.recording.len(),
             meta: None,
+            clipped: ClippedChannel::of(&r.recording),
         }
     }
 }
@@ -329,6 +333,7 @@ pub fn analyze_prepared(
             n_samples: r.n_samples,
             duration_s: r.n_samples as f64 / r.fs_hz,
             segment: r.meta,
+            clipped: r.clipped,
             band: p.band,
             activity_rms: activity_rms[i].clone(),
             activity_ratio: activity_ratio[i],

@@ -51,6 +51,39 @@ pub struct RecordSummary {
     /// speed and position (absent for record files analysed whole).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub segment: Option<vibmode_core::RecordMeta>,
+    /// The record's channels held at an extreme (a saturated sensor or amplifier,
+    /// [`vibmode_core::stats::clipped`]), as read: still analysed, but their spectra and modes
+    /// hold the clipping's harmonics. Empty when none is.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub clipped: Vec<ClippedChannel>,
+}
+
+/// A channel of a record held at one of its extremes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ClippedChannel {
+    /// The channel.
+    pub channel: String,
+    /// Share of the record's samples at the extreme (0-1).
+    pub share: f64,
+    /// The extreme, in the channel's unit.
+    pub value: f64,
+}
+
+impl ClippedChannel {
+    /// The clipped channels of `rec`, in channel order.
+    pub fn of(rec: &vibmode_core::Recording) -> Vec<ClippedChannel> {
+        rec.channels
+            .iter()
+            .filter_map(|ch| {
+                let (n, value) = vibmode_core::stats::clipped(&ch.samples)?;
+                Some(ClippedChannel {
+                    channel: ch.name.clone(),
+                    share: n as f64 / ch.samples.len() as f64,
+                    value,
+                })
+            })
+            .collect()
+    }
 }
 
 /// Everything found for one channel.

@@ -83,6 +83,35 @@ pub fn constant_value(x: &[f64]) -> Option<f64> {
     (max - min <= 1e-9 * peak).then_some(max)
 }
 
+/// Share of the samples at one extreme of a channel above which it counts as clipped (a
+/// continuous signal reaches its extreme once or, quantised, a few times).
+pub const CLIPPED_SHARE: f64 = 0.01;
+/// Fewest samples at one extreme that count as clipped, however short the record.
+pub const CLIPPED_MIN_SAMPLES: usize = 10;
+
+/// Whether a channel is clipped: more than [`CLIPPED_SHARE`] of its samples (and at least
+/// [`CLIPPED_MIN_SAMPLES`]) at its largest or its smallest value, to within 1e-9 of its range
+/// (a saturated sensor or amplifier holds its extreme). `Some((count, value))` of the extreme
+/// held more often; `None` for a channel that is not clipped or is constant
+/// ([`constant_value`]).
+pub fn clipped(x: &[f64]) -> Option<(usize, f64)> {
+    if constant_value(x).is_some() || x.len() < 2 {
+        return None;
+    }
+    let max = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let min = x.iter().copied().fold(f64::INFINITY, f64::min);
+    let tol = 1e-9 * (max - min);
+    let at_max = x.iter().filter(|&&v| v >= max - tol).count();
+    let at_min = x.iter().filter(|&&v| v <= min + tol).count();
+    let need = CLIPPED_MIN_SAMPLES.max((CLIPPED_SHARE * x.len() as f64).ceil() as usize);
+    let (n, value) = if at_max >= at_min {
+        (at_max, max)
+    } else {
+        (at_min, min)
+    };
+    (n >= need).then_some((n, value))
+}
+
 /// The jackknife standard deviation of an estimate from its leave-one-out values `theta`
 /// (`m >= 2` of them): `sqrt((m - 1) / m * sum (theta_s - mean)^2)`. 0 for fewer than two.
 /// SSI-cov's modes, the model update's parameters and the fleet's suspension scores use it.
@@ -99,6 +128,29 @@ pub fn jackknife_std(theta: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_channel_held_at_an_extreme_is_clipped() {
+        // A sine of 1000 samples cut at 0.9: about 29 % of its samples at each extreme.
+        let sine: Vec<f64> = (0..1000)
+            .map(|i| (2.0 * std::f64::consts::PI * i as f64 / 100.0).sin())
+            .collect();
+        assert_eq!(clipped(&sine), None);
+        let cut: Vec<f64> = sine.iter().map(|v| v.clamp(-2.0, 0.9)).collect();
+        let (n, value) = clipped(&cut).unwrap();
+        assert_eq!(value, 0.9);
+        assert_eq!(n, sine.iter().filter(|&&v| v >= 0.9).count());
+        // Ten samples at the top of 1000 (1 %) are clipped; nine are not.
+        let mut x: Vec<f64> = (0..1000).map(|i| ((i * 37) % 101) as f64 / 200.0).collect();
+        for v in x.iter_mut().take(10) {
+            *v = 1.0;
+        }
+        assert_eq!(clipped(&x), Some((10, 1.0)));
+        x[9] = 0.0;
+        assert_eq!(clipped(&x), None);
+        // A constant channel is not "clipped" (it is dead or stuck).
+        assert_eq!(clipped(&[2.0; 50]), None);
+    }
 
     #[test]
     fn a_dead_or_stuck_channel_has_a_constant_value_and_a_moving_one_none() {

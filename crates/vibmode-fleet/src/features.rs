@@ -277,12 +277,8 @@ impl std::fmt::Display for SensorFault {
     }
 }
 
-/// Share of the samples at one extreme of a channel above which it counts as clipped (a
-/// continuous signal reaches its extreme once or, quantised, a few times).
-pub const CLIPPED_SHARE: f64 = 0.01;
-/// Fewest samples at one extreme that count as clipped, however short the record.
-pub const CLIPPED_MIN_SAMPLES: usize = 10;
 pub use crate::config::MIN_PERIODS;
+pub use vibmode_core::stats::{CLIPPED_MIN_SAMPLES, CLIPPED_SHARE};
 
 /// The sensor faults of the channels of `rec` that have a role (sprung or unsprung; other
 /// columns, such as a speed, are not sensors of the features).
@@ -312,19 +308,7 @@ pub fn sensor_faults(rec: &Recording, acfg: &AnalysisConfig) -> Vec<SensorFault>
             }
             None => {}
         }
-        let max = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        let min = x.iter().copied().fold(f64::INFINITY, f64::min);
-        let range = max - min;
-        let tol = 1e-9 * range;
-        let at_max = x.iter().filter(|&&v| v >= max - tol).count();
-        let at_min = x.iter().filter(|&&v| v <= min + tol).count();
-        let need = CLIPPED_MIN_SAMPLES.max((CLIPPED_SHARE * x.len() as f64).ceil() as usize);
-        let (n, value) = if at_max >= at_min {
-            (at_max, max)
-        } else {
-            (at_min, min)
-        };
-        if n >= need {
+        if let Some((n, value)) = vibmode_core::stats::clipped(x) {
             out.push(fault(
                 FaultKind::Clipped,
                 format!(

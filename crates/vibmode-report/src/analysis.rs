@@ -165,6 +165,46 @@ fn pools(r: &AnalysisResults) -> Vec<Pool<'_>> {
     out
 }
 
+/// The records with a clipped channel, in one sentence (`None` when none has one): such a
+/// channel is analysed, but the clipping's harmonics are in its spectra and modes.
+pub fn clipped_text(r: &AnalysisResults) -> Option<String> {
+    let mut parts = Vec::new();
+    let mut n_records: usize = 0;
+    for rec in r.records.iter().filter(|rec| !rec.clipped.is_empty()) {
+        n_records += 1;
+        if parts.len() >= CLIPPED_SHOWN {
+            continue;
+        }
+        let chans: Vec<String> = rec
+            .clipped
+            .iter()
+            .map(|c| {
+                format!(
+                    "channel '{}' {:.1} % of the samples at {}",
+                    vibmode_core::quoted(&c.channel),
+                    100.0 * c.share,
+                    vibmode_core::Num(c.value)
+                )
+            })
+            .collect();
+        parts.push(format!("{}: {}", rec.name, chans.join(", ")));
+    }
+    if n_records == 0 {
+        return None;
+    }
+    let more = n_records.saturating_sub(CLIPPED_SHOWN);
+    Some(format!(
+        "Clipped: {} of {} records hold a channel at its extreme for 1 % of the samples or more (a saturated sensor or amplifier; analysed, but its spectra and modes hold the clipping's harmonics): {}{}.",
+        n_records,
+        r.records.len(),
+        parts.join("; "),
+        if more > 0 { format!("; and {more} more") } else { String::new() }
+    ))
+}
+
+/// Most records [`clipped_text`] names (the JSON lists them all).
+const CLIPPED_SHOWN: usize = 5;
+
 /// The first line of the terminal summary: counts, rate, cutoff, orders and run time.
 pub fn run_summary_line(r: &AnalysisResults) -> String {
     format!(
@@ -249,6 +289,9 @@ pub fn modes_table_text(r: &AnalysisResults, truth: Option<&[TruthRow]>) -> Stri
             r.records.len(),
             stops.join(", ")
         );
+    }
+    if let Some(line) = clipped_text(r) {
+        let _ = writeln!(s, "{line}");
     }
     for pool in pools(r) {
         let _ = writeln!(s, "\nInvariant modes, {}:", pool.title);
@@ -586,6 +629,10 @@ pub fn summary_text(r: &AnalysisResults) -> String {
             cfg.stops.stop_rms_ratio,
             stops.join(", ")
         );
+    }
+    if let Some(line) = clipped_text(r) {
+        s.push_str(&line);
+        s.push(' ');
     }
     if cfg.preset == vibmode_analysis::Preset::Paper {
         s.push_str("These are the paper's settings. At 200 Hz with a 25 Hz cutoff the band 25-100 Hz is empty: three quarters of the poles of every model are spent on it, the prediction-error criterion has no minimum without the -30 dB numerical noise floor vibmode adds to such signals, the ideal filter's edge draws lightly damped poles of its own (poles above 0.8 x the cutoff are left out by the pole filters), and every fit has four times the samples. On the simulated bus this costs about 14 times the default preset's time, spreads the wheel hop over 1.5 Hz and merges the 11 and 12 Hz engine lines into one cluster taken for a structural mode; the default preset analyses at 50 Hz (twice the cutoff, the same information) instead. ");
