@@ -264,11 +264,16 @@ def test_a_dead_or_stuck_channel_is_named_not_analysed(rng):
     # Before: the stuck channel's rounding noise after resampling gave "modes" and lines.
     fs = 100.0
     x = np.stack([rng.standard_normal(2048), np.full(2048, 9.81), np.zeros(2048)])
-    with pytest.raises(ValueError, match=r"channel '1' is constant \(every sample is 9.81\)"):
+    with pytest.raises(ValueError, match=r"channel 'ch1' is constant \(every sample is 9.81\)"):
         vibmode.analyze(x, fs)
-    with pytest.raises(ValueError, match=r"channel '2' is constant \(every sample is 0\)"):
+    with pytest.raises(ValueError, match=r"channel 'ch1' is constant \(every sample is 0\)"):
         vibmode.analyze(x[[0, 2]], fs)
     with pytest.raises(ValueError, match=r"constant \(every sample is 9.81\)"):
         vibmode.ssi_cov(x[:2], fs, block_rows=10, orders=[2, 4, 6])
     res = vibmode.analyze(x[:1], fs, as_frames=False)
-    assert res["records"]
+    assert res["records"] and all("clipped" not in r for r in res["records"])
+    # A saturated sensor is analysed and named per record.
+    clip = np.clip(x[0], -1.0, 1.0)
+    res = vibmode.analyze(clip, fs, as_frames=False)
+    assert all(r["clipped"][0]["channel"] == "ch0" for r in res["records"])
+    assert all(0.1 < r["clipped"][0]["share"] < 0.25 for r in res["records"])
