@@ -403,10 +403,11 @@ fn a_dead_or_stuck_sensor_is_named_not_analysed() {
     assert!(o.join("results.json").exists());
 }
 
-/// A saturated sensor (a tone cut at 0.8) is analysed, and said so: the terminal and the
-/// report name the records and the channel, `results.json` lists them per record.
+/// A saturated sensor (a tone cut at 0.8), or one whose logger filled dropouts, is analysed,
+/// and said so: the terminal and the report name the records and the channel, `results.json`
+/// lists them per record.
 #[test]
-fn a_clipped_channel_is_named_in_the_results() {
+fn a_clipped_or_held_channel_is_named_in_the_results() {
     let d = tempfile::tempdir().unwrap();
     let f = d.path().join("sat.csv");
     csv(
@@ -436,12 +437,39 @@ fn a_clipped_channel_is_named_in_the_results() {
     }
     let html = std::fs::read_to_string(o.join("index.html")).unwrap();
     assert!(html.contains("Clipped: 2 of 2 records"));
+    // Dropouts filled with the last value (0.4 s after sample 499: 41 equal samples) and with 0
+    // (0.2 s) in the first record: 61 of its 1024 samples.
+    let h = d.path().join("drop.csv");
+    let held = |i: usize| match i {
+        500..=539 => tone(499),
+        700..=719 => 0.0,
+        _ => tone(i),
+    };
+    csv(&h, 100.0, 2048, &[("a", &held), ("b", &noise)]);
+    let oh = d.path().join("oh");
+    let out = ok(&["analyze", s(&h), "-o", s(&oh), "-q"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("Held: 1 of 2 records")
+            && text
+                .contains("channel 'a' 6.0 % of the samples in 2 stretch(es), the longest 0.410 s")
+            && !text.contains("Clipped"),
+        "{text}"
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(oh.join("results.json")).unwrap()).unwrap();
+    assert_eq!(v["records"][0]["held"][0]["stretches"], 2);
+    assert!(v["records"][1].get("held").is_none());
     // Unclipped, nothing is said.
     let g = d.path().join("fine.csv");
     csv(&g, 100.0, 2048, &[("a", &tone), ("b", &noise)]);
     let o2 = d.path().join("o2");
     let out = ok(&["analyze", s(&g), "-o", s(&o2), "-q"]);
-    assert!(!String::from_utf8_lossy(&out.stdout).contains("Clipped"));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        !text.contains("Clipped") && !text.contains("Held"),
+        "{text}"
+    );
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(o2.join("results.json")).unwrap()).unwrap();
     assert!(v["records"][0].get("clipped").is_none());

@@ -16,8 +16,8 @@ use crate::identify::SweepIdentifier;
 use crate::lines::LineStage;
 use crate::multichannel::SsiStage;
 use crate::results::{
-    AnalysisResults, ChannelAnalysis, ClippedChannel, RecordSummary, RoleAnalysis, Timing,
-    SCHEMA_VERSION,
+    AnalysisResults, ChannelAnalysis, ClippedChannel, HeldChannel, RecordSummary, RoleAnalysis,
+    Timing, SCHEMA_VERSION,
 };
 use crate::stops::{activity_ratios, band_rms, detect_stops};
 use crate::store::PoleStore;
@@ -213,6 +213,8 @@ pub struct RecordFacts {
     pub meta: Option<vibmode_core::RecordMeta>,
     /// Its channels held at an extreme, as read.
     pub clipped: Vec<ClippedChannel>,
+    /// Its channels that hold one value over stretches, as read.
+    pub held: Vec<HeldChannel>,
 }
 
 impl RecordFacts {
@@ -224,6 +226,7 @@ impl RecordFacts {
             n_samples: r.recording.len(),
             meta: None,
             clipped: ClippedChannel::of(&r.recording),
+            held: HeldChannel::of(&r.recording),
         }
     }
 }
@@ -334,6 +337,7 @@ pub fn analyze_prepared(
             duration_s: r.n_samples as f64 / r.fs_hz,
             segment: r.meta,
             clipped: r.clipped,
+            held: r.held,
             band: p.band,
             activity_rms: activity_rms[i].clone(),
             activity_ratio: activity_ratio[i],

@@ -56,6 +56,61 @@ pub struct RecordSummary {
     /// hold the clipping's harmonics. Empty when none is.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub clipped: Vec<ClippedChannel>,
+    /// The record's channels that hold one value over stretches of [`HELD_MIN_S`] or more for
+    /// [`HELD_SHARE_MIN`] of their samples or more (a data logger's dropouts filled with the last
+    /// value or with 0, [`vibmode_core::stats::held_runs`]), as read: still analysed. Empty when
+    /// none does.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub held: Vec<HeldChannel>,
+}
+
+/// Shortest stretch of one repeated value that counts as held, s (and at least 10 samples): a
+/// live sensor's noise changes its reading from sample to sample.
+pub const HELD_MIN_S: f64 = 0.01;
+/// Share of a record's samples in held stretches from which the channel is named.
+pub const HELD_SHARE_MIN: f64 = 0.01;
+
+/// A channel of a record that holds one value over stretches (dropouts).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct HeldChannel {
+    /// The channel.
+    pub channel: String,
+    /// Share of the record's samples in held stretches (0-1).
+    pub share: f64,
+    /// How many stretches.
+    pub stretches: usize,
+    /// The longest, s.
+    pub longest_s: f64,
+}
+
+impl HeldChannel {
+    /// The channels of `rec` that hold one value for [`HELD_SHARE_MIN`] of the samples or more
+    /// in stretches of [`HELD_MIN_S`] (at least 10 samples), in channel order; a clipped
+    /// channel's stretches at its extremes are clipping, not counted here.
+    pub fn of(rec: &vibmode_core::Recording) -> Vec<HeldChannel> {
+        let min_run = ((HELD_MIN_S * rec.fs_hz).ceil() as usize).max(10);
+        rec.channels
+            .iter()
+            .filter_map(|ch| {
+                let x = &ch.samples;
+                let skip: Vec<f64> = if vibmode_core::stats::clipped(x).is_some() {
+                    let max = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                    let min = x.iter().copied().fold(f64::INFINITY, f64::min);
+                    vec![min, max]
+                } else {
+                    Vec::new()
+                };
+                let (n, stretches, longest) = vibmode_core::stats::held_runs(x, min_run, &skip);
+                let share = n as f64 / x.len().max(1) as f64;
+                (share >= HELD_SHARE_MIN).then(|| HeldChannel {
+                    channel: ch.name.clone(),
+                    share,
+                    stretches,
+                    longest_s: longest as f64 / rec.fs_hz,
+                })
+            })
+            .collect()
+    }
 }
 
 /// A channel of a record held at one of its extremes.

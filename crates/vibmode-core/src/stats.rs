@@ -90,10 +90,11 @@ pub const CLIPPED_SHARE: f64 = 0.01;
 pub const CLIPPED_MIN_SAMPLES: usize = 10;
 
 /// Whether a channel is clipped: more than [`CLIPPED_SHARE`] of its samples (and at least
-/// [`CLIPPED_MIN_SAMPLES`]) at its largest or its smallest value, to within 1e-9 of its range
-/// (a saturated sensor or amplifier holds its extreme). `Some((count, value))` of the extreme
-/// held more often; `None` for a channel that is not clipped or is constant
-/// ([`constant_value`]).
+/// [`CLIPPED_MIN_SAMPLES`]) at its largest or its smallest value, to within 1e-9 of its range,
+/// in stretches of two or more consecutive samples (a saturated sensor or amplifier holds its
+/// extreme; a pure tone whose period is a whole number of samples touches it once per period).
+/// `Some((count, value))` of the extreme held more often; `None` for a channel that is not
+/// clipped or is constant ([`constant_value`]).
 pub fn clipped(x: &[f64]) -> Option<(usize, f64)> {
     if constant_value(x).is_some() || x.len() < 2 {
         return None;
@@ -101,8 +102,14 @@ pub fn clipped(x: &[f64]) -> Option<(usize, f64)> {
     let max = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let min = x.iter().copied().fold(f64::INFINITY, f64::min);
     let tol = 1e-9 * (max - min);
-    let at_max = x.iter().filter(|&&v| v >= max - tol).count();
-    let at_min = x.iter().filter(|&&v| v <= min + tol).count();
+    // Samples satisfying `at` that have a neighbour satisfying it too.
+    let held = |at: &dyn Fn(f64) -> bool| {
+        (0..x.len())
+            .filter(|&i| at(x[i]) && ((i > 0 && at(x[i - 1])) || (i + 1 < x.len() && at(x[i + 1]))))
+            .count()
+    };
+    let at_max = held(&|v| v >= max - tol);
+    let at_min = held(&|v| v <= min + tol);
     let need = CLIPPED_MIN_SAMPLES.max((CLIPPED_SHARE * x.len() as f64).ceil() as usize);
     let (n, value) = if at_max >= at_min {
         (at_max, max)
@@ -110,6 +117,32 @@ pub fn clipped(x: &[f64]) -> Option<(usize, f64)> {
         (at_min, min)
     };
     (n >= need).then_some((n, value))
+}
+
+/// Stretches of a channel that hold one value: `(samples, stretches, longest)` over the runs of
+/// at least `min_run` (>= 2) consecutive samples that are exactly equal, skipping runs at
+/// `skip` (the extremes of a clipped channel, which [`clipped`] reports). A live sensor's
+/// signal, dithered by its own noise, changes from sample to sample (the longest run in the
+/// shipped real recordings is 4 samples at 500 Hz); a data logger's dropout, filled with the
+/// last value or with 0, holds it.
+pub fn held_runs(x: &[f64], min_run: usize, skip: &[f64]) -> (usize, usize, usize) {
+    let min_run = min_run.max(2);
+    let (mut samples, mut stretches, mut longest) = (0, 0, 0);
+    let mut i = 0;
+    while i < x.len() {
+        let mut j = i + 1;
+        while j < x.len() && x[j] == x[i] {
+            j += 1;
+        }
+        let run = j - i;
+        if run >= min_run && !skip.contains(&x[i]) {
+            samples += run;
+            stretches += 1;
+            longest = longest.max(run);
+        }
+        i = j;
+    }
+    (samples, stretches, longest)
 }
 
 /// The jackknife standard deviation of an estimate from its leave-one-out values `theta`
@@ -130,6 +163,19 @@ mod tests {
     use super::*;
 
     #[test]
+    fn held_stretches_are_counted() {
+        // 0, 1, 1, 1, 2, 0, 0, 0, 0, 3 with runs of 3 and 4.
+        let x = [0.0, 1.0, 1.0, 1.0, 2.0, 0.0, 0.0, 0.0, 0.0, 3.0];
+        assert_eq!(held_runs(&x, 3, &[]), (7, 2, 4));
+        assert_eq!(held_runs(&x, 4, &[]), (4, 1, 4));
+        assert_eq!(held_runs(&x, 5, &[]), (0, 0, 0));
+        assert_eq!(held_runs(&x, 3, &[0.0]), (3, 1, 3));
+        // A run at the end counts; min_run below 2 is 2.
+        assert_eq!(held_runs(&[1.0, 2.0, 2.0], 0, &[]), (2, 1, 2));
+        assert_eq!(held_runs(&[], 2, &[]), (0, 0, 0));
+    }
+
+    #[test]
     fn a_channel_held_at_an_extreme_is_clipped() {
         // A sine of 1000 samples cut at 0.9: about 29 % of its samples at each extreme.
         let sine: Vec<f64> = (0..1000)
@@ -140,14 +186,20 @@ mod tests {
         let (n, value) = clipped(&cut).unwrap();
         assert_eq!(value, 0.9);
         assert_eq!(n, sine.iter().filter(|&&v| v >= 0.9).count());
-        // Ten samples at the top of 1000 (1 %) are clipped; nine are not.
+        // Ten samples held at the top of 1000 (1 %) are clipped; nine are not; ten at the top
+        // but never two in a row are a tone's peaks, not clipping.
         let mut x: Vec<f64> = (0..1000).map(|i| ((i * 37) % 101) as f64 / 200.0).collect();
-        for v in x.iter_mut().take(10) {
+        for v in x.iter_mut().skip(1).take(10) {
             *v = 1.0;
         }
         assert_eq!(clipped(&x), Some((10, 1.0)));
-        x[9] = 0.0;
+        x[10] = 0.4;
         assert_eq!(clipped(&x), None);
+        let mut y: Vec<f64> = (0..1000).map(|i| ((i * 37) % 101) as f64 / 200.0).collect();
+        for i in 0..10 {
+            y[1 + 50 * i] = 1.0;
+        }
+        assert_eq!(clipped(&y), None);
         // A constant channel is not "clipped" (it is dead or stuck).
         assert_eq!(clipped(&[2.0; 50]), None);
     }

@@ -165,18 +165,13 @@ fn pools(r: &AnalysisResults) -> Vec<Pool<'_>> {
     out
 }
 
-/// The records with a clipped channel, in one sentence (`None` when none has one): such a
-/// channel is analysed, but the clipping's harmonics are in its spectra and modes.
-pub fn clipped_text(r: &AnalysisResults) -> Option<String> {
-    let mut parts = Vec::new();
-    let mut n_records: usize = 0;
-    for rec in r.records.iter().filter(|rec| !rec.clipped.is_empty()) {
-        n_records += 1;
-        if parts.len() >= CLIPPED_SHOWN {
-            continue;
-        }
-        let chans: Vec<String> = rec
-            .clipped
+/// The records with a clipped or a held channel, one sentence each (none when no record has
+/// one): such a channel is analysed, but the clipping's harmonics or the dropouts are in its
+/// spectra and modes.
+pub fn sensor_notes(r: &AnalysisResults) -> Vec<String> {
+    let mut out = Vec::new();
+    let clipped = records_sentence(r, |rec| {
+        rec.clipped
             .iter()
             .map(|c| {
                 format!(
@@ -186,24 +181,68 @@ pub fn clipped_text(r: &AnalysisResults) -> Option<String> {
                     vibmode_core::Num(c.value)
                 )
             })
-            .collect();
-        parts.push(format!("{}: {}", rec.name, chans.join(", ")));
+            .collect()
+    });
+    if let Some((n, list)) = clipped {
+        out.push(format!(
+            "Clipped: {n} of {} records hold a channel at its extreme for 1 % of the samples or more (a saturated sensor or amplifier; analysed, but its spectra and modes hold the clipping's harmonics): {list}.",
+            r.records.len()
+        ));
     }
-    if n_records == 0 {
-        return None;
+    let held = records_sentence(r, |rec| {
+        rec.held
+            .iter()
+            .map(|h| {
+                format!(
+                    "channel '{}' {:.1} % of the samples in {} stretch(es), the longest {:.3} s",
+                    vibmode_core::quoted(&h.channel),
+                    100.0 * h.share,
+                    h.stretches,
+                    h.longest_s
+                )
+            })
+            .collect()
+    });
+    if let Some((n, list)) = held {
+        out.push(format!(
+            "Held: {n} of {} records hold one value of a channel over stretches of {} s or more (a data logger's dropouts, filled with the last value or 0? a live sensor's reading changes from sample to sample; analysed, but the stretches are in its spectra and modes): {list}.",
+            r.records.len(),
+            vibmode_analysis::HELD_MIN_S
+        ));
     }
-    let more = n_records.saturating_sub(CLIPPED_SHOWN);
-    Some(format!(
-        "Clipped: {} of {} records hold a channel at its extreme for 1 % of the samples or more (a saturated sensor or amplifier; analysed, but its spectra and modes hold the clipping's harmonics): {}{}.",
-        n_records,
-        r.records.len(),
-        parts.join("; "),
-        if more > 0 { format!("; and {more} more") } else { String::new() }
-    ))
+    out
 }
 
-/// Most records [`clipped_text`] names (the JSON lists them all).
-const CLIPPED_SHOWN: usize = 5;
+/// How many records `of` names channels for, and the first [`NOTED_RECORDS_SHOWN`] of them as
+/// `name: item, item; name: ...` (and how many more).
+fn records_sentence(
+    r: &AnalysisResults,
+    of: impl Fn(&vibmode_analysis::RecordSummary) -> Vec<String>,
+) -> Option<(usize, String)> {
+    let mut parts = Vec::new();
+    let mut n_records: usize = 0;
+    for rec in &r.records {
+        let items = of(rec);
+        if items.is_empty() {
+            continue;
+        }
+        n_records += 1;
+        if parts.len() < NOTED_RECORDS_SHOWN {
+            parts.push(format!("{}: {}", rec.name, items.join(", ")));
+        }
+    }
+    let more = n_records.saturating_sub(NOTED_RECORDS_SHOWN);
+    (n_records > 0).then(|| {
+        let mut list = parts.join("; ");
+        if more > 0 {
+            list.push_str(&format!("; and {more} more"));
+        }
+        (n_records, list)
+    })
+}
+
+/// Most records [`sensor_notes`] names per sentence (the JSON lists them all).
+const NOTED_RECORDS_SHOWN: usize = 5;
 
 /// The first line of the terminal summary: counts, rate, cutoff, orders and run time.
 pub fn run_summary_line(r: &AnalysisResults) -> String {
@@ -290,7 +329,7 @@ pub fn modes_table_text(r: &AnalysisResults, truth: Option<&[TruthRow]>) -> Stri
             stops.join(", ")
         );
     }
-    if let Some(line) = clipped_text(r) {
+    for line in sensor_notes(r) {
         let _ = writeln!(s, "{line}");
     }
     for pool in pools(r) {
@@ -630,7 +669,7 @@ pub fn summary_text(r: &AnalysisResults) -> String {
             stops.join(", ")
         );
     }
-    if let Some(line) = clipped_text(r) {
+    for line in sensor_notes(r) {
         s.push_str(&line);
         s.push(' ');
     }
