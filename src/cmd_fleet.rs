@@ -55,7 +55,7 @@ pub enum FleetCommand {
         vehicle: String,
     },
     /// Classify records against the vehicle's latest model set: normal, road, vehicle, both,
-    /// or sensor (a dead, stuck or clipped channel). All files or none are stored.
+    /// or sensor (a dead, stuck, clipped or held channel). All files or none are stored.
     #[command(allow_negative_numbers = true)]
     Check(CheckArgs),
     /// Per vehicle: records, baseline version, last classifications.

@@ -112,7 +112,7 @@ def check(
     vehicle's latest model set (``vibmode fleet check
     --json``): ``{'vehicle', 'model_version', 'records': [...], 'drives': [...]}``, each record
     with its ``assessment`` (classification: normal, road, vehicle, both, or sensor for a dead,
-    stuck or clipped channel listed in ``sensor_faults``; scores, evidence). ``drive`` names the
+    stuck, clipped or held channel listed in ``sensor_faults``; scores, evidence). ``drive`` names the
     files as one drive (at least 3), classified from the medians of their features; without it
     files whose time column holds date-times form one drive per UTC day (``YYYY-MM-DD``, 3 files
     or more), and other files, 3 or more, the drive ``all given records`` (docs/fleet.md,

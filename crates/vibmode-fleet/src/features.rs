@@ -86,7 +86,7 @@ pub struct RecordFeatures {
     /// without both a sprung and an unsprung channel with a corner.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub body_spectra: Option<BodySpectra>,
-    /// Channels with a role whose sensor failed (dead, stuck or clipped); they give no feature,
+    /// Channels with a role whose sensor failed (dead, stuck, clipped or held); they give no feature,
     /// and a check of the record is classed `sensor`. Empty in records stored before it existed.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub sensor_faults: Vec<SensorFault>,
@@ -248,6 +248,10 @@ pub enum FaultKind {
     /// More than [`CLIPPED_SHARE`] of the samples sit at the channel's largest or smallest
     /// value (a saturated sensor or amplifier).
     Clipped,
+    /// [`vibmode_analysis::HELD_SHARE_MIN`] of the samples or more hold one value over
+    /// stretches of [`vibmode_analysis::HELD_MIN_S`] (a logger's dropouts filled with the last
+    /// value or 0).
+    Held,
 }
 
 /// A channel whose sensor failed.
@@ -267,6 +271,7 @@ impl std::fmt::Display for SensorFault {
             FaultKind::Dead => "dead",
             FaultKind::Flat => "flat",
             FaultKind::Clipped => "clipped",
+            FaultKind::Held => "held",
         };
         write!(
             f,
@@ -284,6 +289,7 @@ pub use vibmode_core::stats::{CLIPPED_MIN_SAMPLES, CLIPPED_SHARE};
 /// columns, such as a speed, are not sensors of the features).
 pub fn sensor_faults(rec: &Recording, acfg: &AnalysisConfig) -> Vec<SensorFault> {
     let mut out = Vec::new();
+    let held = vibmode_analysis::HeldChannel::of(rec);
     for ch in &rec.channels {
         if acfg.placement_of(ch).role == Role::Other || ch.samples.is_empty() {
             continue;
@@ -315,6 +321,18 @@ pub fn sensor_faults(rec: &Recording, acfg: &AnalysisConfig) -> Vec<SensorFault>
                     "{:.1} % of the samples at {}",
                     100.0 * n as f64 / x.len() as f64,
                     vibmode_core::Num(value)
+                ),
+            ));
+            continue;
+        }
+        if let Some(h) = held.iter().find(|h| h.channel == ch.name) {
+            out.push(fault(
+                FaultKind::Held,
+                format!(
+                    "{:.1} % of the samples hold one value, in {} stretch(es) up to {:.3} s",
+                    100.0 * h.share,
+                    h.stretches,
+                    h.longest_s
                 ),
             ));
         }
@@ -909,6 +927,10 @@ mod tests {
     fn dead_flat_and_clipped_channels_are_found_healthy_and_unplaced_ones_not() {
         let n = 2048;
         let clipped: Vec<f64> = wave(n, 1.0).iter().map(|x| x.clamp(-1.0, 1.0)).collect();
+        // 0.25 s of dropouts (50 samples at 200 Hz) filled with the last value.
+        let mut held = wave(n, 2.0);
+        let last = held[999];
+        held[1000..1050].fill(last);
         let rec = recording(
             200.0,
             vec![
@@ -916,6 +938,7 @@ mod tests {
                 ("FR_unsprung", vec![0.0; n]),
                 ("RL_unsprung", vec![9.81; n]),
                 ("RR_unsprung", clipped),
+                ("FR_sprung", held),
                 // Not a sensor of the features: a constant speed column is no fault.
                 ("speed", vec![40.0; n]),
             ],
@@ -928,8 +951,15 @@ mod tests {
                 ("FR_unsprung", FaultKind::Dead),
                 ("RL_unsprung", FaultKind::Flat),
                 ("RR_unsprung", FaultKind::Clipped),
+                ("FR_sprung", FaultKind::Held),
             ],
             "{f:?}"
+        );
+        assert!(
+            f[3].to_string()
+                .contains("2.5 % of the samples hold one value, in 1 stretch(es) up to 0.255 s"),
+            "{}",
+            f[3]
         );
         assert!(f[1].to_string().contains("9.81"), "{}", f[1]);
     }

@@ -256,7 +256,7 @@ pub enum Classification {
     Vehicle,
     /// Both outside.
     Both,
-    /// A sensor of the record failed (dead, stuck or clipped channel): its scores say nothing
+    /// A sensor of the record failed (dead, stuck, clipped or held channel): its scores say nothing
     /// about the vehicle or the road until the sensor is fixed.
     Sensor,
 }

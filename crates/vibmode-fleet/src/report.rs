@@ -29,7 +29,7 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
     let mut html = HtmlReport::new("vibmode fleet report");
     let vehicles = store.vehicles()?;
     html.paragraph(&format!(
-        "Store {}: {} vehicle(s). Each record is classified against its vehicle's nominal model set: normal, road (excitation outside the nominal range), vehicle (transmissibility or modes of a corner moved), both, or sensor (a dead, stuck or clipped channel: fix the sensor first) (docs/fleet.md).",
+        "Store {}: {} vehicle(s). Each record is classified against its vehicle's nominal model set: normal, road (excitation outside the nominal range), vehicle (transmissibility or modes of a corner moved), both, or sensor (a dead, stuck, clipped or held channel: fix the sensor first) (docs/fleet.md).",
         store.path(),
         vehicles.len()
     ));
