@@ -93,8 +93,8 @@ pub const CLIPPED_MIN_SAMPLES: usize = 10;
 /// [`CLIPPED_MIN_SAMPLES`]) at its largest or its smallest value, to within 1e-9 of its range,
 /// in stretches of two or more consecutive samples (a saturated sensor or amplifier holds its
 /// extreme; a pure tone whose period is a whole number of samples touches it once per period).
-/// `Some((count, value))` of the extreme held more often; `None` for a channel that is not
-/// clipped or is constant ([`constant_value`]).
+/// `Some((count, value))` of the extreme held more often, `count` every sample at it (held or
+/// not); `None` for a channel that is not clipped or is constant ([`constant_value`]).
 pub fn clipped(x: &[f64]) -> Option<(usize, f64)> {
     if constant_value(x).is_some() || x.len() < 2 {
         return None;
@@ -108,15 +108,17 @@ pub fn clipped(x: &[f64]) -> Option<(usize, f64)> {
             .filter(|&i| at(x[i]) && ((i > 0 && at(x[i - 1])) || (i + 1 < x.len() && at(x[i + 1]))))
             .count()
     };
-    let at_max = held(&|v| v >= max - tol);
-    let at_min = held(&|v| v <= min + tol);
+    let is_max = |v: f64| v >= max - tol;
+    let is_min = |v: f64| v <= min + tol;
+    let (held_max, held_min) = (held(&is_max), held(&is_min));
     let need = CLIPPED_MIN_SAMPLES.max((CLIPPED_SHARE * x.len() as f64).ceil() as usize);
-    let (n, value) = if at_max >= at_min {
-        (at_max, max)
+    // Judged by the held samples, reported with every sample at that extreme.
+    let (n, value, at): (usize, f64, &dyn Fn(f64) -> bool) = if held_max >= held_min {
+        (held_max, max, &is_max)
     } else {
-        (at_min, min)
+        (held_min, min, &is_min)
     };
-    (n >= need).then_some((n, value))
+    (n >= need).then(|| (x.iter().filter(|&&v| at(v)).count(), value))
 }
 
 /// Stretches of a channel that hold one value: `(samples, stretches, longest)` over the runs of
@@ -200,6 +202,11 @@ mod tests {
             y[1 + 50 * i] = 1.0;
         }
         assert_eq!(clipped(&y), None);
+        // Held ten times in a row as well: clipped, and every sample at the top is counted.
+        for v in y.iter_mut().skip(700).take(10) {
+            *v = 1.0;
+        }
+        assert_eq!(clipped(&y), Some((20, 1.0)));
         // A constant channel is not "clipped" (it is dead or stuck).
         assert_eq!(clipped(&[2.0; 50]), None);
     }
