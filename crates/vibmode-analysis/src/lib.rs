@@ -47,8 +47,8 @@ pub use pipeline::{
     check_records, preprocess_records, RecordFacts,
 };
 pub use results::{
-    AnalysisResults, ChannelAnalysis, ClippedChannel, HeldChannel, RecordSummary, RoleAnalysis,
-    Timing, HELD_MIN_S, HELD_SHARE_MIN, SCHEMA_VERSION,
+    sensor_notes, AnalysisResults, ChannelAnalysis, ClippedChannel, HeldChannel, RecordSummary,
+    RoleAnalysis, Timing, HELD_MIN_S, HELD_SHARE_MIN, SCHEMA_VERSION,
 };
 pub use store::PoleStore;
 pub use stream::analyze_source;

@@ -16,8 +16,8 @@ use crate::identify::SweepIdentifier;
 use crate::lines::LineStage;
 use crate::multichannel::SsiStage;
 use crate::results::{
-    AnalysisResults, ChannelAnalysis, ClippedChannel, HeldChannel, RecordSummary, RoleAnalysis,
-    Timing, SCHEMA_VERSION,
+    sensor_notes, AnalysisResults, ChannelAnalysis, ClippedChannel, HeldChannel, RecordSummary,
+    RoleAnalysis, Timing, SCHEMA_VERSION,
 };
 use crate::stops::{activity_ratios, band_rms, detect_stops};
 use crate::store::PoleStore;
@@ -220,13 +220,14 @@ pub struct RecordFacts {
 impl RecordFacts {
     /// The facts of `r` (no segmentation facts).
     pub fn of(r: &RecordInput) -> RecordFacts {
+        let (clipped, held) = sensor_notes(&r.recording);
         RecordFacts {
             name: r.name.clone(),
             fs_hz: r.recording.fs_hz,
             n_samples: r.recording.len(),
             meta: None,
-            clipped: ClippedChannel::of(&r.recording),
-            held: HeldChannel::of(&r.recording),
+            clipped,
+            held,
         }
     }
 }

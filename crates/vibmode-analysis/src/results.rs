@@ -64,11 +64,7 @@ pub struct RecordSummary {
     pub held: Vec<HeldChannel>,
 }
 
-/// Shortest stretch of one repeated value that counts as held, s (and at least 10 samples): a
-/// live sensor's noise changes its reading from sample to sample.
-pub const HELD_MIN_S: f64 = 0.01;
-/// Share of a record's samples in held stretches from which the channel is named.
-pub const HELD_SHARE_MIN: f64 = 0.01;
+pub use vibmode_core::stats::{HELD_MIN_S, HELD_SHARE_MIN};
 
 /// A channel of a record that holds one value over stretches (dropouts).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -83,36 +79,6 @@ pub struct HeldChannel {
     pub longest_s: f64,
 }
 
-impl HeldChannel {
-    /// The channels of `rec` that hold one value for [`HELD_SHARE_MIN`] of the samples or more
-    /// in stretches of [`HELD_MIN_S`] (at least 10 samples), in channel order; a clipped
-    /// channel's stretches at its extremes are clipping, not counted here.
-    pub fn of(rec: &vibmode_core::Recording) -> Vec<HeldChannel> {
-        let min_run = ((HELD_MIN_S * rec.fs_hz).ceil() as usize).max(10);
-        rec.channels
-            .iter()
-            .filter_map(|ch| {
-                let x = &ch.samples;
-                let skip: Vec<f64> = if vibmode_core::stats::clipped(x).is_some() {
-                    let max = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-                    let min = x.iter().copied().fold(f64::INFINITY, f64::min);
-                    vec![min, max]
-                } else {
-                    Vec::new()
-                };
-                let (n, stretches, longest) = vibmode_core::stats::held_runs(x, min_run, &skip);
-                let share = n as f64 / x.len().max(1) as f64;
-                (share >= HELD_SHARE_MIN).then(|| HeldChannel {
-                    channel: ch.name.clone(),
-                    share,
-                    stretches,
-                    longest_s: longest as f64 / rec.fs_hz,
-                })
-            })
-            .collect()
-    }
-}
-
 /// A channel of a record held at one of its extremes.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ClippedChannel {
@@ -124,21 +90,33 @@ pub struct ClippedChannel {
     pub value: f64,
 }
 
-impl ClippedChannel {
-    /// The clipped channels of `rec`, in channel order.
-    pub fn of(rec: &vibmode_core::Recording) -> Vec<ClippedChannel> {
-        rec.channels
-            .iter()
-            .filter_map(|ch| {
-                let (n, value) = vibmode_core::stats::clipped(&ch.samples)?;
-                Some(ClippedChannel {
-                    channel: ch.name.clone(),
-                    share: n as f64 / ch.samples.len() as f64,
-                    value,
-                })
-            })
-            .collect()
+/// The clipped channels of `rec` and those that hold one value for [`HELD_SHARE_MIN`] of the
+/// samples or more in stretches of [`HELD_MIN_S`] (at least
+/// [`vibmode_core::stats::HELD_MIN_SAMPLES`]), each in channel order, from one look at each
+/// channel ([`vibmode_core::stats::channel_health`]); a clipped channel's stretches at its
+/// extremes are clipping, not counted as held.
+pub fn sensor_notes(rec: &vibmode_core::Recording) -> (Vec<ClippedChannel>, Vec<HeldChannel>) {
+    let min_run = vibmode_core::stats::held_min_run(rec.fs_hz);
+    let (mut clipped, mut held) = (Vec::new(), Vec::new());
+    for ch in &rec.channels {
+        let h = vibmode_core::stats::channel_health(&ch.samples, min_run);
+        if let Some((n, value)) = h.clipped {
+            clipped.push(ClippedChannel {
+                channel: ch.name.clone(),
+                share: n as f64 / ch.samples.len() as f64,
+                value,
+            });
+        }
+        if h.is_held() {
+            held.push(HeldChannel {
+                channel: ch.name.clone(),
+                share: h.held_share(),
+                stretches: h.held.1,
+                longest_s: h.held.2 as f64 / rec.fs_hz,
+            });
+        }
     }
+    (clipped, held)
 }
 
 /// Everything found for one channel.

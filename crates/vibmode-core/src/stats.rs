@@ -72,15 +72,10 @@ pub fn constant_value(x: &[f64]) -> Option<f64> {
     if x.len() < 2 {
         return None;
     }
-    let first = x[0];
     let (min, max) = x
         .iter()
-        .fold((first, first), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-    let peak = max.abs().max(min.abs());
-    if peak <= crate::limits::SAMPLE_PEAK_MIN {
-        return Some(0.0);
-    }
-    (max - min <= 1e-9 * peak).then_some(max)
+        .fold((x[0], x[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    constant_from_extremes(min, max)
 }
 
 /// Share of the samples at one extreme of a channel above which it counts as clipped (a
@@ -89,6 +84,84 @@ pub const CLIPPED_SHARE: f64 = 0.01;
 /// Fewest samples at one extreme that count as clipped, however short the record.
 pub const CLIPPED_MIN_SAMPLES: usize = 10;
 
+/// Shortest stretch of one repeated value that counts as held, s (and at least
+/// [`HELD_MIN_SAMPLES`]): a live sensor's noise changes its reading from sample to sample.
+pub const HELD_MIN_S: f64 = 0.01;
+/// Fewest samples in a stretch that counts as held, however high the rate.
+pub const HELD_MIN_SAMPLES: usize = 10;
+/// Share of a record's samples in held stretches from which the channel is named.
+pub const HELD_SHARE_MIN: f64 = 0.01;
+
+/// The shortest held stretch at `fs_hz`, samples: [`HELD_MIN_S`], at least
+/// [`HELD_MIN_SAMPLES`].
+pub fn held_min_run(fs_hz: f64) -> usize {
+    ((HELD_MIN_S * fs_hz).ceil() as usize).max(HELD_MIN_SAMPLES)
+}
+
+/// What a channel's samples say about its sensor, from one look at them ([`channel_health`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ChannelHealth {
+    /// Number of samples.
+    pub n: usize,
+    /// The channel's value when it carries no vibration ([`constant_value`]).
+    pub constant: Option<f64>,
+    /// `(count, value)` when clipped ([`clipped`]).
+    pub clipped: Option<(usize, f64)>,
+    /// `(samples, stretches, longest)` of the stretches that hold one value ([`held_runs`]),
+    /// leaving out a clipped channel's stretches at its extremes (clipping, reported as such).
+    pub held: (usize, usize, usize),
+}
+
+impl ChannelHealth {
+    /// Share of the samples in held stretches (0-1).
+    pub fn held_share(&self) -> f64 {
+        self.held.0 as f64 / self.n.max(1) as f64
+    }
+
+    /// Whether the held stretches cover [`HELD_SHARE_MIN`] of the samples or more.
+    pub fn is_held(&self) -> bool {
+        self.held.0 > 0 && self.held_share() >= HELD_SHARE_MIN
+    }
+}
+
+/// [`constant_value`], [`clipped`] and [`held_runs`] (runs of `min_run` samples or more, see
+/// [`held_min_run`]) of one channel, sharing its extremes: what the analysis notes and the
+/// fleet calls a sensor fault.
+pub fn channel_health(x: &[f64], min_run: usize) -> ChannelHealth {
+    let mut h = ChannelHealth {
+        n: x.len(),
+        constant: None,
+        clipped: None,
+        held: (0, 0, 0),
+    };
+    if x.len() < 2 {
+        return h;
+    }
+    let (min, max) = x
+        .iter()
+        .fold((x[0], x[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    h.constant = constant_from_extremes(min, max);
+    if h.constant.is_some() {
+        return h;
+    }
+    h.clipped = clipped_from_extremes(x, min, max);
+    let skip: &[f64] = if h.clipped.is_some() {
+        &[min, max]
+    } else {
+        &[]
+    };
+    h.held = held_runs(x, min_run, skip);
+    h
+}
+
+fn constant_from_extremes(min: f64, max: f64) -> Option<f64> {
+    let peak = max.abs().max(min.abs());
+    if peak <= crate::limits::SAMPLE_PEAK_MIN {
+        return Some(0.0);
+    }
+    (max - min <= 1e-9 * peak).then_some(max)
+}
+
 /// Whether a channel is clipped: more than [`CLIPPED_SHARE`] of its samples (and at least
 /// [`CLIPPED_MIN_SAMPLES`]) at its largest or its smallest value, to within 1e-9 of its range,
 /// in stretches of two or more consecutive samples (a saturated sensor or amplifier holds its
@@ -96,29 +169,48 @@ pub const CLIPPED_MIN_SAMPLES: usize = 10;
 /// `Some((count, value))` of the extreme held more often, `count` every sample at it (held or
 /// not); `None` for a channel that is not clipped or is constant ([`constant_value`]).
 pub fn clipped(x: &[f64]) -> Option<(usize, f64)> {
-    if constant_value(x).is_some() || x.len() < 2 {
+    if x.len() < 2 {
         return None;
     }
-    let max = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let min = x.iter().copied().fold(f64::INFINITY, f64::min);
+    let (min, max) = x
+        .iter()
+        .fold((x[0], x[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    if constant_from_extremes(min, max).is_some() {
+        return None;
+    }
+    clipped_from_extremes(x, min, max)
+}
+
+/// [`clipped`] of a channel that is not constant, given its extremes.
+fn clipped_from_extremes(x: &[f64], min: f64, max: f64) -> Option<(usize, f64)> {
     let tol = 1e-9 * (max - min);
-    // Samples satisfying `at` that have a neighbour satisfying it too.
-    let held = |at: &dyn Fn(f64) -> bool| {
-        (0..x.len())
-            .filter(|&i| at(x[i]) && ((i > 0 && at(x[i - 1])) || (i + 1 < x.len() && at(x[i + 1]))))
-            .count()
-    };
-    let is_max = |v: f64| v >= max - tol;
-    let is_min = |v: f64| v <= min + tol;
-    let (held_max, held_min) = (held(&is_max), held(&is_min));
+    let (hi, lo) = (max - tol, min + tol);
+    // One pass: the samples at each extreme, and those of them with a neighbour there too.
+    let (mut at_max, mut at_min, mut held_max, mut held_min) = (0usize, 0usize, 0usize, 0usize);
+    for (i, &v) in x.iter().enumerate() {
+        let prev = i.checked_sub(1).map(|j| x[j]);
+        let next = x.get(i + 1).copied();
+        if v >= hi {
+            at_max += 1;
+            if prev.is_some_and(|p| p >= hi) || next.is_some_and(|q| q >= hi) {
+                held_max += 1;
+            }
+        }
+        if v <= lo {
+            at_min += 1;
+            if prev.is_some_and(|p| p <= lo) || next.is_some_and(|q| q <= lo) {
+                held_min += 1;
+            }
+        }
+    }
     let need = CLIPPED_MIN_SAMPLES.max((CLIPPED_SHARE * x.len() as f64).ceil() as usize);
     // Judged by the held samples, reported with every sample at that extreme.
-    let (n, value, at): (usize, f64, &dyn Fn(f64) -> bool) = if held_max >= held_min {
-        (held_max, max, &is_max)
+    let (n, count, value) = if held_max >= held_min {
+        (held_max, at_max, max)
     } else {
-        (held_min, min, &is_min)
+        (held_min, at_min, min)
     };
-    (n >= need).then(|| (x.iter().filter(|&&v| at(v)).count(), value))
+    (n >= need).then_some((count, value))
 }
 
 /// Stretches of a channel that hold one value: `(samples, stretches, longest)` over the runs of
@@ -209,6 +301,72 @@ mod tests {
         assert_eq!(clipped(&y), Some((20, 1.0)));
         // A constant channel is not "clipped" (it is dead or stuck).
         assert_eq!(clipped(&[2.0; 50]), None);
+    }
+
+    #[test]
+    fn one_look_at_a_channel_gives_each_fault() {
+        // A channel with a dropout of 30 samples held at 0.25 and a top clipped at 1.0 over
+        // 12 samples, at 1000 Hz (held runs of 10 samples or more count).
+        let mut x: Vec<f64> = (0..1000).map(|i| ((i * 37) % 101) as f64 / 200.0).collect();
+        for v in x.iter_mut().skip(100).take(30) {
+            *v = 0.25;
+        }
+        for v in x.iter_mut().skip(500).take(12) {
+            *v = 1.0;
+        }
+        let h = channel_health(&x, held_min_run(1000.0));
+        assert_eq!(held_min_run(1000.0), 10);
+        assert_eq!(held_min_run(20_000.0), 200);
+        assert_eq!(h.constant, None);
+        assert_eq!(h.clipped, Some((12, 1.0)));
+        // The clipped top is clipping, not a held stretch.
+        assert_eq!(h.held, (30, 1, 30));
+        assert!((h.held_share() - 0.03).abs() < 1e-12 && h.is_held());
+        let dead = channel_health(&[0.0; 40], 10);
+        assert_eq!(
+            (dead.constant, dead.clipped, dead.held),
+            (Some(0.0), None, (0, 0, 0))
+        );
+        assert!(!dead.is_held());
+        let short = channel_health(&[1.0], 10);
+        assert_eq!((short.constant, short.clipped), (None, None));
+        // The same as each rule alone, over seeded random channels with held and clipped parts.
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for seed in 0..200 {
+            let n = 20 + (next() * 2000.0) as usize;
+            let mut y: Vec<f64> = (0..n).map(|_| (next() * 8.0).round() / 8.0 - 0.5).collect();
+            if seed % 3 == 0 {
+                let c = next() * 0.4;
+                y.iter_mut().for_each(|v| *v = v.clamp(-0.5, c));
+            }
+            if seed % 5 == 0 {
+                let at = (next() * n as f64) as usize;
+                let v = y[at];
+                y.iter_mut().skip(at).take(15).for_each(|s| *s = v);
+            }
+            let h = channel_health(&y, 4);
+            assert_eq!(h.constant, constant_value(&y), "seed {seed}");
+            assert_eq!(h.clipped, clipped(&y), "seed {seed}");
+            let skip = match h.clipped {
+                Some(_) => vec![
+                    y.iter().copied().fold(f64::INFINITY, f64::min),
+                    y.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                ],
+                None => Vec::new(),
+            };
+            let expect = if h.constant.is_some() {
+                (0, 0, 0)
+            } else {
+                held_runs(&y, 4, &skip)
+            };
+            assert_eq!(h.held, expect, "seed {seed}");
+        }
     }
 
     #[test]

@@ -289,7 +289,7 @@ pub use vibmode_core::stats::{CLIPPED_MIN_SAMPLES, CLIPPED_SHARE};
 /// columns, such as a speed, are not sensors of the features).
 pub fn sensor_faults(rec: &Recording, acfg: &AnalysisConfig) -> Vec<SensorFault> {
     let mut out = Vec::new();
-    let held = vibmode_analysis::HeldChannel::of(rec);
+    let min_run = vibmode_core::stats::held_min_run(rec.fs_hz);
     for ch in &rec.channels {
         if acfg.placement_of(ch).role == Role::Other || ch.samples.is_empty() {
             continue;
@@ -300,21 +300,17 @@ pub fn sensor_faults(rec: &Recording, acfg: &AnalysisConfig) -> Vec<SensorFault>
             fault,
             detail,
         };
-        match vibmode_core::stats::constant_value(x) {
-            Some(0.0) => {
-                out.push(fault(FaultKind::Dead, "every sample is 0".into()));
-                continue;
-            }
-            Some(v) => {
-                out.push(fault(
+        let h = vibmode_core::stats::channel_health(x, min_run);
+        if let Some(v) = h.constant {
+            out.push(if v == 0.0 {
+                fault(FaultKind::Dead, "every sample is 0".into())
+            } else {
+                fault(
                     FaultKind::Flat,
                     format!("every sample is {}", vibmode_core::Num(v)),
-                ));
-                continue;
-            }
-            None => {}
-        }
-        if let Some((n, value)) = vibmode_core::stats::clipped(x) {
+                )
+            });
+        } else if let Some((n, value)) = h.clipped {
             out.push(fault(
                 FaultKind::Clipped,
                 format!(
@@ -323,16 +319,14 @@ pub fn sensor_faults(rec: &Recording, acfg: &AnalysisConfig) -> Vec<SensorFault>
                     vibmode_core::Num(value)
                 ),
             ));
-            continue;
-        }
-        if let Some(h) = held.iter().find(|h| h.channel == ch.name) {
+        } else if h.is_held() {
             out.push(fault(
                 FaultKind::Held,
                 format!(
                     "{:.1} % of the samples hold one value, in {} stretch(es) up to {:.3} s",
-                    100.0 * h.share,
-                    h.stretches,
-                    h.longest_s
+                    100.0 * h.held_share(),
+                    h.held.1,
+                    h.held.2 as f64 / rec.fs_hz
                 ),
             ));
         }
