@@ -111,12 +111,59 @@ enum Inner {
         scale: f64,
         remaining: u64,
     },
+    /// A 32-bit float WAV read from its data chunk in blocks of bytes (hound's sample
+    /// iterator costs ~25 ns a sample; the same values, `f32 as f64 * scale`).
+    WavF32 {
+        data: BufReader<File>,
+        scale: f64,
+        remaining: u64,
+        buf: Vec<u8>,
+    },
     Raw {
         file: BufReader<File>,
         width: usize,
         remaining: u64,
         buf: Vec<u8>,
     },
+}
+
+/// Reads into `buf` until it is full or the reader ends; the bytes read.
+fn read_full(r: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut got = 0;
+    while got < buf.len() {
+        match r.read(&mut buf[got..]) {
+            Ok(0) => break,
+            Ok(m) => got += m,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(got)
+}
+
+/// Interleaved little-endian samples of `W` bytes (`nch` a frame, decoded by `decode`) as
+/// channels, each value times `scale`.
+fn deinterleave<const W: usize>(
+    buf: &[u8],
+    nch: usize,
+    scale: f64,
+    decode: impl Fn([u8; W]) -> f64,
+) -> Vec<Vec<f64>> {
+    let n = buf.len() / (W * nch);
+    let mut out: Vec<Vec<f64>> = (0..nch).map(|_| Vec::with_capacity(n)).collect();
+    for frame in buf.chunks_exact(W * nch) {
+        for (ch, v) in out.iter_mut().zip(frame.chunks_exact(W)) {
+            let mut b = [0u8; W];
+            b.copy_from_slice(v);
+            ch.push(decode(b) * scale);
+        }
+    }
+    out
+}
+
+/// Little-endian 32-bit floats as f64.
+fn f32_le(b: [u8; 4]) -> f64 {
+    f32::from_le_bytes(b) as f64
 }
 
 /// A recording read block by block; see the module documentation.
@@ -278,15 +325,23 @@ fn open_wav(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
         start_s: 0.0,
         start_time: sidecar_start_time(Path::new(&side)),
     };
-    Ok(stream(
-        info,
+    let inner = if float {
+        // hound's reader stops at the start of the data chunk (wav_layout: 32 bits).
+        Inner::WavF32 {
+            data: reader.into_inner(),
+            scale,
+            remaining: n,
+            buf: Vec::new(),
+        }
+    } else {
         Inner::Wav {
             reader: Box::new(reader),
             float,
             scale,
             remaining: n,
-        },
-    ))
+        }
+    };
+    Ok(stream(info, inner))
 }
 
 fn delimited_reader(path: &Path) -> Result<DelimitedReader<BufReader<File>>> {
@@ -565,19 +620,43 @@ impl FrameStream {
                     message: format!("{e} (was the file cut off or changed while being read?)"),
                 })?;
                 *remaining -= n as u64;
-                let mut out = vec![Vec::with_capacity(n); nch];
                 if *width == 4 {
-                    for (k, c) in buf.chunks_exact(4).enumerate() {
-                        out[k % nch].push(f32::from_le_bytes([c[0], c[1], c[2], c[3]]) as f64);
-                    }
+                    deinterleave(buf, nch, 1.0, f32_le)
                 } else {
-                    for (k, c) in buf.chunks_exact(8).enumerate() {
-                        out[k % nch].push(f64::from_le_bytes([
-                            c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7],
-                        ]));
-                    }
+                    deinterleave(buf, nch, 1.0, f64::from_le_bytes)
                 }
-                out
+            }
+            Inner::WavF32 {
+                data,
+                scale,
+                remaining,
+                buf,
+            } => {
+                if *remaining == 0 {
+                    return Ok(None);
+                }
+                let nch = self.file_names.len();
+                let n = (*remaining).min(max_frames as u64) as usize;
+                buf.resize(n * nch * 4, 0);
+                let got = read_full(data, buf).map_err(|e| SignalError::Wav {
+                    path: self.info.path.clone(),
+                    problem: WavProblem::CutOffAt {
+                        message: e.to_string(),
+                        frame: self.next_frame,
+                        announced: self.next_frame + *remaining,
+                    },
+                })?;
+                if got < buf.len() {
+                    return Err(SignalError::Wav {
+                        path: self.info.path.clone(),
+                        problem: WavProblem::EndsEarly {
+                            frame: self.next_frame + (got / (4 * nch)) as u64,
+                            announced: self.next_frame + *remaining,
+                        },
+                    });
+                }
+                *remaining -= n as u64;
+                deinterleave(buf, nch, *scale, f32_le)
             }
             Inner::Wav {
                 reader,
