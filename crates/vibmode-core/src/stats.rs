@@ -62,6 +62,27 @@ pub fn dot(x: &[f64], z: &[f64]) -> f64 {
     (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
+/// The smallest and largest of `x` (not empty, no NaN), in four lanes (`<` and `>` compare as
+/// SIMD instructions where `f64::min` and `max`, which mind NaN, do not).
+fn extremes(x: &[f64]) -> (f64, f64) {
+    let (mut lo, mut hi) = ([x[0]; 4], [x[0]; 4]);
+    let chunks = x.chunks_exact(4);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for k in 0..4 {
+            lo[k] = if c[k] < lo[k] { c[k] } else { lo[k] };
+            hi[k] = if c[k] > hi[k] { c[k] } else { hi[k] };
+        }
+    }
+    let mut min = lo.iter().copied().fold(lo[0], f64::min);
+    let mut max = hi.iter().copied().fold(hi[0], f64::max);
+    for &v in rest {
+        min = min.min(v);
+        max = max.max(v);
+    }
+    (min, max)
+}
+
 /// The value of a channel that carries no vibration: `Some(0.0)` when every sample is 0 (a dead
 /// sensor: its peak magnitude at most [`crate::limits::SAMPLE_PEAK_MIN`]), `Some(v)` when every
 /// sample is `v` to within 1e-9 of the peak (a stuck sensor; rounding of a resampled constant
@@ -72,9 +93,7 @@ pub fn constant_value(x: &[f64]) -> Option<f64> {
     if x.len() < 2 {
         return None;
     }
-    let (min, max) = x
-        .iter()
-        .fold((x[0], x[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    let (min, max) = extremes(x);
     constant_from_extremes(min, max)
 }
 
@@ -137,9 +156,7 @@ pub fn channel_health(x: &[f64], min_run: usize) -> ChannelHealth {
     if x.len() < 2 {
         return h;
     }
-    let (min, max) = x
-        .iter()
-        .fold((x[0], x[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    let (min, max) = extremes(x);
     h.constant = constant_from_extremes(min, max);
     if h.constant.is_some() {
         return h;
@@ -172,9 +189,7 @@ pub fn clipped(x: &[f64]) -> Option<(usize, f64)> {
     if x.len() < 2 {
         return None;
     }
-    let (min, max) = x
-        .iter()
-        .fold((x[0], x[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    let (min, max) = extremes(x);
     if constant_from_extremes(min, max).is_some() {
         return None;
     }
@@ -185,6 +200,15 @@ pub fn clipped(x: &[f64]) -> Option<(usize, f64)> {
 fn clipped_from_extremes(x: &[f64], min: f64, max: f64) -> Option<(usize, f64)> {
     let tol = 1e-9 * (max - min);
     let (hi, lo) = (max - tol, min + tol);
+    let need = CLIPPED_MIN_SAMPLES.max((CLIPPED_SHARE * x.len() as f64).ceil() as usize);
+    // A live channel reaches its extremes a few times: counted first (no branches), so that the
+    // neighbours are looked at only when enough samples are there.
+    let (at_hi, at_lo) = x.iter().fold((0usize, 0usize), |(h, l), &v| {
+        (h + usize::from(v >= hi), l + usize::from(v <= lo))
+    });
+    if at_hi.max(at_lo) < need {
+        return None;
+    }
     // One pass: the samples at each extreme, and those of them with a neighbour there too.
     let (mut at_max, mut at_min, mut held_max, mut held_min) = (0usize, 0usize, 0usize, 0usize);
     for (i, &v) in x.iter().enumerate() {
@@ -203,7 +227,6 @@ fn clipped_from_extremes(x: &[f64], min: f64, max: f64) -> Option<(usize, f64)> 
             }
         }
     }
-    let need = CLIPPED_MIN_SAMPLES.max((CLIPPED_SHARE * x.len() as f64).ceil() as usize);
     // Judged by the held samples, reported with every sample at that extreme.
     let (n, count, value) = if held_max >= held_min {
         (held_max, at_max, max)
@@ -301,6 +324,24 @@ mod tests {
         assert_eq!(clipped(&y), Some((20, 1.0)));
         // A constant channel is not "clipped" (it is dead or stuck).
         assert_eq!(clipped(&[2.0; 50]), None);
+    }
+
+    #[test]
+    fn extremes_in_lanes_are_the_fold() {
+        assert_eq!(extremes(&[3.0]), (3.0, 3.0));
+        assert_eq!(extremes(&[1.0, -2.0, 5.0, 0.0, 4.0, -7.0]), (-7.0, 5.0));
+        for n in 1..40 {
+            for shift in 0..n {
+                // The extremes at every position, in the lanes and in the remainder.
+                let x: Vec<f64> = (0..n)
+                    .map(|i| (((i + shift) * 7) % n) as f64 - 3.0)
+                    .collect();
+                let want = x
+                    .iter()
+                    .fold((x[0], x[0]), |(a, b), &v| (a.min(v), b.max(v)));
+                assert_eq!(extremes(&x), want, "n {n} shift {shift}");
+            }
+        }
     }
 
     #[test]
