@@ -61,7 +61,9 @@ pub use read::{
 pub use records::{ChainedRecords, StreamRecords};
 pub use resample::ResampleRecording;
 pub use resample::{planned_fs_out_hz, resample, ResampleMethod, ResampleParams, Resampler};
-pub use stream::{open_stream, FrameBlock, FrameStream, StreamInfo, DEFAULT_BLOCK_FRAMES};
+pub use stream::{
+    open_stream, FrameBlock, FrameStream, StreamInfo, DEFAULT_BLOCK_FRAMES, KEEP_PARSED_MAX_VALUES,
+};
 pub use stream_resample::{
     resample_stream, FirDecimator, FirDesign, ResamplerKind, StreamResampleParams,
     StreamResampleSummary,

@@ -7,12 +7,15 @@
 //!
 //! - **raw**: the sidecar is read first; the file size must be a whole number of frames (a file
 //!   cut off mid-write is refused before any sample is used, [`SignalError::PartialFrame`]);
-//! - **WAV**: samples come from hound's sample iterator; a file cut off mid-write (its header
-//!   announces more samples than it holds) fails with a message saying so;
+//! - **WAV**: a 32-bit float file is read from its data chunk in blocks of bytes, an integer
+//!   one through hound's sample iterator; a file cut off mid-write (its header announces more
+//!   samples than it holds) fails with a message saying so;
 //! - **delimited text**: parsed by [`crate::DelimitedReader`] block by block. With a time column
-//!   the file is read twice: a first pass over the time column gives the rate
-//!   `(n - 1) / (t_last - t_first)`, the jitter and the check that time increases (exactly as
-//!   [`crate::read_path`] does), the second pass yields the samples; with a non-uniform time column
+//!   a first pass over the time column gives the rate `(n - 1) / (t_last - t_first)`, the jitter
+//!   and the check that time increases (exactly as [`crate::read_path`] does); the blocks it
+//!   parsed are kept and handed out when they hold at most [`KEEP_PARSED_MAX_VALUES`] values
+//!   (a 10 s record of 7 channels at 20 kHz holds 13 million), else the file is parsed again
+//!   block by block as the samples are asked for; with a non-uniform time column
 //!   and `allow_nonuniform` the samples are interpolated linearly onto the uniform grid as they
 //!   pass.
 //!
@@ -29,6 +32,12 @@ use vibmode_core::{Channel, ChannelSelector, Recording, RecordingError};
 /// Frames per block read by the command-line tools (65 536: 3.3 s at 20 kHz, 3.7 MB for 7
 /// channels).
 pub const DEFAULT_BLOCK_FRAMES: usize = 1 << 16;
+
+/// Most values (cells of every column) of a delimited file with a time column whose blocks,
+/// parsed by the first pass over the time column, are kept for the samples instead of parsing
+/// the file a second time: 2^24, 128 MiB of `f64`. A longer file is read twice in bounded
+/// memory.
+pub const KEEP_PARSED_MAX_VALUES: usize = 1 << 24;
 
 /// What a stream holds, known when it is opened.
 #[derive(Clone, Debug, PartialEq)]
@@ -94,12 +103,15 @@ struct Interp {
 enum Inner {
     Delimited {
         reader: Box<DelimitedReader<BufReader<File>>>,
+        /// Blocks parsed by the first pass over the time column, handed out before `reader`
+        /// is asked for more (which is then at the end of the file).
+        kept: std::collections::VecDeque<Block>,
         time_col: Option<(usize, f64)>,
         /// The columns that are channels, in order.
         channel_cols: Vec<usize>,
         /// A pandas row index: its column and the value expected next (`None` before the first
         /// row).
-        row_index: Option<(ColumnInfo, usize, Option<f64>)>,
+        row_index: Option<Box<(ColumnInfo, usize, Option<f64>)>>,
         interp: Option<Interp>,
         /// Frames parsed but not yet handed out (channel-major).
         pending: Vec<Vec<f64>>,
@@ -361,9 +373,17 @@ struct TimeScan {
     min_dt: f64,
 }
 
-fn scan_time(path: &Path, col: usize, scale: f64, name: &str) -> Result<TimeScan> {
+/// The first pass over a time column with `r` (just past the header); the blocks parsed, when
+/// they hold at most `keep_max` values ([`KEEP_PARSED_MAX_VALUES`]).
+fn scan_time(
+    r: &mut DelimitedReader<BufReader<File>>,
+    path: &Path,
+    col: usize,
+    scale: f64,
+    name: &str,
+    keep_max: usize,
+) -> Result<(TimeScan, Option<std::collections::VecDeque<Block>>)> {
     let p = path.display().to_string();
-    let mut r = delimited_reader(path)?;
     let mut scan = TimeScan {
         n: 0,
         t0: 0.0,
@@ -371,6 +391,8 @@ fn scan_time(path: &Path, col: usize, scale: f64, name: &str) -> Result<TimeScan
         max_dt: f64::NEG_INFINITY,
         min_dt: f64::INFINITY,
     };
+    let mut kept = Some(std::collections::VecDeque::new());
+    let mut n_values = 0usize;
     while let Some(block) = r.next_block(DEFAULT_BLOCK_FRAMES)? {
         for (k, &raw) in block.columns[col].iter().enumerate() {
             let t = raw * scale;
@@ -401,13 +423,24 @@ fn scan_time(path: &Path, col: usize, scale: f64, name: &str) -> Result<TimeScan
             scan.t_last = t;
             scan.n += 1;
         }
+        n_values += block.columns.iter().map(Vec::len).sum::<usize>();
+        if n_values > keep_max {
+            kept = None;
+        }
+        if let Some(k) = kept.as_mut() {
+            k.push_back(block);
+        }
     }
-    Ok(scan)
+    Ok((scan, kept))
 }
 
 fn open_delimited(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
+    open_delimited_keeping(path, opts, KEEP_PARSED_MAX_VALUES)
+}
+
+fn open_delimited_keeping(path: &Path, opts: &ReadOptions, keep_max: usize) -> Result<FrameStream> {
     let p = path.display().to_string();
-    let reader = delimited_reader(path)?;
+    let mut reader = delimited_reader(path)?;
     let cols = reader.columns().to_vec();
     let tcol = cols.iter().position(|c| c.time_scale_s.is_some());
     let channel_cols: Vec<usize> = (0..cols.len()).filter(|&i| cols[i].is_channel()).collect();
@@ -416,15 +449,21 @@ fn open_delimited(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
     let row_index = cols
         .iter()
         .position(|c| c.row_index)
-        .map(|i| (cols[i].clone(), i, None));
+        .map(|i| Box::new((cols[i].clone(), i, None)));
     if names.is_empty() {
         return Err(SignalError::NoChannels { path: p });
     }
+    let mut kept = std::collections::VecDeque::new();
     let (fs_hz, n_frames, start_s, time_col, interp) = match tcol {
         Some(ti) => {
             let name = cols[ti].name.clone();
             let scale = cols[ti].time_scale(opts.time_scale_s);
-            let scan = scan_time(path, ti, scale, &name)?;
+            let (scan, blocks) = scan_time(&mut reader, path, ti, scale, &name, keep_max)?;
+            match blocks {
+                Some(b) => kept = b,
+                // Too long to keep: parsed again as the samples are asked for.
+                None => reader = delimited_reader(path)?,
+            }
             if scan.n == 0 {
                 return Err(SignalError::NoDataRows { path: p });
             }
@@ -484,6 +523,7 @@ fn open_delimited(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
         info,
         Inner::Delimited {
             reader: Box::new(reader),
+            kept,
             time_col,
             channel_cols,
             row_index,
@@ -706,6 +746,7 @@ impl FrameStream {
             }
             Inner::Delimited {
                 reader,
+                kept,
                 time_col,
                 channel_cols,
                 row_index,
@@ -714,9 +755,13 @@ impl FrameStream {
                 eof,
             } => {
                 while !*eof && pending.first().map_or(0, |p| p.len()) < max_frames {
-                    match reader.next_block(max_frames)? {
+                    let next = match kept.pop_front() {
+                        Some(block) => Some(block),
+                        None => reader.next_block(max_frames)?,
+                    };
+                    match next {
                         Some(block) => {
-                            if let Some((info, col, next)) = row_index.as_mut() {
+                            if let Some((info, col, next)) = row_index.as_deref_mut() {
                                 let values = &block.columns[*col];
                                 let first = next.or(values.first().copied()).unwrap_or(0.0);
                                 *next = Some(check_row_index(
@@ -826,5 +871,53 @@ impl FrameStream {
                 .collect(),
             time_axis: None,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The samples of a delimited file with a time column are the same whether the first
+    /// pass's blocks are kept or the file is parsed again (a bound below the file's values).
+    #[test]
+    fn kept_blocks_and_a_second_pass_give_the_same_samples() {
+        let dir = std::env::temp_dir().join(format!("vibmode-keep-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("t.csv");
+        let mut text = String::from("time_s,a,b\n");
+        for i in 0..5000 {
+            // Jittered times: interpolated onto the grid as they pass.
+            let t = i as f64 * 0.01 + if i % 7 == 3 { 0.002 } else { 0.0 };
+            text += &format!(
+                "{t},{},{}\n",
+                (i as f64 * 0.37).sin(),
+                (i % 13) as f64 - 6.0
+            );
+        }
+        std::fs::write(&path, text).unwrap();
+        let opts = ReadOptions {
+            allow_nonuniform: true,
+            ..Default::default()
+        };
+        let read_all = |keep_max: usize, block: usize| {
+            let mut s = open_delimited_keeping(&path, &opts, keep_max).unwrap();
+            let mut out = vec![Vec::new(); 2];
+            while let Some(b) = s.next_block(block).unwrap() {
+                for (o, c) in out.iter_mut().zip(b.channels) {
+                    o.extend(c);
+                }
+            }
+            (s.info().fs_hz, out)
+        };
+        let whole = crate::read_path(&path, &opts).unwrap();
+        for (keep_max, block) in [(usize::MAX, 1000), (100, 1000), (0, 777), (usize::MAX, 1)] {
+            let (fs, got) = read_all(keep_max, block);
+            assert_eq!(fs, whole.fs_hz);
+            for (g, c) in got.iter().zip(&whole.channels) {
+                assert_eq!(g, &c.samples, "keep_max {keep_max}, block {block}");
+            }
+        }
+        std::fs::remove_dir_all(&dir).ok();
     }
 }
