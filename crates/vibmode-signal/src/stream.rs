@@ -14,7 +14,7 @@
 //!   a first pass over the time column gives the rate `(n - 1) / (t_last - t_first)`, the jitter
 //!   and the check that time increases (exactly as [`crate::read_path`] does); the blocks it
 //!   parsed are kept and handed out when they hold at most [`KEEP_PARSED_MAX_VALUES`] values
-//!   (a 10 s record of 7 channels at 20 kHz holds 13 million), else the file is parsed again
+//!   (a 10.24 s record of 7 channels and a time column at 20 kHz holds 1.6 million), else the file is parsed again
 //!   block by block as the samples are asked for; with a non-uniform time column
 //!   and `allow_nonuniform` the samples are interpolated linearly onto the uniform grid as they
 //!   pass.
