@@ -507,12 +507,11 @@ impl<'a> Search<'a> {
         // Exact a-columns (1/C)[y_{t-k} 1{t >= p}] when affordable; otherwise delayed copies of y/C
         // (ignores that A(q) y is only formed from t = p on: a transient-only approximation).
         let exact = (n as f64) * (p as f64) * (k as f64) <= EXACT_JACOBIAN_BUDGET;
-        if !exact {
-            filter_inv_c(self.ys, c, &mut self.yf);
-        }
         self.exact_cols = false;
         if exact {
             self.exact_ar_block(c, &mut h);
+        } else {
+            filter_inv_c(self.ys, c, &mut self.yf);
         }
         let (yf, ef) = (Lags::new(&self.yf, p), Lags::new(&self.ef, q));
         if !exact {
