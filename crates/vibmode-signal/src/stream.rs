@@ -24,6 +24,7 @@
 use crate::delimited::{check_row_index, Block, ColumnInfo, DelimitedReader};
 use crate::error::{io_err, Result, SignalError, WavProblem};
 use crate::read::{raw_layout, reconcile_fs, wav_names, Format, ReadOptions};
+use std::collections::VecDeque;
 use std::fs::File;
 use std::io::{BufReader, Read};
 use std::path::Path;
@@ -105,7 +106,7 @@ enum Inner {
         reader: Box<DelimitedReader<BufReader<File>>>,
         /// Blocks parsed by the first pass over the time column, handed out before `reader`
         /// is asked for more (which is then at the end of the file).
-        kept: std::collections::VecDeque<Block>,
+        kept: VecDeque<Block>,
         time_col: Option<(usize, f64)>,
         /// The columns that are channels, in order.
         channel_cols: Vec<usize>,
@@ -114,7 +115,7 @@ enum Inner {
         row_index: Option<Box<(ColumnInfo, usize, Option<f64>)>>,
         interp: Option<Interp>,
         /// Frames parsed but not yet handed out (channel-major).
-        pending: Vec<Vec<f64>>,
+        pending: Vec<VecDeque<f64>>,
         eof: bool,
     },
     Wav {
@@ -412,7 +413,7 @@ fn scan_time(
     scale: f64,
     name: &str,
     keep_max: usize,
-) -> Result<(TimeScan, Option<std::collections::VecDeque<Block>>)> {
+) -> Result<(TimeScan, Option<VecDeque<Block>>)> {
     let p = path.display().to_string();
     let mut scan = TimeScan {
         n: 0,
@@ -421,7 +422,7 @@ fn scan_time(
         max_dt: f64::NEG_INFINITY,
         min_dt: f64::INFINITY,
     };
-    let mut kept = Some(std::collections::VecDeque::new());
+    let mut kept = Some(VecDeque::new());
     let mut n_values = 0usize;
     while let Some(block) = r.next_block(DEFAULT_BLOCK_FRAMES)? {
         for (k, &raw) in block.columns[col].iter().enumerate() {
@@ -483,7 +484,7 @@ fn open_delimited_keeping(path: &Path, opts: &ReadOptions, keep_max: usize) -> R
     if names.is_empty() {
         return Err(SignalError::NoChannels { path: p });
     }
-    let mut kept = std::collections::VecDeque::new();
+    let mut kept = VecDeque::new();
     let (fs_hz, n_frames, start_s, time_col, interp) = match tcol {
         Some(ti) => {
             let name = cols[ti].name.clone();
@@ -558,22 +559,22 @@ fn open_delimited_keeping(path: &Path, opts: &ReadOptions, keep_max: usize) -> R
             channel_cols,
             row_index,
             interp,
-            pending: vec![Vec::new(); nch],
+            pending: vec![VecDeque::new(); nch],
             eof: false,
         },
     ))
 }
 
 /// Appends a parsed block's channel columns to `pending`.
-fn push_rows(block: &Block, channel_cols: &[usize], pending: &mut [Vec<f64>]) {
+fn push_rows(block: &Block, channel_cols: &[usize], pending: &mut [VecDeque<f64>]) {
     for (p, &c) in pending.iter_mut().zip(channel_cols) {
-        p.extend_from_slice(&block.columns[c]);
+        p.extend(&block.columns[c]);
     }
 }
 
 impl Interp {
     /// Feeds one row (time `t`, values `y`) and emits every grid point at or before `t`.
-    fn feed(&mut self, t: f64, y: &[f64], pending: &mut [Vec<f64>]) {
+    fn feed(&mut self, t: f64, y: &[f64], pending: &mut [VecDeque<f64>]) {
         while self.emitted < self.n {
             let ti = self.t0 + self.emitted as f64 * self.dt;
             if ti > t {
@@ -583,17 +584,17 @@ impl Interp {
                 Some((ta, ya)) if ti > *ta => {
                     let w = ((ti - ta) / (t - ta)).clamp(0.0, 1.0);
                     for ((p, a), b) in pending.iter_mut().zip(ya).zip(y) {
-                        p.push(a + w * (b - a));
+                        p.push_back(a + w * (b - a));
                     }
                 }
                 Some((_, ya)) => {
                     for (p, a) in pending.iter_mut().zip(ya) {
-                        p.push(*a);
+                        p.push_back(*a);
                     }
                 }
                 None => {
                     for (p, b) in pending.iter_mut().zip(y) {
-                        p.push(*b);
+                        p.push_back(*b);
                     }
                 }
             }
@@ -604,11 +605,11 @@ impl Interp {
 
     /// At the end of the file: the grid points left (rounding past the last time) take the last
     /// row's values.
-    fn finish(&mut self, pending: &mut [Vec<f64>]) {
+    fn finish(&mut self, pending: &mut [VecDeque<f64>]) {
         if let Some((_, y)) = &self.prev {
             while self.emitted < self.n {
                 for (p, v) in pending.iter_mut().zip(y) {
-                    p.push(*v);
+                    p.push_back(*v);
                 }
                 self.emitted += 1;
             }
@@ -840,13 +841,9 @@ impl FrameStream {
                     return Ok(None);
                 }
                 let n = have.min(max_frames);
-                pending
-                    .iter_mut()
-                    .map(|p| {
-                        let rest = p.split_off(n);
-                        std::mem::replace(p, rest)
-                    })
-                    .collect()
+                // From the front of a queue: O(n) however much stays pending (a kept block of
+                // 65 536 rows handed out a few frames at a time).
+                pending.iter_mut().map(|p| p.drain(..n).collect()).collect()
             }
         };
         for (c, d) in all.iter().enumerate() {
