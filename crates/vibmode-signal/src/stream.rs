@@ -8,14 +8,14 @@
 //! - **raw**: the sidecar is read first; the file size must be a whole number of frames (a file
 //!   cut off mid-write is refused before any sample is used, [`SignalError::PartialFrame`]);
 //! - **WAV**: a 32-bit float or 16-bit integer file is read from its data chunk in blocks of
-//!   bytes, other integer widths through hound's sample iterator; a file cut off mid-write (its header announces more
-//!   samples than it holds) fails with a message saying so;
+//!   bytes, other integer widths through hound's sample iterator; a file cut off mid-write (its
+//!   header announces more samples than it holds) fails with a message saying so;
 //! - **delimited text**: parsed by [`crate::DelimitedReader`] block by block. With a time column
 //!   a first pass over the time column gives the rate `(n - 1) / (t_last - t_first)`, the jitter
 //!   and the check that time increases (exactly as [`crate::read_path`] does); the blocks it
-//!   parsed are kept and handed out when they hold at most [`KEEP_PARSED_MAX_VALUES`] values
-//!   (a 10.24 s record of 7 channels and a time column at 20 kHz holds 1.6 million), else the file is parsed again
-//!   block by block as the samples are asked for; with a non-uniform time column
+//!   parsed are kept and handed out when they hold at most [`KEEP_PARSED_MAX_VALUES`] values (a
+//!   10.24 s record of 7 channels and a time column at 20 kHz holds 1.6 million), else the file
+//!   is parsed again block by block as the samples are asked for; with a non-uniform time column
 //!   and `allow_nonuniform` the samples are interpolated linearly onto the uniform grid as they
 //!   pass.
 //!
