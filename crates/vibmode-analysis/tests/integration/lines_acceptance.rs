@@ -132,6 +132,7 @@ fn describe(name: &str, c: &Counts) -> String {
 }
 
 #[test]
+#[ignore = "acceptance tier (about 10 s): cargo test --workspace -- --ignored"]
 fn lines_are_found_per_record_over_five_seeds() {
     let before = run(LineParams {
         sweep_min_range_hz: 0.0,
