@@ -328,6 +328,15 @@ fn check(a: &CheckArgs) -> Result<()> {
             }
         ));
     }
+    // A record of the baseline checked against it is scored by a yardstick made from itself.
+    for c in &out {
+        if let Some(twin) = &c.in_baseline {
+            text.push_str(&format!(
+                "note: {} has the content of {}, a record model set version {} was built from: not an independent check\n",
+                c.file, twin, c.model_version
+            ));
+        }
+    }
     for d in &drives {
         text.push_str(&format!(
             "drive {} ({} records, median of each feature; false alarms per drive at most {} %): {}{}  {}\n",
@@ -355,6 +364,14 @@ fn check(a: &CheckArgs) -> Result<()> {
             .filter(|m| m.starts_with("suspension fit:"))
         {
             text.push_str(&format!("  note: {m}\n"));
+        }
+        if !d.in_baseline.is_empty() {
+            text.push_str(&format!(
+                "  note: {} of the drive's {} records are records of the baseline ({}): its verdict leans toward normal; check records the baseline was not built from\n",
+                d.in_baseline.len(),
+                d.records.len(),
+                vibmode_core::cap_message(&d.in_baseline.join(", "), 120)
+            ));
         }
     }
     match a.json.as_deref() {

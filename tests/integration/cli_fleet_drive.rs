@@ -343,3 +343,67 @@ fn records_with_dates_form_one_drive_per_day() {
     assert_eq!(v1.drives.len(), 4);
     assert_eq!(v1.drives[1].drive, "2026-11-26");
 }
+
+/// A record the baseline was built from, checked again (here a copy under another name), is
+/// named as such, on its row and on its drive: its check is not independent of the baseline.
+/// A nominal record stored after the baseline was built is not.
+#[test]
+fn records_of_the_baseline_in_a_checked_drive_are_named() {
+    let d = tempfile::tempdir().unwrap();
+    let db = store_with_baseline(d.path());
+    let db = db.as_str();
+    let nominal = simulate_csv(&d.path().join("nominal"), "B", "30", "11", "6");
+    // Stored after the baseline: nominal, but not in model set version 1.
+    let later = simulate_csv(&d.path().join("later"), "B", "30", "31", "1");
+    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1", "-q"];
+    args.extend(later.iter().map(String::as_str));
+    ok(&args);
+    let again = d.path().join("again");
+    std::fs::create_dir(&again).unwrap();
+    let copies: Vec<String> = nominal[..2]
+        .iter()
+        .enumerate()
+        .map(|(i, f)| {
+            let to = again.join(format!("copy{i}.csv"));
+            std::fs::copy(f, &to).unwrap();
+            to.to_string_lossy().to_string()
+        })
+        .collect();
+    let test = simulate_csv(&d.path().join("test"), "B", "30", "41", "2");
+    let files: Vec<String> = copies.iter().chain(&later).chain(&test).cloned().collect();
+    let json = d.path().join("check.json");
+    let mut args = vec!["fleet", "check", "--db", db, "--vehicle", "bus-1", "-q"];
+    args.extend(["--json", json.to_str().unwrap()]);
+    args.extend(files.iter().map(String::as_str));
+    let text = String::from_utf8_lossy(&ok(&args).stdout).to_string();
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let records = v["records"].as_array().unwrap();
+    assert_eq!(records.len(), 5, "{v}");
+    for (r, f) in records.iter().zip(&files) {
+        assert_eq!(r["file"], f.as_str());
+        match copies.iter().position(|c| c == f) {
+            Some(i) => {
+                assert_eq!(r["in_baseline"], nominal[i].as_str(), "{r}");
+                assert!(
+                    text.contains(&format!(
+                        "note: {f} has the content of {}, a record model set version 1 was built from",
+                        nominal[i]
+                    )),
+                    "{text}"
+                );
+            }
+            None => {
+                assert!(r.get("in_baseline").is_none(), "{f}: {r}");
+                assert!(!text.contains(&format!("note: {f} ")), "{text}");
+            }
+        }
+    }
+    let drives = v["drives"].as_array().unwrap();
+    assert_eq!(drives.len(), 1, "{v}");
+    assert_eq!(drives[0]["in_baseline"], serde_json::json!(copies), "{v}");
+    assert!(
+        text.contains("note: 2 of the drive's 5 records are records of the baseline"),
+        "{text}"
+    );
+}

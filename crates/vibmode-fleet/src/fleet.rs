@@ -69,6 +69,8 @@ struct Prepared {
     features: RecordFeatures,
     /// The vehicle already had this content when it was read.
     known: bool,
+    /// Known as a nominal record: its file name in the store.
+    known_nominal: Option<String>,
     /// Known, and its stored features get the body equations of the vehicle's model file,
     /// registered after the record was stored.
     refreshed: bool,
@@ -200,6 +202,7 @@ fn prepare_recording(
             metadata: metadata_of(rec),
             features: store.features(row.id)?,
             known: true,
+            known_nominal: nominal_name(&row),
             refreshed: false,
         });
     }
@@ -217,8 +220,14 @@ fn prepare_recording(
         metadata: metadata_of(rec),
         features,
         known: false,
+        known_nominal: None,
         refreshed: false,
     })
+}
+
+/// A stored record's file name when it is a nominal one.
+fn nominal_name(row: &crate::store::RecordRow) -> Option<String> {
+    (row.condition == Condition::Nominal).then(|| row.file_name.clone())
 }
 
 /// Stores prepared records (with their checks) in one transaction.
@@ -370,8 +379,9 @@ fn prepare_files(
     use rayon::prelude::*;
     /// What a path needs.
     enum Plan {
-        /// Stored before for the vehicle: its features (the equations added if they lack them).
-        Known(Box<RecordFeatures>),
+        /// Stored before for the vehicle: its features (the equations added if they lack them),
+        /// and its file name if it is a nominal record.
+        Known(Box<RecordFeatures>, Option<String>),
         /// The same bytes as the path at this index, read before in this call.
         Same(usize),
         /// To be read and analysed.
@@ -389,7 +399,7 @@ fn prepare_files(
      -> Result<Option<Prepared>> {
         match plan {
             Plan::Same(_) => Ok(None),
-            Plan::Known(stored) => {
+            Plan::Known(stored, nominal) => {
                 let fresh = with_equations(stored, model, path, &bytes, opts, cfg)?;
                 Ok(Some(Prepared {
                     file: name.to_string(),
@@ -398,6 +408,7 @@ fn prepare_files(
                     refreshed: fresh.is_some(),
                     features: fresh.unwrap_or_else(|| (**stored).clone()),
                     known: true,
+                    known_nominal: nominal.clone(),
                 }))
             }
             Plan::New => {
@@ -413,6 +424,7 @@ fn prepare_files(
                     metadata: metadata_of(&rec),
                     features,
                     known: false,
+                    known_nominal: None,
                     refreshed: false,
                 }))
             }
@@ -430,7 +442,7 @@ fn prepare_files(
             let name = file_name(path);
             let (bytes, sha) = r?;
             let plan = if let Some(row) = store.find_record(labels.vehicle, &sha)? {
-                Plan::Known(Box::new(store.features(row.id)?))
+                Plan::Known(Box::new(store.features(row.id)?), nominal_name(&row))
             } else if let Some(&k) = first_of.get(&sha) {
                 Plan::Same(k)
             } else {
@@ -460,6 +472,7 @@ fn prepare_files(
                     metadata: serde_json::json!({}),
                     features,
                     known: false,
+                    known_nominal: None,
                     refreshed: false,
                 });
             }
@@ -602,6 +615,18 @@ pub struct Checked {
     /// The verdict.
     #[serde(flatten)]
     pub assessment: Assessment,
+    /// The model set's record (its file name) with this record's content, when the model set
+    /// was built from it: the check is not independent of the baseline. Absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub in_baseline: Option<String>,
+}
+
+/// The file name of a model set's record with the content of `p`, if the set holds it.
+fn in_baseline(set: &ModelSet, p: &Prepared) -> Option<String> {
+    p.known_nominal
+        .as_ref()
+        .filter(|n| set.records.contains(n))
+        .cloned()
 }
 
 /// The vehicle's latest model set; errors name the fix when there is none.
@@ -665,6 +690,7 @@ fn check_prepared_drive(
         .zip(stored)
         .filter_map(|((p, c), s)| {
             c.map(|(v, assessment)| Checked {
+                in_baseline: in_baseline(set, &p),
                 file: p.file,
                 record_id: s.record_id,
                 model_version: v,
@@ -889,6 +915,11 @@ fn drive_verdict(store: &Store, set: &ModelSet, id: &str, records: &[&Prepared])
         },
         assessment,
         suspension: suspension.0,
+        in_baseline: records
+            .iter()
+            .filter(|p| in_baseline(set, p).is_some())
+            .map(|p| p.file.clone())
+            .collect(),
     })
 }
 

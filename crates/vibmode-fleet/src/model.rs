@@ -1530,6 +1530,11 @@ pub struct Drive {
     /// has a registered model file and the model set a fitted suspension.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub suspension: Option<crate::suspension::DriveSuspension>,
+    /// Its records whose content is a record the model set was built from (their file names
+    /// in the model set): scored against a baseline that holds them, so the drive's verdict
+    /// leans toward `normal`. Empty (and absent from the JSON) otherwise.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub in_baseline: Vec<String>,
 }
 
 #[cfg(test)]
