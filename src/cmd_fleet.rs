@@ -330,6 +330,12 @@ fn check(a: &CheckArgs) -> Result<()> {
     }
     // A record of the baseline checked against it is scored by a yardstick made from itself.
     for c in &out {
+        if let Some(first) = &c.same_as {
+            text.push_str(&format!(
+                "note: {} has the content of {}, given before it: counted once in a drive\n",
+                c.file, first
+            ));
+        }
         if let Some(twin) = &c.in_baseline {
             text.push_str(&format!(
                 "note: {} has the content of {}, a record model set version {} was built from: not an independent check\n",

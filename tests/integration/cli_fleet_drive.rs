@@ -407,3 +407,66 @@ fn records_of_the_baseline_in_a_checked_drive_are_named() {
         "{text}"
     );
 }
+
+/// A file given twice in one check (here a copy under another name) is scored alike and
+/// counted once in its drive: a named drive of two distinct records is refused, and the
+/// default drive's median is over distinct records.
+#[test]
+fn a_file_given_twice_counts_once_in_its_drive() {
+    let d = tempfile::tempdir().unwrap();
+    let db = store_with_baseline(d.path());
+    let db = db.as_str();
+    let test = simulate_csv(&d.path().join("test"), "B", "30", "51", "3");
+    let copy = d.path().join("copy.csv").to_string_lossy().to_string();
+    std::fs::copy(&test[0], &copy).unwrap();
+
+    // Three files, two contents: too few for a named drive; nothing stored.
+    fails_with(
+        &[
+            "fleet",
+            "check",
+            "--db",
+            db,
+            "--vehicle",
+            "bus-1",
+            "--drive",
+            "day-3",
+            &test[0],
+            &copy,
+            &test[1],
+        ],
+        &[
+            "drive 'day-3'",
+            "2 record(s) of distinct content",
+            "at least 3",
+        ],
+    );
+    assert_eq!(n_test(db, "bus-1"), 0);
+
+    // Four files, three contents: the drive holds the three, the copy is named.
+    let files = [&test[0], &copy, &test[1], &test[2]];
+    let v = check_json(db, None, &files);
+    let records = v["records"].as_array().unwrap();
+    assert_eq!(records.len(), 4, "{v}");
+    assert_eq!(records[1]["file"], copy.as_str());
+    assert_eq!(records[1]["same_as"], test[0].as_str(), "{v}");
+    for i in [0, 2, 3] {
+        assert!(records[i].get("same_as").is_none(), "{}", records[i]);
+    }
+    assert_eq!(records[1]["classification"], records[0]["classification"]);
+    let drives = v["drives"].as_array().unwrap();
+    assert_eq!(drives.len(), 1, "{v}");
+    assert_eq!(
+        drives[0]["records"],
+        serde_json::json!([&test[0], &test[1], &test[2]]),
+        "{v}"
+    );
+    // The same files again, all stored now: the copy is still found.
+    let v = check_json(db, None, &files);
+    assert_eq!(v["records"][1]["same_as"], test[0].as_str(), "{v}");
+    assert_eq!(
+        v["drives"][0]["records"].as_array().unwrap().len(),
+        3,
+        "{v}"
+    );
+}

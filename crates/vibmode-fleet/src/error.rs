@@ -214,17 +214,17 @@ pub enum FleetError {
         reason: String,
     },
     /// A drive with too few records for its statistic.
-    #[error("drive '{}' has {found} record(s); a drive's statistic (the median over its records) needs at least {needed}: give more records of the drive, or leave out --drive to check records one by one", vibmode_core::quoted(drive))]
+    #[error("drive '{}' has {found} record(s) of distinct content; a drive's statistic (the median over its records) needs at least {needed}: give more records of the drive, or check these records one by one, without a drive id", vibmode_core::quoted(drive))]
     DriveTooShort {
         /// The drive id.
         drive: String,
-        /// Records given.
+        /// Records given, each content counted once.
         found: usize,
         /// Records needed.
         needed: usize,
     },
     /// A drive given with a record stored for another vehicle.
-    #[error("drive '{}' of vehicle '{}' holds '{}', a record of vehicle '{}'; a drive holds the records of one vehicle: check it with --vehicle {} or leave it out", vibmode_core::quoted(drive), vibmode_core::quoted(vehicle), vibmode_core::quoted(record), vibmode_core::quoted(other), vibmode_core::quoted(other))]
+    #[error("drive '{}' of vehicle '{}' holds '{}', a record of vehicle '{}'; a drive holds the records of one vehicle: check it as a record of vehicle '{}' or leave it out", vibmode_core::quoted(drive), vibmode_core::quoted(vehicle), vibmode_core::quoted(record), vibmode_core::quoted(other), vibmode_core::quoted(other))]
     DriveMixesVehicles {
         /// The drive id.
         drive: String,

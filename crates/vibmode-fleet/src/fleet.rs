@@ -71,6 +71,9 @@ struct Prepared {
     known: bool,
     /// Known as a nominal record: its file name in the store.
     known_nominal: Option<String>,
+    /// The file given before it in the same call with the same content (whose features it
+    /// shares, known or not as it is).
+    same_as: Option<String>,
     /// Known, and its stored features get the body equations of the vehicle's model file,
     /// registered after the record was stored.
     refreshed: bool,
@@ -203,6 +206,7 @@ fn prepare_recording(
             features: store.features(row.id)?,
             known: true,
             known_nominal: nominal_name(&row),
+            same_as: None,
             refreshed: false,
         });
     }
@@ -221,6 +225,7 @@ fn prepare_recording(
         features,
         known: false,
         known_nominal: None,
+        same_as: None,
         refreshed: false,
     })
 }
@@ -409,6 +414,7 @@ fn prepare_files(
                     features: fresh.unwrap_or_else(|| (**stored).clone()),
                     known: true,
                     known_nominal: nominal.clone(),
+                    same_as: None,
                 }))
             }
             Plan::New => {
@@ -425,6 +431,7 @@ fn prepare_files(
                     features,
                     known: false,
                     known_nominal: None,
+                    same_as: None,
                     refreshed: false,
                 }))
             }
@@ -441,13 +448,14 @@ fn prepare_files(
         for (path, r) in chunk.iter().zip(read) {
             let name = file_name(path);
             let (bytes, sha) = r?;
-            let plan = if let Some(row) = store.find_record(labels.vehicle, &sha)? {
-                Plan::Known(Box::new(store.features(row.id)?), nominal_name(&row))
-            } else if let Some(&k) = first_of.get(&sha) {
+            let plan = if let Some(&k) = first_of.get(&sha) {
                 Plan::Same(k)
             } else {
                 first_of.insert(sha.clone(), out.len() + plans.len());
-                Plan::New
+                match store.find_record(labels.vehicle, &sha)? {
+                    Some(row) => Plan::Known(Box::new(store.features(row.id)?), nominal_name(&row)),
+                    None => Plan::New,
+                }
             };
             contents.push(match plan {
                 Plan::Same(_) => Vec::new(),
@@ -465,14 +473,15 @@ fn prepare_files(
             if let Some(p) = r? {
                 out.push(p);
             } else if let Plan::Same(k) = plan {
-                let features = out[k].features.clone();
+                let first = &out[k];
                 out.push(Prepared {
                     file: name,
                     content_hash: sha,
                     metadata: serde_json::json!({}),
-                    features,
-                    known: false,
-                    known_nominal: None,
+                    features: first.features.clone(),
+                    known: first.known,
+                    known_nominal: first.known_nominal.clone(),
+                    same_as: Some(first.file.clone()),
                     refreshed: false,
                 });
             }
@@ -619,6 +628,10 @@ pub struct Checked {
     /// was built from it: the check is not independent of the baseline. Absent otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub in_baseline: Option<String>,
+    /// The file given before it in the same check with the same content: scored alike, and
+    /// counted once in a drive. Absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub same_as: Option<String>,
 }
 
 /// The file name of a model set's record with the content of `p`, if the set holds it.
@@ -691,6 +704,7 @@ fn check_prepared_drive(
         .filter_map(|((p, c), s)| {
             c.map(|(v, assessment)| Checked {
                 in_baseline: in_baseline(set, &p),
+                same_as: p.same_as,
                 file: p.file,
                 record_id: s.record_id,
                 model_version: v,
@@ -819,7 +833,8 @@ fn drives_of_records(starts: &[Option<f64>]) -> Vec<(String, Vec<usize>)> {
 
 /// As [`check_files_progress`], and the given files as drives of the vehicle: with `drive`
 /// given, all of them are that one drive, and at least [`MIN_DRIVE_RECORDS`] files are needed
-/// (else an error before anything is read or stored); without it, one drive per day where
+/// (else an error before anything is read or stored; files of the same content count once, a
+/// repeat is left out of every drive); without it, one drive per day where
 /// every record's start is known, else the drive [`DEFAULT_DRIVE_ID`]
 /// ([`drives_of_records`]). Every record must have the baseline's channels (one layout per
 /// drive), and with `drive` given no record may be one stored for another vehicle (one vehicle
@@ -868,12 +883,28 @@ pub fn check_drive_files_progress(
             }
         }
     }
+    // Each content once: a file given twice (or a copy) would weigh twice in the median.
+    let distinct: Vec<usize> = (0..prepared.len())
+        .filter(|&i| prepared[i].same_as.is_none())
+        .collect();
     let groups = match drive {
-        Some(id) => vec![(id.to_string(), (0..prepared.len()).collect())],
+        Some(id) if distinct.len() < MIN_DRIVE_RECORDS => {
+            return Err(FleetError::DriveTooShort {
+                drive: id.to_string(),
+                found: distinct.len(),
+                needed: MIN_DRIVE_RECORDS,
+            });
+        }
+        Some(id) => vec![(id.to_string(), distinct)],
         None => {
-            let starts: Vec<Option<f64>> =
-                prepared.iter().map(|p| p.features.start_unix_s).collect();
+            let starts: Vec<Option<f64>> = distinct
+                .iter()
+                .map(|&i| prepared[i].features.start_unix_s)
+                .collect();
             drives_of_records(&starts)
+                .into_iter()
+                .map(|(id, members)| (id, members.into_iter().map(|k| distinct[k]).collect()))
+                .collect()
         }
     };
     let mut drives = Vec::with_capacity(groups.len());
