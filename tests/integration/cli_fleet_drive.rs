@@ -159,6 +159,34 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
         &["drive 'day-2'", "vehicle 'bus-2'", "record_"],
     );
     assert_eq!(n_test(db, "bus-1"), 4);
+    // The same without a drive id: the three records are the drive `all given records`.
+    fails_with(
+        &[
+            "fleet",
+            "check",
+            "--db",
+            db,
+            "--vehicle",
+            "bus-1",
+            &more[0],
+            &more[1],
+            &more[2],
+        ],
+        &["drive 'all given records'", "vehicle 'bus-2'", "record_"],
+    );
+    assert_eq!(n_test(db, "bus-1"), 4);
+    // Alone, it is checked (no drive).
+    ok(&[
+        "fleet",
+        "check",
+        "--db",
+        db,
+        "--vehicle",
+        "bus-1",
+        "-q",
+        &more[2],
+    ]);
+    assert_eq!(n_test(db, "bus-1"), 5);
 
     // A record with another channel layout (a sprung channel missing) in the drive.
     let text = std::fs::read_to_string(&more[1]).unwrap();
@@ -192,7 +220,7 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
             "baseline of vehicle 'bus-1'",
         ],
     );
-    assert_eq!(n_test(db, "bus-1"), 4);
+    assert_eq!(n_test(db, "bus-1"), 5);
     assert_eq!(drives().len(), 2, "no drive stored by a refused check");
 }
 

@@ -837,8 +837,8 @@ fn drives_of_records(starts: &[Option<f64>]) -> Vec<(String, Vec<usize>)> {
 /// repeat is left out of every drive); without it, one drive per day where
 /// every record's start is known, else the drive [`DEFAULT_DRIVE_ID`]
 /// ([`drives_of_records`]). Every record must have the baseline's channels (one layout per
-/// drive), and with `drive` given no record may be one stored for another vehicle (one vehicle
-/// per drive); else an error, and nothing is stored. The drives come sorted by id.
+/// drive), and no record of a drive may be one stored for another vehicle (one vehicle per
+/// drive); else an error, and nothing is stored. The drives come sorted by id.
 pub fn check_drive_files_progress(
     store: &mut Store,
     set: &ModelSet,
@@ -867,22 +867,6 @@ pub fn check_drive_files_progress(
         &layout,
         progress,
     )?;
-    if let Some(id) = drive {
-        for p in prepared.iter().filter(|p| !p.known) {
-            if let Some(other) = store
-                .other_vehicles_with(&set.vehicle, &p.content_hash)?
-                .into_iter()
-                .next()
-            {
-                return Err(FleetError::DriveMixesVehicles {
-                    drive: id.to_string(),
-                    vehicle: set.vehicle.clone(),
-                    record: p.file.clone(),
-                    other,
-                });
-            }
-        }
-    }
     // Each content once: a file given twice (or a copy) would weigh twice in the median.
     let distinct: Vec<usize> = (0..prepared.len())
         .filter(|&i| prepared[i].same_as.is_none())
@@ -907,6 +891,24 @@ pub fn check_drive_files_progress(
                 .collect()
         }
     };
+    // One vehicle per drive: a record stored for another vehicle is refused in any drive (named
+    // or by day or of all given records); a record checked alone may be one.
+    for (id, members) in &groups {
+        for p in members.iter().map(|&i| &prepared[i]).filter(|p| !p.known) {
+            if let Some(other) = store
+                .other_vehicles_with(&set.vehicle, &p.content_hash)?
+                .into_iter()
+                .next()
+            {
+                return Err(FleetError::DriveMixesVehicles {
+                    drive: id.clone(),
+                    vehicle: set.vehicle.clone(),
+                    record: p.file.clone(),
+                    other,
+                });
+            }
+        }
+    }
     let mut drives = Vec::with_capacity(groups.len());
     for (id, members) in groups {
         let group: Vec<&Prepared> = members.iter().map(|&i| &prepared[i]).collect();
