@@ -185,13 +185,36 @@ fn ingest(a: &IngestArgs) -> Result<()> {
     );
     pb.finish_and_clear();
     let done = done?;
+    // A note every newly stored record has (a sensor layout without a partner channel, say)
+    // is printed once, after the list, not under each record.
+    let new: Vec<&Vec<String>> = done
+        .iter()
+        .filter(|r| !r.already_stored)
+        .map(|r| &r.notes)
+        .collect();
+    let common: Vec<&String> = match new.split_first() {
+        Some((first, rest)) if !rest.is_empty() => first
+            .iter()
+            .filter(|n| rest.iter().all(|o| o.contains(n)))
+            .collect(),
+        _ => Vec::new(),
+    };
+    let n_new = new.len();
+    let own = |r: &'_ vibmode_fleet::Ingested| -> Vec<String> {
+        r.notes
+            .iter()
+            .filter(|n| r.already_stored || !common.contains(n))
+            .cloned()
+            .collect()
+    };
     for r in &done {
+        let notes = own(r);
         if r.already_stored && !r.notes.is_empty() {
             eprintln!(
                 "{}: already stored for vehicle {} (record {})",
                 r.file, a.vehicle, r.record_id
             );
-            for n in &r.notes {
+            for n in &notes {
                 eprintln!("  note: {n}");
             }
         } else if r.already_stored {
@@ -204,10 +227,13 @@ fn ingest(a: &IngestArgs) -> Result<()> {
                 "{}: stored as {} record {} of vehicle {}",
                 r.file, a.condition, r.record_id, a.vehicle
             );
-            for n in &r.notes {
+            for n in &notes {
                 eprintln!("  note: {n}");
             }
         }
+    }
+    for n in common {
+        eprintln!("note (every one of the {n_new} records stored): {n}");
     }
     Ok(())
 }

@@ -264,3 +264,52 @@ fn init_config_sets_the_fleet_settings() {
         &["already holds 3 record(s)", "new store"],
     );
 }
+
+/// A note every record stored by one `fleet ingest` has (here: the FL corner has no sprung
+/// sensor, so no transmissibility) is printed once after the list, not under each record; a
+/// record's own notes stay under it.
+#[test]
+fn a_note_of_every_record_is_printed_once() {
+    let d = tempfile::tempdir().unwrap();
+    let db = d.path().join("fleet.db");
+    let db = db.to_str().unwrap();
+    ok(&["fleet", "init", "--db", db]);
+    let files = simulate_csv(&d.path().join("sim"), "B", "30", "5", "3");
+    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1", "-q"];
+    args.extend(files.iter().map(String::as_str));
+    let o = ok(&args);
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    let once: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("note (every one of the 3 records stored): "))
+        .collect();
+    assert!(
+        once.iter()
+            .any(|l| l.contains("corner FL") && l.contains("no sprung partner")),
+        "{err}"
+    );
+    assert_eq!(err.matches("no sprung partner").count(), 1, "{err}");
+    assert_eq!(
+        err.matches(": stored as nominal record").count(),
+        3,
+        "{err}"
+    );
+    // One record alone: its note under it.
+    let more = simulate_csv(&d.path().join("more"), "B", "30", "6", "1");
+    let o = ok(&[
+        "fleet",
+        "ingest",
+        "--db",
+        db,
+        "--vehicle",
+        "bus-1",
+        "-q",
+        &more[0],
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(
+        err.lines()
+            .any(|l| l.starts_with("  note: corner FL") && l.contains("no sprung partner")),
+        "{err}"
+    );
+}
