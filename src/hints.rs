@@ -136,9 +136,9 @@ fn key(e: &anyhow::Error) -> Option<Hint> {
             return match a {
                 AnalysisError::Signal(s) => signal_hint(s),
                 AnalysisError::Recording(r) => recording_hint(r),
-                AnalysisError::ChannelsDiffer { .. } | AnalysisError::ChannelConstant { .. } => {
-                    Some(Hint::KeepChannels)
-                }
+                AnalysisError::ChannelsDiffer { .. }
+                | AnalysisError::ChannelConstant { .. }
+                | AnalysisError::ChannelMostlyRepeated { .. } => Some(Hint::KeepChannels),
                 _ => None,
             };
         }

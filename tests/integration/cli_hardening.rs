@@ -403,6 +403,37 @@ fn a_dead_or_stuck_sensor_is_named_not_analysed() {
     assert!(o.join("results.json").exists());
 }
 
+/// A dead sensor with glitches (0 but for a spike, or spikes both ways) is refused as a dead
+/// one is, with the share of its samples that repeat a value; without the channel the record
+/// is analysed.
+#[test]
+fn a_dead_sensor_with_glitches_is_named_not_analysed() {
+    let d = tempfile::tempdir().unwrap();
+    let spike = |i: usize| if i == 700 { 2.5 } else { 0.0 };
+    let both = |i: usize| match i {
+        300 => 1.0,
+        1500 => -1.0,
+        _ => 0.0,
+    };
+    let o = d.path().join("o");
+    for (name, f) in [("spike", &spike as &dyn Fn(usize) -> f64), ("both", &both)] {
+        let path = d.path().join(format!("{name}.csv"));
+        csv(&path, 100.0, 2048, &[("a", &tone), ("dead", f)]);
+        fails_with(
+            &["analyze", s(&path), "-o", s(&o), "-q"],
+            &[
+                "channel 'dead' repeats a value over 99.9 % of its samples",
+                "dead or stuck sensor with glitches",
+                "--channel NAME",
+            ],
+        );
+        assert!(!o.exists(), "an output folder for {name}");
+        ok(&["analyze", s(&path), "-c", "a", "-o", s(&o), "-q"]);
+        assert!(o.join("results.json").exists());
+        std::fs::remove_dir_all(&o).unwrap();
+    }
+}
+
 /// A saturated sensor (a tone cut at 0.8), or one whose logger filled dropouts, is analysed,
 /// and said so: the terminal and the report name the records and the channel, `results.json`
 /// lists them per record.

@@ -139,6 +139,19 @@ pub enum AnalysisError {
         /// Its one value.
         value: f64,
     },
+    /// A channel of a record that repeats a value over most of its samples
+    /// ([`vibmode_core::stats::REPEATED_SHARE_MAX`] or more, at a clipped extreme or in held
+    /// stretches, [`vibmode_core::stats::ChannelHealth::is_mostly_repeated`]): a dead or stuck
+    /// sensor with glitches, whose "modes" would be those of its glitches.
+    #[error("record '{record}': channel '{channel}' repeats a value over {:.1} % of its samples (at an extreme or in held stretches): a dead or stuck sensor with glitches has no vibration to identify; check the sensor, or analyse the record without this channel", (1000.0 * .share).floor() / 10.0)]
+    ChannelMostlyRepeated {
+        /// The record.
+        record: String,
+        /// The channel.
+        channel: String,
+        /// Share of its samples that repeat a value (0-1).
+        share: f64,
+    },
     /// Records at different sampling rates.
     #[error("record '{record}' is sampled at {} Hz but '{first}' at {} Hz; resample them to one rate first", short(*fs_hz), short(*first_fs_hz))]
     RatesDiffer {

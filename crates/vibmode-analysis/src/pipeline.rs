@@ -5,6 +5,7 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
+use vibmode_core::stats::ChannelHealth;
 use vibmode_core::{ClusterParams, Identifier, RecordInput, ReferenceMode, Role, SignalFits};
 use vibmode_modal::{InvariantMode, MATCH_MAC_MIN, MATCH_MAX_FREQ_DIFF_REL};
 use vibmode_signal::{preprocess, Preprocessed};
@@ -45,16 +46,35 @@ pub fn check_records(records: &[RecordInput]) -> Result<(), AnalysisError> {
 /// ([`AnalysisError::ChannelConstant`]) would give the modes of the pre-processing's rounding
 /// noise.
 pub fn check_channels_vary(r: &RecordInput) -> Result<(), AnalysisError> {
-    for ch in &r.recording.channels {
-        if let Some(value) = vibmode_core::stats::constant_value(&ch.samples) {
-            return Err(AnalysisError::ChannelConstant {
-                record: r.name.clone(),
-                channel: ch.name.clone(),
-                value,
-            });
-        }
-    }
-    Ok(())
+    RecordFacts::checked(r).map(|_| ())
+}
+
+/// The health of every channel of `r`, refused ([`AnalysisError::ChannelConstant`],
+/// [`AnalysisError::ChannelMostlyRepeated`]) where a channel carries no vibration.
+fn channels_checked(r: &RecordInput) -> Result<Vec<ChannelHealth>, AnalysisError> {
+    let min_run = vibmode_core::stats::held_min_run(r.recording.fs_hz);
+    r.recording
+        .channels
+        .iter()
+        .map(|ch| {
+            let h = vibmode_core::stats::channel_health(&ch.samples, min_run);
+            if let Some(value) = h.constant {
+                return Err(AnalysisError::ChannelConstant {
+                    record: r.name.clone(),
+                    channel: ch.name.clone(),
+                    value,
+                });
+            }
+            if h.is_mostly_repeated() {
+                return Err(AnalysisError::ChannelMostlyRepeated {
+                    record: r.name.clone(),
+                    channel: ch.name.clone(),
+                    share: h.repeated_share(),
+                });
+            }
+            Ok(h)
+        })
+        .collect()
 }
 
 /// Checks that `r` has the channels and rate of `first`.
@@ -193,9 +213,11 @@ pub fn analyze_keeping_first(
     let pre = preprocess_records(records, cfg)?;
     // After the pre-processing's own checks (a rate or a length out of reach is the first thing
     // to fix).
-    records.iter().try_for_each(check_channels_vary)?;
+    let facts = records
+        .iter()
+        .map(RecordFacts::checked)
+        .collect::<Result<Vec<_>, _>>()?;
     let first = pre.first().cloned().ok_or(AnalysisError::NoRecords)?;
-    let facts = records.iter().map(RecordFacts::of).collect();
     let results = analyze_prepared(facts, pre, cfg, identifier, reference, progress, t0)?;
     Ok((results, first))
 }
@@ -221,6 +243,18 @@ impl RecordFacts {
     /// The facts of `r` (no segmentation facts).
     pub fn of(r: &RecordInput) -> RecordFacts {
         let (clipped, held) = sensor_notes(&r.recording);
+        Self::with_notes(r, clipped, held)
+    }
+
+    /// As [`RecordFacts::of`], refusing a channel that carries no vibration
+    /// ([`check_channels_vary`]): one look at each channel for both.
+    pub fn checked(r: &RecordInput) -> Result<RecordFacts, AnalysisError> {
+        let health = channels_checked(r)?;
+        let (clipped, held) = crate::results::sensor_notes_of(&r.recording, &health);
+        Ok(Self::with_notes(r, clipped, held))
+    }
+
+    fn with_notes(r: &RecordInput, clipped: Vec<ClippedChannel>, held: Vec<HeldChannel>) -> Self {
         RecordFacts {
             name: r.name.clone(),
             fs_hz: r.recording.fs_hz,

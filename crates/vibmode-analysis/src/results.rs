@@ -97,9 +97,21 @@ pub struct ClippedChannel {
 /// extremes are clipping, not counted as held.
 pub fn sensor_notes(rec: &vibmode_core::Recording) -> (Vec<ClippedChannel>, Vec<HeldChannel>) {
     let min_run = vibmode_core::stats::held_min_run(rec.fs_hz);
+    let health: Vec<vibmode_core::stats::ChannelHealth> = rec
+        .channels
+        .iter()
+        .map(|ch| vibmode_core::stats::channel_health(&ch.samples, min_run))
+        .collect();
+    sensor_notes_of(rec, &health)
+}
+
+/// As [`sensor_notes`], from each channel's health (`health[i]` of `rec.channels[i]`).
+pub(crate) fn sensor_notes_of(
+    rec: &vibmode_core::Recording,
+    health: &[vibmode_core::stats::ChannelHealth],
+) -> (Vec<ClippedChannel>, Vec<HeldChannel>) {
     let (mut clipped, mut held) = (Vec::new(), Vec::new());
-    for ch in &rec.channels {
-        let h = vibmode_core::stats::channel_health(&ch.samples, min_run);
+    for (ch, h) in rec.channels.iter().zip(health) {
         if let Some((n, value)) = h.clipped {
             clipped.push(ClippedChannel {
                 channel: ch.name.clone(),

@@ -11,7 +11,7 @@ use vibmode_core::{Identifier, RecordInput, RecordMeta, RecordSource, ReferenceM
 use vibmode_signal::{preprocess, Preprocessed};
 
 use crate::config::AnalysisConfig;
-use crate::pipeline::{analyze_prepared, check_channels_vary, check_same_layout, RecordFacts};
+use crate::pipeline::{analyze_prepared, check_same_layout, RecordFacts};
 use crate::results::AnalysisResults;
 use crate::{AnalysisError, FirstRecord};
 
@@ -62,10 +62,14 @@ where
                     preprocess(&r.recording, &cfg.preprocess).map_err(AnalysisError::Signal)
                 })
                 .collect::<Result<_, AnalysisError>>()?;
-            batch.iter().try_for_each(|(r, _)| check_channels_vary(r))?;
+            // The channels checked and their notes in parallel; the first refusal in record order.
+            let checked: Vec<Result<RecordFacts, AnalysisError>> = batch
+                .par_iter()
+                .map(|(r, _)| RecordFacts::checked(r))
+                .collect();
+            let checked = checked.into_iter().collect::<Result<Vec<_>, _>>()?;
             pre.extend(done);
-            for (r, meta) in batch {
-                let mut f = RecordFacts::of(&r);
+            for ((r, meta), mut f) in batch.into_iter().zip(checked) {
                 f.meta = meta;
                 facts.push(f);
                 if first.is_none() {

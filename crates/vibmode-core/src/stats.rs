@@ -111,6 +111,13 @@ pub const HELD_MIN_SAMPLES: usize = 10;
 /// Share of a record's samples in held stretches from which the channel is named.
 pub const HELD_SHARE_MIN: f64 = 0.01;
 
+/// Share of a channel's samples that repeat a value (at a clipped extreme, or in held
+/// stretches) from which it carries no vibration to identify: a dead or stuck sensor with
+/// glitches (a spike, a step), or a logger that held its values through most of the record.
+/// The analysis refuses such a channel as it refuses a constant one ([`constant_value`]); a
+/// saturated sensor clips a few per cent of its samples, a logger's dropouts a few more.
+pub const REPEATED_SHARE_MAX: f64 = 0.9;
+
 /// The shortest held stretch at `fs_hz`, samples: [`HELD_MIN_S`], at least
 /// [`HELD_MIN_SAMPLES`].
 pub fn held_min_run(fs_hz: f64) -> usize {
@@ -140,6 +147,18 @@ impl ChannelHealth {
     /// Whether the held stretches cover [`HELD_SHARE_MIN`] of the samples or more.
     pub fn is_held(&self) -> bool {
         self.held.0 > 0 && self.held_share() >= HELD_SHARE_MIN
+    }
+
+    /// Share of the samples that repeat a value (0-1): those at the clipped extreme and those
+    /// in held stretches (which leave the clipped extremes out: no sample counts twice).
+    pub fn repeated_share(&self) -> f64 {
+        (self.clipped.map_or(0, |c| c.0) + self.held.0) as f64 / self.n.max(1) as f64
+    }
+
+    /// Whether the channel repeats a value over [`REPEATED_SHARE_MAX`] of its samples or more:
+    /// no vibration to identify, as a constant channel.
+    pub fn is_mostly_repeated(&self) -> bool {
+        self.constant.is_none() && self.repeated_share() >= REPEATED_SHARE_MAX
     }
 }
 
@@ -342,6 +361,42 @@ mod tests {
                 assert_eq!(extremes(&x), want, "n {n} shift {shift}");
             }
         }
+    }
+
+    #[test]
+    fn a_channel_that_repeats_a_value_most_of_the_time_carries_no_vibration() {
+        // The fault above: 12 clipped + 30 held of 1000 samples, 4.2 %: a live sensor.
+        let mut x: Vec<f64> = (0..1000).map(|i| ((i * 37) % 101) as f64 / 200.0).collect();
+        for v in x.iter_mut().skip(100).take(30) {
+            *v = 0.25;
+        }
+        for v in x.iter_mut().skip(500).take(12) {
+            *v = 1.0;
+        }
+        let h = channel_health(&x, 10);
+        assert!((h.repeated_share() - 0.042).abs() < 1e-12);
+        assert!(!h.is_mostly_repeated());
+        // A dead sensor with one spike: 999 of 1000 samples at its lower extreme, 0.
+        let mut spike = vec![0.0; 1000];
+        spike[400] = 3.0;
+        let h = channel_health(&spike, 10);
+        assert_eq!(h.clipped, Some((999, 0.0)));
+        assert!((h.repeated_share() - 0.999).abs() < 1e-12 && h.is_mostly_repeated());
+        // Spikes both ways: 0 is no extreme, the zeros are held stretches (998 samples).
+        spike[700] = -3.0;
+        let h = channel_health(&spike, 10);
+        assert_eq!(h.clipped, None);
+        assert_eq!(h.held.0, 998);
+        assert!(h.is_mostly_repeated());
+        // At the bound: 900 of 1000 samples held, the rest varying.
+        let mut edge: Vec<f64> = (0..1000).map(|i| ((i * 37) % 101) as f64).collect();
+        edge.iter_mut().take(900).for_each(|v| *v = 50.5);
+        let h = channel_health(&edge, 10);
+        assert!((h.repeated_share() - 0.9).abs() < 1e-12 && h.is_mostly_repeated());
+        edge[0] = 0.25;
+        assert!(!channel_health(&edge, 10).is_mostly_repeated());
+        // A constant channel is constant, not "mostly repeated".
+        assert!(!channel_health(&[2.0; 50], 10).is_mostly_repeated());
     }
 
     #[test]
