@@ -44,7 +44,8 @@ pub fn check_records(records: &[RecordInput]) -> Result<(), AnalysisError> {
 
 /// Checks that every channel of `r` varies: a dead or stuck sensor
 /// ([`AnalysisError::ChannelConstant`]) would give the modes of the pre-processing's rounding
-/// noise.
+/// noise, and one that repeats a value over most of its samples
+/// ([`AnalysisError::ChannelMostlyRepeated`]: a dead sensor with a spike) those of its glitches.
 pub fn check_channels_vary(r: &RecordInput) -> Result<(), AnalysisError> {
     RecordFacts::checked(r).map(|_| ())
 }
