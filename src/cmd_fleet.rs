@@ -185,125 +185,24 @@ fn ingest(a: &IngestArgs) -> Result<()> {
     );
     pb.finish_and_clear();
     let done = done?;
-    // A note every newly stored record has (a sensor layout without a partner channel, say)
-    // is printed once, after the list, not under each record.
-    let new: Vec<&Vec<String>> = done
-        .iter()
-        .filter(|r| !r.already_stored)
-        .map(|r| &r.notes)
-        .collect();
-    let common: Vec<&String> = match new.split_first() {
-        Some((first, rest)) if !rest.is_empty() => first
-            .iter()
-            .filter(|n| rest.iter().all(|o| o.contains(n)))
-            .collect(),
-        _ => Vec::new(),
-    };
-    let n_new = new.len();
-    let own = |r: &'_ vibmode_fleet::Ingested| -> Vec<String> {
-        r.notes
-            .iter()
-            .filter(|n| r.already_stored || !common.contains(n))
-            .cloned()
-            .collect()
-    };
-    for r in &done {
-        let notes = own(r);
-        if r.already_stored && !r.notes.is_empty() {
-            eprintln!(
-                "{}: already stored for vehicle {} (record {})",
-                r.file, a.vehicle, r.record_id
-            );
-            for n in &notes {
-                eprintln!("  note: {n}");
-            }
-        } else if r.already_stored {
-            eprintln!(
-                "{}: already stored for vehicle {} (record {}), nothing to do",
-                r.file, a.vehicle, r.record_id
-            );
-        } else {
-            eprintln!(
-                "{}: stored as {} record {} of vehicle {}",
-                r.file, a.condition, r.record_id, a.vehicle
-            );
-            for n in &notes {
-                eprintln!("  note: {n}");
-            }
-        }
-    }
-    for n in common {
-        eprintln!("note (every one of the {n_new} records stored): {n}");
-    }
+    eprint!(
+        "{}",
+        vibmode_fleet::text::ingest_text(&done, &a.vehicle, condition)
+    );
     Ok(())
 }
 
 fn register(db: &std::path::Path, vehicle: &str, model: &std::path::Path) -> Result<()> {
     let mut store = Store::open(db)?;
     let done = vibmode_fleet::register_vehicle_model_file(&mut store, vehicle, model)?;
-    let file = model.display();
-    let text = match done {
-        vibmode_fleet::Registered::New => format!(
-            "vehicle {vehicle}: model file {file} registered; records ingested or checked from now on keep their body equations for the suspension fitted per drive (ingest nominal records, then build the baseline)\n"
-        ),
-        vibmode_fleet::Registered::Unchanged => {
-            format!("vehicle {vehicle}: model file {file} already registered (unchanged)\n")
-        }
-        vibmode_fleet::Registered::Replaced => format!(
-            "vehicle {vehicle}: model file {file} registered in place of the one before; records' body equations made with the old file no longer count: ingest nominal records and build a new baseline for the suspension fitted per drive\n"
-        ),
-    };
-    crate::output::print_stdout(&text)
+    crate::output::print_stdout(&vibmode_fleet::text::register_text(vehicle, model, done))
 }
 
 fn baseline(db: &std::path::Path, vehicle: &str) -> Result<()> {
     let mut store = Store::open(db)?;
     let cfg = store.config()?;
     let set = build_baseline(&mut store, vehicle, &cfg)?;
-    let mut text = format!(
-        "vehicle {}: model set version {} from {} nominal records, {} features, {} modes\n",
-        set.vehicle,
-        set.version,
-        set.records.len(),
-        set.features.len(),
-        set.slots.len()
-    );
-    text.push_str("kind               features  Bonferroni  LOO max |z|  limit\n");
-    for l in &set.limits {
-        text.push_str(&format!(
-            "{:<18} {:>8}  {:>10.2}  {:>11.2}  {:>5.2}\n",
-            format!("{:?}", l.kind),
-            l.n_features,
-            l.bonferroni,
-            l.loo_max_abs_z,
-            l.limit
-        ));
-    }
-    if let Some(s) = &set.suspension {
-        text.push_str(&format!(
-            "suspension fitted to {} nominal records: springs and dampers per corner scored per drive, one-sided limit {:.2}{}\n",
-            s.fit.records,
-            s.limit,
-            if s.fit.supported {
-                ""
-            } else {
-                " (the fit's standard deviations exceed the model update's support limits: the scores use them as they are)"
-            }
-        ));
-        for (i, c) in vibmode_fleet::suspension::CORNERS.iter().enumerate() {
-            text.push_str(&format!(
-                "  {c}: spring {:.1} kN/m (sd {:.1} %), damper {:.2} kN s/m (sd {:.1} %)\n",
-                s.fit.spring_n_per_m[i] / 1e3,
-                100.0 * s.fit.spring_rel_sd[i],
-                s.fit.damper_n_s_per_m[i] / 1e3,
-                100.0 * s.fit.damper_rel_sd[i]
-            ));
-        }
-    }
-    for n in &set.notes {
-        text.push_str(&format!("note: {n}\n"));
-    }
-    crate::output::print_stdout(&text)
+    crate::output::print_stdout(&vibmode_fleet::text::baseline_text(&set))
 }
 
 #[derive(Serialize)]
@@ -336,76 +235,7 @@ fn check(a: &CheckArgs) -> Result<()> {
     );
     pb.finish_and_clear();
     let (out, drives) = out?;
-    let mut text = format!(
-        "vehicle {} against model set version {}\nfile                            class     vehicle |z|  road score  evidence\n",
-        a.vehicle, set.version
-    );
-    for c in &out {
-        text.push_str(&format!(
-            "{:<31} {:<9} {:>11.1}  {:>10.1}  {}\n",
-            c.file,
-            c.assessment.classification.to_string(),
-            c.assessment.scores.vehicle_max_abs_z,
-            c.assessment.scores.excitation_max_abs_z,
-            if c.assessment.summary.is_empty() {
-                "-"
-            } else {
-                &c.assessment.summary
-            }
-        ));
-    }
-    // A record of the baseline checked against it is scored by a yardstick made from itself.
-    for c in &out {
-        if let Some(first) = &c.same_as {
-            text.push_str(&format!(
-                "note: {} has the content of {}, given before it: counted once in a drive\n",
-                c.file, first
-            ));
-        }
-        if let Some(twin) = &c.in_baseline {
-            text.push_str(&format!(
-                "note: {} has the content of {}, a record model set version {} was built from: not an independent check\n",
-                c.file, twin, c.model_version
-            ));
-        }
-    }
-    for d in &drives {
-        text.push_str(&format!(
-            "drive {} ({} records, median of each feature; false alarms per drive at most {} %): {}{}  {}\n",
-            d.drive,
-            d.records.len(),
-            100.0 * d.false_alarm_rate,
-            d.assessment.classification,
-            match (d.corner, d.assessment.component) {
-                (Some(c), Some(k)) => format!(" ({c} {k})"),
-                (Some(c), None) => format!(" ({c})"),
-                _ => String::new(),
-            },
-            if d.assessment.summary.is_empty() {
-                "-"
-            } else {
-                &d.assessment.summary
-            }
-        ));
-        // Why the suspension was not fitted to the drive, when the vehicle has a model file or
-        // the model set a fitted suspension: not a silent absence.
-        for m in d
-            .assessment
-            .missing
-            .iter()
-            .filter(|m| m.starts_with("suspension fit:"))
-        {
-            text.push_str(&format!("  note: {m}\n"));
-        }
-        if !d.in_baseline.is_empty() {
-            text.push_str(&format!(
-                "  note: {} of the drive's {} records are records of the baseline ({}): its verdict leans toward normal; check records the baseline was not built from\n",
-                d.in_baseline.len(),
-                d.records.len(),
-                vibmode_core::cap_message(&d.in_baseline.join(", "), 120)
-            ));
-        }
-    }
+    let text = vibmode_fleet::text::check_text(&a.vehicle, set.version, &out, &drives);
     match a.json.as_deref() {
         Some("-") => {
             eprint!("{text}");
@@ -435,60 +265,5 @@ fn status(db: &std::path::Path) -> Result<()> {
             db.display()
         );
     }
-    // One row per vehicle first: its latest drive verdict, the corner, since when, how sure.
-    let mut text = String::from(
-        "vehicle          latest drive verdict  corner, component  since                 |z|/limit  drive\n",
-    );
-    for v in &st {
-        match &v.latest_drive {
-            Some(d) => text.push_str(&format!(
-                "{:<16} {:<21} {:<18} {:<21} {:>9}  {} ({} records, false alarms <= {} per drive)\n",
-                v.vehicle,
-                d.classification.to_string(),
-                d.place(),
-                d.since,
-                d.vehicle_z_over_limit
-                    .map_or("-".to_string(), |z| format!("{z:.2}")),
-                d.drive,
-                d.n_records,
-                d.false_alarm_rate
-            )),
-            None => text.push_str(&format!("{:<16} no drive checked yet\n", v.vehicle)),
-        }
-    }
-    text.push('\n');
-    for v in &st {
-        text.push_str(&format!(
-            "vehicle {}: {} nominal, {} test records, baseline {}\n",
-            v.vehicle,
-            v.n_nominal,
-            v.n_test,
-            v.baseline_version
-                .map_or("none".to_string(), |n| format!("version {n}"))
-        ));
-        if let Some(s) = &v.suspension {
-            text.push_str(&format!("  {s}\n"));
-        }
-        if !v.drives.is_empty() {
-            text.push_str("  drives, newest first (when driven; when checked where the records' times are unknown):\n");
-            for d in &v.drives {
-                text.push_str(&format!(
-                    "    {:<28} {:<8} {:<15} {} {}\n",
-                    d.when(),
-                    d.classification.to_string(),
-                    d.place(),
-                    d.drive,
-                    d.summary
-                ));
-            }
-            text.push_str("  records, newest first:\n");
-        }
-        for (file, class, summary) in &v.last_checks {
-            text.push_str(&format!(
-                "  {file:<31} {:<8} {summary}\n",
-                class.to_string()
-            ));
-        }
-    }
-    crate::output::print_stdout(&text)
+    crate::output::print_stdout(&vibmode_fleet::text::status_text(&st))
 }

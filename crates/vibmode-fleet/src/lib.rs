@@ -20,6 +20,7 @@ pub mod report;
 pub mod stats;
 pub mod store;
 pub mod suspension;
+pub mod text;
 
 pub use body::{fit_body_model, BodyModel, BodySpectra};
 pub use config::{fleet_analysis, FleetConfig, SUSPENSION_BAND_HZ};

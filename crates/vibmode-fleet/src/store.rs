@@ -96,7 +96,8 @@ pub enum Condition {
 }
 
 impl Condition {
-    fn as_str(self) -> &'static str {
+    /// The condition's name as the store and the commands spell it.
+    pub fn as_str(self) -> &'static str {
         match self {
             Condition::Nominal => "nominal",
             Condition::Test => "test",

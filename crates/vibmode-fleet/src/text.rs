@@ -1,0 +1,320 @@
+//! The fleet commands' printed text (as the report crate prints `analyze`'s tables): each
+//! function turns a result into the lines a user reads, so the binary only parses arguments and
+//! prints, and any other front end can print the same.
+
+use crate::fleet::{Checked, Ingested, Registered};
+use crate::model::{Drive, ModelSet};
+use crate::store::{Condition, VehicleStatus};
+use std::fmt::Write as _;
+
+/// What `fleet ingest` says of the records it was given, one line per file, each record's own
+/// notes beneath it. A note that every newly stored record has (a sensor layout without a
+/// partner channel, say) is printed once after the list, not under each record; a record
+/// already stored keeps all its notes.
+pub fn ingest_text(done: &[Ingested], vehicle: &str, condition: Condition) -> String {
+    let new: Vec<&Vec<String>> = done
+        .iter()
+        .filter(|r| !r.already_stored)
+        .map(|r| &r.notes)
+        .collect();
+    let common: Vec<&String> = match new.split_first() {
+        Some((first, rest)) if !rest.is_empty() => first
+            .iter()
+            .filter(|n| rest.iter().all(|o| o.contains(n)))
+            .collect(),
+        _ => Vec::new(),
+    };
+    let n_new = new.len();
+    let condition = condition.as_str();
+    let mut text = String::new();
+    for r in done {
+        let own = r
+            .notes
+            .iter()
+            .filter(|n| r.already_stored || !common.contains(n));
+        if r.already_stored && r.notes.is_empty() {
+            let _ = writeln!(
+                text,
+                "{}: already stored for vehicle {vehicle} (record {}), nothing to do",
+                r.file, r.record_id
+            );
+            continue;
+        }
+        if r.already_stored {
+            let _ = writeln!(
+                text,
+                "{}: already stored for vehicle {vehicle} (record {})",
+                r.file, r.record_id
+            );
+        } else {
+            let _ = writeln!(
+                text,
+                "{}: stored as {condition} record {} of vehicle {vehicle}",
+                r.file, r.record_id
+            );
+        }
+        for n in own {
+            let _ = writeln!(text, "  note: {n}");
+        }
+    }
+    for n in common {
+        let _ = writeln!(text, "note (every one of the {n_new} records stored): {n}");
+    }
+    text
+}
+
+/// What `fleet register` says of a vehicle's model file.
+pub fn register_text(vehicle: &str, file: &std::path::Path, done: Registered) -> String {
+    let file = file.display();
+    match done {
+        Registered::New => format!(
+            "vehicle {vehicle}: model file {file} registered; records ingested or checked from now on keep their body equations for the suspension fitted per drive (ingest nominal records, then build the baseline)\n"
+        ),
+        Registered::Unchanged => {
+            format!("vehicle {vehicle}: model file {file} already registered (unchanged)\n")
+        }
+        Registered::Replaced => format!(
+            "vehicle {vehicle}: model file {file} registered in place of the one before; records' body equations made with the old file no longer count: ingest nominal records and build a new baseline for the suspension fitted per drive\n"
+        ),
+    }
+}
+
+/// A model set as `fleet baseline` prints it: its size, the control limit of each kind of
+/// feature, the fitted suspension where there is one, and its notes.
+pub fn baseline_text(set: &ModelSet) -> String {
+    let mut text = format!(
+        "vehicle {}: model set version {} from {} nominal records, {} features, {} modes\n",
+        set.vehicle,
+        set.version,
+        set.records.len(),
+        set.features.len(),
+        set.slots.len()
+    );
+    text.push_str("kind               features  Bonferroni  LOO max |z|  limit\n");
+    for l in &set.limits {
+        let _ = writeln!(
+            text,
+            "{:<18} {:>8}  {:>10.2}  {:>11.2}  {:>5.2}",
+            format!("{:?}", l.kind),
+            l.n_features,
+            l.bonferroni,
+            l.loo_max_abs_z,
+            l.limit
+        );
+    }
+    if let Some(s) = &set.suspension {
+        let _ = writeln!(
+            text,
+            "suspension fitted to {} nominal records: springs and dampers per corner scored per drive, one-sided limit {:.2}{}",
+            s.fit.records,
+            s.limit,
+            if s.fit.supported {
+                ""
+            } else {
+                " (the fit's standard deviations exceed the model update's support limits: the scores use them as they are)"
+            }
+        );
+        for (i, c) in crate::suspension::CORNERS.iter().enumerate() {
+            let _ = writeln!(
+                text,
+                "  {c}: spring {:.1} kN/m (sd {:.1} %), damper {:.2} kN s/m (sd {:.1} %)",
+                s.fit.spring_n_per_m[i] / 1e3,
+                100.0 * s.fit.spring_rel_sd[i],
+                s.fit.damper_n_s_per_m[i] / 1e3,
+                100.0 * s.fit.damper_rel_sd[i]
+            );
+        }
+    }
+    for n in &set.notes {
+        let _ = writeln!(text, "note: {n}");
+    }
+    text
+}
+
+/// `fleet check`'s table: one row per record (class, scores, evidence), the notes on records
+/// that are not independent checks, then one line per drive with its verdict and notes.
+pub fn check_text(vehicle: &str, model_version: i64, out: &[Checked], drives: &[Drive]) -> String {
+    let mut text = format!(
+        "vehicle {vehicle} against model set version {model_version}\nfile                            class     vehicle |z|  road score  evidence\n"
+    );
+    for c in out {
+        let _ = writeln!(
+            text,
+            "{:<31} {:<9} {:>11.1}  {:>10.1}  {}",
+            c.file,
+            c.assessment.classification.to_string(),
+            c.assessment.scores.vehicle_max_abs_z,
+            c.assessment.scores.excitation_max_abs_z,
+            or_dash(&c.assessment.summary)
+        );
+    }
+    // Records that are not independent checks: the same content given twice, and a record of
+    // the baseline checked against it (scored by a yardstick made from itself).
+    for c in out {
+        if let Some(first) = &c.same_as {
+            let _ = writeln!(
+                text,
+                "note: {} has the content of {first}, given before it: counted once in a drive",
+                c.file
+            );
+        }
+        if let Some(twin) = &c.in_baseline {
+            let _ = writeln!(
+                text,
+                "note: {} has the content of {twin}, a record model set version {} was built from: not an independent check",
+                c.file, c.model_version
+            );
+        }
+    }
+    for d in drives {
+        let _ = writeln!(
+            text,
+            "drive {} ({} records, median of each feature; false alarms per drive at most {} %): {}{}  {}",
+            d.drive,
+            d.records.len(),
+            100.0 * d.false_alarm_rate,
+            d.assessment.classification,
+            match (d.corner, d.assessment.component) {
+                (Some(c), Some(k)) => format!(" ({c} {k})"),
+                (Some(c), None) => format!(" ({c})"),
+                _ => String::new(),
+            },
+            or_dash(&d.assessment.summary)
+        );
+        // Why the suspension was not fitted to the drive, when the vehicle has a model file or
+        // the model set a fitted suspension: not a silent absence.
+        for m in d
+            .assessment
+            .missing
+            .iter()
+            .filter(|m| m.starts_with("suspension fit:"))
+        {
+            let _ = writeln!(text, "  note: {m}");
+        }
+        if !d.in_baseline.is_empty() {
+            let _ = writeln!(
+                text,
+                "  note: {} of the drive's {} records are records of the baseline ({}): its verdict leans toward normal; check records the baseline was not built from",
+                d.in_baseline.len(),
+                d.records.len(),
+                vibmode_core::cap_message(&d.in_baseline.join(", "), 120)
+            );
+        }
+    }
+    text
+}
+
+/// `fleet status`: one row per vehicle first (its latest drive verdict, the corner, since when,
+/// how sure), then each vehicle's counts, drives and latest records, newest first.
+pub fn status_text(st: &[VehicleStatus]) -> String {
+    let mut text = String::from(
+        "vehicle          latest drive verdict  corner, component  since                 |z|/limit  drive\n",
+    );
+    for v in st {
+        match &v.latest_drive {
+            Some(d) => {
+                let _ = writeln!(
+                    text,
+                    "{:<16} {:<21} {:<18} {:<21} {:>9}  {} ({} records, false alarms <= {} per drive)",
+                    v.vehicle,
+                    d.classification.to_string(),
+                    d.place(),
+                    d.since,
+                    d.vehicle_z_over_limit
+                        .map_or("-".to_string(), |z| format!("{z:.2}")),
+                    d.drive,
+                    d.n_records,
+                    d.false_alarm_rate
+                );
+            }
+            None => {
+                let _ = writeln!(text, "{:<16} no drive checked yet", v.vehicle);
+            }
+        }
+    }
+    text.push('\n');
+    for v in st {
+        let _ = writeln!(
+            text,
+            "vehicle {}: {} nominal, {} test records, baseline {}",
+            v.vehicle,
+            v.n_nominal,
+            v.n_test,
+            v.baseline_version
+                .map_or("none".to_string(), |n| format!("version {n}"))
+        );
+        if let Some(s) = &v.suspension {
+            let _ = writeln!(text, "  {s}");
+        }
+        if !v.drives.is_empty() {
+            text.push_str("  drives, newest first (when driven; when checked where the records' times are unknown):\n");
+            for d in &v.drives {
+                let _ = writeln!(
+                    text,
+                    "    {:<28} {:<8} {:<15} {} {}",
+                    d.when(),
+                    d.classification.to_string(),
+                    d.place(),
+                    d.drive,
+                    d.summary
+                );
+            }
+            text.push_str("  records, newest first:\n");
+        }
+        for (file, class, summary) in &v.last_checks {
+            let _ = writeln!(text, "  {file:<31} {:<8} {summary}", class.to_string());
+        }
+    }
+    text
+}
+
+fn or_dash(s: &str) -> &str {
+    if s.is_empty() {
+        "-"
+    } else {
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rec(file: &str, id: i64, already: bool, notes: &[&str]) -> Ingested {
+        Ingested {
+            file: file.into(),
+            record_id: id,
+            already_stored: already,
+            notes: notes.iter().map(|n| n.to_string()).collect(),
+        }
+    }
+
+    #[test]
+    fn a_note_every_new_record_has_is_printed_once_after_the_list() {
+        let done = [
+            rec("a.csv", 1, false, &["layout", "a's own"]),
+            rec("b.csv", 2, false, &["layout"]),
+            rec("c.csv", 3, true, &["layout"]),
+            rec("d.csv", 4, true, &[]),
+        ];
+        let t = ingest_text(&done, "bus1", Condition::Nominal);
+        assert_eq!(
+            t,
+            "a.csv: stored as nominal record 1 of vehicle bus1\n  note: a's own\n\
+             b.csv: stored as nominal record 2 of vehicle bus1\n\
+             c.csv: already stored for vehicle bus1 (record 3)\n  note: layout\n\
+             d.csv: already stored for vehicle bus1 (record 4), nothing to do\n\
+             note (every one of the 2 records stored): layout\n"
+        );
+    }
+
+    #[test]
+    fn a_single_new_record_keeps_its_notes_under_it() {
+        let done = [rec("a.csv", 7, false, &["layout"])];
+        let t = ingest_text(&done, "bus1", Condition::Test);
+        assert_eq!(
+            t,
+            "a.csv: stored as test record 7 of vehicle bus1\n  note: layout\n"
+        );
+    }
+}
