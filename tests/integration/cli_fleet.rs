@@ -5,7 +5,7 @@ use crate::common;
 
 use std::path::Path;
 
-use common::{bin, fails_with, ok, simulate_csv};
+use common::{bin, fails_with, fleet_ingest, ok, simulate_csv};
 
 #[test]
 fn fleet_workflow_and_errors() {
@@ -16,11 +16,9 @@ fn fleet_workflow_and_errors() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("created"));
     let nominal = simulate_csv(&d.path().join("nominal"), "C", "40", "3", "6");
     assert_eq!(nominal.len(), 6, "{nominal:?}");
-    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1"];
-    args.extend(nominal.iter().map(String::as_str));
-    let o = ok(&args);
+    let o = fleet_ingest(db, "bus-1", &nominal);
     assert!(!String::from_utf8_lossy(&o.stderr).contains("already stored"));
-    let o = ok(&args);
+    let o = fleet_ingest(db, "bus-1", &nominal);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(err.matches("already stored").count(), 6, "{err}");
     // No baseline yet.
@@ -234,9 +232,7 @@ fn init_config_sets_the_fleet_settings() {
         cfg.to_str().unwrap(),
     ]);
     let files = simulate_csv(&d.path().join("n"), "A", "30", "7", "3");
-    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus1"];
-    args.extend(files.iter().map(|s| s.as_str()));
-    ok(&args);
+    fleet_ingest(db, "bus1", &files);
     let o = ok(&["fleet", "baseline", "--db", db, "--vehicle", "bus1"]);
     let text = String::from_utf8_lossy(&o.stdout);
     // Two level bands (not the default five), and the Bonferroni limit of a 5 % family-wise
@@ -275,9 +271,7 @@ fn a_note_of_every_record_is_printed_once() {
     let db = db.to_str().unwrap();
     ok(&["fleet", "init", "--db", db]);
     let files = simulate_csv(&d.path().join("sim"), "B", "30", "5", "3");
-    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1", "-q"];
-    args.extend(files.iter().map(String::as_str));
-    let o = ok(&args);
+    let o = fleet_ingest(db, "bus-1", &files);
     let err = String::from_utf8_lossy(&o.stderr).to_string();
     let once: Vec<&str> = err
         .lines()

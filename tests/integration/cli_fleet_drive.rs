@@ -5,7 +5,7 @@
 
 use crate::common;
 
-use common::{fails_with, ok, simulate_csv};
+use common::{fails_with, fleet_ingest, ok, simulate_csv};
 
 /// `vibmode fleet check --json -` of `files` for `bus-1` in the store `db`, as one drive `drive`
 /// when given.
@@ -383,9 +383,7 @@ fn records_of_the_baseline_in_a_checked_drive_are_named() {
     let nominal = simulate_csv(&d.path().join("nominal"), "B", "30", "11", "6");
     // Stored after the baseline: nominal, but not in model set version 1.
     let later = simulate_csv(&d.path().join("later"), "B", "30", "31", "1");
-    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1", "-q"];
-    args.extend(later.iter().map(String::as_str));
-    ok(&args);
+    fleet_ingest(db, "bus-1", &later);
     let again = d.path().join("again");
     std::fs::create_dir(&again).unwrap();
     let copies: Vec<String> = nominal[..2]

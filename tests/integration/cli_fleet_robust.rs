@@ -8,7 +8,7 @@ use crate::common;
 use std::path::Path;
 use std::process::Stdio;
 
-use common::{bin, fails_with, ok, simulate_csv, stderr, vibmode, wait_or_kill};
+use common::{bin, fails_with, fleet_ingest, ok, simulate_csv, stderr, vibmode, wait_or_kill};
 
 /// A CSV record's header and rows.
 fn read_csv(path: &str) -> (String, Vec<Vec<String>>) {
@@ -68,9 +68,7 @@ fn store_is_safe_checks_are_all_or_nothing_and_failed_sensors_are_named() {
     let db = db_path.to_str().unwrap();
     ok(&["fleet", "init", "--db", db]);
     let nominal = simulate_csv(&d.path().join("nominal"), "C", "40", "3", "6");
-    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1"];
-    args.extend(nominal.iter().map(String::as_str));
-    ok(&args);
+    fleet_ingest(db, "bus-1", &nominal);
     ok(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
     let test = simulate_csv(&d.path().join("test"), "C", "40", "4", "1");
     let good = test[0].as_str();

@@ -5,7 +5,7 @@
 
 use crate::common;
 
-use common::{fails_with, ok, simulate_csv, simulate_csv_of};
+use common::{fails_with, fleet_ingest, ok, simulate_csv, simulate_csv_of};
 
 const CITY_BUS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/city_bus.toml");
 
@@ -80,9 +80,7 @@ fn a_spring_at_80_percent_is_named_by_the_fit_per_drive() {
     );
 
     let nominal = simulate_csv(&d.path().join("nominal"), "B", "30", "11", "6");
-    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-1", "-q"];
-    args.extend(nominal.iter().map(String::as_str));
-    ok(&args);
+    fleet_ingest(db, "bus-1", &nominal);
     let base = stdout(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
     assert!(
         base.contains("suspension fitted to 6 nominal records"),

@@ -47,7 +47,7 @@ pub fn check_records(records: &[RecordInput]) -> Result<(), AnalysisError> {
 /// noise, and one that repeats a value over most of its samples
 /// ([`AnalysisError::ChannelMostlyRepeated`]: a dead sensor with a spike) those of its glitches.
 pub fn check_channels_vary(r: &RecordInput) -> Result<(), AnalysisError> {
-    RecordFacts::checked(r).map(|_| ())
+    channels_checked(r).map(|_| ())
 }
 
 /// The health of every channel of `r`, refused ([`AnalysisError::ChannelConstant`],

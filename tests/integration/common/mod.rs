@@ -86,6 +86,14 @@ pub fn ok(args: &[&str]) -> Output {
     o
 }
 
+/// `vibmode fleet ingest -q` of `files` as nominal records of `vehicle` into the store `db`
+/// (exit code 0, else the test fails with stderr).
+pub fn fleet_ingest<S: AsRef<str>>(db: &str, vehicle: &str, files: &[S]) -> Output {
+    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", vehicle, "-q"];
+    args.extend(files.iter().map(AsRef::as_ref));
+    ok(&args)
+}
+
 /// Simulated bus records (CSV, 200 Hz, 10.24 s; road class, speed in km/h) from `vibmode simulate` into `dir`.
 pub fn simulate_csv(
     dir: &std::path::Path,
