@@ -53,6 +53,20 @@ pub fn ssi(
     })
 }
 
+/// What the Toeplitz matrix's lags reach: their span in seconds (the largest lag over `fs_hz`)
+/// and the frequency whose period it is. A mode below that frequency completes less than one
+/// period within the lags; in noise SSI-cov seldom identifies it (docs/ssi.md: 20 block rows at
+/// 50 Hz miss a bus's 1.17 Hz heave, 40 find it), so the text says where the record's band
+/// of interest lies below it.
+pub fn lag_span_note(params: &SsiParams, fs_hz: f64) -> String {
+    let last_lag = params.first_lag + 2 * params.block_rows - 2;
+    let span_s = last_lag as f64 / fs_hz;
+    format!(
+        "the lags span {span_s:.3} s (lag {last_lag} at {fs_hz} Hz): a mode below about {:.3} Hz completes less than one period within them and is seldom identified (a lower rate or more block rows reach lower)",
+        1.0 / span_s
+    )
+}
+
 impl SsiOutput {
     /// The modes that stay over the orders, with their shapes (modulus and phase per channel).
     pub fn summary_text(&self) -> String {
@@ -69,6 +83,7 @@ impl SsiOutput {
             out.found.result.orders.first().map_or(0, |o| o.order),
             out.found.result.orders.last().map_or(0, |o| o.order),
         );
+        let _ = writeln!(s, "  {}", lag_span_note(&out.found.params, out.found.fs_hz));
         let structural: Vec<&InvariantMode> = out
             .found
             .modes
@@ -174,5 +189,37 @@ impl SsiOutput {
             f_max_hz,
         );
         Ok(figures::grid(vec![panel], 1, 1000, 520))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_lag_span_is_the_largest_lag_over_the_rate() {
+        // 20 block rows from lag 1: lags 1..39; at 500 Hz 0.078 s, whose period is 12.8 Hz.
+        let p = SsiParams::default();
+        assert_eq!((p.block_rows, p.first_lag), (20, 1));
+        let t = lag_span_note(&p, 500.0);
+        assert!(
+            t.starts_with(
+                "the lags span 0.078 s (lag 39 at 500 Hz): a mode below about 12.821 Hz"
+            ),
+            "{t}"
+        );
+        // 40 block rows from lag 11 at 50 Hz: lags 11..89, 1.78 s, 0.562 Hz.
+        let p = SsiParams {
+            block_rows: 40,
+            first_lag: 11,
+            ..SsiParams::default()
+        };
+        assert!(
+            lag_span_note(&p, 50.0).starts_with(
+                "the lags span 1.780 s (lag 89 at 50 Hz): a mode below about 0.562 Hz"
+            ),
+            "{}",
+            lag_span_note(&p, 50.0)
+        );
     }
 }
