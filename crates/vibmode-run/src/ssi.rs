@@ -203,9 +203,7 @@ mod tests {
         assert_eq!((p.block_rows, p.first_lag), (20, 1));
         let t = lag_span_note(&p, 500.0);
         assert!(
-            t.starts_with(
-                "the lags span 0.078 s (lag 39 at 500 Hz): a mode below about 12.821 Hz"
-            ),
+            t.starts_with("the lags span 0.078 s (lag 39 at 500 Hz): a mode below about 12.821 Hz"),
             "{t}"
         );
         // 40 block rows from lag 11 at 50 Hz: lags 11..89, 1.78 s, 0.562 Hz.

@@ -3,7 +3,10 @@
 //! behind the stabilisation diagram; how the sweep is summarised and drawn.
 
 use serde::Serialize;
-use vibmode_core::{BandLimit, PoleFilterParams, SweepModel};
+use vibmode_core::{
+    BandLimit, ClusterParams, InvariantMode, ModeClass, PoleFilterParams, PoleObservation,
+    SweepModel,
+};
 use vibmode_ident::{ArMethod, ArmaModel, ArmaParams, IdentError, PoleRejection};
 use vibmode_signal::Recording;
 
@@ -53,6 +56,11 @@ pub struct SweepChannel {
     pub modes: Vec<SweepMode>,
     /// The pole pairs the filters left out.
     pub filtered_out: Vec<FilteredMode>,
+    /// The kept poles clustered over the orders (the analysis' clustering of one record,
+    /// `ClusterParams` defaults in the signal's band): the modes that stay over the orders,
+    /// structural and periodic ones first (`class`), with `order_share` the share of the orders
+    /// each is found at.
+    pub clusters: Vec<InvariantMode>,
     /// Welch frequencies (Hann, 256 samples), Hz.
     pub welch_freq_hz: Vec<f64>,
     /// Welch PSD.
@@ -86,6 +94,7 @@ impl SweepChannel {
             errors: Vec::new(),
             modes: Vec::new(),
             filtered_out: Vec::new(),
+            clusters: Vec::new(),
             welch_freq_hz: Vec::new(),
             welch_psd: Vec::new(),
         }
@@ -133,6 +142,23 @@ impl SweepChannel {
     }
 }
 
+impl SweepChannel {
+    /// Clusters the kept poles over the orders into [`Self::clusters`] (one record, this
+    /// channel; `params` as the analysis' `[cluster]`, its upper frequency from `band` where
+    /// unset).
+    pub fn cluster(&mut self, band: &BandLimit, params: &ClusterParams) -> Result<(), RunError> {
+        let obs: Vec<PoleObservation> = self
+            .modes
+            .iter()
+            .map(|m| PoleObservation::new(m.frequency_hz, m.damping_ratio, m.order, 0, &*self.name))
+            .collect();
+        self.clusters =
+            vibmode_modal::find_invariant_modes(&obs, 1, &self.orders, &params.for_band(band))
+                .map_err(vibmode_analysis::AnalysisError::from)?;
+        Ok(())
+    }
+}
+
 /// The sweep of every channel of `rec` (read from `source`). `band`: what the signal carries
 /// (the pole filters' band). A channel whose every fit fails is an error with the highest
 /// order's reason.
@@ -162,6 +188,7 @@ pub fn sweep(
         }
         let mut out = SweepChannel::new(&ch.name, &ch.unit, orders);
         out.add_fits(&fits, band, &filters);
+        out.cluster(band, &ClusterParams::default())?;
         let wp = vibmode_spectra::WelchParams {
             nperseg: Some(256.min(ch.samples.len())),
             ..Default::default()
@@ -186,14 +213,15 @@ pub fn sweep(
 }
 
 impl SweepOutput {
-    /// One line per channel: orders, pole pairs kept and left out, fits not converged and
-    /// failed.
+    /// Per channel: orders, pole pairs kept and left out, fits not converged and failed; then
+    /// the modes that stay over the orders (structural and periodic clusters), or why none is
+    /// listed.
     pub fn summary_text(&self) -> String {
         let mut text = String::new();
         for c in &self.channels {
             let nc = c.converged.iter().filter(|x| !**x).count();
             text += &format!(
-                "{}: {} orders, {} pole pairs ({} more left out by the pole filters: cancelled by a zero of C or above the valid band), {} fits not converged, {} failed",
+                "{}: {} orders, {} pole pairs ({} more left out by the pole filters: cancelled by a zero of C or above the valid band), {} fits not converged, {} failed\n",
                 c.name,
                 c.orders.len(),
                 c.modes.len(),
@@ -201,7 +229,27 @@ impl SweepOutput {
                 nc,
                 c.errors.iter().filter(|e| e.is_some()).count()
             );
-            text.push('\n');
+            let stay: Vec<&InvariantMode> = c
+                .clusters
+                .iter()
+                .filter(|m| m.class != ModeClass::Spurious)
+                .collect();
+            if stay.is_empty() {
+                text += "  no mode stays over half the orders (poles scattered); try other orders, more samples or a longer record\n";
+            }
+            for m in stay {
+                text += &format!(
+                    "  {:>8.3} Hz  damping {:.4}  in {:.0} % of orders{}\n",
+                    m.frequency_hz,
+                    m.damping_ratio,
+                    100.0 * m.order_share,
+                    if m.class == ModeClass::PeriodicDisturbance {
+                        "  periodic (damping below the disturbance limit)"
+                    } else {
+                        ""
+                    }
+                );
+            }
         }
         text
     }
