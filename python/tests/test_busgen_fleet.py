@@ -33,6 +33,8 @@ import pytest
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO / "tools" / "busgen"))
 
+import harness  # noqa: E402
+
 
 def _need():
     import harness as h  # noqa: E402
@@ -76,20 +78,11 @@ def measured():
 ALPHA = 0.05
 
 
-def _misses_probability(misses, n, goal):
-    """P(X >= misses) for X ~ Binomial(n, 1 - goal): how likely that many missed drives are if
-    the goal held."""
-    from math import comb
-
-    q = 1.0 - goal
-    return sum(comb(n, k) * q**k * (1 - q) ** (n - k) for k in range(misses, n + 1))
-
-
 def _assert_goal(measured, condition, goal):
     s = measured[condition]
     assert s["drive_n"] > 0, (condition, measured["replay"])
     misses = s["drive_n"] - s["drive_ok"]
-    p = _misses_probability(misses, s["drive_n"], goal)
+    p = harness.misses_probability(misses, s["drive_n"], goal)
     assert p >= ALPHA - 1e-12, (
         f"{condition}: {s['drive_ok']}/{s['drive_n']} drives right; {misses} missed would have "
         f"probability {p:.3g} if {goal:.0%} held; replay with {measured['replay']}; {s}"
@@ -98,11 +91,11 @@ def _assert_goal(measured, condition, goal):
 
 def test_the_goal_judgement_by_hand():
     # One drive missed of one: a 99 % goal is shown unmet (P = 0.01), a 95 % one is not (0.05).
-    assert abs(_misses_probability(1, 1, 0.99) - 0.01) < 1e-12
-    assert abs(_misses_probability(1, 1, 0.95) - 0.05) < 1e-12
+    assert abs(harness.misses_probability(1, 1, 0.99) - 0.01) < 1e-12
+    assert abs(harness.misses_probability(1, 1, 0.95) - 0.05) < 1e-12
     # 2 of 20 missed against 95 %: 1 - 0.95^20 - 20 * 0.05 * 0.95^19 = 0.2642.
-    assert abs(_misses_probability(2, 20, 0.95) - 0.26416) < 1e-4
-    assert abs(_misses_probability(0, 5, 0.9) - 1.0) < 1e-12
+    assert abs(harness.misses_probability(2, 20, 0.95) - 0.26416) < 1e-4
+    assert abs(harness.misses_probability(0, 5, 0.9) - 1.0) < 1e-12
 
 
 def test_healthy_drives_are_normal(measured):
@@ -130,7 +123,7 @@ def test_found_faults_name_their_component(measured):
     right = sum(measured[c]["drive_ok"] for c in ("damper60", "tyre75"))
     named = sum(measured[c]["component_ok"] for c in ("damper60", "tyre75"))
     assert right > 0, (measured["replay"], measured)
-    p = _misses_probability(right - named, right, 0.9)
+    p = harness.misses_probability(right - named, right, 0.9)
     assert p >= ALPHA - 1e-12, (f"component named in {named} of {right} found drives "
                                 f"(P = {p:.3g} at 90 %); replay with {measured['replay']}")
 

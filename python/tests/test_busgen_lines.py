@@ -3,7 +3,8 @@ and the structural modes beside them, over buses drawn at random every run.
 
 Runs tools/busgen/lines.py (see its docstring for the scoring) on BUSES buses (printed; replay
 with VIBMODE_BUS_SEEDS=1,2,3) and asserts the issue's figures:
-- recall >= 95 % of the true lines at least 3 % away from every mode;
+- recall >= 95 % of the true lines at least 3 % away from every mode, and of those the sensors
+  show (an oracle test at the line's own frequency, tools/busgen/line_evidence.py; not xfail);
 - no structural mode (bending, wheel hop) classed periodic on >= 95 % of the buses;
 - the bending found as structural within 2 % on >= 90 % of the buses where a sensor sees it.
 The three goals are not met on every draw yet (issue 30 open): each is marked xfail (not
@@ -24,6 +25,7 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tools" / "busgen"))
 
 import harness  # noqa: E402
+import line_evidence  # noqa: E402
 import lines  # noqa: E402
 
 BUSES = 5
@@ -45,20 +47,51 @@ def _ready():
         pytest.skip(f"skipped: {e}")
 
 
+def test_the_oracle_line_test_by_hand():
+    """The oracle of `line_evidence`: white noise gives p-values uniform on (0, 1) (the F(2, 12)
+    law holds at a frequency fixed in advance); a sinusoid as strong as the noise gives a tiny p;
+    Fisher's method by hand."""
+    np = pytest.importorskip("numpy")
+    pytest.importorskip("scipy")
+    rng = np.random.default_rng(20261127)
+    ps = np.array([line_evidence.f_test_p(rng.standard_normal(512), 50.0, 11.3)
+                   for _ in range(400)])
+    # P(p < 0.1) = 0.1 and P(p < 0.5) = 0.5 under the null; 400 draws: sd 0.015 and 0.025.
+    assert abs((ps < 0.1).mean() - 0.1) < 0.05, (ps < 0.1).mean()
+    assert abs((ps < 0.5).mean() - 0.5) < 0.08, (ps < 0.5).mean()
+    t = np.arange(512) / 50.0
+    y = np.sqrt(2.0) * np.sin(2 * np.pi * 11.3 * t + 0.4) + rng.standard_normal(512)
+    assert line_evidence.f_test_p(y, 50.0, 11.3) < 1e-6
+    # Two records of p = 0.1: X = -4 ln 0.1 = 9.21 against chi-square(4): (1 + X/2) e^(-X/2).
+    x = -4.0 * np.log(0.1)
+    assert abs(line_evidence._fisher([0.1, 0.1]) - (1 + x / 2) * np.exp(-x / 2)) < 1e-12
+
+
 @pytest.fixture(scope="module")
 def measured():
     _ready()
     return lines.measure(BUSES, seed=1, jobs=2)
 
 
-@pytest.mark.xfail(reason="issue 30 goal met over 50 buses of two draws on 2026-11-27 (129/134 = "
-                          "96 %; 95 % on the draw of 30), but a draw of 5 buses holds ~13 lines, so "
-                          "one miss (a 10-11.6 Hz order on the wheel-hop flank) fails it: about "
-                          "one run in four; docs/analysis.md, 'Lines on busgen'",
+@pytest.mark.xfail(reason="issue 30 goal not met on every draw: 128/140 (91 %) over 53 buses on "
+                          "2026-11-27, where 9 of the 12 missed 10-11.7 Hz engine orders are shown "
+                          "by no sensor even to a test at their own frequency (p >= 0.01; the "
+                          "lines shown: 128/131, asserted above); docs/analysis.md, fifth step",
                    strict=False)
 def test_lines_apart_from_modes_are_recalled(measured):
     assert measured["apart"] > 0
     assert measured["found"] >= 0.95 * measured["apart"], measured
+
+
+def test_lines_the_sensors_show_are_recalled(measured):
+    """Recall >= 95 % of the judged lines that the sensors show (tools/busgen/line_evidence.py:
+    the harmonic F-test at the line's own frequency, p < 0.01 over the records). Judged as a
+    binomial: fails when the misses of this draw would have probability below 5 % if the
+    recall were 95 % (3 misses of 13 lines). Measured 68/69 over 28 buses on 2026-11-27."""
+    n, found = measured["seen"], measured["seen_found"]
+    assert n > 0, measured
+    p = harness.misses_probability(n - found, n, 0.95)
+    assert p >= 0.05, f"{found}/{n} lines the sensors show recalled (P = {p:.3g} at 95 %)"
 
 
 @pytest.mark.xfail(reason="issue 30 goal met over two draws on 2026-11-27 (48/50 buses, 96 %: "

@@ -156,6 +156,15 @@ def analyze(folder: Path, *extra: str, out: Optional[Path] = None) -> Dict:
         return json.load(f)
 
 
+def misses_probability(misses: int, n: int, goal: float) -> float:
+    """P(X >= misses) for X ~ Binomial(n, 1 - goal): how likely that many misses among `n` are
+    if the goal (a rate of successes) held. The acceptance tests fail a goal when it is below 5 %."""
+    from math import comb
+
+    q = 1.0 - goal
+    return sum(comb(n, k) * q**k * (1 - q) ** (n - k) for k in range(misses, n + 1))
+
+
 def rate(hits: int, total: int) -> str:
     """`hits/total (pct %)`, or `-` with nothing to count."""
     return f"{hits}/{total} ({100.0 * hits / total:.0f} %)" if total else "-"

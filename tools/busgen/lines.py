@@ -21,6 +21,10 @@ Scores per bus:
   lightly damped mode (zeta < 0.1, the bending) or of a mode no sensor sees cannot be judged
   (busgen's README) and are left out of recall and precision; lines between 2 and 3 % from a
   broad mode are left out of recall only.
+- recall of the lines the sensors show: the same over the judged lines whose oracle p-value
+  (`line_evidence.py`: the harmonic F-test at the line's own frequency, Fisher-combined over the
+  records, Bonferroni over the channels) is below `line_evidence.SEEN_P` (0.01). A line above it
+  is shown by no sensor even to a test that knows its frequency; each missed line prints its p.
 - false lines: reported lines matching no true line within `MATCH_REL` (precision's numerator of
   misses); a report on an unjudgeable line counts neither way.
 - structural classed periodic: a false report (above) within max(2 %, zeta) of the bending or of
@@ -46,6 +50,7 @@ from typing import Dict, List, Tuple
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import harness  # noqa: E402
+import line_evidence  # noqa: E402
 
 APART_REL = 0.03
 MATCH_REL = 0.02
@@ -99,7 +104,9 @@ def merge(reps: List[Tuple[float, str]]) -> List[Tuple[float, List[str]]]:
     return merged
 
 
-def score(truth: Dict, res: Dict) -> Dict:
+def score(truth: Dict, res: Dict, evidence: Dict[float, float] = None) -> Dict:
+    """`evidence`: each judged line's oracle p-value (`line_evidence.evidence`); without it
+    every judged line counts as shown by the sensors."""
     modes = truth["modes"]
     lines = [l["f0_hz"] for l in truth["periodic_lines"]]
 
@@ -111,6 +118,8 @@ def score(truth: Dict, res: Dict) -> Dict:
     left_out = [f for f in lines if f not in apart]
     merged = merge(reports(res))
     found = [f for f in apart if any(rel(r, f) <= MATCH_REL for r, _ in merged)]
+    evidence = evidence or {}
+    seen = [f for f in apart if evidence.get(f, 0.0) < line_evidence.SEEN_P]
     false = [(r, w) for r, w in merged
              if not any(rel(r, f) <= MATCH_REL for f in lines) and not unjudgeable(r)]
     structural = [m for m in modes if is_bending(m) or is_wheel_hop(m)]
@@ -126,6 +135,7 @@ def score(truth: Dict, res: Dict) -> Dict:
         bend_found.append((b, structural_hit, hits))
     return {
         "lines": lines, "apart": apart, "left_out": left_out, "found": found,
+        "seen": seen, "evidence": evidence,
         "reported": merged, "false": false, "structural_periodic": called_periodic,
         "bending": bend_found,
     }
@@ -139,7 +149,8 @@ def run_bus(bus: int, seed: int, keep: bool, extra: Tuple[str, ...] = ()) -> Tup
         import shutil
         shutil.rmtree(out, ignore_errors=True)
     t = harness.truth(folder)
-    return bus, t, score(t, res)
+    s0 = score(t, res)
+    return bus, t, score(t, res, line_evidence.evidence(folder, s0["apart"]))
 
 
 def fmt_hz(v: List[float]) -> str:
@@ -159,8 +170,10 @@ def row(bus: int, t: Dict, s: Dict) -> str:
             bend = "no (none within 2 %)"
         vis = max(b.get("visibility", {}).values(), default=float("nan"))
         bend = f"{b['f_n_hz']:.2f}/{b['zeta']:.3f} (visibility {vis:.2f}): {bend}"
+    ev = s.get("evidence", {})
+    missed_ev = ",".join(f"{f:.2f} (p {ev[f]:.0e})" if f in ev else f"{f:.2f}" for f in missed) or "-"
     return (f"bus {bus:5d}: lines {fmt_hz(s['lines'])} | judged {fmt_hz(s['apart'])} found "
-            f"{len(s['found'])}/{len(s['apart'])} missed {fmt_hz(missed)} | false "
+            f"{len(s['found'])}/{len(s['apart'])} missed {missed_ev} | false "
             f"{'; '.join(f'{r:.2f} [{w[0]}]' for r, w in s['false']) or '-'} | structural periodic "
             f"{', '.join(s['structural_periodic']) or '-'} | bending {bend}")
 
@@ -168,12 +181,15 @@ def row(bus: int, t: Dict, s: Dict) -> str:
 def summary(results: List[Tuple[int, Dict, Dict]]) -> Dict:
     n_apart = sum(len(s["apart"]) for _, _, s in results)
     n_found = sum(len(s["found"]) for _, _, s in results)
+    n_seen = sum(len(s["seen"]) for _, _, s in results)
+    n_seen_found = sum(len([f for f in s["seen"] if f in s["found"]]) for _, _, s in results)
     n_rep = sum(len(s["reported"]) for _, _, s in results)
     n_false = sum(len(s["false"]) for _, _, s in results)
     n_clean = sum(1 for _, _, s in results if not s["structural_periodic"])
     seen = [s for _, _, s in results if s["bending"]]
     n_bend = sum(1 for s in seen if s["bending"][0][1])
-    return {"buses": len(results), "apart": n_apart, "found": n_found, "reported": n_rep,
+    return {"buses": len(results), "apart": n_apart, "found": n_found, "seen": n_seen,
+            "seen_found": n_seen_found, "reported": n_rep,
             "false": n_false, "no_structural_periodic": n_clean, "bending_seen": len(seen),
             "bending_structural": n_bend,
             "left_out": sum(len(s["left_out"]) for _, _, s in results)}
@@ -183,6 +199,9 @@ def print_summary(sm: Dict) -> None:
     r = harness.rate
     print(f"recall of lines >= 3 % from every mode: {r(sm['found'], sm['apart'])}"
           f" ({sm['left_out']} lines within 3 % of a mode left out)")
+    print(f"recall of those lines the sensors show (oracle F-test at the line's own frequency, "
+          f"p < {line_evidence.SEEN_P} over the records): {r(sm['seen_found'], sm['seen'])}"
+          f" ({sm['apart'] - sm['seen']} not shown by any sensor)")
     print(f"false lines (reported, matching no true line): {sm['false']} of {sm['reported']} reported")
     print(f"buses with no structural mode classed periodic: {r(sm['no_structural_periodic'], sm['buses'])}")
     print(f"bending found structural within 2 % where a sensor sees it: "
