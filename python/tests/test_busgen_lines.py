@@ -6,7 +6,8 @@ with VIBMODE_BUS_SEEDS=1,2,3) and asserts the issue's figures:
 - recall >= 95 % of the true lines at least 3 % away from every mode, and of those the sensors
   show (an oracle test at the line's own frequency, tools/busgen/line_evidence.py; not xfail);
 - no structural mode (bending, wheel hop) classed periodic on >= 95 % of the buses;
-- the bending found as structural within 2 % on >= 90 % of the buses where a sensor sees it.
+- the bending found as structural within 2 % on >= 90 % of the buses where a sensor sees it
+  (scored where no line lies within 2 % of it: busgen's README says neither can be judged).
 The three goals are not met on every draw yet (issue 30 open): each is marked xfail (not
 strict) with the figures measured on 2026-11-27 (docs/analysis.md, "Lines on busgen"); the test still runs, prints every bus and fails loudly on an
 error in the scoring. Remove the marks once the figures hold.
@@ -103,12 +104,12 @@ def test_no_structural_mode_is_classed_periodic(measured):
     assert measured["no_structural_periodic"] >= 0.95 * measured["buses"], measured
 
 
-@pytest.mark.xfail(reason="issue 30 item 3 not met: 22/48 buses (46 %) over two draws on 2026-11-27 "
-                          "(10/18, 12/30): weak bending peaks (5-45 % of a sensor's strongest), "
-                          "a line within 2 % of the bending, or its SSI-cov poles split or in "
-                          "fewer than half the orders; docs/analysis.md, third step",
+@pytest.mark.xfail(reason="issue 30 item 3 not met: where no line lies within 2 % of the bending "
+                          "(busgen's README: neither can be judged), 28/35 buses (80 %) over three "
+                          "draws on 2026-11-27; the rest: weak bending peaks, or its SSI-cov "
+                          "poles split or in fewer than half the orders; docs/analysis.md, fifth step",
                    strict=False)
 def test_bending_is_found_structural(measured):
-    if measured["bending_seen"] == 0:
-        pytest.skip("skipped: no bus drawn has a bending mode a sensor sees")
-    assert measured["bending_structural"] >= 0.9 * measured["bending_seen"], measured
+    if measured["bending_judged"] == 0:
+        pytest.skip("skipped: no bus drawn has a bending mode a sensor sees, apart from the lines")
+    assert measured["bending_judged_structural"] >= 0.9 * measured["bending_judged"], measured
