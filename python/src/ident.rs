@@ -179,6 +179,7 @@ struct SweepOut {
     fits: Vec<SweepFit>,
     modes: Vec<vibmode_run::sweep::SweepMode>,
     filtered_out: Vec<vibmode_run::sweep::FilteredMode>,
+    clusters: Vec<vibmode_core::InvariantMode>,
 }
 
 /// Order sweep of one signal (`vibmode sweep`): every order's fit and modes, split by the
@@ -232,6 +233,8 @@ fn sweep(
     let band = BandLimit::full(fs);
     let mut ch = vibmode_run::sweep::SweepChannel::new("", "", &orders);
     ch.add_fits(&fits, &band, &PoleFilterParams::default());
+    ch.cluster(&band, &vibmode_core::ClusterParams::default())
+        .map_err(value_err)?;
     let out = SweepOut {
         fs_hz: fs,
         n_samples: y.len(),
@@ -262,6 +265,7 @@ fn sweep(
             .collect(),
         modes: ch.modes,
         filtered_out: ch.filtered_out,
+        clusters: ch.clusters,
     };
     serde_json::to_string(&out).map_err(json_err)
 }

@@ -138,6 +138,13 @@ def test_sweep_stabilises_on_the_mode(ar2_data):
     near = modes[np.abs(modes["frequency_hz"] - F0) < 0.3]
     assert sorted(set(near["order"])) == list(range(2, 9))
     assert len(s.fits) == 7
+    # The clusters over the orders: one mode that stays, at the true frequency, in every order
+    # (the CLI's `vibmode sweep` prints the same clusters).
+    c = s.clusters
+    stay = c[c["class"] != "spurious"]
+    assert len(stay) == 1, c
+    assert abs(stay["frequency_hz"].iloc[0] - F0) < 0.02 * F0, c
+    assert stay["order_share"].iloc[0] == 1.0 and stay["class"].iloc[0] == "structural", c
     s2 = vibmode.sweep(ar2_data[:2000], FS, orders=[2, 4], robust="off", as_frame=False)
     assert isinstance(s2.modes, dict) and set(s2.modes["order"]) <= {2, 4}
 

@@ -190,9 +190,13 @@ def fit_ar(y: Any, fs: float, p: int, method: str = "burg") -> ArmaModel:
 
 class SweepResult:
     """An order sweep: ``fits`` (order, loss, noise_variance, aic, converged, iterations, error),
-    ``modes`` (order, frequency_hz, damping_ratio: the stabilisation diagram) and
-    ``filtered_out`` (pole pairs the analysis' pole filters left out, with the reason). Tables
-    are DataFrames when pandas is installed, else dicts of numpy arrays."""
+    ``modes`` (order, frequency_hz, damping_ratio: the stabilisation diagram),
+    ``filtered_out`` (pole pairs the analysis' pole filters left out, with the reason) and
+    ``clusters`` (the kept poles clustered over the orders, as the analysis clusters one
+    record: frequency_hz, frequency_std_hz, damping_ratio, order_share, min_order, n_poles,
+    class: ``structural`` or ``periodic-disturbance`` when in at least half the orders,
+    ``spurious`` otherwise; ``vibmode sweep`` prints the first two). Tables are DataFrames when
+    pandas is installed, else dicts of numpy arrays."""
 
     def __init__(self, d: Dict[str, Any], as_frame: Optional[bool]):
         self._d = d
@@ -201,6 +205,11 @@ class SweepResult:
         self.fits = columns(d["fits"], ["order", "loss", "noise_variance", "aic", "converged", "iterations", "error"], as_frame)
         self.modes = columns(d["modes"], ["order", "frequency_hz", "damping_ratio"], as_frame)
         self.filtered_out = columns(d["filtered_out"], ["order", "frequency_hz", "damping_ratio", "reason"], as_frame)
+        self.clusters = columns(
+            d["clusters"],
+            ["frequency_hz", "frequency_std_hz", "damping_ratio", "order_share", "min_order", "n_poles", "class"],
+            as_frame,
+        )
 
     def to_dict(self) -> Dict[str, Any]:
         return copy.deepcopy(self._d)

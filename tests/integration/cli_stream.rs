@@ -149,7 +149,7 @@ fn segment_and_analyze_by_gps_carry_speed_and_position() {
         "-o",
         seg_dir.to_str().unwrap(),
     ]));
-    assert!(err.contains("cut by gps"), "{err}");
+    assert!(err.contains("cut by GPS"), "{err}");
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(seg_dir.join("segments.json")).unwrap())
             .unwrap();

@@ -303,13 +303,38 @@ pub struct GpsSummary {
 /// Most points of [`GpsSummary::speed_trace`] (a day at 1 Hz thinned to a drawable line).
 pub const SPEED_TRACE_MAX_POINTS: usize = 4000;
 
+/// How a recording was cut into records.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+#[non_exhaustive]
+pub enum SegmentMethod {
+    /// Where a GPS track says the speed is steady and the heading nearly constant.
+    Gps,
+    /// Where the vibration itself shows no stop, idling or strong manoeuvre.
+    Vibration,
+    /// Consecutive records from the start, stops and idling included.
+    Fixed,
+}
+
+impl std::fmt::Display for SegmentMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            SegmentMethod::Gps => "by GPS (steady speed and heading)",
+            SegmentMethod::Vibration => "by the vibration (stops, idling and strong manoeuvres skipped)",
+            SegmentMethod::Fixed => {
+                "into consecutive windows (no GPS track and no vibration test: stops and idling are kept)"
+            }
+        })
+    }
+}
+
 /// The result: records to cut and the skipped stretches, written as `segments.json`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Segmentation {
     /// The recording.
     pub source: String,
-    /// `"gps"`, `"vibration"` or `"fixed"` (consecutive records).
-    pub method: String,
+    /// How the records were cut (`"gps"`, `"vibration"` or `"fixed"` in the JSON).
+    pub method: SegmentMethod,
     /// Record length, s.
     pub record_length_s: f64,
     /// Sampling rate, Hz.
@@ -374,7 +399,7 @@ impl Segmentation {
             })
             .unwrap_or_default();
         format!(
-            "{}: {:.1} s, {} records of {} s cut by {}; skipped: {}{}",
+            "{}: {:.1} s, {} records of {} s cut {}; skipped: {}{}",
             self.source,
             self.duration_s,
             self.records.len(),
@@ -720,5 +745,25 @@ mod rfc3339_tests {
                 "{t} {s} {back}"
             );
         }
+    }
+}
+
+#[cfg(test)]
+mod method_tests {
+    use super::SegmentMethod;
+
+    #[test]
+    fn the_method_is_written_as_before_and_said_in_words() {
+        for (m, json) in [
+            (SegmentMethod::Gps, "\"gps\""),
+            (SegmentMethod::Vibration, "\"vibration\""),
+            (SegmentMethod::Fixed, "\"fixed\""),
+        ] {
+            assert_eq!(serde_json::to_string(&m).unwrap(), json);
+            assert_eq!(serde_json::from_str::<SegmentMethod>(json).unwrap(), m);
+        }
+        assert!(SegmentMethod::Fixed
+            .to_string()
+            .contains("stops and idling are kept"));
     }
 }

@@ -60,7 +60,7 @@ pub(crate) fn check_length(
 
 pub(crate) fn empty_segmentation(
     info: &StreamInfo,
-    method: &str,
+    method: crate::SegmentMethod,
     duration_s: f64,
     record_length_s: f64,
     p: &SegmentParams,
@@ -68,7 +68,7 @@ pub(crate) fn empty_segmentation(
 ) -> Segmentation {
     Segmentation {
         source: info.path.clone(),
-        method: method.to_string(),
+        method,
         record_length_s,
         fs_hz: info.fs_hz,
         duration_s,
@@ -114,7 +114,14 @@ pub fn fixed_cuts(
     let duration_s = check_length(info, n_frames, record_length_s)?;
     p.check_work(record_length_s, info.fs_hz, duration_s, false)?;
     let start_unix = recording_start(info)?;
-    let mut seg = empty_segmentation(info, "fixed", duration_s, record_length_s, p, start_unix);
+    let mut seg = empty_segmentation(
+        info,
+        crate::SegmentMethod::Fixed,
+        duration_s,
+        record_length_s,
+        p,
+        start_unix,
+    );
     let n = (duration_s / record_length_s + 1e-9).floor() as usize;
     for k in 0..n {
         seg.records.push(record_at(
@@ -338,7 +345,14 @@ pub fn by_gps(
             alignment: alignment.rule.clone(),
         });
     }
-    let mut seg = empty_segmentation(info, "gps", duration_s, record_length_s, p, unix_base);
+    let mut seg = empty_segmentation(
+        info,
+        crate::SegmentMethod::Gps,
+        duration_s,
+        record_length_s,
+        p,
+        unix_base,
+    );
     seg.gps = Some(GpsSummary {
         path: track.path.clone(),
         format: track.format,

@@ -234,7 +234,7 @@ pub fn by_vibration(
     }
     let mut seg = empty_segmentation(
         &info,
-        "vibration",
+        crate::SegmentMethod::Vibration,
         duration_s,
         record_length_s,
         p,
