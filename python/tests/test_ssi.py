@@ -145,6 +145,11 @@ def test_layouts_agree_and_name_channels(rng):
     c = vibmode.ssi_cov(rec, orders=range(6, 7), as_frame=False)
     assert c.channels == list("abcde")
     np.testing.assert_array_equal(a.poles["frequency_hz"], c.poles["frequency_hz"])
+    # The lags' span by hand: 20 block rows from lag 1, lags 1..39 at 50 Hz: 0.78 s (1.28 Hz).
+    assert a.lag_span_s == pytest.approx(39 / 50.0, rel=1e-12)
+    assert "lags span 0.78 s: modes below about 1.28 Hz" in repr(a)
+    assert vibmode.ssi_cov(y, 50.0, block_rows=10, first_lag=3, orders=range(6, 7)).lag_span_s == (
+        pytest.approx(21 / 50.0, rel=1e-12))
     pd = pytest.importorskip("pandas")
     df = pd.DataFrame(y.T, columns=list("vwxyz"))
     df.attrs["fs"] = 50.0

@@ -67,6 +67,10 @@ class SsiResult:
     shapes : complex ndarray (n_modes, n_channels), the mean shape of each row of ``modes``.
     channels : list of channel names.
     singular_values : ndarray, of the block Toeplitz matrix, largest first.
+    lag_span_s : float, the span of the correlation lags in seconds (the largest lag over
+        ``fs_hz``): a mode below ``1 / lag_span_s`` Hz completes less than one period within
+        them and is seldom identified; resample to a lower rate or use more ``block_rows`` to
+        reach lower (a 500 Hz record with the default 20 block rows spans 0.078 s: 12.8 Hz).
     fs_hz, n_samples, params, stability_params : the data and the parameters used.
     """
 
@@ -77,6 +81,7 @@ class SsiResult:
         self.n_samples: int = int(d["n_samples"])
         self.params: Dict[str, Any] = d["params"]
         self.stability_params: Dict[str, Any] = d["stability_params"]
+        self.lag_span_s: float = float(d["lag_span_s"])
         self.singular_values = np.asarray(d["result"]["singular_values"], dtype=np.float64)
         rows, shapes = [], []
         pole_std = d.get("pole_std")
@@ -140,7 +145,8 @@ class SsiResult:
         n_struct = sum(1 for m in self._d["modes"] if m["class"] == "structural")
         return (
             f"<vibmode.SsiResult {len(self.channels)} channels, {len(self._d['result']['orders'])} "
-            f"orders, {n_struct} structural modes>"
+            f"orders, {n_struct} structural modes; lags span {self.lag_span_s:.3g} s: modes below "
+            f"about {1.0 / self.lag_span_s:.3g} Hz are seldom identified>"
         )
 
 

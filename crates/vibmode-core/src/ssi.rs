@@ -83,6 +83,19 @@ impl SsiParams {
         }
     }
 
+    /// The largest correlation lag of the block Toeplitz matrix, samples:
+    /// `first_lag + 2 block_rows - 2`.
+    pub fn last_lag(&self) -> usize {
+        self.first_lag + 2 * self.block_rows - 2
+    }
+
+    /// The span of the lags in seconds at `fs_hz` (`last_lag / fs_hz`). A mode whose period is
+    /// longer (below `1 / span` Hz) completes less than one period within the lags, and in
+    /// noise SSI-cov seldom identifies it (docs/ssi.md, "What the lags reach").
+    pub fn lag_span_s(&self, fs_hz: f64) -> f64 {
+        self.last_lag() as f64 / fs_hz
+    }
+
     /// The identified orders: `order_min, order_min + order_step, ...` up to `order_max`
     /// (inclusive when reached). Empty only for parameters that fail [`SsiParams::validate`].
     pub fn orders(&self) -> Vec<usize> {

@@ -59,10 +59,10 @@ pub fn ssi(
 /// 50 Hz miss a bus's 1.17 Hz heave, 40 find it), so the text says where the record's band
 /// of interest lies below it.
 pub fn lag_span_note(params: &SsiParams, fs_hz: f64) -> String {
-    let last_lag = params.first_lag + 2 * params.block_rows - 2;
-    let span_s = last_lag as f64 / fs_hz;
+    let span_s = params.lag_span_s(fs_hz);
     format!(
-        "the lags span {span_s:.3} s (lag {last_lag} at {fs_hz} Hz): a mode below about {:.3} Hz completes less than one period within them and is seldom identified (a lower rate or more block rows reach lower)",
+        "the lags span {span_s:.3} s (lag {} at {fs_hz} Hz): a mode below about {:.3} Hz completes less than one period within them and is seldom identified (a lower rate or more block rows reach lower)",
+        params.last_lag(),
         1.0 / span_s
     )
 }
@@ -79,7 +79,7 @@ impl SsiOutput {
             out.found.fs_hz,
             out.found.params.block_rows,
             out.found.params.first_lag,
-            out.found.params.first_lag + 2 * out.found.params.block_rows - 2,
+            out.found.params.last_lag(),
             out.found.result.orders.first().map_or(0, |o| o.order),
             out.found.result.orders.last().map_or(0, |o| o.order),
         );

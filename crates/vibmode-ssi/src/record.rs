@@ -24,6 +24,9 @@ pub struct RecordSsi {
     pub params: SsiParams,
     /// The stabilisation criteria used.
     pub stability_params: StabilityParams,
+    /// The span of the correlation lags, s ([`SsiParams::lag_span_s`]): modes below
+    /// `1 / lag_span_s` Hz complete less than one period within them and are seldom identified.
+    pub lag_span_s: f64,
     /// Every identified order's modes, shapes in the channels' units.
     pub result: SsiResult,
     /// Stability label of every mode of every order against the previous order (same nesting
@@ -238,6 +241,7 @@ pub fn identify_record(
         n_samples: channels.first().map_or(0, |c| c.len()),
         params: params.clone(),
         stability_params: options.stability.clone(),
+        lag_span_s: params.lag_span_s(fs_hz),
         result,
         stability,
         modes,
