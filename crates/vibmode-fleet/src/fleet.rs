@@ -782,8 +782,21 @@ pub fn check_files_progress(
     progress: &dyn Fn(usize),
 ) -> Result<Vec<Checked>> {
     check_vehicle_id(&set.vehicle)?;
+    let prepared = prepare_test_files(store, set, paths, opts, progress)?;
+    check_prepared(store, set, prepared)
+}
+
+/// Reads and analyses files to be checked against `set` (its layout and settings), as test
+/// records of its vehicle; `progress(n)` after the first `n`.
+fn prepare_test_files(
+    store: &Store,
+    set: &ModelSet,
+    paths: &[&Path],
+    opts: &ReadOptions,
+    progress: &dyn Fn(usize),
+) -> Result<Vec<Prepared>> {
     let layout = |name: &str, rec: &Recording| check_layout(set, name, rec);
-    let prepared = prepare_files(
+    prepare_files(
         store,
         &test_labels(set),
         paths,
@@ -791,8 +804,7 @@ pub fn check_files_progress(
         &set.config,
         &layout,
         progress,
-    )?;
-    check_prepared(store, set, prepared)
+    )
 }
 
 /// The id of a drive when none is given.
@@ -857,16 +869,7 @@ pub fn check_drive_files_progress(
             });
         }
     }
-    let layout = |name: &str, rec: &Recording| check_layout(set, name, rec);
-    let prepared = prepare_files(
-        store,
-        &test_labels(set),
-        paths,
-        opts,
-        &set.config,
-        &layout,
-        progress,
-    )?;
+    let prepared = prepare_test_files(store, set, paths, opts, progress)?;
     // Each content once: a file given twice (or a copy) would weigh twice in the median.
     let distinct: Vec<usize> = (0..prepared.len())
         .filter(|&i| prepared[i].same_as.is_none())
