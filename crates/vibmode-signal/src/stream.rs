@@ -156,6 +156,23 @@ fn read_full(r: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
     Ok(got)
 }
 
+/// Sizes `buf` for the next block of at most `max_frames` of the `remaining` frames of `nch`
+/// interleaved channels of `width` bytes each; the frames in it, or `None` at the end.
+fn block_bytes(
+    remaining: u64,
+    max_frames: usize,
+    nch: usize,
+    width: usize,
+    buf: &mut Vec<u8>,
+) -> Option<usize> {
+    if remaining == 0 {
+        return None;
+    }
+    let n = remaining.min(max_frames as u64) as usize;
+    buf.resize(n * nch * width, 0);
+    Some(n)
+}
+
 /// Interleaved little-endian samples of `W` bytes (`nch` a frame, decoded by `decode`) as
 /// channels, each value times `scale`.
 fn deinterleave<const W: usize>(
@@ -679,12 +696,10 @@ impl FrameStream {
                 remaining,
                 buf,
             } => {
-                if *remaining == 0 {
-                    return Ok(None);
-                }
                 let nch = self.file_names.len();
-                let n = (*remaining).min(max_frames as u64) as usize;
-                buf.resize(n * nch * *width, 0);
+                let Some(n) = block_bytes(*remaining, max_frames, nch, *width, buf) else {
+                    return Ok(None);
+                };
                 file.read_exact(buf).map_err(|e| SignalError::Io {
                     action: "read",
                     path: self.info.path.clone(),
@@ -704,12 +719,10 @@ impl FrameStream {
                 remaining,
                 buf,
             } => {
-                if *remaining == 0 {
-                    return Ok(None);
-                }
                 let nch = self.file_names.len();
-                let n = (*remaining).min(max_frames as u64) as usize;
-                buf.resize(n * nch * *width, 0);
+                let Some(n) = block_bytes(*remaining, max_frames, nch, *width, buf) else {
+                    return Ok(None);
+                };
                 let got = read_full(data, buf).map_err(|e| SignalError::Wav {
                     path: self.info.path.clone(),
                     problem: WavProblem::CutOffAt {
