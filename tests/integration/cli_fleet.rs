@@ -5,7 +5,7 @@ use crate::common;
 
 use std::path::Path;
 
-use common::{bin, fails_with, fleet_ingest, ok, simulate_csv};
+use common::{bin, fails_with, fleet_args, fleet_ingest, ok, simulate_csv};
 
 #[test]
 fn fleet_workflow_and_errors() {
@@ -23,31 +23,18 @@ fn fleet_workflow_and_errors() {
     assert_eq!(err.matches("already stored").count(), 6, "{err}");
     // No baseline yet.
     fails_with(
-        &[
-            "fleet",
-            "check",
-            "--db",
-            db,
-            "--vehicle",
-            "bus-1",
-            &nominal[0],
-        ],
+        &fleet_args("check", db, "bus-1", &[&nominal[0]]),
         &["no baseline", "bus-1"],
     );
     let o = ok(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
     assert!(String::from_utf8_lossy(&o.stdout).contains("version 1"));
     let test = simulate_csv(&d.path().join("test"), "C", "40", "4", "1");
-    let o = ok(&[
-        "fleet",
+    let o = ok(&fleet_args(
         "check",
-        "--db",
         db,
-        "--vehicle",
         "bus-1",
-        "--json",
-        "-",
-        &test[0],
-    ]);
+        &["--json", "-", &test[0]],
+    ));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let recs = v["records"].as_array().unwrap();
     assert_eq!(recs.len(), 1);
@@ -72,15 +59,7 @@ fn fleet_workflow_and_errors() {
         .replacen("FL_unsprung", "FL_wheel", 1);
     std::fs::write(&odd, text).unwrap();
     fails_with(
-        &[
-            "fleet",
-            "check",
-            "--db",
-            db,
-            "--vehicle",
-            "bus-1",
-            odd.to_str().unwrap(),
-        ],
+        &fleet_args("check", db, "bus-1", &[odd.to_str().unwrap()]),
         &["odd.csv", "FL_wheel", "new baseline"],
     );
     let after = ok(&["fleet", "status", "--db", db]);
@@ -101,19 +80,11 @@ fn fleet_workflow_and_errors() {
     assert!(!rep.join(".index.html.partial").exists());
     // Errors.
     fails_with(
-        &["fleet", "check", "--db", db, "--vehicle", "bus-9", &test[0]],
+        &fleet_args("check", db, "bus-9", &[&test[0]]),
         &["bus-9", "not in the store"],
     );
     fails_with(
-        &[
-            "fleet",
-            "ingest",
-            "--db",
-            db,
-            "--vehicle",
-            "bus-1",
-            "no-such-file.csv",
-        ],
+        &fleet_args("ingest", db, "bus-1", &["no-such-file.csv"]),
         &["no-such-file.csv"],
     );
     let junk = d.path().join("junk.db");
@@ -290,16 +261,7 @@ fn a_note_of_every_record_is_printed_once() {
     );
     // One record alone: its note under it.
     let more = simulate_csv(&d.path().join("more"), "B", "30", "6", "1");
-    let o = ok(&[
-        "fleet",
-        "ingest",
-        "--db",
-        db,
-        "--vehicle",
-        "bus-1",
-        "-q",
-        &more[0],
-    ]);
+    let o = ok(&fleet_args("ingest", db, "bus-1", &["-q", &more[0]]));
     let err = String::from_utf8_lossy(&o.stderr).to_string();
     assert!(
         err.lines()

@@ -5,7 +5,7 @@
 
 use crate::common;
 
-use common::{fails_with, fleet_ingest, ok, simulate_csv};
+use common::{fails_with, fleet_args, fleet_ingest, ok, simulate_csv};
 
 /// `vibmode fleet check --json -` of `files` for `bus-1` in the store `db`, as one drive `drive`
 /// when given.
@@ -115,77 +115,36 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
     // Too few records for a named drive: refused before anything is read or stored.
     let more = simulate_csv(&d.path().join("more"), "B", "30", "31", "3");
     fails_with(
-        &[
-            "fleet",
+        &fleet_args(
             "check",
-            "--db",
             db,
-            "--vehicle",
             "bus-1",
-            "--drive",
-            "day-2",
-            &more[0],
-            &more[1],
-        ],
+            &["--drive", "day-2", &more[0], &more[1]],
+        ),
         &["drive 'day-2'", "2 record(s)", "at least 3"],
     );
     assert_eq!(n_test(db, "bus-1"), 4);
 
     // A record of another vehicle in the drive.
-    ok(&[
-        "fleet",
-        "ingest",
-        "--db",
-        db,
-        "--vehicle",
-        "bus-2",
-        "-q",
-        &more[2],
-    ]);
+    ok(&fleet_args("ingest", db, "bus-2", &["-q", &more[2]]));
     fails_with(
-        &[
-            "fleet",
+        &fleet_args(
             "check",
-            "--db",
             db,
-            "--vehicle",
             "bus-1",
-            "--drive",
-            "day-2",
-            &more[0],
-            &more[1],
-            &more[2],
-        ],
+            &["--drive", "day-2", &more[0], &more[1], &more[2]],
+        ),
         &["drive 'day-2'", "vehicle 'bus-2'", "record_"],
     );
     assert_eq!(n_test(db, "bus-1"), 4);
     // The same without a drive id: the three records are the drive `all given records`.
     fails_with(
-        &[
-            "fleet",
-            "check",
-            "--db",
-            db,
-            "--vehicle",
-            "bus-1",
-            &more[0],
-            &more[1],
-            &more[2],
-        ],
+        &fleet_args("check", db, "bus-1", &[&more[0], &more[1], &more[2]]),
         &["drive 'all given records'", "vehicle 'bus-2'", "record_"],
     );
     assert_eq!(n_test(db, "bus-1"), 4);
     // Alone, it is checked (no drive).
-    ok(&[
-        "fleet",
-        "check",
-        "--db",
-        db,
-        "--vehicle",
-        "bus-1",
-        "-q",
-        &more[2],
-    ]);
+    ok(&fleet_args("check", db, "bus-1", &["-q", &more[2]]));
     assert_eq!(n_test(db, "bus-1"), 5);
 
     // A record with another channel layout (a sprung channel missing) in the drive.
@@ -201,19 +160,18 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
     let other = d.path().join("other_layout.csv");
     std::fs::write(&other, cut).unwrap();
     fails_with(
-        &[
-            "fleet",
+        &fleet_args(
             "check",
-            "--db",
             db,
-            "--vehicle",
             "bus-1",
-            "--drive",
-            "day-2",
-            &more[0],
-            other.to_str().unwrap(),
-            &more[1],
-        ],
+            &[
+                "--drive",
+                "day-2",
+                &more[0],
+                other.to_str().unwrap(),
+                &more[1],
+            ],
+        ),
         &[
             "other_layout.csv",
             "has channels",
@@ -448,19 +406,12 @@ fn a_file_given_twice_counts_once_in_its_drive() {
 
     // Three files, two contents: too few for a named drive; nothing stored.
     fails_with(
-        &[
-            "fleet",
+        &fleet_args(
             "check",
-            "--db",
             db,
-            "--vehicle",
             "bus-1",
-            "--drive",
-            "day-3",
-            &test[0],
-            &copy,
-            &test[1],
-        ],
+            &["--drive", "day-3", &test[0], &copy, &test[1]],
+        ),
         &[
             "drive 'day-3'",
             "2 record(s) of distinct content",

@@ -8,7 +8,9 @@ use crate::common;
 use std::path::Path;
 use std::process::Stdio;
 
-use common::{bin, fails_with, fleet_ingest, ok, simulate_csv, stderr, vibmode, wait_or_kill};
+use common::{
+    bin, fails_with, fleet_args, fleet_ingest, ok, simulate_csv, stderr, vibmode, wait_or_kill,
+};
 
 /// A CSV record's header and rows.
 fn read_csv(path: &str) -> (String, Vec<Vec<String>>) {
@@ -46,17 +48,7 @@ fn status(db: &str) -> String {
 }
 
 fn check_json(db: &str, file: &str) -> serde_json::Value {
-    let o = ok(&[
-        "fleet",
-        "check",
-        "--db",
-        db,
-        "--vehicle",
-        "bus-1",
-        "--json",
-        "-",
-        file,
-    ]);
+    let o = ok(&fleet_args("check", db, "bus-1", &["--json", "-", file]));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     v["records"][0].clone()
 }
@@ -76,34 +68,19 @@ fn store_is_safe_checks_are_all_or_nothing_and_failed_sensors_are_named() {
 
     // 1. The store given as the JSON output: refused before any work, the store unchanged.
     fails_with(
-        &[
-            "fleet",
-            "check",
-            "--db",
-            db,
-            "--vehicle",
-            "bus-1",
-            "--json",
-            db,
-            good,
-        ],
+        &fleet_args("check", db, "bus-1", &["--json", db, good]),
         &["fleet.db", "input"],
     );
     // Through a hard link too (same file, another name).
     let link = d.path().join("link.json");
     std::fs::hard_link(&db_path, &link).unwrap();
     fails_with(
-        &[
-            "fleet",
+        &fleet_args(
             "check",
-            "--db",
             db,
-            "--vehicle",
             "bus-1",
-            "--json",
-            link.to_str().unwrap(),
-            good,
-        ],
+            &["--json", link.to_str().unwrap(), good],
+        ),
         &["link.json", "input"],
     );
     std::fs::remove_file(&link).unwrap();
@@ -117,32 +94,14 @@ fn store_is_safe_checks_are_all_or_nothing_and_failed_sensors_are_named() {
     let missing = d.path().join("missing.csv");
     let missing = missing.to_str().unwrap();
     fails_with(
-        &[
-            "fleet",
-            "check",
-            "--db",
-            db,
-            "--vehicle",
-            "bus-1",
-            good,
-            missing,
-        ],
+        &fleet_args("check", db, "bus-1", &[good, missing]),
         &["missing.csv"],
     );
     let st = status(db);
     assert!(st.contains("6 nominal, 0 test records"), "{st}");
     // An ingest likewise, and it does not report the good file as stored.
     let e = fails_with(
-        &[
-            "fleet",
-            "ingest",
-            "--db",
-            db,
-            "--vehicle",
-            "bus-1",
-            good,
-            missing,
-        ],
+        &fleet_args("ingest", db, "bus-1", &[good, missing]),
         &["missing.csv"],
     );
     assert!(!e.contains("stored as"), "{e}");
@@ -213,7 +172,7 @@ fn store_is_safe_checks_are_all_or_nothing_and_failed_sensors_are_named() {
     assert_eq!(r["sensor_faults"][0]["channel"], "FL_unsprung", "{r}");
     assert_eq!(r["sensor_faults"][0]["fault"], "clipped", "{r}");
     // The terminal table names the channel too.
-    let o = ok(&["fleet", "check", "--db", db, "--vehicle", "bus-1", &dead]);
+    let o = ok(&fleet_args("check", db, "bus-1", &[&dead]));
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(out.contains("sensor") && out.contains("FR_sprung"), "{out}");
     // The healthy record itself is not a sensor fault.
@@ -233,7 +192,7 @@ fn store_is_safe_checks_are_all_or_nothing_and_failed_sensors_are_named() {
         .collect();
     let dead2 = write_csv(&d.path().join("dead2.csv"), &header, &dead2);
     fails_with(
-        &["fleet", "ingest", "--db", db, "--vehicle", "bus-1", &dead2],
+        &fleet_args("ingest", db, "bus-1", &[&dead2]),
         &["dead2.csv", "RL_sprung", "dead"],
     );
     assert_eq!(status(db), before);
@@ -241,13 +200,13 @@ fn store_is_safe_checks_are_all_or_nothing_and_failed_sensors_are_named() {
     // with the minimum, nothing stored.
     let short = write_csv(&d.path().join("short.csv"), &header, &rows[..300]);
     fails_with(
-        &["fleet", "check", "--db", db, "--vehicle", "bus-1", &short],
+        &fleet_args("check", db, "bus-1", &[&short]),
         &["short.csv", "1.5 s", "at least 8 s"],
     );
     let slow: Vec<Vec<String>> = rows.iter().step_by(10).cloned().collect();
     let slow = write_csv(&d.path().join("slow.csv"), &header, &slow);
     fails_with(
-        &["fleet", "check", "--db", db, "--vehicle", "bus-1", &slow],
+        &fleet_args("check", db, "bus-1", &[&slow]),
         &["slow.csv", "20 Hz", "at least 40 Hz"],
     );
     assert_eq!(status(db), before);
@@ -446,14 +405,11 @@ fn concurrent_ingests_and_inits_both_succeed() {
             .filter(|o| stderr(o).starts_with("created"))
             .count();
         assert_eq!(created, 1);
-        ok(&[
-            "fleet",
+        ok(&fleet_args(
             "ingest",
-            "--db",
             db.to_str().unwrap(),
-            "--vehicle",
             "v",
-            &files[0],
-        ]);
+            &[&files[0]],
+        ));
     }
 }

@@ -86,6 +86,18 @@ pub fn ok(args: &[&str]) -> Output {
     o
 }
 
+/// The arguments `fleet SUB --db DB --vehicle VEHICLE REST...`.
+pub fn fleet_args<'a>(
+    sub: &'a str,
+    db: &'a str,
+    vehicle: &'a str,
+    rest: &[&'a str],
+) -> Vec<&'a str> {
+    let mut args = vec!["fleet", sub, "--db", db, "--vehicle", vehicle];
+    args.extend_from_slice(rest);
+    args
+}
+
 /// `vibmode fleet ingest -q` of `files` as nominal records of `vehicle` into the store `db`
 /// (exit code 0, else the test fails with stderr).
 pub fn fleet_ingest<S: AsRef<str>>(db: &str, vehicle: &str, files: &[S]) -> Output {
