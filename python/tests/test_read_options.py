@@ -46,3 +46,28 @@ def test_time_unit_reads_a_timestamp_in_milliseconds(tmp_path):
     assert vibmode.read(p, time_unit="ms").fs == pytest.approx(100.0)
     with pytest.raises(ValueError, match="time_unit"):
         vibmode.read(p, time_unit="fortnights")
+
+
+@pytest.mark.parametrize("dtype", ["float64", "float32", "int16", "int32"])
+def test_wav_files_written_by_scipy_read_as_scipy_reads_them(tmp_path, dtype):
+    """scipy.io.wavfile.write keeps the array's dtype: numpy's default float64 gives a 64-bit
+    IEEE float WAV (which the hound crate refuses; vibmode reads its header itself). Every kind
+    reads back to scipy's own values, integers scaled to full scale 1 (docs/formats.md)."""
+    wavfile = pytest.importorskip("scipy.io.wavfile")
+    rng = np.random.default_rng(3)
+    x = rng.standard_normal((4000, 3)) * 0.2
+    if dtype.startswith("int"):
+        full = np.iinfo(dtype).max + 1
+        data = np.round(x * full).astype(dtype)
+    else:
+        full = 1
+        data = x.astype(dtype)
+    path = tmp_path / f"{dtype}.wav"
+    wavfile.write(path, 2000, data)
+    fs, back = wavfile.read(path)
+    rec = vibmode.read(path)
+    assert rec.fs == fs == 2000
+    assert rec.data.shape == (3, 4000)
+    np.testing.assert_array_equal(rec.data, back.T.astype(np.float64) / full)
+    scaled = vibmode.read(path, scale=19.62)
+    np.testing.assert_allclose(scaled.data, 19.62 * rec.data, rtol=1e-15)

@@ -48,6 +48,7 @@ pub mod resample;
 pub mod stream;
 pub mod stream_resample;
 pub mod stream_write;
+mod wav64;
 pub mod write;
 
 pub use delimited::{Block, ColumnInfo, DateOrder, DelimitedReader, Separator, TimeText};

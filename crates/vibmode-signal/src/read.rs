@@ -298,15 +298,7 @@ pub(crate) fn wav_layout(
     if nch == 0 {
         return Err(wav_err(WavProblem::NoChannels));
     }
-    if !(opts.scale.is_finite() && opts.scale != 0.0) {
-        return Err(SignalError::InvalidParam {
-            name: "scale",
-            value: opts.scale.to_string(),
-            fix:
-                "the WAV scale must be a finite non-zero number, e.g. 19.62 (m/s^2 per full scale)"
-                    .into(),
-        });
-    }
+    check_wav_scale(opts)?;
     match spec.sample_format {
         hound::SampleFormat::Float => {
             if spec.bits_per_sample != 32 {
@@ -324,6 +316,20 @@ pub(crate) fn wav_layout(
             Ok((nch, false, opts.scale / f64::powi(2.0, bits as i32 - 1)))
         }
     }
+}
+
+/// The scale option of a WAV: a finite non-zero number.
+pub(crate) fn check_wav_scale(opts: &ReadOptions) -> Result<()> {
+    if !(opts.scale.is_finite() && opts.scale != 0.0) {
+        return Err(SignalError::InvalidParam {
+            name: "scale",
+            value: opts.scale.to_string(),
+            fix:
+                "the WAV scale must be a finite non-zero number, e.g. 19.62 (m/s^2 per full scale)"
+                    .into(),
+        });
+    }
+    Ok(())
 }
 
 /// Reads delimited text from any buffered reader (the whole stream). `path` is used in messages.
@@ -537,15 +543,21 @@ fn read_wav(path: &Path, bytes: Option<&[u8]>, opts: &ReadOptions) -> Result<Rec
         })
     };
     match bytes {
-        Some(b) => {
-            let reader = hound::WavReader::new(std::io::Cursor::new(b)).map_err(unreadable)?;
-            let spec = reader.spec();
-            if spec.sample_format == hound::SampleFormat::Float && spec.bits_per_sample == 32 {
-                float_wav_from_bytes(path, reader, opts)
-            } else {
-                read_wav_from(path, reader, opts)
+        Some(b) => match hound::WavReader::new(std::io::Cursor::new(b)) {
+            Ok(reader) => {
+                let spec = reader.spec();
+                if spec.sample_format == hound::SampleFormat::Float && spec.bits_per_sample == 32 {
+                    float_wav_from_bytes(path, reader, opts)
+                } else {
+                    read_wav_from(path, reader, opts)
+                }
             }
-        }
+            // hound refuses 64-bit floats; anything else keeps hound's message.
+            Err(e) => match crate::wav64::float64_header(&mut std::io::Cursor::new(b)) {
+                Some(h) => float64_wav_from_bytes(path, &h, b, opts),
+                None => Err(unreadable(e)),
+            },
+        },
         None => {
             if !path.exists() {
                 return Err(io_err(
@@ -554,13 +566,53 @@ fn read_wav(path: &Path, bytes: Option<&[u8]>, opts: &ReadOptions) -> Result<Rec
                     &std::io::Error::from(std::io::ErrorKind::NotFound),
                 ));
             }
-            read_wav_from(
-                path,
-                hound::WavReader::open(path).map_err(unreadable)?,
-                opts,
-            )
+            match hound::WavReader::open(path) {
+                Ok(reader) => read_wav_from(path, reader, opts),
+                Err(e) => {
+                    let float64 = std::fs::File::open(path).ok().and_then(|f| {
+                        crate::wav64::float64_header(&mut std::io::BufReader::new(f))
+                    });
+                    match float64 {
+                        Some(h) => {
+                            let b = std::fs::read(path).map_err(|e| io_err("read", path, &e))?;
+                            float64_wav_from_bytes(path, &h, &b, opts)
+                        }
+                        None => Err(unreadable(e)),
+                    }
+                }
+            }
         }
     }
+}
+
+/// A 64-bit float WAV in memory (`h`: its header, [`crate::wav64`]): its data chunk decoded
+/// into the channels, `f64` values times `opts.scale`.
+fn float64_wav_from_bytes(
+    path: &Path,
+    h: &crate::wav64::Float64Wav,
+    bytes: &[u8],
+    opts: &ReadOptions,
+) -> Result<Recording> {
+    check_wav_scale(opts)?;
+    let nch = usize::from(h.channels);
+    let data = bytes.get(h.data_offset as usize..).unwrap_or(&[]);
+    let declared = h.frames() as usize;
+    if data.len() / (8 * nch) < declared {
+        return Err(wav_error(path)(WavProblem::Truncated {
+            message: format!(
+                "the data chunk declares {} samples, the file holds {}",
+                declared * nch,
+                data.len() / 8
+            ),
+        }));
+    }
+    let samples = crate::stream::deinterleave(
+        &data[..8 * nch * declared],
+        nch,
+        opts.scale,
+        f64::from_le_bytes,
+    );
+    wav_recording(path, h.sample_rate, opts, samples)
 }
 
 /// The error of a WAV file at `path`.
@@ -594,14 +646,8 @@ fn float_wav_from_bytes(
         }));
     }
     let n = declared / nch;
-    let mut samples: Vec<Vec<f64>> = (0..nch).map(|_| Vec::with_capacity(n)).collect();
-    for frame in data[..4 * nch * n].chunks_exact(4 * nch) {
-        for (ch, v) in samples.iter_mut().zip(frame.chunks_exact(4)) {
-            let v = f32::from_le_bytes([v[0], v[1], v[2], v[3]]);
-            ch.push(v as f64 * k);
-        }
-    }
-    wav_recording(path, &spec, opts, samples)
+    let samples = crate::stream::deinterleave(&data[..4 * nch * n], nch, k, crate::stream::f32_le);
+    wav_recording(path, spec.sample_rate, opts, samples)
 }
 
 fn read_wav_from<R: std::io::Read>(
@@ -642,14 +688,14 @@ fn read_wav_from<R: std::io::Read>(
                 .collect()
         })
         .collect();
-    wav_recording(path, &spec, opts, samples)
+    wav_recording(path, spec.sample_rate, opts, samples)
 }
 
 /// The recording of a WAV's decoded channels: refused without samples; its rate checked
 /// against `opts.fs_hz`, names and units from its sidecar, every sample finite.
 fn wav_recording(
     path: &Path,
-    spec: &hound::WavSpec,
+    sample_rate: u32,
     opts: &ReadOptions,
     samples: Vec<Vec<f64>>,
 ) -> Result<Recording> {
@@ -659,7 +705,7 @@ fn wav_recording(
     let fs = reconcile_fs(
         &path.display().to_string(),
         "the WAV header".into(),
-        spec.sample_rate as f64,
+        f64::from(sample_rate),
         opts.fs_hz,
     )?;
     let (names, units) = wav_names(path, samples.len())?;
@@ -973,5 +1019,80 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A 64-bit float WAV (which hound refuses) is read whole, from its bytes and from its path,
+    /// and streamed block by block, to the values written times the scale; one cut off in its
+    /// data chunk, a NaN sample and an absurd scale are one-line errors.
+    #[test]
+    fn a_64_bit_float_wav_is_read_and_streamed_as_written() {
+        use crate::wav64::tests::{fmt_chunk, wav_bytes};
+        let dir = tempfile::tempdir().unwrap();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(64);
+        let (nch, frames) = (3usize, 1000usize);
+        let values: Vec<f64> = (0..nch * frames)
+            .map(|_| rng.gen_range(-50.0..50.0))
+            .collect();
+        let bytes = wav_bytes(&fmt_chunk(3, nch as u16, 2000, 64), &values, true);
+        let path = dir.path().join("f64.wav");
+        std::fs::write(&path, &bytes).unwrap();
+        let opts = ReadOptions {
+            scale: 2.0,
+            ..ReadOptions::default()
+        };
+        let expect = |c: usize, k: usize| 2.0 * values[k * nch + c];
+        for rec in [
+            read_path(&path, &opts).unwrap(),
+            read_path_bytes(&path, &bytes, &opts).unwrap(),
+        ] {
+            assert_eq!((rec.fs_hz, rec.n_channels()), (2000.0, nch));
+            for (c, ch) in rec.channels.iter().enumerate() {
+                assert_eq!(ch.samples.len(), frames);
+                assert!((0..frames).all(|k| ch.samples[k] == expect(c, k)));
+            }
+        }
+        let mut stream = crate::open_stream(&path, &opts).unwrap();
+        assert_eq!(stream.info().n_frames, Some(frames as u64));
+        let mut got = vec![Vec::new(); nch];
+        while let Some(block) = stream.next_block(300).unwrap() {
+            for (g, ch) in got.iter_mut().zip(block.channels) {
+                g.extend(ch);
+            }
+        }
+        for (c, g) in got.iter().enumerate() {
+            assert!(g.len() == frames && (0..frames).all(|k| g[k] == expect(c, k)));
+        }
+
+        // Cut off in the data chunk: the whole reader and the stream say so.
+        let cut = dir.path().join("cut.wav");
+        std::fs::write(&cut, &bytes[..bytes.len() - 100]).unwrap();
+        let e = read_path(&cut, &opts).unwrap_err().to_string();
+        assert!(
+            e.contains("declares 3000 samples, the file holds 2987"),
+            "{e}"
+        );
+        let mut s = crate::open_stream(&cut, &opts).unwrap();
+        let e = loop {
+            match s.next_block(300) {
+                Ok(Some(_)) => {}
+                Ok(None) => panic!("a cut-off file streamed to its end"),
+                Err(e) => break e.to_string(),
+            }
+        };
+        assert!(e.contains("995") && e.contains("1000"), "{e}");
+
+        let mut bad = values.clone();
+        bad[5] = f64::NAN;
+        let nan = dir.path().join("nan.wav");
+        std::fs::write(&nan, wav_bytes(&fmt_chunk(3, 3, 2000, 64), &bad, false)).unwrap();
+        let e = read_path(&nan, &opts).unwrap_err().to_string();
+        assert!(e.contains("NaN") || e.contains("not finite"), "{e}");
+        let zero = ReadOptions {
+            scale: 0.0,
+            ..ReadOptions::default()
+        };
+        let e = read_path(&path, &zero).unwrap_err().to_string();
+        assert!(e.contains("scale"), "{e}");
+        assert!(crate::open_stream(&path, &zero).is_err());
     }
 }

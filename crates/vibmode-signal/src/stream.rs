@@ -7,8 +7,8 @@
 //!
 //! - **raw**: the sidecar is read first; the file size must be a whole number of frames (a file
 //!   cut off mid-write is refused before any sample is used, [`SignalError::PartialFrame`]);
-//! - **WAV**: a 32-bit float or 16-bit integer file is read from its data chunk in blocks of
-//!   bytes, other integer widths through hound's sample iterator; a file cut off mid-write (its
+//! - **WAV**: a 64- or 32-bit float or 16-bit integer file is read from its data chunk in
+//!   blocks of bytes, other integer widths through hound's sample iterator; a file cut off mid-write (its
 //!   header announces more samples than it holds) fails with a message saying so;
 //! - **delimited text**: parsed by [`crate::DelimitedReader`] block by block. With a time column
 //!   a first pass over the time column gives the rate `(n - 1) / (t_last - t_first)`, the jitter
@@ -26,7 +26,7 @@ use crate::error::{io_err, Result, SignalError, WavProblem};
 use crate::read::{raw_layout, reconcile_fs, wav_names, Format, ReadOptions};
 use std::collections::VecDeque;
 use std::fs::File;
-use std::io::{BufReader, Read};
+use std::io::{BufReader, Read, Seek};
 use std::path::Path;
 use vibmode_core::{Channel, ChannelSelector, Recording, RecordingError};
 
@@ -124,11 +124,11 @@ enum Inner {
         scale: f64,
         remaining: u64,
     },
-    /// A 32-bit float or 16-bit integer WAV read from its data chunk in blocks of bytes
+    /// A 64- or 32-bit float or 16-bit integer WAV read from its data chunk in blocks of bytes
     /// (hound's sample iterator costs ~30 ns a sample; the same values, `v as f64 * scale`).
     WavBytes {
         data: BufReader<File>,
-        /// Bytes a sample: 4 (32-bit float) or 2 (16-bit integer).
+        /// Bytes a sample: 8 (64-bit float), 4 (32-bit float) or 2 (16-bit integer).
         width: usize,
         scale: f64,
         remaining: u64,
@@ -175,7 +175,7 @@ fn block_bytes(
 
 /// Interleaved little-endian samples of `W` bytes (`nch` a frame, decoded by `decode`) as
 /// channels, each value times `scale`.
-fn deinterleave<const W: usize>(
+pub(crate) fn deinterleave<const W: usize>(
     buf: &[u8],
     nch: usize,
     scale: f64,
@@ -194,7 +194,7 @@ fn deinterleave<const W: usize>(
 }
 
 /// Little-endian 32-bit floats as f64.
-fn f32_le(b: [u8; 4]) -> f64 {
+pub(crate) fn f32_le(b: [u8; 4]) -> f64 {
     f32::from_le_bytes(b) as f64
 }
 
@@ -332,12 +332,19 @@ fn open_wav(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
         problem,
     };
     let file = open_file(path)?;
-    let mut reader =
-        hound::WavReader::new(BufReader::with_capacity(1 << 20, file)).map_err(|e| {
-            wav_err(WavProblem::Unreadable {
-                message: e.to_string(),
-            })
-        })?;
+    let mut reader = match hound::WavReader::new(BufReader::with_capacity(1 << 20, file)) {
+        Ok(reader) => reader,
+        Err(e) => {
+            // hound refuses 64-bit floats; anything else keeps hound's message.
+            let mut data = BufReader::with_capacity(1 << 20, open_file(path)?);
+            return match crate::wav64::float64_header(&mut data) {
+                Some(h) => open_float64_wav(path, opts, &h, data),
+                None => Err(wav_err(WavProblem::Unreadable {
+                    message: e.to_string(),
+                })),
+            };
+        }
+    };
     let spec = reader.spec();
     let (nch, float, scale) = crate::read::wav_layout(&spec, opts, &wav_err)?;
     let n = u64::from(reader.duration());
@@ -396,6 +403,57 @@ fn open_wav(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
         })?)
     };
     Ok(stream(info, inner))
+}
+
+/// The stream of a 64-bit float WAV (`h`: its header, [`crate::wav64`]), read from its data
+/// chunk in blocks of bytes.
+fn open_float64_wav(
+    path: &Path,
+    opts: &ReadOptions,
+    h: &crate::wav64::Float64Wav,
+    mut data: BufReader<File>,
+) -> Result<FrameStream> {
+    let p = path.display().to_string();
+    let wav_err = |problem: WavProblem| SignalError::Wav {
+        path: p.clone(),
+        problem,
+    };
+    crate::read::check_wav_scale(opts)?;
+    let n = h.frames();
+    if n == 0 {
+        return Err(wav_err(WavProblem::NoSamples));
+    }
+    data.seek(std::io::SeekFrom::Start(h.data_offset))
+        .map_err(|e| io_err("read", path, &e))?;
+    let fs = reconcile_fs(
+        &p,
+        "the WAV header".into(),
+        f64::from(h.sample_rate),
+        opts.fs_hz,
+    )?;
+    let (names, units) = wav_names(path, usize::from(h.channels))?;
+    let mut side = path.as_os_str().to_owned();
+    side.push(".json");
+    let info = StreamInfo {
+        path: p.clone(),
+        format: Format::Wav,
+        fs_hz: fs,
+        names,
+        units,
+        n_frames: Some(n),
+        start_s: 0.0,
+        start_time: sidecar_start_time(Path::new(&side)),
+    };
+    Ok(stream(
+        info,
+        Inner::WavBytes {
+            data,
+            width: 8,
+            scale: opts.scale,
+            remaining: n,
+            buf: Vec::new(),
+        },
+    ))
 }
 
 /// Whether hound reads the first sample of an integer WAV; it then seeks back to the start of
@@ -741,10 +799,10 @@ impl FrameStream {
                     });
                 }
                 *remaining -= n as u64;
-                if *width == 4 {
-                    deinterleave(buf, nch, *scale, f32_le)
-                } else {
-                    deinterleave(buf, nch, *scale, i16_le)
+                match *width {
+                    8 => deinterleave(buf, nch, *scale, f64::from_le_bytes),
+                    4 => deinterleave(buf, nch, *scale, f32_le),
+                    _ => deinterleave(buf, nch, *scale, i16_le),
                 }
             }
             Inner::Wav {
