@@ -113,7 +113,8 @@ pub struct CheckArgs {
     /// The given records are one drive with this id (at least 3 records), classified from the
     /// medians of their features; without it, records whose time column holds date-times form
     /// one drive per UTC day (named `YYYY-MM-DD`, 3 records or more), and other records, 3 or
-    /// more, the drive `all given records` (docs/fleet.md, "Drives").
+    /// more, one drive named by the folder they lie in (`all given records` when they lie in
+    /// several or none; docs/fleet.md, "Drives").
     #[arg(long)]
     pub drive: Option<String>,
     #[command(flatten)]

@@ -115,8 +115,8 @@ def check(
     stuck, clipped or held channel listed in ``sensor_faults``; scores, evidence). ``drive`` names the
     files as one drive (at least 3), classified from the medians of their features; without it
     files whose time column holds date-times form one drive per UTC day (``YYYY-MM-DD``, 3 files
-    or more), and other files, 3 or more, the drive ``all given records`` (docs/fleet.md,
-    "Drives"). With a
+    or more), and other files, 3 or more, one drive named by the folder they lie in (``all given
+    records`` when they lie in several or none; docs/fleet.md, "Drives"). With a
     registered model file (:func:`register`) a drive also has ``suspension``: the springs and
     dampers fitted to its records and every corner's score against the baseline's fit. All or
     nothing: an error in any file stores no record and no check."""

@@ -79,13 +79,14 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
         vec![("2026-11-25".to_string(), "normal".to_string(), 4)]
     );
 
-    // Without --drive: 3 or more records are the drive "all given records"; fewer, no drive.
+    // Without --drive: 3 or more records are a drive named by their folder; fewer, no drive.
+    let folder = d.path().join("test").to_string_lossy().to_string();
     let v = check_json(db, None, &test[..3]);
-    assert_eq!(v["drives"][0]["drive"], "all given records", "{v}");
+    assert_eq!(v["drives"][0]["drive"], folder.as_str(), "{v}");
     let v = check_json(db, None, &test[..1]);
     assert_eq!(v["drives"].as_array().unwrap().len(), 0, "{v}");
     assert_eq!(drives().len(), 2);
-    assert_eq!(drives()[1].0, "all given records");
+    assert_eq!(drives()[1].0, folder);
 
     // The status leads with each vehicle's latest drive verdict and since when (the first
     // drive of the latest run of equal verdicts: both drives are normal).
@@ -95,7 +96,7 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
         .unwrap();
     let v1 = st.iter().find(|v| v.vehicle == "bus-1").unwrap();
     let latest = v1.latest_drive.as_ref().unwrap();
-    assert_eq!(latest.drive, "all given records");
+    assert_eq!(latest.drive, folder);
     assert_eq!(latest.classification.to_string(), "normal");
     assert_eq!(latest.n_records, 3);
     assert_eq!(v1.drives.len(), 2);
@@ -137,10 +138,18 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
         &["drive 'day-2'", "vehicle 'bus-2'", "record_"],
     );
     assert_eq!(n_test(db, "bus-1"), 4);
-    // The same without a drive id: the three records are the drive `all given records`.
+    // The same without a drive id: the three records are the drive of their folder.
+    let folder = d.path().join("more").to_string_lossy().to_string();
     fails_with(
         &fleet_args("check", db, "bus-1", &[&more[0], &more[1], &more[2]]),
-        &["drive 'all given records'", "vehicle 'bus-2'", "record_"],
+        &[&format!("drive '{folder}'"), "vehicle 'bus-2'", "record_"],
+    );
+    // Given from two folders, they are `all given records`.
+    let elsewhere = d.path().join("elsewhere.csv").to_string_lossy().to_string();
+    std::fs::copy(&more[2], &elsewhere).unwrap();
+    fails_with(
+        &fleet_args("check", db, "bus-1", &[&more[0], &more[1], &elsewhere]),
+        &["drive 'all given records'", "vehicle 'bus-2'", "elsewhere.csv"],
     );
     assert_eq!(n_test(db, "bus-1"), 4);
     // Alone, it is checked (no drive).
@@ -206,8 +215,8 @@ fn dated(path: &str, day: &str, hh: u32, mm: u32) -> String {
 
 /// Without `--drive`, records whose time column holds date-times are grouped by their UTC day:
 /// one drive per day with 3 records or more (named by the date), a day with fewer checked
-/// record by record only; where a record's start is unknown, all are the one drive `all given
-/// records`.
+/// record by record only; where a record's start is unknown, all are one drive, named by the
+/// folder they lie in.
 #[test]
 fn records_with_dates_form_one_drive_per_day() {
     let d = tempfile::tempdir().unwrap();
@@ -317,13 +326,18 @@ fn records_with_dates_form_one_drive_per_day() {
     let v = check_json(db, None, &mixed);
     let drives = v["drives"].as_array().unwrap();
     assert_eq!(drives.len(), 1, "{v}");
-    assert_eq!(drives[0]["drive"], "all given records");
+    let folder = d.path().join("test").to_string_lossy().to_string();
+    assert_eq!(
+        drives[0]["drive"],
+        folder.as_str(),
+        "named by the records' folder"
+    );
     assert_eq!(drives[0]["records"].as_array().unwrap().len(), 4);
     // That drive has no time of its own: it is placed by when it was checked (now, after the
     // dated ones), and shows that time.
     let v1 = status();
     let latest = v1.latest_drive.as_ref().unwrap();
-    assert_eq!(latest.drive, "all given records");
+    assert_eq!(latest.drive, folder);
     assert_eq!(latest.driven, None);
     assert_eq!(latest.when(), format!("checked {}", latest.checked));
     assert_eq!(v1.drives.len(), 4);

@@ -807,8 +807,28 @@ fn prepare_test_files(
     )
 }
 
-/// The id of a drive when none is given.
+/// The id of a drive when none is given, the records' starts are not known and the records
+/// lie in different folders (or in the current one): see [`drive_of_folder`].
 pub const DEFAULT_DRIVE_ID: &str = "all given records";
+
+/// The id of a drive of records whose starts are not known: the folder all of them lie in, as
+/// given (`bus17/2026-11-26` for `bus17/2026-11-26/rec01.csv ...`: a day's records are
+/// commonly kept in a folder of their own), else [`DEFAULT_DRIVE_ID`] (records of several
+/// folders, or given without one).
+pub fn drive_of_folder<S: AsRef<str>>(files: &[S]) -> String {
+    let folder = |f: &S| {
+        Path::new(f.as_ref())
+            .parent()
+            .map(|p| p.display().to_string())
+    };
+    let first = files.first().and_then(folder);
+    match first {
+        Some(dir) if !dir.is_empty() && files.iter().all(|f| folder(f).as_ref() == Some(&dir)) => {
+            dir
+        }
+        _ => DEFAULT_DRIVE_ID.to_string(),
+    }
+}
 
 /// The drive (its id, `YYYY-MM-DD`) of a record that started at this Unix time (s): its day
 /// in UTC. `None` outside the years chrono can represent.
@@ -820,8 +840,9 @@ pub fn drive_of_day(start_unix_s: f64) -> Option<String> {
 /// The drives of records checked without a drive id, as (id, indices of the records): where
 /// every record's start is known (a time column of date-times), one drive per UTC day with at
 /// least [`MIN_DRIVE_RECORDS`] records (the records of a day with fewer are checked one by one
-/// only); else all the records as the drive [`DEFAULT_DRIVE_ID`] when there are that many.
-fn drives_of_records(starts: &[Option<f64>]) -> Vec<(String, Vec<usize>)> {
+/// only); else all the records as one drive, named by [`drive_of_folder`] of `files`, when
+/// there are that many.
+fn drives_of_records(starts: &[Option<f64>], files: &[&str]) -> Vec<(String, Vec<usize>)> {
     let days: Option<Vec<String>> = starts.iter().map(|s| s.and_then(drive_of_day)).collect();
     match days {
         Some(days) if !days.is_empty() => {
@@ -837,7 +858,7 @@ fn drives_of_records(starts: &[Option<f64>]) -> Vec<(String, Vec<usize>)> {
             out
         }
         _ if starts.len() >= MIN_DRIVE_RECORDS => {
-            vec![(DEFAULT_DRIVE_ID.to_string(), (0..starts.len()).collect())]
+            vec![(drive_of_folder(files), (0..starts.len()).collect())]
         }
         _ => Vec::new(),
     }
@@ -847,8 +868,8 @@ fn drives_of_records(starts: &[Option<f64>]) -> Vec<(String, Vec<usize>)> {
 /// given, all of them are that one drive, and at least [`MIN_DRIVE_RECORDS`] files are needed
 /// (else an error before anything is read or stored; files of the same content count once, a
 /// repeat is left out of every drive); without it, one drive per day where
-/// every record's start is known, else the drive [`DEFAULT_DRIVE_ID`]
-/// ([`drives_of_records`]). Every record must have the baseline's channels (one layout per
+/// every record's start is known, else one drive named by their folder ([`drive_of_folder`];
+/// [`drives_of_records`]). Every record must have the baseline's channels (one layout per
 /// drive), and no record of a drive may be one stored for another vehicle (one vehicle per
 /// drive); else an error, and nothing is stored. The drives come sorted by id.
 pub fn check_drive_files_progress(
@@ -888,7 +909,11 @@ pub fn check_drive_files_progress(
                 .iter()
                 .map(|&i| prepared[i].features.start_unix_s)
                 .collect();
-            drives_of_records(&starts)
+            let files: Vec<&str> = distinct
+                .iter()
+                .map(|&i| prepared[i].file.as_str())
+                .collect();
+            drives_of_records(&starts, &files)
                 .into_iter()
                 .map(|(id, members)| (id, members.into_iter().map(|k| distinct[k]).collect()))
                 .collect()
@@ -1069,8 +1094,9 @@ mod tests {
             day(1.0, 0.1),
             day(0.0, 0.0),
         ];
+        let files = ["d/r1.csv"; 7];
         assert_eq!(
-            drives_of_records(&starts),
+            drives_of_records(&starts, &files),
             vec![
                 (id("2026-11-27"), vec![1, 4, 6]),
                 (id("2026-11-28"), vec![0, 2, 5])
@@ -1080,11 +1106,32 @@ mod tests {
         let mut some = starts.to_vec();
         some[3] = None;
         assert_eq!(
-            drives_of_records(&some),
-            vec![(id(DEFAULT_DRIVE_ID), (0..7).collect())]
+            drives_of_records(&some, &files),
+            vec![(id("d"), (0..7).collect())]
         );
-        assert_eq!(drives_of_records(&[None, None]), vec![]);
-        assert_eq!(drives_of_records(&[day(0.0, 1.0), day(0.0, 2.0)]), vec![]);
-        assert_eq!(drives_of_records(&[]), vec![]);
+        assert_eq!(drives_of_records(&[None, None], &files[..2]), vec![]);
+        assert_eq!(
+            drives_of_records(&[day(0.0, 1.0), day(0.0, 2.0)], &files[..2]),
+            vec![]
+        );
+        assert_eq!(drives_of_records(&[], &[]), vec![]);
+    }
+
+    /// A drive of records of unknown start is named by the one folder they lie in, as given.
+    #[test]
+    fn a_drive_without_dates_is_named_by_its_folder() {
+        assert_eq!(drive_of_folder(&["a/b/r1.csv", "a/b/r2.csv"]), "a/b");
+        assert_eq!(
+            drive_of_folder(&["/data/2026-11-26/r.wav"]),
+            "/data/2026-11-26"
+        );
+        for other in [
+            &["a/r1.csv", "b/r2.csv"][..],
+            &["r1.csv", "r2.csv"],
+            &["a/r1.csv", "r2.csv"],
+            &[],
+        ] {
+            assert_eq!(drive_of_folder(other), DEFAULT_DRIVE_ID, "{other:?}");
+        }
     }
 }

@@ -31,8 +31,8 @@ pub use features::{
 };
 pub use fleet::{
     add_body_equations, build_baseline, check_drive_files_progress, check_file, check_files,
-    check_files_progress, check_recording, check_vehicle_id, drive_of_day, ingest_file,
-    ingest_files, ingest_files_progress, ingest_recording, record_file_name,
+    check_files_progress, check_recording, check_vehicle_id, drive_of_day, drive_of_folder,
+    ingest_file, ingest_files, ingest_files_progress, ingest_recording, record_file_name,
     register_vehicle_model, register_vehicle_model_file, registered_model, require_baseline,
     sha256_hex, Checked, IngestLabels, Ingested, Registered, DEFAULT_DRIVE_ID,
 };

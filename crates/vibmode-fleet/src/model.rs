@@ -1506,7 +1506,7 @@ fn summary(evidence: &[Evidence]) -> String {
 /// The verdict on a drive: records of one vehicle checked together ([`assess_drive`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Drive {
-    /// The drive id (`--drive ID`, else `all given records`).
+    /// The drive id (`--drive ID`, else the day, else the records' folder or `all given records`).
     pub drive: String,
     /// The model-set version it was scored against.
     pub model_version: i64,
