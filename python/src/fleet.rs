@@ -148,7 +148,7 @@ fn fleet_model(py: Python<'_>, db: PathBuf, vehicle: &str) -> PyResult<Option<St
 
 /// Builds the vehicle's nominal model set; JSON of the `ModelSet`.
 #[pyfunction]
-fn fleet_baseline(py: Python<'_>, db: PathBuf, vehicle: &str) -> PyResult<String> {
+fn fleet_baseline(py: Python<'_>, db: PathBuf, vehicle: &str) -> PyResult<(String, String)> {
     let set = py
         .detach(|| {
             let mut store = Store::open(&db)?;
@@ -156,7 +156,8 @@ fn fleet_baseline(py: Python<'_>, db: PathBuf, vehicle: &str) -> PyResult<String
             build_baseline(&mut store, vehicle, &cfg)
         })
         .map_err(fleet_err)?;
-    serde_json::to_string(&set).map_err(json_err)
+    let text = vibmode_fleet::text::baseline_text(&set);
+    Ok((serde_json::to_string(&set).map_err(json_err)?, text))
 }
 
 #[derive(Serialize)]
@@ -167,7 +168,8 @@ struct CheckOut {
     drives: Vec<vibmode_fleet::Drive>,
 }
 
-/// Checks files against the vehicle's latest model set; JSON as `vibmode fleet check --json`.
+/// Checks files against the vehicle's latest model set; JSON as `vibmode fleet check --json`,
+/// and the table `vibmode fleet check` prints.
 #[pyfunction]
 #[pyo3(signature = (db, vehicle, files, fs=None, scale=1.0, unit=None, allow_nonuniform=false, time_unit=None, drive=None))]
 #[allow(clippy::too_many_arguments)]
@@ -182,7 +184,7 @@ fn fleet_check(
     allow_nonuniform: bool,
     time_unit: Option<&str>,
     drive: Option<&str>,
-) -> PyResult<String> {
+) -> PyResult<(String, String)> {
     let opts = read_options(fs, scale, unit, allow_nonuniform, time_unit)?;
     let out = py
         .detach(|| {
@@ -202,17 +204,21 @@ fn fleet_check(
             })
         })
         .map_err(fleet_err)?;
-    serde_json::to_string(&out).map_err(json_err)
+    let text =
+        vibmode_fleet::text::check_text(&out.vehicle, out.model_version, &out.records, &out.drives);
+    Ok((serde_json::to_string(&out).map_err(json_err)?, text))
 }
 
-/// Status of every vehicle (its last `last` records); JSON list of `VehicleStatus`.
+/// Status of every vehicle (its last `last` records); JSON list of `VehicleStatus` and the
+/// text `vibmode fleet status` prints.
 #[pyfunction]
 #[pyo3(signature = (db, last=10))]
-fn fleet_status(py: Python<'_>, db: PathBuf, last: usize) -> PyResult<String> {
+fn fleet_status(py: Python<'_>, db: PathBuf, last: usize) -> PyResult<(String, String)> {
     let out = py
         .detach(|| Store::open(&db)?.status(last))
         .map_err(fleet_err)?;
-    serde_json::to_string(&out).map_err(json_err)
+    let text = vibmode_fleet::text::status_text(&out);
+    Ok((serde_json::to_string(&out).map_err(json_err)?, text))
 }
 
 /// A record's fleet features, computed away from the store (e.g. on a Dask worker).

@@ -61,3 +61,38 @@ def test_python_and_cli_give_the_same_results_json(tmp_path):
     assert diffs == [], "\n".join(diffs[:20])
     # Something was found, so the comparison compared results, not two empty lists.
     assert any(m["class"] == "structural" for role in cli["roles"] for m in role["invariant_modes"])
+
+
+def test_fleet_check_and_status_print_as_the_cli(tmp_path):
+    """`print(vibmode.fleet.check(...))` shows the table `vibmode fleet check` prints (the same
+    library text, `vibmode_fleet::text`), and the result stays the JSON dict; the same for the
+    baseline and the status. Two copies of one store, checked once by each."""
+    exe = binary()
+    if exe is None:
+        pytest.skip("no vibmode binary (set VIBMODE_BIN or run cargo build first)")
+    vibmode.simulate("city_bus", records=6, fs=200.0, effects="none", seed=21, out_dir=tmp_path / "nominal")
+    vibmode.simulate("city_bus", records=3, fs=200.0, effects="none", seed=41, out_dir=tmp_path / "today")
+    nominal = sorted(str(p) for p in (tmp_path / "nominal").glob("record_*.wav"))
+    today = sorted(str(p) for p in (tmp_path / "today").glob("record_*.wav"))
+    db = tmp_path / "a.db"
+    vibmode.fleet.init(db)
+    vibmode.fleet.ingest(db, "bus-1", nominal)
+    set_ = vibmode.fleet.baseline(db, "bus-1")
+    assert set_["vehicle"] == "bus-1" and str(set_).startswith("vehicle bus-1: model set version 1")
+    copy = tmp_path / "b.db"
+    copy.write_bytes(db.read_bytes())
+
+    py = vibmode.fleet.check(db, "bus-1", today)
+    cli = subprocess.run([str(exe), "fleet", "check", "--db", str(copy), "--vehicle", "bus-1", *today],
+                         check=True, capture_output=True, text=True)
+    assert str(py) == cli.stdout
+    assert py["drives"][0]["drive"] == str(tmp_path / "today")
+    assert str(tmp_path / "today") in str(py)
+    assert json.loads(json.dumps(py)) == dict(py)
+
+    st = vibmode.fleet.status(db)
+    assert str(st).startswith("vehicle          latest drive verdict")
+    assert st[0]["vehicle"] == "bus-1" and "bus-1" in str(st).splitlines()[1]
+    cli = subprocess.run([str(exe), "fleet", "status", "--db", str(db)], check=True, capture_output=True,
+                         text=True)
+    assert str(st) == cli.stdout

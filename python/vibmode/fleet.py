@@ -93,8 +93,11 @@ def model(db: PathLike, vehicle: str) -> Optional[str]:
 
 
 def baseline(db: PathLike, vehicle: str) -> Dict[str, Any]:
-    """Builds the vehicle's nominal model set from its nominal records (at least 5); returns it."""
-    return json.loads(_native.fleet_baseline(os.fspath(db), vehicle))
+    """Builds the vehicle's nominal model set from its nominal records (at least 5); returns it
+    (a dict, a :class:`FleetResult`: ``print(result)`` shows what ``vibmode fleet baseline``
+    prints, the limits per feature kind, also in ``result.text``)."""
+    data, text = _native.fleet_baseline(os.fspath(db), vehicle)
+    return FleetResult(json.loads(data), text)
 
 
 def check(
@@ -119,18 +122,47 @@ def check(
     records`` when they lie in several or none; docs/fleet.md, "Drives"). With a
     registered model file (:func:`register`) a drive also has ``suspension``: the springs and
     dampers fitted to its records and every corner's score against the baseline's fit. All or
-    nothing: an error in any file stores no record and no check."""
-    return json.loads(
-        _native.fleet_check(
-            os.fspath(db), vehicle, _paths(files), fs, float(scale), unit, bool(allow_nonuniform), time_unit,
-            drive,
-        )
+    nothing: an error in any file stores no record and no check.
+
+    The result is a dict (a :class:`FleetResult`); ``print(result)`` shows the table
+    ``vibmode fleet check`` prints, also in ``result.text``."""
+    data, text = _native.fleet_check(
+        os.fspath(db), vehicle, _paths(files), fs, float(scale), unit, bool(allow_nonuniform), time_unit,
+        drive,
     )
+    return FleetResult(json.loads(data), text)
 
 
 def status(db: PathLike, last: int = 10) -> List[Dict[str, Any]]:
-    """Status of every vehicle in the store, with its last ``last`` records."""
-    return json.loads(_native.fleet_status(os.fspath(db), int(last)))
+    """Status of every vehicle in the store, with its last ``last`` records: a list of dicts (a
+    :class:`FleetList`); ``print(result)`` shows what ``vibmode fleet status`` prints (one
+    row per vehicle with its latest drive verdict first), also in ``result.text``."""
+    data, text = _native.fleet_status(os.fspath(db), int(last))
+    return FleetList(json.loads(data), text)
+
+
+class FleetResult(dict):
+    """The result of :func:`check` or :func:`baseline`: the command's JSON as a dict, printed as
+    the command prints it (``text``)."""
+
+    def __init__(self, data: Dict[str, Any], text: str) -> None:
+        super().__init__(data)
+        self.text = text
+
+    def __str__(self) -> str:
+        return self.text
+
+
+class FleetList(list):
+    """The result of :func:`status`: one dict per vehicle, printed as ``vibmode fleet status``
+    prints it (``text``)."""
+
+    def __init__(self, data: List[Dict[str, Any]], text: str) -> None:
+        super().__init__(data)
+        self.text = text
+
+    def __str__(self) -> str:
+        return self.text
 
 
 def features(
