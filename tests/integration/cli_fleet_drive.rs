@@ -149,7 +149,11 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
     std::fs::copy(&more[2], &elsewhere).unwrap();
     fails_with(
         &fleet_args("check", db, "bus-1", &[&more[0], &more[1], &elsewhere]),
-        &["drive 'all given records'", "vehicle 'bus-2'", "elsewhere.csv"],
+        &[
+            "drive 'all given records'",
+            "vehicle 'bus-2'",
+            "elsewhere.csv",
+        ],
     );
     assert_eq!(n_test(db, "bus-1"), 4);
     // Alone, it is checked (no drive).

@@ -351,25 +351,7 @@ fn open_wav(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
     if n == 0 {
         return Err(wav_err(WavProblem::NoSamples));
     }
-    let fs = reconcile_fs(
-        &p,
-        "the WAV header".into(),
-        spec.sample_rate as f64,
-        opts.fs_hz,
-    )?;
-    let (names, units) = wav_names(path, nch)?;
-    let mut side = path.as_os_str().to_owned();
-    side.push(".json");
-    let info = StreamInfo {
-        path: p,
-        format: Format::Wav,
-        fs_hz: fs,
-        names,
-        units,
-        n_frames: Some(n),
-        start_s: 0.0,
-        start_time: sidecar_start_time(Path::new(&side)),
-    };
+    let info = wav_info(path, spec.sample_rate, nch, n, opts)?;
     let bytes = |data, width| Inner::WavBytes {
         data,
         width,
@@ -405,6 +387,37 @@ fn open_wav(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
     Ok(stream(info, inner))
 }
 
+/// What a WAV stream of `n` frames of `nch` channels at the header's `sample_rate` (Hz) is: the
+/// rate checked against `opts.fs_hz`, names and units and the start time from its sidecar.
+fn wav_info(
+    path: &Path,
+    sample_rate: u32,
+    nch: usize,
+    n: u64,
+    opts: &ReadOptions,
+) -> Result<StreamInfo> {
+    let p = path.display().to_string();
+    let fs = reconcile_fs(
+        &p,
+        "the WAV header".into(),
+        f64::from(sample_rate),
+        opts.fs_hz,
+    )?;
+    let (names, units) = wav_names(path, nch)?;
+    let mut side = path.as_os_str().to_owned();
+    side.push(".json");
+    Ok(StreamInfo {
+        path: p,
+        format: Format::Wav,
+        fs_hz: fs,
+        names,
+        units,
+        n_frames: Some(n),
+        start_s: 0.0,
+        start_time: sidecar_start_time(Path::new(&side)),
+    })
+}
+
 /// The stream of a 64-bit float WAV (`h`: its header, [`crate::wav64`]), read from its data
 /// chunk in blocks of bytes.
 fn open_float64_wav(
@@ -425,25 +438,7 @@ fn open_float64_wav(
     }
     data.seek(std::io::SeekFrom::Start(h.data_offset))
         .map_err(|e| io_err("read", path, &e))?;
-    let fs = reconcile_fs(
-        &p,
-        "the WAV header".into(),
-        f64::from(h.sample_rate),
-        opts.fs_hz,
-    )?;
-    let (names, units) = wav_names(path, usize::from(h.channels))?;
-    let mut side = path.as_os_str().to_owned();
-    side.push(".json");
-    let info = StreamInfo {
-        path: p.clone(),
-        format: Format::Wav,
-        fs_hz: fs,
-        names,
-        units,
-        n_frames: Some(n),
-        start_s: 0.0,
-        start_time: sidecar_start_time(Path::new(&side)),
-    };
+    let info = wav_info(path, h.sample_rate, usize::from(h.channels), n, opts)?;
     Ok(stream(
         info,
         Inner::WavBytes {
