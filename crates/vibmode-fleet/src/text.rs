@@ -248,15 +248,18 @@ pub fn status_text(st: &[VehicleStatus]) -> String {
         }
         if !v.drives.is_empty() {
             text.push_str("  drives, newest first (when driven; when checked where the records' times are unknown):\n");
+            text.push_str("    when                         verdict  corner, part    drive               evidence\n");
             for d in &v.drives {
+                // The drive (a date, a folder or a given id) padded, then two spaces: a long
+                // folder still stands apart from the evidence.
                 let _ = writeln!(
                     text,
-                    "    {:<28} {:<8} {:<15} {} {}",
+                    "    {:<28} {:<8} {:<15} {:<18}  {}",
                     d.when(),
                     d.classification.to_string(),
                     d.place(),
                     d.drive,
-                    d.summary
+                    or_dash(&d.summary)
                 );
             }
             text.push_str("  records, newest first:\n");
@@ -316,5 +319,63 @@ mod tests {
             t,
             "a.csv: stored as test record 7 of vehicle bus1\n  note: layout\n"
         );
+    }
+
+    /// The status' drive timeline: a drive named by a long folder stays apart from its
+    /// evidence, and a drive without evidence shows a dash.
+    #[test]
+    fn the_drive_timeline_keeps_the_drive_apart_from_its_evidence() {
+        use crate::model::Classification;
+        use crate::store::DriveStatus;
+        let drive = |name: &str, class: Classification, summary: &str| DriveStatus {
+            drive: name.into(),
+            checked: "2026-11-28T02:30:12Z".into(),
+            classification: class,
+            corner: None,
+            component: None,
+            summary: summary.into(),
+            vehicle_z_over_limit: None,
+            false_alarm_rate: 0.01,
+            n_records: 8,
+            driven: None,
+            since: "2026-11-28T02:30:12Z".into(),
+        };
+        let long = "/data/fleet/bus-017/2026-11-26";
+        let v = VehicleStatus {
+            vehicle: "bus-017".into(),
+            n_nominal: 16,
+            n_test: 16,
+            baseline_version: Some(1),
+            last_checks: vec![],
+            latest_drive: None,
+            drives: vec![
+                drive(
+                    long,
+                    Classification::Vehicle,
+                    "FR: level vs RR 8-20 Hz +35 %",
+                ),
+                drive("today", Classification::Normal, ""),
+            ],
+            suspension: None,
+        };
+        let text = status_text(&[v]);
+        let lines: Vec<&str> = text.lines().collect();
+        let at = |needle: &str| {
+            lines
+                .iter()
+                .find(|l| l.contains(needle))
+                .copied()
+                .unwrap_or_else(|| panic!("no line with {needle}: {text}"))
+        };
+        assert!(
+            at(long).ends_with(&format!("{long}  FR: level vs RR 8-20 Hz +35 %")),
+            "{text}"
+        );
+        let today = at(" today ");
+        assert!(today.ends_with("today               -"), "{text}");
+        // The header's columns stand over the rows'.
+        let header = at("evidence");
+        assert_eq!(header.find("drive"), today.find("today"), "{text}");
+        assert_eq!(header.find("verdict"), today.find("normal"), "{text}");
     }
 }
