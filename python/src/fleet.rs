@@ -88,7 +88,7 @@ fn fleet_ingest(
     unit: Option<String>,
     allow_nonuniform: bool,
     time_unit: Option<&str>,
-) -> PyResult<String> {
+) -> PyResult<(String, String)> {
     let condition: Condition = condition.parse().map_err(fleet_err)?;
     let opts = read_options(fs, scale, unit, allow_nonuniform, time_unit)?;
     let out = py
@@ -107,7 +107,8 @@ fn fleet_ingest(
             ingest_files(&mut store, &labels, &paths, &opts, &cfg)
         })
         .map_err(fleet_err)?;
-    serde_json::to_string(&out).map_err(json_err)
+    let text = vibmode_fleet::text::ingest_text(&out, vehicle, condition);
+    Ok((serde_json::to_string(&out).map_err(json_err)?, text))
 }
 
 /// Registers the vehicle's full-car model file (`vibmode fleet register`): "new", "unchanged"

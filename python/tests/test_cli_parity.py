@@ -66,7 +66,7 @@ def test_python_and_cli_give_the_same_results_json(tmp_path):
 def test_fleet_check_and_status_print_as_the_cli(tmp_path):
     """`print(vibmode.fleet.check(...))` shows the table `vibmode fleet check` prints (the same
     library text, `vibmode_fleet::text`), and the result stays the JSON dict; the same for the
-    baseline and the status. Two copies of one store, checked once by each."""
+    ingest, the baseline and the status. Two copies of one store, checked once by each."""
     exe = binary()
     if exe is None:
         pytest.skip("no vibmode binary (set VIBMODE_BIN or run cargo build first)")
@@ -76,7 +76,9 @@ def test_fleet_check_and_status_print_as_the_cli(tmp_path):
     today = sorted(str(p) for p in (tmp_path / "today").glob("record_*.wav"))
     db = tmp_path / "a.db"
     vibmode.fleet.init(db)
-    vibmode.fleet.ingest(db, "bus-1", nominal)
+    done = vibmode.fleet.ingest(db, "bus-1", nominal)
+    assert len(done) == 6 and done[0]["file"] == nominal[0]
+    assert str(done).splitlines()[0] == f"{nominal[0]}: stored as nominal record 1 of vehicle bus-1"
     set_ = vibmode.fleet.baseline(db, "bus-1")
     assert set_["vehicle"] == "bus-1" and str(set_).startswith("vehicle bus-1: model set version 1")
     copy = tmp_path / "b.db"

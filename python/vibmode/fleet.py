@@ -59,13 +59,13 @@ def ingest(
     sorted by name) for ``vehicle`` (``condition`` 'nominal' or 'test');
     a file already stored is not stored twice. All or nothing: every file is read and analysed
     first, then all are stored in one transaction; an error stores none. Returns one dict per
-    file."""
-    return json.loads(
-        _native.fleet_ingest(
-            os.fspath(db), vehicle, _paths(files), condition, road, fs, float(scale), unit,
-            bool(allow_nonuniform), time_unit,
-        )
+    file (a :class:`FleetList`: ``print(result)`` shows what ``vibmode fleet ingest`` prints,
+    also in ``result.text``)."""
+    data, text = _native.fleet_ingest(
+        os.fspath(db), vehicle, _paths(files), condition, road, fs, float(scale), unit,
+        bool(allow_nonuniform), time_unit,
     )
+    return FleetList(json.loads(data), text)
 
 
 def register(db: PathLike, vehicle: str, model: PathLike) -> str:
@@ -154,8 +154,8 @@ class FleetResult(dict):
 
 
 class FleetList(list):
-    """The result of :func:`status`: one dict per vehicle, printed as ``vibmode fleet status``
-    prints it (``text``)."""
+    """The result of :func:`ingest` or :func:`status`: one dict per file or vehicle, printed as
+    the command prints it (``text``)."""
 
     def __init__(self, data: List[Dict[str, Any]], text: str) -> None:
         super().__init__(data)
