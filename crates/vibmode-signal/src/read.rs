@@ -1051,16 +1051,19 @@ mod tests {
                 assert!((0..frames).all(|k| ch.samples[k] == expect(c, k)));
             }
         }
-        let mut stream = crate::open_stream(&path, &opts).unwrap();
-        assert_eq!(stream.info().n_frames, Some(frames as u64));
-        let mut got = vec![Vec::new(); nch];
-        while let Some(block) = stream.next_block(300).unwrap() {
-            for (g, ch) in got.iter_mut().zip(block.channels) {
-                g.extend(ch);
+        for max_frames in [1, 7, 300, 100_000] {
+            let mut stream = crate::open_stream(&path, &opts).unwrap();
+            assert_eq!(stream.info().n_frames, Some(frames as u64));
+            assert_eq!(stream.info().fs_hz, 2000.0);
+            let mut got = vec![Vec::new(); nch];
+            while let Some(block) = stream.next_block(max_frames).unwrap() {
+                for (g, ch) in got.iter_mut().zip(block.channels) {
+                    g.extend(ch);
+                }
             }
-        }
-        for (c, g) in got.iter().enumerate() {
-            assert!(g.len() == frames && (0..frames).all(|k| g[k] == expect(c, k)));
+            for (c, g) in got.iter().enumerate() {
+                assert!(g.len() == frames && (0..frames).all(|k| g[k] == expect(c, k)));
+            }
         }
 
         // Cut off in the data chunk: the whole reader and the stream say so.
