@@ -814,7 +814,7 @@ pub const DEFAULT_DRIVE_ID: &str = "all given records";
 /// The id of a drive of records whose starts are not known: the folder all of them lie in, as
 /// given (`bus17/2026-11-26` for `bus17/2026-11-26/rec01.csv ...`: a day's records are
 /// commonly kept in a folder of their own), else [`DEFAULT_DRIVE_ID`] (records of several
-/// folders, or given without one).
+/// folders, or given without one or as `./rec01.csv`).
 pub fn drive_of_folder<S: AsRef<str>>(files: &[S]) -> String {
     let folder = |f: &S| {
         Path::new(f.as_ref())
@@ -823,7 +823,11 @@ pub fn drive_of_folder<S: AsRef<str>>(files: &[S]) -> String {
     };
     let first = files.first().and_then(folder);
     match first {
-        Some(dir) if !dir.is_empty() && files.iter().all(|f| folder(f).as_ref() == Some(&dir)) => {
+        Some(dir)
+            if !dir.is_empty()
+                && dir != "."
+                && files.iter().all(|f| folder(f).as_ref() == Some(&dir)) =>
+        {
             dir
         }
         _ => DEFAULT_DRIVE_ID.to_string(),
@@ -1128,6 +1132,7 @@ mod tests {
         for other in [
             &["a/r1.csv", "b/r2.csv"][..],
             &["r1.csv", "r2.csv"],
+            &["./r1.csv", "./r2.csv"],
             &["a/r1.csv", "r2.csv"],
             &[],
         ] {
