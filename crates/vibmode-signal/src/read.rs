@@ -1074,14 +1074,7 @@ mod tests {
             e.contains("declares 3000 samples, the file holds 2987"),
             "{e}"
         );
-        let mut s = crate::open_stream(&cut, &opts).unwrap();
-        let e = loop {
-            match s.next_block(300) {
-                Ok(Some(_)) => {}
-                Ok(None) => panic!("a cut-off file streamed to its end"),
-                Err(e) => break e.to_string(),
-            }
-        };
+        let e = crate::stream::tests::stream_error(&cut, &opts, 300);
         assert!(e.contains("995") && e.contains("1000"), "{e}");
 
         let mut bad = values.clone();

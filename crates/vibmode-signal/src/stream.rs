@@ -426,15 +426,13 @@ fn open_float64_wav(
     h: &crate::wav64::Float64Wav,
     mut data: BufReader<File>,
 ) -> Result<FrameStream> {
-    let p = path.display().to_string();
-    let wav_err = |problem: WavProblem| SignalError::Wav {
-        path: p.clone(),
-        problem,
-    };
     crate::read::check_wav_scale(opts)?;
     let n = h.frames();
     if n == 0 {
-        return Err(wav_err(WavProblem::NoSamples));
+        return Err(SignalError::Wav {
+            path: path.display().to_string(),
+            problem: WavProblem::NoSamples,
+        });
     }
     data.seek(std::io::SeekFrom::Start(h.data_offset))
         .map_err(|e| io_err("read", path, &e))?;
@@ -973,8 +971,21 @@ impl FrameStream {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// The message of the error that streaming `path` in blocks of `max_frames` ends with
+    /// (a file cut off mid-write); panics when it streams to its end.
+    pub(crate) fn stream_error(path: &Path, opts: &ReadOptions, max_frames: usize) -> String {
+        let mut st = open_stream(path, opts).unwrap();
+        loop {
+            match st.next_block(max_frames) {
+                Ok(Some(_)) => {}
+                Ok(None) => panic!("{} streamed to its end", path.display()),
+                Err(e) => break e.to_string(),
+            }
+        }
+    }
 
     /// The samples of a delimited file with a time column are the same whether the first
     /// pass's blocks are kept or the file is parsed again (a bound below the file's values).
@@ -1063,14 +1074,7 @@ mod tests {
         let bytes = std::fs::read(&path).unwrap();
         let cut = dir.join("cut.wav");
         std::fs::write(&cut, &bytes[..bytes.len() - 1001]).unwrap();
-        let mut st = open_stream(&cut, &opts).unwrap();
-        let e = loop {
-            match st.next_block(1000) {
-                Ok(Some(_)) => {}
-                Ok(None) => panic!("a cut-off WAV must fail"),
-                Err(e) => break e.to_string(),
-            }
-        };
+        let e = stream_error(&cut, &opts, 1000);
         assert!(e.contains("cut off") && e.contains("of the 4000"), "{e}");
         std::fs::remove_dir_all(&dir).ok();
     }
