@@ -102,7 +102,7 @@ fn fleet_check_names_records_by_the_path_given() {
     let table = String::from_utf8_lossy(&o.stdout).to_string();
     let rows: Vec<&str> = table
         .lines()
-        .filter(|l| l.contains("record_01.csv"))
+        .filter(|l| l.contains("record_01.csv") && !l.starts_with("note: "))
         .collect();
     assert_eq!(rows.len(), 2, "{table}");
     assert!(rows[0].starts_with("a/record_01.csv "), "{table}");

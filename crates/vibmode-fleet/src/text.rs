@@ -3,7 +3,7 @@
 //! prints, and any other front end can print the same.
 
 use crate::fleet::{Checked, Ingested, Registered};
-use crate::model::{Drive, ModelSet};
+use crate::model::{Drive, ModelSet, MIN_DRIVE_RECORDS};
 use crate::store::{Condition, VehicleStatus};
 use std::fmt::Write as _;
 
@@ -201,6 +201,27 @@ pub fn check_text(vehicle: &str, model_version: i64, out: &[Checked], drives: &[
             );
         }
     }
+    // Records checked one by one only: say so, rather than let a per-record verdict pass for
+    // a drive's (a copy given twice has its own note and counts with its first).
+    let loose: Vec<&str> = out
+        .iter()
+        .filter(|c| c.same_as.is_none() && !drives.iter().any(|d| d.records.contains(&c.file)))
+        .map(|c| c.file.as_str())
+        .collect();
+    if !loose.is_empty() {
+        let which = match loose.as_slice() {
+            [one] => format!("{one} is in no drive"),
+            many => format!(
+                "{} records are in no drive ({})",
+                many.len(),
+                vibmode_core::cap_message(&many.join(", "), 120)
+            ),
+        };
+        let _ = writeln!(
+            text,
+            "note: {which}: a drive needs at least {MIN_DRIVE_RECORDS} records (of one day, where the records' starts are known); a single record's verdict flags a healthy vehicle more often than a drive's"
+        );
+    }
     text
 }
 
@@ -319,6 +340,81 @@ mod tests {
             t,
             "a.csv: stored as test record 7 of vehicle bus1\n  note: layout\n"
         );
+    }
+
+    /// `fleet check`: records that form no drive (too few, or a day of too few) are named in a
+    /// note, so that their per-record verdicts do not pass for a drive's; records in a drive
+    /// and a copy given twice are not.
+    #[test]
+    fn records_in_no_drive_are_named() {
+        use crate::model::{Assessment, Classification, Scores};
+        let assessment = Assessment {
+            classification: Classification::Normal,
+            scores: Scores {
+                vehicle_max_abs_z: 1.0,
+                excitation_max_abs_z: 0.0,
+                n_vehicle: 4,
+                n_excitation: 1,
+            },
+            evidence: vec![],
+            summary: String::new(),
+            missing: vec![],
+            sensor_faults: vec![],
+            component: None,
+        };
+        let checked = |file: &str, same_as: Option<&str>| Checked {
+            file: file.into(),
+            record_id: 1,
+            model_version: 1,
+            assessment: assessment.clone(),
+            in_baseline: None,
+            same_as: same_as.map(String::from),
+        };
+        let drive = |records: &[&str]| Drive {
+            drive: "2026-11-27".into(),
+            model_version: 1,
+            records: records.iter().map(|r| r.to_string()).collect(),
+            start_unix_s: None,
+            corner: None,
+            false_alarm_rate: 0.01,
+            assessment: assessment.clone(),
+            suspension: None,
+            in_baseline: vec![],
+        };
+        let note = |out: &[Checked], drives: &[Drive]| -> Option<String> {
+            check_text("bus1", 1, out, drives)
+                .lines()
+                .find(|l| l.contains("in no drive"))
+                .map(String::from)
+        };
+        // One record alone.
+        let one = [checked("today/a.csv", None)];
+        assert_eq!(
+            note(&one, &[]).as_deref(),
+            Some(
+                "note: today/a.csv is in no drive: a drive needs at least 3 records (of one day, \
+                 where the records' starts are known); a single record's verdict flags a healthy \
+                 vehicle more often than a drive's"
+            )
+        );
+        // A day of three records forms a drive; the next day's two records do not; a copy of
+        // a record of the drive is no loose record.
+        let out = [
+            checked("d1/a.csv", None),
+            checked("d1/b.csv", None),
+            checked("d1/c.csv", None),
+            checked("d1/c2.csv", Some("d1/c.csv")),
+            checked("d2/a.csv", None),
+            checked("d2/b.csv", None),
+        ];
+        let drives = [drive(&["d1/a.csv", "d1/b.csv", "d1/c.csv"])];
+        let n = note(&out, &drives).unwrap_or_default();
+        assert!(
+            n.starts_with("note: 2 records are in no drive (d2/a.csv, d2/b.csv): "),
+            "{n}"
+        );
+        // Every record in a drive: no note.
+        assert_eq!(note(&out[..4], &drives), None);
     }
 
     /// The status' drive timeline: a drive named by a long folder stays apart from its
