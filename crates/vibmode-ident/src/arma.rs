@@ -239,8 +239,9 @@ fn mean_loss(eps: &[f64], rho: Option<f64>) -> f64 {
     eps.iter().map(|&e| loss_of(e, rho)).sum::<f64>() / eps.len() as f64
 }
 
-/// Monic polynomial (z^-1 form, leading 1) from its roots.
-fn poly_from_roots(roots: &[Complex64]) -> Vec<f64> {
+/// Monic polynomial (z^-1 form, leading 1) from its roots: the real parts of the coefficients
+/// of `prod (z - r)`, highest power first (real where `roots` is closed under conjugation).
+pub(crate) fn poly_from_roots(roots: &[Complex64]) -> Vec<f64> {
     let mut c = vec![Complex64::new(1.0, 0.0)];
     for &r in roots {
         let mut next = vec![Complex64::new(0.0, 0.0); c.len() + 1];

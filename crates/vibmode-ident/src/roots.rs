@@ -356,21 +356,6 @@ mod tests {
         r
     }
 
-    /// The real coefficients of `prod (z - r)` over `roots` (closed under conjugation), highest
-    /// power first.
-    fn real_polynomial(roots: &[Complex64]) -> Vec<f64> {
-        let mut c = vec![Complex64::new(1.0, 0.0)];
-        for &r in roots {
-            let mut next = vec![Complex64::new(0.0, 0.0); c.len() + 1];
-            for (i, &ci) in c.iter().enumerate() {
-                next[i] += ci;
-                next[i + 1] -= ci * r;
-            }
-            c = next;
-        }
-        c.iter().map(|v| v.re).collect()
-    }
-
     /// Aberth's roots against the companion matrix's (the definition: the same set) on seeded
     /// random real polynomials of degree 1..60 with roots inside and outside the unit circle, as
     /// a trial C of the ARMA search has them; started on the circle and from nearby roots.
@@ -393,7 +378,7 @@ mod tests {
                     roots.push(Complex64::new(if uniform() < 0.5 { r } else { -r }, 0.0));
                 }
             }
-            let c = real_polynomial(&roots);
+            let c = crate::arma::poly_from_roots(&roots);
             // Cold (on the circle), and warm from the roots of a nearby polynomial (each root
             // moved by 1e-3 of its modulus, as between two trial steps of a search).
             let start: Vec<Complex64> = roots
@@ -469,7 +454,7 @@ mod tests {
                     roots.push(Complex64::new(if uniform() < 0.5 { r } else { -r }, 0.0));
                 }
             }
-            let c = real_polynomial(&roots);
+            let c = crate::arma::poly_from_roots(&roots);
             let got = polynomial_roots(&c).unwrap_or_default();
             let raw = companion_eigenvalues(&c).unwrap_or_default();
             let want: Vec<Complex64> = (0..raw.len())

@@ -160,16 +160,7 @@ impl SsiOutput {
         let mut freq = Vec::new();
         let mut psd: Vec<f64> = Vec::new();
         for ch in &rec.channels {
-            let wp = vibmode_spectra::WelchParams {
-                nperseg: Some(256.min(ch.samples.len())),
-                ..Default::default()
-            };
-            let w = vibmode_spectra::welch(&ch.samples, rec.fs_hz, &wp).map_err(|source| {
-                RunError::Spectrum {
-                    channel: ch.name.clone(),
-                    source,
-                }
-            })?;
+            let w = crate::sweep::figure_welch(ch, rec.fs_hz)?;
             if psd.is_empty() {
                 psd = vec![0.0; w.psd.len()];
                 freq = w.freq_hz;

@@ -159,6 +159,22 @@ impl SweepChannel {
     }
 }
 
+/// A channel's Welch PSD drawn behind the poles of a stabilisation diagram: segments of 256
+/// samples (the whole record when shorter), the other settings scipy's defaults.
+pub(crate) fn figure_welch(
+    ch: &vibmode_signal::Channel,
+    fs_hz: f64,
+) -> Result<vibmode_spectra::Spectrum, RunError> {
+    let wp = vibmode_spectra::WelchParams {
+        nperseg: Some(256.min(ch.samples.len())),
+        ..Default::default()
+    };
+    vibmode_spectra::welch(&ch.samples, fs_hz, &wp).map_err(|source| RunError::Spectrum {
+        channel: ch.name.clone(),
+        source,
+    })
+}
+
 /// The sweep of every channel of `rec` (read from `source`). `band`: what the signal carries
 /// (the pole filters' band). A channel whose every fit fails is an error with the highest
 /// order's reason.
@@ -189,16 +205,7 @@ pub fn sweep(
         let mut out = SweepChannel::new(&ch.name, &ch.unit, orders);
         out.add_fits(&fits, band, &filters);
         out.cluster(band, &ClusterParams::default())?;
-        let wp = vibmode_spectra::WelchParams {
-            nperseg: Some(256.min(ch.samples.len())),
-            ..Default::default()
-        };
-        let w = vibmode_spectra::welch(&ch.samples, rec.fs_hz, &wp).map_err(|source| {
-            RunError::Spectrum {
-                channel: ch.name.clone(),
-                source,
-            }
-        })?;
+        let w = figure_welch(ch, rec.fs_hz)?;
         out.welch_freq_hz = w.freq_hz;
         out.welch_psd = w.psd;
         channels.push(out);
