@@ -360,22 +360,32 @@ fn fleet_store_features(
                     refresh_features: fresh.is_some(),
                 })
                 .collect();
+            let others = items
+                .iter()
+                .map(|it| store.other_vehicles_with(vehicle, &it.content_hash))
+                .collect::<Result<Vec<_>, _>>()?;
             let stored = store.store_batch(&batch)?;
             let out: Vec<Ingested> = items
                 .iter()
                 .zip(stored)
                 .zip(&refreshed)
-                .map(|((it, s), fresh)| Ingested {
-                    file: it.file.clone(),
-                    record_id: s.record_id,
-                    already_stored: !s.inserted,
-                    notes: if s.inserted {
-                        it.features.notes.clone()
-                    } else if fresh.is_some() {
-                        vec![vibmode_fleet::fleet::REFRESHED_NOTE.to_string()]
-                    } else {
-                        Vec::new()
-                    },
+                .zip(&others)
+                .map(|(((it, s), fresh), o)| {
+                    vibmode_fleet::fleet::with_other_vehicles(
+                        Ingested {
+                            file: it.file.clone(),
+                            record_id: s.record_id,
+                            already_stored: !s.inserted,
+                            notes: if s.inserted {
+                                it.features.notes.clone()
+                            } else if fresh.is_some() {
+                                vec![vibmode_fleet::fleet::REFRESHED_NOTE.to_string()]
+                            } else {
+                                Vec::new()
+                            },
+                        },
+                        o,
+                    )
                 })
                 .collect();
             Ok::<_, FleetError>(out)

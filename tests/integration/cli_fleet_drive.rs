@@ -1,7 +1,7 @@
 //! `vibmode fleet check` per drive: the given records of a vehicle classified together (the
 //! median of every feature over them), the JSON's `drives` beside its `records`, and the drive's
 //! bad input (too few records, records of another vehicle, another channel layout): one line,
-//! exit code 2, nothing stored.
+//! exit code 2, nothing stored; a record stored for another vehicle is ingested with a note.
 
 use crate::common;
 
@@ -159,6 +159,17 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
     // Alone, it is checked (no drive).
     ok(&fleet_args("check", db, "bus-1", &["-q", &more[2]]));
     assert_eq!(n_test(db, "bus-1"), 5);
+    // Stored for a third vehicle, it is stored with a note naming the two that have it.
+    let o = ok(&fleet_args("ingest", db, "bus-3", &["-q", &more[2]]));
+    let text = common::stderr(&o);
+    assert!(
+        text.contains("note: its content is stored for vehicle 'bus-1', 'bus-2' too: a record is of one vehicle"),
+        "{text}"
+    );
+    // Given again, it is already stored: no note.
+    let o = ok(&fleet_args("ingest", db, "bus-3", &["-q", &more[2]]));
+    let text = String::from_utf8_lossy(&o.stdout).to_string() + &common::stderr(&o);
+    assert!(!text.contains("note"), "{text}");
 
     // A record with another channel layout (a sprung channel missing) in the drive.
     let text = std::fs::read_to_string(&more[1]).unwrap();

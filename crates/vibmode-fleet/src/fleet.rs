@@ -331,6 +331,7 @@ pub fn ingest_recording(
 ) -> Result<Ingested> {
     check_vehicle_id(labels.vehicle)?;
     let p = prepare_recording(store, labels, name, content_hash, rec, cfg)?;
+    let others = store.other_vehicles_with(labels.vehicle, content_hash)?;
     let stored = store_prepared(store, labels, std::slice::from_ref(&p), &[None])?;
     let s = stored
         .first()
@@ -339,7 +340,7 @@ pub fn ingest_recording(
             what: format!("'{}'", vibmode_core::quoted(name)),
             reason: "the store returned no row".into(),
         })?;
-    Ok(ingested(p, s))
+    Ok(with_other_vehicles(ingested(p, s), &others))
 }
 
 /// The name a record file is stored and reported under: the path as the user gave it, not
@@ -518,13 +519,40 @@ pub fn ingest_files_progress(
 ) -> Result<Vec<Ingested>> {
     check_vehicle_id(labels.vehicle)?;
     let prepared = prepare_files(store, labels, paths, opts, cfg, &|_, _| Ok(()), progress)?;
+    let others = other_vehicles(store, labels.vehicle, &prepared)?;
     let checks = vec![None; prepared.len()];
     let stored = store_prepared(store, labels, &prepared, &checks)?;
     Ok(prepared
         .into_iter()
         .zip(stored)
-        .map(|(p, s)| ingested(p, s))
+        .zip(others)
+        .map(|((p, s), o)| with_other_vehicles(ingested(p, s), &o))
         .collect())
+}
+
+/// Per prepared record, the other vehicles that have a record of its content.
+fn other_vehicles(store: &Store, vehicle: &str, prepared: &[Prepared]) -> Result<Vec<Vec<String>>> {
+    prepared
+        .iter()
+        .map(|p| store.other_vehicles_with(vehicle, &p.content_hash))
+        .collect()
+}
+
+/// A newly stored record whose content another vehicle has too gets a note naming it: a
+/// record is of one vehicle, and a nominal record of another would enter this one's baseline.
+/// `others`: [`Store::other_vehicles_with`] of its content, looked up before it was stored.
+pub fn with_other_vehicles(mut done: Ingested, others: &[String]) -> Ingested {
+    if !done.already_stored && !others.is_empty() {
+        let names: Vec<String> = others
+            .iter()
+            .map(|o| format!("'{}'", vibmode_core::quoted(o)))
+            .collect();
+        done.notes.push(format!(
+            "its content is stored for vehicle {} too: a record is of one vehicle; if it is that vehicle's, it does not belong to this one",
+            names.join(", ")
+        ));
+    }
+    done
 }
 
 /// Ingests a file (read with `opts`): a no-op when its bytes are already stored for the vehicle.
