@@ -172,3 +172,24 @@ def test_features_carry_the_stores_content_hash(tmp_path):
     assert vibmode.fleet.store_features(db, "bus-1", [item])[0]["already_stored"] is False
     # The CLI's ingest of the same file keys it the same way: a no-op.
     assert vibmode.fleet.ingest(db, "bus-1", [path])[0]["already_stored"] is True
+
+
+def test_a_record_of_another_vehicle_gets_the_same_note_from_workers_and_ingest(tmp_path):
+    """A record whose content the store holds for another vehicle is stored with a note naming
+    it, by store_features (the workers' path) exactly as by ingest (the CLI's)."""
+    vibmode.simulate("city_bus", records=2, fs=200.0, effects="none", seed=17, out_dir=tmp_path / "r")
+    first, second = (str(tmp_path / "r" / f"record_0{k}.wav") for k in (1, 2))
+    db = tmp_path / "o.db"
+    vibmode.fleet.init(db)
+    vibmode.fleet.ingest(db, "bus-1", [first, second])
+    kind = vibmode.fleet.content_hash(db)
+    by_worker = vibmode.fleet.store_features(db, "bus-2", [vibmode.fleet.features(first, content_hash=kind)])
+    by_ingest = vibmode.fleet.ingest(db, "bus-3", [second])
+    note = "its content is stored for vehicle 'bus-1' too: a record is of one vehicle"
+    assert [n for n in by_worker[0]["notes"] if n.startswith("its content")] == [
+        n for n in by_ingest[0]["notes"] if n.startswith("its content")
+    ]
+    assert any(n.startswith(note) for n in by_worker[0]["notes"]), by_worker
+    # Stored again: already stored, no note.
+    again = vibmode.fleet.store_features(db, "bus-2", [vibmode.fleet.features(first, content_hash=kind)])
+    assert again[0]["already_stored"] is True and again[0]["notes"] == []
