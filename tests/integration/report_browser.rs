@@ -245,6 +245,22 @@ fn fleet_report_leads_with_the_drive_verdicts_in_headless_chromium() {
         args.extend(files.iter().map(String::as_str));
         run(&args);
     }
+    // A second vehicle whose records were checked one by one only: its row says so and gives
+    // the latest record's verdict.
+    let mut args = vec!["fleet", "ingest", "--db", db, "--vehicle", "bus-8", "-q"];
+    args.extend(nominal.iter().map(String::as_str));
+    run(&args);
+    run(&["fleet", "baseline", "--db", db, "--vehicle", "bus-8"]);
+    run(&[
+        "fleet",
+        "check",
+        "--db",
+        db,
+        "--vehicle",
+        "bus-8",
+        "-q",
+        &test[0],
+    ]);
     let out = dir.path().join("report");
     run(&[
         "fleet",
@@ -274,6 +290,16 @@ fn fleet_report_leads_with_the_drive_verdicts_in_headless_chromium() {
         verdicts.contains("<td>bus-7</td>") && verdicts.contains("tuesday (3 records"),
         "{verdicts}"
     );
+    let bus8 = verdicts
+        .split("<td>bus-8</td>")
+        .nth(1)
+        .and_then(|t| t.split("</tr>").next())
+        .unwrap_or("");
+    assert!(
+        bus8.contains("no drive checked") && bus8.contains("latest record checked: "),
+        "{verdicts}"
+    );
+    assert!(bus8.contains(&*test[0]), "{bus8}");
     let timeline = html
         .split("Drive verdicts, newest first")
         .nth(1)

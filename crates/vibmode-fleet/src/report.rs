@@ -52,6 +52,8 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
                 ),
                 d.summary.clone(),
             ],
+            // Records checked one by one only: the latest one's verdict in the evidence, so a
+            // flagged record is not hidden behind "no drive checked".
             None => vec![
                 s.vehicle.clone(),
                 "no drive checked".into(),
@@ -59,7 +61,18 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
                 "-".into(),
                 "-".into(),
                 "-".into(),
-                String::new(),
+                s.last_checks
+                    .first()
+                    .map_or(String::new(), |(file, class, summary)| {
+                        format!(
+                            "latest record checked: {class} ({file}){}",
+                            if summary.is_empty() {
+                                String::new()
+                            } else {
+                                format!(": {summary}")
+                            }
+                        )
+                    }),
             ],
         })
         .collect();

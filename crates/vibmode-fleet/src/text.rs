@@ -248,9 +248,20 @@ pub fn status_text(st: &[VehicleStatus]) -> String {
                     d.false_alarm_rate
                 );
             }
-            None => {
-                let _ = writeln!(text, "{:<16} no drive checked yet", v.vehicle);
-            }
+            // Records checked one by one only: the latest one's verdict, so that a flagged
+            // record is not hidden behind "no drive".
+            None => match v.last_checks.first() {
+                Some((file, class, _)) => {
+                    let _ = writeln!(
+                        text,
+                        "{:<16} no drive checked yet; latest record checked: {class} ({file})",
+                        v.vehicle
+                    );
+                }
+                None => {
+                    let _ = writeln!(text, "{:<16} no drive checked yet", v.vehicle);
+                }
+            },
         }
     }
     text.push('\n');
@@ -415,6 +426,47 @@ mod tests {
         );
         // Every record in a drive: no note.
         assert_eq!(note(&out[..4], &drives), None);
+    }
+
+    /// `fleet status` of a vehicle whose records were checked one by one only: its row says
+    /// so and gives the latest record's verdict; without any check, only that no drive was.
+    #[test]
+    fn a_vehicle_without_drives_shows_its_latest_record_check() {
+        use crate::model::Classification;
+        let v = |last_checks: Vec<(String, Classification, String)>| VehicleStatus {
+            vehicle: "bus-017".into(),
+            n_nominal: 16,
+            n_test: last_checks.len(),
+            baseline_version: Some(1),
+            last_checks,
+            latest_drive: None,
+            drives: vec![],
+            suspension: None,
+        };
+        let checked = v(vec![
+            (
+                "today/rec02.csv".into(),
+                Classification::Vehicle,
+                "RL: level vs FL 8-20 Hz +33 %".into(),
+            ),
+            (
+                "today/rec01.csv".into(),
+                Classification::Normal,
+                String::new(),
+            ),
+        ]);
+        let text = status_text(&[checked]);
+        assert_eq!(
+            text.lines().nth(1),
+            Some("bus-017          no drive checked yet; latest record checked: vehicle (today/rec02.csv)"),
+            "{text}"
+        );
+        let text = status_text(&[v(vec![])]);
+        assert_eq!(
+            text.lines().nth(1),
+            Some("bus-017          no drive checked yet"),
+            "{text}"
+        );
     }
 
     /// The status' drive timeline: a drive named by a long folder stays apart from its
