@@ -204,6 +204,14 @@ fn render(browser: &str, index: &Path, profile: &Path) -> String {
     dom
 }
 
+/// The text between the first `start` in `text` and the next `end` ("" where either is missing).
+fn between<'a>(text: &'a str, start: &str, end: &str) -> &'a str {
+    text.split(start)
+        .nth(1)
+        .and_then(|t| t.split(end).next())
+        .unwrap_or("")
+}
+
 /// The fleet report leads with what a maintenance planner acts on: per vehicle, the latest
 /// drive verdict, the corner, since when and how sure, then the timeline of drive verdicts,
 /// then the records and trends (issue 31); it renders in headless Chromium without errors.
@@ -281,30 +289,18 @@ fn fleet_report_leads_with_the_drive_verdicts_in_headless_chromium() {
             && pos("Drive verdicts, newest first") < pos("Records per vehicle"),
         "the drive verdicts lead the page"
     );
-    let verdicts = html
-        .split("Latest drive verdict per vehicle")
-        .nth(1)
-        .and_then(|t| t.split("</table>").next())
-        .unwrap_or("");
+    let verdicts = between(&html, "Latest drive verdict per vehicle", "</table>");
     assert!(
         verdicts.contains("<td>bus-7</td>") && verdicts.contains("tuesday (3 records"),
         "{verdicts}"
     );
-    let bus8 = verdicts
-        .split("<td>bus-8</td>")
-        .nth(1)
-        .and_then(|t| t.split("</tr>").next())
-        .unwrap_or("");
+    let bus8 = between(verdicts, "<td>bus-8</td>", "</tr>");
     assert!(
         bus8.contains("no drive checked") && bus8.contains("latest record checked: "),
         "{verdicts}"
     );
     assert!(bus8.contains(&*test[0]), "{bus8}");
-    let timeline = html
-        .split("Drive verdicts, newest first")
-        .nth(1)
-        .and_then(|t| t.split("</table>").next())
-        .unwrap_or("");
+    let timeline = between(&html, "Drive verdicts, newest first", "</table>");
     assert!(
         timeline.find("<td>tuesday</td>") < timeline.find("<td>monday</td>")
             && timeline.contains("<td>monday</td>"),
