@@ -1200,9 +1200,11 @@ impl LineParams {
 #[serde(deny_unknown_fields, default)]
 pub struct BodyFitParams {
     /// Band of the fitted equations, Hz. `None` (default): from the vehicle file's body modes,
-    /// `[0.45 f_min, 1.6 f_max]` over heave, pitch and roll (0.46-2.1 Hz on the demo bus). A
-    /// band from 0 Hz lets the manoeuvres' body moments in; one above ~2 Hz lets in the body's
-    /// bending, which three sprung sensors cannot see (docs/model_update.md).
+    /// `[0.45 f_min, 1.6 f_max]` over heave, pitch and roll (0.46-2.1 Hz on the demo bus), or
+    /// the wide band `[0.45 f_min, 3 f_max]` fitted beside it, taken where its body modes agree
+    /// with the default band's (`vibmode_vehicle::update::choose_band`). A band from 0 Hz lets
+    /// the manoeuvres' body moments in; one above ~2 Hz can let in the body's bending, which
+    /// three sprung sensors cannot see (docs/model_update.md, "Band").
     pub band_hz: Option<[f64; 2]>,
     /// Samples dropped at each end of a record, s (default 1.0; the band-pass rings there).
     pub edge_s: f64,

@@ -69,6 +69,11 @@ impl ReportSection {
             r.band_hz[1],
             100.0 * r.explained
         );
+        // Which band was taken, and why (the default band's fit against the wide one's).
+        let intro = match &r.band_choice {
+            Some(c) => format!("{intro} Band: {}.", c.reason),
+            None => intro,
+        };
         let intro = if r.absent.is_empty() {
             intro
         } else {

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use vibmode_analysis::{AnalysisConfig, RecordInput, RecordSource};
 use vibmode_vehicle::update::{BodyFit, BodyFitResult};
-use vibmode_vehicle::VehicleParams;
+use vibmode_vehicle::{VehicleError, VehicleParams};
 
 use crate::RunError;
 
@@ -16,13 +16,22 @@ pub struct ModelUpdate {
     state: UpdateState,
 }
 
+/// The vehicle, the fit of the configured (or default) band, and with the default band also
+/// the wide band's (an error once a record failed in it).
+type Fitting = (
+    VehicleParams,
+    BodyFit,
+    Option<Result<BodyFit, VehicleError>>,
+);
+
 /// Where the model update stands.
 #[derive(Debug)]
 enum UpdateState {
     /// No vehicle: nothing to update.
     Off,
-    /// Records are being added.
-    Fitting(Box<(VehicleParams, BodyFit)>),
+    /// Records are being added; with the default band the better of the two bands' fits is
+    /// taken at the end ([`vibmode_vehicle::update::choose_band`]).
+    Fitting(Box<Fitting>),
     /// A record could not be used (the reason), so the update was stopped.
     Skipped(String),
 }
@@ -37,7 +46,19 @@ impl ModelUpdate {
         let state = match vehicle {
             Some(v) => {
                 let fit = BodyFit::new(&v, cfg.model_update.clone())?;
-                UpdateState::Fitting(Box::new((v, fit)))
+                // With the default band, the wide band's fit beside it.
+                let wide = cfg.model_update.band_hz.is_none().then(|| {
+                    vibmode_vehicle::update::wide_band_hz(&v).and_then(|b| {
+                        BodyFit::new(
+                            &v,
+                            vibmode_core::BodyFitParams {
+                                band_hz: Some(b),
+                                ..cfg.model_update.clone()
+                            },
+                        )
+                    })
+                });
+                UpdateState::Fitting(Box::new((v, fit, wide)))
             }
             None => UpdateState::Off,
         };
@@ -52,6 +73,11 @@ impl ModelUpdate {
     pub fn add(&mut self, r: &RecordInput) {
         if let UpdateState::Fitting(b) = &mut self.state {
             let cfg = &self.cfg;
+            if let Some(Ok(w)) = &mut b.2 {
+                if let Err(e) = w.add_record_placed(&r.recording, |c| cfg.placement_for_update(c)) {
+                    b.2 = Some(Err(e));
+                }
+            }
             if let Err(e) =
                 b.1.add_record_placed(&r.recording, |c| cfg.placement_for_update(c))
             {
@@ -65,9 +91,14 @@ impl ModelUpdate {
         match std::mem::replace(&mut self.state, UpdateState::Off) {
             UpdateState::Off => UpdateOutcome::Off,
             UpdateState::Skipped(why) => UpdateOutcome::Skipped(why),
-            UpdateState::Fitting(b) => match b.1.solve() {
-                Ok(r) => UpdateOutcome::Done(Box::new((b.0, r))),
-                Err(e) => UpdateOutcome::Skipped(e.to_string()),
+            UpdateState::Fitting(b) => match (b.1.solve(), b.2) {
+                (Ok(r), None) => UpdateOutcome::Done(Box::new((b.0, r))),
+                (Ok(r), Some(wide)) => {
+                    let wide = wide.and_then(|w| w.solve());
+                    let r = vibmode_vehicle::update::choose_band(r, wide);
+                    UpdateOutcome::Done(Box::new((b.0, r)))
+                }
+                (Err(e), _) => UpdateOutcome::Skipped(e.to_string()),
             },
         }
     }

@@ -172,6 +172,27 @@ pub struct BodyFitResult {
     /// ([`noise_scale`]): 1 = all of it (bias-compensated least squares); below 1 when the
     /// equations become singular before (generalized total least squares).
     pub noise_share: f64,
+    /// With the default band: whether the wide band's fit was taken instead, and why
+    /// ([`choose_band`]); `None` when the band was given or the comparison was not made.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub band_choice: Option<BandChoice>,
+}
+
+/// The default band's fit against the wide band's ([`choose_band`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct BandChoice {
+    /// The default band, Hz (`[0.45 f_min, 1.6 f_max]` over the file's body modes).
+    pub default_band_hz: [f64; 2],
+    /// The wide band, Hz (`[0.45 f_min, 3 f_max]`).
+    pub wide_band_hz: [f64; 2],
+    /// Whether the fit reported is the wide band's.
+    pub wide_taken: bool,
+    /// The largest shift of a body mode's frequency from the default band's fit to the wide
+    /// band's, in standard deviations of the default band's fit (`None` where not compared).
+    pub largest_shift_sd: Option<f64>,
+    /// Why, in one line.
+    pub reason: String,
 }
 
 /// Relative standard deviation of a body mode's frequency above which the fit is not supported.
@@ -331,6 +352,9 @@ impl BodyFitResult {
             self.band_hz[1],
             100.0 * self.explained
         );
+        if let Some(c) = &self.band_choice {
+            s.push_str(&format!("  {}\n", c.reason));
+        }
         s.push_str(&format!(
             "  {:<12} {:>9} {:>11} {:>8} {:>8} {:>13} {:>16} {:>8}\n",
             "mode",
@@ -431,6 +455,192 @@ impl BodyFitResult {
     }
 }
 
+/// The default band's lower edge over the file's lowest body mode (heave, pitch or roll).
+pub const BAND_LOW_FACTOR: f64 = 0.45;
+/// The default band's upper edge over the file's highest body mode.
+pub const BAND_HIGH_FACTOR: f64 = 1.6;
+/// The wide band's upper edge over the file's highest body mode ([`choose_band`]).
+pub const WIDE_BAND_HIGH_FACTOR: f64 = 3.0;
+/// How many standard deviations of the default band's fit a body mode may move in the wide
+/// band's fit for the wide one to be taken ([`choose_band`]): the two-sided 1 % quantile of
+/// Student's t with 7 degrees of freedom (3.50; a jackknife over 8 records), so that a wide
+/// band as right as the default one is refused in about 3 % of fits (three body modes; with
+/// the default band's standard deviation, an upper bound of the difference's).
+pub const WIDE_BAND_MAX_SHIFT_SD: f64 = 3.5;
+/// A relative shift of a body mode between the two bands' fits that is no evidence against
+/// the wide band whatever the standard deviations (a third of the 3 % the body modes are
+/// asked to hold; [`choose_band`]).
+pub const WIDE_BAND_MAX_SHIFT_REL: f64 = 0.01;
+
+/// The wide band of `vehicle`'s model update, Hz: `[0.45 f_min, 3 f_max]` over its body modes.
+pub fn wide_band_hz(vehicle: &VehicleParams) -> Result<[f64; 2]> {
+    let body: Vec<f64> = FullCar::new(vehicle)?
+        .modes()?
+        .iter()
+        .filter(|m| m.label.is_body_rigid())
+        .map(|m| m.frequency_hz)
+        .collect();
+    if body.is_empty() {
+        return Err(fit_error(
+            "the vehicle model has no body heave, pitch or roll mode".into(),
+            "check the vehicle file's masses and springs, or give the band",
+        ));
+    }
+    let lo = body.iter().cloned().fold(f64::INFINITY, f64::min);
+    let hi = body.iter().cloned().fold(0.0, f64::max);
+    Ok([BAND_LOW_FACTOR * lo, WIDE_BAND_HIGH_FACTOR * hi])
+}
+
+/// The fit of the default band or of the wide one ([`wide_band_hz`]), fitted to the same
+/// records. The wide band holds more of the wheels' motion (its signal grows with frequency
+/// while the sensors' noise is white), so its fit is the more precise, but above about twice
+/// the body modes the body's bending, which three sprung sensors cannot tell from pitch, can
+/// enter it (docs/model_update.md, "Band"). The wide band's fit is taken when every body
+/// mode's frequency lies within [`WIDE_BAND_MAX_SHIFT_SD`] standard deviations (jackknife) of
+/// the default band's or within [`WIDE_BAND_MAX_SHIFT_REL`] of it, and its sensors' noise was
+/// taken out wherever the default band's was;
+/// else the default band's, with the reason. Without the default band's standard deviations
+/// (fewer than three records) or with a failed wide fit, the default band's.
+pub fn choose_band(narrow: BodyFitResult, wide: Result<BodyFitResult>) -> BodyFitResult {
+    let bands = |w: [f64; 2]| format!("{:.2}-{:.2} Hz", w[0], w[1]);
+    let keep = |mut r: BodyFitResult, wide_band_hz: [f64; 2], shift: Option<f64>, why: String| {
+        r.band_choice = Some(BandChoice {
+            default_band_hz: r.band_hz,
+            wide_band_hz,
+            wide_taken: false,
+            largest_shift_sd: shift,
+            reason: why,
+        });
+        r
+    };
+    let wide = match wide {
+        Ok(w) => w,
+        Err(e) => {
+            return keep(
+                narrow,
+                [f64::NAN; 2],
+                None,
+                format!("default band kept: the wide band's fit failed ({e})"),
+            )
+        }
+    };
+    let wb = wide.band_hz;
+    if narrow.mode_sd.is_empty() {
+        return keep(
+            narrow,
+            wb,
+            None,
+            format!(
+                "default band kept: comparing it with the wide band {} needs three records or more",
+                bands(wb)
+            ),
+        );
+    }
+    let floors = |r: &BodyFitResult| {
+        r.noise_density
+            .iter()
+            .filter(|c| c.density_per_hz > 0.0)
+            .count()
+    };
+    if floors(&wide) < floors(&narrow) {
+        return keep(
+            narrow,
+            wb,
+            None,
+            format!(
+                "default band kept: the sensors' noise could not be measured above the wide band {} (the rate is too low for it)",
+                bands(wb)
+            ),
+        );
+    }
+    // Per body mode: (shift in the default band's standard deviations, label, relative shift,
+    // relative standard deviation).
+    let mut shifts: Vec<(f64, ModeLabel, f64, f64)> = Vec::new();
+    let body: Vec<(ModeLabel, f64)> = narrow
+        .body_mode_pairs()
+        .iter()
+        .map(|(_, u)| (u.label, u.frequency_hz))
+        .collect();
+    for (label, f) in body {
+        let Some(w) = wide.mode(label) else {
+            return keep(
+                narrow,
+                wb,
+                None,
+                format!(
+                    "default band kept: the wide band {} gave no {label}",
+                    bands(wb)
+                ),
+            );
+        };
+        // The default band's standard deviation; where its jackknife has none (a record left
+        // out loses the mode), the wide band's, which is the smaller and so the stricter.
+        let Some(sd) = narrow
+            .mode_spread(label)
+            .or_else(|| wide.mode_spread(label))
+            .map(|m| m.frequency_hz_sd)
+        else {
+            return keep(
+                narrow,
+                wb,
+                None,
+                format!(
+                    "default band kept: neither band's fit has a standard deviation of the {label}"
+                ),
+            );
+        };
+        shifts.push((
+            (w.frequency_hz - f).abs() / sd.max(f64::MIN_POSITIVE),
+            label,
+            w.frequency_hz / f - 1.0,
+            sd / f,
+        ));
+    }
+    if shifts.is_empty() {
+        return keep(
+            narrow,
+            wb,
+            None,
+            "default band kept: no body mode to compare".into(),
+        );
+    }
+    shifts.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let shift = shifts[0].0;
+    if let Some(&(s, label, rel, sd_rel)) = shifts
+        .iter()
+        .find(|m| m.0 > WIDE_BAND_MAX_SHIFT_SD && m.2.abs() > WIDE_BAND_MAX_SHIFT_REL)
+    {
+        return keep(
+            narrow,
+            wb,
+            Some(shift),
+            format!(
+                "default band kept: in the wide band {} the {label} moved by {:+.1} %, {s:.1} standard deviations of the default band's fit ({:.2} %): the body is not rigid that far up for these sensors (bending)",
+                bands(wb),
+                100.0 * rel,
+                100.0 * sd_rel
+            ),
+        );
+    }
+    let rel = shifts.iter().map(|m| m.2.abs()).fold(0.0, f64::max);
+    let default_band_hz = narrow.band_hz;
+    BodyFitResult {
+        band_choice: Some(BandChoice {
+            default_band_hz,
+            wide_band_hz: wb,
+            wide_taken: true,
+            largest_shift_sd: Some(shift),
+            reason: format!(
+                "wide band {} taken: its body modes lie within {:.1} % (at most {shift:.1} standard deviations) of the default band's ({}) fit, and it holds more of the wheels' motion",
+                bands(wb),
+                100.0 * rel.abs(),
+                bands(default_band_hz)
+            ),
+        }),
+        ..wide
+    }
+}
+
 fn fit_error(problem: String, fix: &'static str) -> VehicleError {
     VehicleError::BodyFit { problem, fix }
 }
@@ -456,7 +666,7 @@ impl BodyFit {
                 }
                 let lo = body.iter().cloned().fold(f64::INFINITY, f64::min);
                 let hi = body.iter().cloned().fold(0.0, f64::max);
-                [0.45 * lo, 1.6 * hi]
+                [BAND_LOW_FACTOR * lo, BAND_HIGH_FACTOR * hi]
             }
         };
         let bars = [
@@ -1034,6 +1244,7 @@ impl BodyFit {
             not_supported,
             noise_density: self.noise_summary(),
             noise_share: scale,
+            band_choice: None,
         })
     }
 

@@ -432,3 +432,141 @@ fn equations_kept_and_added_later_give_the_same_fit() {
     assert!(e.contains("unknowns"), "{e}");
     assert_eq!(other.records(), 0);
 }
+
+/// `choose_band`: the same records fitted in the default band and in the wide one. On the rigid
+/// bus (no bending) the wide band's body modes agree with the default band's (within 1 % or
+/// two standard deviations) and its fit is taken; on the flexible bus, whose bending the sprung sensors see, a body mode
+/// moves by more than both in the wide band and the default band's fit is kept, with the mode
+/// named. Records of the changed
+/// bus (the demo's effects: noise, lines, misalignment, manoeuvres) at 2 kHz, where both bands
+/// have a noise range.
+#[test]
+fn the_wide_band_is_taken_only_where_the_body_stays_rigid() {
+    use vibmode_vehicle::update::{choose_band, wide_band_hz};
+    for (file, rigid) in [
+        (VehicleParams::city_bus(), true),
+        (VehicleParams::city_bus_flexible(), false),
+    ] {
+        let sp = SimParams {
+            fs_hz: 2000.0,
+            ..SimParams::demo(8, 3)
+        };
+        let sim = simulate(&changed(file.clone()), &sp).unwrap();
+        let wide_band = wide_band_hz(&file).unwrap();
+        let mut narrow = BodyFit::new(&file, BodyFitParams::default()).unwrap();
+        let mut wide = BodyFit::new(
+            &file,
+            BodyFitParams {
+                band_hz: Some(wide_band),
+                ..BodyFitParams::default()
+            },
+        )
+        .unwrap();
+        for r in &sim.records {
+            narrow.add_record(&r.recording).unwrap();
+            wide.add_record(&r.recording).unwrap();
+        }
+        let n = narrow.solve().unwrap();
+        let wide_fit = wide.solve().unwrap();
+        let chosen = choose_band(n.clone(), Ok(wide_fit.clone()));
+        let c = chosen.band_choice.clone().unwrap();
+        assert_eq!(c.wide_taken, rigid, "rigid {rigid}: {}", c.reason);
+        assert_eq!(c.default_band_hz, n.band_hz);
+        assert_eq!(c.wide_band_hz, wide_band);
+        let shift = c.largest_shift_sd.unwrap();
+        if rigid {
+            assert_eq!(chosen.band_hz, wide_band);
+            assert!(c.reason.starts_with("wide band"), "{}", c.reason);
+        } else {
+            assert_eq!(chosen.band_hz, n.band_hz);
+            assert!(shift > 2.0 && c.reason.contains("moved by"), "{}", c.reason);
+            let moved = chosen.body_mode_pairs().iter().any(|(_, u)| {
+                let w = wide_fit.mode(u.label).unwrap();
+                (w.frequency_hz / u.frequency_hz - 1.0).abs() > 0.01
+            });
+            assert!(moved, "{}", c.reason);
+        }
+        eprintln!("rigid {rigid}: {}", c.reason);
+    }
+}
+
+/// `choose_band` by hand: one fit (4 noise-free records of the rigid bus) as the default band's,
+/// its copy with the body pitch moved as the wide band's, and the default band's pitch standard
+/// deviation set to 1 % of its frequency. Taken: 0.8 % (below 1 %, 0.8 sd), 3 % (3 sd); kept:
+/// 4 % (4 sd > 3.5); with the sd at 0.1 %: 0.8 % taken (below 1 %), 1.5 % kept (15 sd); a wide
+/// fit without the pitch, or a failed one, kept; fewer than three records' worth of sd (none),
+/// kept.
+#[test]
+fn choose_band_by_hand() {
+    use vibmode_vehicle::update::choose_band;
+    let mut fit = BodyFit::new(&VehicleParams::city_bus(), BodyFitParams::default()).unwrap();
+    for r in &rigid_records(&VehicleParams::city_bus(), 3) {
+        fit.add_record(r).unwrap();
+    }
+    let base = fit.solve().unwrap();
+    let pitch = ModeLabel::BodyPitch;
+    let f = base.mode(pitch).unwrap().frequency_hz;
+    let with_sd = |rel_sd: f64| {
+        let mut r = base.clone();
+        for m in r.mode_sd.iter_mut() {
+            m.frequency_hz_sd = 1e-9;
+            if m.label == pitch {
+                m.frequency_hz_sd = rel_sd * f;
+            }
+        }
+        r
+    };
+    let moved = |rel: f64| {
+        let mut w = base.clone();
+        w.band_hz = [0.5, 4.0];
+        for m in w.modes.iter_mut().filter(|m| m.label == pitch) {
+            m.frequency_hz *= 1.0 + rel;
+        }
+        w
+    };
+    for (rel_sd, rel, taken) in [
+        (0.01, 0.008, true),
+        (0.01, 0.03, true),
+        (0.01, -0.04, false),
+        (0.001, 0.008, true),
+        (0.001, -0.015, false),
+    ] {
+        let r = choose_band(with_sd(rel_sd), Ok(moved(rel)));
+        let c = r.band_choice.clone().unwrap();
+        assert_eq!(
+            c.wide_taken, taken,
+            "sd {rel_sd}, shift {rel}: {}",
+            c.reason
+        );
+        assert_eq!(r.band_hz, if taken { [0.5, 4.0] } else { base.band_hz });
+        let sd_shift = c.largest_shift_sd.unwrap();
+        assert!((sd_shift - rel.abs() / rel_sd).abs() < 1e-6, "{sd_shift}");
+        if !taken {
+            assert!(c.reason.contains("body pitch moved by"), "{}", c.reason);
+        }
+    }
+    // The wide fit without a body pitch, a failed wide fit, no standard deviations: kept.
+    let mut no_pitch = moved(0.0);
+    no_pitch.modes.retain(|m| m.label != pitch);
+    let r = choose_band(with_sd(0.01), Ok(no_pitch));
+    assert!(!r.band_choice.unwrap().wide_taken);
+    let failed = BodyFit::new(
+        &VehicleParams::city_bus(),
+        BodyFitParams {
+            band_hz: Some([2.0, 1.0]),
+            ..BodyFitParams::default()
+        },
+    )
+    .and_then(|f| f.solve());
+    let r = choose_band(with_sd(0.01), failed);
+    let c = r.band_choice.unwrap();
+    assert!(!c.wide_taken && c.reason.contains("failed"), "{}", c.reason);
+    let mut no_sd = base.clone();
+    no_sd.mode_sd.clear();
+    let c = choose_band(no_sd, Ok(moved(0.0))).band_choice.unwrap();
+    assert!(
+        !c.wide_taken && c.reason.contains("three records"),
+        "{}",
+        c.reason
+    );
+}
