@@ -21,7 +21,7 @@ pub struct ModelUpdate {
 type Fitting = (
     VehicleParams,
     BodyFit,
-    Option<Result<BodyFit, VehicleError>>,
+    Option<([f64; 2], Result<BodyFit, VehicleError>)>,
 );
 
 /// Where the model update stands.
@@ -47,17 +47,18 @@ impl ModelUpdate {
             Some(v) => {
                 let fit = BodyFit::new(&v, cfg.model_update.clone())?;
                 // With the default band, the wide band's fit beside it.
-                let wide = cfg.model_update.band_hz.is_none().then(|| {
-                    vibmode_vehicle::update::wide_band_hz(&v).and_then(|b| {
-                        BodyFit::new(
-                            &v,
-                            vibmode_core::BodyFitParams {
-                                band_hz: Some(b),
-                                ..cfg.model_update.clone()
-                            },
-                        )
-                    })
-                });
+                // (The default band's fit above fails where the wide band cannot be made.)
+                let wide = match cfg.model_update.band_hz {
+                    None => {
+                        let b = vibmode_vehicle::update::wide_band_hz(&v)?;
+                        let params = vibmode_core::BodyFitParams {
+                            band_hz: Some(b),
+                            ..cfg.model_update.clone()
+                        };
+                        Some((b, BodyFit::new(&v, params)))
+                    }
+                    Some(_) => None,
+                };
                 UpdateState::Fitting(Box::new((v, fit, wide)))
             }
             None => UpdateState::Off,
@@ -73,9 +74,13 @@ impl ModelUpdate {
     pub fn add(&mut self, r: &RecordInput) {
         if let UpdateState::Fitting(b) = &mut self.state {
             let cfg = &self.cfg;
-            if let Some(Ok(w)) = &mut b.2 {
-                if let Err(e) = w.add_record_placed(&r.recording, |c| cfg.placement_for_update(c)) {
-                    b.2 = Some(Err(e));
+            if let Some((_, wide)) = &mut b.2 {
+                if let Ok(w) = wide {
+                    if let Err(e) =
+                        w.add_record_placed(&r.recording, |c| cfg.placement_for_update(c))
+                    {
+                        *wide = Err(e);
+                    }
                 }
             }
             if let Err(e) =
@@ -93,9 +98,9 @@ impl ModelUpdate {
             UpdateState::Skipped(why) => UpdateOutcome::Skipped(why),
             UpdateState::Fitting(b) => match (b.1.solve(), b.2) {
                 (Ok(r), None) => UpdateOutcome::Done(Box::new((b.0, r))),
-                (Ok(r), Some(wide)) => {
+                (Ok(r), Some((band, wide))) => {
                     let wide = wide.and_then(|w| w.solve());
-                    let r = vibmode_vehicle::update::choose_band(r, wide);
+                    let r = vibmode_vehicle::update::choose_band(r, band, wide);
                     UpdateOutcome::Done(Box::new((b.0, r)))
                 }
                 (Err(e), _) => UpdateOutcome::Skipped(e.to_string()),

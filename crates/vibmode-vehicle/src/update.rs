@@ -491,8 +491,8 @@ pub fn wide_band_hz(vehicle: &VehicleParams) -> Result<[f64; 2]> {
     Ok([BAND_LOW_FACTOR * lo, WIDE_BAND_HIGH_FACTOR * hi])
 }
 
-/// The fit of the default band or of the wide one ([`wide_band_hz`]), fitted to the same
-/// records. The wide band holds more of the wheels' motion (its signal grows with frequency
+/// The fit of the default band or of the wide one (`wide_band_hz`, [`wide_band_hz`]; `wide`
+/// its fit of the same records, or why it failed). The wide band holds more of the wheels' motion (its signal grows with frequency
 /// while the sensors' noise is white), so its fit is the more precise, but above about twice
 /// the body modes the body's bending, which three sprung sensors cannot tell from pitch, can
 /// enter it (docs/model_update.md, "Band"). The wide band's fit is taken when every body
@@ -501,7 +501,11 @@ pub fn wide_band_hz(vehicle: &VehicleParams) -> Result<[f64; 2]> {
 /// taken out wherever the default band's was;
 /// else the default band's, with the reason. Without the default band's standard deviations
 /// (fewer than three records) or with a failed wide fit, the default band's.
-pub fn choose_band(narrow: BodyFitResult, wide: Result<BodyFitResult>) -> BodyFitResult {
+pub fn choose_band(
+    narrow: BodyFitResult,
+    wide_band_hz: [f64; 2],
+    wide: Result<BodyFitResult>,
+) -> BodyFitResult {
     let bands = |w: [f64; 2]| format!("{:.2}-{:.2} Hz", w[0], w[1]);
     let keep = |mut r: BodyFitResult, wide_band_hz: [f64; 2], shift: Option<f64>, why: String| {
         r.band_choice = Some(BandChoice {
@@ -518,13 +522,13 @@ pub fn choose_band(narrow: BodyFitResult, wide: Result<BodyFitResult>) -> BodyFi
         Err(e) => {
             return keep(
                 narrow,
-                [f64::NAN; 2],
+                wide_band_hz,
                 None,
                 format!("default band kept: the wide band's fit failed ({e})"),
             )
         }
     };
-    let wb = wide.band_hz;
+    let wb = wide_band_hz;
     if narrow.mode_sd.is_empty() {
         return keep(
             narrow,

@@ -468,7 +468,7 @@ fn the_wide_band_is_taken_only_where_the_body_stays_rigid() {
         }
         let n = narrow.solve().unwrap();
         let wide_fit = wide.solve().unwrap();
-        let chosen = choose_band(n.clone(), Ok(wide_fit.clone()));
+        let chosen = choose_band(n.clone(), wide_band, Ok(wide_fit.clone()));
         let c = chosen.band_choice.clone().unwrap();
         assert_eq!(c.wide_taken, rigid, "rigid {rigid}: {}", c.reason);
         assert_eq!(c.default_band_hz, n.band_hz);
@@ -531,7 +531,7 @@ fn choose_band_by_hand() {
         (0.001, 0.008, true),
         (0.001, -0.015, false),
     ] {
-        let r = choose_band(with_sd(rel_sd), Ok(moved(rel)));
+        let r = choose_band(with_sd(rel_sd), [0.5, 4.0], Ok(moved(rel)));
         let c = r.band_choice.clone().unwrap();
         assert_eq!(
             c.wide_taken, taken,
@@ -548,7 +548,7 @@ fn choose_band_by_hand() {
     // The wide fit without a body pitch, a failed wide fit, no standard deviations: kept.
     let mut no_pitch = moved(0.0);
     no_pitch.modes.retain(|m| m.label != pitch);
-    let r = choose_band(with_sd(0.01), Ok(no_pitch));
+    let r = choose_band(with_sd(0.01), [0.5, 4.0], Ok(no_pitch));
     assert!(!r.band_choice.unwrap().wide_taken);
     let failed = BodyFit::new(
         &VehicleParams::city_bus(),
@@ -558,12 +558,15 @@ fn choose_band_by_hand() {
         },
     )
     .and_then(|f| f.solve());
-    let r = choose_band(with_sd(0.01), failed);
+    let r = choose_band(with_sd(0.01), [0.5, 4.0], failed);
     let c = r.band_choice.unwrap();
     assert!(!c.wide_taken && c.reason.contains("failed"), "{}", c.reason);
+    assert_eq!(c.wide_band_hz, [0.5, 4.0]);
     let mut no_sd = base.clone();
     no_sd.mode_sd.clear();
-    let c = choose_band(no_sd, Ok(moved(0.0))).band_choice.unwrap();
+    let c = choose_band(no_sd, [0.5, 4.0], Ok(moved(0.0)))
+        .band_choice
+        .unwrap();
     assert!(
         !c.wide_taken && c.reason.contains("three records"),
         "{}",
