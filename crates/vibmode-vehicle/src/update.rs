@@ -474,8 +474,13 @@ pub const WIDE_BAND_MAX_SHIFT_REL: f64 = 0.01;
 
 /// The wide band of `vehicle`'s model update, Hz: `[0.45 f_min, 3 f_max]` over its body modes.
 pub fn wide_band_hz(vehicle: &VehicleParams) -> Result<[f64; 2]> {
-    let body: Vec<f64> = FullCar::new(vehicle)?
-        .modes()?
+    body_band_hz(&FullCar::new(vehicle)?.modes()?, WIDE_BAND_HIGH_FACTOR)
+}
+
+/// `[BAND_LOW_FACTOR f_min, high_factor f_max]` over the body modes (heave, pitch, roll) among
+/// `modes`, Hz.
+fn body_band_hz(modes: &[ModeInfo], high_factor: f64) -> Result<[f64; 2]> {
+    let body: Vec<f64> = modes
         .iter()
         .filter(|m| m.label.is_body_rigid())
         .map(|m| m.frequency_hz)
@@ -488,12 +493,12 @@ pub fn wide_band_hz(vehicle: &VehicleParams) -> Result<[f64; 2]> {
     }
     let lo = body.iter().cloned().fold(f64::INFINITY, f64::min);
     let hi = body.iter().cloned().fold(0.0, f64::max);
-    Ok([BAND_LOW_FACTOR * lo, WIDE_BAND_HIGH_FACTOR * hi])
+    Ok([BAND_LOW_FACTOR * lo, high_factor * hi])
 }
 
 /// The fit of the default band or of the wide one (`wide_band_hz`, [`wide_band_hz`]; `wide`
-/// its fit of the same records, or why it failed). The wide band holds more of the wheels' motion (its signal grows with frequency
-/// while the sensors' noise is white), so its fit is the more precise, but above about twice
+/// its fit of the same records, or why it failed). The wide band holds more of the wheels'
+/// motion (its signal grows with frequency while the sensors' noise is white), so its fit is the more precise, but above about twice
 /// the body modes the body's bending, which three sprung sensors cannot tell from pitch, can
 /// enter it (docs/model_update.md, "Band"). The wide band's fit is taken when every body
 /// mode's frequency lies within [`WIDE_BAND_MAX_SHIFT_SD`] standard deviations (jackknife) of
@@ -656,22 +661,7 @@ impl BodyFit {
         let nominal_modes = FullCar::new(vehicle)?.modes()?;
         let band_hz = match params.band_hz {
             Some(b) => b,
-            None => {
-                let body: Vec<f64> = nominal_modes
-                    .iter()
-                    .filter(|m| m.label.is_body_rigid())
-                    .map(|m| m.frequency_hz)
-                    .collect();
-                if body.is_empty() {
-                    return Err(fit_error(
-                        "the vehicle model has no body heave, pitch or roll mode".into(),
-                        "check the vehicle file's masses and springs, or give the band",
-                    ));
-                }
-                let lo = body.iter().cloned().fold(f64::INFINITY, f64::min);
-                let hi = body.iter().cloned().fold(0.0, f64::max);
-                [BAND_LOW_FACTOR * lo, BAND_HIGH_FACTOR * hi]
-            }
+            None => body_band_hz(&nominal_modes, BAND_HIGH_FACTOR)?,
         };
         let bars = [
             vehicle.front.anti_roll_stiffness_nm_per_rad > 0.0,
