@@ -25,7 +25,7 @@ pub struct ResampleArgs {
     /// Skip the anti-alias filter (plain decimation; shows aliasing).
     #[arg(long)]
     pub no_filter: bool,
-    /// Output file: .csv (with a time_s column), .wav (32-bit float), or .f32/.f64 (+ .json sidecar).
+    /// Output file: .csv (with a time_s column), .wav (32-bit float), or .f32/.f64 (+ .json sidecar; .npy is read, not written).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
     /// Plot raw, resampled without and with the filter, in time and frequency (.svg or .png),

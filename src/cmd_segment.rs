@@ -135,6 +135,8 @@ pub fn run(a: &SegmentArgs) -> Result<()> {
         },
         None => match stream.info().format {
             vibmode_signal::Format::Raw => "f32".into(),
+            // Records are written, not arrays: raw f64 with its sidecar (numpy.fromfile).
+            vibmode_signal::Format::Npy => "f64".into(),
             vibmode_signal::Format::Wav => "wav".into(),
             vibmode_signal::Format::Delimited => "csv".into(),
         },

@@ -183,7 +183,7 @@ fn segment_hint(e: &SegmentError) -> Option<Hint> {
 
 fn signal_hint(e: &SignalError) -> Option<Hint> {
     match e {
-        SignalError::NoSampleRate { .. } => Some(Hint::Fs),
+        SignalError::NoSampleRate { .. } | SignalError::NpyNoSampleRate { .. } => Some(Hint::Fs),
         SignalError::SampleRateMismatch { .. } => Some(Hint::DropFs),
         SignalError::NonUniformTime { .. } => Some(Hint::ResampleNonuniform),
         SignalError::Recording(r) => recording_hint(r),

@@ -71,3 +71,47 @@ def test_wav_files_written_by_scipy_read_as_scipy_reads_them(tmp_path, dtype):
     np.testing.assert_array_equal(rec.data, back.T.astype(np.float64) / full)
     scaled = vibmode.read(path, scale=19.62)
     np.testing.assert_allclose(scaled.data, 19.62 * rec.data, rtol=1e-15)
+
+
+@pytest.mark.parametrize("kind", ["c", "fortran", "float32", "one_channel", "version2"])
+def test_npy_files_written_by_numpy_read_as_their_arrays(tmp_path, kind):
+    """numpy.save's files, as numpy (the independent implementation) writes them: a 2-D array
+    (samples, channels) in C order, in Fortran order (pandas' ``DataFrame.to_numpy()`` of one
+    dtype gives one), float32, a 1-D array, and format version 2.0 (``numpy.lib.format``).
+    vibmode reads exactly the array (float32 widened), channels ch0, ch1, ..., at the given
+    rate; without a rate, or transposed, or of integers, it refuses naming the value."""
+    rng = np.random.default_rng(11)
+    a = rng.standard_normal((3000, 4))
+    path = tmp_path / f"{kind}.npy"
+    if kind == "fortran":
+        a = np.asfortranarray(a)
+    elif kind == "float32":
+        a = a.astype(np.float32)
+    elif kind == "one_channel":
+        a = a[:, 0].copy()
+    if kind == "version2":
+        with open(path, "wb") as f:
+            np.lib.format.write_array(f, a, version=(2, 0))
+    else:
+        np.save(path, a)
+    back = np.load(path)
+    rec = vibmode.read(path, fs=500.0)
+    want = back.reshape(len(back), -1).T.astype(np.float64)
+    assert rec.fs == 500.0
+    assert list(rec.channels) == [f"ch{i}" for i in range(want.shape[0])]
+    np.testing.assert_array_equal(rec.data, want)
+    with pytest.raises(ValueError, match="holds no sampling rate"):
+        vibmode.read(path)
+
+
+def test_npy_refusals_name_the_value(tmp_path):
+    a = np.random.default_rng(2).standard_normal((2000, 3))
+    np.save(tmp_path / "t.npy", a.T.copy())
+    with pytest.raises(ValueError, match=r"shape \(3, 2000\) would be 2000 channels of 3 samples"):
+        vibmode.read(tmp_path / "t.npy", fs=100.0)
+    np.save(tmp_path / "i.npy", (a * 100).astype(np.int32))
+    with pytest.raises(ValueError, match="data type '<i4' is not supported"):
+        vibmode.read(tmp_path / "i.npy", fs=100.0)
+    np.save(tmp_path / "b.npy", a.astype(">f8"))
+    with pytest.raises(ValueError, match="data type '>f8'"):
+        vibmode.read(tmp_path / "b.npy", fs=100.0)

@@ -123,7 +123,8 @@ def read(
     time_unit: Optional[str] = None,
 ):
     """Reads a recording: delimited text (separator, header, units, decimal commas and a time
-    column detected), WAV (PCM or float) or raw f32/f64 with a JSON sidecar (docs/formats.md).
+    column detected), WAV (PCM or float), raw f32/f64 with a JSON sidecar, or a NumPy ``.npy``
+    array of samples by channels (``numpy.save``; give ``fs``) (docs/formats.md).
 
     ``fs``: sampling rate in Hz for files without a time column. ``channels``: names or 0-based
     indices to keep. ``scale``: multiplier of WAV integer samples (full scale = 1.0).

@@ -356,3 +356,75 @@ fn a_folder_stands_for_its_recordings() {
     );
     assert!(!out.exists(), "nothing written");
 }
+
+/// A `numpy.save` file of `n` samples by 3 channels (float64, C order), as NumPy writes it.
+fn npy(path: &Path, n: usize) {
+    let mut h = format!("{{'descr': '<f8', 'fortran_order': False, 'shape': ({n}, 3), }}");
+    while (10 + h.len() + 1) % 64 != 0 {
+        h.push(' ');
+    }
+    h.push('\n');
+    let mut b = b"\x93NUMPY\x01\x00".to_vec();
+    b.extend((h.len() as u16).to_le_bytes());
+    b.extend(h.as_bytes());
+    let mut g = Lcg(5);
+    for i in 0..n {
+        let t = i as f64 / 200.0;
+        for f in [1.5, 4.0, 9.0] {
+            b.extend(((2.0 * std::f64::consts::PI * f * t).sin() + 0.2 * g.next()).to_le_bytes());
+        }
+    }
+    std::fs::write(path, b).unwrap();
+}
+
+/// A NumPy array file is a recording of its own: `analyze` and `psd` read it with the rate
+/// given (channels `ch0`..), alone or in a folder; without a rate, or asked to write `.npy`,
+/// the commands refuse with one line and exit code 2, and write nothing.
+#[test]
+fn numpy_arrays_are_read_with_the_rate_given() {
+    let d = tempfile::tempdir().unwrap();
+    let a = d.path().join("a.npy");
+    npy(&a, 4000);
+    let out = d.path().join("an");
+    ok(&["analyze", "-q", "--fs", "200", s(&a), "-o", s(&out)]);
+    let r = json(&out.join("results.json"));
+    let names: Vec<&str> = r["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["ch0", "ch1", "ch2"]);
+    let folder = d.path().join("dir");
+    std::fs::create_dir(&folder).unwrap();
+    npy(&folder.join("b.npy"), 4000);
+    ok(&[
+        "analyze",
+        "-q",
+        "--fs",
+        "200",
+        s(&folder),
+        "-o",
+        s(&d.path().join("an2")),
+    ]);
+    fails_with(
+        &["analyze", "-q", s(&a)],
+        &["a.npy", "holds no sampling rate"],
+    );
+    fails_with(&["psd", s(&a)], &["holds no sampling rate"]);
+    let o = d.path().join("r.npy");
+    fails_with(
+        &[
+            "resample",
+            "--fs",
+            "200",
+            s(&a),
+            "--fs-out",
+            "50",
+            "-o",
+            s(&o),
+        ],
+        &[".npy is read, not written"],
+    );
+    assert!(!o.exists());
+}

@@ -68,7 +68,7 @@ pub enum SignalError {
     },
     /// Bytes that are not text (NUL or other control characters) where delimited text was
     /// expected.
-    #[error("{path_q} is not a text file (line {line} has control bytes); give a CSV/text export, a .wav, or raw samples with a .json sidecar", path_q = vibmode_core::quoted(.path))]
+    #[error("{path_q} is not a text file (line {line} has control bytes); give a CSV/text export, a .wav, a .npy, or raw samples with a .json sidecar", path_q = vibmode_core::quoted(.path))]
     NotText {
         /// The file.
         path: String,
@@ -260,8 +260,22 @@ pub enum SignalError {
         /// What is wrong, with the values, and how to fix it.
         problem: WavProblem,
     },
+    /// A NumPy `.npy` file that cannot be used.
+    #[error("{path_q}: {problem}", path_q = vibmode_core::quoted(.path))]
+    Npy {
+        /// The file.
+        path: String,
+        /// What is wrong, with the values, and how to fix it.
+        problem: NpyProblem,
+    },
+    /// A NumPy `.npy` file (which holds no rate) read without a sampling rate.
+    #[error("{path_q} is a NumPy array, which holds no sampling rate; give its sampling rate (fs_hz)", path_q = vibmode_core::quoted(.path))]
+    NpyNoSampleRate {
+        /// The file.
+        path: String,
+    },
     /// A file extension or format name that is not known.
-    #[error("unknown format '{given_q}'; valid formats: delimited (.csv/.txt/.tsv/.dat), wav (.wav), raw (.f32/.f64/.bin/.raw + .json sidecar)", given_q = vibmode_core::quoted(.given))]
+    #[error("unknown format '{given_q}'; valid formats: delimited (.csv/.txt/.tsv/.dat), wav (.wav), raw (.f32/.f64/.bin/.raw + .json sidecar), npy (.npy)", given_q = vibmode_core::quoted(.given))]
     UnknownFormat {
         /// The name or extension given.
         given: String,
@@ -285,6 +299,48 @@ pub enum SignalError {
         n: usize,
         /// What is needed.
         fix: String,
+    },
+}
+
+/// What makes a NumPy `.npy` file unusable (the detail of [`SignalError::Npy`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum NpyProblem {
+    /// A header that cannot be read.
+    #[error("its .npy header cannot be read ({message}); save the array again with numpy.save")]
+    Header {
+        /// What was found.
+        message: String,
+    },
+    /// A data type other than little-endian float32 or float64.
+    #[error("data type '{descr}' is not supported; save little-endian float32 or float64: numpy.save(path, a.astype('<f8'))")]
+    Dtype {
+        /// NumPy's type string (`<i8`, `>f8`, ...).
+        descr: String,
+    },
+    /// Neither a 1-D nor a 2-D array.
+    #[error("an array of shape {shape}; save a 1-D array of samples or a 2-D array of samples by channels")]
+    Dimensions {
+        /// The shape, as NumPy prints it.
+        shape: String,
+    },
+    /// More columns than rows: most likely channels by samples.
+    #[error("shape ({rows}, {columns}) would be {columns} channels of {rows} samples (rows are samples, columns channels); save the transpose: numpy.save(path, a.T)")]
+    Transposed {
+        /// Rows (samples).
+        rows: u64,
+        /// Columns (channels).
+        columns: u64,
+    },
+    /// Data of another size than the shape needs.
+    #[error("its data holds {bytes} bytes, not the shape {shape}'s values of {width} bytes each; the file is cut off or was changed, save it again")]
+    DataSize {
+        /// Bytes after the header.
+        bytes: u64,
+        /// The shape.
+        shape: String,
+        /// Bytes per value.
+        width: usize,
     },
 }
 
@@ -361,7 +417,7 @@ pub enum SidecarProblem {
         message: String,
     },
     /// A WAV file's sidecar naming another number of channels.
-    #[error("names {names} channels but the WAV has {channels}; fix the channel list or delete the file")]
+    #[error("names {names} channels but the file has {channels}; fix the channel list or delete the file")]
     WavChannels {
         /// Names in the sidecar.
         names: usize,

@@ -40,6 +40,7 @@
 
 pub mod delimited;
 pub mod error;
+mod npy;
 mod number;
 mod preprocess;
 pub mod read;
@@ -52,7 +53,8 @@ mod wav64;
 pub mod write;
 
 pub use delimited::{Block, ColumnInfo, DateOrder, DelimitedReader, Separator, TimeText};
-pub use error::{BinaryFormat, SidecarProblem, SignalError, WavProblem};
+pub use error::{BinaryFormat, NpyProblem, SidecarProblem, SignalError, WavProblem};
+pub use npy::NPY_MAGIC;
 pub use preprocess::{preprocess, Preprocessed};
 pub use read::{
     expand_folders, read_delimited, read_delimited_bytes, read_path, read_path_bytes,

@@ -18,6 +18,10 @@ pub enum Format {
     Wav,
     /// Raw interleaved little-endian f32/f64 with a JSON sidecar: `.f32`, `.f64`, `.bin`, `.raw`.
     Raw,
+    /// NumPy's `.npy` (`numpy.save`): a 1-D array of samples or a 2-D array of samples by
+    /// channels, little-endian float32 or float64; channels named as WAV's are (`<path>.json`,
+    /// else `ch0`, `ch1`, ...); the rate must be given.
+    Npy,
 }
 
 impl Format {
@@ -28,12 +32,13 @@ impl Format {
             "csv" | "txt" | "tsv" | "dat" | "asc" => Some(Format::Delimited),
             "wav" | "wave" => Some(Format::Wav),
             "f32" | "f64" | "bin" | "raw" => Some(Format::Raw),
+            "npy" => Some(Format::Npy),
             _ => None,
         }
     }
 
     /// The format of `path` from its extension; unknown extensions are read as delimited text
-    /// unless the file starts with `RIFF` (WAV) or a sidecar exists (raw).
+    /// unless the file starts with `RIFF` (WAV) or `\x93NUMPY` (npy), or a sidecar exists (raw).
     pub fn from_path(path: &Path) -> Format {
         if let Some(f) = path
             .extension()
@@ -43,9 +48,13 @@ impl Format {
             return f;
         }
         if let Ok(mut f) = std::fs::File::open(path) {
-            let mut magic = [0u8; 4];
-            if std::io::Read::read_exact(&mut f, &mut magic).is_ok() && &magic == b"RIFF" {
+            let mut magic = [0u8; 6];
+            let got = std::io::Read::read(&mut f, &mut magic).unwrap_or(0);
+            if got >= 4 && &magic[..4] == b"RIFF" {
                 return Format::Wav;
+            }
+            if got == 6 && &magic == crate::npy::NPY_MAGIC {
+                return Format::Npy;
             }
         }
         if sidecar_candidates(path).iter().any(|p| p.is_file()) {
@@ -121,6 +130,7 @@ impl FromStr for Format {
             "delimited" | "csv" | "text" | "txt" => Ok(Format::Delimited),
             "wav" => Ok(Format::Wav),
             "raw" | "bin" | "binary" => Ok(Format::Raw),
+            "npy" | "numpy" => Ok(Format::Npy),
             _ => Err(SignalError::UnknownFormat {
                 given: s.to_string(),
             }),
@@ -134,6 +144,7 @@ impl fmt::Display for Format {
             Format::Delimited => "delimited",
             Format::Wav => "wav",
             Format::Raw => "raw",
+            Format::Npy => "npy",
         })
     }
 }
@@ -250,6 +261,7 @@ fn read_path_or_bytes(path: &Path, bytes: Option<&[u8]>, opts: &ReadOptions) -> 
             }
         }
         (Format::Raw, _) => read_raw(path, opts)?,
+        (Format::Npy, bytes) => read_npy(path, bytes, opts)?,
     };
     crate::error::check_names_of(path, rec.channels.iter().map(|c| c.name.as_str()))?;
     if let Some(u) = &opts.unit {
@@ -708,6 +720,12 @@ fn wav_recording(
         f64::from(sample_rate),
         opts.fs_hz,
     )?;
+    named_recording(path, fs, samples)
+}
+
+/// The recording of a WAV's or `.npy` file's channels at `fs_hz`: names, units and start time
+/// from its sidecar `<path>.json` ([`wav_names`]), every sample finite.
+fn named_recording(path: &Path, fs_hz: f64, samples: Vec<Vec<f64>>) -> Result<Recording> {
     let (names, units) = wav_names(path, samples.len())?;
     let channels: Vec<Channel> = samples
         .into_iter()
@@ -723,9 +741,9 @@ fn wav_recording(
     let mut side = path.as_os_str().to_owned();
     side.push(".json");
     Ok(Recording {
-        fs_hz: fs,
+        fs_hz,
         channels,
-        time_axis: sidecar_time_axis(Path::new(&side), fs)?,
+        time_axis: sidecar_time_axis(Path::new(&side), fs_hz)?,
     })
 }
 
@@ -770,7 +788,8 @@ pub struct WavSidecar {
     pub units: Option<Vec<String>>,
 }
 
-/// Channel names and units of a WAV: from `<path>.json` when it exists, else `ch0`, `ch1`, ...
+/// Channel names and units of a WAV or `.npy` file: from `<path>.json` when it exists, else
+/// `ch0`, `ch1`, ...
 pub(crate) fn wav_names(path: &Path, nch: usize) -> Result<(Vec<String>, Vec<String>)> {
     let mut full = path.as_os_str().to_owned();
     full.push(".json");
@@ -903,6 +922,28 @@ pub(crate) fn raw_layout(path: &Path) -> Result<RawLayout> {
         side,
         width,
     })
+}
+
+fn read_npy(path: &Path, bytes: Option<&[u8]>, opts: &ReadOptions) -> Result<Recording> {
+    let owned;
+    let bytes = match bytes {
+        Some(b) => b,
+        None => {
+            owned = std::fs::read(path).map_err(|e| io_err("read", path, &e))?;
+            &owned
+        }
+    };
+    let layout =
+        crate::npy::npy_layout(path, &mut std::io::Cursor::new(bytes), bytes.len() as u64)?;
+    let p = path.display().to_string();
+    let fs = opts
+        .fs_hz
+        .ok_or_else(|| SignalError::NpyNoSampleRate { path: p.clone() })?;
+    named_recording(
+        path,
+        fs,
+        crate::npy::npy_channels(&bytes[layout.data_offset as usize..], &layout),
+    )
 }
 
 fn read_raw(path: &Path, opts: &ReadOptions) -> Result<Recording> {

@@ -26,7 +26,7 @@ use crate::error::{io_err, Result, SignalError, WavProblem};
 use crate::read::{raw_layout, reconcile_fs, wav_names, Format, ReadOptions};
 use std::collections::VecDeque;
 use std::fs::File;
-use std::io::{BufReader, Read, Seek};
+use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 use vibmode_core::{Channel, ChannelSelector, Recording, RecordingError};
 
@@ -102,6 +102,14 @@ struct Interp {
 }
 
 enum Inner {
+    /// Little-endian floats stored channel after channel (a Fortran-order `.npy`), one reader
+    /// per channel.
+    Columns {
+        files: Vec<BufReader<File>>,
+        width: usize,
+        remaining: u64,
+        buf: Vec<u8>,
+    },
     Delimited {
         reader: Box<DelimitedReader<BufReader<File>>>,
         /// Blocks parsed by the first pass over the time column, handed out before `reader`
@@ -235,6 +243,7 @@ pub fn open_stream(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
     let format = opts.format.unwrap_or_else(|| Format::from_path(path));
     let mut s = match format {
         Format::Raw => open_raw(path, opts)?,
+        Format::Npy => open_npy(path, opts)?,
         Format::Wav => open_wav(path, opts)?,
         Format::Delimited => open_delimited(path, opts)?,
     };
@@ -325,6 +334,61 @@ fn open_raw(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
     ))
 }
 
+/// `<path>.json`: the sidecar of a WAV or `.npy` file.
+fn sidecar_of(path: &Path) -> std::path::PathBuf {
+    let mut side = path.as_os_str().to_owned();
+    side.push(".json");
+    side.into()
+}
+
+fn open_npy(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
+    let p = path.display().to_string();
+    let layout = crate::npy::npy_layout_of(path)?;
+    let fs = opts
+        .fs_hz
+        .ok_or_else(|| SignalError::NpyNoSampleRate { path: p.clone() })?;
+    let nch = layout.channels;
+    let (names, units) = wav_names(path, nch)?;
+    let info = StreamInfo {
+        path: p,
+        format: Format::Npy,
+        fs_hz: fs,
+        units,
+        names,
+        n_frames: Some(layout.frames),
+        start_s: 0.0,
+        start_time: sidecar_start_time(&sidecar_of(path)),
+    };
+    let at = |offset: u64| -> Result<BufReader<File>> {
+        let mut f = open_file(path)?;
+        f.seek(SeekFrom::Start(offset))
+            .map_err(|e| io_err("read", path, &e))?;
+        // Per channel in Fortran order: smaller buffers, one per channel.
+        let cap = if layout.fortran { 1 << 16 } else { 1 << 20 };
+        Ok(BufReader::with_capacity(cap, f))
+    };
+    let inner = if layout.fortran {
+        // Channel after channel: one reader per channel, each at its column.
+        let column_bytes = layout.frames * layout.width as u64;
+        Inner::Columns {
+            files: (0..nch as u64)
+                .map(|c| at(layout.data_offset + c * column_bytes))
+                .collect::<Result<_>>()?,
+            width: layout.width,
+            remaining: layout.frames,
+            buf: Vec::new(),
+        }
+    } else {
+        Inner::Raw {
+            file: at(layout.data_offset)?,
+            width: layout.width,
+            remaining: layout.frames,
+            buf: Vec::new(),
+        }
+    };
+    Ok(stream(info, inner))
+}
+
 fn open_wav(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
     let p = path.display().to_string();
     let wav_err = |problem: WavProblem| SignalError::Wav {
@@ -404,8 +468,6 @@ fn wav_info(
         opts.fs_hz,
     )?;
     let (names, units) = wav_names(path, nch)?;
-    let mut side = path.as_os_str().to_owned();
-    side.push(".json");
     Ok(StreamInfo {
         path: p,
         format: Format::Wav,
@@ -414,7 +476,7 @@ fn wav_info(
         units,
         n_frames: Some(n),
         start_s: 0.0,
-        start_time: sidecar_start_time(Path::new(&side)),
+        start_time: sidecar_start_time(&sidecar_of(path)),
     })
 }
 
@@ -741,6 +803,31 @@ impl FrameStream {
             });
         }
         let all = match &mut self.inner {
+            Inner::Columns {
+                files,
+                width,
+                remaining,
+                buf,
+            } => {
+                let Some(n) = block_bytes(*remaining, max_frames, 1, *width, buf) else {
+                    return Ok(None);
+                };
+                let mut out = Vec::with_capacity(files.len());
+                for file in files.iter_mut() {
+                    file.read_exact(buf).map_err(|e| SignalError::Io {
+                        action: "read",
+                        path: self.info.path.clone(),
+                        message: format!("{e} (was the file cut off or changed while being read?)"),
+                    })?;
+                    out.push(if *width == 4 {
+                        deinterleave(buf, 1, 1.0, f32_le).remove(0)
+                    } else {
+                        deinterleave(buf, 1, 1.0, f64::from_le_bytes).remove(0)
+                    });
+                }
+                *remaining -= n as u64;
+                out
+            }
             Inner::Raw {
                 file,
                 width,

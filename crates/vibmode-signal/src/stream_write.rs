@@ -168,6 +168,13 @@ impl StreamWriter {
                     Some((with_suffix(path, ".json"), text + "\n")),
                 )
             }
+            Some(Format::Npy) => {
+                return Err(SignalError::InvalidParam {
+                    name: "output format",
+                    value: path.display().to_string(),
+                    fix: ".npy is read, not written; write .f64 (raw samples with a .json sidecar, numpy.fromfile reads them), .csv or .wav".into(),
+                });
+            }
             None => {
                 return Err(SignalError::UnknownFormat {
                     given: if ext.is_empty() {

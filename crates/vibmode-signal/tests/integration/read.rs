@@ -770,7 +770,7 @@ fn wav_keeps_channel_names_and_units_through_its_sidecar() {
     let e = vibmode_signal::read_path(&path, &vibmode_signal::ReadOptions::default())
         .unwrap_err()
         .to_string();
-    assert!(e.contains("names 1 channels but the WAV has 2"), "{e}");
+    assert!(e.contains("names 1 channels but the file has 2"), "{e}");
     // without a sidecar: ch0, ch1
     std::fs::remove_file(dir.path().join("r.wav.json")).unwrap();
     let plain = vibmode_signal::read_path(&path, &vibmode_signal::ReadOptions::default()).unwrap();

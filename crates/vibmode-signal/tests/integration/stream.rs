@@ -86,6 +86,226 @@ fn every_format_streams_like_the_whole_file_reader_over_seeds_and_block_sizes() 
     }
 }
 
+/// A `.npy` file as `numpy.save` lays it out (format version `major`): the header with
+/// `descr`, `fortran_order` and the shape as given (text), padded to 64 bytes, then `data`.
+fn npy_file(descr: &str, fortran: bool, shape: &str, data: &[u8], major: u8) -> Vec<u8> {
+    let order = if fortran { "True" } else { "False" };
+    let mut h = format!("{{'descr': '{descr}', 'fortran_order': {order}, 'shape': {shape}, }}");
+    let fixed = if major == 1 { 10 } else { 12 };
+    while (fixed + h.len() + 1) % 64 != 0 {
+        h.push(' ');
+    }
+    h.push('\n');
+    let mut out = b"\x93NUMPY".to_vec();
+    out.extend([major, 0]);
+    if major == 1 {
+        out.extend((h.len() as u16).to_le_bytes());
+    } else {
+        out.extend((h.len() as u32).to_le_bytes());
+    }
+    out.extend(h.as_bytes());
+    out.extend(data);
+    out
+}
+
+/// A `.npy` file of the values given by channel, stored in C order (frame by frame) or Fortran
+/// order (channel by channel).
+fn npy_bytes(chans: &[Vec<f64>], f32_values: bool, fortran: bool, major: u8) -> Vec<u8> {
+    let (n, nch) = (chans[0].len(), chans.len());
+    let descr = if f32_values { "<f4" } else { "<f8" };
+    let shape = if nch == 1 {
+        format!("({n},)")
+    } else {
+        format!("({n}, {nch})")
+    };
+    let mut data = Vec::new();
+    let mut put = |v: f64| {
+        if f32_values {
+            data.extend((v as f32).to_le_bytes())
+        } else {
+            data.extend(v.to_le_bytes())
+        }
+    };
+    if fortran {
+        chans.iter().flatten().for_each(|&v| put(v));
+    } else {
+        (0..n).for_each(|i| chans.iter().for_each(|c| put(c[i])));
+    }
+    npy_file(descr, fortran, &shape, &data, major)
+}
+
+/// By hand: the values 1..6 as a (3, 2) float64 array are read row by row in C order
+/// (channels [1, 3, 5] and [2, 4, 6]) and column by column in Fortran order ([1, 2, 3] and
+/// [4, 5, 6]), in format versions 1 and 2; a (2,) float32 array is one channel; Python 2's
+/// `(3L, 2L)` is read; each refusal names its value (an integer or big-endian type, a 3-D
+/// array, more columns than rows, data cut short, another magic, an unknown key).
+#[test]
+fn npy_small_arrays_by_hand() {
+    let dir = tmp();
+    let p = dir.path().join("h.npy");
+    let opts = ReadOptions {
+        fs_hz: Some(10.0),
+        ..ReadOptions::default()
+    };
+    let read = |bytes: Vec<u8>| {
+        std::fs::write(&p, bytes).unwrap();
+        read_path(&p, &opts).map(|r| {
+            r.channels
+                .into_iter()
+                .map(|c| c.samples)
+                .collect::<Vec<_>>()
+        })
+    };
+    let vals: Vec<u8> = [1.0f64, 2.0, 3.0, 4.0, 5.0, 6.0]
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    for major in [1, 2] {
+        let c = read(npy_file("<f8", false, "(3, 2)", &vals, major)).unwrap();
+        assert_eq!(c, [vec![1.0, 3.0, 5.0], vec![2.0, 4.0, 6.0]]);
+        let f = read(npy_file("<f8", true, "(3, 2)", &vals, major)).unwrap();
+        assert_eq!(f, [vec![1.0, 2.0, 3.0], vec![4.0, 5.0, 6.0]]);
+    }
+    let py2 = read(npy_file("<f8", false, "(3L, 2L)", &vals, 1)).unwrap();
+    assert_eq!(py2.len(), 2);
+    let one: Vec<u8> = [0.5f32, -1.5]
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    assert_eq!(
+        read(npy_file("<f4", false, "(2,)", &one, 1)).unwrap(),
+        [vec![0.5, -1.5]]
+    );
+    let msg = |b: Vec<u8>| read(b).unwrap_err().to_string();
+    let d8 = vec![0u8; 48];
+    assert!(msg(npy_file("<i8", false, "(3, 2)", &d8, 1)).contains("'<i8'"));
+    assert!(msg(npy_file(">f8", false, "(3, 2)", &d8, 1)).contains("'>f8'"));
+    assert!(msg(npy_file("<f8", false, "(1, 3, 2)", &d8, 1)).contains("(1, 3, 2)"));
+    let t = msg(npy_file("<f8", false, "(2, 3)", &d8, 1));
+    assert!(t.contains("3 channels of 2 samples"), "{t}");
+    let cut = msg(npy_file("<f8", false, "(3, 2)", &d8[..40], 1));
+    assert!(cut.contains("40 bytes"), "{cut}");
+    let mut magic = npy_file("<f8", false, "(3, 2)", &d8, 1);
+    magic[5] = b'X';
+    std::fs::write(&p, &magic).unwrap();
+    let e = read_path(&p, &opts).unwrap_err().to_string();
+    assert!(e.contains("NUMPY"), "{e}");
+    let mut key = npy_file("<f8", false, "(3, 2)", &d8, 1);
+    let at = key.windows(7).position(|w| w == b"'shape'").unwrap();
+    key[at + 1] = b'x';
+    assert!(msg(key).contains("unexpected key 'xhape'"));
+}
+
+/// `.npy` files in C and Fortran order, float32 and float64, format versions 1 and 2, 1 to 4
+/// channels: the whole-file reader gives the array's values (float32 widened), channels
+/// `ch0`, `ch1`, ..., at the given rate, and the stream gives the same at every block size.
+#[test]
+fn npy_files_read_and_stream_as_their_arrays_over_seeds() {
+    let dir = tmp();
+    let opts = ReadOptions {
+        fs_hz: Some(250.0),
+        ..ReadOptions::default()
+    };
+    for seed in 0..8u64 {
+        let n = 500 + 311 * seed as usize;
+        let rec = random_recording(seed, n, 1 + (seed as usize % 4), 250.0);
+        let chans: Vec<Vec<f64>> = rec.channels.iter().map(|c| c.samples.clone()).collect();
+        for (f32_values, fortran, major) in [
+            (false, false, 1),
+            (true, false, 2),
+            (false, true, 1),
+            (true, true, 3),
+        ] {
+            let p = dir
+                .path()
+                .join(format!("r{seed}_{f32_values}_{fortran}.npy"));
+            std::fs::write(&p, npy_bytes(&chans, f32_values, fortran, major)).unwrap();
+            let whole = read_path(&p, &opts).unwrap();
+            assert_eq!(whole.fs_hz, 250.0);
+            let names: Vec<String> = (0..chans.len()).map(|i| format!("ch{i}")).collect();
+            assert_eq!(whole.names(), names);
+            for (got, want) in whole.channels.iter().zip(&chans) {
+                let want: Vec<f64> = if f32_values {
+                    want.iter().map(|&v| v as f32 as f64).collect()
+                } else {
+                    want.clone()
+                };
+                assert_eq!(
+                    got.samples, want,
+                    "seed {seed} f32 {f32_values} F {fortran}"
+                );
+            }
+            for block in [1, 7, 256, 100_000] {
+                same(&stream_all(&p, &opts, block), &whole);
+            }
+            // Named by its first bytes too, whatever its extension.
+            let q = dir
+                .path()
+                .join(format!("r{seed}_{f32_values}_{fortran}.array"));
+            std::fs::copy(&p, &q).unwrap();
+            same(&read_path(&q, &opts).unwrap(), &whole);
+        }
+    }
+}
+
+/// A `.npy` file without a rate, cut short, or of integers is refused by both readers with the
+/// value named; its channels take names and units from `<file>.json` as a WAV's do; writing
+/// `.npy` is refused with the formats that are written.
+#[test]
+fn npy_refusals_name_the_value() {
+    let dir = tmp();
+    let chans = vec![vec![1.0; 100], vec![2.0; 100]];
+    let p = dir.path().join("a.npy");
+    std::fs::write(&p, npy_bytes(&chans, false, false, 1)).unwrap();
+    for e in [
+        read_path(&p, &ReadOptions::default()).unwrap_err(),
+        open_stream(&p, &ReadOptions::default()).unwrap_err(),
+    ] {
+        assert!(e.to_string().contains("holds no sampling rate"), "{e}");
+    }
+    let opts = ReadOptions {
+        fs_hz: Some(100.0),
+        ..ReadOptions::default()
+    };
+    let mut cut = npy_bytes(&chans, false, false, 1);
+    cut.truncate(cut.len() - 8);
+    std::fs::write(&p, &cut).unwrap();
+    for e in [
+        read_path(&p, &opts).unwrap_err(),
+        open_stream(&p, &opts).unwrap_err(),
+    ] {
+        assert!(e.to_string().contains("1592 bytes"), "{e}");
+    }
+    let mut ints = npy_bytes(&chans, false, false, 1);
+    let at = ints.windows(3).position(|w| w == b"<f8").unwrap();
+    ints[at + 1] = b'i';
+    std::fs::write(&p, &ints).unwrap();
+    let e = read_path(&p, &opts).unwrap_err().to_string();
+    assert!(e.contains("'<i8'") && e.contains("astype"), "{e}");
+    // Names and units from `<file>.json`, as a WAV's; a list of the wrong length is refused.
+    let q = dir.path().join("named.npy");
+    std::fs::write(&q, npy_bytes(&chans, true, true, 1)).unwrap();
+    let side = dir.path().join("named.npy.json");
+    std::fs::write(
+        &side,
+        r#"{"channels": ["FL_z", "S_FR"], "units": ["g", "m/s^2"]}"#,
+    )
+    .unwrap();
+    let whole = read_path(&q, &opts).unwrap();
+    assert_eq!(whole.names(), ["FL_z", "S_FR"]);
+    assert_eq!(whole.channels[0].unit, "g");
+    same(&stream_all(&q, &opts, 33), &whole);
+    std::fs::write(&side, r#"{"channels": ["FL_z"]}"#).unwrap();
+    let e = read_path(&q, &opts).unwrap_err().to_string();
+    assert!(e.contains("names 1 channels but the file has 2"), "{e}");
+    let rec = random_recording(1, 100, 2, 100.0);
+    let e = write_path(&dir.path().join("out.npy"), &rec)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains(".npy is read, not written"), "{e}");
+    assert!(!dir.path().join("out.npy").exists());
+}
+
 #[test]
 fn delimited_time_column_rate_and_nonuniform_interpolation_match_read_path() {
     let dir = tmp();
