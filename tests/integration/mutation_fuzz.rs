@@ -136,6 +136,22 @@ fn mutated_files_of_every_format_never_panic_or_give_out_of_range_data() {
         ));
         excel.push_str(&format!("{i},{:.3},{:.3},\n", (i as f64 * 0.2).sin(), 9.81));
     }
+    // A NumPy array (vibmode does not write one): numpy.save's header, then the samples by
+    // channels in C order.
+    let mut npy = b"\x93NUMPY\x01\x00".to_vec();
+    let mut h = String::from("{'descr': '<f8', 'fortran_order': False, 'shape': (400, 2), }");
+    while (10 + h.len() + 1) % 64 != 0 {
+        h.push(' ');
+    }
+    h.push('\n');
+    npy.extend((h.len() as u16).to_le_bytes());
+    npy.extend(h.as_bytes());
+    for i in 0..400 {
+        for c in &rec.channels {
+            npy.extend(c.samples[i].to_le_bytes());
+        }
+    }
+    bases.push(("npy", npy, false));
     bases.push(("csv", semi.into_bytes(), true));
     bases.push(("txt", ws.into_bytes(), true));
     bases.push(("csv", excel.into_bytes(), true));
@@ -158,6 +174,16 @@ fn mutated_files_of_every_format_never_panic_or_give_out_of_range_data() {
                         let s = br#"{"channels": ["a", "b"], "units": ["m/s^2", "m/s^2"]}"#;
                         std::fs::write(&side, mutate(&mut rng, s, true)).unwrap();
                     }
+                }
+                "npy" => {
+                    // Mutate the header more often than the samples: the header is the parser.
+                    let mut b = base.clone();
+                    for _ in 0..rng.gen_range(1..3) {
+                        let i = rng.gen_range(0..128);
+                        b[i] = rng.gen();
+                    }
+                    let b = if rng.gen_bool(0.5) { b } else { bytes.clone() };
+                    std::fs::write(&p, &b).unwrap();
                 }
                 "f32" | "f64" => {
                     let side = d.path().join(format!("m{k}.{ext}.json"));

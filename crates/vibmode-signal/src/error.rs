@@ -307,13 +307,13 @@ pub enum SignalError {
 #[non_exhaustive]
 pub enum NpyProblem {
     /// A header that cannot be read.
-    #[error("its .npy header cannot be read ({message}); save the array again with numpy.save")]
+    #[error("its .npy header cannot be read ({message_q}); save the array again with numpy.save", message_q = vibmode_core::quoted(.message))]
     Header {
         /// What was found.
         message: String,
     },
     /// A data type other than little-endian float32 or float64.
-    #[error("data type '{descr}' is not supported; save little-endian float32 or float64: numpy.save(path, a.astype('<f8'))")]
+    #[error("data type '{descr_q}' is not supported; save little-endian float32 or float64: numpy.save(path, a.astype('<f8'))", descr_q = vibmode_core::quoted(.descr))]
     Dtype {
         /// NumPy's type string (`<i8`, `>f8`, ...).
         descr: String,

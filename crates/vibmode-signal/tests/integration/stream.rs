@@ -137,8 +137,9 @@ fn npy_bytes(chans: &[Vec<f64>], f32_values: bool, fortran: bool, major: u8) -> 
 /// By hand: the values 1..6 as a (3, 2) float64 array are read row by row in C order
 /// (channels [1, 3, 5] and [2, 4, 6]) and column by column in Fortran order ([1, 2, 3] and
 /// [4, 5, 6]), in format versions 1 and 2; a (2,) float32 array is one channel; Python 2's
-/// `(3L, 2L)` is read; each refusal names its value (an integer or big-endian type, a 3-D
-/// array, more columns than rows, data cut short, another magic, an unknown key).
+/// `(3L, 2L)` is read; each refusal names its value (an integer or big-endian type, one with
+/// control characters, a 3-D array, more columns than rows, data cut short, another magic, an
+/// unknown key).
 #[test]
 fn npy_small_arrays_by_hand() {
     let dir = tmp();
@@ -181,6 +182,12 @@ fn npy_small_arrays_by_hand() {
     assert!(msg(npy_file("<i8", false, "(3, 2)", &d8, 1)).contains("'<i8'"));
     assert!(msg(npy_file(">f8", false, "(3, 2)", &d8, 1)).contains("'>f8'"));
     assert!(msg(npy_file("<f8", false, "(1, 3, 2)", &d8, 1)).contains("(1, 3, 2)"));
+    // The file's own text is shown without its control characters (one line).
+    let ctl = msg(npy_file("<f\n\x1b8", false, "(3, 2)", &d8, 1));
+    assert!(
+        ctl.contains("'<f??8'") && !ctl.chars().any(char::is_control),
+        "{ctl:?}"
+    );
     let t = msg(npy_file("<f8", false, "(2, 3)", &d8, 1));
     assert!(t.contains("3 channels of 2 samples"), "{t}");
     let cut = msg(npy_file("<f8", false, "(3, 2)", &d8[..40], 1));
