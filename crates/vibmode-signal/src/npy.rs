@@ -10,6 +10,7 @@
 use crate::error::{io_err, NpyProblem, Result, SignalError};
 use std::io::Read;
 use std::path::Path;
+use vibmode_core::limits::CHANNELS_MAX;
 
 /// The magic bytes that start every `.npy` file.
 pub const NPY_MAGIC: &[u8; 6] = b"\x93NUMPY";
@@ -112,6 +113,14 @@ pub(crate) fn npy_layout(path: &Path, r: &mut impl Read, file_bytes: u64) -> Res
                 columns: channels,
             },
         ));
+    }
+    if channels > CHANNELS_MAX as u64 {
+        return Err(vibmode_core::RecordingError::TooManyChannels {
+            what: path.display().to_string(),
+            count: channels as usize,
+            max: CHANNELS_MAX,
+        }
+        .into());
     }
     if frames == 0 || channels == 0 {
         return Err(SignalError::EmptyFile {

@@ -138,8 +138,8 @@ fn npy_bytes(chans: &[Vec<f64>], f32_values: bool, fortran: bool, major: u8) -> 
 /// (channels [1, 3, 5] and [2, 4, 6]) and column by column in Fortran order ([1, 2, 3] and
 /// [4, 5, 6]), in format versions 1 and 2; a (2,) float32 array is one channel; Python 2's
 /// `(3L, 2L)` is read; each refusal names its value (an integer or big-endian type, one with
-/// control characters, a 3-D array, more columns than rows, data cut short, another magic, an
-/// unknown key).
+/// control characters, a 3-D array, more columns than rows, more than 1024 channels, data cut
+/// short, another magic, an unknown key).
 #[test]
 fn npy_small_arrays_by_hand() {
     let dir = tmp();
@@ -190,6 +190,8 @@ fn npy_small_arrays_by_hand() {
     );
     let t = msg(npy_file("<f8", false, "(2, 3)", &d8, 1));
     assert!(t.contains("3 channels of 2 samples"), "{t}");
+    let wide = msg(npy_file("<f8", false, "(2000, 1500)", &d8, 1));
+    assert!(wide.contains("1500") && wide.contains("1024"), "{wide}");
     let cut = msg(npy_file("<f8", false, "(3, 2)", &d8[..40], 1));
     assert!(cut.contains("40 bytes"), "{cut}");
     let mut magic = npy_file("<f8", false, "(3, 2)", &d8, 1);
