@@ -107,12 +107,30 @@ def ssi_peer(data_dir, meta, quick):
     return res
 
 
+def npy_peer(data_dir, quick):
+    """numpy.load of the .npy that vibmode-bench wrote (checked equal to the raw samples first)."""
+    path = os.path.join(data_dir, "seven_channels.npy")
+    raw = np.fromfile(os.path.join(data_dir, "raw7.f64"), dtype="<f8").reshape(-1, 7)
+    if not np.array_equal(np.load(path), raw):
+        raise SystemExit("seven_channels.npy does not load as raw7.f64: the bench's header is wrong")
+    r = 3 if quick else 11
+    # vibmode hands out each channel contiguous (the layout of `Recording`); numpy.load keeps the
+    # file's frames, so the like-for-like peer also makes the channels contiguous.
+    return {"read_npy_7x204800": {
+        "numpy.load": median_time(lambda: np.load(path), r),
+        "numpy.load + channels contiguous (ascontiguousarray(a.T))": median_time(
+            lambda: np.ascontiguousarray(np.load(path).T), r),
+    }}
+
+
 def peers(data_dir, quick, only=None):
     res = {}
     meta = json.load(open(os.path.join(data_dir, "meta.json")))
     if only is not None:
-        # One case's peers only (SSI-cov is the one with a peer worth timing alone).
+        # One case's peers only (SSI-cov and the .npy reader are the ones worth timing alone).
         res = ssi_peer(data_dir, meta, quick) if "ssi_cov".startswith(only) or only.startswith("ssi_cov") else {}
+        if "read_npy".startswith(only) or only.startswith("read_npy"):
+            res.update(npy_peer(data_dir, quick))
         res.setdefault("_versions", {}).update({"numpy": np.__version__, "scipy": scipy.__version__})
         return res
     csv_path = os.path.join(data_dir, "seven_channels.csv")
@@ -151,6 +169,7 @@ def peers(data_dir, quick, only=None):
     except ImportError:
         pass
     res["read_csv_7x204800"] = csv
+    res.update(npy_peer(data_dir, quick))
     res.update(ssi_peer(data_dir, meta, quick))
     # ARMA fits (statsmodels exact-likelihood ARIMA), same data as vibmode.
     try:

@@ -206,6 +206,19 @@ fn gen(dir: &Path) -> Result<()> {
         writeln!(csv, "{}", cells.join(","))?;
     }
     csv.flush()?;
+    // The same samples as NumPy's `.npy` of shape (n, 7), C order: NumPy's header (version 1.0,
+    // padded to 64 bytes) before the interleaved values; `bench/run.py` checks that `numpy.load`
+    // gives back `raw`.
+    let mut header = format!("{{'descr': '<f8', 'fortran_order': False, 'shape': ({n}, 7), }}");
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    let mut npy = b"\x93NUMPY\x01\x00".to_vec();
+    npy.extend((header.len() as u16).to_le_bytes());
+    npy.extend(header.as_bytes());
+    npy.extend(raw.iter().flat_map(|v| v.to_le_bytes()));
+    std::fs::write(dir.join("seven_channels.npy"), npy)?;
     for p in ARMA_ORDERS {
         write_f64(
             &dir.join(format!("arma{p}.f64")),
@@ -354,6 +367,19 @@ fn run(dir: &Path, quick: bool) -> Result<Value> {
     out.insert(
         "read_csv_7x204800".into(),
         json!({"vibmode_signal::read_path": t_csv}),
+    );
+    // Reading the same samples as a NumPy array.
+    let npy_path = dir.join("seven_channels.npy");
+    let t_npy = median_time(if quick { 3 } else { 11 }, || {
+        let rec = vibmode_signal::read_path(&npy_path, &opts)?;
+        if rec.channels.len() != 7 || rec.len() != 204_800 {
+            bail!("read {} channels x {} rows", rec.channels.len(), rec.len());
+        }
+        Ok(())
+    })?;
+    out.insert(
+        "read_npy_7x204800".into(),
+        json!({"vibmode_signal::read_path": t_npy}),
     );
     // Clustering the paper-size pole cloud.
     let cloud: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("poles.json"))?)?;

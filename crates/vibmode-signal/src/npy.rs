@@ -160,26 +160,20 @@ pub(crate) fn npy_layout_of(path: &Path) -> Result<NpyLayout> {
 
 /// The channels of a `.npy` file's data bytes (after the header) laid out as `layout` says.
 pub(crate) fn npy_channels(data: &[u8], layout: &NpyLayout) -> Vec<Vec<f64>> {
-    let (n, nch, w) = (layout.frames as usize, layout.channels, layout.width);
-    let decode = |b: &[u8]| -> f64 {
-        if w == 4 {
-            f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64
+    use crate::stream::{deinterleave, f32_le};
+    let decode = |bytes: &[u8], nch: usize| {
+        if layout.width == 4 {
+            deinterleave(bytes, nch, 1.0, f32_le)
         } else {
-            f64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]])
+            deinterleave(bytes, nch, 1.0, f64::from_le_bytes)
         }
     };
     if layout.fortran {
-        data.chunks_exact(n * w)
-            .map(|col| col.chunks_exact(w).map(decode).collect())
+        data.chunks_exact(layout.frames as usize * layout.width)
+            .flat_map(|column| decode(column, 1))
             .collect()
     } else {
-        let mut out: Vec<Vec<f64>> = (0..nch).map(|_| Vec::with_capacity(n)).collect();
-        for frame in data.chunks_exact(nch * w) {
-            for (ch, v) in out.iter_mut().zip(frame.chunks_exact(w)) {
-                ch.push(decode(v));
-            }
-        }
-        out
+        decode(data, layout.channels)
     }
 }
 
