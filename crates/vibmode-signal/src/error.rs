@@ -269,7 +269,7 @@ pub enum SignalError {
         problem: NpyProblem,
     },
     /// A NumPy `.npy` file (which holds no rate) read without a sampling rate.
-    #[error("{path_q} is a NumPy array, which holds no sampling rate; give its sampling rate (fs_hz)", path_q = vibmode_core::quoted(.path))]
+    #[error("{path_q} is a NumPy array, which holds no sampling rate; give its sampling rate (fs_hz), or write it into the sidecar {path_q}.json as {{\"fs_hz\": 20000}}", path_q = vibmode_core::quoted(.path))]
     NpyNoSampleRate {
         /// The file.
         path: String,

@@ -7,7 +7,8 @@
 //! spaces and ended by a newline; the data follows. The header is parsed here (three keys of
 //! fixed kinds) rather than by a crate that brings a whole Python-literal grammar.
 
-use crate::error::{io_err, NpyProblem, Result, SignalError};
+use crate::error::{io_err, NpyProblem, Result, SidecarProblem, SignalError};
+use crate::read::reconcile_fs;
 use std::io::Read;
 use std::path::Path;
 use vibmode_core::limits::CHANNELS_MAX;
@@ -149,6 +150,47 @@ pub(crate) fn npy_layout(path: &Path, r: &mut impl Read, file_bytes: u64) -> Res
         channels: channels as usize,
         data_offset,
     })
+}
+
+/// The sampling rate of the `.npy` file `path`: `"fs_hz"` of its sidecar `<path>.json` when
+/// it has one (checked against `given` within 1 %), else `given`, else an error.
+pub(crate) fn npy_rate(path: &Path, given: Option<f64>) -> Result<f64> {
+    let p = path.display().to_string();
+    let mut side = path.as_os_str().to_owned();
+    side.push(".json");
+    let side = std::path::PathBuf::from(side);
+    let from_side = if side.is_file() {
+        let sp = side.display().to_string();
+        let text =
+            vibmode_core::files::read_text_capped(&side).map_err(|e| io_err("read", &side, &e))?;
+        let bad = |problem| SignalError::Sidecar {
+            path: sp.clone(),
+            problem,
+        };
+        let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
+            bad(SidecarProblem::WavJson {
+                message: e.to_string(),
+            })
+        })?;
+        match v.get("fs_hz") {
+            None | Some(serde_json::Value::Null) => None,
+            Some(serde_json::Value::Number(n)) => {
+                let fs_hz = n.as_f64().unwrap_or(f64::NAN);
+                if !(fs_hz.is_finite() && fs_hz > 0.0) {
+                    return Err(bad(SidecarProblem::Rate { fs_hz }));
+                }
+                Some((fs_hz, sp))
+            }
+            Some(_) => return Err(bad(SidecarProblem::Rate { fs_hz: f64::NAN })),
+        }
+    } else {
+        None
+    };
+    match (from_side, given) {
+        (Some((fs_hz, sp)), given) => reconcile_fs(&p, format!("the sidecar {sp}"), fs_hz, given),
+        (None, Some(g)) => Ok(g),
+        (None, None) => Err(SignalError::NpyNoSampleRate { path: p }),
+    }
 }
 
 /// The layout of the file `path`, opened and measured.

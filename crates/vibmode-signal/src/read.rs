@@ -781,7 +781,9 @@ fn sidecar_time_axis(sidecar: &Path, fs_hz: f64) -> Result<Option<TimeAxis>> {
 /// cannot hold. vibmode writes one beside every WAV it writes; other keys are ignored.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct WavSidecar {
-    /// Channel names, in the WAV's channel order.
+    /// Channel names, in the WAV's channel order (none given: `ch0`, `ch1`, ..., as without a
+    /// sidecar; a sidecar may hold only a `start_time`, or an `.npy` file's `fs_hz`).
+    #[serde(default)]
     pub channels: Vec<String>,
     /// Units per channel (optional; same length as `channels`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -812,9 +814,14 @@ pub(crate) fn wav_names(path: &Path, nch: usize) -> Result<(Vec<String>, Vec<Str
             message: e.to_string(),
         })
     })?;
-    if w.channels.len() != nch {
+    let names = if w.channels.is_empty() {
+        (0..nch).map(|c| format!("ch{c}")).collect()
+    } else {
+        w.channels
+    };
+    if names.len() != nch {
         return Err(bad(SidecarProblem::WavChannels {
-            names: w.channels.len(),
+            names: names.len(),
             channels: nch,
         }));
     }
@@ -828,7 +835,7 @@ pub(crate) fn wav_names(path: &Path, nch: usize) -> Result<(Vec<String>, Vec<Str
         }
         None => vec![String::new(); nch],
     };
-    Ok((w.channels, units))
+    Ok((names, units))
 }
 
 /// The JSON sidecar of a raw binary file.
@@ -935,10 +942,7 @@ fn read_npy(path: &Path, bytes: Option<&[u8]>, opts: &ReadOptions) -> Result<Rec
     };
     let layout =
         crate::npy::npy_layout(path, &mut std::io::Cursor::new(bytes), bytes.len() as u64)?;
-    let p = path.display().to_string();
-    let fs = opts
-        .fs_hz
-        .ok_or_else(|| SignalError::NpyNoSampleRate { path: p.clone() })?;
+    let fs = crate::npy::npy_rate(path, opts.fs_hz)?;
     named_recording(
         path,
         fs,

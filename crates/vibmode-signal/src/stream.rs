@@ -344,9 +344,7 @@ fn sidecar_of(path: &Path) -> std::path::PathBuf {
 fn open_npy(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
     let p = path.display().to_string();
     let layout = crate::npy::npy_layout_of(path)?;
-    let fs = opts
-        .fs_hz
-        .ok_or_else(|| SignalError::NpyNoSampleRate { path: p.clone() })?;
+    let fs = crate::npy::npy_rate(path, opts.fs_hz)?;
     let nch = layout.channels;
     let (names, units) = wav_names(path, nch)?;
     let info = StreamInfo {

@@ -771,6 +771,15 @@ fn wav_keeps_channel_names_and_units_through_its_sidecar() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("names 1 channels but the file has 2"), "{e}");
+    // a sidecar with only a start time: ch0, ch1, and the start time
+    std::fs::write(
+        dir.path().join("r.wav.json"),
+        r#"{"start_time": "2026-11-28T08:00:00Z"}"#,
+    )
+    .unwrap();
+    let timed = vibmode_signal::read_path(&path, &vibmode_signal::ReadOptions::default()).unwrap();
+    assert_eq!(timed.channels[1].name, "ch1");
+    assert!(timed.time_axis.is_some());
     // without a sidecar: ch0, ch1
     std::fs::remove_file(dir.path().join("r.wav.json")).unwrap();
     let plain = vibmode_signal::read_path(&path, &vibmode_signal::ReadOptions::default()).unwrap();

@@ -258,8 +258,9 @@ fn npy_files_read_and_stream_as_their_arrays_over_seeds() {
 }
 
 /// A `.npy` file without a rate, cut short, or of integers is refused by both readers with the
-/// value named; its channels take names and units from `<file>.json` as a WAV's do; writing
-/// `.npy` is refused with the formats that are written.
+/// value named; its channels take names and units from `<file>.json` as a WAV's do, and its
+/// rate that file's `fs_hz` (checked against a given rate); writing `.npy` is refused with the
+/// formats that are written.
 #[test]
 fn npy_refusals_name_the_value() {
     let dir = tmp();
@@ -307,6 +308,24 @@ fn npy_refusals_name_the_value() {
     std::fs::write(&side, r#"{"channels": ["FL_z"]}"#).unwrap();
     let e = read_path(&q, &opts).unwrap_err().to_string();
     assert!(e.contains("names 1 channels but the file has 2"), "{e}");
+    // The rate from the sidecar's `fs_hz` (names then ch0, ch1), checked against a given one.
+    std::fs::write(&q, npy_bytes(&chans, false, false, 1)).unwrap();
+    std::fs::write(&side, r#"{"fs_hz": 512.5}"#).unwrap();
+    let rated = read_path(&q, &ReadOptions::default()).unwrap();
+    assert_eq!((rated.fs_hz, rated.names()), (512.5, vec!["ch0", "ch1"]));
+    same(&stream_all(&q, &ReadOptions::default(), 64), &rated);
+    let e = read_path(&q, &opts).unwrap_err().to_string();
+    assert!(e.contains("512.5 Hz but 100 Hz was given"), "{e}");
+    std::fs::write(&side, r#"{"fs_hz": "fast"}"#).unwrap();
+    for e in [
+        read_path(&q, &opts).unwrap_err(),
+        open_stream(&q, &opts).unwrap_err(),
+    ] {
+        assert!(
+            e.to_string().contains("must be a positive finite number"),
+            "{e}"
+        );
+    }
     let rec = random_recording(1, 100, 2, 100.0);
     let e = write_path(&dir.path().join("out.npy"), &rec)
         .unwrap_err()
