@@ -102,10 +102,13 @@ struct Interp {
 }
 
 enum Inner {
-    /// Little-endian floats stored channel after channel (a Fortran-order `.npy`), one reader
-    /// per channel.
+    /// Little-endian floats stored channel after channel (a Fortran-order `.npy`): each block
+    /// read column by column from one file handle, at each column's start plus the frames
+    /// already handed out.
     Columns {
-        files: Vec<BufReader<File>>,
+        file: File,
+        column_starts: Vec<u64>,
+        done: u64,
         width: usize,
         remaining: u64,
         buf: Vec<u8>,
@@ -357,28 +360,24 @@ fn open_npy(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
         start_s: 0.0,
         start_time: sidecar_start_time(&sidecar_of(path)),
     };
-    let at = |offset: u64| -> Result<BufReader<File>> {
-        let mut f = open_file(path)?;
-        f.seek(SeekFrom::Start(offset))
-            .map_err(|e| io_err("read", path, &e))?;
-        // Per channel in Fortran order: smaller buffers, one per channel.
-        let cap = if layout.fortran { 1 << 16 } else { 1 << 20 };
-        Ok(BufReader::with_capacity(cap, f))
-    };
     let inner = if layout.fortran {
-        // Channel after channel: one reader per channel, each at its column.
         let column_bytes = layout.frames * layout.width as u64;
         Inner::Columns {
-            files: (0..nch as u64)
-                .map(|c| at(layout.data_offset + c * column_bytes))
-                .collect::<Result<_>>()?,
+            file: open_file(path)?,
+            column_starts: (0..nch as u64)
+                .map(|c| layout.data_offset + c * column_bytes)
+                .collect(),
+            done: 0,
             width: layout.width,
             remaining: layout.frames,
             buf: Vec::new(),
         }
     } else {
+        let mut f = open_file(path)?;
+        f.seek(SeekFrom::Start(layout.data_offset))
+            .map_err(|e| io_err("read", path, &e))?;
         Inner::Raw {
-            file: at(layout.data_offset)?,
+            file: BufReader::with_capacity(1 << 20, f),
             width: layout.width,
             remaining: layout.frames,
             buf: Vec::new(),
@@ -802,7 +801,9 @@ impl FrameStream {
         }
         let all = match &mut self.inner {
             Inner::Columns {
-                files,
+                file,
+                column_starts,
+                done,
                 width,
                 remaining,
                 buf,
@@ -810,13 +811,17 @@ impl FrameStream {
                 let Some(n) = block_bytes(*remaining, max_frames, 1, *width, buf) else {
                     return Ok(None);
                 };
-                let mut out = Vec::with_capacity(files.len());
-                for file in files.iter_mut() {
-                    file.read_exact(buf).map_err(|e| SignalError::Io {
-                        action: "read",
-                        path: self.info.path.clone(),
-                        message: format!("{e} (was the file cut off or changed while being read?)"),
-                    })?;
+                let mut out = Vec::with_capacity(column_starts.len());
+                for &start in column_starts.iter() {
+                    file.seek(SeekFrom::Start(start + *done * *width as u64))
+                        .and_then(|_| file.read_exact(buf))
+                        .map_err(|e| SignalError::Io {
+                            action: "read",
+                            path: self.info.path.clone(),
+                            message: format!(
+                                "{e} (was the file cut off or changed while being read?)"
+                            ),
+                        })?;
                     out.push(if *width == 4 {
                         deinterleave(buf, 1, 1.0, f32_le).remove(0)
                     } else {
@@ -824,6 +829,7 @@ impl FrameStream {
                     });
                 }
                 *remaining -= n as u64;
+                *done += n as u64;
                 out
             }
             Inner::Raw {
