@@ -74,7 +74,8 @@ pub fn selectors(channels: &[String]) -> Result<Vec<ChannelSelector>> {
 /// Options every analysis command shares for reading its input.
 #[derive(Args, Debug, Clone)]
 pub struct InputArgs {
-    /// Input file: delimited text (.csv, .txt, .tsv), WAV (.wav), or raw f32/f64 with a JSON sidecar.
+    /// Input file: delimited text (.csv, .txt, .tsv), WAV (.wav), raw f32/f64 with a JSON sidecar,
+    /// or a NumPy array (.npy, samples x channels).
     pub input: PathBuf,
     #[command(flatten)]
     pub channel: ChannelArgs,
