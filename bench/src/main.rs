@@ -351,36 +351,33 @@ fn run(dir: &Path, quick: bool) -> Result<Value> {
         "resample_7x204800_20k_to_200".into(),
         json!({"Recording::resample (ideal DFT filter)": t_res}),
     );
-    // Reading the CSV.
-    let csv_path = dir.join("seven_channels.csv");
+    // Reading the CSV, and the same samples as a NumPy array.
     let opts = vibmode_signal::ReadOptions {
         fs_hz: Some(20000.0),
         ..Default::default()
     };
-    let t_csv = median_time(if quick { 2 } else { 7 }, || {
-        let rec = vibmode_signal::read_path(&csv_path, &opts)?;
-        if rec.channels.len() != 7 || rec.len() != 204_800 {
-            bail!("read {} channels x {} rows", rec.channels.len(), rec.len());
-        }
-        Ok(())
-    })?;
-    out.insert(
-        "read_csv_7x204800".into(),
-        json!({"vibmode_signal::read_path": t_csv}),
-    );
-    // Reading the same samples as a NumPy array.
-    let npy_path = dir.join("seven_channels.npy");
-    let t_npy = median_time(if quick { 3 } else { 11 }, || {
-        let rec = vibmode_signal::read_path(&npy_path, &opts)?;
-        if rec.channels.len() != 7 || rec.len() != 204_800 {
-            bail!("read {} channels x {} rows", rec.channels.len(), rec.len());
-        }
-        Ok(())
-    })?;
-    out.insert(
-        "read_npy_7x204800".into(),
-        json!({"vibmode_signal::read_path": t_npy}),
-    );
+    for (case, file, repeat) in [
+        (
+            "read_csv_7x204800",
+            "seven_channels.csv",
+            if quick { 2 } else { 7 },
+        ),
+        (
+            "read_npy_7x204800",
+            "seven_channels.npy",
+            if quick { 3 } else { 11 },
+        ),
+    ] {
+        let path = dir.join(file);
+        let t = median_time(repeat, || {
+            let rec = vibmode_signal::read_path(&path, &opts)?;
+            if rec.channels.len() != 7 || rec.len() != 204_800 {
+                bail!("read {} channels x {} rows", rec.channels.len(), rec.len());
+            }
+            Ok(())
+        })?;
+        out.insert(case.into(), json!({"vibmode_signal::read_path": t}));
+    }
     // Clustering the paper-size pole cloud.
     let cloud: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("poles.json"))?)?;
     let poles: Vec<vibmode_core::PoleObservation> = serde_json::from_value(cloud["poles"].clone())?;

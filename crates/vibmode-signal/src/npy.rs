@@ -8,7 +8,7 @@
 //! fixed kinds) rather than by a crate that brings a whole Python-literal grammar.
 
 use crate::error::{io_err, NpyProblem, Result, SidecarProblem, SignalError};
-use crate::read::reconcile_fs;
+use crate::read::{reconcile_fs, sidecar_of};
 use std::io::Read;
 use std::path::Path;
 use vibmode_core::limits::CHANNELS_MAX;
@@ -106,6 +106,11 @@ pub(crate) fn npy_layout(path: &Path, r: &mut impl Read, file_bytes: u64) -> Res
             ))
         }
     };
+    if frames == 0 || channels == 0 {
+        return Err(SignalError::EmptyFile {
+            path: path.display().to_string(),
+        });
+    }
     if channels > frames {
         return Err(problem(
             path,
@@ -122,11 +127,6 @@ pub(crate) fn npy_layout(path: &Path, r: &mut impl Read, file_bytes: u64) -> Res
             max: CHANNELS_MAX,
         }
         .into());
-    }
-    if frames == 0 || channels == 0 {
-        return Err(SignalError::EmptyFile {
-            path: path.display().to_string(),
-        });
     }
     let data_offset = (fixed + len) as u64;
     let expected = frames
@@ -156,9 +156,7 @@ pub(crate) fn npy_layout(path: &Path, r: &mut impl Read, file_bytes: u64) -> Res
 /// it has one (checked against `given` within 1 %), else `given`, else an error.
 pub(crate) fn npy_rate(path: &Path, given: Option<f64>) -> Result<f64> {
     let p = path.display().to_string();
-    let mut side = path.as_os_str().to_owned();
-    side.push(".json");
-    let side = std::path::PathBuf::from(side);
+    let side = sidecar_of(path);
     let from_side = if side.is_file() {
         let sp = side.display().to_string();
         let text =

@@ -20,7 +20,7 @@ pub enum Format {
     Raw,
     /// NumPy's `.npy` (`numpy.save`): a 1-D array of samples or a 2-D array of samples by
     /// channels, little-endian float32 or float64; channels named as WAV's are (`<path>.json`,
-    /// else `ch0`, `ch1`, ...); the rate must be given.
+    /// else `ch0`, `ch1`, ...); the rate given, or that sidecar's `fs_hz`.
     Npy,
 }
 
@@ -738,12 +738,10 @@ fn named_recording(path: &Path, fs_hz: f64, samples: Vec<Vec<f64>>) -> Result<Re
         })
         .collect();
     check_finite(&channels)?;
-    let mut side = path.as_os_str().to_owned();
-    side.push(".json");
     Ok(Recording {
         fs_hz,
         channels,
-        time_axis: sidecar_time_axis(Path::new(&side), fs_hz)?,
+        time_axis: sidecar_time_axis(&sidecar_of(path), fs_hz)?,
     })
 }
 
@@ -793,9 +791,7 @@ pub struct WavSidecar {
 /// Channel names and units of a WAV or `.npy` file: from `<path>.json` when it exists, else
 /// `ch0`, `ch1`, ...
 pub(crate) fn wav_names(path: &Path, nch: usize) -> Result<(Vec<String>, Vec<String>)> {
-    let mut full = path.as_os_str().to_owned();
-    full.push(".json");
-    let side = PathBuf::from(full);
+    let side = sidecar_of(path);
     if !side.is_file() {
         return Ok((
             (0..nch).map(|c| format!("ch{c}")).collect(),
@@ -852,11 +848,16 @@ pub struct Sidecar {
     pub units: Option<Vec<String>>,
 }
 
+/// `<path>.json`: the sidecar of a WAV or `.npy` file, and the first one tried for a raw file.
+pub(crate) fn sidecar_of(path: &Path) -> PathBuf {
+    let mut side = path.as_os_str().to_owned();
+    side.push(".json");
+    side.into()
+}
+
 /// The sidecar paths tried for a raw file, in order: `<path>.json`, then `<stem>.json`.
 pub fn sidecar_candidates(path: &Path) -> Vec<PathBuf> {
-    let mut full = path.as_os_str().to_owned();
-    full.push(".json");
-    let mut v = vec![PathBuf::from(full)];
+    let mut v = vec![sidecar_of(path)];
     if path.extension().is_some() {
         v.push(path.with_extension("json"));
     }

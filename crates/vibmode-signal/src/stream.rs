@@ -23,7 +23,7 @@
 
 use crate::delimited::{check_row_index, Block, ColumnInfo, DelimitedReader};
 use crate::error::{io_err, Result, SignalError, WavProblem};
-use crate::read::{raw_layout, reconcile_fs, wav_names, Format, ReadOptions};
+use crate::read::{raw_layout, reconcile_fs, sidecar_of, wav_names, Format, ReadOptions};
 use std::collections::VecDeque;
 use std::fs::File;
 use std::io::{BufReader, Read, Seek, SeekFrom};
@@ -335,13 +335,6 @@ fn open_raw(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
             buf: Vec::new(),
         },
     ))
-}
-
-/// `<path>.json`: the sidecar of a WAV or `.npy` file.
-fn sidecar_of(path: &Path) -> std::path::PathBuf {
-    let mut side = path.as_os_str().to_owned();
-    side.push(".json");
-    side.into()
 }
 
 fn open_npy(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
