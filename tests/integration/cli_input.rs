@@ -334,7 +334,11 @@ fn a_folder_stands_for_its_recordings() {
     let out = d.path().join("never");
     fails_with(
         &["analyze", "-q", s(&empty), "-o", s(&out)],
-        &["holds no recording", "give the record files"],
+        &[
+            "holds no recording",
+            ".wav, NumPy .npy",
+            "give the record files",
+        ],
     );
     std::fs::copy(recs.join("rec_a.csv"), recs.join("rec_a.txt")).unwrap();
     fails_with(

@@ -947,6 +947,7 @@ impl<R: BufRead> DelimitedReader<R> {
                 None => {
                     return Err(SignalError::EmptyFile {
                         path: r.path.clone(),
+                        expected: "numeric rows (optionally after one header row)",
                     })
                 }
                 Some(n) => {

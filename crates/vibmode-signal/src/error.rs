@@ -44,7 +44,7 @@ pub enum SignalError {
         message: String,
     },
     /// A folder given as an input holds no recording.
-    #[error("the folder {path_q} holds no recording (.csv, .txt, .tsv, .dat, .asc, .wav, or raw .f32, .f64, .bin, .raw with a .json sidecar); give the record files or another folder", path_q = vibmode_core::quoted(.path))]
+    #[error("the folder {path_q} holds no recording (.csv, .txt, .tsv, .dat, .asc, .wav, NumPy .npy, or raw .f32, .f64, .bin, .raw with a .json sidecar); give the record files or another folder", path_q = vibmode_core::quoted(.path))]
     FolderWithoutRecordings {
         /// The folder.
         path: String,
@@ -61,10 +61,12 @@ pub enum SignalError {
         second: String,
     },
     /// The file has no content at all.
-    #[error("{path_q} is empty; expected numeric rows (optionally after one header row)", path_q = vibmode_core::quoted(.path))]
+    #[error("{path_q} is empty; expected {expected}", path_q = vibmode_core::quoted(.path))]
     EmptyFile {
         /// The file.
         path: String,
+        /// What the file should hold, for its format.
+        expected: &'static str,
     },
     /// Bytes that are not text (NUL or other control characters) where delimited text was
     /// expected.
@@ -324,6 +326,14 @@ pub enum NpyProblem {
         /// The shape, as NumPy prints it.
         shape: String,
     },
+    /// A shape with no samples or no channels.
+    #[error(
+        "an array of shape {shape} holds no samples; save the recording's samples by channels"
+    )]
+    Empty {
+        /// The shape, as NumPy prints it.
+        shape: String,
+    },
     /// More columns than rows: most likely channels by samples.
     #[error("shape ({rows}, {columns}) would be {columns} channels of {rows} samples (rows are samples, columns channels); save the transpose: numpy.save(path, a.T)")]
     Transposed {
@@ -343,6 +353,10 @@ pub enum NpyProblem {
         width: usize,
     },
 }
+
+/// What an empty raw file should hold ([`SignalError::EmptyFile`]).
+pub(crate) const RAW_EXPECTED: &str =
+    "the raw samples its sidecar describes (one value per channel per frame)";
 
 /// What makes a WAV file unusable (the detail of [`SignalError::Wav`]). The WAV library's own
 /// messages are kept as their text.

@@ -107,9 +107,12 @@ pub(crate) fn npy_layout(path: &Path, r: &mut impl Read, file_bytes: u64) -> Res
         }
     };
     if frames == 0 || channels == 0 {
-        return Err(SignalError::EmptyFile {
-            path: path.display().to_string(),
-        });
+        return Err(problem(
+            path,
+            NpyProblem::Empty {
+                shape: shape_text(&shape),
+            },
+        ));
     }
     if channels > frames {
         return Err(problem(

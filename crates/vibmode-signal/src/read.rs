@@ -1,7 +1,7 @@
 //! Reading recordings from delimited text, WAV and raw binary files.
 
 use crate::delimited::{check_row_index, Block, ColumnInfo, DelimitedReader};
-use crate::error::{io_err, Result, SidecarProblem, SignalError, WavProblem};
+use crate::error::{io_err, Result, SidecarProblem, SignalError, WavProblem, RAW_EXPECTED};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::io::BufRead;
@@ -972,7 +972,10 @@ fn read_raw(path: &Path, opts: &ReadOptions) -> Result<Recording> {
     }
     let n = bytes.len() / frame;
     if n == 0 {
-        return Err(SignalError::EmptyFile { path: p });
+        return Err(SignalError::EmptyFile {
+            path: p,
+            expected: RAW_EXPECTED,
+        });
     }
     let fs = reconcile_fs(&p, format!("the sidecar {sp}"), side.fs_hz, opts.fs_hz)?;
     let mut channels: Vec<Channel> = side

@@ -22,7 +22,7 @@
 //! Every sample is checked to be finite, naming the channel and the sample's index in the file.
 
 use crate::delimited::{check_row_index, Block, ColumnInfo, DelimitedReader};
-use crate::error::{io_err, Result, SignalError, WavProblem};
+use crate::error::{io_err, Result, SignalError, WavProblem, RAW_EXPECTED};
 use crate::read::{raw_layout, reconcile_fs, sidecar_of, wav_names, Format, ReadOptions};
 use std::collections::VecDeque;
 use std::fs::File;
@@ -304,7 +304,10 @@ fn open_raw(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
     }
     let n = bytes / frame;
     if n == 0 {
-        return Err(SignalError::EmptyFile { path: p });
+        return Err(SignalError::EmptyFile {
+            path: p,
+            expected: RAW_EXPECTED,
+        });
     }
     let fs = reconcile_fs(
         &p,

@@ -292,6 +292,33 @@ fn npy_refusals_name_the_value() {
     std::fs::write(&p, &ints).unwrap();
     let e = read_path(&p, &opts).unwrap_err().to_string();
     assert!(e.contains("'<i8'") && e.contains("astype"), "{e}");
+    // An array with no samples (`numpy.save(p, np.empty((0, 7)))`), and a raw file with none.
+    std::fs::write(&p, npy_file("<f8", false, "(0, 7)", &[], 1)).unwrap();
+    for e in [
+        read_path(&p, &opts).unwrap_err(),
+        open_stream(&p, &opts).unwrap_err(),
+    ] {
+        let e = e.to_string();
+        assert!(e.contains("shape (0, 7) holds no samples"), "{e}");
+        assert!(!e.contains("header row"), "{e}");
+    }
+    let raw = dir.path().join("e.f32");
+    std::fs::write(&raw, b"").unwrap();
+    std::fs::write(
+        dir.path().join("e.f32.json"),
+        r#"{"fs_hz": 100, "dtype": "f32", "channels": ["a"]}"#,
+    )
+    .unwrap();
+    for e in [
+        read_path(&raw, &ReadOptions::default()).unwrap_err(),
+        open_stream(&raw, &ReadOptions::default()).unwrap_err(),
+    ] {
+        let e = e.to_string();
+        assert!(
+            e.contains("e.f32 is empty; expected the raw samples"),
+            "{e}"
+        );
+    }
     // Names and units from `<file>.json`, as a WAV's; a list of the wrong length is refused.
     let q = dir.path().join("named.npy");
     std::fs::write(&q, npy_bytes(&chans, true, true, 1)).unwrap();
