@@ -9,6 +9,16 @@ pub enum SignalError {
     /// lengths) or a channel that cannot be found.
     #[error(transparent)]
     Recording(#[from] vibmode_core::RecordingError),
+    /// A NaN, infinite or too large sample in a file ([`vibmode_core::RecordingError::NonFinite`],
+    /// [`vibmode_core::RecordingError::SampleTooLarge`]), with the file named: among many records
+    /// the channel and sample alone do not tell which file to clean.
+    #[error("{}: {source}", vibmode_core::quoted(.path))]
+    BadSample {
+        /// The file.
+        path: String,
+        /// The sample, its channel and index.
+        source: vibmode_core::RecordingError,
+    },
     /// A file with two channels of the same name.
     #[error("{}: channels {} and {} are both named '{}'; give each channel its own name (in the file's header or its sidecar)", vibmode_core::quoted(.path), .first + 1, .second + 1, vibmode_core::quoted(.name))]
     SameChannelName {
@@ -504,6 +514,20 @@ pub(crate) fn io_err(
         action,
         path: path.display().to_string(),
         message: e.to_string(),
+    }
+}
+
+/// `e` with the file `path` named where it is a bad sample ([`SignalError::BadSample`]).
+pub(crate) fn in_file(path: &str, e: SignalError) -> SignalError {
+    use vibmode_core::RecordingError as R;
+    match e {
+        SignalError::Recording(r @ (R::NonFinite { .. } | R::SampleTooLarge { .. })) => {
+            SignalError::BadSample {
+                path: path.to_string(),
+                source: r,
+            }
+        }
+        e => e,
     }
 }
 

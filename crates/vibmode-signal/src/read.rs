@@ -230,6 +230,7 @@ impl ReadOptions {
 /// All samples are checked to be finite; channel order is file order (time column removed).
 pub fn read_path(path: &Path, opts: &ReadOptions) -> Result<Recording> {
     read_path_or_bytes(path, None, opts)
+        .map_err(|e| crate::error::in_file(&path.display().to_string(), e))
 }
 
 /// Reads a recording from the bytes of the file at `path`, already read (for example to hash
@@ -238,6 +239,7 @@ pub fn read_path(path: &Path, opts: &ReadOptions) -> Result<Recording> {
 /// a raw file is read from `path` with its sidecar as by [`read_path`].
 pub fn read_path_bytes(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Recording> {
     read_path_or_bytes(path, Some(bytes), opts)
+        .map_err(|e| crate::error::in_file(&path.display().to_string(), e))
 }
 
 fn read_path_or_bytes(path: &Path, bytes: Option<&[u8]>, opts: &ReadOptions) -> Result<Recording> {

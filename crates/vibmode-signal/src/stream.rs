@@ -242,6 +242,11 @@ fn open_file(path: &Path) -> Result<File> {
 /// Opens `path` as a stream of frame blocks (see the module documentation). The options are
 /// those of [`crate::read_path`] (`unit` fills in missing units).
 pub fn open_stream(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
+    open_stream_of_file(path, opts)
+        .map_err(|e| crate::error::in_file(&path.display().to_string(), e))
+}
+
+fn open_stream_of_file(path: &Path, opts: &ReadOptions) -> Result<FrameStream> {
     opts.check()?;
     let format = opts.format.unwrap_or_else(|| Format::from_path(path));
     let mut s = match format {
@@ -788,6 +793,11 @@ impl FrameStream {
     /// Errors: read errors (a WAV cut off mid-write), parse errors of text files (naming line and
     /// column), non-finite samples (naming channel and frame), `max_frames` = 0.
     pub fn next_block(&mut self, max_frames: usize) -> Result<Option<FrameBlock>> {
+        self.next_block_of_file(max_frames)
+            .map_err(|e| crate::error::in_file(&self.info.path, e))
+    }
+
+    fn next_block_of_file(&mut self, max_frames: usize) -> Result<Option<FrameBlock>> {
         if max_frames == 0 {
             return Err(SignalError::InvalidParam {
                 name: "max_frames",

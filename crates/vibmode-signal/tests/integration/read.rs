@@ -282,11 +282,17 @@ fn bad_delimited_inputs() {
         &o,
     ));
     assert!(
-        e.contains("channel 'y' sample 2 is NaN") && e.contains("clean the data"),
+        e.contains("nan.csv: channel 'y' sample 2 is NaN") && e.contains("clean the data"),
         "{e}"
     );
     let e = err_of(read_path(&write(d.path(), "inf.csv", "x\n1\n-inf\n"), &o));
-    assert!(e.contains("sample 1 is -inf"), "{e}");
+    assert!(e.contains("inf.csv: channel 'x' sample 1 is -inf"), "{e}");
+    // Streamed too, the file is named (among many records the channel alone does not tell).
+    let e = vibmode_signal::open_stream(&d.path().join("inf.csv"), &o)
+        .and_then(|mut s| s.read_to_recording())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("inf.csv: channel 'x' sample 1 is -inf"), "{e}");
     let ok = write(d.path(), "ok.csv", "x\n1\n2\n");
     for bad in [0.0, -3.0, f64::NAN, f64::INFINITY] {
         let e = err_of(read_path(&ok, &opts_fs(bad)));
