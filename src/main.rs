@@ -7,6 +7,7 @@
 mod cmd_analyze;
 mod cmd_fit;
 mod cmd_fleet;
+mod cmd_info;
 mod cmd_psd;
 mod cmd_resample;
 mod cmd_segment;
@@ -39,6 +40,10 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// What each recording file holds: format, rate, channels, length, start time, and each
+    /// channel's range, mean, std and RMS (a dead or stuck sensor marked).
+    #[command(allow_negative_numbers = true)]
+    Info(cmd_info::InfoArgs),
     /// Power spectral density (Welch and/or periodogram) of one or more channels.
     #[command(allow_negative_numbers = true)]
     Psd(cmd_psd::PsdArgs),
@@ -93,6 +98,7 @@ fn main() -> ExitCode {
     };
     progress::set_quiet(cli.quiet);
     let result = match cli.command {
+        Command::Info(a) => cmd_info::run(&a),
         Command::Psd(a) => cmd_psd::run(&a),
         Command::Resample(a) => cmd_resample::run(&a),
         Command::Segment(a) => cmd_segment::run(&a),

@@ -98,3 +98,34 @@ def test_fleet_check_and_status_print_as_the_cli(tmp_path):
     cli = subprocess.run([str(exe), "fleet", "status", "--db", str(db)], check=True, capture_output=True,
                          text=True)
     assert str(st) == cli.stdout
+
+
+def test_info_statistics_agree_with_numpy(tmp_path):
+    """`vibmode info --json` against numpy (the independent implementation) on arrays numpy
+    writes: min and max exactly; mean, population std (`ddof=0`) and RMS per channel within
+    1e-12 relative, times the channel's condition |mean| / std for the std (both sides round
+    each sample at |mean|: a channel at 1e5 with std 1e-3 agrees to about 1e-12 x 1e8; a naive
+    sum of squares would lose it entirely, 1e-16 x 1e16). Over seeds, lengths across the
+    reader's 65 536-frame blocks; a dead channel is marked."""
+    np = pytest.importorskip("numpy")
+    exe = binary()
+    if exe is None:
+        pytest.skip("no vibmode binary (set VIBMODE_BIN or run cargo build first)")
+    for seed, n in [(1, 5), (2, 65_536), (3, 65_537), (4, 200_003)]:
+        rng = np.random.default_rng(seed)
+        a = rng.standard_normal((n, 3)) * [1.0, 1e-3, 50.0] + [0.0, 1e5, -7.0]
+        a[:, 0] = 0.0 if seed == 1 else a[:, 0]
+        path = tmp_path / f"a{seed}.npy"
+        np.save(path, a)
+        out = subprocess.run([str(exe), "info", "--json", "--fs", "2000", str(path)],
+                             check=True, capture_output=True, text=True).stdout
+        (s,) = json.loads(out)
+        assert (s["frames"], s["fs_hz"], len(s["channels"])) == (n, 2000.0, 3)
+        assert s["duration_s"] == pytest.approx(n / 2000.0, rel=1e-15)
+        for c, x in zip(s["channels"], a.T):
+            assert (c["min"], c["max"]) == (x.min(), x.max())
+            cond = max(1.0, abs(x.mean()) / max(x.std(), 1e-300))
+            for key, ref, rel in [("mean", x.mean(), 1e-12), ("std", x.std(), 1e-12 * cond),
+                                  ("rms", np.sqrt(np.mean(x * x)), 1e-12)]:
+                assert c[key] == pytest.approx(ref, rel=rel, abs=1e-300), (seed, key)
+        assert s["channels"][0]["constant"] == (0.0 if seed == 1 else None)

@@ -432,3 +432,54 @@ fn numpy_arrays_are_read_with_the_rate_given() {
     );
     assert!(!o.exists());
 }
+
+#[test]
+fn info_prints_what_each_file_holds() {
+    let d = tempfile::tempdir().unwrap();
+    // By hand: a = 1, 2, 3, 4 (mean 2.5, std sqrt(1.25) = 1.118, rms sqrt(7.5) = 2.739), b dead.
+    let csv = d.path().join("rec.csv");
+    std::fs::write(
+        &csv,
+        "time_s,a (g),b (g)\n0,1,0\n0.01,2,0\n0.02,3,0\n0.03,4,0\n",
+    )
+    .unwrap();
+    let o = ok(&["info", s(&csv)]);
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        text.contains("rec.csv: delimited text, 2 channels, 4 frames at 100 Hz (0.04 s)"),
+        "{text}"
+    );
+    assert!(
+        text.contains(
+            "  a        g           1.000       4.000       2.500       1.118       2.739"
+        ),
+        "{text}"
+    );
+    assert!(text.contains("all 0: a dead sensor"), "{text}");
+    // JSON: one array, the folder expanded to its recordings (the npy needs its rate).
+    let dir = d.path().join("dir");
+    std::fs::create_dir(&dir).unwrap();
+    std::fs::copy(&csv, dir.join("a.csv")).unwrap();
+    npy(&dir.join("b.npy"), 400);
+    let o = ok(&["info", "--json", "--fs", "100", s(&dir)]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let files = v.as_array().unwrap();
+    assert_eq!(files.len(), 2);
+    assert_eq!(files[0]["channels"][0]["mean"], 2.5);
+    assert_eq!(files[0]["channels"][1]["constant"], 0.0);
+    assert_eq!(files[1]["format"], "Npy");
+    assert_eq!(files[1]["frames"], 400);
+    assert_eq!(files[1]["fs_hz"], 100.0);
+    // Refusals: the reader's, one line, exit 2.
+    fails_with(
+        &["info", s(&dir.join("b.npy"))],
+        &["b.npy", "holds no sampling rate", "--fs HZ"],
+    );
+    fails_with(&["info", s(&d.path().join("none.csv"))], &["none.csv"]);
+    let nan = d.path().join("nan.csv");
+    std::fs::write(&nan, "time_s,a\n0,1\n0.01,nan\n0.02,3\n").unwrap();
+    fails_with(
+        &["info", s(&csv), s(&nan)],
+        &["nan.csv: channel 'a' sample 1 is NaN"],
+    );
+}

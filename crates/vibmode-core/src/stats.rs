@@ -190,7 +190,10 @@ pub fn channel_health(x: &[f64], min_run: usize) -> ChannelHealth {
     h
 }
 
-fn constant_from_extremes(min: f64, max: f64) -> Option<f64> {
+/// [`constant_value`] from a channel's extremes (for a channel read in blocks): `Some(0.0)`
+/// when its peak magnitude is at most [`crate::limits::SAMPLE_PEAK_MIN`], `Some(max)` when
+/// `max - min` is within 1e-9 of the peak, else `None`.
+pub fn constant_from_extremes(min: f64, max: f64) -> Option<f64> {
     let peak = max.abs().max(min.abs());
     if peak <= crate::limits::SAMPLE_PEAK_MIN {
         return Some(0.0);

@@ -16,8 +16,8 @@ pub enum SignalError {
     BadSample {
         /// The file.
         path: String,
-        /// The sample, its channel and index.
-        source: vibmode_core::RecordingError,
+        /// The sample, its channel and index (boxed: it would make every `SignalError` larger).
+        source: Box<vibmode_core::RecordingError>,
     },
     /// A file with two channels of the same name.
     #[error("{}: channels {} and {} are both named '{}'; give each channel its own name (in the file's header or its sidecar)", vibmode_core::quoted(.path), .first + 1, .second + 1, vibmode_core::quoted(.name))]
@@ -524,7 +524,7 @@ pub(crate) fn in_file(path: &str, e: SignalError) -> SignalError {
         SignalError::Recording(r @ (R::NonFinite { .. } | R::SampleTooLarge { .. })) => {
             SignalError::BadSample {
                 path: path.to_string(),
-                source: r,
+                source: Box::new(r),
             }
         }
         e => e,

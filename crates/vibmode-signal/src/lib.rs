@@ -7,6 +7,8 @@
 //!   column detected automatically), WAV (PCM integer or 32-bit float) and raw little-endian
 //!   f32/f64 with a JSON sidecar into a [`Recording`]. The conventions are documented in
 //!   `docs/formats.md`. [`DelimitedReader`] streams text files as blocks of rows.
+//! - [`summarize`] reads a file once, block by block, into a [`FileSummary`]: format, rate,
+//!   channels, length, start time and each channel's range, mean, std and RMS (`vibmode info`).
 //! - [`write_path`] writes CSV (with a `time_s` column), 32-bit float WAV or raw + sidecar.
 //! - [`resample()`], [`Resampler`] and [`ResampleRecording::resample`] implement the ideal DFT low-pass
 //!   followed by decimation (integer ratios) or Fourier resampling (other ratios, equal to
@@ -49,6 +51,7 @@ pub mod resample;
 pub mod stream;
 pub mod stream_resample;
 pub mod stream_write;
+pub mod summary;
 mod wav64;
 pub mod write;
 
@@ -72,6 +75,7 @@ pub use stream_resample::{
     StreamResampleSummary,
 };
 pub use stream_write::StreamWriter;
+pub use summary::{summarize, ChannelSummary, FileSummary};
 pub use vibmode_core::{
     Channel, ChannelSelector, Recording, RecordingError, RecordingView, TimeAxis,
 };

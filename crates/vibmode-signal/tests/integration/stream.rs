@@ -1344,3 +1344,93 @@ fn a_split_date_and_time_or_a_time_of_day_is_the_time() {
         }
     }
 }
+
+#[test]
+fn summaries_match_the_whole_files_statistics_over_seeds() {
+    // `summarize` (one streamed pass, blocks of 65 536 frames merged by Chan's update) against
+    // two-pass statistics of the file read whole, over seeds, lengths across the block size,
+    // offsets that make a naive sum of squares cancel, and every format vibmode writes.
+    let dir = tmp();
+    for seed in 0..12u64 {
+        let mut r = ChaCha8Rng::seed_from_u64(1000 + seed);
+        let n = [2usize, 3, 65_535, 65_536, 65_537, 150_001][seed as usize % 6];
+        let mut rec = random_recording(seed, n, 1 + seed as usize % 4, 250.0);
+        let offset = [0.0, 1e6, -3.5e3][seed as usize % 3];
+        for ch in &mut rec.channels {
+            for v in &mut ch.samples {
+                *v += offset + r.gen_range(-1.0..1.0);
+            }
+        }
+        let ext = ["csv", "f64", "wav"][seed as usize % 3];
+        let p = dir.path().join(format!("s{seed}.{ext}"));
+        write_path(&p, &rec).unwrap();
+        let whole = read_path(&p, &ReadOptions::default()).unwrap();
+        let s = vibmode_signal::summarize(&p, &ReadOptions::default()).unwrap();
+        assert_eq!(s.frames as usize, whole.len(), "{ext} {n}");
+        assert_eq!(s.fs_hz, whole.fs_hz);
+        assert!((s.duration_s - n as f64 / 250.0).abs() < 1e-12);
+        assert_eq!(s.channels.len(), whole.channels.len());
+        for (c, w) in s.channels.iter().zip(&whole.channels) {
+            let x = &w.samples;
+            let m = x.iter().sum::<f64>() / x.len() as f64;
+            let var = x.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / x.len() as f64;
+            let ms = x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64;
+            let min = x.iter().cloned().fold(f64::INFINITY, f64::min);
+            let max = x.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+            assert_eq!((c.name.as_str(), c.min, c.max), (w.name.as_str(), min, max));
+            let scale = m.abs().max(1.0);
+            assert!(
+                (c.mean - m).abs() <= 1e-12 * scale,
+                "{ext}: {} vs {m}",
+                c.mean
+            );
+            assert!(
+                (c.std - var.sqrt()).abs() <= 1e-9 * var.sqrt().max(1e-300) + 1e-12,
+                "{ext} offset {offset}: std {} vs {}",
+                c.std,
+                var.sqrt()
+            );
+            assert!((c.rms - ms.sqrt()).abs() <= 1e-12 * ms.sqrt(), "{ext}");
+            assert_eq!(c.constant, None, "{ext} n {n}");
+        }
+    }
+    // A dead channel (all 0) and a stuck one (all 2.5) are marked, a live one is not.
+    let rec = Recording {
+        fs_hz: 100.0,
+        channels: vec![
+            Channel::new("dead", "", vec![0.0; 300]),
+            Channel::new("stuck", "", vec![2.5; 300]),
+            Channel::new("live", "", (0..300).map(|i| i as f64).collect()),
+        ],
+        time_axis: None,
+    };
+    let p = dir.path().join("health.f64");
+    write_path(&p, &rec).unwrap();
+    let s = vibmode_signal::summarize(&p, &ReadOptions::default()).unwrap();
+    let c: Vec<Option<f64>> = s.channels.iter().map(|c| c.constant).collect();
+    assert_eq!(c, [Some(0.0), Some(2.5), None]);
+    let text = s.to_string();
+    assert!(text.contains("all 0: a dead sensor"), "{text}");
+    assert!(text.contains("constant 2.500: a stuck sensor"), "{text}");
+    assert!(
+        text.contains(
+            "health.f64: raw samples with a sidecar, 3 channels, 300 frames at 100 Hz (3 s)"
+        ),
+        "{text}"
+    );
+    // By hand: 0..299 has mean 149.5, population std sqrt((300^2 - 1) / 12) = 86.60 and rms
+    // sqrt(299 * 599 / 6) = 172.8.
+    assert!(
+        text.contains(
+            "  live                     0       299.0       149.5       86.60       172.8"
+        ),
+        "{text}"
+    );
+    // Refusals are the readers': a NaN names its channel.
+    let bad = dir.path().join("nan.csv");
+    std::fs::write(&bad, "time_s,a\n0,1\n0.01,nan\n0.02,3\n").unwrap();
+    let e = vibmode_signal::summarize(&bad, &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("nan.csv: channel 'a' sample 1 is NaN"), "{e}");
+}

@@ -1,0 +1,290 @@
+//! What a recording file holds, from one streamed pass: format, rate, channels, length, start
+//! time, and each channel's range, mean, standard deviation and RMS (`vibmode info`).
+//!
+//! The file is read block by block ([`open_stream`]), so an hour of 20 kHz data needs the memory
+//! of one block. Every check of the readers applies (a NaN or Inf sample is refused, naming its
+//! channel and frame). A channel whose samples are all one value ([`constant_value`]: a dead or
+//! stuck sensor) is marked; the analysis refuses it.
+//!
+//! Statistics: `mean` and `std` are the population mean and standard deviation (`numpy.mean`,
+//! `numpy.std` with `ddof = 0`), `rms` is `sqrt(mean(x^2))`, each merged over the blocks with
+//! Chan's pairwise update (no cancellation of a large mean). Units are the channel's own.
+//!
+//! [`constant_value`]: vibmode_core::stats::constant_value
+
+use std::fmt;
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::error::Result;
+use crate::read::{Format, ReadOptions};
+use crate::stream::open_stream;
+
+/// Frames read per block.
+const BLOCK_FRAMES: usize = 65_536;
+
+/// One channel's statistics over the whole file.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct ChannelSummary {
+    /// Name, as the readers give it.
+    pub name: String,
+    /// Unit (empty when the file does not say and none was given).
+    pub unit: String,
+    /// Smallest sample, in `unit`.
+    pub min: f64,
+    /// Largest sample, in `unit`.
+    pub max: f64,
+    /// Mean, in `unit`.
+    pub mean: f64,
+    /// Population standard deviation (`ddof = 0`), in `unit`.
+    pub std: f64,
+    /// Root mean square, in `unit`.
+    pub rms: f64,
+    /// The channel's one value when it carries no vibration (a dead sensor reads 0, a stuck one
+    /// a constant), `None` when it varies.
+    pub constant: Option<f64>,
+}
+
+/// What a recording file holds ([`summarize`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct FileSummary {
+    /// The file as given.
+    pub path: String,
+    /// Its format.
+    pub format: Format,
+    /// Sampling rate, Hz.
+    pub fs_hz: f64,
+    /// Number of frames (samples per channel).
+    pub frames: u64,
+    /// `frames / fs_hz`, s.
+    pub duration_s: f64,
+    /// Time of the first frame on the file's own time axis, s (a time column's first value).
+    pub start_s: f64,
+    /// The absolute start time from the sidecar (`"start_time"`), as written.
+    pub start_time: Option<String>,
+    /// The channels, in file order.
+    pub channels: Vec<ChannelSummary>,
+}
+
+/// Running statistics of one channel.
+#[derive(Clone, Copy, Debug)]
+struct Acc {
+    n: u64,
+    min: f64,
+    max: f64,
+    mean: f64,
+    /// Sum of squared deviations from `mean`.
+    m2: f64,
+}
+
+impl Acc {
+    fn new() -> Acc {
+        Acc {
+            n: 0,
+            min: f64::INFINITY,
+            max: f64::NEG_INFINITY,
+            mean: 0.0,
+            m2: 0.0,
+        }
+    }
+
+    /// Merges one block (two passes over it, then Chan's update).
+    fn add(&mut self, x: &[f64]) {
+        if x.is_empty() {
+            return;
+        }
+        let nb = x.len() as f64;
+        let mb = x.iter().sum::<f64>() / nb;
+        let m2b: f64 = x.iter().map(|v| (v - mb) * (v - mb)).sum();
+        for &v in x {
+            self.min = self.min.min(v);
+            self.max = self.max.max(v);
+        }
+        let na = self.n as f64;
+        let n = na + nb;
+        let d = mb - self.mean;
+        self.mean += d * nb / n;
+        self.m2 += m2b + d * d * na * nb / n;
+        self.n += x.len() as u64;
+    }
+
+    fn summary(&self, name: String, unit: String) -> ChannelSummary {
+        let n = self.n.max(1) as f64;
+        let var = (self.m2 / n).max(0.0);
+        ChannelSummary {
+            name,
+            unit,
+            min: self.min,
+            max: self.max,
+            mean: self.mean,
+            std: var.sqrt(),
+            rms: (var + self.mean * self.mean).sqrt(),
+            constant: vibmode_core::stats::constant_from_extremes(self.min, self.max),
+        }
+    }
+}
+
+/// Reads `path` once, block by block, and summarises it (see the module documentation). The
+/// options are those of [`crate::read_path`].
+///
+/// Errors: every error of [`open_stream`] and of reading its blocks (a missing or unreadable
+/// file, a malformed row, a NaN or Inf sample, no sampling rate where the file has none).
+pub fn summarize(path: &Path, opts: &ReadOptions) -> Result<FileSummary> {
+    let mut s = open_stream(path, opts)?;
+    let info = s.info().clone();
+    let mut acc = vec![Acc::new(); info.n_channels()];
+    let mut frames = 0u64;
+    while let Some(block) = s.next_block(BLOCK_FRAMES)? {
+        frames += block.n_frames() as u64;
+        for (a, ch) in acc.iter_mut().zip(&block.channels) {
+            a.add(ch);
+        }
+    }
+    let channels = acc
+        .iter()
+        .zip(info.names.iter().zip(&info.units))
+        .map(|(a, (name, unit))| a.summary(name.clone(), unit.clone()))
+        .collect();
+    Ok(FileSummary {
+        path: path.display().to_string(),
+        format: info.format,
+        fs_hz: info.fs_hz,
+        frames,
+        duration_s: frames as f64 / info.fs_hz,
+        start_s: info.start_s,
+        start_time: info.start_time,
+        channels,
+    })
+}
+
+fn format_name(f: Format) -> &'static str {
+    match f {
+        Format::Delimited => "delimited text",
+        Format::Wav => "WAV",
+        Format::Raw => "raw samples with a sidecar",
+        Format::Npy => "NumPy array",
+    }
+}
+
+/// `v` with 4 significant digits (plain below 1e5 and from 1e-3, else scientific).
+fn num(v: f64) -> String {
+    if v == 0.0 {
+        return "0".into();
+    }
+    let a = v.abs();
+    if (1e-3..1e5).contains(&a) {
+        let digits = (3 - a.log10().floor() as i32).max(0) as usize;
+        format!("{v:.digits$}")
+    } else {
+        format!("{v:.3e}")
+    }
+}
+
+impl fmt::Display for FileSummary {
+    /// A heading line (format, channels, frames, rate, duration, start), then one row per
+    /// channel: name, unit, min, max, mean, std, rms, and a note for a constant channel.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        // The path whole (a table's heading, not an error's quote), control characters as `?`.
+        let path: String = self
+            .path
+            .chars()
+            .map(|c| if c.is_control() { '?' } else { c })
+            .collect();
+        write!(
+            f,
+            "{path}: {}, {} channel{}, {} frames at {} Hz ({} s)",
+            format_name(self.format),
+            self.channels.len(),
+            if self.channels.len() == 1 { "" } else { "s" },
+            self.frames,
+            vibmode_core::num(&self.fs_hz),
+            vibmode_core::num(&self.duration_s),
+        )?;
+        if self.start_s != 0.0 {
+            write!(f, ", time axis from {} s", vibmode_core::num(&self.start_s))?;
+        }
+        match &self.start_time {
+            Some(t) => writeln!(f, ", starts {}", vibmode_core::quoted(t))?,
+            None => writeln!(f, ", no absolute start time")?,
+        }
+        let w = self
+            .channels
+            .iter()
+            .map(|c| vibmode_core::quoted(&c.name).to_string().chars().count())
+            .max()
+            .unwrap_or(0)
+            .max("channel".len());
+        let u = self
+            .channels
+            .iter()
+            .map(|c| vibmode_core::quoted(&c.unit).to_string().chars().count())
+            .max()
+            .unwrap_or(0)
+            .max("unit".len());
+        writeln!(
+            f,
+            "  {:<w$}  {:<u$}  {:>11} {:>11} {:>11} {:>11} {:>11}",
+            "channel", "unit", "min", "max", "mean", "std", "rms"
+        )?;
+        for c in &self.channels {
+            write!(
+                f,
+                "  {:<w$}  {:<u$}  {:>11} {:>11} {:>11} {:>11} {:>11}",
+                vibmode_core::quoted(&c.name).to_string(),
+                vibmode_core::quoted(&c.unit).to_string(),
+                num(c.min),
+                num(c.max),
+                num(c.mean),
+                num(c.std),
+                num(c.rms),
+            )?;
+            match c.constant {
+                Some(0.0) => write!(f, "  all 0: a dead sensor (the analysis refuses it)")?,
+                Some(v) => write!(
+                    f,
+                    "  constant {}: a stuck sensor (the analysis refuses it)",
+                    num(v)
+                )?,
+                None => {}
+            }
+            writeln!(f)?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn block_merging_by_hand() {
+        // x = 1, 2, 3, 4 in blocks [1, 2] and [3, 4]: mean 2.5, squared deviations 2.25 + 0.25
+        // + 0.25 + 2.25 = 5, population variance 1.25, rms sqrt((1 + 4 + 9 + 16) / 4) = sqrt(7.5).
+        let mut a = Acc::new();
+        a.add(&[1.0, 2.0]);
+        a.add(&[]);
+        a.add(&[3.0, 4.0]);
+        let s = a.summary("x".into(), "g".into());
+        assert_eq!((s.min, s.max, s.mean), (1.0, 4.0, 2.5));
+        assert!((s.std - 1.25f64.sqrt()).abs() < 1e-15, "{}", s.std);
+        assert!((s.rms - 7.5f64.sqrt()).abs() < 1e-15, "{}", s.rms);
+        assert_eq!(s.constant, None);
+        let mut z = Acc::new();
+        z.add(&[0.0; 5]);
+        assert_eq!(z.summary("d".into(), String::new()).constant, Some(0.0));
+    }
+
+    #[test]
+    fn numbers_print_with_four_significant_digits() {
+        assert_eq!(num(0.0), "0");
+        assert_eq!(num(20000.0), "20000");
+        assert_eq!(num(10.24), "10.24");
+        assert_eq!(num(-0.0123456), "-0.01235");
+        assert_eq!(num(1.5e-6), "1.500e-6");
+        assert_eq!(num(2.5e7), "2.500e7");
+    }
+}
