@@ -14,6 +14,7 @@ use crate::errors::{json_err, signal_err, value_err};
 /// Registers the functions of this module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read, m)?)?;
+    m.add_function(wrap_pyfunction!(info, m)?)?;
     m.add_function(wrap_pyfunction!(write, m)?)?;
     m.add_function(wrap_pyfunction!(time_column_scale, m)?)?;
     m.add_function(wrap_pyfunction!(resample_rows, m)?)?;
@@ -143,6 +144,31 @@ fn read<'py>(
         })
         .map_err(signal_err)?;
     to_py(py, &rec)
+}
+
+/// What each file holds (`vibmode_signal::summarize`, folders expanded), as the JSON array
+/// `vibmode info --json` prints.
+#[pyfunction]
+#[pyo3(signature = (paths, fs=None, scale=1.0, unit=None, allow_nonuniform=false, time_unit=None))]
+fn info(
+    py: Python<'_>,
+    paths: Vec<PathBuf>,
+    fs: Option<f64>,
+    scale: f64,
+    unit: Option<String>,
+    allow_nonuniform: bool,
+    time_unit: Option<&str>,
+) -> PyResult<String> {
+    let opts = read_options(fs, scale, unit, allow_nonuniform, time_unit)?;
+    let all = py
+        .detach(|| {
+            vibmode_signal::expand_folders(&paths)?
+                .iter()
+                .map(|p| vibmode_signal::summarize(p, &opts))
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .map_err(signal_err)?;
+    serde_json::to_string(&all).map_err(json_err)
 }
 
 /// The channels `sel` (names or 0-based indices) of `rec`; all when `None` or empty.

@@ -1,5 +1,7 @@
 """The shared reading options (the command line's --resample-nonuniform and --time-unit) in
 read, analyze and the fleet functions: a 100 Hz file with a jittery Time_ms column."""
+import os
+
 import numpy as np
 import pytest
 
@@ -115,3 +117,31 @@ def test_npy_refusals_name_the_value(tmp_path):
     np.save(tmp_path / "b.npy", a.astype(">f8"))
     with pytest.raises(ValueError, match="data type '>f8'"):
         vibmode.read(tmp_path / "b.npy", fs=100.0)
+
+
+def test_info_gives_what_the_cli_prints_and_numpy_agrees(tmp_path):
+    """``vibmode.info`` is ``vibmode info --json`` (the same library call): per file its format,
+    rate, frames and per channel min/max (exact), mean, std (ddof 0) and RMS against numpy; a
+    folder stands for its files; ``as_frame`` gives one row per file and channel; a missing
+    file raises OSError, a file without a rate ValueError naming it."""
+    rng = np.random.default_rng(7)
+    a = rng.standard_normal((5000, 2)) + [3.0, -1.0]
+    np.save(tmp_path / "a.npy", a)
+    (s,) = vibmode.info(tmp_path / "a.npy", fs=500.0)
+    assert (s["format"], s["fs_hz"], s["frames"], s["duration_s"]) == ("Npy", 500.0, 5000, 10.0)
+    for c, x in zip(s["channels"], a.T):
+        assert (c["min"], c["max"], c["constant"]) == (x.min(), x.max(), None)
+        assert c["mean"] == pytest.approx(x.mean(), rel=1e-13)
+        assert c["std"] == pytest.approx(x.std(), rel=1e-12)
+        assert c["rms"] == pytest.approx(np.sqrt(np.mean(x * x)), rel=1e-13)
+    vibmode.write(tmp_path / "b.csv", a[:100].T, fs=500.0, channels=["x", "y"])
+    both = vibmode.info([tmp_path], fs=500.0)
+    assert [os.path.basename(f["path"]) for f in both] == ["a.npy", "b.csv"]
+    pd = pytest.importorskip("pandas")
+    df = vibmode.info(tmp_path, fs=500.0, as_frame=True)
+    assert isinstance(df, pd.DataFrame) and len(df) == 4
+    assert list(df["channel"]) == ["ch0", "ch1", "x", "y"]
+    with pytest.raises(OSError):
+        vibmode.info(tmp_path / "none.csv")
+    with pytest.raises(ValueError, match="a.npy.*holds no sampling rate"):
+        vibmode.info(tmp_path / "a.npy")

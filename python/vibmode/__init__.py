@@ -13,7 +13,7 @@ the library's one-line messages. Long calls release the GIL.
 
 from . import fleet
 from ._analysis import Simulation, SimRecord, analysis_config, analyze, fullcar, simulate
-from ._io import Recording, read, resample_ideal, write
+from ._io import Recording, info, read, resample_ideal, write
 from ._models import ArmaModel, SweepResult, fit_ar, fit_arma, sweep
 from ._native import __version__
 from ._spectral import coherence, csd, get_window, periodogram, welch
@@ -39,6 +39,7 @@ __all__ = [
     "fleet_check",
     "fullcar",
     "get_window",
+    "info",
     "periodogram",
     "read",
     "resample_ideal",

@@ -148,6 +148,42 @@ def read(
     return rec.to_frame() if as_frame else rec
 
 
+def info(
+    paths: Union[PathLike, Sequence[PathLike]],
+    fs: Optional[float] = None,
+    scale: float = 1.0,
+    unit: Optional[str] = None,
+    allow_nonuniform: bool = False,
+    time_unit: Optional[str] = None,
+    as_frame: bool = False,
+):
+    """What each recording file holds, read once block by block (files of any length): the
+    command line's ``vibmode info --json`` (docs/formats.md, "Checking a file").
+
+    ``paths``: a file or folder, or a list of them (a folder stands for its recordings). The
+    reading options are :func:`read`'s. Returns a list with one dict per file (``path``,
+    ``format``, ``fs_hz``, ``frames``, ``duration_s``, ``start_s``, ``start_time`` and
+    ``channels``: dicts with ``name``, ``unit``, ``min``, ``max``, ``mean``, ``std`` (population,
+    ``ddof=0``), ``rms`` and ``constant``, the one value of a dead or stuck channel, else None),
+    or with ``as_frame=True`` a pandas DataFrame with one row per file and channel.
+    Raises OSError (FileNotFoundError) for files that cannot be read, ValueError for contents.
+    """
+    if isinstance(paths, (str, bytes, os.PathLike)):
+        paths = [paths]
+    out = json.loads(_native.info(
+        [os.fspath(p) for p in paths], None if fs is None else _check_fs(fs), float(scale), unit,
+        bool(allow_nonuniform), time_unit,
+    ))
+    if not as_frame:
+        return out
+    pd = require_pandas("info(..., as_frame=True)")
+    rows = [{"path": f["path"], "fs_hz": f["fs_hz"], "frames": f["frames"],
+             "duration_s": f["duration_s"], **{("channel" if k == "name" else k): v
+                                                 for k, v in c.items()}}
+            for f in out for c in f["channels"]]
+    return pd.DataFrame(rows)
+
+
 def write(path: PathLike, recording: Any, fs: Optional[float] = None, channels=None, units=None) -> None:
     """Writes a recording (a :class:`Recording`, a DataFrame from ``read(..., as_frame=True)``
     or an array (n_channels, n_samples) with ``fs`` in Hz). The format follows the extension:

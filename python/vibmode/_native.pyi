@@ -49,6 +49,10 @@ def read(
     allow_nonuniform: bool = False, format: Optional[str] = None, channels: Optional[List[str]] = None,
     time_unit: Optional[str] = None,
 ) -> _PyRecording: ...
+def info(
+    paths: List[str], fs: Optional[float] = None, scale: float = 1.0, unit: Optional[str] = None,
+    allow_nonuniform: bool = False, time_unit: Optional[str] = None,
+) -> str: ...
 def write(
     path: str, data: F64, fs: float, names: List[str], units: List[str], placements: Optional[str] = None,
 ) -> None: ...
