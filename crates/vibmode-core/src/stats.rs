@@ -284,6 +284,135 @@ pub fn held_runs(x: &[f64], min_run: usize, skip: &[f64]) -> (usize, usize, usiz
     (samples, stretches, longest)
 }
 
+/// [`channel_health`] of a channel read in blocks, as a second pass once its extremes are known
+/// (the first pass: `min`, `max` and the number of samples `n`). Feed every block in order with
+/// [`HealthScan::push`]; [`HealthScan::finish`] gives what `channel_health` gives for the whole
+/// channel, exactly (runs are carried across blocks).
+#[derive(Clone, Debug)]
+pub struct HealthScan {
+    n: usize,
+    min: f64,
+    max: f64,
+    hi: f64,
+    lo: f64,
+    min_run: usize,
+    constant: Option<f64>,
+    at: [usize; 2],
+    held_at: [usize; 2],
+    run_at: [usize; 2],
+    /// The current run of one value: its value and length.
+    run: Option<(f64, usize)>,
+    /// `(samples, stretches, longest)` of held runs at another value than an extreme, and at
+    /// an extreme (left out when the channel is clipped).
+    held_other: (usize, usize, usize),
+    held_extreme: (usize, usize, usize),
+}
+
+impl HealthScan {
+    /// A scan of a channel of `n` samples between `min` and `max`, held runs of `min_run`
+    /// samples or more ([`held_min_run`]).
+    pub fn new(n: usize, min: f64, max: f64, min_run: usize) -> HealthScan {
+        let tol = 1e-9 * (max - min);
+        HealthScan {
+            n,
+            min,
+            max,
+            hi: max - tol,
+            lo: min + tol,
+            min_run: min_run.max(2),
+            constant: if n < 2 {
+                None
+            } else {
+                constant_from_extremes(min, max)
+            },
+            at: [0; 2],
+            held_at: [0; 2],
+            run_at: [0; 2],
+            run: None,
+            held_other: (0, 0, 0),
+            held_extreme: (0, 0, 0),
+        }
+    }
+
+    fn end_run(&mut self) {
+        if let Some((v, len)) = self.run.take() {
+            if len >= self.min_run {
+                let h = if v == self.min || v == self.max {
+                    &mut self.held_extreme
+                } else {
+                    &mut self.held_other
+                };
+                h.0 += len;
+                h.1 += 1;
+                h.2 = h.2.max(len);
+            }
+        }
+    }
+
+    fn end_extreme_run(&mut self, k: usize) {
+        if self.run_at[k] >= 2 {
+            self.held_at[k] += self.run_at[k];
+        }
+        self.run_at[k] = 0;
+    }
+
+    /// The next block of the channel's samples.
+    pub fn push(&mut self, x: &[f64]) {
+        if self.constant.is_some() || self.n < 2 {
+            return;
+        }
+        for &v in x {
+            for (k, at) in [v >= self.hi, v <= self.lo].into_iter().enumerate() {
+                if at {
+                    self.at[k] += 1;
+                    self.run_at[k] += 1;
+                } else {
+                    self.end_extreme_run(k);
+                }
+            }
+            match &mut self.run {
+                Some((value, len)) if *value == v => *len += 1,
+                _ => {
+                    self.end_run();
+                    self.run = Some((v, 1));
+                }
+            }
+        }
+    }
+
+    /// What [`channel_health`] gives for the channel fed.
+    pub fn finish(mut self) -> ChannelHealth {
+        let mut h = ChannelHealth {
+            n: self.n,
+            constant: self.constant,
+            clipped: None,
+            held: (0, 0, 0),
+        };
+        if self.n < 2 || h.constant.is_some() {
+            return h;
+        }
+        self.end_run();
+        self.end_extreme_run(0);
+        self.end_extreme_run(1);
+        let need = CLIPPED_MIN_SAMPLES.max((CLIPPED_SHARE * self.n as f64).ceil() as usize);
+        if self.at[0].max(self.at[1]) >= need {
+            let (held, count, value) = if self.held_at[0] >= self.held_at[1] {
+                (self.held_at[0], self.at[0], self.max)
+            } else {
+                (self.held_at[1], self.at[1], self.min)
+            };
+            h.clipped = (held >= need).then_some((count, value));
+        }
+        let (o, e) = (self.held_other, self.held_extreme);
+        h.held = if h.clipped.is_some() {
+            o
+        } else {
+            (o.0 + e.0, o.1 + e.1, o.2.max(e.2))
+        };
+        h
+    }
+}
+
 /// The jackknife standard deviation of an estimate from its leave-one-out values `theta`
 /// (`m >= 2` of them): `sqrt((m - 1) / m * sum (theta_s - mean)^2)`. 0 for fewer than two.
 /// SSI-cov's modes, the model update's parameters and the fleet's suspension scores use it.
@@ -300,6 +429,72 @@ pub fn jackknife_std(theta: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_scan_in_blocks_is_channel_health() {
+        // Channels that are live, clipped at either extreme or both, held (dropouts filled with
+        // the last value or with an extreme), constant, dead, or of 0-3 samples, cut into blocks
+        // at every split of a seeded generator: the scan equals `channel_health` of the whole.
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut kinds = [0usize; 3];
+        for case in 0..400 {
+            let n = match case % 10 {
+                0 => (next() % 4) as usize,
+                _ => 20 + (next() % 3000) as usize,
+            };
+            let mut x: Vec<f64> = (0..n)
+                .map(|_| (next() % 2001) as f64 / 1000.0 - 1.0)
+                .collect();
+            match case % 7 {
+                1 => x.iter_mut().for_each(|v| *v = v.clamp(-2.0, 0.8)),
+                2 => x.iter_mut().for_each(|v| *v = v.clamp(-0.7, 0.7)),
+                3 if n > 0 => {
+                    let (a, len) = ((next() as usize) % n, (next() % 400) as usize);
+                    let v = x[a];
+                    x.iter_mut().skip(a).take(len).for_each(|s| *s = v);
+                }
+                4 => x.iter_mut().for_each(|v| *v = 0.25),
+                5 => x.iter_mut().for_each(|v| *v = 0.0),
+                6 if n > 0 => {
+                    let top = x.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+                    let (a, len) = ((next() as usize) % n, (next() % 200) as usize);
+                    x.iter_mut().skip(a).take(len).for_each(|s| *s = top);
+                }
+                _ => {}
+            }
+            let min_run = 2 + (next() % 12) as usize;
+            let whole = channel_health(&x, min_run);
+            let (min, max) = if x.is_empty() {
+                (f64::INFINITY, f64::NEG_INFINITY)
+            } else {
+                extremes(&x)
+            };
+            let mut scan = HealthScan::new(x.len(), min, max, min_run);
+            let mut i = 0;
+            while i < x.len() {
+                let len = 1 + (next() % 700) as usize;
+                let j = (i + len).min(x.len());
+                scan.push(&x[i..j]);
+                i = j;
+            }
+            assert_eq!(
+                scan.finish(),
+                whole,
+                "case {case}: n {n}, min_run {min_run}"
+            );
+            kinds[0] += usize::from(whole.constant.is_some());
+            kinds[1] += usize::from(whole.clipped.is_some());
+            kinds[2] += usize::from(whole.held.1 > 0);
+        }
+        // Every kind was there to compare: constant, clipped, held.
+        assert!(kinds.iter().all(|&k| k >= 20), "{kinds:?}");
+    }
 
     #[test]
     fn held_stretches_are_counted() {

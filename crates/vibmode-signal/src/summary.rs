@@ -2,20 +2,27 @@
 //! time, and each channel's range, mean, standard deviation and RMS (`vibmode info`).
 //!
 //! The file is read block by block ([`open_stream`]), so an hour of 20 kHz data needs the memory
-//! of one block. Every check of the readers applies (a NaN or Inf sample is refused, naming its
-//! channel and frame). A channel whose samples are all one value ([`constant_value`]: a dead or
-//! stuck sensor) is marked; the analysis refuses it.
+//! of one block, and twice: the statistics first, then each channel's sensor checks against its
+//! extremes ([`HealthScan`]: exactly what the analysis notes per record). Every check of the
+//! readers applies (a NaN or Inf sample is refused, naming its file, channel and frame). A
+//! channel whose samples are all one value ([`constant_value`]: a dead or stuck sensor) is
+//! marked, and so are a clipped channel and one with held stretches (a logger's dropouts filled
+//! with one value); the analysis refuses a constant channel and one that repeats a value over
+//! 90 % of its samples.
 //!
 //! Statistics: `mean` and `std` are the population mean and standard deviation (`numpy.mean`,
 //! `numpy.std` with `ddof = 0`), `rms` is `sqrt(mean(x^2))`, each merged over the blocks with
 //! Chan's pairwise update (no cancellation of a large mean). Units are the channel's own.
 //!
 //! [`constant_value`]: vibmode_core::stats::constant_value
+//! [`HealthScan`]: vibmode_core::stats::HealthScan
 
 use std::fmt;
 use std::path::Path;
 
 use serde::Serialize;
+
+use vibmode_core::stats::{ChannelHealth, HealthScan};
 
 use crate::error::Result;
 use crate::read::{Format, ReadOptions};
@@ -45,6 +52,20 @@ pub struct ChannelSummary {
     /// The channel's one value when it carries no vibration (a dead sensor reads 0, a stuck one
     /// a constant), `None` when it varies.
     pub constant: Option<f64>,
+    /// Samples at the clipped extreme ([`vibmode_core::stats::clipped`]), 0 when not clipped.
+    pub clipped_samples: usize,
+    /// The clipped extreme, in `unit`; `None` when not clipped.
+    pub clipped_value: Option<f64>,
+    /// Samples in held stretches ([`vibmode_core::stats::held_runs`], runs of at least
+    /// [`vibmode_core::stats::HELD_MIN_S`]), the stretches and the longest, in samples.
+    pub held_samples: usize,
+    /// Number of held stretches.
+    pub held_stretches: usize,
+    /// The longest held stretch, samples.
+    pub held_longest: usize,
+    /// Whether the analysis refuses the channel: constant, or a value repeated (clipped or
+    /// held) over [`vibmode_core::stats::REPEATED_SHARE_MAX`] of its samples.
+    pub refused_by_analysis: bool,
 }
 
 /// What a recording file holds ([`summarize`]).
@@ -111,7 +132,7 @@ impl Acc {
         self.n += x.len() as u64;
     }
 
-    fn summary(&self, name: String, unit: String) -> ChannelSummary {
+    fn summary(&self, name: String, unit: String, h: &ChannelHealth) -> ChannelSummary {
         let n = self.n.max(1) as f64;
         let var = (self.m2 / n).max(0.0);
         ChannelSummary {
@@ -122,7 +143,13 @@ impl Acc {
             mean: self.mean,
             std: var.sqrt(),
             rms: (var + self.mean * self.mean).sqrt(),
-            constant: vibmode_core::stats::constant_from_extremes(self.min, self.max),
+            constant: h.constant,
+            clipped_samples: h.clipped.map_or(0, |c| c.0),
+            clipped_value: h.clipped.map(|c| c.1),
+            held_samples: h.held.0,
+            held_stretches: h.held.1,
+            held_longest: h.held.2,
+            refused_by_analysis: h.constant.is_some() || h.is_mostly_repeated(),
         }
     }
 }
@@ -143,10 +170,24 @@ pub fn summarize(path: &Path, opts: &ReadOptions) -> Result<FileSummary> {
             a.add(ch);
         }
     }
+    // The second pass: clipping and held stretches need the channel's extremes.
+    let n = usize::try_from(frames).unwrap_or(usize::MAX);
+    let min_run = vibmode_core::stats::held_min_run(info.fs_hz);
+    let mut scans: Vec<HealthScan> = acc
+        .iter()
+        .map(|a| HealthScan::new(n, a.min, a.max, min_run))
+        .collect();
+    let mut s = open_stream(path, opts)?;
+    while let Some(block) = s.next_block(BLOCK_FRAMES)? {
+        for (h, ch) in scans.iter_mut().zip(&block.channels) {
+            h.push(ch);
+        }
+    }
     let channels = acc
         .iter()
+        .zip(scans)
         .zip(info.names.iter().zip(&info.units))
-        .map(|(a, (name, unit))| a.summary(name.clone(), unit.clone()))
+        .map(|((a, h), (name, unit))| a.summary(name.clone(), unit.clone(), &h.finish()))
         .collect();
     Ok(FileSummary {
         path: path.display().to_string(),
@@ -241,14 +282,32 @@ impl fmt::Display for FileSummary {
                 num(c.std),
                 num(c.rms),
             )?;
+            let share = |k: usize| 100.0 * k as f64 / self.frames.max(1) as f64;
             match c.constant {
-                Some(0.0) => write!(f, "  all 0: a dead sensor (the analysis refuses it)")?,
-                Some(v) => write!(
-                    f,
-                    "  constant {}: a stuck sensor (the analysis refuses it)",
-                    num(v)
-                )?,
+                Some(0.0) => write!(f, "  all 0: a dead sensor")?,
+                Some(v) => write!(f, "  constant {}: a stuck sensor", num(v))?,
                 None => {}
+            }
+            if let Some(v) = c.clipped_value {
+                write!(
+                    f,
+                    "  clipped at {}: {} % of samples",
+                    num(v),
+                    num(share(c.clipped_samples))
+                )?;
+            }
+            if c.held_stretches > 0 {
+                write!(
+                    f,
+                    "  held: {} stretch{}, {} % of samples, longest {} s",
+                    c.held_stretches,
+                    if c.held_stretches == 1 { "" } else { "es" },
+                    num(share(c.held_samples)),
+                    num(c.held_longest as f64 / self.fs_hz)
+                )?;
+            }
+            if c.refused_by_analysis {
+                write!(f, " (the analysis refuses it)")?;
             }
             writeln!(f)?;
         }
@@ -268,14 +327,17 @@ mod tests {
         a.add(&[1.0, 2.0]);
         a.add(&[]);
         a.add(&[3.0, 4.0]);
-        let s = a.summary("x".into(), "g".into());
+        let live = vibmode_core::stats::channel_health(&[1.0, 2.0, 3.0, 4.0], 2);
+        let s = a.summary("x".into(), "g".into(), &live);
         assert_eq!((s.min, s.max, s.mean), (1.0, 4.0, 2.5));
         assert!((s.std - 1.25f64.sqrt()).abs() < 1e-15, "{}", s.std);
         assert!((s.rms - 7.5f64.sqrt()).abs() < 1e-15, "{}", s.rms);
         assert_eq!(s.constant, None);
+        let dead = vibmode_core::stats::channel_health(&[0.0; 5], 2);
         let mut z = Acc::new();
         z.add(&[0.0; 5]);
-        assert_eq!(z.summary("d".into(), String::new()).constant, Some(0.0));
+        let d = z.summary("d".into(), String::new(), &dead);
+        assert_eq!((d.constant, d.refused_by_analysis), (Some(0.0), true));
     }
 
     #[test]

@@ -1351,6 +1351,7 @@ fn summaries_match_the_whole_files_statistics_over_seeds() {
     // two-pass statistics of the file read whole, over seeds, lengths across the block size,
     // offsets that make a naive sum of squares cancel, and every format vibmode writes.
     let dir = tmp();
+    let (mut clipped, mut held) = (0, 0);
     for seed in 0..12u64 {
         let mut r = ChaCha8Rng::seed_from_u64(1000 + seed);
         let n = [2usize, 3, 65_535, 65_536, 65_537, 150_001][seed as usize % 6];
@@ -1359,6 +1360,19 @@ fn summaries_match_the_whole_files_statistics_over_seeds() {
         for ch in &mut rec.channels {
             for v in &mut ch.samples {
                 *v += offset + r.gen_range(-1.0..1.0);
+            }
+        }
+        // A clipped channel, and one with a held stretch across the 65 536-frame blocks.
+        if n > 100 {
+            let c0 = &mut rec.channels[0].samples;
+            match seed % 4 {
+                1 => c0.iter_mut().for_each(|v| *v = v.min(offset + 2.0)),
+                2 => {
+                    let a = n / 2 - n.min(300) / 3;
+                    let held = c0[a];
+                    c0[a..a + n.min(300) / 2].iter_mut().for_each(|v| *v = held);
+                }
+                _ => {}
             }
         }
         let ext = ["csv", "f64", "wav"][seed as usize % 3];
@@ -1392,8 +1406,27 @@ fn summaries_match_the_whole_files_statistics_over_seeds() {
             );
             assert!((c.rms - ms.sqrt()).abs() <= 1e-12 * ms.sqrt(), "{ext}");
             assert_eq!(c.constant, None, "{ext} n {n}");
+            // The sensor checks are the analysis's, on the whole channel.
+            let h = vibmode_core::stats::channel_health(
+                x,
+                vibmode_core::stats::held_min_run(whole.fs_hz),
+            );
+            assert_eq!(
+                (c.clipped_samples, c.clipped_value),
+                h.clipped.map_or((0, None), |(k, v)| (k, Some(v))),
+                "{ext} seed {seed}"
+            );
+            assert_eq!(
+                (c.held_samples, c.held_stretches, c.held_longest),
+                h.held,
+                "{ext} seed {seed}"
+            );
+            clipped += usize::from(c.clipped_value.is_some());
+            held += usize::from(c.held_stretches > 0);
         }
     }
+    // The clipped and held channels made above were found (seeds 5, 9 and 2, 10).
+    assert_eq!((clipped, held), (2, 2));
     // A dead channel (all 0) and a stuck one (all 2.5) are marked, a live one is not.
     let rec = Recording {
         fs_hz: 100.0,
