@@ -1,5 +1,6 @@
 //! `vibmode info`: what each recording file holds (format, rate, channels, length, start time,
-//! each channel's range, mean, std and RMS), read once block by block.
+//! each channel's range, mean, std and RMS, and the analysis's sensor checks), read block by
+//! block.
 
 use crate::input::ReadArgs;
 use anyhow::{Context, Result};

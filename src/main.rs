@@ -41,7 +41,8 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// What each recording file holds: format, rate, channels, length, start time, and each
-    /// channel's range, mean, std and RMS (a dead or stuck sensor marked).
+    /// channel's range, mean, std and RMS (dead, stuck and clipped sensors and held stretches
+    /// marked).
     #[command(allow_negative_numbers = true)]
     Info(cmd_info::InfoArgs),
     /// Power spectral density (Welch and/or periodogram) of one or more channels.

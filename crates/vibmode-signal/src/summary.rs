@@ -1,4 +1,4 @@
-//! What a recording file holds, from one streamed pass: format, rate, channels, length, start
+//! What a recording file holds, from two streamed passes: format, rate, channels, length, start
 //! time, and each channel's range, mean, standard deviation and RMS (`vibmode info`).
 //!
 //! The file is read block by block ([`open_stream`]), so an hour of 20 kHz data needs the memory
@@ -154,8 +154,8 @@ impl Acc {
     }
 }
 
-/// Reads `path` once, block by block, and summarises it (see the module documentation). The
-/// options are those of [`crate::read_path`].
+/// Reads `path` block by block, twice (the statistics, then the sensor checks), and summarises
+/// it (see the module documentation). The options are those of [`crate::read_path`].
 ///
 /// Errors: every error of [`open_stream`] and of reading its blocks (a missing or unreadable
 /// file, a malformed row, a NaN or Inf sample, no sampling rate where the file has none).
