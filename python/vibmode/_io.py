@@ -157,14 +157,16 @@ def info(
     time_unit: Optional[str] = None,
     as_frame: bool = False,
 ):
-    """What each recording file holds, read once block by block (files of any length): the
+    """What each recording file holds, read block by block (files of any length): the
     command line's ``vibmode info --json`` (docs/formats.md, "Checking a file").
 
     ``paths``: a file or folder, or a list of them (a folder stands for its recordings). The
     reading options are :func:`read`'s. Returns a list with one dict per file (``path``,
     ``format``, ``fs_hz``, ``frames``, ``duration_s``, ``start_s``, ``start_time`` and
     ``channels``: dicts with ``name``, ``unit``, ``min``, ``max``, ``mean``, ``std`` (population,
-    ``ddof=0``), ``rms`` and ``constant``, the one value of a dead or stuck channel, else None),
+    ``ddof=0``), ``rms``, ``constant`` (the one value of a dead or stuck channel, else None),
+    ``clipped_samples`` and ``clipped_value``, ``held_samples``, ``held_stretches`` and
+    ``held_longest`` (samples) and ``refused_by_analysis``: the analysis's own sensor checks),
     or with ``as_frame=True`` a pandas DataFrame with one row per file and channel.
     Raises OSError (FileNotFoundError) for files that cannot be read, ValueError for contents.
     """
