@@ -123,6 +123,34 @@ def npy_peer(data_dir, quick):
     }}
 
 
+def summarize_peer(data_dir, quick):
+    """What `vibmode info` computes, by numpy and pandas: each channel's min, max, mean, std
+    (ddof 0) and RMS after loading the .npy or reading the CSV (the sensor checks have no peer;
+    vibmode's time includes them)."""
+    npy = os.path.join(data_dir, "seven_channels.npy")
+    csv = os.path.join(data_dir, "seven_channels.csv")
+
+    def stats(a):
+        return (a.min(axis=0), a.max(axis=0), a.mean(axis=0), a.std(axis=0),
+                np.sqrt((a * a).mean(axis=0)))
+
+    r = 3 if quick else 11
+    out = {"summarize_npy_7x204800": {
+        "numpy.load + min, max, mean, std, rms per column": median_time(lambda: stats(np.load(npy)), r)}}
+    try:
+        import pandas as pd
+
+        def pandas_stats():
+            df = pd.read_csv(csv)
+            return df.min(), df.max(), df.mean(), df.std(ddof=0), np.sqrt((df * df).mean())
+
+        out["summarize_csv_7x204800"] = {
+            "pandas.read_csv + min, max, mean, std, rms per column": median_time(pandas_stats, 3 if quick else 7)}
+    except ImportError as e:
+        print(f"note: pandas peer skipped ({e})", file=sys.stderr)
+    return out
+
+
 def peers(data_dir, quick, only=None):
     res = {}
     meta = json.load(open(os.path.join(data_dir, "meta.json")))
@@ -131,6 +159,8 @@ def peers(data_dir, quick, only=None):
         res = ssi_peer(data_dir, meta, quick) if "ssi_cov".startswith(only) or only.startswith("ssi_cov") else {}
         if "read_npy".startswith(only) or only.startswith("read_npy"):
             res.update(npy_peer(data_dir, quick))
+        if "summarize".startswith(only) or only.startswith("summarize"):
+            res.update(summarize_peer(data_dir, quick))
         res.setdefault("_versions", {}).update({"numpy": np.__version__, "scipy": scipy.__version__})
         return res
     csv_path = os.path.join(data_dir, "seven_channels.csv")
@@ -170,6 +200,7 @@ def peers(data_dir, quick, only=None):
         pass
     res["read_csv_7x204800"] = csv
     res.update(npy_peer(data_dir, quick))
+    res.update(summarize_peer(data_dir, quick))
     res.update(ssi_peer(data_dir, meta, quick))
     # ARMA fits (statsmodels exact-likelihood ARIMA), same data as vibmode.
     try:

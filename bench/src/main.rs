@@ -378,6 +378,28 @@ fn run(dir: &Path, quick: bool) -> Result<Value> {
         })?;
         out.insert(case.into(), json!({"vibmode_signal::read_path": t}));
     }
+    // What `vibmode info` computes: each channel's statistics and sensor checks, streamed.
+    for (case, file) in [
+        ("summarize_csv_7x204800", "seven_channels.csv"),
+        ("summarize_npy_7x204800", "seven_channels.npy"),
+    ] {
+        let path = dir.join(file);
+        let t = median_time(if quick { 3 } else { 11 }, || {
+            let s = vibmode_signal::summarize(&path, &opts)?;
+            if s.channels.len() != 7 || s.frames != 204_800 {
+                bail!(
+                    "summarised {} channels x {} frames",
+                    s.channels.len(),
+                    s.frames
+                );
+            }
+            Ok(())
+        })?;
+        out.insert(
+            case.into(),
+            json!({"vibmode_signal::summarize (vibmode info)": t}),
+        );
+    }
     // Clustering the paper-size pole cloud.
     let cloud: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("poles.json"))?)?;
     let poles: Vec<vibmode_core::PoleObservation> = serde_json::from_value(cloud["poles"].clone())?;

@@ -7,7 +7,7 @@
 //!   column detected automatically), WAV (PCM integer or 32-bit float) and raw little-endian
 //!   f32/f64 with a JSON sidecar into a [`Recording`]. The conventions are documented in
 //!   `docs/formats.md`. [`DelimitedReader`] streams text files as blocks of rows.
-//! - [`summarize`] reads a file block by block (twice) into a [`FileSummary`]: format, rate,
+//! - [`summarize`] reads a file block by block into a [`FileSummary`]: format, rate,
 //!   channels, length, start time and each channel's range, mean, std and RMS (`vibmode info`).
 //! - [`write_path`] writes CSV (with a `time_s` column), 32-bit float WAV or raw + sidecar.
 //! - [`resample()`], [`Resampler`] and [`ResampleRecording::resample`] implement the ideal DFT low-pass

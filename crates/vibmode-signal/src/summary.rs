@@ -1,9 +1,10 @@
-//! What a recording file holds, from two streamed passes: format, rate, channels, length, start
+//! What a recording file holds, from one or two streamed passes: format, rate, channels, length, start
 //! time, and each channel's range, mean, standard deviation and RMS (`vibmode info`).
 //!
 //! The file is read block by block ([`open_stream`]), so an hour of 20 kHz data needs the memory
-//! of one block, and twice: the statistics first, then each channel's sensor checks against its
-//! extremes ([`HealthScan`]: exactly what the analysis notes per record). Every check of the
+//! of one block: the statistics first, then each channel's sensor checks against its extremes
+//! ([`HealthScan`]: exactly what the analysis notes per record), over the first pass's blocks
+//! kept in memory up to [`KEEP_PARSED_MAX_VALUES`] samples, else over the file read again. Every check of the
 //! readers applies (a NaN or Inf sample is refused, naming its file, channel and frame). A
 //! channel whose samples are all one value ([`constant_value`]: a dead or stuck sensor) is
 //! marked, and so are a clipped channel and one with held stretches (a logger's dropouts filled
@@ -26,7 +27,7 @@ use vibmode_core::stats::{ChannelHealth, HealthScan};
 
 use crate::error::Result;
 use crate::read::{Format, ReadOptions};
-use crate::stream::open_stream;
+use crate::stream::{open_stream, FrameBlock, KEEP_PARSED_MAX_VALUES};
 
 /// Frames read per block.
 const BLOCK_FRAMES: usize = 65_536;
@@ -154,20 +155,39 @@ impl Acc {
     }
 }
 
-/// Reads `path` block by block, twice (the statistics, then the sensor checks), and summarises
-/// it (see the module documentation). The options are those of [`crate::read_path`].
+/// Reads `path` block by block and summarises it (see the module documentation). The sensor
+/// checks need each channel's extremes, so they are a second pass: over the blocks of the first,
+/// kept in memory when they hold at most [`KEEP_PARSED_MAX_VALUES`] samples (128 MiB, as a text
+/// file's stream keeps its parsed blocks), else over the file read again. The options are those
+/// of [`crate::read_path`].
 ///
 /// Errors: every error of [`open_stream`] and of reading its blocks (a missing or unreadable
 /// file, a malformed row, a NaN or Inf sample, no sampling rate where the file has none).
 pub fn summarize(path: &Path, opts: &ReadOptions) -> Result<FileSummary> {
+    summarize_keeping(path, opts, KEEP_PARSED_MAX_VALUES)
+}
+
+/// [`summarize`], keeping the first pass's blocks for the second when they hold at most
+/// `keep_max` samples.
+fn summarize_keeping(path: &Path, opts: &ReadOptions, keep_max: usize) -> Result<FileSummary> {
     let mut s = open_stream(path, opts)?;
     let info = s.info().clone();
     let mut acc = vec![Acc::new(); info.n_channels()];
     let mut frames = 0u64;
+    let mut kept: Option<Vec<FrameBlock>> = Some(Vec::new());
+    let mut kept_values = 0usize;
     while let Some(block) = s.next_block(BLOCK_FRAMES)? {
         frames += block.n_frames() as u64;
         for (a, ch) in acc.iter_mut().zip(&block.channels) {
             a.add(ch);
+        }
+        if let Some(k) = &mut kept {
+            kept_values = kept_values.saturating_add(block.n_frames() * block.channels.len());
+            if kept_values <= keep_max {
+                k.push(block);
+            } else {
+                kept = None;
+            }
         }
     }
     // The second pass: clipping and held stretches need the channel's extremes.
@@ -177,10 +197,18 @@ pub fn summarize(path: &Path, opts: &ReadOptions) -> Result<FileSummary> {
         .iter()
         .map(|a| HealthScan::new(n, a.min, a.max, min_run))
         .collect();
-    let mut s = open_stream(path, opts)?;
-    while let Some(block) = s.next_block(BLOCK_FRAMES)? {
+    let mut push = |block: &FrameBlock| {
         for (h, ch) in scans.iter_mut().zip(&block.channels) {
             h.push(ch);
+        }
+    };
+    match kept {
+        Some(blocks) => blocks.iter().for_each(&mut push),
+        None => {
+            let mut s = open_stream(path, opts)?;
+            while let Some(block) = s.next_block(BLOCK_FRAMES)? {
+                push(&block);
+            }
         }
     }
     let channels = acc
@@ -338,6 +366,39 @@ mod tests {
         z.add(&[0.0; 5]);
         let d = z.summary("d".into(), String::new(), &dead);
         assert_eq!((d.constant, d.refused_by_analysis), (Some(0.0), true));
+    }
+
+    #[test]
+    fn the_second_pass_from_memory_or_from_the_file_is_the_same() {
+        // A clipped channel, a held one and a live one over 200 000 frames (four blocks): the
+        // sensor checks over the kept blocks and over the file read again agree.
+        let dir = tempfile::tempdir().unwrap();
+        let n = 200_000;
+        let live: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+        let clip: Vec<f64> = live.iter().map(|v| v.min(0.8)).collect();
+        let mut held = live.clone();
+        let v = held[70_000];
+        held[65_000..70_000].iter_mut().for_each(|s| *s = v);
+        let rec = vibmode_core::Recording {
+            fs_hz: 1000.0,
+            channels: vec![
+                vibmode_core::Channel::new("live", "g", live),
+                vibmode_core::Channel::new("clip", "g", clip),
+                vibmode_core::Channel::new("held", "g", held),
+            ],
+            time_axis: None,
+        };
+        let path = dir.path().join("r.f64");
+        crate::write_path(&path, &rec).unwrap();
+        let opts = ReadOptions::default();
+        let kept = summarize_keeping(&path, &opts, usize::MAX).unwrap();
+        let again = summarize_keeping(&path, &opts, 0).unwrap();
+        assert_eq!(kept, again);
+        assert_eq!(kept, summarize(&path, &opts).unwrap());
+        let c = &kept.channels;
+        assert_eq!((c[0].clipped_value, c[0].held_stretches), (None, 0));
+        assert_eq!(c[1].clipped_value, Some(0.8));
+        assert_eq!((c[2].held_stretches, c[2].held_longest), (1, 5001));
     }
 
     #[test]
