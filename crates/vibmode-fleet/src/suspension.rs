@@ -136,7 +136,9 @@ pub struct CornerFit {
     /// Their relative standard deviations.
     pub damper_rel_sd: [f64; 4],
     /// Whether the model update calls the records' support of the whole fit sufficient (modes
-    /// to 1.5 %, springs and dampers to 5 %); the scores use the standard deviations either way.
+    /// within 3 %, springs and dampers within 10 %, at 95 % together:
+    /// `vibmode_vehicle::update::support_factor`); the scores use the standard deviations either
+    /// way.
     pub supported: bool,
     /// Standard deviations of [`CornerFit::relative`]'s spring statistics from the jackknife's
     /// replicates of the whole fit (the corners' errors are correlated); absent in model sets

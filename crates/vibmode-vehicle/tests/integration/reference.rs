@@ -421,3 +421,29 @@ fn noise_scale_matches_scipy() {
     }
     assert!(below >= 5, "only {below} cases below 1");
 }
+
+const SUPPORT_FACTOR: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../tools/reference/data/support_factor.json"
+));
+
+/// The model update's support factor (Student t quantile, Bonferroni over the quantities) against
+/// scipy.stats.t.ppf (tools/reference/support_factor.py, scipy 1.14.1): 3-40 records, 1-20
+/// quantities, to 1e-9.
+#[test]
+fn support_factor_matches_scipy() {
+    use vibmode_vehicle::update::support_factor;
+    let r: Value = serde_json::from_str(SUPPORT_FACTOR).unwrap();
+    let cases = r["cases"].as_array().unwrap();
+    assert!(cases.len() >= 100);
+    for c in cases {
+        let records = c["records"].as_u64().unwrap() as usize;
+        let m = c["quantities"].as_u64().unwrap() as usize;
+        let want = c["factor"].as_f64().unwrap();
+        let got = support_factor(records, m);
+        assert!(
+            (got - want).abs() <= 1e-9 * want,
+            "{records} records, {m} quantities: {got} against scipy's {want}"
+        );
+    }
+}
