@@ -223,6 +223,39 @@ pub fn support_factor(records: usize, quantities: usize) -> f64 {
         .unwrap_or(f64::INFINITY)
 }
 
+/// The fewest records of the same kind that would support a fit: the smallest `R' >= records`
+/// with `support_factor(R', quantities) * worst * sqrt(records / R') <= 1`, where `worst` is the
+/// largest ratio of a judged quantity's relative standard deviation to its tolerance from
+/// `records` records. It assumes the spread falls as `1 / sqrt(records)` (measured: 32 records
+/// of busgen's bus 0 halved the sd of 8, docs/model_update.md) and that the fit is unbiased.
+/// `None` when `worst` is not finite or more than 100 000 records would be needed.
+pub fn records_to_support(records: usize, quantities: usize, worst: f64) -> Option<usize> {
+    const MOST: usize = 100_000;
+    if !worst.is_finite() || worst < 0.0 || records < 2 || quantities == 0 {
+        return None;
+    }
+    let holds = |r: usize| {
+        support_factor(r, quantities) * worst * (records as f64 / r as f64).sqrt() <= 1.0
+    };
+    if holds(records) {
+        return Some(records);
+    }
+    if !holds(MOST) {
+        return None;
+    }
+    // The left side falls with r (t's quantile and 1/sqrt(r) both do): bisection.
+    let (mut lo, mut hi) = (records, MOST);
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        if holds(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some(hi)
+}
+
 /// One fitted parameter, SI units.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[non_exhaustive]
@@ -1242,8 +1275,18 @@ impl BodyFit {
                     Some(std::cmp::Ordering::Greater) | None
                 )
             }) {
+                let worst = judged
+                    .iter()
+                    .map(|(_, rel, tol)| rel / tol)
+                    .fold(0.0, f64::max);
+                let more = match records_to_support(loo_values.len(), judged.len(), worst) {
+                    Some(r) => format!(
+                        "; about {r} records like these would support it (the spread falls as 1/sqrt(records))"
+                    ),
+                    None => String::new(),
+                };
                 not_supported = Some(format!(
-                    "the {name} is known to +-{:.1} % ({k:.2} jackknife standard deviations of {:.2} %: {:.0} % confidence over {} quantities from {} records), more than the {:.0} % a supported fit meets",
+                    "the {name} is known to +-{:.1} % ({k:.2} jackknife standard deviations of {:.2} %: {:.0} % confidence over {} quantities from {} records), more than the {:.0} % a supported fit meets{more}",
                     100.0 * k * rel,
                     100.0 * rel,
                     100.0 * SUPPORT_CONFIDENCE,
@@ -1819,6 +1862,36 @@ mod tests {
         // More records and fewer quantities ask for fewer standard deviations.
         assert!(support_factor(16, 11) < support_factor(8, 11));
         assert!(support_factor(8, 3) < support_factor(8, 11));
+    }
+
+    /// The records that would support a fit: the fewest for which the condition holds (and one
+    /// fewer does not), the same count when it holds already, more for a wider spread. By hand
+    /// for many records, where t is the normal quantile z = 2.8376 (11 quantities): a spread
+    /// `worst` = 1 from 8 records needs about 8 z^2 = 64.4 records; with t's quantile, 2.935 at
+    /// 69 records and 2.9365 at 68 (scipy.stats.t.ppf(1 - 0.05/22, 67)), exactly 69.
+    #[test]
+    fn records_to_support_is_the_fewest_that_would() {
+        use super::{records_to_support, support_factor};
+        let holds = |r: usize, records: usize, w: f64| {
+            support_factor(r, 11) * w * (records as f64 / r as f64).sqrt() <= 1.0
+        };
+        for (records, w) in [(8usize, 0.5), (8, 1.0), (8, 2.0), (16, 0.9), (3, 0.3)] {
+            let r = records_to_support(records, 11, w).unwrap();
+            assert!(holds(r, records, w), "{records}, {w}: {r}");
+            if r > records {
+                assert!(
+                    !holds(r - 1, records, w),
+                    "{records}, {w}: {r} is not the fewest"
+                );
+            }
+        }
+        let r1 = records_to_support(8, 11, 1.0).unwrap();
+        assert_eq!(r1, 69);
+        // Already supported: the same count.
+        assert_eq!(records_to_support(8, 11, 0.2), Some(8));
+        assert!(records_to_support(8, 11, 2.0).unwrap() > r1);
+        assert_eq!(records_to_support(8, 11, f64::NAN), None);
+        assert_eq!(records_to_support(8, 11, 1e6), None);
     }
 
     /// The gate's coverage: m quantities, each the mean of R standard normal draws, its jackknife
