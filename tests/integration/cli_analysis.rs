@@ -414,6 +414,35 @@ fn analyze_with_a_vehicle_updates_the_model() {
         html.contains("<h2>Full-car model updated from the records</h2>"),
         "report section"
     );
+    // Two records cannot show how well the fit is known: not supported, no vehicle file; the
+    // terminal says why, and the report shows the reason and the fit's figures beneath it.
+    let out6 = d.path().join("report6");
+    let mut args: Vec<&str> = vec!["analyze", "-q", "--method", "ssi-cov", "--vehicle", file];
+    args.extend(wavs[..2].iter().map(String::as_str));
+    args.extend(["-o", out6.to_str().unwrap()]);
+    let o = vibmode(&args);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        text.contains("Full-car model not updated: the records do not support the fit: 2 records cannot show how well the fit is known"),
+        "{text}"
+    );
+    assert!(!out6.join("updated_vehicle.toml").exists());
+    let rj: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out6.join("results.json")).unwrap()).unwrap();
+    assert_eq!(rj["model_update"]["records"], 2, "{rj}");
+    assert_eq!(rj["model_update"]["supported"], false, "{rj}");
+    let html = std::fs::read_to_string(out6.join("index.html")).unwrap();
+    let section = html
+        .split("<h2>Full-car model not updated: the records do not support the fit</h2>")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no section for the fit not supported"));
+    assert!(
+        section.contains("2 records cannot show")
+            && section.contains("updated [Hz]")
+            && section.contains("no updated vehicle file was written"),
+        "report section of the fit not supported"
+    );
     // The fit's band from the analysis config's [model_update]; a bad band is a one-line error.
     let cfg = d.path().join("band.toml");
     std::fs::write(&cfg, "[model_update]\nband_hz = [0.5, 2.0]\nedge_s = 0.5\n").unwrap();

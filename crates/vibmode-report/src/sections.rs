@@ -61,8 +61,34 @@ impl ReportSection {
         r: &BodyFitResult,
         identified: &[InvariantMode],
     ) -> ReportSection {
+        Self::fit_section(file, r, identified, None)
+    }
+
+    /// A fit the records do not support (`why`): the reason first, then the fit's figures with
+    /// their standard deviations (what the records gave, and how far they determine it), no
+    /// vehicle file (`results.json`: `model_update` holds the figures and `not_updated`).
+    pub fn model_update_unsupported(
+        file: &VehicleParams,
+        r: &BodyFitResult,
+        identified: &[InvariantMode],
+        why: &str,
+    ) -> ReportSection {
+        Self::fit_section(file, r, identified, Some(why))
+    }
+
+    fn fit_section(
+        file: &VehicleParams,
+        r: &BodyFitResult,
+        identified: &[InvariantMode],
+        not_used: Option<&str>,
+    ) -> ReportSection {
+        let files = if not_used.is_some() {
+            "no updated vehicle file was written"
+        } else {
+            "the updated vehicle file is updated_vehicle.toml beside this page"
+        };
         let intro = format!(
-            "The vehicle file's suspension and body inertias were fitted to the records from the full-car model's three body equations, which carry no road input: {} records, {} equations in {:.2}-{:.2} Hz, {:.1} % of their variance explained. Each sensor's white noise, measured from its spectrum above the band, was taken out of the equations, as much of its share as leaves them positive semi-definite (generalized total least squares; noise_share in model_update.json), and the standard deviations are the jackknife's over the records. The sprung mass, unsprung masses, tyres and bending are the file's. These body modes do not depend on the road's wheelbase delay, which biases output-only heave and pitch (docs/model_update.md); the updated vehicle file is updated_vehicle.toml beside this page, every number is in model_update.json and, under model_update, in results.json.",
+            "The vehicle file's suspension and body inertias were fitted to the records from the full-car model's three body equations, which carry no road input: {} records, {} equations in {:.2}-{:.2} Hz, {:.1} % of their variance explained. Each sensor's white noise, measured from its spectrum above the band, was taken out of the equations, as much of its share as leaves them positive semi-definite (generalized total least squares; noise_share in model_update.json), and the standard deviations are the jackknife's over the records. The sprung mass, unsprung masses, tyres and bending are the file's. These body modes do not depend on the road's wheelbase delay, which biases output-only heave and pitch (docs/model_update.md); {files}, every number is in model_update.json and, under model_update, in results.json.",
             r.records,
             r.equations,
             r.band_hz[0],
@@ -138,14 +164,30 @@ impl ReportSection {
                 })
                 .collect(),
         };
+        let mut json = serde_json::to_value(r).ok();
+        let (title, paragraphs) = match not_used {
+            None => ("Full-car model updated from the records", vec![intro]),
+            Some(why) => {
+                if let Some(o) = json.as_mut().and_then(|v| v.as_object_mut()) {
+                    o.insert("not_updated".into(), why.into());
+                }
+                (
+                    "Full-car model not updated: the records do not support the fit",
+                    vec![
+                        format!(
+                            "The fit below was not used: {why}. Its figures are shown with their standard deviations, as what these records give and how far they determine it; the modes above are matched to the vehicle file's model as it is."
+                        ),
+                        intro,
+                    ],
+                )
+            }
+        };
         ReportSection {
-            title: "Full-car model updated from the records".into(),
-            paragraphs: vec![intro],
+            title: title.into(),
+            paragraphs,
             tables: vec![modes, params],
             figures: vec![body_modes_figure(r, identified)],
-            json: serde_json::to_value(r)
-                .ok()
-                .map(|v| ("model_update".to_string(), v)),
+            json: json.map(|v| ("model_update".to_string(), v)),
         }
     }
 

@@ -188,7 +188,9 @@ impl UpdateOutcome {
             UpdateOutcome::Off => Vec::new(),
             UpdateOutcome::Skipped(why) => vec![ReportSection::model_update_skipped(why)],
             UpdateOutcome::Done(b) => match unsupported(&b.1) {
-                Some(why) => vec![ReportSection::model_update_skipped(&why)],
+                Some(why) => vec![ReportSection::model_update_unsupported(
+                    &b.0, &b.1, identified, &why,
+                )],
                 None => vec![ReportSection::model_update(&b.0, &b.1, identified)],
             },
         }
