@@ -1,6 +1,6 @@
 //! `vibmode fleet`: fleet monitoring on an SQLite store (init, ingest, baseline, check, status).
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 use clap::{Args, Subcommand};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -261,10 +261,11 @@ fn status(db: &std::path::Path) -> Result<()> {
     let store = Store::open(db)?;
     let st = store.status(5)?;
     if st.is_empty() {
-        bail!(
-            "the store {} has no vehicle yet; ingest nominal records first (vibmode fleet ingest --vehicle ID)",
+        // An empty store is a state, not an error (as `fleet report` says it on its page).
+        return crate::output::print_stdout(&format!(
+            "the store {} has no vehicle yet: nothing ingested or checked, no verdict; ingest a vehicle's nominal records first (vibmode fleet ingest --vehicle ID --condition nominal FILES)\n",
             db.display()
-        );
+        ));
     }
     crate::output::print_stdout(&vibmode_fleet::text::status_text(&st))
 }

@@ -434,12 +434,13 @@ fn analyze_with_a_vehicle_updates_the_model() {
     assert_eq!(rj["model_update"]["supported"], false, "{rj}");
     let html = std::fs::read_to_string(out6.join("index.html")).unwrap();
     let section = html
-        .split("<h2>Full-car model not updated: the records do not support the fit</h2>")
+        .split("<h2>Full-car model not updated</h2>")
         .nth(1)
         .unwrap_or_else(|| panic!("no section for the fit not supported"));
     assert!(
-        section.contains("2 records cannot show")
-            && section.contains("updated [Hz]")
+        section.contains(
+            "The fit below was not used: the records do not support the fit: 2 records cannot show"
+        ) && section.contains("updated [Hz]")
             && section.contains("no updated vehicle file was written"),
         "report section of the fit not supported"
     );

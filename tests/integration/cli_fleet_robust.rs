@@ -291,8 +291,19 @@ fn settings_a_later_command_cannot_read_are_refused() {
         cfg.to_str().unwrap(),
     ]);
     let o = vibmode(&["fleet", "status", "--db", db]);
-    // No vehicle yet: the status error, not an unreadable store.
-    assert!(stderr(&o).contains("no vehicle yet"), "{}", stderr(&o));
+    // No vehicle yet: said on stdout with success (a state, not an error), not an unreadable
+    // store.
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("has no vehicle yet"),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    // The report of an empty store says so too, rather than showing empty tables.
+    let rep = d.path().join("rep");
+    ok(&["fleet", "report", "--db", db, "-o", rep.to_str().unwrap()]);
+    let html = std::fs::read_to_string(rep.join("index.html")).unwrap();
+    assert!(html.contains("The store holds no vehicle yet"), "{html}");
 }
 
 #[test]

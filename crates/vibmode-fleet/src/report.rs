@@ -33,6 +33,12 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
         store.path(),
         vehicles.len()
     ));
+    if vehicles.is_empty() {
+        // Nothing to report is said, not left as empty tables.
+        html.paragraph(
+            "The store holds no vehicle yet: nothing has been ingested or checked, so there is no verdict to report. Ingest a vehicle's nominal records and build its baseline first (docs/fleet.md).",
+        );
+    }
     let status = store.status(usize::MAX / 2)?;
     // What a maintenance planner acts on first: per vehicle, its latest drive verdict, the
     // corner named, since when, and how sure; then the timeline of its drive verdicts.

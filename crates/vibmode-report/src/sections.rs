@@ -172,7 +172,7 @@ impl ReportSection {
                     o.insert("not_updated".into(), why.into());
                 }
                 (
-                    "Full-car model not updated: the records do not support the fit",
+                    "Full-car model not updated",
                     vec![
                         format!(
                             "The fit below was not used: {why}. Its figures are shown with their standard deviations, as what these records give and how far they determine it; the modes above are matched to the vehicle file's model as it is."
