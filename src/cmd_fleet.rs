@@ -260,12 +260,5 @@ fn check(a: &CheckArgs) -> Result<()> {
 fn status(db: &std::path::Path) -> Result<()> {
     let store = Store::open(db)?;
     let st = store.status(5)?;
-    if st.is_empty() {
-        // An empty store is a state, not an error (as `fleet report` says it on its page).
-        return crate::output::print_stdout(&format!(
-            "the store {} has no vehicle yet: nothing ingested or checked, no verdict; ingest a vehicle's nominal records first (vibmode fleet ingest --vehicle ID --condition nominal FILES)\n",
-            db.display()
-        ));
-    }
     crate::output::print_stdout(&vibmode_fleet::text::status_text(&st))
 }

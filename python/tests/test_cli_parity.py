@@ -76,6 +76,12 @@ def test_fleet_check_and_status_print_as_the_cli(tmp_path):
     today = sorted(str(p) for p in (tmp_path / "today").glob("record_*.wav"))
     db = tmp_path / "a.db"
     vibmode.fleet.init(db)
+    # An empty store: a state both say, the same way (not an error, not an empty table).
+    empty = vibmode.fleet.status(db)
+    assert str(empty).startswith("no vehicle in the store yet")
+    cli = subprocess.run([str(exe), "fleet", "status", "--db", str(db)], check=True,
+                         capture_output=True, text=True)
+    assert str(empty) == cli.stdout
     done = vibmode.fleet.ingest(db, "bus-1", nominal)
     assert len(done) == 6 and done[0]["file"] == nominal[0]
     assert str(done).splitlines()[0] == f"{nominal[0]}: stored as nominal record 1 of vehicle bus-1"

@@ -295,7 +295,7 @@ fn settings_a_later_command_cannot_read_are_refused() {
     // store.
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(
-        String::from_utf8_lossy(&o.stdout).contains("has no vehicle yet"),
+        String::from_utf8_lossy(&o.stdout).contains("no vehicle in the store yet"),
         "{}",
         String::from_utf8_lossy(&o.stdout)
     );

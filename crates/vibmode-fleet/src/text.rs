@@ -228,6 +228,10 @@ pub fn check_text(vehicle: &str, model_version: i64, out: &[Checked], drives: &[
 /// `fleet status`: one row per vehicle first (its latest drive verdict, the corner, since when,
 /// how sure), then each vehicle's counts, drives and latest records, newest first.
 pub fn status_text(st: &[VehicleStatus]) -> String {
+    if st.is_empty() {
+        // An empty store is a state, said as such (not an empty table).
+        return "no vehicle in the store yet: nothing ingested or checked, so no verdict; ingest a vehicle's nominal records and build its baseline first (docs/fleet.md)\n".to_string();
+    }
     let mut text = String::from(
         "vehicle          latest drive verdict  corner, component  since                 |z|/limit  drive\n",
     );
@@ -461,6 +465,7 @@ mod tests {
             Some("bus-017          no drive checked yet; latest record checked: vehicle (today/rec02.csv)"),
             "{text}"
         );
+        assert!(status_text(&[]).starts_with("no vehicle in the store yet"));
         let text = status_text(&[v(vec![])]);
         assert_eq!(
             text.lines().nth(1),
