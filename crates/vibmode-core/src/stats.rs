@@ -62,9 +62,12 @@ pub fn dot(x: &[f64], z: &[f64]) -> f64 {
     (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
-/// The smallest and largest of `x` (not empty, no NaN), in four lanes (`<` and `>` compare as
-/// SIMD instructions where `f64::min` and `max`, which mind NaN, do not).
-fn extremes(x: &[f64]) -> (f64, f64) {
+/// The smallest and largest of `x` (no NaN), in four lanes (`<` and `>` compare as SIMD
+/// instructions where `f64::min` and `max`, which mind NaN, do not).
+///
+/// # Panics
+/// When `x` is empty.
+pub fn extremes(x: &[f64]) -> (f64, f64) {
     let (mut lo, mut hi) = ([x[0]; 4], [x[0]; 4]);
     let chunks = x.chunks_exact(4);
     let rest = chunks.remainder();

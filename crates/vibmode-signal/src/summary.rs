@@ -121,10 +121,9 @@ impl Acc {
         let nb = x.len() as f64;
         let mb = x.iter().sum::<f64>() / nb;
         let m2b: f64 = x.iter().map(|v| (v - mb) * (v - mb)).sum();
-        for &v in x {
-            self.min = self.min.min(v);
-            self.max = self.max.max(v);
-        }
+        let (lo, hi) = vibmode_core::stats::extremes(x);
+        self.min = self.min.min(lo);
+        self.max = self.max.max(hi);
         let na = self.n as f64;
         let n = na + nb;
         let d = mb - self.mean;
