@@ -58,7 +58,7 @@ pub struct RecordSummary {
     pub clipped: Vec<ClippedChannel>,
     /// The record's channels that hold one value over stretches of [`HELD_MIN_S`] or more for
     /// [`HELD_SHARE_MIN`] of their samples or more (a data logger's dropouts filled with the last
-    /// value or with 0, [`vibmode_core::stats::held_runs`]), as read: still analysed. Empty when
+    /// value or with 0, [`vibmode_core::stats::ChannelHealth::held`]), as read: still analysed. Empty when
     /// none does.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub held: Vec<HeldChannel>,

@@ -136,8 +136,12 @@ pub struct ChannelHealth {
     pub constant: Option<f64>,
     /// `(count, value)` when clipped ([`clipped`]).
     pub clipped: Option<(usize, f64)>,
-    /// `(samples, stretches, longest)` of the stretches that hold one value ([`held_runs`]),
-    /// leaving out a clipped channel's stretches at its extremes (clipping, reported as such).
+    /// `(samples, stretches, longest)` of the stretches that hold one value: runs of at least
+    /// `min_run` (>= 2) consecutive samples that are exactly equal, leaving out a clipped
+    /// channel's runs at its extremes (clipping, reported as such). A live sensor's signal,
+    /// dithered by its own noise, changes from sample to sample (the longest run in the shipped
+    /// real recordings is 4 samples at 500 Hz); a data logger's dropout, filled with the last
+    /// value or with 0, holds it.
     pub held: (usize, usize, usize),
 }
 
@@ -165,32 +169,19 @@ impl ChannelHealth {
     }
 }
 
-/// [`constant_value`], [`clipped`] and [`held_runs`] (runs of `min_run` samples or more, see
-/// [`held_min_run`]) of one channel, sharing its extremes: what the analysis notes and the
-/// fleet calls a sensor fault.
+/// [`constant_value`], [`clipped`] and the held stretches ([`ChannelHealth::held`]: runs of
+/// `min_run` samples or more, see [`held_min_run`]) of one channel: what the analysis notes and
+/// the fleet calls a sensor fault. The [`HealthScan`] of the whole channel, its extremes found
+/// first: one rule for a channel in memory and one read in blocks.
 pub fn channel_health(x: &[f64], min_run: usize) -> ChannelHealth {
-    let mut h = ChannelHealth {
-        n: x.len(),
-        constant: None,
-        clipped: None,
-        held: (0, 0, 0),
-    };
-    if x.len() < 2 {
-        return h;
-    }
-    let (min, max) = extremes(x);
-    h.constant = constant_from_extremes(min, max);
-    if h.constant.is_some() {
-        return h;
-    }
-    h.clipped = clipped_from_extremes(x, min, max);
-    let skip: &[f64] = if h.clipped.is_some() {
-        &[min, max]
+    let (min, max) = if x.is_empty() {
+        (0.0, 0.0)
     } else {
-        &[]
+        extremes(x)
     };
-    h.held = held_runs(x, min_run, skip);
-    h
+    let mut scan = HealthScan::new(x.len(), min, max, min_run);
+    scan.push(x);
+    scan.finish()
 }
 
 /// [`constant_value`] from a channel's extremes (for a channel read in blocks): `Some(0.0)`
@@ -211,86 +202,14 @@ pub fn constant_from_extremes(min: f64, max: f64) -> Option<f64> {
 /// `Some((count, value))` of the extreme held more often, `count` every sample at it (held or
 /// not); `None` for a channel that is not clipped or is constant ([`constant_value`]).
 pub fn clipped(x: &[f64]) -> Option<(usize, f64)> {
-    if x.len() < 2 {
-        return None;
-    }
-    let (min, max) = extremes(x);
-    if constant_from_extremes(min, max).is_some() {
-        return None;
-    }
-    clipped_from_extremes(x, min, max)
+    channel_health(x, HELD_MIN_SAMPLES).clipped
 }
 
-/// [`clipped`] of a channel that is not constant, given its extremes.
-fn clipped_from_extremes(x: &[f64], min: f64, max: f64) -> Option<(usize, f64)> {
-    let tol = 1e-9 * (max - min);
-    let (hi, lo) = (max - tol, min + tol);
-    let need = CLIPPED_MIN_SAMPLES.max((CLIPPED_SHARE * x.len() as f64).ceil() as usize);
-    // A live channel reaches its extremes a few times: counted first (no branches), so that the
-    // neighbours are looked at only when enough samples are there.
-    let (at_hi, at_lo) = x.iter().fold((0usize, 0usize), |(h, l), &v| {
-        (h + usize::from(v >= hi), l + usize::from(v <= lo))
-    });
-    if at_hi.max(at_lo) < need {
-        return None;
-    }
-    // One pass: the samples at each extreme, and those of them with a neighbour there too.
-    let (mut at_max, mut at_min, mut held_max, mut held_min) = (0usize, 0usize, 0usize, 0usize);
-    for (i, &v) in x.iter().enumerate() {
-        let prev = i.checked_sub(1).map(|j| x[j]);
-        let next = x.get(i + 1).copied();
-        if v >= hi {
-            at_max += 1;
-            if prev.is_some_and(|p| p >= hi) || next.is_some_and(|q| q >= hi) {
-                held_max += 1;
-            }
-        }
-        if v <= lo {
-            at_min += 1;
-            if prev.is_some_and(|p| p <= lo) || next.is_some_and(|q| q <= lo) {
-                held_min += 1;
-            }
-        }
-    }
-    // Judged by the held samples, reported with every sample at that extreme.
-    let (n, count, value) = if held_max >= held_min {
-        (held_max, at_max, max)
-    } else {
-        (held_min, at_min, min)
-    };
-    (n >= need).then_some((count, value))
-}
-
-/// Stretches of a channel that hold one value: `(samples, stretches, longest)` over the runs of
-/// at least `min_run` (>= 2) consecutive samples that are exactly equal, skipping runs at
-/// `skip` (the extremes of a clipped channel, which [`clipped`] reports). A live sensor's
-/// signal, dithered by its own noise, changes from sample to sample (the longest run in the
-/// shipped real recordings is 4 samples at 500 Hz); a data logger's dropout, filled with the
-/// last value or with 0, holds it.
-pub fn held_runs(x: &[f64], min_run: usize, skip: &[f64]) -> (usize, usize, usize) {
-    let min_run = min_run.max(2);
-    let (mut samples, mut stretches, mut longest) = (0, 0, 0);
-    let mut i = 0;
-    while i < x.len() {
-        let mut j = i + 1;
-        while j < x.len() && x[j] == x[i] {
-            j += 1;
-        }
-        let run = j - i;
-        if run >= min_run && !skip.contains(&x[i]) {
-            samples += run;
-            stretches += 1;
-            longest = longest.max(run);
-        }
-        i = j;
-    }
-    (samples, stretches, longest)
-}
-
-/// [`channel_health`] of a channel read in blocks, as a second pass once its extremes are known
-/// (the first pass: `min`, `max` and the number of samples `n`). Feed every block in order with
-/// [`HealthScan::push`]; [`HealthScan::finish`] gives what `channel_health` gives for the whole
-/// channel, exactly (runs are carried across blocks).
+/// The rules of [`channel_health`] (constant, clipped, held) applied in one pass over a channel
+/// whose extremes are known, so that a channel read in blocks is judged as a whole one is (the
+/// first pass: `min`, `max` and the number of samples `n`). Feed every block in order with
+/// [`HealthScan::push`]; [`HealthScan::finish`] gives the same for any cut into blocks (runs
+/// are carried across them). `channel_health` is this scan of the whole channel.
 #[derive(Clone, Debug)]
 pub struct HealthScan {
     n: usize,
@@ -339,16 +258,21 @@ impl HealthScan {
 
     fn end_run(&mut self) {
         if let Some((v, len)) = self.run.take() {
-            if len >= self.min_run {
-                let h = if v == self.min || v == self.max {
-                    &mut self.held_extreme
-                } else {
-                    &mut self.held_other
-                };
-                h.0 += len;
-                h.1 += 1;
-                h.2 = h.2.max(len);
-            }
+            self.count_run(v, len);
+        }
+    }
+
+    /// Counts a run of `len` samples of `v` that has ended, when it is long enough.
+    fn count_run(&mut self, v: f64, len: usize) {
+        if len >= self.min_run {
+            let h = if v == self.min || v == self.max {
+                &mut self.held_extreme
+            } else {
+                &mut self.held_other
+            };
+            h.0 += len;
+            h.1 += 1;
+            h.2 = h.2.max(len);
         }
     }
 
@@ -364,23 +288,34 @@ impl HealthScan {
         if self.constant.is_some() || self.n < 2 {
             return;
         }
+        // The current run in locals (NaN equals no sample: a first sample starts a run).
+        let (mut value, mut len) = self.run.take().unwrap_or((f64::NAN, 0));
         for &v in x {
-            for (k, at) in [v >= self.hi, v <= self.lo].into_iter().enumerate() {
-                if at {
-                    self.at[k] += 1;
-                    self.run_at[k] += 1;
-                } else {
-                    self.end_extreme_run(k);
+            // Most samples lie strictly between the extremes: one test, and the extremes' runs
+            // (if any) end.
+            if v < self.hi && v > self.lo {
+                if self.run_at != [0, 0] {
+                    self.end_extreme_run(0);
+                    self.end_extreme_run(1);
+                }
+            } else {
+                for (k, at) in [v >= self.hi, v <= self.lo].into_iter().enumerate() {
+                    if at {
+                        self.at[k] += 1;
+                        self.run_at[k] += 1;
+                    } else {
+                        self.end_extreme_run(k);
+                    }
                 }
             }
-            match &mut self.run {
-                Some((value, len)) if *value == v => *len += 1,
-                _ => {
-                    self.end_run();
-                    self.run = Some((v, 1));
-                }
+            if v == value {
+                len += 1;
+            } else {
+                self.count_run(value, len);
+                (value, len) = (v, 1);
             }
         }
+        self.run = (len > 0).then_some((value, len));
     }
 
     /// What [`channel_health`] gives for the channel fed.
@@ -433,11 +368,70 @@ pub fn jackknife_std(theta: &[f64]) -> f64 {
 mod tests {
     use super::*;
 
+    /// Oracle: stretches of a channel that hold one value: `(samples, stretches, longest)` over the runs of
+    /// at least `min_run` (>= 2) consecutive samples that are exactly equal, skipping runs at
+    /// `skip` (the extremes of a clipped channel, which [`clipped`] reports). A live sensor's
+    /// signal, dithered by its own noise, changes from sample to sample (the longest run in the
+    /// shipped real recordings is 4 samples at 500 Hz); a data logger's dropout, filled with the
+    /// last value or with 0, holds it.
+    fn held_runs(x: &[f64], min_run: usize, skip: &[f64]) -> (usize, usize, usize) {
+        let min_run = min_run.max(2);
+        let (mut samples, mut stretches, mut longest) = (0, 0, 0);
+        let mut i = 0;
+        while i < x.len() {
+            let mut j = i + 1;
+            while j < x.len() && x[j] == x[i] {
+                j += 1;
+            }
+            let run = j - i;
+            if run >= min_run && !skip.contains(&x[i]) {
+                samples += run;
+                stretches += 1;
+                longest = longest.max(run);
+            }
+            i = j;
+        }
+        (samples, stretches, longest)
+    }
+
+    /// Oracle of the clipped rule, written from its definition ([`clipped`]): the samples at
+    /// each extreme, those with a neighbour there too, judged by the held ones.
+    fn clipped_by_definition(x: &[f64]) -> Option<(usize, f64)> {
+        if x.len() < 2 {
+            return None;
+        }
+        let min = x.iter().copied().fold(f64::INFINITY, f64::min);
+        let max = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        if constant_value(x).is_some() {
+            return None;
+        }
+        let tol = 1e-9 * (max - min);
+        let need = CLIPPED_MIN_SAMPLES.max((CLIPPED_SHARE * x.len() as f64).ceil() as usize);
+        let count = |at: &dyn Fn(f64) -> bool| {
+            let all = x.iter().filter(|&&v| at(v)).count();
+            let held = (0..x.len())
+                .filter(|&i| {
+                    at(x[i]) && ((i > 0 && at(x[i - 1])) || (i + 1 < x.len() && at(x[i + 1])))
+                })
+                .count();
+            (held, all)
+        };
+        let (held_hi, at_hi) = count(&|v| v >= max - tol);
+        let (held_lo, at_lo) = count(&|v| v <= min + tol);
+        let (held, all, value) = if held_hi >= held_lo {
+            (held_hi, at_hi, max)
+        } else {
+            (held_lo, at_lo, min)
+        };
+        (held >= need).then_some((all, value))
+    }
+
     #[test]
-    fn a_scan_in_blocks_is_channel_health() {
+    fn a_scan_in_blocks_is_the_scan_of_the_whole_and_each_rule() {
         // Channels that are live, clipped at either extreme or both, held (dropouts filled with
         // the last value or with an extreme), constant, dead, or of 0-3 samples, cut into blocks
-        // at every split of a seeded generator: the scan equals `channel_health` of the whole.
+        // at every split of a seeded generator: the scan equals `channel_health` of the whole, and
+        // that equals each rule written out from its definition (the oracles above).
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
         let mut next = move || {
             state ^= state << 13;
@@ -491,6 +485,19 @@ mod tests {
                 whole,
                 "case {case}: n {n}, min_run {min_run}"
             );
+            // And the whole is each rule written from its definition.
+            assert_eq!(whole.constant, constant_value(&x), "case {case}");
+            assert_eq!(whole.clipped, clipped_by_definition(&x), "case {case}");
+            let skip = match whole.clipped {
+                Some(_) => vec![min, max],
+                None => Vec::new(),
+            };
+            let held = if whole.constant.is_some() {
+                (0, 0, 0)
+            } else {
+                held_runs(&x, min_run, &skip)
+            };
+            assert_eq!(whole.held, held, "case {case}");
             kinds[0] += usize::from(whole.constant.is_some());
             kinds[1] += usize::from(whole.clipped.is_some());
             kinds[2] += usize::from(whole.held.1 > 0);
@@ -649,7 +656,7 @@ mod tests {
             }
             let h = channel_health(&y, 4);
             assert_eq!(h.constant, constant_value(&y), "seed {seed}");
-            assert_eq!(h.clipped, clipped(&y), "seed {seed}");
+            assert_eq!(h.clipped, clipped_by_definition(&y), "seed {seed}");
             let skip = match h.clipped {
                 Some(_) => vec![
                     y.iter().copied().fold(f64::INFINITY, f64::min),

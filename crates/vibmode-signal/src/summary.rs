@@ -57,7 +57,7 @@ pub struct ChannelSummary {
     pub clipped_samples: usize,
     /// The clipped extreme, in `unit`; `None` when not clipped.
     pub clipped_value: Option<f64>,
-    /// Samples in held stretches ([`vibmode_core::stats::held_runs`], runs of at least
+    /// Samples in held stretches ([`vibmode_core::stats::ChannelHealth::held`], runs of at least
     /// [`vibmode_core::stats::HELD_MIN_S`]), the stretches and the longest, in samples.
     pub held_samples: usize,
     /// Number of held stretches.
