@@ -1268,7 +1268,12 @@ impl BodyFit {
                 }
             }
             let k = support_factor(loo_values.len(), judged.len());
-            if let Some((name, rel, tol)) = judged.iter().find(|(_, rel, tol)| {
+            if judged.is_empty() {
+                // Nothing to judge supports nothing (every fit has springs and dampers today).
+                not_supported = Some(
+                    "no body mode frequency, spring or damper of the fit has a standard deviation to judge its support by".to_string(),
+                );
+            } else if let Some((name, rel, tol)) = judged.iter().find(|(_, rel, tol)| {
                 // Outside, or not a number (an sd that is NaN supports nothing).
                 matches!(
                     (k * rel).partial_cmp(tol),
