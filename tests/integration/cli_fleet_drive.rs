@@ -67,6 +67,14 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
     assert_eq!(dr["classification"], "normal", "{dr}");
     // No vehicle evidence: no component named.
     assert!(dr.get("component").is_none(), "{dr}");
+    // No model file registered: the drive says what it could not look at (not a silent normal).
+    let missing = dr["missing"].as_array().unwrap();
+    assert!(
+        missing
+            .iter()
+            .any(|m| m.as_str() == Some(vibmode_fleet::fleet::NO_MODEL_FILE)),
+        "{dr}"
+    );
     assert_eq!(n_test(db, "bus-1"), 4);
     let drives = || {
         vibmode_fleet::Store::open(std::path::Path::new(db))

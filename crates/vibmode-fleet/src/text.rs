@@ -430,6 +430,17 @@ mod tests {
         );
         // Every record in a drive: no note.
         assert_eq!(note(&out[..4], &drives), None);
+        // A drive whose vehicle has no model file: its verdict line is followed by why its
+        // suspension was not fitted.
+        let mut bare = drive(&["d1/a.csv", "d1/b.csv", "d1/c.csv"]);
+        bare.assessment.missing = vec![crate::fleet::NO_MODEL_FILE.to_string()];
+        let t = check_text("bus1", 1, &out[..4], &[bare]);
+        let at = t.lines().position(|l| l.starts_with("drive 2026-11-27"));
+        assert_eq!(
+            at.and_then(|i| t.lines().nth(i + 1)),
+            Some(format!("  note: {}", crate::fleet::NO_MODEL_FILE).as_str()),
+            "{t}"
+        );
     }
 
     /// `fleet status` of a vehicle whose records were checked one by one only: its row says
