@@ -557,10 +557,12 @@ impl<'a> Search<'a> {
         for (i, &bi) in b.iter().enumerate() {
             let (done, rest) = self.cols.split_at_mut(i + 1);
             let (prev, next) = (&done[i], &mut rest[0]);
+            // One pass: the previous column delayed by one, plus the impulse's share from p on
+            // (the same sums as a copy followed by the addition).
             next[0] = 0.0;
-            next[1..].copy_from_slice(&prev[..n - 1]);
-            for (nt, &gt) in next[p..].iter_mut().zip(&self.g) {
-                *nt += bi * gt;
+            next[1..p].copy_from_slice(&prev[..p - 1]);
+            for ((nt, &pt), &gt) in next[p..].iter_mut().zip(&prev[p - 1..n - 1]).zip(&self.g) {
+                *nt = pt + bi * gt;
             }
         }
         self.exact_cols = true;
