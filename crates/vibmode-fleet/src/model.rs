@@ -52,6 +52,29 @@ pub enum Kind {
     DamperFit,
 }
 
+impl Kind {
+    /// The kind's name, as the JSON spells it (`mode-frequency`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Level => "level",
+            Kind::Transmissibility => "transmissibility",
+            Kind::ModeFrequency => "mode-frequency",
+            Kind::ModeDamping => "mode-damping",
+            Kind::SideRatio => "side-ratio",
+            Kind::TrackRatio => "track-ratio",
+            Kind::BodyResponse => "body-response",
+            Kind::SpringFit => "spring-fit",
+            Kind::DamperFit => "damper-fit",
+        }
+    }
+}
+
+impl std::fmt::Display for Kind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// Every kind, in the order of the model set's limits.
 const KINDS: [Kind; 7] = [
     Kind::Level,
@@ -1540,6 +1563,16 @@ pub struct Drive {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_kind_prints_as_its_json_name() {
+        for k in KINDS.into_iter().chain([Kind::SpringFit, Kind::DamperFit]) {
+            assert_eq!(
+                serde_json::to_value(k).unwrap(),
+                serde_json::Value::String(k.to_string())
+            );
+        }
+    }
     use crate::features::{ChannelFeatures, CornerTransmissibility, ModeEstimate};
     use crate::stats::MAD_TO_SIGMA;
 

@@ -95,7 +95,7 @@ pub fn baseline_text(set: &ModelSet) -> String {
         let _ = writeln!(
             text,
             "{:<18} {:>8}  {:>10.2}  {:>11.2}  {:>5.2}",
-            format!("{:?}", l.kind),
+            l.kind.to_string(),
             l.n_features,
             l.bonferroni,
             l.loo_max_abs_z,
