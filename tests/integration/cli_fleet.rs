@@ -210,8 +210,8 @@ fn init_config_sets_the_fleet_settings() {
     // false-alarm rate over them: z(1 - 0.05 / (2 x 2)) = 2.24 (at the default 1 %: 2.81).
     let level = text
         .lines()
-        .find(|l| l.starts_with("Level"))
-        .unwrap_or_else(|| panic!("no Level row in:\n{text}"));
+        .find(|l| l.starts_with("level "))
+        .unwrap_or_else(|| panic!("no level row in:\n{text}"));
     let cols: Vec<&str> = level.split_whitespace().collect();
     assert_eq!(cols[1], "2", "{level}");
     assert_eq!(cols[2], "2.24", "{level}");
