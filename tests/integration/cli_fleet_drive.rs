@@ -120,6 +120,14 @@ fn a_drive_is_classified_from_its_records_and_bad_drives_are_refused() {
         row.starts_with("bus-1") && row.contains("normal") && row.contains(&latest.since),
         "{text}"
     );
+    // And that the vehicle's springs and dampers are not fitted: it has no model file.
+    assert!(
+        text.contains(&format!(
+            "  {}\n",
+            vibmode_fleet::store::NO_MODEL_FILE_STATUS
+        )),
+        "{text}"
+    );
 
     // Too few records for a named drive: refused before anything is read or stored.
     let more = simulate_csv(&d.path().join("more"), "B", "30", "31", "3");

@@ -142,9 +142,7 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
                 count(Classification::Vehicle),
                 count(Classification::Both),
                 count(Classification::Sensor),
-                s.suspension
-                    .clone()
-                    .unwrap_or_else(|| "no model file registered".into()),
+                s.suspension.clone().unwrap_or_default(),
             ]
         })
         .collect();

@@ -152,6 +152,9 @@ pub struct RecordRow {
     pub road: Option<String>,
 }
 
+/// A vehicle's suspension line in the status when it has no registered model file.
+pub const NO_MODEL_FILE_STATUS: &str = "no model file registered: springs and dampers are not fitted per drive, so a lost spring may go unseen (docs/fleet.md, \"The suspension fitted per drive\")";
+
 /// Status of one vehicle.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct VehicleStatus {
@@ -172,7 +175,7 @@ pub struct VehicleStatus {
     #[serde(default)]
     pub drives: Vec<DriveStatus>,
     /// The suspension fitted per drive: whether the vehicle has a registered model file and
-    /// whether its latest model set fits it (one line); absent without a model file.
+    /// whether its latest model set fits it (one line; [`NO_MODEL_FILE_STATUS`] without one).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub suspension: Option<String>,
 }
@@ -1185,7 +1188,8 @@ impl Store {
             }
             let drives = self.drive_statuses(vid, &v)?;
             let suspension = match self.vehicle_model(&v)? {
-                None => None,
+                // Said, not left out: without the fit a lost spring may pass unseen.
+                None => Some(NO_MODEL_FILE_STATUS.to_string()),
                 Some((sha, _)) => Some(match self.latest_model_set(&v)? {
                     None => "model file registered; no baseline yet".to_string(),
                     Some(set) => match &set.suspension {

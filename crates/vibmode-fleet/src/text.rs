@@ -181,8 +181,8 @@ pub fn check_text(vehicle: &str, model_version: i64, out: &[Checked], drives: &[
             },
             or_dash(&d.assessment.summary)
         );
-        // Why the suspension was not fitted to the drive, when the vehicle has a model file or
-        // the model set a fitted suspension: not a silent absence.
+        // Why the suspension was not fitted to the drive (no model file, no fit in the model
+        // set, too few records...): not a silent absence.
         for m in d
             .assessment
             .missing
