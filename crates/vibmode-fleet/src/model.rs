@@ -1563,6 +1563,8 @@ pub struct Drive {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::features::{ChannelFeatures, CornerTransmissibility, ModeEstimate};
+    use crate::stats::MAD_TO_SIGMA;
 
     #[test]
     fn a_kind_prints_as_its_json_name() {
@@ -1573,8 +1575,6 @@ mod tests {
             );
         }
     }
-    use crate::features::{ChannelFeatures, CornerTransmissibility, ModeEstimate};
-    use crate::stats::MAD_TO_SIGMA;
 
     /// A record with one unsprung level and one transmissibility in band 2-5 Hz.
     fn record(level: f64, trans: f64) -> RecordFeatures {
