@@ -215,6 +215,11 @@ fn init_config_sets_the_fleet_settings() {
     let cols: Vec<&str> = level.split_whitespace().collect();
     assert_eq!(cols[1], "2", "{level}");
     assert_eq!(cols[2], "2.24", "{level}");
+    // Its zero leave-one-out maximum is explained under the table.
+    assert!(
+        text.contains("(level: a road scored only beyond the nominal records' largest level"),
+        "{text}"
+    );
     let status = ok(&["fleet", "status", "--db", db]);
     assert!(status.status.success());
     // Other settings once records are stored: refused, the store unchanged.

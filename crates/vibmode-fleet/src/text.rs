@@ -102,6 +102,16 @@ pub fn baseline_text(set: &ModelSet) -> String {
             l.limit
         );
     }
+    if set
+        .limits
+        .iter()
+        .any(|l| l.kind == crate::model::Kind::Level)
+    {
+        // One-sided, so its leave-one-out maximum is 0 on every baseline: said, not a puzzle.
+        text.push_str(
+            "(level: a road scored only beyond the nominal records' largest level and the road margin, so a nominal record scores 0)\n",
+        );
+    }
     if let Some(s) = &set.suspension {
         let _ = writeln!(
             text,
