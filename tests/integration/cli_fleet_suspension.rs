@@ -86,8 +86,11 @@ fn a_spring_at_80_percent_is_named_by_the_fit_per_drive() {
         base.contains("suspension fitted to 6 nominal records"),
         "{base}"
     );
-    // The limit: Phi^-1(1 - 0.01 / 8).
-    assert!(base.contains("limit 3.02"), "{base}");
+    // The limit: Phi^-1(1 - 0.01 / 12), the drive's 8 tests and the trend's 4.
+    assert!(
+        base.contains("and the springs over the last 3 drives, one-sided limit 3.14"),
+        "{base}"
+    );
     let status = stdout(&["fleet", "status", "--db", db]);
     assert!(
         status.contains("baseline version 1 fits the suspension (6 nominal records)"),
@@ -101,18 +104,23 @@ fn a_spring_at_80_percent_is_named_by_the_fit_per_drive() {
     let scores = dr["suspension"]["scores"].as_array().unwrap();
     assert_eq!(scores.len(), 8, "{dr}");
     assert!(
-        scores.iter().all(|x| x["z"].as_f64().unwrap() > -3.02),
+        scores.iter().all(|x| x["z"].as_f64().unwrap() > -3.14),
         "{dr}"
     );
     assert_eq!(dr["suspension"]["fit"]["records"], 4, "{dr}");
     // The bound per drive: the features' 1 % and the fit's own 1 %.
     assert_eq!(dr["false_alarm_rate"], 0.02, "{dr}");
+    let missing: Vec<&str> = dr["missing"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|m| m.as_str())
+        .collect();
+    assert!(missing.iter().all(|m| !m.contains("suspension")), "{dr}");
+    // The first drive after the baseline has no earlier ones to pool its springs with: said.
+    assert!(dr["suspension"].get("trend").is_none(), "{dr}");
     assert!(
-        dr["missing"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .all(|m| !m.as_str().unwrap_or("").contains("suspension")),
+        missing.contains(&"spring trend over the last 3 drives: not made: 0 earlier drive(s) of the vehicle fitted against baseline version 1, 2 needed (a spring's slow loss is then judged on this drive alone)"),
         "{dr}"
     );
 
@@ -138,9 +146,56 @@ fn a_spring_at_80_percent_is_named_by_the_fit_per_drive() {
     let fit = fit_evidence(&dr);
     assert!(
         fit.iter()
-            .any(|(k, c, z)| k == "spring-fit" && c == "RL" && *z < -3.02),
+            .any(|(k, c, z)| k == "spring-fit" && c == "RL" && *z < -3.14),
         "{fit:?}"
     );
+    // The second drive had one earlier drive; the third pools its springs with the two before
+    // it, newest first, and scores every corner's.
+    assert!(dr["suspension"].get("trend").is_none(), "{dr}");
+    let files = simulate_csv_of(
+        soft.to_str().unwrap(),
+        &d.path().join("soft2"),
+        "B",
+        "30",
+        "41",
+        "4",
+    );
+    let mut args = vec![
+        "fleet",
+        "check",
+        "--db",
+        db,
+        "--vehicle",
+        "bus-1",
+        "-q",
+        "--drive",
+        "third",
+        "--json",
+        "-",
+    ];
+    args.extend(files.iter().map(String::as_str));
+    let v: serde_json::Value = serde_json::from_slice(&ok(&args).stdout).unwrap();
+    let dr = &v["drives"][0];
+    let trend = &dr["suspension"]["trend"];
+    assert_eq!(
+        trend["drives"],
+        serde_json::json!(["third", "d", "d"]),
+        "{dr}"
+    );
+    let scores = trend["scores"].as_array().unwrap();
+    assert_eq!(scores.len(), 4, "{dr}");
+    assert!(scores.iter().all(|x| x["part"] == "spring"), "{dr}");
+    // Two drives of the spring at 80 % and one healthy: RL the lowest of the four.
+    let lowest = scores
+        .iter()
+        .min_by(|a, b| {
+            a["z"]
+                .as_f64()
+                .unwrap()
+                .total_cmp(&b["z"].as_f64().unwrap())
+        })
+        .unwrap();
+    assert_eq!(lowest["corner"], "RL", "{dr}");
 }
 
 /// A model file that is not one, or that gives no fit, is refused before anything is stored;

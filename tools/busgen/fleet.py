@@ -11,7 +11,9 @@ Per bus (bus seeds drawn at random, printed; `VIBMODE_BUS_SEEDS=1,2,3` replays):
 - faults at a corner drawn at random: damper at 60 % and 70 %, spring at 80 %, tyre at 75 %;
 - a healthy drive on a class D road.
 
-Each drive is given to one `fleet check --json -` (its 8 records: one drive). Scored:
+Each drive is given to one `fleet check --json -` (its 8 records: one drive), on a copy of the
+store as the baseline left it: the drives are alternatives, not one vehicle's sequence (the
+spring trend pools a vehicle's last drives; `spring_trend.py` measures sequences). Scored:
 
 - healthy: `normal` (per drive, per record);
 - faults: `vehicle` or `both` with the faulty corner named first (the first vehicle evidence of
@@ -129,7 +131,8 @@ def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
             config: Optional[Path] = None) -> Dict:
     """Simulates, ingests, baselines and checks one bus; returns its rows.
 
-    The store is deleted unless `keep` (then it stays in `work` as fleet-SEED.db, beside each
+    Each drive is checked on a copy of the store as the baseline left it. The stores are deleted
+    unless `keep` (then each drive's stays in `work` as fleet-SEED-I-CONDITION.db, beside its
     check's JSON as check-SEED-CONDITION.json)."""
     db = work / f"fleet-{bus_seed}.db"
     if db.exists():
@@ -147,6 +150,12 @@ def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
             h.run_vibmode(["fleet", "register", "--db", db, "--vehicle", vehicle, toml])
     h.run_vibmode(["fleet", "ingest", "--db", db, "--vehicle", vehicle, "-q", *base])
     h.run_vibmode(["fleet", "baseline", "--db", db, "--vehicle", vehicle])
+    # The drives are alternatives, not one vehicle's sequence: each is checked on a copy of the
+    # store as the baseline left it, so that the spring trend (which pools a vehicle's last
+    # drives) does not carry one condition's fault into the next (tools/busgen/spring_trend.py
+    # measures sequences).
+    pristine = work / f"fleet-{bus_seed}.base.db"
+    h.copy_store(db, pristine)
     rows = []
     drives = conditions(bus_seed, rng)
     n_first = len(drives)
@@ -156,6 +165,9 @@ def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
         seed = base_seed + (10000 * (i + 1) if i < n_first else cond["seed"])
         folder = h.simulate(bus_seed, seed, *cond["extra"], *(test_extra or []),
                             records=n_records)
+        if keep:
+            db = work / f"fleet-{bus_seed}-{i}-{cond['name']}.db"
+        h.copy_store(pristine, db)
         r = h.run_vibmode(["fleet", "check", "--db", db, "--vehicle", vehicle, "-q",
                            "--json", "-", *h.records(folder)])
         out = json.loads(r.stdout)
@@ -180,8 +192,10 @@ def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
                      else verdict_ok(drive[0], drive[1], cond) and drive[3] == cond["component"],
                      "false_both": sum(c == "both" for c, _, _ in recs)
                      if cond["expect"] != "vehicle" else 0})
+    pristine.unlink()
     if not keep:
-        db.unlink()
+        for f in work.glob(f"fleet-{bus_seed}.db*"):
+            f.unlink()
     return {"bus": bus_seed, "rows": rows}
 
 

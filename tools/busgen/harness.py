@@ -130,6 +130,23 @@ def simulate(bus_seed: int, seed: int, *extra: str, records: int = RECORDS,
     return out
 
 
+def copy_store(src: Path, dst: Path) -> None:
+    """Copies the SQLite store `src` (with what its write-ahead log holds) to `dst`, replacing
+    it: SQLite's online backup."""
+    import sqlite3
+
+    for f in (dst, dst.with_name(dst.name + "-wal"), dst.with_name(dst.name + "-shm")):
+        if f.exists():
+            f.unlink()
+    a = sqlite3.connect(src)
+    b = sqlite3.connect(dst)
+    try:
+        a.backup(b)
+    finally:
+        b.close()
+        a.close()
+
+
 def records(folder: Path) -> List[Path]:
     return sorted(folder.glob("rec*.csv"))
 

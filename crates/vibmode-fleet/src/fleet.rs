@@ -969,10 +969,21 @@ pub fn check_drive_files_progress(
             }
         }
     }
-    let mut drives = Vec::with_capacity(groups.len());
+    let mut drives: Vec<(Drive, Vec<usize>)> = Vec::with_capacity(groups.len());
     for (id, members) in groups {
         let group: Vec<&Prepared> = members.iter().map(|&i| &prepared[i]).collect();
-        drives.push((drive_verdict(store, set, &id, &group)?, members));
+        // The drives of this check before it count as earlier drives of the spring trend.
+        let earlier: Vec<(Drive, Vec<String>)> = drives
+            .iter()
+            .map(|(d, m)| {
+                let hashes = m
+                    .iter()
+                    .map(|&i| prepared[i].content_hash.clone())
+                    .collect();
+                (d.clone(), hashes)
+            })
+            .collect();
+        drives.push((drive_verdict(store, set, &id, &group, &earlier)?, members));
     }
     let checked = check_prepared_drive(store, set, prepared, &drives)?;
     Ok((checked, drives.into_iter().map(|(d, _)| d).collect()))
@@ -982,24 +993,65 @@ pub fn check_drive_files_progress(
 /// suspension): what the verdict could not look at.
 pub const NO_MODEL_FILE: &str = "suspension fit: not made: the vehicle has no registered full-car model file, so its springs and dampers are not fitted per drive and a lost spring may go unseen (docs/fleet.md, \"The suspension fitted per drive\")";
 
-/// The verdict of one drive of `records`.
-fn drive_verdict(store: &Store, set: &ModelSet, id: &str, records: &[&Prepared]) -> Result<Drive> {
-    let suspension = drive_suspension(store, set, records)?;
+/// The verdict of one drive of `records`; `earlier` are the drives checked before it in the
+/// same call, with their records' content hashes.
+fn drive_verdict(
+    store: &Store,
+    set: &ModelSet,
+    id: &str,
+    records: &[&Prepared],
+    earlier: &[(Drive, Vec<String>)],
+) -> Result<Drive> {
+    let mut suspension = drive_suspension(store, set, records)?;
+    let start_unix_s = records
+        .iter()
+        .map(|p| p.features.start_unix_s)
+        .collect::<Option<Vec<f64>>>()
+        .and_then(|s| s.into_iter().reduce(f64::min));
+    let mut trend_missing = None;
+    if let (Some(d), Some(reference)) = (suspension.0.as_mut(), set.suspension.as_ref()) {
+        let mut candidates = store.drives_of_model_set(&set.vehicle, set.version)?;
+        candidates.extend(earlier.iter().cloned());
+        let hashes: Vec<&str> = records.iter().map(|p| p.content_hash.as_str()).collect();
+        let before = earlier_fits(&candidates, &hashes, start_unix_s);
+        if before.len() + 1 >= crate::suspension::TREND_DRIVES {
+            let mut fits = vec![&d.fit];
+            let mut ids = vec![id.to_string()];
+            for (drive, fit) in before.iter().take(crate::suspension::TREND_DRIVES - 1) {
+                fits.push(fit);
+                ids.push(drive.to_string());
+            }
+            d.trend = Some(crate::suspension::SpringTrend {
+                drives: ids,
+                scores: crate::suspension::spring_trend(&reference.fit, &fits),
+            });
+        } else {
+            trend_missing = Some(format!(
+                "spring trend over the last {} drives: not made: {} earlier drive(s) of the vehicle fitted against baseline version {}, {} needed (a spring's slow loss is then judged on this drive alone)",
+                crate::suspension::TREND_DRIVES,
+                before.len(),
+                set.version,
+                crate::suspension::TREND_DRIVES - 1
+            ));
+        }
+    }
     let feats: Vec<&RecordFeatures> = records.iter().map(|p| &p.features).collect();
     let scores = suspension.0.as_ref().map_or(&[][..], |d| &d.scores[..]);
-    let mut assessment = assess_drive_fitted(set, &feats, scores);
+    let trend = suspension
+        .0
+        .as_ref()
+        .and_then(|d| d.trend.as_ref())
+        .map_or(&[][..], |t| &t.scores[..]);
+    let mut assessment = assess_drive_fitted(set, &feats, scores, trend);
     if let Some(why) = &suspension.1 {
         assessment.missing.push(why.clone());
     }
+    assessment.missing.extend(trend_missing);
     Ok(Drive {
         drive: id.to_string(),
         model_version: set.version,
         records: records.iter().map(|p| p.file.clone()).collect(),
-        start_unix_s: records
-            .iter()
-            .map(|p| p.features.start_unix_s)
-            .collect::<Option<Vec<f64>>>()
-            .and_then(|s| s.into_iter().reduce(f64::min)),
+        start_unix_s,
         corner: assessment
             .evidence
             .iter()
@@ -1018,6 +1070,54 @@ fn drive_verdict(store: &Store, set: &ModelSet, id: &str, records: &[&Prepared])
             .map(|p| p.file.clone())
             .collect(),
     })
+}
+
+/// The fitted drives before a drive of records with `hashes` and start `start_unix_s`, newest
+/// first, from `candidates` (the vehicle's drives against the same baseline, in the order they
+/// were checked, with their records' content hashes): those with a fit that share no record
+/// with it, one of each set of records (a drive checked twice counts once). They are ordered by
+/// when they were driven where this drive's start and all theirs are known (and only those
+/// driven before it count), else by when they were checked.
+fn earlier_fits<'a>(
+    candidates: &'a [(Drive, Vec<String>)],
+    hashes: &[&str],
+    start_unix_s: Option<f64>,
+) -> Vec<(&'a str, &'a crate::suspension::CornerFit)> {
+    let fitted: Vec<&(Drive, Vec<String>)> = candidates
+        .iter()
+        .filter(|(d, h)| d.suspension.is_some() && !h.iter().any(|x| hashes.contains(&x.as_str())))
+        .collect();
+    let timed = start_unix_s.is_some() && fitted.iter().all(|(d, _)| d.start_unix_s.is_some());
+    let mut ordered: Vec<&(Drive, Vec<String>)> = match start_unix_s {
+        Some(t) if timed => {
+            let mut v: Vec<_> = fitted
+                .into_iter()
+                .filter(|(d, _)| d.start_unix_s.is_some_and(|s| s < t))
+                .collect();
+            v.sort_by(|a, b| {
+                b.0.start_unix_s
+                    .unwrap_or(0.0)
+                    .total_cmp(&a.0.start_unix_s.unwrap_or(0.0))
+            });
+            v
+        }
+        _ => fitted.into_iter().rev().collect(),
+    };
+    let mut seen: Vec<Vec<&str>> = Vec::new();
+    ordered.retain(|(_, h)| {
+        let mut set: Vec<&str> = h.iter().map(String::as_str).collect();
+        set.sort_unstable();
+        if seen.contains(&set) {
+            false
+        } else {
+            seen.push(set);
+            true
+        }
+    });
+    ordered
+        .into_iter()
+        .filter_map(|(d, _)| d.suspension.as_ref().map(|s| (d.drive.as_str(), &s.fit)))
+        .collect()
 }
 
 /// The suspension fitted to a drive's records and scored against the model set's, or why not
@@ -1077,6 +1177,7 @@ fn drive_suspension(
                 scores: corner_scores(&reference.fit, &fit),
                 fit,
                 limit: reference.limit,
+                trend: None,
             }),
             None,
         )),
@@ -1107,6 +1208,92 @@ pub fn check_file(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A stored drive for [`earlier_fits`]: fitted or not, its start, its records' hashes.
+    fn stored(id: &str, start: Option<f64>, fitted: bool, hashes: &[&str]) -> (Drive, Vec<String>) {
+        let fit = crate::suspension::CornerFit {
+            records: 8,
+            spring_n_per_m: [2.0e5; 4],
+            spring_rel_sd: [0.05; 4],
+            damper_n_s_per_m: [1.0e4; 4],
+            damper_rel_sd: [0.05; 4],
+            supported: true,
+            spring_relative_sd: None,
+        };
+        let drive = Drive {
+            drive: id.to_string(),
+            model_version: 1,
+            records: Vec::new(),
+            start_unix_s: start,
+            corner: None,
+            false_alarm_rate: 0.02,
+            assessment: Assessment {
+                classification: crate::model::Classification::Normal,
+                scores: crate::model::Scores {
+                    vehicle_max_abs_z: 0.0,
+                    excitation_max_abs_z: 0.0,
+                    n_vehicle: 0,
+                    n_excitation: 0,
+                },
+                evidence: Vec::new(),
+                summary: String::new(),
+                missing: Vec::new(),
+                sensor_faults: Vec::new(),
+                component: None,
+            },
+            suspension: fitted.then(|| crate::suspension::DriveSuspension {
+                fit,
+                scores: Vec::new(),
+                limit: 3.0,
+                trend: None,
+            }),
+            in_baseline: Vec::new(),
+        };
+        (drive, hashes.iter().map(|h| h.to_string()).collect())
+    }
+
+    fn ids(v: &[(&str, &crate::suspension::CornerFit)]) -> Vec<String> {
+        v.iter().map(|(d, _)| d.to_string()).collect()
+    }
+
+    /// By hand: the drives before a drive, newest first; without times in the order checked,
+    /// with times by when driven and only those driven before; a drive without a fit, one
+    /// sharing a record with the drive checked, and a second drive of the same records are left
+    /// out.
+    #[test]
+    fn the_earlier_drives_of_a_spring_trend_by_hand() {
+        let c = vec![
+            stored("mon", None, true, &["a", "b"]),
+            stored("tue", None, false, &["c", "d"]),
+            stored("wed", None, true, &["e", "f"]),
+            stored("wed again", None, true, &["f", "e"]),
+            stored("thu", None, true, &["g", "h"]),
+            stored("today, checked before", None, true, &["x", "h2"]),
+        ];
+        // The drive checked holds record "x": the drive that shares it is not earlier.
+        let got = earlier_fits(&c, &["x", "y"], None);
+        assert_eq!(ids(&got), ["thu", "wed again", "mon"]);
+        // With times: by when driven, and only those before the drive's start.
+        let t = vec![
+            stored("late", Some(500.0), true, &["a"]),
+            stored("first", Some(100.0), true, &["b"]),
+            stored("second", Some(200.0), true, &["c"]),
+            stored("after", Some(900.0), true, &["d"]),
+        ];
+        assert_eq!(
+            ids(&earlier_fits(&t, &["z"], Some(600.0))),
+            ["late", "second", "first"]
+        );
+        assert_eq!(ids(&earlier_fits(&t, &["z"], Some(150.0))), ["first"]);
+        // One drive without a time: all in the order checked.
+        let mut u = t.clone();
+        u.push(stored("untimed", None, true, &["e"]));
+        assert_eq!(
+            ids(&earlier_fits(&u, &["z"], Some(150.0))),
+            ["untimed", "after", "second", "first", "late"]
+        );
+        assert!(earlier_fits(&[], &["z"], None).is_empty());
+    }
 
     /// By hand: 2026-11-27 is day 20784 after 1970-01-01.
     #[test]

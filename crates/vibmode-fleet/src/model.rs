@@ -1043,7 +1043,7 @@ pub fn assess(set: &ModelSet, rf: &RecordFeatures) -> Assessment {
         set.line_free,
         set.noise_free,
     );
-    let mut a = score_values(set, &values, &[]);
+    let mut a = score_values(set, &values, &[], &[]);
     if !rf.sensor_faults.is_empty() {
         a.classification = Classification::Sensor;
         let faults: Vec<String> = rf.sensor_faults.iter().map(|f| f.to_string()).collect();
@@ -1077,16 +1077,19 @@ pub const MIN_DRIVE_RECORDS: usize = 3;
 /// fewer than [`MIN_DRIVE_RECORDS`] records left the drive is classed
 /// [`Classification::Sensor`].
 pub fn assess_drive(set: &ModelSet, records: &[&RecordFeatures]) -> Assessment {
-    assess_drive_fitted(set, records, &[])
+    assess_drive_fitted(set, records, &[], &[])
 }
 
 /// As [`assess_drive`], with the drive's suspension scores against the model set's fitted
-/// suspension ([`crate::suspension::corner_scores`]): a score below minus the model set's
-/// suspension limit is vehicle evidence at its corner, naming the spring or the damper.
+/// suspension ([`crate::suspension::corner_scores`]) and its springs pooled over the vehicle's
+/// last drives (`trend`, [`crate::suspension::spring_trend`]; empty where not made): a score
+/// below minus the model set's suspension limit is vehicle evidence at its corner, naming the
+/// spring or the damper.
 pub fn assess_drive_fitted(
     set: &ModelSet,
     records: &[&RecordFeatures],
     fitted: &[crate::suspension::CornerScore],
+    trend: &[crate::suspension::CornerScore],
 ) -> Assessment {
     let usable: Vec<&RecordFeatures> = records
         .iter()
@@ -1116,7 +1119,7 @@ pub fn assess_drive_fitted(
         .filter(|(_, xs)| xs.len() >= need)
         .filter_map(|(m, xs)| median(&xs).map(|x| (m, x)))
         .collect();
-    let mut a = score_values(set, &values, fitted);
+    let mut a = score_values(set, &values, fitted, trend);
     let left_out = records.len() - usable.len();
     if left_out > 0 {
         let mut faults: Vec<String> = records
@@ -1151,33 +1154,52 @@ pub fn assess_drive_fitted(
     a
 }
 
-/// The evidence of a drive's suspension scores: every corner's spring and damper scored, those
-/// below minus the limit flagged.
+/// The evidence of a drive's suspension scores: every corner's spring and damper scored, and
+/// every corner's spring over the last drives (`trend`), those below minus the limit flagged.
 fn fitted_evidence(
     set: &ModelSet,
     fitted: &[crate::suspension::CornerScore],
+    trend: &[crate::suspension::CornerScore],
     scores: &mut Scores,
 ) -> Vec<Evidence> {
     let Some(reference) = &set.suspension else {
         return Vec::new();
     };
     let mut out = Vec::new();
-    for f in fitted {
+    let tagged = fitted
+        .iter()
+        .map(|f| (f, false))
+        .chain(trend.iter().map(|f| (f, true)));
+    for (f, pooled) in tagged {
         let (kind, what) = match f.part {
             crate::suspension::Part::Spring => (Kind::SpringFit, "spring"),
             crate::suspension::Part::Damper => (Kind::DamperFit, "damper"),
+        };
+        let (key, label) = if pooled {
+            (
+                format!("fit:{what}-trend:{}", f.corner),
+                format!(
+                    "{what} (fitted over the last {} drives) vs the other corners",
+                    crate::suspension::TREND_DRIVES
+                ),
+            )
+        } else {
+            (
+                format!("fit:{what}:{}", f.corner),
+                format!("{what} (fitted) vs the other corners"),
+            )
         };
         scores.n_vehicle += 1;
         scores.vehicle_max_abs_z = scores.vehicle_max_abs_z.max(f.z.abs());
         if f.flagged(reference.limit) {
             out.push(Evidence {
                 meta: FeatureMeta {
-                    key: format!("fit:{what}:{}", f.corner),
+                    key,
                     group: Group::Vehicle,
                     kind,
                     corner: Some(f.corner),
                     channel: String::new(),
-                    label: format!("{what} (fitted) vs the other corners"),
+                    label,
                 },
                 value: f.value,
                 centre: f.centre,
@@ -1195,6 +1217,7 @@ fn score_values(
     set: &ModelSet,
     values: &[(FeatureMeta, f64)],
     fitted: &[crate::suspension::CornerScore],
+    trend: &[crate::suspension::CornerScore],
 ) -> Assessment {
     let by_key: BTreeMap<&str, f64> = values.iter().map(|(m, v)| (m.key.as_str(), *v)).collect();
     let mut evidence = Vec::new();
@@ -1235,7 +1258,7 @@ fn score_values(
         }
     }
     attribute_ratios(set, values, &mut evidence);
-    evidence.extend(fitted_evidence(set, fitted, &mut scores));
+    evidence.extend(fitted_evidence(set, fitted, trend, &mut scores));
     evidence.sort_by(|a, b| b.z.abs().total_cmp(&a.z.abs()));
     let vehicle = evidence.iter().any(|e| e.meta.group == Group::Vehicle);
     let road = evidence.iter().any(|e| e.meta.group == Group::Excitation);

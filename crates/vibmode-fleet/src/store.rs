@@ -910,6 +910,51 @@ impl Store {
         Ok(out)
     }
 
+    /// The stored drive verdicts of `vehicle` scored against model set `model_version`, in the
+    /// order they were stored, each with its records' content hashes (for the spring trend over
+    /// a vehicle's drives, [`crate::suspension::spring_trend`]).
+    pub fn drives_of_model_set(
+        &self,
+        vehicle: &str,
+        model_version: i64,
+    ) -> Result<Vec<(crate::model::Drive, Vec<String>)>> {
+        let Some(vid) = self.vehicle_id(vehicle)? else {
+            return Ok(Vec::new());
+        };
+        let mut st = self
+            .conn
+            .prepare(
+                "SELECT d.drive, d.json,
+                        (SELECT group_concat(r.content_hash, ' ') FROM drive_records x
+                         JOIN records r ON r.id = x.record_id WHERE x.drive_id = d.id)
+                 FROM drives d WHERE d.vehicle_id = ?1 AND d.model_version = ?2 ORDER BY d.id",
+            )
+            .map_err(self.sql("reading drives"))?;
+        let rows = st
+            .query_map(params![vid, model_version], |r| {
+                Ok((
+                    r.get::<_, String>(0)?,
+                    r.get::<_, String>(1)?,
+                    r.get::<_, Option<String>>(2)?,
+                ))
+            })
+            .map_err(self.sql("reading drives"))?
+            .collect::<rusqlite::Result<Vec<_>>>()
+            .map_err(self.sql("reading drives"))?;
+        let mut out = Vec::with_capacity(rows.len());
+        for (drive, json, hashes) in rows {
+            let d: crate::model::Drive = serde_json::from_str(&json)
+                .map_err(|e| self.corrupt(&format!("drive {drive} of {vehicle}"), e))?;
+            let hashes = hashes
+                .unwrap_or_default()
+                .split_whitespace()
+                .map(str::to_string)
+                .collect();
+            out.push((d, hashes));
+        }
+        Ok(out)
+    }
+
     /// The drive verdicts of `vehicle`, oldest first: (drive, classification, records).
     pub fn drives(&self, vehicle: &str) -> Result<Vec<(String, String, usize)>> {
         let Some(vid) = self.vehicle_id(vehicle)? else {

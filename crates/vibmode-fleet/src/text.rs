@@ -115,8 +115,9 @@ pub fn baseline_text(set: &ModelSet) -> String {
     if let Some(s) = &set.suspension {
         let _ = writeln!(
             text,
-            "suspension fitted to {} nominal records: springs and dampers per corner scored per drive, one-sided limit {:.2}{}",
+            "suspension fitted to {} nominal records: springs and dampers per corner scored per drive, and the springs over the last {} drives, one-sided limit {:.2}{}",
             s.fit.records,
+            crate::suspension::TREND_DRIVES,
             s.limit,
             if s.fit.supported {
                 ""

@@ -4,8 +4,9 @@
 //! roads B and C and with 15 % more load, and with one corner's spring at 80 % or damper at 70 %.
 //!
 //! Judged against the goals and the stated false-alarm rate, not against what was
-//! measured: a healthy drive flags a corner with probability at most 1 % (the limit, -3.02 =
-//! Phi^-1(0.01 / 8)), so 2 or more flagged of the healthy drives would be improbable (< 5 %) if
+//! measured: a healthy drive flags a corner with probability at most 1 % (the limit, -3.14 =
+//! Phi^-1(0.01 / 12), the drive's 8 tests and the spring trend's 4; a drive alone uses 8 of the
+//! 12), so 2 or more flagged of the healthy drives would be improbable (< 5 %) if
 //! the rate held; a fault is found with its corner and part lowest in at least 90 % of drives.
 
 use crate::common;
