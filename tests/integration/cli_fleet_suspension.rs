@@ -86,9 +86,11 @@ fn a_spring_at_80_percent_is_named_by_the_fit_per_drive() {
         base.contains("suspension fitted to 6 nominal records"),
         "{base}"
     );
-    // The limit: Phi^-1(1 - 0.01 / 12), the drive's 8 tests and the trend's 4.
+    // The limits: Phi^-1(1 - 0.01 / 16) for the drive's 8 tests, Phi^-1(1 - 0.01 / 8) for the trend's 4.
     assert!(
-        base.contains("and the springs over the last 3 drives, one-sided limit 3.14"),
+        base.contains(
+            "and the springs over the last 3 drives, one-sided limits 3.23 and 3.02 (the trend)"
+        ),
         "{base}"
     );
     let status = stdout(&["fleet", "status", "--db", db]);

@@ -1024,6 +1024,7 @@ fn drive_verdict(
             d.trend = Some(crate::suspension::SpringTrend {
                 drives: ids,
                 scores: crate::suspension::spring_trend(&reference.fit, &fits),
+                limit: crate::suspension::trend_limit(set.config.false_alarm_rate),
             });
         } else {
             trend_missing = Some(format!(
@@ -1037,11 +1038,7 @@ fn drive_verdict(
     }
     let feats: Vec<&RecordFeatures> = records.iter().map(|p| &p.features).collect();
     let scores = suspension.0.as_ref().map_or(&[][..], |d| &d.scores[..]);
-    let trend = suspension
-        .0
-        .as_ref()
-        .and_then(|d| d.trend.as_ref())
-        .map_or(&[][..], |t| &t.scores[..]);
+    let trend = suspension.0.as_ref().and_then(|d| d.trend.as_ref());
     let mut assessment = assess_drive_fitted(set, &feats, scores, trend);
     if let Some(why) = &suspension.1 {
         assessment.missing.push(why.clone());

@@ -1043,7 +1043,7 @@ pub fn assess(set: &ModelSet, rf: &RecordFeatures) -> Assessment {
         set.line_free,
         set.noise_free,
     );
-    let mut a = score_values(set, &values, &[], &[]);
+    let mut a = score_values(set, &values, &[], None);
     if !rf.sensor_faults.is_empty() {
         a.classification = Classification::Sensor;
         let faults: Vec<String> = rf.sensor_faults.iter().map(|f| f.to_string()).collect();
@@ -1077,19 +1077,19 @@ pub const MIN_DRIVE_RECORDS: usize = 3;
 /// fewer than [`MIN_DRIVE_RECORDS`] records left the drive is classed
 /// [`Classification::Sensor`].
 pub fn assess_drive(set: &ModelSet, records: &[&RecordFeatures]) -> Assessment {
-    assess_drive_fitted(set, records, &[], &[])
+    assess_drive_fitted(set, records, &[], None)
 }
 
 /// As [`assess_drive`], with the drive's suspension scores against the model set's fitted
 /// suspension ([`crate::suspension::corner_scores`]) and its springs pooled over the vehicle's
-/// last drives (`trend`, [`crate::suspension::spring_trend`]; empty where not made): a score
-/// below minus the model set's suspension limit is vehicle evidence at its corner, naming the
-/// spring or the damper.
+/// last drives (`trend`, [`crate::suspension::spring_trend`], where made): a drive's score below
+/// minus the model set's suspension limit, or a trend's below minus its own limit, is vehicle
+/// evidence at its corner, naming the spring or the damper.
 pub fn assess_drive_fitted(
     set: &ModelSet,
     records: &[&RecordFeatures],
     fitted: &[crate::suspension::CornerScore],
-    trend: &[crate::suspension::CornerScore],
+    trend: Option<&crate::suspension::SpringTrend>,
 ) -> Assessment {
     let usable: Vec<&RecordFeatures> = records
         .iter()
@@ -1159,18 +1159,19 @@ pub fn assess_drive_fitted(
 fn fitted_evidence(
     set: &ModelSet,
     fitted: &[crate::suspension::CornerScore],
-    trend: &[crate::suspension::CornerScore],
+    trend: Option<&crate::suspension::SpringTrend>,
     scores: &mut Scores,
 ) -> Vec<Evidence> {
     let Some(reference) = &set.suspension else {
         return Vec::new();
     };
     let mut out = Vec::new();
-    let tagged = fitted
-        .iter()
-        .map(|f| (f, false))
-        .chain(trend.iter().map(|f| (f, true)));
-    for (f, pooled) in tagged {
+    let tagged = fitted.iter().map(|f| (f, false, reference.limit)).chain(
+        trend
+            .into_iter()
+            .flat_map(|t| t.scores.iter().map(|f| (f, true, t.limit))),
+    );
+    for (f, pooled, limit) in tagged {
         let (kind, what) = match f.part {
             crate::suspension::Part::Spring => (Kind::SpringFit, "spring"),
             crate::suspension::Part::Damper => (Kind::DamperFit, "damper"),
@@ -1191,7 +1192,7 @@ fn fitted_evidence(
         };
         scores.n_vehicle += 1;
         scores.vehicle_max_abs_z = scores.vehicle_max_abs_z.max(f.z.abs());
-        if f.flagged(reference.limit) {
+        if f.flagged(limit) {
             out.push(Evidence {
                 meta: FeatureMeta {
                     key,
@@ -1205,7 +1206,7 @@ fn fitted_evidence(
                 centre: f.centre,
                 z: f.z,
                 change_pct: 100.0 * f.change(),
-                limit: reference.limit,
+                limit,
                 flagged: true,
             });
         }
@@ -1217,7 +1218,7 @@ fn score_values(
     set: &ModelSet,
     values: &[(FeatureMeta, f64)],
     fitted: &[crate::suspension::CornerScore],
-    trend: &[crate::suspension::CornerScore],
+    trend: Option<&crate::suspension::SpringTrend>,
 ) -> Assessment {
     let by_key: BTreeMap<&str, f64> = values.iter().map(|(m, v)| (m.key.as_str(), *v)).collect();
     let mut evidence = Vec::new();

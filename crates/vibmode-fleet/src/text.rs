@@ -115,10 +115,11 @@ pub fn baseline_text(set: &ModelSet) -> String {
     if let Some(s) = &set.suspension {
         let _ = writeln!(
             text,
-            "suspension fitted to {} nominal records: springs and dampers per corner scored per drive, and the springs over the last {} drives, one-sided limit {:.2}{}",
+            "suspension fitted to {} nominal records: springs and dampers per corner scored per drive, and the springs over the last {} drives, one-sided limits {:.2} and {:.2} (the trend){}",
             s.fit.records,
             crate::suspension::TREND_DRIVES,
             s.limit,
+            crate::suspension::trend_limit(set.config.false_alarm_rate),
             if s.fit.supported {
                 ""
             } else {

@@ -4,9 +4,9 @@
 //! roads B and C and with 15 % more load, and with one corner's spring at 80 % or damper at 70 %.
 //!
 //! Judged against the goals and the stated false-alarm rate, not against what was
-//! measured: a healthy drive flags a corner with probability at most 1 % (the limit, -3.14 =
-//! Phi^-1(0.01 / 12), the drive's 8 tests and the spring trend's 4; a drive alone uses 8 of the
-//! 12), so 2 or more flagged of the healthy drives would be improbable (< 5 %) if
+//! measured: a healthy drive flags a corner with probability at most 0.5 % (the limit, -3.23 =
+//! Phi^-1(0.01 / 16): the drive's 8 tests get half the 1 %, the spring trend's 4 the other
+//! half), so 2 or more flagged of the healthy drives would be improbable (< 5 %) if
 //! the rate held; a fault is found with its corner and part lowest in at least 90 % of drives.
 
 use crate::common;
@@ -135,7 +135,7 @@ fn springs_and_dampers_fitted_per_drive_over_seeds() {
     }
     println!("healthy drives flagged {flagged}/{healthy}, faults found {found}/{faults}");
     assert!(
-        tail(flagged, healthy, cfg.false_alarm_rate) >= 0.05,
+        tail(flagged, healthy, cfg.false_alarm_rate / 2.0) >= 0.05,
         "{flagged} of {healthy} healthy drives flagged"
     );
     // At least 90 %: missing more is improbable (< 5 %) if the goal held.
