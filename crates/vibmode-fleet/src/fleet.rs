@@ -1028,11 +1028,11 @@ fn drive_verdict(
             });
         } else {
             trend_missing = Some(format!(
-                "spring trend over the last {} drives: not made: {} earlier drive(s) of the vehicle fitted against baseline version {}, {} needed (a spring's slow loss is then judged on this drive alone)",
+                "suspension fit: no spring trend over the last {} drives yet: {} of the {} earlier drives it needs fitted against baseline version {} (a spring's slow loss is judged on this drive alone)",
                 crate::suspension::TREND_DRIVES,
                 before.len(),
+                crate::suspension::TREND_DRIVES - 1,
                 set.version,
-                crate::suspension::TREND_DRIVES - 1
             ));
         }
     }

@@ -1,0 +1,96 @@
+"""Acceptance of the spring trend (`vibmode fleet check`, docs/fleet.md "The spring trend") on the
+independent bus family (../shared/busgen), issue 31 item 3: a vehicle's drives in sequence in one
+store, healthy first, then its spring at 80 % at one corner (tools/busgen/spring_trend.py does the
+work).
+
+Buses drawn at random every run (seeds printed; `VIBMODE_BUS_SEEDS=1,2,3` replays). Number of
+buses: `VIBMODE_TREND_BUSES` (default 1: a baseline of 2 drives, 3 healthy drives and 3 spring
+drives of 8 records, about as long as one bus of test_busgen_fleet.py). The figures of
+docs/fleet.md come from `python3 tools/busgen/spring_trend.py --buses 20`.
+
+Goals judged as in test_busgen_fleet.py: a test fails when what the drawn buses missed would be
+improbable (P < 0.05, one-sided binomial) if the goal held.
+
+Skips ("skipped: ...") without busgen or without VIBMODE_BIN, fails instead when
+VIBMODE_REQUIRE contains busgen.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(REPO / "tools" / "busgen"))
+
+import harness  # noqa: E402
+
+HEALTHY, FAULTY = 3, 3
+ALPHA = 0.05
+
+
+def _need():
+    why = None
+    if not (REPO.parent / "shared" / "busgen" / "simulate.py").is_file() and not os.environ.get(
+        "VIBMODE_BUSGEN"
+    ):
+        why = f"busgen not found at {REPO.parent / 'shared' / 'busgen'}"
+    elif not os.environ.get("VIBMODE_BIN"):
+        why = "VIBMODE_BIN (the vibmode binary to test) is not set"
+    else:
+        try:
+            harness.busgen_dir()
+            harness.busgen_python()
+            harness.vibmode_bin()
+        except harness.Skip as e:
+            why = str(e)
+    if why:
+        if harness.required():
+            pytest.fail(f"VIBMODE_REQUIRE has busgen, but {why}")
+        pytest.skip(f"skipped: {why}")
+
+
+@pytest.fixture(scope="module")
+def measured():
+    _need()
+    import spring_trend  # tools/busgen/spring_trend.py
+
+    n = int(os.environ.get("VIBMODE_TREND_BUSES", "1"))
+    seeds = harness.draw_bus_seeds(n, "spring trend acceptance")
+    buses = spring_trend.measure(seeds, HEALTHY, FAULTY)
+    s = spring_trend.summarise(buses, HEALTHY)
+    spring_trend.print_summary(s)
+    s["rows"] = [r for b in buses for r in b["rows"]]
+    s["replay"] = "VIBMODE_BUS_SEEDS=" + ",".join(str(b) for b in seeds)
+    return s
+
+
+def test_the_trend_is_made_from_the_third_drive_on(measured):
+    # Each drive with 2 earlier fitted drives against the baseline pools its springs with
+    # theirs; the first two cannot.
+    for r in measured["rows"]:
+        assert r["trend"] == (r["k"] >= 2), (r, measured["replay"])
+
+
+def test_healthy_sequences_are_normal(measured):
+    # The issue's healthy goal, >= 99 % of drives normal, on the drives of a healthy sequence
+    # (the trend's tests included).
+    n, ok = measured["healthy_n"], measured["healthy_normal"]
+    assert n > 0, measured["replay"]
+    p = harness.misses_probability(n - ok, n, 0.99)
+    assert p >= ALPHA - 1e-12, (f"{ok}/{n} healthy drives normal (P = {p:.3g} at 99 %); "
+                                f"replay with {measured['replay']}")
+
+
+@pytest.mark.xfail(reason="issue 31 item 3: the spring at 80 % is found with its corner on the "
+                          "third drive after onset on 14 of 16 busgen buses (docs/fleet.md, "
+                          "\"The spring trend\"), short of 90 % on a class A road's drives",
+                   strict=False)
+def test_spring_80_found_by_the_third_drive(measured):
+    third = measured["spring"][FAULTY - 1]
+    misses = third["n"] - third["found"]
+    p = harness.misses_probability(misses, third["n"], 0.90)
+    assert p >= ALPHA - 1e-12, (third, measured["replay"])
