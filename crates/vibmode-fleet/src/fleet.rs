@@ -1010,7 +1010,8 @@ fn drive_verdict(
         .and_then(|s| s.into_iter().reduce(f64::min));
     let mut trend_missing = None;
     if let (Some(d), Some(reference)) = (suspension.0.as_mut(), set.suspension.as_ref()) {
-        let mut candidates = store.drives_of_model_set(&set.vehicle, set.version)?;
+        let mut candidates =
+            store.drives_of_model_set(&set.vehicle, set.version, TREND_CANDIDATES)?;
         candidates.extend(earlier.iter().cloned());
         let hashes: Vec<&str> = records.iter().map(|p| p.content_hash.as_str()).collect();
         let before = earlier_fits(&candidates, &hashes, start_unix_s);
@@ -1068,6 +1069,11 @@ fn drive_verdict(
             .collect(),
     })
 }
+
+/// The drives checked last against a baseline among which [`earlier_fits`] looks for a drive's
+/// earlier drives: enough for a week of drives checked out of order, and a bound on what each
+/// check reads back from the store.
+const TREND_CANDIDATES: usize = 64;
 
 /// The fitted drives before a drive of records with `hashes` and start `start_unix_s`, newest
 /// first, from `candidates` (the vehicle's drives against the same baseline, in the order they

@@ -910,13 +910,14 @@ impl Store {
         Ok(out)
     }
 
-    /// The stored drive verdicts of `vehicle` scored against model set `model_version`, in the
+    /// The last `last` drive verdicts of `vehicle` stored with model set `model_version`, in the
     /// order they were stored, each with its records' content hashes (for the spring trend over
     /// a vehicle's drives, [`crate::suspension::spring_trend`]).
     pub fn drives_of_model_set(
         &self,
         vehicle: &str,
         model_version: i64,
+        last: usize,
     ) -> Result<Vec<(crate::model::Drive, Vec<String>)>> {
         let Some(vid) = self.vehicle_id(vehicle)? else {
             return Ok(Vec::new());
@@ -927,11 +928,13 @@ impl Store {
                 "SELECT d.drive, d.json,
                         (SELECT group_concat(r.content_hash, ' ') FROM drive_records x
                          JOIN records r ON r.id = x.record_id WHERE x.drive_id = d.id)
-                 FROM drives d WHERE d.vehicle_id = ?1 AND d.model_version = ?2 ORDER BY d.id",
+                 FROM drives d WHERE d.vehicle_id = ?1 AND d.model_version = ?2
+                 ORDER BY d.id DESC LIMIT ?3",
             )
             .map_err(self.sql("reading drives"))?;
-        let rows = st
-            .query_map(params![vid, model_version], |r| {
+        let last = i64::try_from(last).unwrap_or(i64::MAX);
+        let mut rows = st
+            .query_map(params![vid, model_version, last], |r| {
                 Ok((
                     r.get::<_, String>(0)?,
                     r.get::<_, String>(1)?,
@@ -941,6 +944,7 @@ impl Store {
             .map_err(self.sql("reading drives"))?
             .collect::<rusqlite::Result<Vec<_>>>()
             .map_err(self.sql("reading drives"))?;
+        rows.reverse();
         let mut out = Vec::with_capacity(rows.len());
         for (drive, json, hashes) in rows {
             let d: crate::model::Drive = serde_json::from_str(&json)
