@@ -86,3 +86,35 @@ def test_workers_add_equations_to_records_stored_before_registering(tmp_path):
     # Again: nothing to do.
     out = vibmode.fleet.store_features(db, "bus-1", items)
     assert all(o["already_stored"] and not o["notes"] for o in out), out
+
+
+def test_the_third_drive_pools_its_springs_with_the_two_before(tmp_path):
+    # As `vibmode fleet check` (docs/fleet.md, "The spring trend"): the first two drives after
+    # the baseline say why they have no trend; the third's pools the three, newest first.
+    db = tmp_path / "fleet.db"
+    vibmode.fleet.init(db)
+    assert vibmode.fleet.register(db, "bus-1", CITY_BUS) == "new"
+    nominal = tmp_path / "nominal"
+    vibmode.simulate("city_bus", records=6, fs=200.0, seed=21, out_dir=nominal)
+    vibmode.fleet.ingest(db, "bus-1", sorted(nominal.glob("record_*.wav")))
+    base = vibmode.fleet.baseline(db, "bus-1")
+    assert base["suspension"]["fit"]["records"] == 6
+    drives = []
+    for k, name in enumerate(["mon", "tue", "wed"]):
+        folder = tmp_path / name
+        vibmode.simulate("city_bus", records=3, fs=200.0, seed=31 + k, out_dir=folder)
+        out = vibmode.fleet.check(db, "bus-1", sorted(folder.glob("record_*.wav")), drive=name)
+        drives.append(out["drives"][0])
+    for k, d in enumerate(drives[:2]):
+        assert "trend" not in d["suspension"], d
+        assert any(
+            m.startswith("suspension fit: no spring trend over the last 3 drives yet: "
+                         f"{k} of the 2 earlier drives")
+            for m in d["missing"]
+        ), d["missing"]
+    trend = drives[2]["suspension"]["trend"]
+    assert trend["drives"] == ["wed", "tue", "mon"]
+    assert [s["corner"] for s in trend["scores"]] == ["FL", "FR", "RL", "RR"]
+    assert all(s["part"] == "spring" for s in trend["scores"])
+    # Phi^-1(1 - 0.01 / 8): the trend's half of the fit's 1 % over its 4 tests.
+    assert abs(trend["limit"] - 3.0233414) < 1e-6
