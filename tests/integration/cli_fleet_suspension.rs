@@ -95,7 +95,7 @@ fn a_spring_at_80_percent_is_named_by_the_fit_per_drive() {
     );
     let status = stdout(&["fleet", "status", "--db", db]);
     assert!(
-        status.contains("baseline version 1 fits the suspension (6 nominal records)"),
+        status.contains("baseline version 1 fits the suspension (6 nominal records): springs and dampers scored per drive, springs also over the last 3 drives"),
         "{status}"
     );
 

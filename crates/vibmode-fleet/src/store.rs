@@ -1243,8 +1243,10 @@ impl Store {
                     None => "model file registered; no baseline yet".to_string(),
                     Some(set) => match &set.suspension {
                         Some(r) if r.model_sha256 == sha => format!(
-                            "model file registered; baseline version {} fits the suspension ({} nominal records): springs and dampers scored per drive",
-                            set.version, r.fit.records
+                            "model file registered; baseline version {} fits the suspension ({} nominal records): springs and dampers scored per drive, springs also over the last {} drives",
+                            set.version,
+                            r.fit.records,
+                            crate::suspension::TREND_DRIVES
                         ),
                         _ => format!(
                             "model file registered, but baseline version {} has no fit of it: drives are checked without the suspension fit until nominal records ingested since and a new baseline",
