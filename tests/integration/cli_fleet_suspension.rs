@@ -205,6 +205,25 @@ fn a_spring_at_80_percent_is_named_by_the_fit_per_drive() {
         })
         .unwrap();
     assert_eq!(lowest["corner"], "RL", "{dr}");
+    // How sure, in the status: each flagged vehicle feature's |z| over its own limit (the
+    // drive's fit and the trend have different ones), the largest.
+    let want = dr["evidence"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e["group"] == "vehicle")
+        .map(|e| e["z"].as_f64().unwrap().abs() / e["limit"].as_f64().unwrap())
+        .reduce(f64::max);
+    let st = vibmode_fleet::Store::open(std::path::Path::new(db))
+        .unwrap()
+        .status(10)
+        .unwrap();
+    let latest = st[0].latest_drive.as_ref().unwrap();
+    assert_eq!(latest.drive, "third");
+    match (latest.vehicle_z_over_limit, want) {
+        (Some(got), Some(want)) => assert!((got - want).abs() < 1e-12, "{got} vs {want}"),
+        (got, want) => assert_eq!(got, want, "{dr}"),
+    }
 }
 
 /// A model file that is not one, or that gives no fit, is refused before anything is stored;

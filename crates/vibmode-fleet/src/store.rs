@@ -197,7 +197,8 @@ pub struct DriveStatus {
     pub component: Option<crate::model::Component>,
     /// One line: the flagged features per corner.
     pub summary: String,
-    /// The largest |z| of the vehicle features against the limit (how sure: 1 at the limit).
+    /// The largest |z| of the flagged vehicle features, each over its own limit (how sure: 1 at
+    /// the limit); absent without one.
     pub vehicle_z_over_limit: Option<f64>,
     /// The false-alarm rate per drive and feature group.
     pub false_alarm_rate: f64,
@@ -1316,12 +1317,15 @@ impl Store {
                 Some(prev) if prev.classification == class => prev.since.clone(),
                 _ => driven.clone().unwrap_or_else(|| checked.clone()),
             };
-            let limit = d
+            // Each flagged vehicle feature against its own limit (a drive's fit and the spring
+            // trend have limits of their own): the largest ratio.
+            let z_over_limit = d
                 .assessment
                 .evidence
                 .iter()
-                .find(|e| e.meta.group == crate::model::Group::Vehicle)
-                .map(|e| e.limit);
+                .filter(|e| e.meta.group == crate::model::Group::Vehicle && e.limit > 0.0)
+                .map(|e| e.z.abs() / e.limit)
+                .reduce(f64::max);
             out.push(DriveStatus {
                 drive,
                 checked,
@@ -1329,9 +1333,7 @@ impl Store {
                 corner: d.corner.map(|c| c.to_string()),
                 component: d.assessment.component,
                 summary: d.assessment.summary.clone(),
-                vehicle_z_over_limit: limit
-                    .filter(|l| *l > 0.0)
-                    .map(|l| d.assessment.scores.vehicle_max_abs_z / l),
+                vehicle_z_over_limit: z_over_limit,
                 false_alarm_rate: d.false_alarm_rate,
                 n_records: n.max(0) as usize,
                 driven,
