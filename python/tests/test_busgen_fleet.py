@@ -36,32 +36,8 @@ sys.path.insert(0, str(REPO / "tools" / "busgen"))
 import harness  # noqa: E402
 
 
-def _need():
-    import harness as h  # noqa: E402
-
-    why = None
-    if not (REPO.parent / "shared" / "busgen" / "simulate.py").is_file() and not os.environ.get(
-        "VIBMODE_BUSGEN"
-    ):
-        why = f"busgen not found at {REPO.parent / 'shared' / 'busgen'}"
-    elif not os.environ.get("VIBMODE_BIN"):
-        why = "VIBMODE_BIN (the vibmode binary to test) is not set"
-    else:
-        try:
-            h.busgen_dir()
-            h.busgen_python()
-            h.vibmode_bin()
-        except h.Skip as e:
-            why = str(e)
-    if why:
-        if h.required():
-            pytest.fail(f"VIBMODE_REQUIRE has busgen, but {why}")
-        pytest.skip(f"skipped: {why}")
-
-
 @pytest.fixture(scope="module")
-def measured():
-    _need()
+def measured(busgen):
     import fleet  # tools/busgen/fleet.py
 
     n = int(os.environ.get("VIBMODE_FLEET_BUSES", "1"))

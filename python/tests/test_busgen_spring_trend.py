@@ -32,30 +32,8 @@ HEALTHY, FAULTY = 3, 3
 ALPHA = 0.05
 
 
-def _need():
-    why = None
-    if not (REPO.parent / "shared" / "busgen" / "simulate.py").is_file() and not os.environ.get(
-        "VIBMODE_BUSGEN"
-    ):
-        why = f"busgen not found at {REPO.parent / 'shared' / 'busgen'}"
-    elif not os.environ.get("VIBMODE_BIN"):
-        why = "VIBMODE_BIN (the vibmode binary to test) is not set"
-    else:
-        try:
-            harness.busgen_dir()
-            harness.busgen_python()
-            harness.vibmode_bin()
-        except harness.Skip as e:
-            why = str(e)
-    if why:
-        if harness.required():
-            pytest.fail(f"VIBMODE_REQUIRE has busgen, but {why}")
-        pytest.skip(f"skipped: {why}")
-
-
 @pytest.fixture(scope="module")
-def measured():
-    _need()
+def measured(busgen):
     import spring_trend  # tools/busgen/spring_trend.py
 
     n = int(os.environ.get("VIBMODE_TREND_BUSES", "1"))

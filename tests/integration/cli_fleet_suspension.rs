@@ -18,7 +18,8 @@ fn register(db: &str, model: &str) -> String {
     stdout(&["fleet", "register", "--db", db, "--vehicle", "bus-1", model])
 }
 
-fn check_drive(db: &str, files: &[String]) -> serde_json::Value {
+/// `fleet check --drive ID --json -` of `files` for bus-1: the drive's verdict.
+fn check_drive(db: &str, id: &str, files: &[String]) -> serde_json::Value {
     let mut args = vec![
         "fleet",
         "check",
@@ -28,7 +29,7 @@ fn check_drive(db: &str, files: &[String]) -> serde_json::Value {
         "bus-1",
         "-q",
         "--drive",
-        "d",
+        id,
         "--json",
         "-",
     ];
@@ -100,7 +101,7 @@ fn a_spring_at_80_percent_is_named_by_the_fit_per_drive() {
     );
 
     let healthy = simulate_csv(&d.path().join("healthy"), "B", "30", "21", "4");
-    let dr = check_drive(db, &healthy);
+    let dr = check_drive(db, "d", &healthy);
     assert!(fit_evidence(&dr).is_empty(), "{dr}");
     // Every corner's spring and damper score is kept, flagged or not.
     let scores = dr["suspension"]["scores"].as_array().unwrap();
@@ -145,7 +146,7 @@ fn a_spring_at_80_percent_is_named_by_the_fit_per_drive() {
         "31",
         "4",
     );
-    let dr = check_drive(db, &files);
+    let dr = check_drive(db, "d", &files);
     assert!(
         dr["classification"] == "vehicle" || dr["classification"] == "both",
         "{dr}"
@@ -169,22 +170,7 @@ fn a_spring_at_80_percent_is_named_by_the_fit_per_drive() {
         "41",
         "4",
     );
-    let mut args = vec![
-        "fleet",
-        "check",
-        "--db",
-        db,
-        "--vehicle",
-        "bus-1",
-        "-q",
-        "--drive",
-        "third",
-        "--json",
-        "-",
-    ];
-    args.extend(files.iter().map(String::as_str));
-    let v: serde_json::Value = serde_json::from_slice(&ok(&args).stdout).unwrap();
-    let dr = &v["drives"][0];
+    let dr = check_drive(db, "third", &files);
     let trend = &dr["suspension"]["trend"];
     assert_eq!(
         trend["drives"],

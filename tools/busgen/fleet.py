@@ -125,15 +125,13 @@ def more_drives(bus_seed: int, n_healthy: int) -> List[Dict]:
     return out
 
 
-def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
-            test_extra: Optional[List[str]] = None, keep: bool = False,
-            model: bool = False, n_more: int = 0,
-            config: Optional[Path] = None) -> Dict:
-    """Simulates, ingests, baselines and checks one bus; returns its rows.
-
-    Each drive is checked on a copy of the store as the baseline left it. The stores are deleted
-    unless `keep` (then each drive's stays in `work` as fleet-SEED-I-CONDITION.db, beside its
-    check's JSON as check-SEED-CONDITION.json)."""
+def make_baseline(bus_seed: int, n_records: int, work: Path, rng: random.Random,
+                  model: bool = False, config: Optional[Path] = None):
+    """A new store `work/fleet-SEED.db` with the bus's baseline: 2 healthy drives of `n_records`
+    (busgen defaults) ingested as nominal, `fleet baseline` built; with `model` the bus's model
+    file registered first (`update.vehicle_toml`: its true geometry, masses and tyres, generic
+    suspension). The seed of the baseline's simulations is `rng`'s first draw. Returns (store,
+    vehicle id, that seed)."""
     db = work / f"fleet-{bus_seed}.db"
     if db.exists():
         db.unlink()
@@ -150,6 +148,19 @@ def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
             h.run_vibmode(["fleet", "register", "--db", db, "--vehicle", vehicle, toml])
     h.run_vibmode(["fleet", "ingest", "--db", db, "--vehicle", vehicle, "-q", *base])
     h.run_vibmode(["fleet", "baseline", "--db", db, "--vehicle", vehicle])
+    return db, vehicle, base_seed
+
+
+def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
+            test_extra: Optional[List[str]] = None, keep: bool = False,
+            model: bool = False, n_more: int = 0,
+            config: Optional[Path] = None) -> Dict:
+    """Simulates, ingests, baselines and checks one bus; returns its rows.
+
+    Each drive is checked on a copy of the store as the baseline left it. The stores are deleted
+    unless `keep` (then each drive's stays in `work` as fleet-SEED-I-CONDITION.db, beside its
+    check's JSON as check-SEED-CONDITION.json)."""
+    db, vehicle, base_seed = make_baseline(bus_seed, n_records, work, rng, model, config)
     # The drives are alternatives, not one vehicle's sequence: each is checked on a copy of the
     # store as the baseline left it, so that the spring trend (which pools a vehicle's last
     # drives) does not carry one condition's fault into the next (tools/busgen/spring_trend.py

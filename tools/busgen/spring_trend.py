@@ -38,7 +38,6 @@ from typing import Dict, List, Optional
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import fleet  # noqa: E402
 import harness as h  # noqa: E402
-import update  # noqa: E402
 
 
 def how_found(drive: Dict, corner: str) -> Optional[str]:
@@ -59,20 +58,7 @@ def how_found(drive: Dict, corner: str) -> Optional[str]:
 
 def run_bus(bus_seed: int, n_healthy: int, n_faulty: int, work: Path) -> Dict:
     rng = random.Random(bus_seed * 7919 + 3)
-    db = work / f"fleet-{bus_seed}.db"
-    vehicle = f"bus{bus_seed}"
-    base_seed = rng.randrange(1, 10**6)
-    h.run_vibmode(["fleet", "init", "--db", db])
-    base = []
-    for d in range(2):
-        folder = h.simulate(bus_seed, base_seed + 1000 * d)
-        base += h.records(folder)
-        if d == 0:
-            toml = work / f"bus{bus_seed}.toml"
-            toml.write_text(update.vehicle_toml(h.truth(folder), True))
-            h.run_vibmode(["fleet", "register", "--db", db, "--vehicle", vehicle, toml])
-    h.run_vibmode(["fleet", "ingest", "--db", db, "--vehicle", vehicle, "-q", *base])
-    h.run_vibmode(["fleet", "baseline", "--db", db, "--vehicle", vehicle])
+    db, vehicle, base_seed = fleet.make_baseline(bus_seed, h.RECORDS, work, rng, model=True)
     corner = rng.choice(fleet.CORNERS)
     rows = []
     for k in range(n_healthy + n_faulty):
