@@ -1230,20 +1230,7 @@ mod tests {
             start_unix_s: start,
             corner: None,
             false_alarm_rate: 0.02,
-            assessment: Assessment {
-                classification: crate::model::Classification::Normal,
-                scores: crate::model::Scores {
-                    vehicle_max_abs_z: 0.0,
-                    excitation_max_abs_z: 0.0,
-                    n_vehicle: 0,
-                    n_excitation: 0,
-                },
-                evidence: Vec::new(),
-                summary: String::new(),
-                missing: Vec::new(),
-                sensor_faults: Vec::new(),
-                component: None,
-            },
+            assessment: Assessment::normal_for_tests(),
             suspension: fitted.then(|| crate::suspension::DriveSuspension {
                 fit,
                 scores: Vec::new(),

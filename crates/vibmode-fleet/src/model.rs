@@ -394,6 +394,27 @@ pub struct Assessment {
     pub component: Option<Component>,
 }
 
+#[cfg(test)]
+impl Assessment {
+    /// A `normal` verdict without evidence, scores 0 (tests build on it).
+    pub(crate) fn normal_for_tests() -> Self {
+        Assessment {
+            classification: Classification::Normal,
+            scores: Scores {
+                vehicle_max_abs_z: 0.0,
+                excitation_max_abs_z: 0.0,
+                n_vehicle: 0,
+                n_excitation: 0,
+            },
+            evidence: Vec::new(),
+            summary: String::new(),
+            missing: Vec::new(),
+            sensor_faults: Vec::new(),
+            component: None,
+        }
+    }
+}
+
 fn band_label(b: &[f64; 2]) -> String {
     format!("{}-{} Hz", b[0], b[1])
 }

@@ -1707,20 +1707,8 @@ mod tests {
             road: None,
             metadata: serde_json::json!({}),
         };
-        let a = Assessment {
-            classification: Classification::Normal,
-            scores: crate::model::Scores {
-                vehicle_max_abs_z: f64::NAN,
-                excitation_max_abs_z: 0.0,
-                n_vehicle: 0,
-                n_excitation: 0,
-            },
-            evidence: Vec::new(),
-            summary: String::new(),
-            missing: Vec::new(),
-            sensor_faults: Vec::new(),
-            component: None,
-        };
+        let mut a = Assessment::normal_for_tests();
+        a.scores.vehicle_max_abs_z = f64::NAN;
         let f = features();
         let e = s
             .store_batch(&[BatchItem {

@@ -374,21 +374,11 @@ mod tests {
     /// and a copy given twice are not.
     #[test]
     fn records_in_no_drive_are_named() {
-        use crate::model::{Assessment, Classification, Scores};
-        let assessment = Assessment {
-            classification: Classification::Normal,
-            scores: Scores {
-                vehicle_max_abs_z: 1.0,
-                excitation_max_abs_z: 0.0,
-                n_vehicle: 4,
-                n_excitation: 1,
-            },
-            evidence: vec![],
-            summary: String::new(),
-            missing: vec![],
-            sensor_faults: vec![],
-            component: None,
-        };
+        use crate::model::Assessment;
+        let mut assessment = Assessment::normal_for_tests();
+        assessment.scores.vehicle_max_abs_z = 1.0;
+        assessment.scores.n_vehicle = 4;
+        assessment.scores.n_excitation = 1;
         let checked = |file: &str, same_as: Option<&str>| Checked {
             file: file.into(),
             record_id: 1,
