@@ -20,8 +20,12 @@
 //! 4 corners' spring and damper), `Phi^-1(1 - a / 16)` (3.23 at 1 %), half for the trend's 4
 //! (each corner's spring over the last drives), `Phi^-1(1 - a / 8)` (3.02). The trend's share
 //! is the larger per test because its scores find a lost spring more often (docs/fleet.md, "The
-//! spring trend"). On busgen's buses the healthy drives' scores have an rms of about 1
-//! (docs/fleet.md), so the stated rate holds where the jackknife does.
+//! spring trend"). The jackknife's variances are estimates (a drive of 8 records: 7 degrees of
+//! freedom), so a score's ratio `t` has Student's heavier tail (Welch-Satterthwaite's degrees of
+//! freedom, about 14 for a drive of 8 records against a baseline of 16): each score is made the
+//! normal score of the same tail probability ([`t_as_normal`]) before the limits, so the stated
+//! rate holds for drives of few records and of many (docs/fleet.md, "Scores of estimated
+//! spread").
 
 use serde::{Deserialize, Serialize};
 use vibmode_analysis::{AnalysisConfig, Corner};
@@ -317,8 +321,20 @@ pub struct CornerScore {
     pub value: f64,
     /// The baseline's.
     pub centre: f64,
-    /// The score (negative: lower than at the baseline).
+    /// The score (negative: lower than at the baseline) as a standard normal score: the
+    /// difference over its standard deviation, [`CornerScore::t`], is a Student t with
+    /// [`CornerScore::df`] degrees of freedom (the jackknife's variances are estimates), and
+    /// `z = Phi^-1(F_t(t; df))` has its tail probability ([`t_as_normal`]), so one limit holds
+    /// for drives of few records and of many.
     pub z: f64,
+    /// The difference over its standard deviation; absent in scores stored before it was kept
+    /// (their `z` is this ratio).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub t: Option<f64>,
+    /// The degrees of freedom of the standard deviation (Welch-Satterthwaite over the fits'
+    /// variances, each with its records - 1: [`welch_df`]); absent as [`CornerScore::t`] is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub df: Option<f64>,
 }
 
 /// The smallest loss a fitted spring or damper must show against the other corners to be
@@ -371,43 +387,57 @@ pub struct SpringTrend {
 
 /// Every corner's spring score of `fits` (a vehicle's last drives' fits against one baseline)
 /// pooled, against `reference`. Per corner the drives' `r_c` are averaged with weights
-/// `1 / var_i`, whose mean has the variance `1 / sum(1 / var_i)` (the drives' records are
-/// independent); the score is `z = (r_pooled - r_baseline) / sqrt(var_pooled +
-/// var_baseline)`: the baseline's variance stays, which is why pooling more drives gains less
-/// and less. Where a drive's variance is not positive (a noise-free fit) the plain mean is
-/// taken, with the variance `sum(var_i) / n^2`. Empty without fits.
+/// `w_i = (1 / var_i) / sum(1 / var_j)` (drives fitted on poor roads have jackknife spreads
+/// up to ten times others', docs/fleet.md); their mean has the variance `m sum(w_i^2 var_i)`,
+/// where `m = 1 + 4 sum(w_i (1 - w_i) / df_i)` is Meier's (1953) factor for weights from
+/// estimated variances (`df_i` = records - 1: without it, seeded drives of 8 records of equal
+/// spread score twice the stated rate past the trend's limit). The score's `t = (r_pooled -
+/// r_baseline) / sqrt(var_pooled + var_baseline)` has [`welch_df`]'s degrees of freedom (each
+/// drive's part `m w_i^2 var_i` with its records - 1, the baseline's with its own) and is made
+/// a normal score ([`CornerScore::z`]). The baseline's variance stays, which is why pooling
+/// more drives gains less and less. Where a drive's variance is not positive (a noise-free fit)
+/// the drives weigh by their records, without the factor. Empty without fits.
 pub fn spring_trend(reference: &CornerFit, fits: &[&CornerFit]) -> Vec<CornerScore> {
     if fits.is_empty() {
         return Vec::new();
     }
     let r = reference.relative(Part::Spring);
     let drives: Vec<[(f64, f64); 4]> = fits.iter().map(|f| f.relative(Part::Spring)).collect();
-    let n = drives.len() as f64;
     CORNERS
         .iter()
         .enumerate()
         .map(|(i, corner)| {
+            // Inverse-variance weights where every variance is positive, else by records.
             let weighted = drives.iter().all(|d| d[i].1 > 0.0 && d[i].1.is_finite());
-            let (mean, var) = if weighted {
-                let w: f64 = drives.iter().map(|d| 1.0 / d[i].1).sum();
-                let m = drives.iter().map(|d| d[i].0 / d[i].1).sum::<f64>() / w;
-                (m, 1.0 / w)
+            let raw: Vec<f64> = if weighted {
+                drives.iter().map(|d| 1.0 / d[i].1).collect()
             } else {
-                let m = drives.iter().map(|d| d[i].0).sum::<f64>() / n;
-                (m, drives.iter().map(|d| d[i].1).sum::<f64>() / (n * n))
+                fits.iter().map(|f| f.records.max(1) as f64).collect()
             };
-            let total = var + r[i].1;
-            CornerScore {
-                corner: *corner,
-                part: Part::Spring,
-                value: mean.exp(),
-                centre: r[i].0.exp(),
-                z: if total > 0.0 {
-                    (mean - r[i].0) / total.sqrt()
-                } else {
-                    0.0
-                },
-            }
+            let sum: f64 = raw.iter().sum();
+            let weights: Vec<f64> = raw.iter().map(|w| w / sum).collect();
+            // Meier's factor for weights from estimated variances.
+            let meier = if weighted {
+                1.0 + 4.0
+                    * weights
+                        .iter()
+                        .zip(fits)
+                        .map(|(w, f)| w * (1.0 - w) / records_df(f).max(1.0))
+                        .sum::<f64>()
+            } else {
+                1.0
+            };
+            // Each drive's weight and its variance's share of the pooled variance (weight^2
+            // var_i), which is what the degrees of freedom add.
+            let mean: f64 = drives.iter().zip(&weights).map(|(d, w)| w * d[i].0).sum();
+            let mut parts: Vec<(f64, f64)> = drives
+                .iter()
+                .zip(&weights)
+                .zip(fits)
+                .map(|((d, w), f)| (meier * w * w * d[i].1, records_df(f)))
+                .collect();
+            parts.push((r[i].1, records_df(reference)));
+            score(*corner, Part::Spring, mean, r[i].0, &parts)
         })
         .collect()
 }
@@ -418,22 +448,99 @@ pub fn corner_scores(reference: &CornerFit, drive: &CornerFit) -> Vec<CornerScor
     for part in [Part::Spring, Part::Damper] {
         let (r, d) = (reference.relative(part), drive.relative(part));
         for (i, corner) in CORNERS.iter().enumerate() {
-            let var = r[i].1 + d[i].1;
-            let z = if var > 0.0 {
-                (d[i].0 - r[i].0) / var.sqrt()
-            } else {
-                0.0
-            };
-            out.push(CornerScore {
-                corner: *corner,
-                part,
-                value: d[i].0.exp(),
-                centre: r[i].0.exp(),
-                z,
-            });
+            let parts = [(d[i].1, records_df(drive)), (r[i].1, records_df(reference))];
+            out.push(score(*corner, part, d[i].0, r[i].0, &parts));
         }
     }
     out
+}
+
+/// The degrees of freedom of a fit's jackknife variances: its records - 1.
+fn records_df(fit: &CornerFit) -> f64 {
+    fit.records.saturating_sub(1) as f64
+}
+
+/// The score of `r` against `r_reference`, whose difference has the variance of the `parts`
+/// added, `(variance, degrees of freedom)`: `t = (r - r_reference) / sqrt(sum of variances)`
+/// with [`welch_df`]'s degrees of freedom, made a normal score by [`t_as_normal`]. A total
+/// variance that is not positive (a noise-free fit) scores 0.
+fn score(
+    corner: Corner,
+    part: Part,
+    r: f64,
+    r_reference: f64,
+    parts: &[(f64, f64)],
+) -> CornerScore {
+    let var: f64 = parts.iter().map(|p| p.0).sum();
+    let (z, t, df) = if var > 0.0 && var.is_finite() {
+        let t = (r - r_reference) / var.sqrt();
+        let df = welch_df(parts);
+        (t_as_normal(t, df), Some(t), Some(df))
+    } else {
+        (0.0, None, None)
+    };
+    CornerScore {
+        corner,
+        part,
+        value: r.exp(),
+        centre: r_reference.exp(),
+        z,
+        t,
+        df,
+    }
+}
+
+/// The Welch-Satterthwaite degrees of freedom of a sum of independent variance estimates
+/// `(variance, degrees of freedom)`: `(sum v_i)^2 / sum(v_i^2 / df_i)`. A part with a variance
+/// of 0 adds nothing; one with no degrees of freedom (a fit of one record) makes the sum's 0.
+/// Infinite when every variance is 0.
+pub fn welch_df(parts: &[(f64, f64)]) -> f64 {
+    let total: f64 = parts.iter().map(|p| p.0).sum();
+    let denominator: f64 = parts
+        .iter()
+        .filter(|p| p.0 > 0.0)
+        .map(|p| {
+            if p.1 > 0.0 {
+                p.0 * p.0 / p.1
+            } else {
+                f64::INFINITY
+            }
+        })
+        .sum();
+    if denominator > 0.0 {
+        total * total / denominator
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The standard normal score with the tail probability of `t` under Student's t with `df`
+/// degrees of freedom: `Phi^-1(F_t(t; df))`, computed from the nearer tail (so -3.5 with 14
+/// degrees of freedom is -2.92 and 3.5 is 2.92). `t` itself where `df` is infinite or NaN (the
+/// normal), and where the tail probability underflows (beyond about 37 standard deviations,
+/// where either is far past any limit); 0 for a NaN `t` and for `df` <= 0 (no estimate of the
+/// spread: no evidence).
+pub fn t_as_normal(t: f64, df: f64) -> f64 {
+    use statrs::distribution::{ContinuousCDF, StudentsT};
+    if t.is_nan() || df <= 0.0 {
+        return 0.0;
+    }
+    if !df.is_finite() {
+        return t;
+    }
+    let Ok(dist) = StudentsT::new(0.0, 1.0, df) else {
+        return 0.0;
+    };
+    let lower = dist.cdf(-t.abs());
+    if lower.is_nan() || lower <= 0.0 {
+        return t;
+    }
+    let z = -normal_quantile(lower);
+    if t < 0.0 {
+        -z
+    } else {
+        z
+    }
 }
 
 #[cfg(test)]
@@ -469,13 +576,24 @@ mod tests {
             .find(|x| x.corner == Corner::FL && x.part == Part::Spring)
             .map(|x| x.value.ln());
         assert!((fl.unwrap_or(0.0) + 0.8f64.ln() / 3.0).abs() < 1e-12);
-        // The variance: 0.02^2 (1 + 3/9) per fit, two fits: z = -0.2231 / sqrt(2 * 0.000533).
-        let z = s
+        // The variance: 0.02^2 (1 + 3/9) per fit, two fits: t = -0.2231 / sqrt(2 * 0.000533),
+        // with 7 + 7 degrees of freedom (two equal variances of 8 records each), and z its
+        // normal score.
+        let rl = s
             .iter()
             .find(|x| x.corner == Corner::RL && x.part == Part::Spring)
-            .map_or(0.0, |x| x.z);
+            .cloned()
+            .unwrap();
         let expect = 0.8f64.ln() / (2.0f64 * 0.0004 * (1.0 + 3.0 / 9.0)).sqrt();
-        assert!((z - expect).abs() < 1e-9, "{z} vs {expect}");
+        let t = rl.t.unwrap();
+        assert!((t - expect).abs() < 1e-9, "{t} vs {expect}");
+        assert!((rl.df.unwrap() - 14.0).abs() < 1e-9, "{:?}", rl.df);
+        assert_eq!(rl.z, t_as_normal(t, 14.0));
+        assert!(
+            rl.z > t && rl.z < 0.0,
+            "the t's heavier tail: {} vs t {t}",
+            rl.z
+        );
         // A load change (every spring alike) moves no score.
         let loaded = fit([2.3e5; 4], 0.02);
         assert!(corner_scores(&base, &loaded)
@@ -502,8 +620,9 @@ mod tests {
         f
     }
 
-    /// By hand: three drives of equal variance pool to their mean with a third of it; unequal
-    /// variances weigh by their inverses; a variance that is not positive takes the plain mean;
+    /// By hand: three drives of equal variance pool to their mean with a third of it (times
+    /// Meier's factor); unequal variances weigh by their inverses; a variance that is not
+    /// positive takes the plain mean;
     /// a load change moves nothing; no fits, no scores.
     #[test]
     fn spring_trend_by_hand() {
@@ -519,21 +638,36 @@ mod tests {
         assert_eq!(rl.corner, Corner::RL);
         let mean = (0.8f64.ln() + 0.9f64.ln() + 0.7f64.ln()) / 3.0;
         assert!((rl.value.ln() - mean).abs() < 1e-12);
-        let z = mean / (0.06f64.powi(2) / 3.0 + 0.04f64.powi(2)).sqrt();
-        assert!((rl.z - z).abs() < 1e-9, "{} vs {z}", rl.z);
-        // Weights 1/0.03^2 and 1/0.09^2 (9 : 1).
+        // Meier's factor for three equal weights of 7 degrees of freedom each: 1 + 4 * 3 *
+        // (1/3 * 2/3) / 7 = 1 + 8/21.
+        let m = 1.0 + 8.0 / 21.0;
+        let t = mean / (m * 0.06f64.powi(2) / 3.0 + 0.04f64.powi(2)).sqrt();
+        assert!((rl.t.unwrap() - t).abs() < 1e-9, "{:?} vs {t}", rl.t);
+        // Degrees of freedom: three parts m 0.06^2 / 9 = 0.000552 and the baseline's 0.0016,
+        // each with 8 - 1: 0.003257^2 / ((3 * 0.000552^2 + 0.0016^2) / 7) = 21.37.
+        let part = m * 0.0004;
+        let df =
+            (3.0 * part + 0.0016f64).powi(2) / ((3.0 * part.powi(2) + 0.0016f64.powi(2)) / 7.0);
+        assert!(
+            (rl.df.unwrap() - df).abs() < 1e-9 && (df - 21.37).abs() < 0.005,
+            "{df}"
+        );
+        assert!((rl.z - t_as_normal(t, df)).abs() < 1e-12);
+        // Weights 1/0.03^2 and 1/0.09^2 (9 : 1), variance 1 / (1/0.0009 + 1/0.0081) times
+        // Meier's factor 1 + 4 (0.9 * 0.1 / 7 + 0.1 * 0.9 / 7) = 1.1029.
         let (p, q) = (drive(0.8, 0.03), drive(1.0, 0.09));
         let rl = spring_trend(&base, &[&p, &q])[2].clone();
         let mean = 0.9 * 0.8f64.ln();
-        let var: f64 = 1.0 / (1.0 / 0.0009 + 1.0 / 0.0081);
+        let var: f64 = 1.0 / (1.0 / 0.0009 + 1.0 / 0.0081) * (1.0 + 4.0 * 0.18 / 7.0);
         assert!((rl.value.ln() - mean).abs() < 1e-12);
-        assert!((rl.z - mean / (var + 0.0016).sqrt()).abs() < 1e-9);
-        // A noise-free fit (variance 0): the plain mean, variance (0 + 0.03^2) / 4.
+        assert!((rl.t.unwrap() - mean / (var + 0.0016).sqrt()).abs() < 1e-9);
+        // A noise-free fit (variance 0) of as many records: the plain mean, variance (0 +
+        // 0.09^2) / 4 (no factor: the weights are not estimated).
         let zero = drive(0.8, 0.0);
         let rl = spring_trend(&base, &[&zero, &q])[2].clone();
         let mean = 0.8f64.ln() / 2.0;
         assert!((rl.value.ln() - mean).abs() < 1e-12);
-        assert!((rl.z - mean / (0.0081_f64 / 4.0 + 0.0016).sqrt()).abs() < 1e-9);
+        assert!((rl.t.unwrap() - mean / (0.0081_f64 / 4.0 + 0.0016).sqrt()).abs() < 1e-9);
         // A load that scales every spring alike moves no corner.
         let loaded = relative_fit([2.4e5; 4], [0.05; 4]);
         assert!(spring_trend(&base, &[&loaded, &loaded, &loaded])
@@ -542,10 +676,11 @@ mod tests {
         assert!(spring_trend(&base, &[]).is_empty());
     }
 
-    /// Seeded random drives: a drive's `r_c` drawn from N(mu, sd_i^2), independent; the trend's
-    /// score over many draws has mean `mu / sqrt(var + var_base)` and unit spread when the
-    /// baseline sits at 0 with its variance taken as known (the baseline's own error is then
-    /// one draw per trial too).
+    /// Seeded random drives as the jackknife sees them: a drive's `r_c` drawn from N(0, sd_i^2)
+    /// and its variance estimated with 7 degrees of freedom (8 records: sd_i^2 chi^2_7 / 7),
+    /// the baseline's likewise with 15 (16 records). Over many draws the trend's score is
+    /// standard normal, in the spread and in the tail the limit is set in (P(z < -2.326) = 1 %),
+    /// where the ratio of the difference to its estimated spread (`t`) has the heavier tail.
     #[test]
     fn spring_trend_scores_are_standard_normal_under_the_null_over_seeds() {
         let mut state = 0x2545_f491_4f6c_dd1d_u64;
@@ -559,33 +694,76 @@ mod tests {
             let (u, v) = (uniform().max(1e-300), uniform());
             (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
         };
+        // A variance estimate with `df` degrees of freedom of a true sd.
+        let estimate = |sd: f64, df: usize, normal: &mut dyn FnMut() -> f64| {
+            let chi2: f64 = (0..df).map(|_| normal().powi(2)).sum();
+            (sd * sd * chi2 / df as f64).sqrt()
+        };
         let (sd_base, sds) = (0.046, [0.05, 0.063, 0.09]);
-        let n = 4000;
-        let (mut sum, mut sum2) = (0.0, 0.0);
+        let n = 20_000;
+        let (mut sum, mut sum2, mut below, mut t_below) = (0.0, 0.0, 0, 0);
         for _ in 0..n {
             let b = sd_base * normal();
-            let base = relative_fit([2.0e5, 2.0e5, 2.0e5 * b.exp(), 2.0e5], [sd_base; 4]);
+            let sd_b = estimate(sd_base, 15, &mut normal);
+            let mut base = relative_fit([2.0e5, 2.0e5, 2.0e5 * b.exp(), 2.0e5], [sd_b; 4]);
+            base.records = 16;
             let drives: Vec<CornerFit> = sds
                 .iter()
                 .map(|sd| {
-                    relative_fit(
-                        [2.0e5, 2.0e5, 2.0e5 * (sd * normal()).exp(), 2.0e5],
-                        [*sd; 4],
-                    )
+                    let r = sd * normal();
+                    let sd_i = estimate(*sd, 7, &mut normal);
+                    relative_fit([2.0e5, 2.0e5, 2.0e5 * r.exp(), 2.0e5], [sd_i; 4])
                 })
                 .collect();
             // RL's r with the others equal is ln(k_RL / 2e5), so its variance is the one given
             // only for RL; the test reads RL alone.
             let refs: Vec<&CornerFit> = drives.iter().collect();
-            let z = spring_trend(&base, &refs)[2].z;
-            sum += z;
-            sum2 += z * z;
+            let rl = spring_trend(&base, &refs)[2].clone();
+            sum += rl.z;
+            sum2 += rl.z * rl.z;
+            below += usize::from(rl.z < -2.326);
+            t_below += usize::from(rl.t.unwrap_or(0.0) < -2.326);
         }
         let mean = sum / n as f64;
         let sd = (sum2 / n as f64 - mean * mean).sqrt();
-        // Standard errors: 1/sqrt(4000) = 0.016 for the mean, about 0.011 for the sd.
-        assert!(mean.abs() < 0.06, "mean {mean}");
-        assert!((sd - 1.0).abs() < 0.05, "sd {sd}");
+        // Standard errors: 1/sqrt(20000) = 0.007 for the mean, 0.005 for the sd, and
+        // sqrt(0.01 * 0.99 / 20000) = 0.0007 for the 1 % tail.
+        assert!(mean.abs() < 0.03, "mean {mean}");
+        assert!((sd - 1.0).abs() < 0.03, "sd {sd}");
+        let (rate, t_rate) = (below as f64 / n as f64, t_below as f64 / n as f64);
+        assert!((rate - 0.01).abs() < 0.0025, "P(z < -2.326) = {rate}");
+        assert!(t_rate > 0.0125, "the ratio's own tail is heavier: {t_rate}");
+    }
+
+    /// By hand: Welch-Satterthwaite's degrees of freedom; equal variances add theirs, a
+    /// variance of 0 adds nothing, none at all is the normal, a part without degrees of freedom
+    /// leaves none.
+    #[test]
+    fn welch_df_by_hand() {
+        assert!((welch_df(&[(0.01, 7.0), (0.01, 7.0)]) - 14.0).abs() < 1e-12);
+        // (0.04 + 0.01)^2 / (0.04^2 / 7 + 0.01^2 / 15) = 0.0025 / 0.000235238 = 10.63.
+        let want = 0.0025 / (0.0016 / 7.0 + 0.0001 / 15.0);
+        assert!((welch_df(&[(0.04, 7.0), (0.01, 15.0)]) - want).abs() < 1e-9);
+        assert!((want - 10.6275).abs() < 1e-3);
+        assert_eq!(welch_df(&[(0.0, 7.0), (0.02, 9.0)]), 9.0);
+        assert_eq!(welch_df(&[(0.0, 7.0), (0.0, 9.0)]), f64::INFINITY);
+        assert_eq!(welch_df(&[(0.01, 0.0), (0.02, 9.0)]), 0.0);
+    }
+
+    /// By hand: the normal where the degrees of freedom are infinite, 0 without any or for NaN,
+    /// symmetric, and for 1 degree of freedom (the Cauchy, F(t) = 1/2 + atan(t) / pi) t = -1 is
+    /// the lower quartile, Phi^-1(1/4) = -0.674 49.
+    #[test]
+    fn t_as_normal_by_hand() {
+        assert_eq!(t_as_normal(-3.1, f64::INFINITY), -3.1);
+        assert_eq!(t_as_normal(-3.1, 0.0), 0.0);
+        assert_eq!(t_as_normal(f64::NAN, 7.0), 0.0);
+        assert_eq!(t_as_normal(2.5, 7.0), -t_as_normal(-2.5, 7.0));
+        assert_eq!(t_as_normal(0.0, 7.0), 0.0);
+        assert!((t_as_normal(-1.0, 1.0) + 0.674_489_750_196_08).abs() < 1e-8);
+        // The t's tail is heavier: its score is nearer 0, and nearer t as df grows.
+        let (a, b) = (t_as_normal(-3.5, 7.0), t_as_normal(-3.5, 100.0));
+        assert!(-3.5 < b && b < a && a < 0.0, "{a} {b}");
     }
 
     /// By hand: replicates whose four values move together (a common factor, e.g. the noise
@@ -640,6 +818,8 @@ mod tests {
             value,
             centre: 1.0,
             z,
+            t: None,
+            df: None,
         };
         assert!(!score(0.998, -4.9).flagged(3.02), "-0.2 % at z -4.9");
         assert!(!score(0.91, -6.0).flagged(3.02), "-9 %");

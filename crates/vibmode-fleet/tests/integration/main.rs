@@ -10,4 +10,5 @@ mod config_props;
 mod end_to_end;
 mod ingest_files;
 mod level_ratios;
+mod reference;
 mod suspension;
