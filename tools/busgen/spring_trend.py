@@ -84,6 +84,11 @@ def run_bus(bus_seed: int, n_healthy: int, n_faulty: int, work: Path) -> Dict:
                 s["corner"]: round(s["z"], 2) for s in trend["scores"]},
             "fit_z": {s["corner"]: round(s["z"], 2) for s in susp.get("scores", [])
                       if s["part"] == "spring"},
+            # Raw, for studies of other limits offline: the drive's fit, scores and trend, and
+            # its evidence (key, group, corner, z, limit).
+            "suspension": susp,
+            "evidence": [{k: e.get(k) for k in ("key", "group", "corner", "z", "limit")}
+                         for e in dv.get("evidence", [])],
         })
     return {"bus": bus_seed, "corner": corner.upper(), "rows": rows}
 
