@@ -53,9 +53,11 @@ def test_the_trend_is_made_from_the_third_drive_on(measured):
         assert r["trend"] == (r["k"] >= 2), (r, measured["replay"])
 
 
-@pytest.mark.xfail(reason="issue 31 item 6 not met with the suspension fit on: 257 of 264 "
-                          "healthy drives normal over 56 busgen buses in sequence (97.3 %; "
-                          "docs/fleet.md \"The spring trend\"), 99 % is the goal",
+@pytest.mark.xfail(reason="reported, not asserted: with the t scores 238 of 240 healthy drives "
+                          "are normal over 40 busgen buses in sequence (docs/fleet.md \"Scores "
+                          "of estimated spread\"), but one alarm among this run's 3 drives "
+                          "fails the 5 % test (P 0.03 at 99 %), which a 1 % rate gives in about "
+                          "3 % of runs",
                    strict=False)
 def test_healthy_sequences_are_normal(measured):
     # The issue's healthy goal, >= 99 % of drives normal, on the drives of a healthy sequence
@@ -68,8 +70,9 @@ def test_healthy_sequences_are_normal(measured):
 
 
 @pytest.mark.xfail(reason="issue 31 item 3 not met: the spring at 80 % is found with its "
-                          "corner on the third drive after onset on 46 of 56 busgen buses (82 %, "
-                          "docs/fleet.md \"The spring trend\"); 90 % is the goal",
+                          "corner on the third drive after onset on 26 of 40 busgen buses with "
+                          "the t scores (65 %, docs/fleet.md \"Scores of estimated spread\"); "
+                          "90 % is the goal",
                    strict=False)
 def test_spring_80_found_by_the_third_drive(measured):
     third = measured["spring"][FAULTY - 1]
