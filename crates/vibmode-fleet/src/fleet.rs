@@ -969,6 +969,13 @@ pub fn check_drive_files_progress(
             }
         }
     }
+    // The vehicle's stored drives against this baseline, read once for every drive's spring
+    // trend (only where the model set fits the suspension).
+    let stored = if set.suspension.is_some() {
+        store.drives_of_model_set(&set.vehicle, set.version, TREND_CANDIDATES)?
+    } else {
+        Vec::new()
+    };
     let mut drives: Vec<(Drive, Vec<usize>)> = Vec::with_capacity(groups.len());
     for (id, members) in groups {
         let group: Vec<&Prepared> = members.iter().map(|&i| &prepared[i]).collect();
@@ -983,7 +990,10 @@ pub fn check_drive_files_progress(
                 (d.clone(), hashes)
             })
             .collect();
-        drives.push((drive_verdict(store, set, &id, &group, &earlier)?, members));
+        drives.push((
+            drive_verdict(store, set, &id, &group, &stored, &earlier)?,
+            members,
+        ));
     }
     let checked = check_prepared_drive(store, set, prepared, &drives)?;
     Ok((checked, drives.into_iter().map(|(d, _)| d).collect()))
@@ -993,13 +1003,15 @@ pub fn check_drive_files_progress(
 /// suspension): what the verdict could not look at.
 pub const NO_MODEL_FILE: &str = "suspension fit: not made: the vehicle has no registered full-car model file, so its springs and dampers are not fitted per drive and a lost spring may go unseen (docs/fleet.md, \"The suspension fitted per drive\")";
 
-/// The verdict of one drive of `records`; `earlier` are the drives checked before it in the
-/// same call, with their records' content hashes.
+/// The verdict of one drive of `records`; `stored` are the vehicle's stored drives against the
+/// model set ([`Store::drives_of_model_set`]) and `earlier` the drives checked before it in the
+/// same call, each with their records' content hashes.
 fn drive_verdict(
     store: &Store,
     set: &ModelSet,
     id: &str,
     records: &[&Prepared],
+    stored: &[(Drive, Vec<String>)],
     earlier: &[(Drive, Vec<String>)],
 ) -> Result<Drive> {
     let mut suspension = drive_suspension(store, set, records)?;
@@ -1010,8 +1022,7 @@ fn drive_verdict(
         .and_then(|s| s.into_iter().reduce(f64::min));
     let mut trend_missing = None;
     if let (Some(d), Some(reference)) = (suspension.0.as_mut(), set.suspension.as_ref()) {
-        let mut candidates =
-            store.drives_of_model_set(&set.vehicle, set.version, TREND_CANDIDATES)?;
+        let mut candidates = stored.to_vec();
         candidates.extend(earlier.iter().cloned());
         let hashes: Vec<&str> = records.iter().map(|p| p.content_hash.as_str()).collect();
         let before = earlier_fits(&candidates, &hashes, start_unix_s);
