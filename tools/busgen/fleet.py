@@ -126,8 +126,8 @@ def more_drives(bus_seed: int, n_healthy: int) -> List[Dict]:
 
 
 def make_baseline(bus_seed: int, n_records: int, work: Path, rng: random.Random,
-                  model: bool = False, config: Optional[Path] = None):
-    """A new store `work/fleet-SEED.db` with the bus's baseline: 2 healthy drives of `n_records`
+                  model: bool = False, config: Optional[Path] = None, drives: int = 2):
+    """A new store `work/fleet-SEED.db` with the bus's baseline: `drives` healthy drives of `n_records`
     (busgen defaults) ingested as nominal, `fleet baseline` built; with `model` the bus's model
     file registered first (`update.vehicle_toml`: its true geometry, masses and tyres, generic
     suspension). The seed of the baseline's simulations is `rng`'s first draw. Returns (store,
@@ -139,7 +139,7 @@ def make_baseline(bus_seed: int, n_records: int, work: Path, rng: random.Random,
     base_seed = rng.randrange(1, 10**6)
     h.run_vibmode(["fleet", "init", "--db", db, *(["--config", config] if config else [])])
     base = []
-    for d in range(2):
+    for d in range(drives):
         folder = h.simulate(bus_seed, base_seed + 1000 * d, records=n_records)
         base += h.records(folder)
         if model and d == 0:

@@ -8,7 +8,7 @@ Per bus (bus seeds drawn at random, printed; `VIBMODE_BUS_SEEDS=1,2,3` replays):
 
 - the bus's model file registered (its true geometry, masses and tyres, generic suspension:
   `update.vehicle_toml`), a baseline of 2 healthy drives of 8 records (busgen defaults: class B,
-  25-35 km/h, nominal load);
+  25-35 km/h, nominal load; `--baseline-drives` for more);
 - `--healthy` healthy drives, each on drawn conditions (speed 20-40 km/h or busgen's 25-35, load
   0.85-1.20, road class A-C: `fleet.healthy_drive`);
 - then `--faulty` drives with the spring at 80 % at one corner drawn per bus, on drawn conditions
@@ -20,6 +20,7 @@ by the drive's own fit, by the trend, or by other features). Printed per positio
 (1st, 2nd, 3rd spring drive: the 3rd is the first whose trend holds only spring drives).
 
 Usage: python3 tools/busgen/spring_trend.py [--buses N] [--healthy 4] [--faulty 3] [--json OUT]
+       [--baseline-drives 2]
 Needs VIBMODE_BIN (else target/release/vibmode) and a Python with numpy+scipy for busgen
 (BUSGEN_PYTHON).
 """
@@ -56,9 +57,11 @@ def how_found(drive: Dict, corner: str) -> Optional[str]:
     return "other"
 
 
-def run_bus(bus_seed: int, n_healthy: int, n_faulty: int, work: Path) -> Dict:
+def run_bus(bus_seed: int, n_healthy: int, n_faulty: int, work: Path,
+            baseline_drives: int = 2) -> Dict:
     rng = random.Random(bus_seed * 7919 + 3)
-    db, vehicle, base_seed = fleet.make_baseline(bus_seed, h.RECORDS, work, rng, model=True)
+    db, vehicle, base_seed = fleet.make_baseline(bus_seed, h.RECORDS, work, rng, model=True,
+                                                 drives=baseline_drives)
     corner = rng.choice(fleet.CORNERS)
     rows = []
     for k in range(n_healthy + n_faulty):
@@ -134,12 +137,13 @@ def print_summary(s: Dict) -> None:
           + ", ".join(f"{k}: {v}/{s['buses']}" for k, v in s["found_by"].items()))
 
 
-def measure(seeds: List[int], n_healthy: int = 4, n_faulty: int = 3) -> List[Dict]:
+def measure(seeds: List[int], n_healthy: int = 4, n_faulty: int = 3,
+            baseline_drives: int = 2) -> List[Dict]:
     work = Path(tempfile.mkdtemp(prefix="vibmode-spring-trend-"))
     buses = []
     try:
         for s in seeds:
-            b = run_bus(s, n_healthy, n_faulty, work)
+            b = run_bus(s, n_healthy, n_faulty, work, baseline_drives)
             for r in b["rows"]:
                 tag = "spring " + r["corner"] if r["faulty"] else "healthy"
                 print(f"bus {r['bus']:>5} d{r['k']} {tag:<10} {r['detail']:<30} "
@@ -158,14 +162,18 @@ def main(argv: Optional[List[str]] = None) -> int:
     p.add_argument("--healthy", type=int, default=4, help="healthy drives before the fault")
     p.add_argument("--faulty", type=int, default=3, help="drives with the spring at 80 %%")
     p.add_argument("--json", type=Path, help="write the rows and the summary here")
+    p.add_argument("--baseline-drives", type=int, default=2,
+                   help="healthy drives of 8 records in the baseline (busgen defaults)")
     a = p.parse_args(argv)
+    if a.baseline_drives < 1:
+        p.error(f"--baseline-drives {a.baseline_drives}: at least 1")
     try:
         h.check_tools()
     except h.Skip as e:
         print(f"skipped: {e}")
         return 0
     seeds = h.draw_bus_seeds(a.buses, "spring trend")
-    buses = measure(seeds, a.healthy, a.faulty)
+    buses = measure(seeds, a.healthy, a.faulty, a.baseline_drives)
     s = summarise(buses, a.healthy)
     print_summary(s)
     if a.json:
