@@ -132,8 +132,15 @@ def run_bus(bus_seed: int, n_records: int, work: Path, scales: Dict[str, List[fl
         h.run_vibmode(["fleet", "register", "--db", db, "--vehicle", vehicle, toml])
     h.run_vibmode(["fleet", "ingest", "--db", db, "--vehicle", vehicle, "-q", *base])
     h.run_vibmode(["fleet", "baseline", "--db", db, "--vehicle", vehicle])
+    # The drives are alternatives, not one vehicle's sequence: each is checked on a copy of the
+    # store as the baseline left it, as in fleet.py, so that the spring trend (which pools a
+    # vehicle's last drives) does not pool one fault's or scale's drive with the next (until
+    # 2026-11-28 it did: the spring at 80 % was pooled with the drives at 50 % and 65 %).
+    pristine = work / f"sweep-{bus_seed}.base.db"
+    h.copy_store(db, pristine)
     rows = []
     for fault, scale, extra, seed, corner in drives:
+        h.copy_store(pristine, db)
         out = check(db, vehicle, h.simulate(bus_seed, seed, *extra, records=n_records))
         dv = (out.get("drives") or [{}])[0]
         cls = dv.get("classification")
@@ -157,7 +164,10 @@ def run_bus(bus_seed: int, n_records: int, work: Path, scales: Dict[str, List[fl
               f"{'right' if ok else 'WRONG'} records {rec_ok}/{len(recs)}"
               + ("" if ok else f"  {row['summary'][:160]}"), flush=True)
         rows.append(row)
-    db.unlink()
+    for f in (db, pristine):
+        for g in (f, f.with_name(f.name + "-wal"), f.with_name(f.name + "-shm")):
+            if g.exists():
+                g.unlink()
     return rows
 
 
