@@ -492,3 +492,37 @@ fn a_file_given_twice_counts_once_in_its_drive() {
         "{v}"
     );
 }
+
+/// The timeline rows of `fleet status` (the drives, newest first) naming drive `id`.
+fn timeline_rows(db: &str, id: &str) -> usize {
+    let o = ok(&["fleet", "status", "--db", db]);
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    text.lines()
+        .skip_while(|l| !l.trim_start().starts_with("drives, newest first"))
+        .skip(1)
+        .take_while(|l| l.starts_with("    "))
+        .filter(|l| l.split_whitespace().any(|w| w == id))
+        .count()
+}
+
+/// The same drive (its name and its records) checked again replaces its stored verdict, so the
+/// timeline holds it once (a nightly job run twice); the same records under another name, or
+/// another drive between, are other drives.
+#[test]
+fn the_same_drive_checked_again_is_stored_once() {
+    let d = tempfile::tempdir().unwrap();
+    let db = store_with_baseline(d.path());
+    let db = db.as_str();
+    let mon = simulate_csv(&d.path().join("mon"), "B", "30", "61", "3");
+    let tue = simulate_csv(&d.path().join("tue"), "B", "30", "62", "3");
+    check_json(db, Some("mon"), &mon);
+    check_json(db, Some("tue"), &tue);
+    let again = check_json(db, Some("mon"), &mon);
+    assert_eq!(again["drives"][0]["drive"], "mon", "{again}");
+    assert_eq!((timeline_rows(db, "mon"), timeline_rows(db, "tue")), (1, 1));
+    check_json(db, Some("mon-2"), &mon);
+    assert_eq!(
+        (timeline_rows(db, "mon"), timeline_rows(db, "mon-2")),
+        (1, 1)
+    );
+}

@@ -885,6 +885,49 @@ impl Store {
                     |r| r.get(0),
                 )
                 .map_err(err)?;
+            // The same drive checked again (its name, its records and the baseline version):
+            // its stored verdict is replaced by this one, checked now, so the timeline holds it
+            // once (as the latest check where its records' times are unknown).
+            let mut ids: Vec<i64> = members.iter().map(|&i| out[i].record_id).collect();
+            ids.sort_unstable();
+            ids.dedup();
+            let same = {
+                let candidates: Vec<i64> = tx
+                    .prepare(
+                        "SELECT id FROM drives
+                         WHERE vehicle_id = ?1 AND drive = ?2 AND model_version = ?3
+                         ORDER BY id DESC",
+                    )
+                    .map_err(err)?
+                    .query_map(params![vid, d.drive, d.model_version], |r| r.get(0))
+                    .map_err(err)?
+                    .collect::<std::result::Result<_, _>>()
+                    .map_err(err)?;
+                let mut found = None;
+                for c in candidates {
+                    let records: Vec<i64> = tx
+                        .prepare(
+                            "SELECT record_id FROM drive_records WHERE drive_id = ?1
+                             ORDER BY record_id",
+                        )
+                        .map_err(err)?
+                        .query_map([c], |r| r.get(0))
+                        .map_err(err)?
+                        .collect::<std::result::Result<_, _>>()
+                        .map_err(err)?;
+                    if records == ids {
+                        found = Some(c);
+                        break;
+                    }
+                }
+                found
+            };
+            if let Some(old) = same {
+                tx.execute("DELETE FROM drive_records WHERE drive_id = ?1", [old])
+                    .map_err(err)?;
+                tx.execute("DELETE FROM drives WHERE id = ?1", [old])
+                    .map_err(err)?;
+            }
             tx.execute(
                 "INSERT INTO drives (vehicle_id, drive, model_version, checked, classification, json)
                  VALUES (?1, ?2, ?3, ?4, ?5, ?6)",
