@@ -164,10 +164,8 @@ def run_bus(bus_seed: int, n_records: int, work: Path, scales: Dict[str, List[fl
               f"{'right' if ok else 'WRONG'} records {rec_ok}/{len(recs)}"
               + ("" if ok else f"  {row['summary'][:160]}"), flush=True)
         rows.append(row)
-    for f in (db, pristine):
-        for g in (f, f.with_name(f.name + "-wal"), f.with_name(f.name + "-shm")):
-            if g.exists():
-                g.unlink()
+    h.remove_store(db)
+    h.remove_store(pristine)
     return rows
 
 

@@ -130,14 +130,19 @@ def simulate(bus_seed: int, seed: int, *extra: str, records: int = RECORDS,
     return out
 
 
+def remove_store(path: Path) -> None:
+    """Removes the SQLite store `path` with its write-ahead log and shared-memory files."""
+    for f in (path, path.with_name(path.name + "-wal"), path.with_name(path.name + "-shm")):
+        if f.exists():
+            f.unlink()
+
+
 def copy_store(src: Path, dst: Path) -> None:
     """Copies the SQLite store `src` (with what its write-ahead log holds) to `dst`, replacing
     it: SQLite's online backup."""
     import sqlite3
 
-    for f in (dst, dst.with_name(dst.name + "-wal"), dst.with_name(dst.name + "-shm")):
-        if f.exists():
-            f.unlink()
+    remove_store(dst)
     a = sqlite3.connect(src)
     b = sqlite3.connect(dst)
     try:

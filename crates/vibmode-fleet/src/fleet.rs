@@ -1022,10 +1022,8 @@ fn drive_verdict(
         .and_then(|s| s.into_iter().reduce(f64::min));
     let mut trend_missing = None;
     if let (Some(d), Some(reference)) = (suspension.0.as_mut(), set.suspension.as_ref()) {
-        let mut candidates = stored.to_vec();
-        candidates.extend(earlier.iter().cloned());
         let hashes: Vec<&str> = records.iter().map(|p| p.content_hash.as_str()).collect();
-        let before = earlier_fits(&candidates, &hashes, start_unix_s);
+        let before = earlier_fits(stored.iter().chain(earlier), &hashes, start_unix_s);
         if before.len() + 1 >= crate::suspension::TREND_DRIVES {
             let mut fits = vec![&d.fit];
             let mut ids = vec![id.to_string()];
@@ -1093,12 +1091,12 @@ const TREND_CANDIDATES: usize = 64;
 /// when they were driven where this drive's start and all theirs are known (and only those
 /// driven before it count), else by when they were checked.
 fn earlier_fits<'a>(
-    candidates: &'a [(Drive, Vec<String>)],
+    candidates: impl IntoIterator<Item = &'a (Drive, Vec<String>)>,
     hashes: &[&str],
     start_unix_s: Option<f64>,
 ) -> Vec<(&'a str, &'a crate::suspension::CornerFit)> {
     let fitted: Vec<&(Drive, Vec<String>)> = candidates
-        .iter()
+        .into_iter()
         .filter(|(d, h)| d.suspension.is_some() && !h.iter().any(|x| hashes.contains(&x.as_str())))
         .collect();
     let timed = start_unix_s.is_some() && fitted.iter().all(|(d, _)| d.start_unix_s.is_some());

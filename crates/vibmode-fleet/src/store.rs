@@ -888,41 +888,8 @@ impl Store {
             // The same drive checked again (its name, its records and the baseline version):
             // its stored verdict is replaced by this one, checked now, so the timeline holds it
             // once (as the latest check where its records' times are unknown).
-            let mut ids: Vec<i64> = members.iter().map(|&i| out[i].record_id).collect();
-            ids.sort_unstable();
-            ids.dedup();
-            let same = {
-                let candidates: Vec<i64> = tx
-                    .prepare(
-                        "SELECT id FROM drives
-                         WHERE vehicle_id = ?1 AND drive = ?2 AND model_version = ?3
-                         ORDER BY id DESC",
-                    )
-                    .map_err(err)?
-                    .query_map(params![vid, d.drive, d.model_version], |r| r.get(0))
-                    .map_err(err)?
-                    .collect::<std::result::Result<_, _>>()
-                    .map_err(err)?;
-                let mut found = None;
-                for c in candidates {
-                    let records: Vec<i64> = tx
-                        .prepare(
-                            "SELECT record_id FROM drive_records WHERE drive_id = ?1
-                             ORDER BY record_id",
-                        )
-                        .map_err(err)?
-                        .query_map([c], |r| r.get(0))
-                        .map_err(err)?
-                        .collect::<std::result::Result<_, _>>()
-                        .map_err(err)?;
-                    if records == ids {
-                        found = Some(c);
-                        break;
-                    }
-                }
-                found
-            };
-            if let Some(old) = same {
+            let ids: Vec<i64> = members.iter().map(|&i| out[i].record_id).collect();
+            if let Some(old) = same_drive(&tx, vid, &d.drive, d.model_version, &ids).map_err(err)? {
                 tx.execute("DELETE FROM drive_records WHERE drive_id = ?1", [old])
                     .map_err(err)?;
                 tx.execute("DELETE FROM drives WHERE id = ?1", [old])
@@ -1312,6 +1279,34 @@ impl Store {
         }
         Ok(out)
     }
+}
+
+/// The stored drive of vehicle `vid` named `drive` against model set `model_version` whose
+/// records are exactly `record_ids` (in any order, repeats counted once), if any.
+fn same_drive(
+    tx: &rusqlite::Transaction<'_>,
+    vid: i64,
+    drive: &str,
+    model_version: i64,
+    record_ids: &[i64],
+) -> rusqlite::Result<Option<i64>> {
+    let mut want = record_ids.to_vec();
+    want.sort_unstable();
+    want.dedup();
+    let mut st = tx.prepare(
+        "SELECT x.drive_id, x.record_id FROM drive_records x JOIN drives d ON d.id = x.drive_id
+         WHERE d.vehicle_id = ?1 AND d.drive = ?2 AND d.model_version = ?3
+         ORDER BY x.drive_id, x.record_id",
+    )?;
+    let rows = st
+        .query_map(params![vid, drive, model_version], |r| {
+            Ok((r.get::<_, i64>(0)?, r.get::<_, i64>(1)?))
+        })?
+        .collect::<rusqlite::Result<Vec<_>>>()?;
+    Ok(rows
+        .chunk_by(|a, b| a.0 == b.0)
+        .find(|g| g.iter().map(|r| r.1).eq(want.iter().copied()))
+        .map(|g| g[0].0))
 }
 
 impl Store {
