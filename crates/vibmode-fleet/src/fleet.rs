@@ -11,7 +11,8 @@ use crate::error::{FleetError, Result};
 use crate::features::{compute_features, RecordFeatures};
 use crate::hash::ContentHash;
 use crate::model::{
-    assess, assess_drive_fitted, build_model_set, Assessment, Drive, ModelSet, MIN_DRIVE_RECORDS,
+    assess, assess_drive_fitted, build_model_set, Assessment, Classification, Drive, ModelSet,
+    MIN_DRIVE_RECORDS,
 };
 use crate::store::{BatchItem, Condition, NewRecord, Store, Stored};
 use crate::suspension::{corner_scores, suspension_limit, SuspensionReference, VehicleModel};
@@ -1014,26 +1015,45 @@ fn drive_verdict(
     stored: &[(Drive, Vec<String>)],
     earlier: &[(Drive, Vec<String>)],
 ) -> Result<Drive> {
-    let mut suspension = drive_suspension(store, set, records)?;
     let start_unix_s = records
         .iter()
         .map(|p| p.features.start_unix_s)
         .collect::<Option<Vec<f64>>>()
         .and_then(|s| s.into_iter().reduce(f64::min));
+    let hashes: Vec<&str> = records.iter().map(|p| p.content_hash.as_str()).collect();
+    let before = earlier_fits(stored.iter().chain(earlier), &hashes, start_unix_s);
+    let window = crate::suspension::TREND_DRIVES - 1;
+    // The reference: the baseline's fit with the vehicle's first normal drives after it, those
+    // older than this drive's trend (the oldest first).
+    let mut reference_drives: Vec<(&str, &crate::suspension::CornerFit)> = before
+        .iter()
+        .skip(window)
+        .filter(|(_, _, class)| *class == Classification::Normal)
+        .map(|(d, f, _)| (*d, *f))
+        .collect();
+    reference_drives.reverse();
+    reference_drives.truncate(set.config.reference_drives);
+    let extra: Vec<&crate::suspension::CornerFit> =
+        reference_drives.iter().map(|(_, f)| *f).collect();
+    let mut suspension = drive_suspension(store, set, records, &extra)?;
     let mut trend_missing = None;
     if let (Some(d), Some(reference)) = (suspension.0.as_mut(), set.suspension.as_ref()) {
-        let hashes: Vec<&str> = records.iter().map(|p| p.content_hash.as_str()).collect();
-        let before = earlier_fits(stored.iter().chain(earlier), &hashes, start_unix_s);
-        if before.len() + 1 >= crate::suspension::TREND_DRIVES {
+        d.reference_drives = reference_drives
+            .iter()
+            .map(|(id, _)| id.to_string())
+            .collect();
+        if before.len() >= window {
             let mut fits = vec![&d.fit];
             let mut ids = vec![id.to_string()];
-            for (drive, fit) in before.iter().take(crate::suspension::TREND_DRIVES - 1) {
+            for (drive, fit, _) in before.iter().take(window) {
                 fits.push(fit);
                 ids.push(drive.to_string());
             }
+            let mut refs = vec![&reference.fit];
+            refs.extend(&extra);
             d.trend = Some(crate::suspension::SpringTrend {
                 drives: ids,
-                scores: crate::suspension::spring_trend(&reference.fit, &fits),
+                scores: crate::suspension::spring_trend(&refs, &fits),
                 limit: crate::suspension::trend_limit(set.config.false_alarm_rate),
             });
         } else {
@@ -1041,7 +1061,7 @@ fn drive_verdict(
                 "suspension fit: no spring trend over the last {} drives yet: {} of the {} earlier drives it needs fitted against baseline version {} (a spring's slow loss is judged on this drive alone)",
                 crate::suspension::TREND_DRIVES,
                 before.len(),
-                crate::suspension::TREND_DRIVES - 1,
+                window,
                 set.version,
             ));
         }
@@ -1094,7 +1114,7 @@ fn earlier_fits<'a>(
     candidates: impl IntoIterator<Item = &'a (Drive, Vec<String>)>,
     hashes: &[&str],
     start_unix_s: Option<f64>,
-) -> Vec<(&'a str, &'a crate::suspension::CornerFit)> {
+) -> Vec<(&'a str, &'a crate::suspension::CornerFit, Classification)> {
     let fitted: Vec<&(Drive, Vec<String>)> = candidates
         .into_iter()
         .filter(|(d, h)| d.suspension.is_some() && !h.iter().any(|x| hashes.contains(&x.as_str())))
@@ -1128,7 +1148,11 @@ fn earlier_fits<'a>(
     });
     ordered
         .into_iter()
-        .filter_map(|(d, _)| d.suspension.as_ref().map(|s| (d.drive.as_str(), &s.fit)))
+        .filter_map(|(d, _)| {
+            d.suspension
+                .as_ref()
+                .map(|s| (d.drive.as_str(), &s.fit, d.assessment.classification))
+        })
         .collect()
 }
 
@@ -1139,6 +1163,7 @@ fn drive_suspension(
     store: &Store,
     set: &ModelSet,
     prepared: &[&Prepared],
+    reference_drives: &[&crate::suspension::CornerFit],
 ) -> Result<(Option<crate::suspension::DriveSuspension>, Option<String>)> {
     let model = registered_model(store, &set.vehicle)?;
     let (model, reference) = match (model, &set.suspension) {
@@ -1186,10 +1211,16 @@ fn drive_suspension(
     match model.fit_corners(&set.config.analysis, &eqs) {
         Ok(fit) => Ok((
             Some(crate::suspension::DriveSuspension {
-                scores: corner_scores(&reference.fit, &fit),
+                scores: corner_scores(
+                    &std::iter::once(&reference.fit)
+                        .chain(reference_drives.iter().copied())
+                        .collect::<Vec<_>>(),
+                    &fit,
+                ),
                 fit,
                 limit: reference.limit,
                 trend: None,
+                reference_drives: Vec::new(),
             }),
             None,
         )),
@@ -1245,14 +1276,15 @@ mod tests {
                 scores: Vec::new(),
                 limit: 3.0,
                 trend: None,
+                reference_drives: Vec::new(),
             }),
             in_baseline: Vec::new(),
         };
         (drive, hashes.iter().map(|h| h.to_string()).collect())
     }
 
-    fn ids(v: &[(&str, &crate::suspension::CornerFit)]) -> Vec<String> {
-        v.iter().map(|(d, _)| d.to_string()).collect()
+    fn ids(v: &[(&str, &crate::suspension::CornerFit, Classification)]) -> Vec<String> {
+        v.iter().map(|(d, _, _)| d.to_string()).collect()
     }
 
     /// By hand: the drives before a drive, newest first; without times in the order checked,

@@ -52,6 +52,13 @@ pub const TREND_DRIVES: usize = 3;
 /// drives.
 pub const TESTS_PER_TREND: usize = 4;
 
+/// The most drives `reference_drives` ([`crate::FleetConfig`]) may pool with the baseline's fit
+/// into the reference a drive and the spring trend are scored against: the vehicle's first
+/// drives against the baseline classed `normal` (the oldest, so that a fault that begins later
+/// does not enter it), older than the drive checked and its trend's drives, among the drives
+/// checked last that a check reads (64).
+pub const REFERENCE_DRIVES_MAX: usize = 32;
+
 /// A vehicle's registered full-car model.
 #[derive(Clone, Debug)]
 pub struct VehicleModel {
@@ -372,6 +379,11 @@ pub struct DriveSuspension {
     /// absent and the drive's `missing` says why.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub trend: Option<SpringTrend>,
+    /// The drives pooled with the baseline's fit into the reference the scores and the trend
+    /// are against ([`crate::FleetConfig::reference_drives`]), oldest first; empty (and absent in the JSON) when
+    /// the reference is the baseline's fit alone, as in drives stored before it was kept.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub reference_drives: Vec<String>,
 }
 
 /// The springs of a vehicle's last drives pooled (kept with the drive's verdict).
@@ -385,71 +397,99 @@ pub struct SpringTrend {
     pub limit: f64,
 }
 
-/// Every corner's spring score of `fits` (a vehicle's last drives' fits against one baseline)
-/// pooled, against `reference`. Per corner the drives' `r_c` are averaged with weights
-/// `w_i = (1 / var_i) / sum(1 / var_j)` (drives fitted on poor roads have jackknife spreads
-/// up to ten times others', docs/fleet.md); their mean has the variance `m sum(w_i^2 var_i)`,
-/// where `m = 1 + 4 sum(w_i (1 - w_i) / df_i)` is Meier's (1953) factor for weights from
-/// estimated variances (`df_i` = records - 1: without it, seeded drives of 8 records of equal
-/// spread score twice the stated rate past the trend's limit). The score's `t = (r_pooled -
-/// r_baseline) / sqrt(var_pooled + var_baseline)` has [`welch_df`]'s degrees of freedom (each
-/// drive's part `m w_i^2 var_i` with its records - 1, the baseline's with its own) and is made
-/// a normal score ([`CornerScore::z`]). The baseline's variance stays, which is why pooling
-/// more drives gains less and less. Where a drive's variance is not positive (a noise-free fit)
-/// the drives weigh by their records, without the factor. Empty without fits.
-pub fn spring_trend(reference: &CornerFit, fits: &[&CornerFit]) -> Vec<CornerScore> {
-    if fits.is_empty() {
-        return Vec::new();
-    }
-    let r = reference.relative(Part::Spring);
-    let drives: Vec<[(f64, f64); 4]> = fits.iter().map(|f| f.relative(Part::Spring)).collect();
-    CORNERS
-        .iter()
-        .enumerate()
-        .map(|(i, corner)| {
-            // Inverse-variance weights where every variance is positive, else by records.
-            let weighted = drives.iter().all(|d| d[i].1 > 0.0 && d[i].1.is_finite());
-            let raw: Vec<f64> = if weighted {
-                drives.iter().map(|d| 1.0 / d[i].1).collect()
-            } else {
-                fits.iter().map(|f| f.records.max(1) as f64).collect()
-            };
-            let sum: f64 = raw.iter().sum();
-            let weights: Vec<f64> = raw.iter().map(|w| w / sum).collect();
-            // Meier's factor for weights from estimated variances.
-            let meier = if weighted {
-                1.0 + 4.0
-                    * weights
-                        .iter()
-                        .zip(fits)
-                        .map(|(w, f)| w * (1.0 - w) / records_df(f).max(1.0))
-                        .sum::<f64>()
-            } else {
-                1.0
-            };
-            // Each drive's weight and its variance's share of the pooled variance (weight^2
+/// Fits pooled per corner: the inverse-variance mean of their `r_c` and the parts of its
+/// variance, `(variance, degrees of freedom)` per fit. Weights `w_i = (1 / var_i) / sum(1 /
+/// var_j)` (drives fitted on poor roads have jackknife spreads up to ten times others',
+/// docs/fleet.md); each fit's part is `m w_i^2 var_i` with Meier's (1953) factor `m = 1 + 4
+/// sum(w_i (1 - w_i) / df_i)` for weights from estimated variances (`df_i` = records - 1).
+/// Where a fit's variance is not positive (a noise-free fit) the fits weigh by their records,
+/// without the factor. One fit pools to itself (weight 1, factor 1).
+struct Pooled {
+    mean: f64,
+    parts: Vec<(f64, f64)>,
+}
+
+fn pool(fits: &[&CornerFit], part: Part) -> [Pooled; 4] {
+    let rel: Vec<[(f64, f64); 4]> = fits.iter().map(|f| f.relative(part)).collect();
+    std::array::from_fn(|i| {
+        // Inverse-variance weights where every variance is positive, else by records.
+        let weighted = rel.iter().all(|d| d[i].1 > 0.0 && d[i].1.is_finite());
+        let raw: Vec<f64> = if weighted {
+            rel.iter().map(|d| 1.0 / d[i].1).collect()
+        } else {
+            fits.iter().map(|f| f.records.max(1) as f64).collect()
+        };
+        let sum: f64 = raw.iter().sum();
+        let weights: Vec<f64> = raw.iter().map(|w| w / sum).collect();
+        // Meier's factor for weights from estimated variances.
+        let meier = if weighted {
+            1.0 + 4.0
+                * weights
+                    .iter()
+                    .zip(fits)
+                    .map(|(w, f)| w * (1.0 - w) / records_df(f).max(1.0))
+                    .sum::<f64>()
+        } else {
+            1.0
+        };
+        Pooled {
+            mean: rel.iter().zip(&weights).map(|(d, w)| w * d[i].0).sum(),
+            // Each fit's weight and its variance's share of the pooled variance (weight^2
             // var_i), which is what the degrees of freedom add.
-            let mean: f64 = drives.iter().zip(&weights).map(|(d, w)| w * d[i].0).sum();
-            let mut parts: Vec<(f64, f64)> = drives
+            parts: rel
                 .iter()
                 .zip(&weights)
                 .zip(fits)
                 .map(|((d, w), f)| (meier * w * w * d[i].1, records_df(f)))
-                .collect();
-            parts.push((r[i].1, records_df(reference)));
-            score(*corner, Part::Spring, mean, r[i].0, &parts)
+                .collect(),
+        }
+    })
+}
+
+/// Every corner's spring score of `fits` (a vehicle's last drives' fits against one baseline)
+/// pooled, against `reference` (the baseline's fit, with the vehicle's first normal drives
+/// after it where there are any: [`crate::FleetConfig::reference_drives`]), both pooled alike. Per corner the
+/// drives' `r_c` are averaged with weights `w_i = (1 / var_i) / sum(1 / var_j)` (drives fitted
+/// on poor roads have jackknife spreads up to ten times others', docs/fleet.md); their mean has
+/// the variance `m sum(w_i^2 var_i)`, where `m = 1 + 4 sum(w_i (1 - w_i) / df_i)` is Meier's
+/// (1953) factor for weights from estimated variances (`df_i` = records - 1: without it,
+/// seeded drives of 8 records of equal spread score twice the stated rate past the trend's
+/// limit). The score's `t = (r_pooled - r_reference) / sqrt(var_pooled + var_reference)` has
+/// [`welch_df`]'s degrees of freedom (each fit's part `m w_i^2 var_i` with its records - 1)
+/// and is made a normal score ([`CornerScore::z`]). The reference's variance stays, which is
+/// why pooling more drives gains less and less. Where a drive's variance is not positive (a
+/// noise-free fit) the drives weigh by their records, without the factor. Empty without fits
+/// or without a reference.
+pub fn spring_trend(reference: &[&CornerFit], fits: &[&CornerFit]) -> Vec<CornerScore> {
+    if fits.is_empty() || reference.is_empty() {
+        return Vec::new();
+    }
+    let r = pool(reference, Part::Spring);
+    let drives = pool(fits, Part::Spring);
+    CORNERS
+        .iter()
+        .zip(drives.iter().zip(&r))
+        .map(|(corner, (d, r))| {
+            let parts: Vec<(f64, f64)> = d.parts.iter().chain(&r.parts).copied().collect();
+            score(*corner, Part::Spring, d.mean, r.mean, &parts)
         })
         .collect()
 }
 
-/// Every corner's spring and damper score of `drive` against `reference`.
-pub fn corner_scores(reference: &CornerFit, drive: &CornerFit) -> Vec<CornerScore> {
+/// Every corner's spring and damper score of `drive` against `reference` (the baseline's fit,
+/// with the vehicle's first normal drives after it where there are any, pooled as
+/// [`spring_trend`] pools: [`crate::FleetConfig::reference_drives`]). Empty without a reference.
+pub fn corner_scores(reference: &[&CornerFit], drive: &CornerFit) -> Vec<CornerScore> {
     let mut out = Vec::with_capacity(TESTS_PER_FIT);
+    if reference.is_empty() {
+        return out;
+    }
     for part in [Part::Spring, Part::Damper] {
-        let (r, d) = (reference.relative(part), drive.relative(part));
+        let (r, d) = (pool(reference, part), drive.relative(part));
         for (i, corner) in CORNERS.iter().enumerate() {
-            let parts = [(d[i].1, records_df(drive)), (r[i].1, records_df(reference))];
-            out.push(score(*corner, part, d[i].0, r[i].0, &parts));
+            let mut parts = vec![(d[i].1, records_df(drive))];
+            parts.extend_from_slice(&r[i].parts);
+            out.push(score(*corner, part, d[i].0, r[i].mean, &parts));
         }
     }
     out
@@ -565,7 +605,7 @@ mod tests {
         // -0.2231 / 3 = -0.0744, so theirs rises by 0.0744.
         let base = fit([2.0e5; 4], 0.02);
         let drive = fit([2.0e5, 2.0e5, 1.6e5, 2.0e5], 0.02);
-        let s = corner_scores(&base, &drive);
+        let s = corner_scores(&[&base], &drive);
         let rl = s
             .iter()
             .find(|x| x.corner == Corner::RL && x.part == Part::Spring)
@@ -596,7 +636,7 @@ mod tests {
         );
         // A load change (every spring alike) moves no score.
         let loaded = fit([2.3e5; 4], 0.02);
-        assert!(corner_scores(&base, &loaded)
+        assert!(corner_scores(&[&base], &loaded)
             .iter()
             .all(|x| x.z.abs() < 1e-9));
     }
@@ -631,7 +671,7 @@ mod tests {
         // the baseline's is 0.
         let drive = |s: f64, sd: f64| relative_fit([2.0e5, 2.0e5, 2.0e5 * s, 2.0e5], [sd; 4]);
         let (a, b, c) = (drive(0.8, 0.06), drive(0.9, 0.06), drive(0.7, 0.06));
-        let t = spring_trend(&base, &[&a, &b, &c]);
+        let t = spring_trend(&[&base], &[&a, &b, &c]);
         assert_eq!(t.len(), 4);
         assert!(t.iter().all(|x| x.part == Part::Spring));
         let rl = &t[2];
@@ -656,7 +696,7 @@ mod tests {
         // Weights 1/0.03^2 and 1/0.09^2 (9 : 1), variance 1 / (1/0.0009 + 1/0.0081) times
         // Meier's factor 1 + 4 (0.9 * 0.1 / 7 + 0.1 * 0.9 / 7) = 1.1029.
         let (p, q) = (drive(0.8, 0.03), drive(1.0, 0.09));
-        let rl = spring_trend(&base, &[&p, &q])[2].clone();
+        let rl = spring_trend(&[&base], &[&p, &q])[2].clone();
         let mean = 0.9 * 0.8f64.ln();
         let var: f64 = 1.0 / (1.0 / 0.0009 + 1.0 / 0.0081) * (1.0 + 4.0 * 0.18 / 7.0);
         assert!((rl.value.ln() - mean).abs() < 1e-12);
@@ -664,16 +704,16 @@ mod tests {
         // A noise-free fit (variance 0) of as many records: the plain mean, variance (0 +
         // 0.09^2) / 4 (no factor: the weights are not estimated).
         let zero = drive(0.8, 0.0);
-        let rl = spring_trend(&base, &[&zero, &q])[2].clone();
+        let rl = spring_trend(&[&base], &[&zero, &q])[2].clone();
         let mean = 0.8f64.ln() / 2.0;
         assert!((rl.value.ln() - mean).abs() < 1e-12);
         assert!((rl.t.unwrap() - mean / (0.0081_f64 / 4.0 + 0.0016).sqrt()).abs() < 1e-9);
         // A load that scales every spring alike moves no corner.
         let loaded = relative_fit([2.4e5; 4], [0.05; 4]);
-        assert!(spring_trend(&base, &[&loaded, &loaded, &loaded])
+        assert!(spring_trend(&[&base], &[&loaded, &loaded, &loaded])
             .iter()
             .all(|x| x.z.abs() < 1e-9));
-        assert!(spring_trend(&base, &[]).is_empty());
+        assert!(spring_trend(&[&base], &[]).is_empty());
     }
 
     /// Seeded random drives as the jackknife sees them: a drive's `r_c` drawn from N(0, sd_i^2)
@@ -718,7 +758,7 @@ mod tests {
             // RL's r with the others equal is ln(k_RL / 2e5), so its variance is the one given
             // only for RL; the test reads RL alone.
             let refs: Vec<&CornerFit> = drives.iter().collect();
-            let rl = spring_trend(&base, &refs)[2].clone();
+            let rl = spring_trend(&[&base], &refs)[2].clone();
             sum += rl.z;
             sum2 += rl.z * rl.z;
             below += usize::from(rl.z < -2.326);
@@ -733,6 +773,131 @@ mod tests {
         let (rate, t_rate) = (below as f64 / n as f64, t_below as f64 / n as f64);
         assert!((rate - 0.01).abs() < 0.0025, "P(z < -2.326) = {rate}");
         assert!(t_rate > 0.0125, "the ratio's own tail is heavier: {t_rate}");
+    }
+
+    /// By hand: a reference of the baseline's fit and one normal drive of equal variance is
+    /// their mean, each part a quarter of the variance times Meier's factor (weights 1/2, 15 and
+    /// 7 degrees of freedom: 1 + 4 (1/4 / 15 + 1/4 / 7)); the drive and the trend are scored
+    /// against it; a reference of the baseline alone is the baseline; no reference, no scores.
+    #[test]
+    fn a_reference_of_the_baseline_and_normal_drives_by_hand() {
+        let mut base = relative_fit([2.0e5; 4], [0.04; 4]);
+        base.records = 16;
+        let drive = |s: f64, sd: f64| relative_fit([2.0e5, 2.0e5, 2.0e5 * s, 2.0e5], [sd; 4]);
+        let normal = drive(0.9, 0.04);
+        let checked = drive(0.8, 0.06);
+        let m: f64 = 1.0 + 4.0 * (0.25 / 15.0 + 0.25 / 7.0);
+        let centre = 0.9f64.ln() / 2.0;
+        let var_ref: f64 = m * 0.25 * 0.0016 * 2.0;
+        let rl = corner_scores(&[&base, &normal], &checked)[2].clone();
+        assert_eq!((rl.corner, rl.part), (Corner::RL, Part::Spring));
+        assert!((rl.centre.ln() - centre).abs() < 1e-12);
+        let t = (0.8f64.ln() - centre) / (0.0036f64 + var_ref).sqrt();
+        assert!((rl.t.unwrap() - t).abs() < 1e-9, "{:?} vs {t}", rl.t);
+        // Degrees of freedom: the drive's 0.0036 (7), the reference's two parts m 0.0004 (15, 7).
+        let p: f64 = m * 0.0004;
+        let df =
+            (0.0036f64 + 2.0 * p).powi(2) / (0.0036f64.powi(2) / 7.0 + p * p / 15.0 + p * p / 7.0);
+        assert!((rl.df.unwrap() - df).abs() < 1e-9, "{:?} vs {df}", rl.df);
+        // The trend of three such drives against the same reference.
+        let tr = spring_trend(&[&base, &normal], &[&checked, &checked, &checked])[2].clone();
+        assert!((tr.centre.ln() - centre).abs() < 1e-12);
+        let m3 = 1.0 + 8.0 / 21.0;
+        let t3 = (0.8f64.ln() - centre) / (m3 * 0.0036 / 3.0 + var_ref).sqrt();
+        assert!((tr.t.unwrap() - t3).abs() < 1e-9, "{:?} vs {t3}", tr.t);
+        // The baseline alone pools to itself: the scores of before.
+        let alone = corner_scores(&[&base], &checked)[2].clone();
+        let t1 = 0.8f64.ln() / (0.0036f64 + 0.0016).sqrt();
+        assert!(
+            (alone.t.unwrap() - t1).abs() < 1e-9,
+            "{:?} vs {t1}",
+            alone.t
+        );
+        assert!((alone.centre - 1.0).abs() < 1e-12);
+        assert!(corner_scores(&[], &checked).is_empty());
+        assert!(spring_trend(&[], &[&checked]).is_empty());
+    }
+
+    /// Seeded null draws as in the test above, the reference now the baseline (15 degrees of
+    /// freedom) pooled with 6 normal drives of unequal spread (7 each): the drive's own score
+    /// and the trend's should be standard normal, in the spread, at the 1 % tail and at their
+    /// limits (3.23 and 3.02, within a quarter of the stated tail; the sampling error is 9 %).
+    /// They are not: the drive's tail at its limit is about 1.9 times the stated one and the
+    /// trend's 2.3 times (a precise reference leaves the drives' own 7 degrees of freedom,
+    /// whose Welch-Satterthwaite estimate rises exactly when a drive's variance comes out low,
+    /// and Meier's factor is first order). Hence `reference_drives` = 0 by default
+    /// (docs/fleet.md, "A reference grown from normal drives"); run with `--ignored`.
+    #[test]
+    #[ignore = "known to fail: the pooled reference's scores are too wide in the far tail (issue 31)"]
+    fn scores_against_a_pooled_reference_are_standard_normal_under_the_null_over_seeds() {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut uniform = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut normal = || {
+            let (u, v) = (uniform().max(1e-300), uniform());
+            (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+        };
+        let estimate = |sd: f64, df: usize, normal: &mut dyn FnMut() -> f64| {
+            let chi2: f64 = (0..df).map(|_| normal().powi(2)).sum();
+            (sd * sd * chi2 / df as f64).sqrt()
+        };
+        let draw = |sd: f64, records: usize, normal: &mut dyn FnMut() -> f64| {
+            let r = sd * normal();
+            let sd_i = estimate(sd, records - 1, normal);
+            let mut f = relative_fit([2.0e5, 2.0e5, 2.0e5 * r.exp(), 2.0e5], [sd_i; 4]);
+            f.records = records;
+            f
+        };
+        let ref_sds = [0.05, 0.063, 0.09, 0.04, 0.12, 0.07];
+        let trend_sds = [0.05, 0.063, 0.09];
+        let n = 200_000;
+        let mut far = [0usize; 2];
+        let mut stats = [(0.0, 0.0, 0usize); 2];
+        for _ in 0..n {
+            let base = draw(0.046, 16, &mut normal);
+            let normals: Vec<CornerFit> =
+                ref_sds.iter().map(|sd| draw(*sd, 8, &mut normal)).collect();
+            let drives: Vec<CornerFit> = trend_sds
+                .iter()
+                .map(|sd| draw(*sd, 8, &mut normal))
+                .collect();
+            let mut reference = vec![&base];
+            reference.extend(normals.iter());
+            let fits: Vec<&CornerFit> = drives.iter().collect();
+            let zs = [
+                corner_scores(&reference, &drives[0])[2].z,
+                spring_trend(&reference, &fits)[2].z,
+            ];
+            far[0] += usize::from(zs[0] < -3.227);
+            far[1] += usize::from(zs[1] < -3.023);
+            for (s, z) in stats.iter_mut().zip(zs) {
+                s.0 += z;
+                s.1 += z * z;
+                s.2 += usize::from(z < -2.326);
+            }
+        }
+        let far = [far[0] as f64 / n as f64, far[1] as f64 / n as f64];
+        eprintln!(
+            "P(z < -3.227) of the drive's score {} (stated 0.000625), P(z < -3.023) of the trend's {} (stated 0.00125)",
+            far[0], far[1]
+        );
+        for (what, (sum, sum2, below)) in ["drive", "trend"].iter().zip(stats) {
+            let mean = sum / n as f64;
+            let sd = (sum2 / n as f64 - mean * mean).sqrt();
+            let rate = below as f64 / n as f64;
+            assert!(mean.abs() < 0.03, "{what}: mean {mean}");
+            assert!((sd - 1.0).abs() < 0.03, "{what}: sd {sd}");
+            assert!(
+                (rate - 0.01).abs() < 0.0025,
+                "{what}: P(z < -2.326) = {rate}"
+            );
+        }
+        assert!((far[0] / 0.000625 - 1.0).abs() < 0.25, "drive: {}", far[0]);
+        assert!((far[1] / 0.00125 - 1.0).abs() < 0.25, "trend: {}", far[1]);
     }
 
     /// By hand: Welch-Satterthwaite's degrees of freedom; equal variances add theirs, a

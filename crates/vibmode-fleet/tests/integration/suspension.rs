@@ -113,7 +113,7 @@ fn springs_and_dampers_fitted_per_drive_over_seeds() {
                 4,
                 Disturbances::in_service(),
             ));
-            let scores = corner_scores(&base, &drive);
+            let scores = corner_scores(&[&base], &drive);
             let lowest = scores.iter().min_by(|a, c| a.z.total_cmp(&c.z)).unwrap();
             println!(
                 "baseline {b} drive {k} {fault:?}: lowest {:?} {:?} z {:.2}",
