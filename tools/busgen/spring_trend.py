@@ -58,10 +58,10 @@ def how_found(drive: Dict, corner: str) -> Optional[str]:
 
 
 def run_bus(bus_seed: int, n_healthy: int, n_faulty: int, work: Path,
-            baseline_drives: int = 2) -> Dict:
+            baseline_drives: int = 2, config: Optional[Path] = None) -> Dict:
     rng = random.Random(bus_seed * 7919 + 3)
     db, vehicle, base_seed = fleet.make_baseline(bus_seed, h.RECORDS, work, rng, model=True,
-                                                 drives=baseline_drives)
+                                                 drives=baseline_drives, config=config)
     corner = rng.choice(fleet.CORNERS)
     rows = []
     for k in range(n_healthy + n_faulty):
@@ -138,12 +138,12 @@ def print_summary(s: Dict) -> None:
 
 
 def measure(seeds: List[int], n_healthy: int = 4, n_faulty: int = 3,
-            baseline_drives: int = 2) -> List[Dict]:
+            baseline_drives: int = 2, config: Optional[Path] = None) -> List[Dict]:
     work = Path(tempfile.mkdtemp(prefix="vibmode-spring-trend-"))
     buses = []
     try:
         for s in seeds:
-            b = run_bus(s, n_healthy, n_faulty, work, baseline_drives)
+            b = run_bus(s, n_healthy, n_faulty, work, baseline_drives, config)
             for r in b["rows"]:
                 tag = "spring " + r["corner"] if r["faulty"] else "healthy"
                 print(f"bus {r['bus']:>5} d{r['k']} {tag:<10} {r['detail']:<30} "
@@ -164,6 +164,8 @@ def main(argv: Optional[List[str]] = None) -> int:
     p.add_argument("--json", type=Path, help="write the rows and the summary here")
     p.add_argument("--baseline-drives", type=int, default=2,
                    help="healthy drives of 8 records in the baseline (busgen defaults)")
+    p.add_argument("--config", type=Path,
+                   help="fleet settings (TOML) given to `fleet init --config`, e.g. reference_drives = 6")
     a = p.parse_args(argv)
     if a.baseline_drives < 1:
         p.error(f"--baseline-drives {a.baseline_drives}: at least 1")
@@ -173,7 +175,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         print(f"skipped: {e}")
         return 0
     seeds = h.draw_bus_seeds(a.buses, "spring trend")
-    buses = measure(seeds, a.healthy, a.faulty, a.baseline_drives)
+    buses = measure(seeds, a.healthy, a.faulty, a.baseline_drives, a.config)
     s = summarise(buses, a.healthy)
     print_summary(s)
     if a.json:

@@ -75,10 +75,10 @@ pub struct FleetConfig {
     /// Floor of the spread of the body response, ln units (default 0.03).
     pub floor_body_response: f64,
     /// Normal drives pooled with the baseline's suspension fit into the reference a drive's
-    /// fitted springs and dampers and the spring trend are scored against (default 0: the
-    /// baseline's fit alone). With 6, a spring at 80 % is found sooner on busgen's buses, but
-    /// the scores' stated false-alarm rate no longer holds in the far tail (about twice it on
-    /// seeded null draws): docs/fleet.md, "A reference grown from normal drives".
+    /// fitted springs and dampers and the spring trend are scored against: the vehicle's first
+    /// drives classed `normal` after the baseline, older than the drive checked and its trend
+    /// (default 6; 0: the baseline's fit alone). A baseline of 2 drives is most of the spring
+    /// trend's variance (docs/fleet.md, "The reference grows with normal drives").
     pub reference_drives: usize,
 }
 
@@ -148,7 +148,7 @@ impl Default for FleetConfig {
             body_band_hz: [0.4, 4.0],
             body_response_bands_hz: vec![[2.0, 4.0]],
             floor_body_response: 0.03,
-            reference_drives: 0,
+            reference_drives: 6,
         }
     }
 }

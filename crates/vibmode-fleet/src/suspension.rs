@@ -469,10 +469,7 @@ pub fn spring_trend(reference: &[&CornerFit], fits: &[&CornerFit]) -> Vec<Corner
     CORNERS
         .iter()
         .zip(drives.iter().zip(&r))
-        .map(|(corner, (d, r))| {
-            let parts: Vec<(f64, f64)> = d.parts.iter().chain(&r.parts).copied().collect();
-            score(*corner, Part::Spring, d.mean, r.mean, &parts)
-        })
+        .map(|(corner, (d, r))| score(*corner, Part::Spring, d, r))
         .collect()
 }
 
@@ -485,11 +482,9 @@ pub fn corner_scores(reference: &[&CornerFit], drive: &CornerFit) -> Vec<CornerS
         return out;
     }
     for part in [Part::Spring, Part::Damper] {
-        let (r, d) = (pool(reference, part), drive.relative(part));
-        for (i, corner) in CORNERS.iter().enumerate() {
-            let mut parts = vec![(d[i].1, records_df(drive))];
-            parts.extend_from_slice(&r[i].parts);
-            out.push(score(*corner, part, d[i].0, r[i].mean, &parts));
+        let (r, d) = (pool(reference, part), pool(&[drive], part));
+        for ((corner, d), r) in CORNERS.iter().zip(&d).zip(&r) {
+            out.push(score(*corner, part, d, r));
         }
     }
     out
@@ -500,33 +495,142 @@ fn records_df(fit: &CornerFit) -> f64 {
     fit.records.saturating_sub(1) as f64
 }
 
-/// The score of `r` against `r_reference`, whose difference has the variance of the `parts`
-/// added, `(variance, degrees of freedom)`: `t = (r - r_reference) / sqrt(sum of variances)`
-/// with [`welch_df`]'s degrees of freedom, made a normal score by [`t_as_normal`]. A total
-/// variance that is not positive (a noise-free fit) scores 0.
-fn score(
-    corner: Corner,
-    part: Part,
-    r: f64,
-    r_reference: f64,
-    parts: &[(f64, f64)],
-) -> CornerScore {
+/// The score of side `a` (a drive, or the drives of a trend, pooled) against side `b` (the
+/// reference, pooled): `t = (r_a - r_b) / sqrt(V)` with `V` the sides' estimated variances
+/// added, made a normal score by [`fiducial_z`] over the sides' parts; `df` is the
+/// Welch-Satterthwaite approximation's ([`welch_df`]), kept for the record. A total variance
+/// that is not positive (a noise-free fit) scores 0.
+fn score(corner: Corner, part: Part, a: &Pooled, b: &Pooled) -> CornerScore {
+    let parts: Vec<(f64, f64)> = a.parts.iter().chain(&b.parts).copied().collect();
     let var: f64 = parts.iter().map(|p| p.0).sum();
     let (z, t, df) = if var > 0.0 && var.is_finite() {
-        let t = (r - r_reference) / var.sqrt();
-        let df = welch_df(parts);
-        (t_as_normal(t, df), Some(t), Some(df))
+        let t = (a.mean - b.mean) / var.sqrt();
+        let z = fiducial_z_with(a.mean - b.mean, &parts, SCORE_DRAWS);
+        (z, Some(t), Some(welch_df(&parts)))
     } else {
         (0.0, None, None)
     };
     CornerScore {
         corner,
         part,
-        value: r.exp(),
-        centre: r_reference.exp(),
+        value: a.mean.exp(),
+        centre: b.mean.exp(),
         z,
         t,
         df,
+    }
+}
+
+/// Draws of [`fiducial_z`]'s average (fixed, so a score is reproducible).
+pub const FIDUCIAL_DRAWS: usize = 32_768;
+
+/// The draws of a drive's scores: [`FIDUCIAL_DRAWS`]; 256 in this crate's unit tests, whose
+/// seeded null draws score tens of thousands of drives (the Monte Carlo error of 256 draws, a
+/// few hundredths in `z`, widens a null score's spread by about 0.1 %).
+const SCORE_DRAWS: usize = if cfg!(test) { 256 } else { FIDUCIAL_DRAWS };
+
+/// The standard normal score of a difference `d` whose variance is the sum of the `parts`
+/// `(variance estimate, degrees of freedom)`, by the Behrens-Fisher fiducial argument (Fisher
+/// 1935): given its estimate `v` with `k` degrees of freedom, a part's variance is `v k /
+/// chi^2_k`, and the tail probability of `d` is `p = E[Phi(-|d| / sqrt(sum_i v_i k_i /
+/// chi^2_(k_i)))]`, averaged over [`FIDUCIAL_DRAWS`] draws of the chi-squares (a fixed seed:
+/// the same parts give the same score); `z = Phi^-1(p)` with the sign of `d`. With one part
+/// this is Student's t with `k` degrees of freedom exactly (the t is the normal's scale
+/// mixture over `k / chi^2_k`): [`t_as_normal`]`(d / sqrt(v), k)`.
+///
+/// Why not the Welch-Satterthwaite t ([`welch_df`], [`t_as_normal`]): its degrees of freedom
+/// are estimated from the same variances and rise exactly when the dominant part's estimate
+/// comes out low, so where one part of few degrees of freedom dominates (a drive of 8 records
+/// against a precise reference) its tail at the limits is about twice the stated one; the
+/// fiducial score errs the other way, keeping the tail at or below the stated rate (seeded null
+/// draws: docs/fleet.md, "Scores of estimated spread"). Parts with a variance of 0 add nothing;
+/// parts of more than 1000 degrees of freedom are taken as known. 0 when `d` is 0 or NaN, when
+/// no part has a positive variance, and when one with a positive variance has no degrees of
+/// freedom (no estimate of the spread: no evidence).
+pub fn fiducial_z(d: f64, parts: &[(f64, f64)]) -> f64 {
+    fiducial_z_with(d, parts, FIDUCIAL_DRAWS)
+}
+
+/// [`fiducial_z`] over `draws` draws (at least 1).
+pub fn fiducial_z_with(d: f64, parts: &[(f64, f64)], draws: usize) -> f64 {
+    use statrs::function::erf::erfc;
+    let parts: Vec<(f64, f64)> = parts.iter().copied().filter(|p| p.0 > 0.0).collect();
+    if d.is_nan()
+        || d == 0.0
+        || parts.is_empty()
+        || parts
+            .iter()
+            .any(|&(v, k)| !v.is_finite() || k.is_nan() || k < 1.0)
+    {
+        return 0.0;
+    }
+    let draws = draws.max(1);
+    let mut rng = XorShift(0x243f_6a88_85a3_08d3);
+    let x = -d.abs();
+    let mut p = 0.0;
+    for _ in 0..draws {
+        let var: f64 = parts
+            .iter()
+            .map(|&(v, k)| {
+                if k > 1000.0 {
+                    v
+                } else {
+                    let k = k.round();
+                    v * k / (2.0 * rng.gamma(k / 2.0))
+                }
+            })
+            .sum();
+        p += 0.5 * erfc(-x / (var.sqrt() * std::f64::consts::SQRT_2));
+    }
+    let z = normal_quantile(p / draws as f64);
+    if !z.is_finite() {
+        // The tail probability underflows (beyond about 37 standard deviations): the
+        // difference over its estimated spread, far past any limit either way.
+        return d / parts.iter().map(|p| p.0).sum::<f64>().sqrt();
+    }
+    if d < 0.0 {
+        z
+    } else {
+        -z
+    }
+}
+
+/// Marsaglia's xorshift64 with the Box-Muller transform: [`fiducial_z`]'s fixed draws.
+struct XorShift(u64);
+
+impl XorShift {
+    fn uniform(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        ((self.0 >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+
+    fn normal(&mut self) -> f64 {
+        let (u, v) = (self.uniform(), self.uniform());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    }
+
+    /// A Gamma(`shape`, 1) draw (`chi^2_k` = 2 Gamma(k / 2)): Marsaglia and Tsang (2000), with
+    /// `Gamma(a) = Gamma(a + 1) U^(1/a)` below shape 1.
+    fn gamma(&mut self, shape: f64) -> f64 {
+        if shape < 1.0 {
+            let u = self.uniform();
+            return self.gamma(shape + 1.0) * u.powf(1.0 / shape);
+        }
+        let d = shape - 1.0 / 3.0;
+        let c = 1.0 / (9.0 * d).sqrt();
+        loop {
+            let x = self.normal();
+            let v = (1.0 + c * x).powi(3);
+            if v <= 0.0 {
+                continue;
+            }
+            let u = self.uniform();
+            if u.ln() < 0.5 * x * x + d - d * v + d * v.ln() {
+                return d * v;
+            }
+        }
     }
 }
 
@@ -628,11 +732,14 @@ mod tests {
         let t = rl.t.unwrap();
         assert!((t - expect).abs() < 1e-9, "{t} vs {expect}");
         assert!((rl.df.unwrap() - 14.0).abs() < 1e-9, "{:?}", rl.df);
-        assert_eq!(rl.z, t_as_normal(t, 14.0));
+        // The fiducial score of two equal parts of 7 degrees of freedom: a tail heavier than
+        // Welch's t with 14 and lighter than a t with 7 (one part's).
         assert!(
-            rl.z > t && rl.z < 0.0,
-            "the t's heavier tail: {} vs t {t}",
-            rl.z
+            rl.z > t_as_normal(t, 14.0) && rl.z < t_as_normal(t, 7.0) && rl.z < 0.0,
+            "{} against {} and {}",
+            rl.z,
+            t_as_normal(t, 14.0),
+            t_as_normal(t, 7.0)
         );
         // A load change (every spring alike) moves no score.
         let loaded = fit([2.3e5; 4], 0.02);
@@ -692,7 +799,13 @@ mod tests {
             (rl.df.unwrap() - df).abs() < 1e-9 && (df - 21.37).abs() < 0.005,
             "{df}"
         );
-        assert!((rl.z - t_as_normal(t, df)).abs() < 1e-12);
+        assert!(
+            rl.z > t_as_normal(t, df) && rl.z < t_as_normal(t, 7.0),
+            "{} against {} and {}",
+            rl.z,
+            t_as_normal(t, df),
+            t_as_normal(t, 7.0)
+        );
         // Weights 1/0.03^2 and 1/0.09^2 (9 : 1), variance 1 / (1/0.0009 + 1/0.0081) times
         // Meier's factor 1 + 4 (0.9 * 0.1 / 7 + 0.1 * 0.9 / 7) = 1.1029.
         let (p, q) = (drive(0.8, 0.03), drive(1.0, 0.09));
@@ -714,65 +827,6 @@ mod tests {
             .iter()
             .all(|x| x.z.abs() < 1e-9));
         assert!(spring_trend(&[&base], &[]).is_empty());
-    }
-
-    /// Seeded random drives as the jackknife sees them: a drive's `r_c` drawn from N(0, sd_i^2)
-    /// and its variance estimated with 7 degrees of freedom (8 records: sd_i^2 chi^2_7 / 7),
-    /// the baseline's likewise with 15 (16 records). Over many draws the trend's score is
-    /// standard normal, in the spread and in the tail the limit is set in (P(z < -2.326) = 1 %),
-    /// where the ratio of the difference to its estimated spread (`t`) has the heavier tail.
-    #[test]
-    fn spring_trend_scores_are_standard_normal_under_the_null_over_seeds() {
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut uniform = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let mut normal = || {
-            let (u, v) = (uniform().max(1e-300), uniform());
-            (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-        };
-        // A variance estimate with `df` degrees of freedom of a true sd.
-        let estimate = |sd: f64, df: usize, normal: &mut dyn FnMut() -> f64| {
-            let chi2: f64 = (0..df).map(|_| normal().powi(2)).sum();
-            (sd * sd * chi2 / df as f64).sqrt()
-        };
-        let (sd_base, sds) = (0.046, [0.05, 0.063, 0.09]);
-        let n = 20_000;
-        let (mut sum, mut sum2, mut below, mut t_below) = (0.0, 0.0, 0, 0);
-        for _ in 0..n {
-            let b = sd_base * normal();
-            let sd_b = estimate(sd_base, 15, &mut normal);
-            let mut base = relative_fit([2.0e5, 2.0e5, 2.0e5 * b.exp(), 2.0e5], [sd_b; 4]);
-            base.records = 16;
-            let drives: Vec<CornerFit> = sds
-                .iter()
-                .map(|sd| {
-                    let r = sd * normal();
-                    let sd_i = estimate(*sd, 7, &mut normal);
-                    relative_fit([2.0e5, 2.0e5, 2.0e5 * r.exp(), 2.0e5], [sd_i; 4])
-                })
-                .collect();
-            // RL's r with the others equal is ln(k_RL / 2e5), so its variance is the one given
-            // only for RL; the test reads RL alone.
-            let refs: Vec<&CornerFit> = drives.iter().collect();
-            let rl = spring_trend(&[&base], &refs)[2].clone();
-            sum += rl.z;
-            sum2 += rl.z * rl.z;
-            below += usize::from(rl.z < -2.326);
-            t_below += usize::from(rl.t.unwrap_or(0.0) < -2.326);
-        }
-        let mean = sum / n as f64;
-        let sd = (sum2 / n as f64 - mean * mean).sqrt();
-        // Standard errors: 1/sqrt(20000) = 0.007 for the mean, 0.005 for the sd, and
-        // sqrt(0.01 * 0.99 / 20000) = 0.0007 for the 1 % tail.
-        assert!(mean.abs() < 0.03, "mean {mean}");
-        assert!((sd - 1.0).abs() < 0.03, "sd {sd}");
-        let (rate, t_rate) = (below as f64 / n as f64, t_below as f64 / n as f64);
-        assert!((rate - 0.01).abs() < 0.0025, "P(z < -2.326) = {rate}");
-        assert!(t_rate > 0.0125, "the ratio's own tail is heavier: {t_rate}");
     }
 
     /// By hand: a reference of the baseline's fit and one normal drive of equal variance is
@@ -818,19 +872,15 @@ mod tests {
         assert!(spring_trend(&[], &[&checked]).is_empty());
     }
 
-    /// Seeded null draws as in the test above, the reference now the baseline (15 degrees of
-    /// freedom) pooled with 6 normal drives of unequal spread (7 each): the drive's own score
-    /// and the trend's should be standard normal, in the spread, at the 1 % tail and at their
-    /// limits (3.23 and 3.02, within a quarter of the stated tail; the sampling error is 9 %).
-    /// They are not: the drive's tail at its limit is about 1.9 times the stated one and the
-    /// trend's 2.3 times (a precise reference leaves the drives' own 7 degrees of freedom,
-    /// whose Welch-Satterthwaite estimate rises exactly when a drive's variance comes out low,
-    /// and Meier's factor is first order). Hence `reference_drives` = 0 by default
-    /// (docs/fleet.md, "A reference grown from normal drives"); run with `--ignored`.
-    #[test]
-    #[ignore = "known to fail: the pooled reference's scores are too wide in the far tail (issue 31)"]
-    fn scores_against_a_pooled_reference_are_standard_normal_under_the_null_over_seeds() {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    /// Null statistics of the scores over `n` seeded draws as the jackknife sees them: each
+    /// fit's `r_c` drawn from N(0, sd_i^2) and its variance estimated with records - 1 degrees
+    /// of freedom (`sd_i^2 chi^2 / df`); the baseline of 16 records (sd 0.046), `reference`
+    /// normal drives of 8 records pooled with it (sds 0.05-0.12, the spread of busgen's roads),
+    /// and a drive of 8 records (sd 0.05) scored alone and in a trend of 3 (sds 0.05, 0.063,
+    /// 0.09). Per score (the drive's, the trend's): the mean, the sd, the share below -2.326
+    /// (1 %) and the share below its limit (3.227 and 3.023).
+    fn null_statistics(n: usize, reference: usize, seed: u64) -> [[f64; 4]; 2] {
+        let mut state = seed;
         let mut uniform = || {
             state ^= state << 13;
             state ^= state >> 7;
@@ -845,6 +895,8 @@ mod tests {
             let chi2: f64 = (0..df).map(|_| normal().powi(2)).sum();
             (sd * sd * chi2 / df as f64).sqrt()
         };
+        // RL's r with the others equal is ln(k_RL / 2e5), so its variance is the one given only
+        // for RL; the scores read RL alone.
         let draw = |sd: f64, records: usize, normal: &mut dyn FnMut() -> f64| {
             let r = sd * normal();
             let sd_i = estimate(sd, records - 1, normal);
@@ -854,50 +906,108 @@ mod tests {
         };
         let ref_sds = [0.05, 0.063, 0.09, 0.04, 0.12, 0.07];
         let trend_sds = [0.05, 0.063, 0.09];
-        let n = 200_000;
-        let mut far = [0usize; 2];
-        let mut stats = [(0.0, 0.0, 0usize); 2];
+        let mut acc = [[0.0; 4]; 2];
         for _ in 0..n {
             let base = draw(0.046, 16, &mut normal);
-            let normals: Vec<CornerFit> =
-                ref_sds.iter().map(|sd| draw(*sd, 8, &mut normal)).collect();
+            let normals: Vec<CornerFit> = ref_sds[..reference]
+                .iter()
+                .map(|sd| draw(*sd, 8, &mut normal))
+                .collect();
             let drives: Vec<CornerFit> = trend_sds
                 .iter()
                 .map(|sd| draw(*sd, 8, &mut normal))
                 .collect();
-            let mut reference = vec![&base];
-            reference.extend(normals.iter());
+            let mut refs = vec![&base];
+            refs.extend(normals.iter());
             let fits: Vec<&CornerFit> = drives.iter().collect();
             let zs = [
-                corner_scores(&reference, &drives[0])[2].z,
-                spring_trend(&reference, &fits)[2].z,
+                (
+                    corner_scores(&refs, &drives[0])[2].z,
+                    suspension_limit(0.01),
+                ),
+                (spring_trend(&refs, &fits)[2].z, trend_limit(0.01)),
             ];
-            far[0] += usize::from(zs[0] < -3.227);
-            far[1] += usize::from(zs[1] < -3.023);
-            for (s, z) in stats.iter_mut().zip(zs) {
-                s.0 += z;
-                s.1 += z * z;
-                s.2 += usize::from(z < -2.326);
+            for (a, (z, limit)) in acc.iter_mut().zip(zs) {
+                a[0] += z;
+                a[1] += z * z;
+                a[2] += f64::from(u8::from(z < -2.326));
+                a[3] += f64::from(u8::from(z < -limit));
             }
         }
-        let far = [far[0] as f64 / n as f64, far[1] as f64 / n as f64];
-        eprintln!(
-            "P(z < -3.227) of the drive's score {} (stated 0.000625), P(z < -3.023) of the trend's {} (stated 0.00125)",
-            far[0], far[1]
-        );
-        for (what, (sum, sum2, below)) in ["drive", "trend"].iter().zip(stats) {
-            let mean = sum / n as f64;
-            let sd = (sum2 / n as f64 - mean * mean).sqrt();
-            let rate = below as f64 / n as f64;
-            assert!(mean.abs() < 0.03, "{what}: mean {mean}");
-            assert!((sd - 1.0).abs() < 0.03, "{what}: sd {sd}");
-            assert!(
-                (rate - 0.01).abs() < 0.0025,
-                "{what}: P(z < -2.326) = {rate}"
-            );
+        acc.map(|a| {
+            let mean = a[0] / n as f64;
+            [
+                mean,
+                (a[1] / n as f64 - mean * mean).sqrt(),
+                a[2] / n as f64,
+                a[3] / n as f64,
+            ]
+        })
+    }
+
+    /// Seeded null draws ([`null_statistics`]), the reference the baseline alone and the
+    /// baseline with 6 normal drives: the drive's and the trend's scores keep the stated 1 %
+    /// (within 2.5 standard errors, 0.0032 over 6000 draws) and are standard normal or
+    /// narrower (the fiducial score is conservative: sd 0.9-1.03; the sd's standard error is
+    /// 0.009). With the Welch-Satterthwaite t ([`t_as_normal`]) the pooled reference's trend
+    /// had an sd of 1.057 and the drive's and trend's tails at their limits 1.9 and 2.3 times
+    /// the stated ones (the far tails are the ignored test below).
+    #[test]
+    fn the_scores_keep_the_stated_rate_under_the_null_over_seeds() {
+        let n = 6000;
+        for (reference, seed) in [(0, 0x2545_f491_4f6c_dd1d_u64), (6, 0x9e37_79b9_7f4a_7c15)] {
+            let stats = null_statistics(n, reference, seed);
+            for (what, [mean, sd, rate, _]) in ["drive", "trend"].iter().zip(stats) {
+                let at = format!("{what} against the baseline and {reference} drives");
+                assert!(mean.abs() < 0.04, "{at}: mean {mean}");
+                assert!((0.9..1.03).contains(&sd), "{at}: sd {sd}");
+                assert!(
+                    (0.004..0.0132).contains(&rate),
+                    "{at}: P(z < -2.326) = {rate}"
+                );
+            }
         }
-        assert!((far[0] / 0.000625 - 1.0).abs() < 0.25, "drive: {}", far[0]);
-        assert!((far[1] / 0.00125 - 1.0).abs() < 0.25, "trend: {}", far[1]);
+    }
+
+    /// The far tails at the limits over 200 000 seeded null draws (minutes; `cargo test
+    /// --release -p vibmode-fleet --lib far_tails -- --ignored --nocapture`): at most the
+    /// stated `Phi(-3.227)` = 0.000625 for the drive and `Phi(-3.023)` = 0.00125 for the trend,
+    /// plus 3 standard errors (9 %), with and without normal drives in the reference.
+    #[test]
+    #[ignore = "minutes: the far tails of the scores under the null (docs/fleet.md)"]
+    fn far_tails_of_the_scores_under_the_null_over_seeds() {
+        let n = 200_000;
+        for (reference, seed) in [(0, 0x2545_f491_4f6c_dd1d_u64), (6, 0x9e37_79b9_7f4a_7c15)] {
+            let [drive, trend] = null_statistics(n, reference, seed);
+            eprintln!(
+                "reference of the baseline and {reference} drives: P(z < -3.227) of the drive {} (stated 0.000625), P(z < -3.023) of the trend {} (stated 0.00125); sd {:.3} and {:.3}",
+                drive[3], trend[3], drive[1], trend[1]
+            );
+            assert!(drive[3] < 0.000625 * 1.27, "drive: {}", drive[3]);
+            assert!(trend[3] < 0.00125 * 1.27, "trend: {}", trend[3]);
+        }
+    }
+
+    /// By hand: one part is Student's t (the t is the normal's scale mixture over k /
+    /// chi^2_k), to the Monte Carlo's 0.03; a known variance (over 1000 degrees of freedom) is
+    /// the normal exactly; the sign follows `d`; parts of variance 0 add nothing; no score for
+    /// d = 0, NaN, no positive variance or a part without degrees of freedom.
+    #[test]
+    fn fiducial_z_by_hand() {
+        for k in [3.0, 7.0, 15.0] {
+            for t in [-5.0, -3.227, -1.5, 2.5] {
+                let (got, want) = (fiducial_z(0.2 * t, &[(0.04, k)]), t_as_normal(t, k));
+                assert!((got - want).abs() < 0.03, "k {k} t {t}: {got} vs {want}");
+            }
+        }
+        assert!((fiducial_z(-0.3, &[(0.01, 2000.0)]) + 3.0).abs() < 1e-9);
+        let parts = [(0.0036, 7.0), (0.0016, 15.0), (0.0, 7.0)];
+        assert_eq!(fiducial_z(0.2, &parts), -fiducial_z(-0.2, &parts));
+        assert_eq!(fiducial_z(0.2, &parts), fiducial_z(0.2, &parts[..2]));
+        assert_eq!(fiducial_z(0.0, &parts), 0.0);
+        assert_eq!(fiducial_z(f64::NAN, &parts), 0.0);
+        assert_eq!(fiducial_z(0.2, &[(0.0, 7.0)]), 0.0);
+        assert_eq!(fiducial_z(0.2, &[(0.01, 0.0), (0.01, 7.0)]), 0.0);
     }
 
     /// By hand: Welch-Satterthwaite's degrees of freedom; equal variances add theirs, a
