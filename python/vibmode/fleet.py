@@ -121,9 +121,11 @@ def check(
     or more), and other files, 3 or more, one drive named by the folder they lie in (``all given
     records`` when they lie in several or none; docs/fleet.md, "Drives"). With a
     registered model file (:func:`register`) a drive also has ``suspension``: the springs and
-    dampers fitted to its records and every corner's score against the baseline's fit (``z``,
-    the normal score of the ratio ``t`` under Student's t with ``df`` degrees of freedom:
-    docs/fleet.md, "Scores of estimated spread"), and, from the vehicle's third drive against
+    dampers fitted to its records and every corner's score against the reference (the
+    baseline's fit pooled with the vehicle's first normal drives, listed in
+    ``suspension['reference_drives']``): the ratio ``t``, Welch's ``df``, and ``z``, the normal
+    score of its Behrens-Fisher fiducial tail (docs/fleet.md, "Scores by the fiducial tail"),
+    and, from the vehicle's third drive against
     that baseline on, ``suspension['trend']``: each corner's spring pooled with the two drives
     before it (docs/fleet.md, "The spring trend"). All or nothing: an error in any file stores no
     record and no check.

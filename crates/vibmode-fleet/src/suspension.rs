@@ -21,11 +21,12 @@
 //! (each corner's spring over the last drives), `Phi^-1(1 - a / 8)` (3.02). The trend's share
 //! is the larger per test because its scores find a lost spring more often (docs/fleet.md, "The
 //! spring trend"). The jackknife's variances are estimates (a drive of 8 records: 7 degrees of
-//! freedom), so a score's ratio `t` has Student's heavier tail (Welch-Satterthwaite's degrees of
-//! freedom, about 14 for a drive of 8 records against a baseline of 16): each score is made the
-//! normal score of the same tail probability ([`t_as_normal`]) before the limits, so the stated
-//! rate holds for drives of few records and of many (docs/fleet.md, "Scores of estimated
-//! spread").
+//! freedom), so a score's ratio `t` has a heavier tail than the normal: each score is made the
+//! normal score of its Behrens-Fisher fiducial tail probability ([`fiducial_z`]) before the
+//! limits, so the stated rate is an upper bound for drives of few records and of many. The
+//! baseline's side is the reference: the baseline's fit pooled with the vehicle's first normal
+//! drives after it ([`crate::FleetConfig::reference_drives`]; docs/fleet.md, "Scores by the
+//! fiducial tail").
 
 use serde::{Deserialize, Serialize};
 use vibmode_analysis::{AnalysisConfig, Corner};
@@ -326,20 +327,22 @@ pub struct CornerScore {
     pub part: Part,
     /// The drive's value relative to the other corners, `exp(r)`.
     pub value: f64,
-    /// The baseline's.
+    /// The reference's: the baseline's fit, pooled with the vehicle's first normal drives
+    /// where there are any ([`DriveSuspension::reference_drives`]).
     pub centre: f64,
-    /// The score (negative: lower than at the baseline) as a standard normal score: the
-    /// difference over its standard deviation, [`CornerScore::t`], is a Student t with
-    /// [`CornerScore::df`] degrees of freedom (the jackknife's variances are estimates), and
-    /// `z = Phi^-1(F_t(t; df))` has its tail probability ([`t_as_normal`]), so one limit holds
-    /// for drives of few records and of many.
+    /// The score (negative: lower than at the reference) as a standard normal score: the
+    /// difference's Behrens-Fisher fiducial tail probability over its estimated variances
+    /// ([`fiducial_z`]; the jackknife's variances are estimates of few degrees of freedom), so
+    /// one limit holds, as an upper bound, for drives of few records and of many. Scores stored
+    /// from 2026-11-28 to 2026-11-29 are `t_as_normal(t, df)`, before that `t`.
     pub z: f64,
     /// The difference over its standard deviation; absent in scores stored before it was kept
     /// (their `z` is this ratio).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub t: Option<f64>,
-    /// The degrees of freedom of the standard deviation (Welch-Satterthwaite over the fits'
-    /// variances, each with its records - 1: [`welch_df`]); absent as [`CornerScore::t`] is.
+    /// The degrees of freedom of the standard deviation by Welch-Satterthwaite's approximation
+    /// over the fits' variances, each with its records - 1 ([`welch_df`]; for the record: `z` is
+    /// the fiducial score); absent as [`CornerScore::t`] is.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub df: Option<f64>,
 }
@@ -543,7 +546,7 @@ const SCORE_DRAWS: usize = if cfg!(test) { 256 } else { FIDUCIAL_DRAWS };
 /// comes out low, so where one part of few degrees of freedom dominates (a drive of 8 records
 /// against a precise reference) its tail at the limits is about twice the stated one; the
 /// fiducial score errs the other way, keeping the tail at or below the stated rate (seeded null
-/// draws: docs/fleet.md, "Scores of estimated spread"). Parts with a variance of 0 add nothing;
+/// draws: docs/fleet.md, "Scores by the fiducial tail"). Parts with a variance of 0 add nothing;
 /// parts of more than 1000 degrees of freedom are taken as known. 0 when `d` is 0 or NaN, when
 /// no part has a positive variance, and when one with a positive variance has no degrees of
 /// freedom (no estimate of the spread: no evidence).
