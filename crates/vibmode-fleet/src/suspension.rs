@@ -972,14 +972,19 @@ mod tests {
         }
     }
 
-    /// The far tails at the limits over 200 000 seeded null draws (minutes; `cargo test
-    /// --release -p vibmode-fleet --lib far_tails -- --ignored --nocapture`): at most the
-    /// stated `Phi(-3.227)` = 0.000625 for the drive and `Phi(-3.023)` = 0.00125 for the trend,
-    /// plus 3 standard errors (9 %), with and without normal drives in the reference.
+    /// The far tails at the limits over seeded null draws, with and without normal drives in
+    /// the reference: below 1.27 times the stated `Phi(-3.227)` = 0.000625 for the drive and
+    /// `Phi(-3.023)` = 0.00125 for the trend. 50 000 draws in the acceptance tier (the fixed
+    /// seeds make it deterministic; the sampling error of a calibrated tail would be 18 % and
+    /// 13 %); docs/fleet.md's figures are from 200 000 (`VIBMODE_NULL_DRAWS=200000 cargo test
+    /// --release -p vibmode-fleet --lib far_tails -- --ignored --nocapture`, minutes).
     #[test]
-    #[ignore = "minutes: the far tails of the scores under the null (docs/fleet.md)"]
+    #[ignore = "slow: the far tails of the scores under the null (docs/fleet.md)"]
     fn far_tails_of_the_scores_under_the_null_over_seeds() {
-        let n = 200_000;
+        let n = std::env::var("VIBMODE_NULL_DRAWS")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(50_000);
         for (reference, seed) in [(0, 0x2545_f491_4f6c_dd1d_u64), (6, 0x9e37_79b9_7f4a_7c15)] {
             let [drive, trend] = null_statistics(n, reference, seed);
             eprintln!(
