@@ -1023,16 +1023,7 @@ fn drive_verdict(
     let hashes: Vec<&str> = records.iter().map(|p| p.content_hash.as_str()).collect();
     let before = earlier_fits(stored.iter().chain(earlier), &hashes, start_unix_s);
     let window = crate::suspension::TREND_DRIVES - 1;
-    // The reference: the baseline's fit with the vehicle's first normal drives after it, those
-    // older than this drive's trend (the oldest first).
-    let mut reference_drives: Vec<(&str, &crate::suspension::CornerFit)> = before
-        .iter()
-        .skip(window)
-        .filter(|(_, _, class)| *class == Classification::Normal)
-        .map(|(d, f, _)| (*d, *f))
-        .collect();
-    reference_drives.reverse();
-    reference_drives.truncate(set.config.reference_drives);
+    let reference_drives = reference_drives(&before, window, set.config.reference_drives);
     let extra: Vec<&crate::suspension::CornerFit> =
         reference_drives.iter().map(|(_, f)| *f).collect();
     let mut suspension = drive_suspension(store, set, records, &extra)?;
@@ -1154,6 +1145,25 @@ fn earlier_fits<'a>(
                 .map(|s| (d.drive.as_str(), &s.fit, d.assessment.classification))
         })
         .collect()
+}
+
+/// The drives pooled with the baseline's fit into the reference: of `before` (a drive's earlier
+/// fitted drives, newest first: [`earlier_fits`]), those older than its trend's `window` drives
+/// and classed `normal`, the oldest `most` of them, oldest first.
+fn reference_drives<'a>(
+    before: &[(&'a str, &'a crate::suspension::CornerFit, Classification)],
+    window: usize,
+    most: usize,
+) -> Vec<(&'a str, &'a crate::suspension::CornerFit)> {
+    let mut out: Vec<(&str, &crate::suspension::CornerFit)> = before
+        .iter()
+        .skip(window)
+        .filter(|(_, _, class)| *class == Classification::Normal)
+        .map(|(d, f, _)| (*d, *f))
+        .collect();
+    out.reverse();
+    out.truncate(most);
+    out
 }
 
 /// The suspension fitted to a drive's records and scored against the model set's, or why not
@@ -1285,6 +1295,42 @@ mod tests {
 
     fn ids(v: &[(&str, &crate::suspension::CornerFit, Classification)]) -> Vec<String> {
         v.iter().map(|(d, _, _)| d.to_string()).collect()
+    }
+
+    /// By hand: of 9 earlier drives (newest first), the 2 of the trend are skipped, the ones
+    /// not `normal` are left out, and the oldest `most` of the rest are the reference, oldest
+    /// first; none when the drive has no more than its trend's drives before it.
+    #[test]
+    fn the_reference_drives_by_hand() {
+        let fit = crate::suspension::CornerFit {
+            records: 8,
+            spring_n_per_m: [2.0e5; 4],
+            spring_rel_sd: [0.05; 4],
+            damper_n_s_per_m: [1.0e4; 4],
+            damper_rel_sd: [0.05; 4],
+            supported: true,
+            spring_relative_sd: None,
+        };
+        use Classification::{Normal, Road, Vehicle};
+        let classes = [
+            Normal, Normal, Vehicle, Normal, Road, Normal, Normal, Normal, Normal,
+        ];
+        let names = ["d9", "d8", "d7", "d6", "d5", "d4", "d3", "d2", "d1"];
+        let before: Vec<(&str, &crate::suspension::CornerFit, Classification)> = names
+            .iter()
+            .zip(classes)
+            .map(|(n, c)| (*n, &fit, c))
+            .collect();
+        let got = |most| -> Vec<&str> {
+            reference_drives(&before, 2, most)
+                .iter()
+                .map(|(d, _)| *d)
+                .collect()
+        };
+        assert_eq!(got(6), ["d1", "d2", "d3", "d4", "d6"]);
+        assert_eq!(got(3), ["d1", "d2", "d3"]);
+        assert!(got(0).is_empty());
+        assert!(reference_drives(&before[..2], 2, 6).is_empty());
     }
 
     /// By hand: the drives before a drive, newest first; without times in the order checked,
