@@ -203,6 +203,19 @@ pub fn check_text(vehicle: &str, model_version: i64, out: &[Checked], drives: &[
         {
             let _ = writeln!(text, "  note: {m}");
         }
+        // What the fitted suspension was scored against, once normal drives joined the baseline.
+        if let Some(s) = d
+            .suspension
+            .as_ref()
+            .filter(|s| !s.reference_drives.is_empty())
+        {
+            let _ = writeln!(
+                text,
+                "  note: suspension fit scored against the baseline's fit pooled with the vehicle's first {} normal drive(s): {}",
+                s.reference_drives.len(),
+                vibmode_core::cap_message(&s.reference_drives.join(", "), 120)
+            );
+        }
         if !d.in_baseline.is_empty() {
             let _ = writeln!(
                 text,
@@ -367,6 +380,50 @@ mod tests {
             t,
             "a.csv: stored as test record 7 of vehicle bus1\n  note: layout\n"
         );
+    }
+
+    /// `fleet check`: a drive scored against a reference of normal drives names them under its
+    /// verdict; one scored against the baseline alone (or without a fit) has no such note.
+    #[test]
+    fn the_reference_drives_are_named_under_the_drive() {
+        use crate::model::Assessment;
+        let fit = crate::suspension::CornerFit {
+            records: 8,
+            spring_n_per_m: [2.0e5; 4],
+            spring_rel_sd: [0.05; 4],
+            damper_n_s_per_m: [1.0e4; 4],
+            damper_rel_sd: [0.05; 4],
+            supported: true,
+            spring_relative_sd: None,
+        };
+        let drive = |reference: &[&str]| Drive {
+            drive: "d9".into(),
+            model_version: 1,
+            records: vec!["a.csv".into(), "b.csv".into(), "c.csv".into()],
+            start_unix_s: None,
+            corner: None,
+            false_alarm_rate: 0.02,
+            assessment: Assessment::normal_for_tests(),
+            suspension: Some(crate::suspension::DriveSuspension {
+                fit: fit.clone(),
+                scores: vec![],
+                limit: 3.23,
+                trend: None,
+                reference_drives: reference.iter().map(|d| d.to_string()).collect(),
+            }),
+            in_baseline: vec![],
+        };
+        let note = |d: Drive| -> Option<String> {
+            check_text("bus1", 1, &[], &[d])
+                .lines()
+                .find(|l| l.contains("pooled with"))
+                .map(String::from)
+        };
+        assert_eq!(
+            note(drive(&["d1", "d2"])).as_deref(),
+            Some("  note: suspension fit scored against the baseline's fit pooled with the vehicle's first 2 normal drive(s): d1, d2")
+        );
+        assert_eq!(note(drive(&[])), None);
     }
 
     /// `fleet check`: records that form no drive (too few, or a day of too few) are named in a
