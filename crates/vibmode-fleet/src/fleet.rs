@@ -1264,15 +1264,7 @@ mod tests {
 
     /// A stored drive for [`earlier_fits`]: fitted or not, its start, its records' hashes.
     fn stored(id: &str, start: Option<f64>, fitted: bool, hashes: &[&str]) -> (Drive, Vec<String>) {
-        let fit = crate::suspension::CornerFit {
-            records: 8,
-            spring_n_per_m: [2.0e5; 4],
-            spring_rel_sd: [0.05; 4],
-            damper_n_s_per_m: [1.0e4; 4],
-            damper_rel_sd: [0.05; 4],
-            supported: true,
-            spring_relative_sd: None,
-        };
+        let fit = crate::suspension::CornerFit::even_for_tests();
         let drive = Drive {
             drive: id.to_string(),
             model_version: 1,
@@ -1302,15 +1294,7 @@ mod tests {
     /// first; none when the drive has no more than its trend's drives before it.
     #[test]
     fn the_reference_drives_by_hand() {
-        let fit = crate::suspension::CornerFit {
-            records: 8,
-            spring_n_per_m: [2.0e5; 4],
-            spring_rel_sd: [0.05; 4],
-            damper_n_s_per_m: [1.0e4; 4],
-            damper_rel_sd: [0.05; 4],
-            supported: true,
-            spring_relative_sd: None,
-        };
+        let fit = crate::suspension::CornerFit::even_for_tests();
         use Classification::{Normal, Road, Vehicle};
         let classes = [
             Normal, Normal, Vehicle, Normal, Road, Normal, Normal, Normal, Normal,

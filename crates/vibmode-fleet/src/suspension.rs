@@ -294,6 +294,23 @@ fn jackknife_relative_sd(replicates: &[[f64; 4]]) -> Option<[f64; 4]> {
     }))
 }
 
+#[cfg(test)]
+impl CornerFit {
+    /// A fit of 8 records with equal corners (springs 200 kN/m, dampers 10 kN s/m, relative sds
+    /// 5 %): the fixture of the crate's tests.
+    pub(crate) fn even_for_tests() -> Self {
+        CornerFit {
+            records: 8,
+            spring_n_per_m: [2.0e5; 4],
+            spring_rel_sd: [0.05; 4],
+            damper_n_s_per_m: [1.0e4; 4],
+            damper_rel_sd: [0.05; 4],
+            supported: true,
+            spring_relative_sd: None,
+        }
+    }
+}
+
 /// The baseline's fit, kept in the model set.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SuspensionReference {

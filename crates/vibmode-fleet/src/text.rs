@@ -387,15 +387,7 @@ mod tests {
     #[test]
     fn the_reference_drives_are_named_under_the_drive() {
         use crate::model::Assessment;
-        let fit = crate::suspension::CornerFit {
-            records: 8,
-            spring_n_per_m: [2.0e5; 4],
-            spring_rel_sd: [0.05; 4],
-            damper_n_s_per_m: [1.0e4; 4],
-            damper_rel_sd: [0.05; 4],
-            supported: true,
-            spring_relative_sd: None,
-        };
+        let fit = crate::suspension::CornerFit::even_for_tests();
         let drive = |reference: &[&str]| Drive {
             drive: "d9".into(),
             model_version: 1,
