@@ -23,8 +23,10 @@
 //! spring trend"). The jackknife's variances are estimates (a drive of 8 records: 7 degrees of
 //! freedom), so a score's ratio `t` has a heavier tail than the normal: each score is made the
 //! normal score of its Behrens-Fisher fiducial tail probability ([`fiducial_z`]) before the
-//! limits, so the stated rate is an upper bound for drives of few records and of many. The
-//! baseline's side is the reference: the baseline's fit pooled with the vehicle's first normal
+//! limits, so the stated rate is an upper bound for drives of few records and of many. A
+//! drive's four spring variances are read as one scale in the reference's proportions (the road
+//! sets the scale, the vehicle the proportions), which gives them up to three times the
+//! records' degrees of freedom ([`spring_trend`]). The baseline's side is the reference: the baseline's fit pooled with the vehicle's first normal
 //! drives after it ([`crate::FleetConfig::reference_drives`]; docs/fleet.md, "Scores by the
 //! fiducial tail").
 
@@ -169,6 +171,13 @@ pub struct CornerFit {
     /// stored before they were kept.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spring_relative_sd: Option<[f64; 4]>,
+    /// The degrees of freedom of the springs' variances read as one scale over the four corners
+    /// ([`spring_scale_df`]): `(records - 1) 16 / sum_ij R_ij^2`, `R` the jackknife correlation
+    /// of [`CornerFit::relative`]'s spring statistics over the fit's replicates (between
+    /// `records - 1` and three times it); absent in fits stored before it was kept, whose
+    /// springs are then scored with each corner's own variance.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spring_scale_df: Option<f64>,
 }
 
 /// Spring or damper.
@@ -191,6 +200,7 @@ impl CornerFit {
             damper_rel_sd: [0.0; 4],
             supported: r.supported,
             spring_relative_sd: None,
+            spring_scale_df: None,
         };
         for (i, c) in CORNERS.iter().enumerate() {
             for (p, value, sd) in [
@@ -233,9 +243,16 @@ impl CornerFit {
                 .iter()
                 .map(|rep| std::array::from_fn(|c| rep.get(cols[c]).copied().unwrap_or(f64::NAN)))
                 .collect();
-            out.spring_relative_sd = jackknife_relative_sd(&reps);
+            out.set_spring_replicates(&reps);
         }
         Ok(out)
+    }
+
+    /// Keeps the jackknife spread of the springs' relative statistics over the fit's replicates
+    /// (the springs, N/m, with each record left out in turn) and its scale's degrees of freedom.
+    fn set_spring_replicates(&mut self, replicates: &[[f64; 4]]) {
+        self.spring_relative_sd = jackknife_relative_sd(replicates);
+        self.spring_scale_df = spring_scale_df(replicates);
     }
 
     fn values(&self, part: Part) -> (&[f64; 4], &[f64; 4]) {
@@ -294,6 +311,95 @@ fn jackknife_relative_sd(replicates: &[[f64; 4]]) -> Option<[f64; 4]> {
     }))
 }
 
+/// The degrees of freedom of a fit's spring variances read as one scale over the corners, from
+/// its replicates (the springs with each record left out in turn). A fit's four statistics
+/// `r_c` ([`relative_of`]) sum to 0; their jackknife covariance `S` estimates theirs, `Sigma`,
+/// with `k` = replicates - 1 degrees of freedom (a Wishart matrix of rank 3 at most). Where the
+/// corners' variances keep their proportions `g_c` (the vehicle's shape: the drive's road sets
+/// the scale `s^2`, `Sigma_cc = s^2 g_c`), `s^2` is estimated from all four corners as `mean_c
+/// S_cc / g_c`, with `k (tr R)^2 / tr(R^2) = 16 k / sum_ij R_ij^2` degrees of freedom (`R` the
+/// correlation matrix of `r`; `Var(tr(B S)) = 2 tr((B Sigma)^2) / k`): `3 k` for equal corners
+/// (`R_ij` = -1/3), `k` where one direction carries all the variance. `R` is estimated here from
+/// `S`, whose sampling noise raises `sum R_ij^2`, so the figure errs low (the safe side).
+/// `None` with fewer than [`MIN_FIT_RECORDS`] replicates, a value that is not positive, or a
+/// corner without spread.
+pub(crate) fn spring_scale_df(replicates: &[[f64; 4]]) -> Option<f64> {
+    let m = replicates.len();
+    if m < MIN_FIT_RECORDS
+        || replicates
+            .iter()
+            .flatten()
+            .any(|v| !(v.is_finite() && *v > 0.0))
+    {
+        return None;
+    }
+    let stats: Vec<[f64; 4]> = replicates.iter().map(relative_of).collect();
+    let mean: [f64; 4] =
+        std::array::from_fn(|c| stats.iter().map(|s| s[c]).sum::<f64>() / m as f64);
+    let cov: [[f64; 4]; 4] = std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            stats
+                .iter()
+                .map(|s| (s[i] - mean[i]) * (s[j] - mean[j]))
+                .sum::<f64>()
+        })
+    });
+    if cov.iter().enumerate().any(|(i, row)| {
+        let v = row[i];
+        v.is_nan() || v <= f64::EPSILON * mean.iter().map(|x| x * x).sum::<f64>().max(1e-300)
+    }) {
+        return None;
+    }
+    let r2: f64 = (0..4)
+        .flat_map(|i| (0..4).map(move |j| (i, j)))
+        .map(|(i, j)| cov[i][j] * cov[i][j] / (cov[i][i] * cov[j][j]))
+        .sum();
+    let k = (m - 1) as f64;
+    let df = 16.0 * k / r2;
+    df.is_finite().then(|| df.clamp(k, 3.0 * k))
+}
+
+/// The vehicle's shape of the springs' variances over the corners, `g_c` (geometric mean 1),
+/// from the reference's fits: each fit's `ln var_c` less its mean over the corners, averaged
+/// with the fits' degrees of freedom as weights, and the degrees of freedom of those
+/// proportions, the fits' summed (a fit's `ln var_c` has the variance `2 / k` about; the
+/// weighted mean `2 / sum k`; taking the centring as exact errs on the safe side). `None`
+/// where a fit has no
+/// [`CornerFit::spring_relative_sd`] or a spread that is not positive.
+fn spring_shape(reference: &[&CornerFit]) -> Option<([f64; 4], f64)> {
+    let mut acc = [0.0; 4];
+    let mut weight = 0.0;
+    for f in reference {
+        let sd = f.spring_relative_sd?;
+        if sd.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+            return None;
+        }
+        let ln = sd.map(|v| 2.0 * v.ln());
+        let centre = ln.iter().sum::<f64>() / 4.0;
+        let w = records_df(f).max(1.0);
+        for (a, l) in acc.iter_mut().zip(ln) {
+            *a += w * (l - centre);
+        }
+        weight += w;
+    }
+    (weight > 0.0).then(|| (acc.map(|a| (a / weight).exp()), weight))
+}
+
+/// A drive's spring statistics with their variances read as one scale over the corners:
+/// `var_c = g_c mean_j(v_j / g_j)` (`g` the reference's [`spring_shape`], `v` the drive's own
+/// jackknife variances) and the scale's degrees of freedom ([`CornerFit::spring_scale_df`]).
+/// `None` where the drive lacks either.
+fn scaled_springs(fit: &CornerFit, shape: &[f64; 4]) -> Option<([(f64, f64); 4], f64)> {
+    let df = fit.spring_scale_df.filter(|d| d.is_finite() && *d >= 1.0)?;
+    fit.spring_relative_sd?;
+    let rel = fit.relative(Part::Spring);
+    if rel.iter().any(|(_, v)| !(v.is_finite() && *v > 0.0)) {
+        return None;
+    }
+    let scale = rel.iter().zip(shape).map(|((_, v), g)| v / g).sum::<f64>() / 4.0;
+    Some((std::array::from_fn(|c| (rel[c].0, shape[c] * scale)), df))
+}
+
 #[cfg(test)]
 impl CornerFit {
     /// A fit of 8 records with equal corners (springs 200 kN/m, dampers 10 kN s/m, relative sds
@@ -307,6 +413,7 @@ impl CornerFit {
             damper_rel_sd: [0.05; 4],
             supported: true,
             spring_relative_sd: None,
+            spring_scale_df: None,
         }
     }
 }
@@ -417,25 +524,47 @@ pub struct SpringTrend {
     pub limit: f64,
 }
 
+/// A fit's `(r_c, variance)` per corner, their degrees of freedom, and whether the variances
+/// are the fit's scale in the reference's proportions ([`scaled_springs`]).
+type FitSpread = ([(f64, f64); 4], f64, bool);
+
 /// Fits pooled per corner: the inverse-variance mean of their `r_c` and the parts of its
 /// variance, `(variance, degrees of freedom)` per fit. Weights `w_i = (1 / var_i) / sum(1 /
 /// var_j)` (drives fitted on poor roads have jackknife spreads up to ten times others',
 /// docs/fleet.md); each fit's part is `m w_i^2 var_i` with Meier's (1953) factor `m = 1 + 4
-/// sum(w_i (1 - w_i) / df_i)` for weights from estimated variances (`df_i` = records - 1).
+/// sum(w_i (1 - w_i) / df_i)` for weights from estimated variances (`df_i` = records - 1, or
+/// for a drive's springs read as one scale over the corners its scale's: [`pool`]'s `shape`).
 /// Where a fit's variance is not positive (a noise-free fit) the fits weigh by their records,
 /// without the factor. One fit pools to itself (weight 1, factor 1).
 struct Pooled {
     mean: f64,
     parts: Vec<(f64, f64)>,
+    /// Per part: whether its variance is a drive's scale times the reference's proportion
+    /// (the proportion's uncertainty, [`Pooled::shape_df`], is then shared by these parts).
+    shared: Vec<bool>,
+    /// The degrees of freedom of the proportions ([`spring_shape`]).
+    shape_df: f64,
 }
 
-fn pool(fits: &[&CornerFit], part: Part) -> [Pooled; 4] {
-    let rel: Vec<[(f64, f64); 4]> = fits.iter().map(|f| f.relative(part)).collect();
+fn pool(fits: &[&CornerFit], part: Part, shape: Option<&([f64; 4], f64)>) -> [Pooled; 4] {
+    // Each fit's statistics, variances and degrees of freedom: a spring's variances as one scale
+    // over the corners where a shape is given and the fit has its scale's degrees of freedom
+    // ([`scaled_springs`]), else each corner's own with records - 1.
+    let rel: Vec<FitSpread> = fits
+        .iter()
+        .map(|f| {
+            shape
+                .filter(|_| part == Part::Spring)
+                .and_then(|(g, _)| scaled_springs(f, g))
+                .map(|(r, df)| (r, df, true))
+                .unwrap_or_else(|| (f.relative(part), records_df(f), false))
+        })
+        .collect();
     std::array::from_fn(|i| {
         // Inverse-variance weights where every variance is positive, else by records.
-        let weighted = rel.iter().all(|d| d[i].1 > 0.0 && d[i].1.is_finite());
+        let weighted = rel.iter().all(|d| d.0[i].1 > 0.0 && d.0[i].1.is_finite());
         let raw: Vec<f64> = if weighted {
-            rel.iter().map(|d| 1.0 / d[i].1).collect()
+            rel.iter().map(|d| 1.0 / d.0[i].1).collect()
         } else {
             fits.iter().map(|f| f.records.max(1) as f64).collect()
         };
@@ -446,22 +575,23 @@ fn pool(fits: &[&CornerFit], part: Part) -> [Pooled; 4] {
             1.0 + 4.0
                 * weights
                     .iter()
-                    .zip(fits)
-                    .map(|(w, f)| w * (1.0 - w) / records_df(f).max(1.0))
+                    .zip(&rel)
+                    .map(|(w, d)| w * (1.0 - w) / d.1.max(1.0))
                     .sum::<f64>()
         } else {
             1.0
         };
         Pooled {
-            mean: rel.iter().zip(&weights).map(|(d, w)| w * d[i].0).sum(),
+            mean: rel.iter().zip(&weights).map(|(d, w)| w * d.0[i].0).sum(),
             // Each fit's weight and its variance's share of the pooled variance (weight^2
             // var_i), which is what the degrees of freedom add.
             parts: rel
                 .iter()
                 .zip(&weights)
-                .zip(fits)
-                .map(|((d, w), f)| (meier * w * w * d[i].1, records_df(f)))
+                .map(|(d, w)| (meier * w * w * d.0[i].1, d.1))
                 .collect(),
+            shared: rel.iter().map(|d| d.2).collect(),
+            shape_df: shape.map_or(f64::INFINITY, |s| s.1),
         }
     })
 }
@@ -480,12 +610,23 @@ fn pool(fits: &[&CornerFit], part: Part) -> [Pooled; 4] {
 /// why pooling more drives gains less and less. Where a drive's variance is not positive (a
 /// noise-free fit) the drives weigh by their records, without the factor. Empty without fits
 /// or without a reference.
+///
+/// The drives' variances are read as one scale over the corners (since 2026-11-29;
+/// docs/fleet.md, "A drive's spring variances as one scale"): a drive's road sets how much its
+/// fit scatters, the vehicle how that scatter divides among the corners (on busgen the
+/// proportions vary from drive to drive only as a jackknife of 7 degrees of freedom must, the
+/// level by a factor of two). So each drive's four jackknife variances give one scale, `s^2 =
+/// mean_c v_c / g_c`, with the reference's proportions `g` ([`spring_shape`]), and each corner's
+/// variance is `g_c s^2`, with the scale's degrees of freedom ([`spring_scale_df`]: up to three
+/// times the records' 7) instead of the corner's own 7. The reference's fits keep their own
+/// variances (the proportions are theirs). A drive or reference without the kept spreads
+/// (stored before them) keeps each corner's own variance.
 pub fn spring_trend(reference: &[&CornerFit], fits: &[&CornerFit]) -> Vec<CornerScore> {
     if fits.is_empty() || reference.is_empty() {
         return Vec::new();
     }
-    let r = pool(reference, Part::Spring);
-    let drives = pool(fits, Part::Spring);
+    let r = pool(reference, Part::Spring, None);
+    let drives = pool(fits, Part::Spring, spring_shape(reference).as_ref());
     CORNERS
         .iter()
         .zip(drives.iter().zip(&r))
@@ -495,14 +636,20 @@ pub fn spring_trend(reference: &[&CornerFit], fits: &[&CornerFit]) -> Vec<Corner
 
 /// Every corner's spring and damper score of `drive` against `reference` (the baseline's fit,
 /// with the vehicle's first normal drives after it where there are any, pooled as
-/// [`spring_trend`] pools: [`crate::FleetConfig::reference_drives`]). Empty without a reference.
+/// [`spring_trend`] pools: [`crate::FleetConfig::reference_drives`]). The drive's spring
+/// variances are read as one scale over its corners in the reference's proportions, as the
+/// trend's drives' are ([`spring_trend`]). Empty without a reference.
 pub fn corner_scores(reference: &[&CornerFit], drive: &CornerFit) -> Vec<CornerScore> {
     let mut out = Vec::with_capacity(TESTS_PER_FIT);
     if reference.is_empty() {
         return out;
     }
+    let shape = spring_shape(reference);
     for part in [Part::Spring, Part::Damper] {
-        let (r, d) = (pool(reference, part), pool(&[drive], part));
+        let (r, d) = (
+            pool(reference, part, None),
+            pool(&[drive], part, shape.as_ref()),
+        );
         for ((corner, d), r) in CORNERS.iter().zip(&d).zip(&r) {
             out.push(score(*corner, part, d, r));
         }
@@ -522,10 +669,12 @@ fn records_df(fit: &CornerFit) -> f64 {
 /// that is not positive (a noise-free fit) scores 0.
 fn score(corner: Corner, part: Part, a: &Pooled, b: &Pooled) -> CornerScore {
     let parts: Vec<(f64, f64)> = a.parts.iter().chain(&b.parts).copied().collect();
+    let shared: Vec<bool> = a.shared.iter().chain(&b.shared).copied().collect();
     let var: f64 = parts.iter().map(|p| p.0).sum();
     let (z, t, df) = if var > 0.0 && var.is_finite() {
         let t = (a.mean - b.mean) / var.sqrt();
-        let z = fiducial_z_with(a.mean - b.mean, &parts, SCORE_DRAWS);
+        let shape_df = a.shape_df.min(b.shape_df);
+        let z = fiducial_z_shared(a.mean - b.mean, &parts, &shared, shape_df, SCORE_DRAWS);
         (z, Some(t), Some(welch_df(&parts)))
     } else {
         (0.0, None, None)
@@ -573,14 +722,38 @@ pub fn fiducial_z(d: f64, parts: &[(f64, f64)]) -> f64 {
 
 /// [`fiducial_z`] over `draws` draws (at least 1).
 pub fn fiducial_z_with(d: f64, parts: &[(f64, f64)], draws: usize) -> f64 {
+    fiducial_z_shared(d, parts, &[], f64::INFINITY, draws)
+}
+
+/// [`fiducial_z_with`] where the parts marked in `shared` are estimates `v_i = g s_i^2` that
+/// share one factor `g` estimated with `shared_df` degrees of freedom (a drive's spring variance
+/// read as its scale times the reference's proportion, [`spring_trend`]): per draw their sum is
+/// also multiplied by `shared_df / chi^2_(shared_df)`. Without a shared part (or with
+/// `shared_df` infinite or above 1000) it is [`fiducial_z_with`] draw for draw.
+pub fn fiducial_z_shared(
+    d: f64,
+    parts: &[(f64, f64)],
+    shared: &[bool],
+    shared_df: f64,
+    draws: usize,
+) -> f64 {
     use statrs::function::erf::erfc;
-    let parts: Vec<(f64, f64)> = parts.iter().copied().filter(|p| p.0 > 0.0).collect();
+    let parts: Vec<(f64, f64, bool)> = parts
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (p.0, p.1, shared.get(i).copied().unwrap_or(false)))
+        .filter(|p| p.0 > 0.0)
+        .collect();
+    let factor_df = (parts.iter().any(|p| p.2) && shared_df <= 1000.0).then_some(shared_df);
+    if factor_df.is_some_and(|k| k.is_nan() || k < 1.0) {
+        return 0.0;
+    }
     if d.is_nan()
         || d == 0.0
         || parts.is_empty()
         || parts
             .iter()
-            .any(|&(v, k)| !v.is_finite() || k.is_nan() || k < 1.0)
+            .any(|&(v, k, _)| !v.is_finite() || k.is_nan() || k < 1.0)
     {
         return 0.0;
     }
@@ -589,17 +762,27 @@ pub fn fiducial_z_with(d: f64, parts: &[(f64, f64)], draws: usize) -> f64 {
     let x = -d.abs();
     let mut p = 0.0;
     for _ in 0..draws {
-        let var: f64 = parts
-            .iter()
-            .map(|&(v, k)| {
-                if k > 1000.0 {
-                    v
-                } else {
-                    let k = k.round();
-                    v * k / (2.0 * rng.gamma(k / 2.0))
-                }
-            })
-            .sum();
+        let (mut own, mut common) = (0.0, 0.0);
+        for &(v, k, s) in &parts {
+            let drawn = if k > 1000.0 {
+                v
+            } else {
+                let k = k.round();
+                v * k / (2.0 * rng.gamma(k / 2.0))
+            };
+            if s {
+                common += drawn;
+            } else {
+                own += drawn;
+            }
+        }
+        let var = match factor_df {
+            Some(k) if common > 0.0 => {
+                let k = k.round();
+                own + common * k / (2.0 * rng.gamma(k / 2.0))
+            }
+            _ => own + common,
+        };
         p += 0.5 * erfc(-x / (var.sqrt() * std::f64::consts::SQRT_2));
     }
     let z = normal_quantile(p / draws as f64);
@@ -720,6 +903,7 @@ mod tests {
             damper_rel_sd: [sd; 4],
             supported: true,
             spring_relative_sd: None,
+            spring_scale_df: None,
         }
     }
 
@@ -989,6 +1173,126 @@ mod tests {
         }
     }
 
+    /// A fit of `records` records drawn under the null as the model update's jackknife sees
+    /// it: per record each corner's `ln k` is its mean plus `sqrt(records) scale shape_c` times
+    /// a standard normal draw (the corners independent, `shape` the vehicle's, `scale` the
+    /// road's); the fit is the mean over the records and its replicates leave each record out.
+    fn replicate_fit(
+        records: usize,
+        scale: f64,
+        shape: &[f64; 4],
+        normal: &mut dyn FnMut() -> f64,
+    ) -> CornerFit {
+        let ln0 = [2.0e5f64, 1.9e5, 2.6e5, 2.5e5].map(f64::ln);
+        let x: Vec<[f64; 4]> = (0..records)
+            .map(|_| {
+                std::array::from_fn(|c| {
+                    ln0[c] + (records as f64).sqrt() * scale * shape[c] * normal()
+                })
+            })
+            .collect();
+        let mean_without = |skip: Option<usize>| -> [f64; 4] {
+            std::array::from_fn(|c| {
+                let (sum, n) = x
+                    .iter()
+                    .enumerate()
+                    .filter(|(i, _)| Some(*i) != skip)
+                    .fold((0.0, 0.0), |(s, n), (_, v)| (s + v[c], n + 1.0));
+                (sum / n).exp()
+            })
+        };
+        let mut f = fit(mean_without(None), 0.02);
+        f.records = records;
+        let reps: Vec<[f64; 4]> = (0..records).map(|i| mean_without(Some(i))).collect();
+        f.set_spring_replicates(&reps);
+        f
+    }
+
+    /// Null statistics of the scores with the drives' spring variances read as one scale over
+    /// the corners ([`scaled_springs`]), over `n` seeded draws of whole fits
+    /// ([`replicate_fit`]; the corners' spreads in the proportions 1 : 0.7 : 0.8 : 1.3, the
+    /// scales of [`null_statistics`]: the baseline 0.046 of 16 records, `reference` normal drives
+    /// 0.04-0.12, the drive 0.05 and the trend's 0.05, 0.063, 0.09, each of 8). Every corner's
+    /// score is counted. Per score (the drive's, the trend's): the mean, the sd, the share below
+    /// -2.326 (1 %) and below its limit (3.227 and 3.023).
+    fn scaled_null_statistics(n: usize, reference: usize, seed: u64) -> [[f64; 4]; 2] {
+        let mut state = seed;
+        let mut uniform = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut normal = || {
+            let (u, v) = (uniform().max(1e-300), uniform());
+            (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+        };
+        let shape = [1.0, 0.7, 0.8, 1.3];
+        let ref_scales = [0.05, 0.063, 0.09, 0.04, 0.12, 0.07];
+        let trend_scales = [0.05, 0.063, 0.09];
+        let mut acc = [[0.0; 4]; 2];
+        let mut count = 0.0;
+        for _ in 0..n {
+            let base = replicate_fit(16, 0.046, &shape, &mut normal);
+            let normals: Vec<CornerFit> = ref_scales[..reference]
+                .iter()
+                .map(|s| replicate_fit(8, *s, &shape, &mut normal))
+                .collect();
+            let drives: Vec<CornerFit> = trend_scales
+                .iter()
+                .map(|s| replicate_fit(8, *s, &shape, &mut normal))
+                .collect();
+            let mut refs = vec![&base];
+            refs.extend(normals.iter());
+            let fits: Vec<&CornerFit> = drives.iter().collect();
+            let drive = corner_scores(&refs, &drives[0]);
+            let trend = spring_trend(&refs, &fits);
+            for c in 0..4 {
+                let zs = [
+                    (drive[c].z, suspension_limit(0.01)),
+                    (trend[c].z, trend_limit(0.01)),
+                ];
+                for (a, (z, limit)) in acc.iter_mut().zip(zs) {
+                    a[0] += z;
+                    a[1] += z * z;
+                    a[2] += f64::from(u8::from(z < -2.326));
+                    a[3] += f64::from(u8::from(z < -limit));
+                }
+            }
+            count += 4.0;
+        }
+        acc.map(|a| {
+            let mean = a[0] / count;
+            [
+                mean,
+                (a[1] / count - mean * mean).sqrt(),
+                a[2] / count,
+                a[3] / count,
+            ]
+        })
+    }
+
+    /// Seeded null draws of whole fits ([`scaled_null_statistics`]), the reference the baseline
+    /// alone and with 6 normal drives: with the drives' spring variances read as one scale over
+    /// the corners the scores keep the stated 1 % (within 2.5 standard errors of 6000 draws x 4
+    /// corners, correlated: 0.0032) and are standard normal or narrower.
+    #[test]
+    fn scaled_spring_scores_keep_the_stated_rate_under_the_null_over_seeds() {
+        let n = 6000;
+        for (reference, seed) in [(0, 0x5851_f42d_4c95_7f2d_u64), (6, 0x1405_7b7e_f767_814f)] {
+            let stats = scaled_null_statistics(n, reference, seed);
+            for (what, [mean, sd, rate, _]) in ["drive", "trend"].iter().zip(stats) {
+                let at = format!("{what} against the baseline and {reference} drives");
+                assert!(mean.abs() < 0.04, "{at}: mean {mean}");
+                assert!((0.85..1.03).contains(&sd), "{at}: sd {sd}");
+                assert!(
+                    (0.002..0.0132).contains(&rate),
+                    "{at}: P(z < -2.326) = {rate}"
+                );
+            }
+        }
+    }
+
     /// The far tails at the limits over seeded null draws, with and without normal drives in
     /// the reference: below 1.27 times the stated `Phi(-3.227)` = 0.000625 for the drive and
     /// `Phi(-3.023)` = 0.00125 for the trend. 50 000 draws in the acceptance tier (the fixed
@@ -1010,6 +1314,13 @@ mod tests {
             );
             assert!(drive[3] < 0.000625 * 1.27, "drive: {}", drive[3]);
             assert!(trend[3] < 0.00125 * 1.27, "trend: {}", trend[3]);
+            let [drive, trend] = scaled_null_statistics(n, reference, seed);
+            eprintln!(
+                "the same, the drives' spring variances as one scale over the corners (every corner): P(z < -3.227) of the drive {} (stated 0.000625), P(z < -3.023) of the trend {} (stated 0.00125); sd {:.3} and {:.3}",
+                drive[3], trend[3], drive[1], trend[1]
+            );
+            assert!(drive[3] < 0.000625 * 1.27, "scaled drive: {}", drive[3]);
+            assert!(trend[3] < 0.00125 * 1.27, "scaled trend: {}", trend[3]);
         }
     }
 
@@ -1105,6 +1416,86 @@ mod tests {
         assert!(
             (damper - 0.03_f64.powi(2) * (4.0 / 3.0)).abs() < 1e-15,
             "{damper}"
+        );
+    }
+
+    /// By hand: replicates that each move one corner by the same factor (the four corners
+    /// independent and alike) give the statistics' correlations -1/3, so `sum R_ij^2` = 4 +
+    /// 12 / 9 and the scale has three times the replicates' 3 degrees of freedom, 9; replicates
+    /// moving one corner alone give correlations of +-1 (one direction), so only their own, 2.
+    /// A common factor (no spread), fewer than three replicates or a value that is not
+    /// positive: none.
+    #[test]
+    fn spring_scale_df_by_hand() {
+        let a = 0.05_f64;
+        let each: Vec<[f64; 4]> = (0..4)
+            .map(|c| std::array::from_fn(|j| 2.0e5 * if j == c { a.exp() } else { 1.0 }))
+            .collect();
+        let df = spring_scale_df(&each).unwrap();
+        assert!((df - 9.0).abs() < 1e-9, "{df}");
+        let one: Vec<[f64; 4]> = [-a, 0.0, a]
+            .iter()
+            .map(|x| [2.0 * x.exp(), 2.0, 2.0, 2.0])
+            .collect();
+        let df = spring_scale_df(&one).unwrap();
+        assert!((df - 2.0).abs() < 1e-9, "{df}");
+        let common: Vec<[f64; 4]> = [0.9, 1.0, 1.2]
+            .iter()
+            .map(|s| [1.4e5 * s, 1.3e5 * s, 2.5e5 * s, 2.6e5 * s])
+            .collect();
+        assert!(spring_scale_df(&common).is_none());
+        assert!(spring_scale_df(&each[..2]).is_none());
+        let mut bad = each.clone();
+        bad[1][2] = -1.0;
+        assert!(spring_scale_df(&bad).is_none());
+    }
+
+    /// By hand: a reference whose corners' spring variances are 0.04^2, 0.02^2, 0.04^2, 0.02^2
+    /// has the shape 2, 1/2, 2, 1/2 (geometric mean 1); a drive whose four variances are
+    /// 0.06^2 then has the scale 0.0036 (1/2 + 2 + 1/2 + 2) / 4 = 0.0045 and the variances
+    /// 0.009, 0.00225, 0.009, 0.00225, with its scale's degrees of freedom; the reference keeps
+    /// its own. A drive without the scale's degrees of freedom, or a reference without the
+    /// springs' own spreads, keeps each corner's own variance (0.0036, 7).
+    #[test]
+    fn a_drives_spring_variances_as_one_scale_by_hand() {
+        let mut base = relative_fit([2.0e5; 4], [0.04, 0.02, 0.04, 0.02]);
+        base.records = 16;
+        let (g, k) = spring_shape(&[&base]).unwrap();
+        for (got, want) in g.iter().zip([2.0, 0.5, 2.0, 0.5]) {
+            assert!((got - want).abs() < 1e-12, "{g:?}");
+        }
+        // The proportions' degrees of freedom: the baseline's 15.
+        assert_eq!(k, 15.0);
+        let mut drive = relative_fit([1.6e5, 2.0e5, 2.0e5, 2.0e5], [0.06; 4]);
+        drive.spring_scale_df = Some(21.0);
+        let fl = corner_scores(&[&base], &drive)[0].clone();
+        assert_eq!((fl.corner, fl.part), (Corner::FL, Part::Spring));
+        let t = 0.8f64.ln() / (0.009f64 + 0.0016).sqrt();
+        assert!((fl.t.unwrap() - t).abs() < 1e-9, "{:?} vs {t}", fl.t);
+        let df = 0.0106f64.powi(2) / (0.009f64.powi(2) / 21.0 + 0.0016f64.powi(2) / 15.0);
+        assert!((fl.df.unwrap() - df).abs() < 1e-9, "{:?} vs {df}", fl.df);
+        let fr = corner_scores(&[&base], &drive)[1].clone();
+        let d = fr.value.ln() - fr.centre.ln();
+        assert!((fr.t.unwrap() - d / (0.00225f64 + 0.0004).sqrt()).abs() < 1e-9);
+        // The trend's drives likewise: three such drives, equal weights, Meier's factor with 21.
+        let tr = spring_trend(&[&base], &[&drive, &drive, &drive])[0].clone();
+        let m: f64 = 1.0 + 4.0 * 3.0 * (1.0 / 3.0 * 2.0 / 3.0) / 21.0;
+        let t3 = 0.8f64.ln() / (m * 0.009 / 3.0 + 0.0016).sqrt();
+        assert!((tr.t.unwrap() - t3).abs() < 1e-9, "{:?} vs {t3}", tr.t);
+        // Without the drive's scale degrees of freedom, or the reference's spreads: its own.
+        let t_own = 0.8f64.ln() / (0.0036f64 + 0.0016).sqrt();
+        drive.spring_scale_df = None;
+        let own = corner_scores(&[&base], &drive)[0].clone();
+        assert!((own.t.unwrap() - t_own).abs() < 1e-9);
+        drive.spring_scale_df = Some(21.0);
+        base.spring_relative_sd = None;
+        assert!(spring_shape(&[&base]).is_none());
+        let own = corner_scores(&[&base], &drive)[0].clone();
+        let t_old = 0.8f64.ln() / (0.0036f64 + 0.02f64.powi(2) * 4.0 / 3.0).sqrt();
+        assert!(
+            (own.t.unwrap() - t_old).abs() < 1e-9,
+            "{:?} vs {t_old}",
+            own.t
         );
     }
 

@@ -2,7 +2,7 @@
 //! in tools/reference/, their JSON committed).
 
 use serde_json::Value;
-use vibmode_fleet::suspension::{fiducial_z, t_as_normal};
+use vibmode_fleet::suspension::{fiducial_z, fiducial_z_shared, t_as_normal, FIDUCIAL_DRAWS};
 
 const T_AS_NORMAL: &str = include_str!(concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -41,13 +41,17 @@ const FIDUCIAL_Z: &str = include_str!(concat!(
 /// The Behrens-Fisher fiducial score of a difference over two estimated variance parts, against
 /// scipy's nested quadrature of the same expectation (tools/reference/fiducial_z.py, scipy
 /// 1.14.1): a drive against a baseline, against a precise reference, two equal parts, a trend
-/// against a baseline; |z| from 0.8 to 5; to 0.03 (vibmode's Monte Carlo of 32768 draws).
+/// against a baseline; |z| from 0.8 to 5; and a part that shares a factor of its own degrees of
+/// freedom (a drive's spring variance as its scale times the reference's proportion,
+/// `fiducial_z_shared`: scipy's triple quadrature); to 0.03 (vibmode's Monte Carlo of 32768
+/// draws).
 #[test]
 fn fiducial_z_matches_scipy_quadrature() {
     let r: Value = serde_json::from_str(FIDUCIAL_Z).unwrap();
     assert_eq!(r["versions"]["scipy"], "1.14.1");
     let cases = r["cases"].as_array().unwrap();
-    assert!(cases.len() >= 28);
+    assert!(cases.len() >= 36);
+    assert!(cases.iter().filter(|c| c.get("shared").is_some()).count() >= 8);
     for c in cases {
         let d = c["d"].as_f64().unwrap();
         let parts: Vec<(f64, f64)> = c["parts"]
@@ -57,7 +61,19 @@ fn fiducial_z_matches_scipy_quadrature() {
             .map(|p| (p[0].as_f64().unwrap(), p[1].as_f64().unwrap()))
             .collect();
         let want = c["z"].as_f64().unwrap();
-        let got = fiducial_z(d, &parts);
+        let got = match c.get("shared") {
+            Some(shared) => {
+                let shared: Vec<bool> = shared
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|b| b.as_bool().unwrap())
+                    .collect();
+                let k = c["shared_df"].as_f64().unwrap();
+                fiducial_z_shared(d, &parts, &shared, k, FIDUCIAL_DRAWS)
+            }
+            None => fiducial_z(d, &parts),
+        };
         assert!(
             (got - want).abs() <= 0.03,
             "d {d} parts {parts:?}: {got} vs scipy {want}"
