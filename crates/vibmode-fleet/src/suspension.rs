@@ -1294,7 +1294,9 @@ mod tests {
     }
 
     /// The far tails at the limits over seeded null draws, with and without normal drives in
-    /// the reference: below 1.27 times the stated `Phi(-3.227)` = 0.000625 for the drive and
+    /// the reference, of fits with each corner's own spring variance ([`null_statistics`]) and
+    /// of whole fits whose drives' variances are read as one scale
+    /// ([`scaled_null_statistics`]): below 1.27 times the stated `Phi(-3.227)` = 0.000625 for the drive and
     /// `Phi(-3.023)` = 0.00125 for the trend. 50 000 draws in the acceptance tier (the fixed
     /// seeds make it deterministic; the sampling error of a calibrated tail would be 18 % and
     /// 13 %); docs/fleet.md's figures are from 200 000 (`VIBMODE_NULL_DRAWS=200000 cargo test
