@@ -26,9 +26,9 @@
 //! limits, so the stated rate is an upper bound for drives of few records and of many. A
 //! drive's four spring variances are read as one scale in the reference's proportions (the road
 //! sets the scale, the vehicle the proportions), which gives them up to three times the
-//! records' degrees of freedom ([`spring_trend`]). The baseline's side is the reference: the baseline's fit pooled with the vehicle's first normal
-//! drives after it ([`crate::FleetConfig::reference_drives`]; docs/fleet.md, "Scores by the
-//! fiducial tail").
+//! records' degrees of freedom ([`spring_trend`]). The baseline's side is the reference: the
+//! baseline's fit pooled with the vehicle's first normal drives after it
+//! ([`crate::FleetConfig::reference_drives`]; docs/fleet.md, "Scores by the fiducial tail").
 
 use serde::{Deserialize, Serialize};
 use vibmode_analysis::{AnalysisConfig, Corner};
@@ -323,7 +323,7 @@ fn jackknife_relative_sd(replicates: &[[f64; 4]]) -> Option<[f64; 4]> {
 /// `S`, whose sampling noise raises `sum R_ij^2`, so the figure errs low (the safe side).
 /// `None` with fewer than [`MIN_FIT_RECORDS`] replicates, a value that is not positive, or a
 /// corner without spread.
-pub(crate) fn spring_scale_df(replicates: &[[f64; 4]]) -> Option<f64> {
+fn spring_scale_df(replicates: &[[f64; 4]]) -> Option<f64> {
     let m = replicates.len();
     if m < MIN_FIT_RECORDS
         || replicates
@@ -364,8 +364,7 @@ pub(crate) fn spring_scale_df(replicates: &[[f64; 4]]) -> Option<f64> {
 /// with the fits' degrees of freedom as weights, and the degrees of freedom of those
 /// proportions, the fits' summed (a fit's `ln var_c` has the variance `2 / k` about; the
 /// weighted mean `2 / sum k`; taking the centring as exact errs on the safe side). `None`
-/// where a fit has no
-/// [`CornerFit::spring_relative_sd`] or a spread that is not positive.
+/// where a fit has no [`CornerFit::spring_relative_sd`] or a spread that is not positive.
 fn spring_shape(reference: &[&CornerFit]) -> Option<([f64; 4], f64)> {
     let mut acc = [0.0; 4];
     let mut weight = 0.0;
