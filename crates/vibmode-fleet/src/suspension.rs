@@ -293,19 +293,22 @@ fn relative_of(v: &[f64; 4]) -> [f64; 4] {
     })
 }
 
+/// [`relative_of`] of each replicate of a fit; `None` with fewer than [`MIN_FIT_RECORDS`]
+/// replicates or a value that is not positive.
+fn replicate_statistics(replicates: &[[f64; 4]]) -> Option<Vec<[f64; 4]>> {
+    let usable = replicates.len() >= MIN_FIT_RECORDS
+        && replicates
+            .iter()
+            .flatten()
+            .all(|v| v.is_finite() && *v > 0.0);
+    usable.then(|| replicates.iter().map(relative_of).collect())
+}
+
 /// The jackknife standard deviation of [`relative_of`] per corner from the replicates of a fit
 /// (the values with each record left out in turn; [`vibmode_core::stats::jackknife_std`]).
 /// `None` with fewer than [`MIN_FIT_RECORDS`] replicates or a value that is not positive.
 fn jackknife_relative_sd(replicates: &[[f64; 4]]) -> Option<[f64; 4]> {
-    if replicates.len() < MIN_FIT_RECORDS
-        || replicates
-            .iter()
-            .flatten()
-            .any(|v| !(v.is_finite() && *v > 0.0))
-    {
-        return None;
-    }
-    let stats: Vec<[f64; 4]> = replicates.iter().map(relative_of).collect();
+    let stats = replicate_statistics(replicates)?;
     Some(std::array::from_fn(|c| {
         vibmode_core::stats::jackknife_std(&stats.iter().map(|s| s[c]).collect::<Vec<_>>())
     }))
@@ -324,16 +327,8 @@ fn jackknife_relative_sd(replicates: &[[f64; 4]]) -> Option<[f64; 4]> {
 /// `None` with fewer than [`MIN_FIT_RECORDS`] replicates, a value that is not positive, or a
 /// corner without spread.
 fn spring_scale_df(replicates: &[[f64; 4]]) -> Option<f64> {
-    let m = replicates.len();
-    if m < MIN_FIT_RECORDS
-        || replicates
-            .iter()
-            .flatten()
-            .any(|v| !(v.is_finite() && *v > 0.0))
-    {
-        return None;
-    }
-    let stats: Vec<[f64; 4]> = replicates.iter().map(relative_of).collect();
+    let stats = replicate_statistics(replicates)?;
+    let m = stats.len();
     let mean: [f64; 4] =
         std::array::from_fn(|c| stats.iter().map(|s| s[c]).sum::<f64>() / m as f64);
     let cov: [[f64; 4]; 4] = std::array::from_fn(|i| {
@@ -1083,17 +1078,8 @@ mod tests {
     /// 0.09). Per score (the drive's, the trend's): the mean, the sd, the share below -2.326
     /// (1 %) and the share below its limit (3.227 and 3.023).
     fn null_statistics(n: usize, reference: usize, seed: u64) -> [[f64; 4]; 2] {
-        let mut state = seed;
-        let mut uniform = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let mut normal = || {
-            let (u, v) = (uniform().max(1e-300), uniform());
-            (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-        };
+        let mut rng = XorShift(seed);
+        let mut normal = || rng.normal();
         let estimate = |sd: f64, df: usize, normal: &mut dyn FnMut() -> f64| {
             let chi2: f64 = (0..df).map(|_| normal().powi(2)).sum();
             (sd * sd * chi2 / df as f64).sqrt()
@@ -1109,7 +1095,7 @@ mod tests {
         };
         let ref_sds = [0.05, 0.063, 0.09, 0.04, 0.12, 0.07];
         let trend_sds = [0.05, 0.063, 0.09];
-        let mut acc = [[0.0; 4]; 2];
+        let mut tally = Tally::default();
         for _ in 0..n {
             let base = draw(0.046, 16, &mut normal);
             let normals: Vec<CornerFit> = ref_sds[..reference]
@@ -1123,29 +1109,42 @@ mod tests {
             let mut refs = vec![&base];
             refs.extend(normals.iter());
             let fits: Vec<&CornerFit> = drives.iter().collect();
-            let zs = [
-                (
-                    corner_scores(&refs, &drives[0])[2].z,
-                    suspension_limit(0.01),
-                ),
-                (spring_trend(&refs, &fits)[2].z, trend_limit(0.01)),
-            ];
-            for (a, (z, limit)) in acc.iter_mut().zip(zs) {
+            tally.add(
+                corner_scores(&refs, &drives[0])[2].z,
+                spring_trend(&refs, &fits)[2].z,
+            );
+        }
+        tally.summary()
+    }
+
+    /// Null scores counted: per score (the drive's, the trend's) the sums of `z` and `z^2`, and
+    /// the counts below -2.326 (1 %) and below the score's limit (3.227 and 3.023).
+    #[derive(Default)]
+    struct Tally {
+        acc: [[f64; 4]; 2],
+        count: f64,
+    }
+
+    impl Tally {
+        fn add(&mut self, drive: f64, trend: f64) {
+            let zs = [(drive, suspension_limit(0.01)), (trend, trend_limit(0.01))];
+            for (a, (z, limit)) in self.acc.iter_mut().zip(zs) {
                 a[0] += z;
                 a[1] += z * z;
                 a[2] += f64::from(u8::from(z < -2.326));
                 a[3] += f64::from(u8::from(z < -limit));
             }
+            self.count += 1.0;
         }
-        acc.map(|a| {
-            let mean = a[0] / n as f64;
-            [
-                mean,
-                (a[1] / n as f64 - mean * mean).sqrt(),
-                a[2] / n as f64,
-                a[3] / n as f64,
-            ]
-        })
+
+        /// Per score: the mean, the sd, the share below -2.326 and the share below the limit.
+        fn summary(&self) -> [[f64; 4]; 2] {
+            let n = self.count.max(1.0);
+            self.acc.map(|a| {
+                let mean = a[0] / n;
+                [mean, (a[1] / n - mean * mean).sqrt(), a[2] / n, a[3] / n]
+            })
+        }
     }
 
     /// Seeded null draws ([`null_statistics`]), the reference the baseline alone and the
@@ -1160,15 +1159,21 @@ mod tests {
         let n = 6000;
         for (reference, seed) in [(0, 0x2545_f491_4f6c_dd1d_u64), (6, 0x9e37_79b9_7f4a_7c15)] {
             let stats = null_statistics(n, reference, seed);
-            for (what, [mean, sd, rate, _]) in ["drive", "trend"].iter().zip(stats) {
-                let at = format!("{what} against the baseline and {reference} drives");
-                assert!(mean.abs() < 0.04, "{at}: mean {mean}");
-                assert!((0.9..1.03).contains(&sd), "{at}: sd {sd}");
-                assert!(
-                    (0.004..0.0132).contains(&rate),
-                    "{at}: P(z < -2.326) = {rate}"
-                );
-            }
+            assert_null(stats, &format!("{reference} drives"), 0.9, 0.004);
+        }
+    }
+
+    /// Null statistics (mean, sd, rate below -2.326; [`Tally::summary`]) within bounds: a mean
+    /// within 0.04 of 0, an sd from `sd_least` to 1.03, a rate from `rate_least` to 0.0132.
+    fn assert_null(stats: [[f64; 4]; 2], reference: &str, sd_least: f64, rate_least: f64) {
+        for (what, [mean, sd, rate, _]) in ["drive", "trend"].iter().zip(stats) {
+            let at = format!("{what} against the baseline and {reference}");
+            assert!(mean.abs() < 0.04, "{at}: mean {mean}");
+            assert!((sd_least..1.03).contains(&sd), "{at}: sd {sd}");
+            assert!(
+                (rate_least..0.0132).contains(&rate),
+                "{at}: P(z < -2.326) = {rate}"
+            );
         }
     }
 
@@ -1215,22 +1220,12 @@ mod tests {
     /// score is counted. Per score (the drive's, the trend's): the mean, the sd, the share below
     /// -2.326 (1 %) and below its limit (3.227 and 3.023).
     fn scaled_null_statistics(n: usize, reference: usize, seed: u64) -> [[f64; 4]; 2] {
-        let mut state = seed;
-        let mut uniform = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let mut normal = || {
-            let (u, v) = (uniform().max(1e-300), uniform());
-            (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-        };
+        let mut rng = XorShift(seed);
+        let mut normal = || rng.normal();
         let shape = [1.0, 0.7, 0.8, 1.3];
         let ref_scales = [0.05, 0.063, 0.09, 0.04, 0.12, 0.07];
         let trend_scales = [0.05, 0.063, 0.09];
-        let mut acc = [[0.0; 4]; 2];
-        let mut count = 0.0;
+        let mut tally = Tally::default();
         for _ in 0..n {
             let base = replicate_fit(16, 0.046, &shape, &mut normal);
             let normals: Vec<CornerFit> = ref_scales[..reference]
@@ -1247,28 +1242,10 @@ mod tests {
             let drive = corner_scores(&refs, &drives[0]);
             let trend = spring_trend(&refs, &fits);
             for c in 0..4 {
-                let zs = [
-                    (drive[c].z, suspension_limit(0.01)),
-                    (trend[c].z, trend_limit(0.01)),
-                ];
-                for (a, (z, limit)) in acc.iter_mut().zip(zs) {
-                    a[0] += z;
-                    a[1] += z * z;
-                    a[2] += f64::from(u8::from(z < -2.326));
-                    a[3] += f64::from(u8::from(z < -limit));
-                }
+                tally.add(drive[c].z, trend[c].z);
             }
-            count += 4.0;
         }
-        acc.map(|a| {
-            let mean = a[0] / count;
-            [
-                mean,
-                (a[1] / count - mean * mean).sqrt(),
-                a[2] / count,
-                a[3] / count,
-            ]
-        })
+        tally.summary()
     }
 
     /// Seeded null draws of whole fits ([`scaled_null_statistics`]), the reference the baseline
@@ -1280,15 +1257,12 @@ mod tests {
         let n = 6000;
         for (reference, seed) in [(0, 0x5851_f42d_4c95_7f2d_u64), (6, 0x1405_7b7e_f767_814f)] {
             let stats = scaled_null_statistics(n, reference, seed);
-            for (what, [mean, sd, rate, _]) in ["drive", "trend"].iter().zip(stats) {
-                let at = format!("{what} against the baseline and {reference} drives");
-                assert!(mean.abs() < 0.04, "{at}: mean {mean}");
-                assert!((0.85..1.03).contains(&sd), "{at}: sd {sd}");
-                assert!(
-                    (0.002..0.0132).contains(&rate),
-                    "{at}: P(z < -2.326) = {rate}"
-                );
-            }
+            assert_null(
+                stats,
+                &format!("{reference} drives, one scale"),
+                0.85,
+                0.002,
+            );
         }
     }
 
