@@ -762,7 +762,7 @@ pub fn fiducial_z_shared(
                 v
             } else {
                 let k = k.round();
-                v * k / (2.0 * rng.gamma(k / 2.0))
+                v * k / rng.chi2(k)
             };
             if s {
                 common += drawn;
@@ -773,7 +773,7 @@ pub fn fiducial_z_shared(
         let var = match factor_df {
             Some(k) if common > 0.0 => {
                 let k = k.round();
-                own + common * k / (2.0 * rng.gamma(k / 2.0))
+                own + common * k / rng.chi2(k)
             }
             _ => own + common,
         };
@@ -806,6 +806,11 @@ impl XorShift {
     fn normal(&mut self) -> f64 {
         let (u, v) = (self.uniform(), self.uniform());
         (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    }
+
+    /// A chi-square draw of `k` degrees of freedom, `2 Gamma(k / 2)`.
+    fn chi2(&mut self, k: f64) -> f64 {
+        2.0 * self.gamma(k / 2.0)
     }
 
     /// A Gamma(`shape`, 1) draw (`chi^2_k` = 2 Gamma(k / 2)): Marsaglia and Tsang (2000), with
