@@ -95,7 +95,11 @@ def model(db: PathLike, vehicle: str) -> Optional[str]:
 def baseline(db: PathLike, vehicle: str) -> Dict[str, Any]:
     """Builds the vehicle's nominal model set from its nominal records (at least 5); returns it
     (a dict, a :class:`FleetResult`: ``print(result)`` shows what ``vibmode fleet baseline``
-    prints, the limits per feature kind, also in ``result.text``)."""
+    prints, the limits per feature kind, also in ``result.text``). Where the nominal records
+    form two or more drives (days, else folders), ``result["held_out_drives"]`` holds each drive
+    checked against a model set of the other nominal records: its ``classification`` (``normal``
+    unless the drive rule would flag this vehicle's healthy drives), ``component`` and
+    ``summary``."""
     data, text = _native.fleet_baseline(os.fspath(db), vehicle)
     return FleetResult(json.loads(data), text)
 

@@ -526,3 +526,70 @@ fn the_same_drive_checked_again_is_stored_once() {
         (1, 1)
     );
 }
+
+/// `fleet baseline` holds each nominal drive out (its folder, as given: the records' starts are
+/// not known) and checks it as a drive against a model set of the other nominal records. Two
+/// healthy drives of one road and speed: neither is flagged. A drive on a class D road ingested
+/// as nominal by mistake is flagged `road` against the others, and the output warns that healthy
+/// drives like it will be flagged. One folder: no drive to hold out, and the note says so.
+#[test]
+fn baseline_drives_are_each_checked_against_the_other_nominal_records() {
+    let d = tempfile::tempdir().unwrap();
+    let db = d.path().join("fleet.db").to_str().unwrap().to_string();
+    ok(&["fleet", "init", "--db", &db]);
+    let mon = simulate_csv(&d.path().join("mon"), "B", "30", "71", "5");
+    let tue = simulate_csv(&d.path().join("tue"), "B", "30", "72", "5");
+    let mut args = vec!["fleet", "ingest", "--db", &db, "--vehicle", "bus-1", "-q"];
+    args.extend(mon.iter().chain(&tue).map(String::as_str));
+    ok(&args);
+    let o = ok(&["fleet", "baseline", "--db", &db, "--vehicle", "bus-1"]);
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        text.contains("leave-one-drive-out: 2 nominal drive(s), each checked as a drive against a model set of the other nominal records: 0 flagged"),
+        "{text}"
+    );
+    let held: Vec<&str> = text
+        .lines()
+        .filter(|l| l.starts_with("  ") && l.contains("records, against 5: "))
+        .collect();
+    assert_eq!(held.len(), 2, "{text}");
+    assert!(
+        held[0]
+            .trim_start()
+            .starts_with(&format!("{}", d.path().join("mon").display())),
+        "{text}"
+    );
+    assert!(held.iter().all(|l| l.contains(": normal")), "{text}");
+    assert!(!text.contains("warning:"), "{text}");
+
+    // A rough-road drive among the nominal ones.
+    let rough = simulate_csv(&d.path().join("rough"), "D", "30", "73", "5");
+    let mut args = vec!["fleet", "ingest", "--db", &db, "--vehicle", "bus-1", "-q"];
+    args.extend(rough.iter().map(String::as_str));
+    ok(&args);
+    let o = ok(&["fleet", "baseline", "--db", &db, "--vehicle", "bus-1"]);
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    let line = text
+        .lines()
+        .find(|l| {
+            l.trim_start()
+                .starts_with(&format!("{}", d.path().join("rough").display()))
+        })
+        .unwrap_or_else(|| panic!("no held-out line of the rough drive in {text}"));
+    assert!(line.contains("5 records, against 10: road"), "{line}");
+    assert!(
+        text.contains("healthy nominal drives would be flagged against the other nominal records"),
+        "{text}"
+    );
+
+    // All nominal records in one folder.
+    let d1 = tempfile::tempdir().unwrap();
+    let db1 = store_with_baseline(d1.path());
+    let o = ok(&["fleet", "baseline", "--db", &db1, "--vehicle", "bus-1"]);
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        text.contains("note: leave-one-drive-out: not made: the 6 nominal records form one drive"),
+        "{text}"
+    );
+    assert!(!text.contains("leave-one-drive-out: 2"), "{text}");
+}

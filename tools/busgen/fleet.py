@@ -23,6 +23,10 @@ spring trend pools a vehicle's last drives; `spring_trend.py` measures sequences
 The component a fault drive names (`drives[].component`: damper, spring, tyre or suspension) is
 counted apart: a right fault drive whose component is the fault's.
 
+The baseline's own drives held out (`fleet baseline`'s leave-one-drive-out: each checked as a
+drive against a model set of the other drive's records, read from the store's model set) are
+printed per bus and summed as `held out`: healthy drives, so `normal` is right.
+
 The drive's verdict is the JSON's `drives` entry when the binary writes one, else (older
 binaries) it is not scored per drive.
 
@@ -39,10 +43,12 @@ Needs VIBMODE_BIN (else target/release/vibmode) and a Python with numpy+scipy fo
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import random
 import shutil
+import sqlite3
 import sys
 import tempfile
 from pathlib import Path
@@ -161,6 +167,11 @@ def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
     unless `keep` (then each drive's stays in `work` as fleet-SEED-I-CONDITION.db, beside its
     check's JSON as check-SEED-CONDITION.json)."""
     db, vehicle, base_seed = make_baseline(bus_seed, n_records, work, rng, model, config)
+    held = held_out(db)
+    for d in held:
+        print(f"bus {bus_seed:>5} baseline drive held out: {d['classification']}"
+              f"{'/' + d['component'] if d.get('component') else ''} against "
+              f"{d['reference_records']} records  {d.get('summary', '')[:160]}", flush=True)
     # The drives are alternatives, not one vehicle's sequence: each is checked on a copy of the
     # store as the baseline left it, so that the spring trend (which pools a vehicle's last
     # drives) does not carry one condition's fault into the next (tools/busgen/spring_trend.py
@@ -207,7 +218,15 @@ def run_bus(bus_seed: int, n_records: int, work: Path, rng: random.Random,
     if not keep:
         for f in work.glob(f"fleet-{bus_seed}.db*"):
             f.unlink()
-    return {"bus": bus_seed, "rows": rows}
+    return {"bus": bus_seed, "rows": rows, "held_out": held}
+
+
+def held_out(db: Path) -> List[Dict]:
+    """The latest model set's nominal drives held out (`fleet baseline`'s leave-one-drive-out:
+    each checked against a model set of the other nominal records), read from the store."""
+    with contextlib.closing(sqlite3.connect(f"file:{db}?mode=ro", uri=True)) as c:
+        row = c.execute("SELECT json FROM model_sets ORDER BY version DESC LIMIT 1").fetchone()
+    return json.loads(row[0]).get("held_out_drives", []) if row else []
 
 
 def summarise(buses: List[Dict]) -> Dict[str, Dict]:
@@ -226,6 +245,12 @@ def summarise(buses: List[Dict]) -> Dict[str, Dict]:
                 s["drive_n"] += 1
             if r.get("component_ok"):
                 s["component_ok"] += 1
+        for d in b.get("held_out", []):
+            s = summary.setdefault("held out", {"rec_ok": 0, "rec_n": 0, "drive_ok": 0,
+                                                "drive_n": 0, "false_both": 0,
+                                                "component_ok": 0})
+            s["drive_ok"] += int(d["classification"] == "normal")
+            s["drive_n"] += 1
     return summary
 
 
@@ -303,7 +328,11 @@ def print_summary(summary: Dict[str, Dict]) -> None:
           "class D road; component = right drives naming the fault's component):")
     for cond, s in summary.items():
         comp = (f" component {s.get('component_ok', 0)}/{s['drive_n']}"
-                if cond not in ("healthy", "roadD") else "")
+                if cond not in ("healthy", "roadD", "held out") else "")
+        if cond == "held out":
+            print(f"  {cond:<9} baseline drives checked against the other baseline drive(s): "
+                  f"normal {h.rate(s['drive_ok'], s['drive_n'])}")
+            continue
         print(f"  {cond:<9} records {h.rate(s['rec_ok'], s['rec_n']):<16} drives "
               f"{h.rate(s['drive_ok'], s['drive_n']):<14} false 'both' records "
               f"{s['false_both']}{comp}")

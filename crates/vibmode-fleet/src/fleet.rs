@@ -616,7 +616,8 @@ pub fn build_baseline(store: &mut Store, vehicle: &str, cfg: &FleetConfig) -> Re
     }
     let mut set = build_model_set(vehicle, &names, &feats, cfg)?;
     set.notes.extend(notes);
-    if let Some(model) = registered_model(store, vehicle)? {
+    let model = registered_model(store, vehicle)?;
+    if let Some(model) = &model {
         let eqs: Vec<&vibmode_vehicle::update::RecordEquations> = feats
             .iter()
             .filter_map(|f| f.suspension.as_ref())
@@ -637,8 +638,130 @@ pub fn build_baseline(store: &mut Store, vehicle: &str, cfg: &FleetConfig) -> Re
             )),
         }
     }
+    let fitted = set.suspension.as_ref().and(model.as_ref());
+    let (held_out, why_not) = held_out_drives(vehicle, &names, &feats, cfg, fitted);
+    set.held_out_drives = held_out;
+    set.notes.extend(why_not);
     store.save_model_set(&mut set)?;
     Ok(set)
+}
+
+/// The drives of a vehicle's nominal records, as (id, indices of the records), sorted by id:
+/// one per UTC day where every record's start is known, else one per folder the records were
+/// given in ([`DEFAULT_DRIVE_ID`] for those given without one). Unlike a check's drives
+/// ([`drives_of_records`]) records of several folders are several drives: a baseline is
+/// commonly ingested a drive's folder at a time, or all of them at once.
+pub fn nominal_drives<S: AsRef<str>>(
+    starts: &[Option<f64>],
+    files: &[S],
+) -> Vec<(String, Vec<usize>)> {
+    let days: Option<Vec<String>> = starts.iter().map(|s| s.and_then(drive_of_day)).collect();
+    let ids: Vec<String> = match days {
+        Some(days) => days,
+        None => files
+            .iter()
+            .map(|f| drive_of_folder(std::slice::from_ref(f)))
+            .collect(),
+    };
+    let mut out: Vec<(String, Vec<usize>)> = Vec::new();
+    for (i, id) in ids.into_iter().enumerate() {
+        match out.iter_mut().find(|(d, _)| *d == id) {
+            Some((_, members)) => members.push(i),
+            None => out.push((id, vec![i])),
+        }
+    }
+    out.sort_by(|a, b| a.0.cmp(&b.0));
+    out
+}
+
+/// Leave one drive out: each drive of the nominal records ([`nominal_drives`]) with at least
+/// [`MIN_DRIVE_RECORDS`] records, checked as a drive ([`assess_drive_fitted`]) against a model
+/// set built from the other nominal records (and, with `model`, the suspension fitted to them),
+/// where those are at least `cfg.min_nominal`. Every such drive was driven healthy, so a
+/// verdict other than `normal` is a false alarm of the drive rule on this vehicle's own
+/// records. The second value says why no drive could be held out (fewer than two drives, or
+/// too few records besides each).
+pub fn held_out_drives(
+    vehicle: &str,
+    names: &[String],
+    feats: &[RecordFeatures],
+    cfg: &FleetConfig,
+    model: Option<&VehicleModel>,
+) -> (Vec<crate::model::HeldOutDrive>, Option<String>) {
+    let starts: Vec<Option<f64>> = feats.iter().map(|f| f.start_unix_s).collect();
+    let drives = nominal_drives(&starts, names);
+    let mut out = Vec::new();
+    let mut skipped = Vec::new();
+    for (id, members) in &drives {
+        let rest: Vec<usize> = (0..feats.len()).filter(|i| !members.contains(i)).collect();
+        if members.len() < MIN_DRIVE_RECORDS || rest.len() < cfg.min_nominal {
+            skipped.push(format!(
+                "{} ({} records)",
+                vibmode_core::quoted(id),
+                members.len()
+            ));
+            continue;
+        }
+        let rest_names: Vec<String> = rest.iter().map(|&i| names[i].clone()).collect();
+        let rest_feats: Vec<RecordFeatures> = rest.iter().map(|&i| feats[i].clone()).collect();
+        let mut held = match build_model_set(vehicle, &rest_names, &rest_feats, cfg) {
+            Ok(set) => set,
+            Err(_) => {
+                skipped.push(format!(
+                    "{} (the other records gave no model set)",
+                    vibmode_core::quoted(id)
+                ));
+                continue;
+            }
+        };
+        let drive: Vec<&RecordFeatures> = members.iter().map(|&i| &feats[i]).collect();
+        let mut scores = Vec::new();
+        if let Some(model) = model {
+            let equations = |idx: &[usize]| -> Vec<&vibmode_vehicle::update::RecordEquations> {
+                idx.iter()
+                    .map(|&i| &feats[i])
+                    .filter(|f| f.sensor_faults.is_empty())
+                    .filter_map(|f| f.suspension.as_ref())
+                    .filter(|e| e.model_sha256 == model.sha256)
+                    .map(|e| &e.equations)
+                    .collect()
+            };
+            if let (Ok(reference), Ok(fit)) = (
+                model.fit_corners(&cfg.analysis, &equations(&rest)),
+                model.fit_corners(&cfg.analysis, &equations(members)),
+            ) {
+                scores = corner_scores(&[&reference], &fit);
+                held.suspension = Some(SuspensionReference {
+                    model_sha256: model.sha256.clone(),
+                    fit: reference,
+                    limit: suspension_limit(cfg.false_alarm_rate),
+                });
+            }
+        }
+        let a = assess_drive_fitted(&held, &drive, &scores, None);
+        out.push(crate::model::HeldOutDrive {
+            drive: id.clone(),
+            records: members.iter().map(|&i| names[i].clone()).collect(),
+            reference_records: rest.len(),
+            classification: a.classification,
+            component: a.component,
+            summary: a.summary,
+        });
+    }
+    let why_not = match (out.is_empty(), drives.len()) {
+        (false, _) => None,
+        (true, 1) => Some(format!(
+            "leave-one-drive-out: not made: the {} nominal records form one drive ({}), so no healthy drive of this vehicle was checked against the others; a drive's stated false-alarm rate is then a bound, not measured on it (ingest nominal records of another day or folder)",
+            feats.len(),
+            vibmode_core::quoted(&drives[0].0)
+        )),
+        (true, _) => Some(format!(
+            "leave-one-drive-out: not made: no nominal drive has {MIN_DRIVE_RECORDS} records with {} others beside it: {}",
+            cfg.min_nominal,
+            skipped.join(", ")
+        )),
+    };
+    (out, why_not)
 }
 
 /// One checked record.
@@ -1406,6 +1529,49 @@ mod tests {
             vec![]
         );
         assert_eq!(drives_of_records(&[], &[]), vec![]);
+    }
+
+    /// The baseline's drives: by day where every start is known (small days kept: they stay in
+    /// every held-out model set), else one per folder as given, sorted by id.
+    #[test]
+    fn nominal_records_are_grouped_by_day_else_by_folder() {
+        let day = |d: f64, h: f64| Some((20784.0 + d) * 86400.0 + h * 3600.0);
+        let id = |s: &str| s.to_string();
+        let files = [
+            "tue/r1.csv",
+            "mon/r1.csv",
+            "tue/r2.csv",
+            "r3.csv",
+            "./r4.csv",
+            "mon/r2.csv",
+        ];
+        let dated = [
+            day(1.0, 8.0),
+            day(0.0, 8.0),
+            day(1.0, 9.0),
+            day(2.0, 1.0),
+            day(0.0, 9.0),
+            day(0.0, 10.0),
+        ];
+        assert_eq!(
+            nominal_drives(&dated, &files),
+            vec![
+                (id("2026-11-27"), vec![1, 4, 5]),
+                (id("2026-11-28"), vec![0, 2]),
+                (id("2026-11-29"), vec![3]),
+            ]
+        );
+        let mut undated = dated.to_vec();
+        undated[2] = None;
+        assert_eq!(
+            nominal_drives(&undated, &files),
+            vec![
+                (id(DEFAULT_DRIVE_ID), vec![3, 4]),
+                (id("mon"), vec![1, 5]),
+                (id("tue"), vec![0, 2]),
+            ]
+        );
+        assert_eq!(nominal_drives::<&str>(&[], &[]), vec![]);
     }
 
     /// A drive of records of unknown start is named by the one folder they lie in, as given.

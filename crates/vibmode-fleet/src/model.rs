@@ -255,6 +255,33 @@ pub struct ModelSet {
     /// ([`crate::suspension`]); else absent and `notes` says why.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub suspension: Option<crate::suspension::SuspensionReference>,
+    /// The baseline's own drives, each checked as a drive against a model set built from the
+    /// other nominal records ([`crate::fleet::held_out_drives`]): how often a healthy drive of
+    /// this vehicle is flagged. Empty when the nominal records form fewer than two drives
+    /// (`notes` says so) and in model sets stored before it existed.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub held_out_drives: Vec<HeldOutDrive>,
+}
+
+/// A nominal drive of the baseline checked against the other nominal records (leave one drive
+/// out): a drive the vehicle drove healthy, so any verdict but `normal` is a false alarm of the
+/// drive rule on this vehicle.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct HeldOutDrive {
+    /// The drive's id: its UTC day where every nominal record's start is known, else the
+    /// folder its records were given in.
+    pub drive: String,
+    /// Its records (file names as given at ingest).
+    pub records: Vec<String>,
+    /// The nominal records the held-out model set was built from.
+    pub reference_records: usize,
+    /// The drive's verdict against them.
+    pub classification: Classification,
+    /// The component named first, when a vehicle feature is flagged.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub component: Option<Component>,
+    /// The flagged features, as a check's summary (empty when `normal`).
+    pub summary: String,
 }
 
 impl ModelSet {
@@ -1031,6 +1058,7 @@ pub fn build_model_set(
         line_free,
         noise_free,
         suspension: None,
+        held_out_drives: Vec::new(),
     })
 }
 

@@ -3,7 +3,7 @@
 //! prints, and any other front end can print the same.
 
 use crate::fleet::{Checked, Ingested, Registered};
-use crate::model::{Drive, ModelSet, MIN_DRIVE_RECORDS};
+use crate::model::{Classification, Drive, ModelSet, MIN_DRIVE_RECORDS};
 use crate::store::{Condition, VehicleStatus};
 use std::fmt::Write as _;
 
@@ -137,10 +137,49 @@ pub fn baseline_text(set: &ModelSet) -> String {
             );
         }
     }
+    held_out_text(&mut text, &set.held_out_drives);
     for n in &set.notes {
         let _ = writeln!(text, "note: {n}");
     }
     text
+}
+
+/// The baseline's leave-one-drive-out lines: one per held-out nominal drive, and a warning
+/// when any of them is flagged.
+fn held_out_text(text: &mut String, drives: &[crate::model::HeldOutDrive]) {
+    if drives.is_empty() {
+        return;
+    }
+    let flagged: Vec<&crate::model::HeldOutDrive> = drives
+        .iter()
+        .filter(|d| d.classification != Classification::Normal)
+        .collect();
+    let _ = writeln!(
+        text,
+        "leave-one-drive-out: {} nominal drive(s), each checked as a drive against a model set of the other nominal records: {} flagged",
+        drives.len(),
+        flagged.len()
+    );
+    for d in drives {
+        let component = d.component.map(|c| format!(" ({c})")).unwrap_or_default();
+        let _ = writeln!(
+            text,
+            "  {:<30} {} records, against {}: {}{component}  {}",
+            d.drive,
+            d.records.len(),
+            d.reference_records,
+            d.classification,
+            or_dash(&d.summary)
+        );
+    }
+    if !flagged.is_empty() {
+        let _ = writeln!(
+            text,
+            "warning: {} of {} healthy nominal drives would be flagged against the other nominal records: this vehicle's healthy drives differ more than the limits allow, so checks will flag healthy drives like them; ingest nominal drives of more days, roads and loads and build the baseline again",
+            flagged.len(),
+            drives.len()
+        );
+    }
 }
 
 /// `fleet check`'s table: one row per record (class, scores, evidence), the notes on records
@@ -498,7 +537,6 @@ mod tests {
     /// so and gives the latest record's verdict; without any check, only that no drive was.
     #[test]
     fn a_vehicle_without_drives_shows_its_latest_record_check() {
-        use crate::model::Classification;
         let v = |last_checks: Vec<(String, Classification, String)>| VehicleStatus {
             vehicle: "bus-017".into(),
             n_nominal: 16,
@@ -540,7 +578,6 @@ mod tests {
     /// evidence, and a drive without evidence shows a dash.
     #[test]
     fn the_drive_timeline_keeps_the_drive_apart_from_its_evidence() {
-        use crate::model::Classification;
         use crate::store::DriveStatus;
         let drive = |name: &str, class: Classification, summary: &str| DriveStatus {
             drive: name.into(),
