@@ -561,6 +561,12 @@ fn baseline_drives_are_each_checked_against_the_other_nominal_records() {
     );
     assert!(held.iter().all(|l| l.contains(": normal")), "{text}");
     assert!(!text.contains("warning:"), "{text}");
+    let o = ok(&["fleet", "status", "--db", &db]);
+    let status = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        status.contains("false alarms per drive, measured: 0 of 2 healthy nominal drives of 1 vehicle(s) flagged when held out of their baseline, a rate of at most 77.6 % (95 % upper bound"),
+        "{status}"
+    );
 
     // A rough-road drive among the nominal ones.
     let rough = simulate_csv(&d.path().join("rough"), "D", "30", "73", "5");

@@ -302,6 +302,11 @@ fn fleet_report_leads_with_the_drive_verdicts_in_headless_chromium() {
         "{verdicts}"
     );
     assert!(bus8.contains(&*test[0]), "{bus8}");
+    // Both baselines hold one folder of nominal records: no drive held out, and said so.
+    assert!(
+        pos("false alarms per drive, measured: not yet") < pos("Drive verdicts, newest first"),
+        "the measured false-alarm rate follows the verdicts"
+    );
     let timeline = between(&html, "Drive verdicts, newest first", "</table>");
     assert!(
         timeline.find("<td>tuesday</td>") < timeline.find("<td>monday</td>")

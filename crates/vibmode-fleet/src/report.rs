@@ -95,6 +95,9 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
         ],
         &verdicts,
     );
+    if !status.is_empty() {
+        html.paragraph(&crate::text::held_out_fleet_line(&status));
+    }
     let timeline: Vec<Vec<String>> = status
         .iter()
         .flat_map(|s| {

@@ -97,9 +97,77 @@ pub fn bonferroni_limit(false_alarm_rate: f64, n_features: usize) -> f64 {
     -normal_quantile(false_alarm_rate / (2.0 * m))
 }
 
+/// The one-sided upper confidence bound of a rate from `hits` events in `trials`
+/// (Clopper-Pearson: the rate `p` at which `P(X <= hits) = 1 - confidence` for `X ~
+/// Binomial(trials, p)`, the `confidence` quantile of `Beta(hits + 1, trials - hits)`). `None`
+/// without trials, with more hits than trials, or with `confidence` outside (0, 1); 1 when every
+/// trial was a hit. With no hit it is `1 - (1 - confidence)^(1 / trials)`: 0 of 40 drives flagged
+/// bound a drive's false-alarm rate by 7.2 % at 95 %.
+pub fn rate_upper_bound(hits: usize, trials: usize, confidence: f64) -> Option<f64> {
+    use statrs::distribution::{Beta, ContinuousCDF};
+    if trials == 0 || hits > trials || !(confidence > 0.0 && confidence < 1.0) {
+        return None;
+    }
+    if hits == trials {
+        return Some(1.0);
+    }
+    if hits == 0 {
+        return Some(1.0 - (1.0 - confidence).powf(1.0 / trials as f64));
+    }
+    let beta = Beta::new(hits as f64 + 1.0, (trials - hits) as f64).ok()?;
+    Some(beta.inverse_cdf(confidence))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rate_upper_bound_by_hand() {
+        // No hit: 1 - 0.05^(1/n). n = 1: 0.95; n = 40: 0.0721; n = 300: 0.00994.
+        let b = |k, n| rate_upper_bound(k, n, 0.95).unwrap_or(f64::NAN);
+        assert!((b(0, 1) - 0.95).abs() < 1e-12);
+        assert!((b(0, 40) - 0.072_158).abs() < 1e-6, "{}", b(0, 40));
+        assert!((b(0, 300) - 0.009_936).abs() < 1e-6, "{}", b(0, 300));
+        // One hit of two: P(X <= 1) = 1 - p^2 = 0.05 -> p = sqrt(0.95).
+        assert!((b(1, 2) - 0.95f64.sqrt()).abs() < 1e-9, "{}", b(1, 2));
+        // n - 1 hits of n: P(X <= n - 1) = 1 - p^n -> p = 0.95^(1/n).
+        assert!((b(4, 5) - 0.95f64.powf(0.2)).abs() < 1e-9, "{}", b(4, 5));
+        assert_eq!(b(3, 3), 1.0);
+        assert_eq!(rate_upper_bound(0, 0, 0.95), None);
+        assert_eq!(rate_upper_bound(3, 2, 0.95), None);
+        assert_eq!(rate_upper_bound(0, 5, 1.0), None);
+        assert_eq!(rate_upper_bound(0, 5, f64::NAN), None);
+    }
+
+    /// At the bound the binomial's lower tail is `1 - confidence` (the bound's definition), over
+    /// seeded counts.
+    #[test]
+    fn rate_upper_bound_puts_the_lower_tail_at_one_minus_the_confidence() {
+        use statrs::distribution::{Binomial, DiscreteCDF};
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = |m: u64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state % m
+        };
+        for _ in 0..300 {
+            let n = 1 + next(400) as usize;
+            let k = next(n as u64) as usize;
+            let conf = [0.8, 0.9, 0.95, 0.99][next(4) as usize];
+            let p = rate_upper_bound(k, n, conf).unwrap_or(f64::NAN);
+            let tail = Binomial::new(p, n as u64).map_or(f64::NAN, |d| d.cdf(k as u64));
+            assert!(
+                (tail - (1.0 - conf)).abs() < 1e-6,
+                "{k} of {n} at {conf}: bound {p}, P(X <= k) {tail}"
+            );
+            // More hits, a higher bound.
+            if k + 1 < n {
+                assert!(rate_upper_bound(k + 1, n, conf).unwrap_or(0.0) > p);
+            }
+        }
+    }
 
     #[test]
     fn median_and_mad_by_hand() {

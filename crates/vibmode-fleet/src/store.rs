@@ -178,6 +178,20 @@ pub struct VehicleStatus {
     /// whether its latest model set fits it (one line; [`NO_MODEL_FILE_STATUS`] without one).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub suspension: Option<String>,
+    /// The latest model set's nominal drives, each held out against the other nominal records
+    /// ([`crate::model::ModelSet::held_out_drives`]); absent without one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub held_out: Option<HeldOutCount>,
+}
+
+/// How many of a baseline's nominal drives, held out against its other nominal records, were
+/// flagged (a verdict other than `normal`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct HeldOutCount {
+    /// Drives held out.
+    pub drives: usize,
+    /// Of them, flagged.
+    pub flagged: usize,
 }
 
 /// One drive verdict as the status shows it.
@@ -1247,10 +1261,22 @@ impl Store {
                 last_checks.push((file, a.classification, a.summary));
             }
             let drives = self.drive_statuses(vid, &v)?;
+            let latest = self.latest_model_set(&v)?;
+            let held_out = latest
+                .as_ref()
+                .filter(|set| !set.held_out_drives.is_empty())
+                .map(|set| HeldOutCount {
+                    drives: set.held_out_drives.len(),
+                    flagged: set
+                        .held_out_drives
+                        .iter()
+                        .filter(|d| d.classification != Classification::Normal)
+                        .count(),
+                });
             let suspension = match self.vehicle_model(&v)? {
                 // Said, not left out: without the fit a lost spring may pass unseen.
                 None => Some(NO_MODEL_FILE_STATUS.to_string()),
-                Some((sha, _)) => Some(match self.latest_model_set(&v)? {
+                Some((sha, _)) => Some(match latest {
                     None => "model file registered; no baseline yet".to_string(),
                     Some(set) => match &set.suspension {
                         Some(r) if r.model_sha256 == sha => format!(
@@ -1275,6 +1301,7 @@ impl Store {
                 latest_drive: drives.first().cloned(),
                 drives: drives.into_iter().take(last).collect(),
                 suspension,
+                held_out,
             });
         }
         Ok(out)

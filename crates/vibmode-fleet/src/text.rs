@@ -332,6 +332,8 @@ pub fn status_text(st: &[VehicleStatus]) -> String {
             },
         }
     }
+    text.push_str(&held_out_fleet_line(st));
+    text.push('\n');
     text.push('\n');
     for v in st {
         let _ = writeln!(
@@ -345,6 +347,13 @@ pub fn status_text(st: &[VehicleStatus]) -> String {
         );
         if let Some(s) = &v.suspension {
             let _ = writeln!(text, "  {s}");
+        }
+        if let Some(h) = &v.held_out {
+            let _ = writeln!(
+                text,
+                "  baseline's nominal drives, each checked against the other nominal records: {} of {} flagged",
+                h.flagged, h.drives
+            );
         }
         if !v.drives.is_empty() {
             text.push_str("  drives, newest first (when driven; when checked where the records' times are unknown):\n");
@@ -370,6 +379,29 @@ pub fn status_text(st: &[VehicleStatus]) -> String {
     }
     text
 }
+
+/// The fleet's measured false-alarm rate per drive, one line: the baselines' nominal drives held
+/// out, summed over the vehicles, with the one-sided upper bound of the rate they measure
+/// ([`HELD_OUT_CONFIDENCE`]), or that none was held out yet.
+pub fn held_out_fleet_line(st: &[VehicleStatus]) -> String {
+    let (mut drives, mut flagged, mut vehicles) = (0, 0, 0);
+    for h in st.iter().filter_map(|v| v.held_out) {
+        drives += h.drives;
+        flagged += h.flagged;
+        vehicles += 1;
+    }
+    match crate::stats::rate_upper_bound(flagged, drives, HELD_OUT_CONFIDENCE) {
+        Some(bound) => format!(
+            "false alarms per drive, measured: {flagged} of {drives} healthy nominal drives of {vehicles} vehicle(s) flagged when held out of their baseline, a rate of at most {:.1} % ({:.0} % upper bound; the stated rate, a bound, is in each drive's row)",
+            100.0 * bound,
+            100.0 * HELD_OUT_CONFIDENCE
+        ),
+        None => "false alarms per drive, measured: not yet: no baseline has nominal records of two drives (days, else folders), so the rate per drive is the stated bound only".to_string(),
+    }
+}
+
+/// The confidence of the upper bound on the measured false-alarm rate per drive.
+pub const HELD_OUT_CONFIDENCE: f64 = 0.95;
 
 fn or_dash(s: &str) -> &str {
     if s.is_empty() {
@@ -546,6 +578,7 @@ mod tests {
             latest_drive: None,
             drives: vec![],
             suspension: None,
+            held_out: None,
         };
         let checked = v(vec![
             (
@@ -609,6 +642,7 @@ mod tests {
                 drive("today", Classification::Normal, ""),
             ],
             suspension: None,
+            held_out: None,
         };
         let text = status_text(&[v]);
         let lines: Vec<&str> = text.lines().collect();
@@ -629,5 +663,38 @@ mod tests {
         let header = at("evidence");
         assert_eq!(header.find("drive"), today.find("today"), "{text}");
         assert_eq!(header.find("verdict"), today.find("normal"), "{text}");
+    }
+
+    /// `fleet status` sums the baselines' held-out nominal drives over the fleet and bounds the
+    /// false-alarm rate per drive they measure; without any, it says the rate is only stated.
+    #[test]
+    fn the_fleets_held_out_drives_bound_its_false_alarm_rate() {
+        let v = |name: &str, held_out| VehicleStatus {
+            vehicle: name.into(),
+            n_nominal: 16,
+            n_test: 0,
+            baseline_version: Some(1),
+            last_checks: vec![],
+            latest_drive: None,
+            drives: vec![],
+            suspension: None,
+            held_out,
+        };
+        let count = |drives, flagged| Some(crate::store::HeldOutCount { drives, flagged });
+        let text = status_text(&[v("a", count(2, 0)), v("b", count(3, 1)), v("c", None)]);
+        // 1 of 5: scipy.stats.beta.ppf(0.95, 2, 4) = 0.6574.
+        assert!(
+            text.contains("false alarms per drive, measured: 1 of 5 healthy nominal drives of 2 vehicle(s) flagged when held out of their baseline, a rate of at most 65.7 % (95 % upper bound; the stated rate, a bound, is in each drive's row)"),
+            "{text}"
+        );
+        assert!(
+            text.contains("vehicle b: 16 nominal, 0 test records, baseline version 1\n  baseline's nominal drives, each checked against the other nominal records: 1 of 3 flagged"),
+            "{text}"
+        );
+        let text = status_text(&[v("c", None)]);
+        assert!(
+            text.contains("false alarms per drive, measured: not yet"),
+            "{text}"
+        );
     }
 }

@@ -80,3 +80,33 @@ fn fiducial_z_matches_scipy_quadrature() {
         );
     }
 }
+
+const RATE_UPPER_BOUND: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../tools/reference/data/rate_upper_bound.json"
+));
+
+/// The Clopper-Pearson upper bound of a false-alarm rate from k flagged of n held-out drives,
+/// against `scipy.stats.beta.ppf(confidence, k + 1, n - k)` (tools/reference/rate_upper_bound.py,
+/// scipy 1.14.1): n 1..2000, k from 0 to n, confidence 0.8..0.999, to 1e-9 absolute plus 1e-7
+/// relative.
+#[test]
+fn rate_upper_bound_matches_scipy() {
+    let r: Value = serde_json::from_str(RATE_UPPER_BOUND).unwrap();
+    assert_eq!(r["versions"]["scipy"], "1.14.1");
+    let cases = r["cases"].as_array().unwrap();
+    assert!(cases.len() >= 200, "{}", cases.len());
+    for c in cases {
+        let (k, n, conf, want) = (
+            c["k"].as_u64().unwrap() as usize,
+            c["n"].as_u64().unwrap() as usize,
+            c["confidence"].as_f64().unwrap(),
+            c["bound"].as_f64().unwrap(),
+        );
+        let got = vibmode_fleet::stats::rate_upper_bound(k, n, conf).unwrap_or(f64::NAN);
+        assert!(
+            (got - want).abs() <= 1e-9 + 1e-7 * want.abs(),
+            "{k} of {n} at {conf}: {got} vs scipy {want}"
+        );
+    }
+}
