@@ -150,6 +150,53 @@ pub struct LineFree {
     /// [`crate::model::ModelSet::noise_free`]). Empty in records stored before it existed.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub noise_density: Vec<f64>,
+    /// The transmissibility's parts per Welch bin, lines in: a model set leaves out of every
+    /// record the bins of the vehicle's own lines ([`crate::model::ModelSet::vehicle_line_bins_hz`])
+    /// besides the record's, so that a line found in some records and not in others does not
+    /// move the feature. Absent in records stored before it existed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bins: Option<TransmissibilityBins>,
+}
+
+/// A record's cross-spectral transmissibility per Welch bin (within the bands), from which a
+/// band's value with any set of bins left out is `sqrt(sum coherent / sum input)` over the
+/// band's other bins ([`TransmissibilityBins::band_value`]): the H1 estimate's power over the
+/// input power, as [`h1_band_values`] computes it.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TransmissibilityBins {
+    /// Bin centres, Hz.
+    pub freq_hz: Vec<f64>,
+    /// Per entry of [`RecordFeatures::transmissibility`] (same order): `|S_us|^2 / S_uu` per bin,
+    /// the unsprung input's power coherent with the sprung output, scaled by the output (0 where
+    /// `S_uu` is 0).
+    pub coherent: Vec<Vec<f64>>,
+    /// Per entry of [`RecordFeatures::transmissibility`]: `S_uu` per bin, the unsprung PSD.
+    pub input: Vec<Vec<f64>>,
+}
+
+impl TransmissibilityBins {
+    /// The transmissibility of entry `entry` in `band` (Hz, edges included as in
+    /// [`vibmode_spectra::band_rms`]) with the bins at the frequencies of `left_out` (either
+    /// list, Hz) left out of both sums; `None` where no input power is left or the entry is
+    /// absent.
+    pub fn band_value(&self, entry: usize, band: [f64; 2], left_out: &[&[f64]]) -> Option<f64> {
+        let (coherent, input) = (self.coherent.get(entry)?, self.input.get(entry)?);
+        let out = |f: f64| {
+            left_out
+                .iter()
+                .any(|l| l.iter().any(|&x| (x - f).abs() <= 1e-9 * f.abs().max(1.0)))
+        };
+        let (mut num, mut den) = (0.0, 0.0);
+        for ((&f, &c), &p) in self.freq_hz.iter().zip(coherent).zip(input) {
+            if f >= band[0] && f <= band[1] && !out(f) {
+                num += c;
+                den += p;
+            }
+        }
+        (den > 0.0)
+            .then(|| (num / den).sqrt())
+            .filter(|v| v.is_finite())
+    }
 }
 
 /// Where an unsprung channel's spectrum is taken as its sensor's noise floor, Hz: from
@@ -730,6 +777,15 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
             .map(|p| finite(band_rms(&freq, &continuum(p, &unsprung_lines), rlo, rhi)))
             .collect(),
         noise_density,
+        bins: transmissibility_bins(
+            &freq,
+            &transmissibility,
+            &channels,
+            &pairs,
+            &cross,
+            &psd,
+            &cfg.bands_hz,
+        ),
     };
     if !channels.iter().any(|c| c.role == Role::Unsprung) {
         notes.push("no unsprung channel: no excitation levels".into());
@@ -755,6 +811,53 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
         suspension: None,
         start_unix_s: None,
     })
+}
+
+/// The transmissibility's parts per bin within the bands ([`TransmissibilityBins`]), in the
+/// order of `transmissibility`; `None` when a corner's spectra are missing or of another length.
+fn transmissibility_bins(
+    freq: &[f64],
+    transmissibility: &[CornerTransmissibility],
+    channels: &[ChannelFeatures],
+    pairs: &[(Corner, usize, usize)],
+    cross: &[Vec<(f64, f64)>],
+    psd: &[Vec<f64>],
+    bands_hz: &[[f64; 2]],
+) -> Option<TransmissibilityBins> {
+    let lo = bands_hz.iter().map(|b| b[0]).fold(f64::INFINITY, f64::min);
+    let hi = bands_hz
+        .iter()
+        .map(|b| b[1])
+        .fold(f64::NEG_INFINITY, f64::max);
+    let keep: Vec<usize> = (0..freq.len())
+        .filter(|&k| freq[k] >= lo && freq[k] <= hi)
+        .collect();
+    let mut out = TransmissibilityBins {
+        freq_hz: keep.iter().map(|&k| freq[k]).collect(),
+        ..TransmissibilityBins::default()
+    };
+    for t in transmissibility {
+        let uidx = channels.iter().position(|c| c.name == t.unsprung)?;
+        let k = pairs.iter().position(|(c, _, _)| *c == t.corner)?;
+        let (sx, suu) = (cross.get(k)?, psd.get(uidx)?);
+        if sx.len() != freq.len() || suu.len() != freq.len() {
+            return None;
+        }
+        out.coherent.push(
+            keep.iter()
+                .map(|&j| {
+                    let (re, im) = sx[j];
+                    if suu[j] > 0.0 {
+                        (re * re + im * im) / suu[j]
+                    } else {
+                        0.0
+                    }
+                })
+                .collect(),
+        );
+        out.input.push(keep.iter().map(|&j| suu[j]).collect());
+    }
+    Some(out)
 }
 
 /// Per band, `sqrt(sum_band |S_us|^2 / S_uu / sum_band S_uu)` from the mean cross-spectrum
@@ -798,6 +901,25 @@ pub fn h1_band_values(
 mod tests {
     use super::*;
     use vibmode_core::{Channel, Num};
+
+    /// A band's transmissibility from the per-bin parts by hand: bins 1-4 Hz, coherent power
+    /// 1, 4, 9, 16 and input 4, 4, 4, 4; 1-3 Hz: sqrt(14 / 12); with 2 Hz left out by either
+    /// list: sqrt(10 / 8); 4 Hz only: sqrt(16 / 4) = 2; nothing left or no such entry: none.
+    #[test]
+    fn band_value_leaves_out_the_given_bins_by_hand() {
+        let b = TransmissibilityBins {
+            freq_hz: vec![1.0, 2.0, 3.0, 4.0],
+            coherent: vec![vec![1.0, 4.0, 9.0, 16.0]],
+            input: vec![vec![4.0; 4]],
+        };
+        let v = |band, out: &[&[f64]]| b.band_value(0, band, out).unwrap_or(f64::NAN);
+        assert!((v([1.0, 3.0], &[]) - (14.0f64 / 12.0).sqrt()).abs() < 1e-15);
+        assert!((v([1.0, 3.0], &[&[2.0]]) - (10.0f64 / 8.0).sqrt()).abs() < 1e-15);
+        assert!((v([1.0, 3.0], &[&[], &[2.0, 9.0]]) - (10.0f64 / 8.0).sqrt()).abs() < 1e-15);
+        assert_eq!(v([3.5, 4.0], &[]), 2.0);
+        assert_eq!(b.band_value(0, [3.5, 4.0], &[&[4.0]]), None);
+        assert_eq!(b.band_value(1, [1.0, 4.0], &[]), None);
+    }
 
     /// H1 band value by hand: a cross-spectrum `0.5 e^(i theta) S_uu` gives 0.5 in every band
     /// whatever the phase and the weights; a band without unsprung power gives none.
@@ -1051,5 +1173,22 @@ mod tests {
             lf.h1[0][b812].expect("line-free h1"),
         );
         assert!((a / b - 1.0).abs() < 1e-9, "8-12 Hz {a} vs {b}");
+        // The per-bin parts give the same values: with the record's lines left out, the
+        // line-free ones; with none left out, those with the line.
+        let bins = lf.bins.as_ref().expect("per-bin parts");
+        for (k, band) in f.bands_hz.iter().enumerate() {
+            let pairs = [
+                (bins.band_value(0, *band, &[&lf.line_bins_hz]), lf.h1[0][k]),
+                (bins.band_value(0, *band, &[]), f.transmissibility[0].h1[k]),
+            ];
+            for (got, want) in pairs {
+                match (got, want) {
+                    (Some(g), Some(w)) => {
+                        assert!((g / w - 1.0).abs() < 1e-9, "{band:?}: {g} vs {w}")
+                    }
+                    (g, w) => assert_eq!(g, w, "{band:?}"),
+                }
+            }
+        }
     }
 }

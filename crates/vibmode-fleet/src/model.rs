@@ -261,6 +261,16 @@ pub struct ModelSet {
     /// (`notes` says so) and in model sets stored before it existed.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub held_out_drives: Vec<HeldOutDrive>,
+    /// The bins (Hz) of the vehicle's own periodic lines: those left out of the line-free
+    /// transmissibility of at least [`VEHICLE_LINE_MIN_RECORDS`] nominal records. Every record
+    /// scored against the set (its nominal records too) has them left out of its transmissibility
+    /// besides its own lines' (key `transh1lu:`), so that a line its analysis found in some
+    /// records and not in others (a driveline order on a smooth road at low speed, not on the
+    /// baseline's rougher one) does not move the feature. `None` in model sets stored before it
+    /// existed or built from records without the transmissibility per bin
+    /// ([`crate::features::LineFree::bins`]): they score `transh1lf:` as before.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vehicle_line_bins_hz: Option<Vec<f64>>,
 }
 
 /// A nominal drive of the baseline checked against the other nominal records (leave one drive
@@ -285,6 +295,20 @@ pub struct HeldOutDrive {
 }
 
 impl ModelSet {
+    /// A record's scalar features as this model set reads them ([`scalar_features`] with its
+    /// modes, body response and variants).
+    pub fn record_features(&self, rf: &RecordFeatures) -> Vec<(FeatureMeta, f64)> {
+        scalar_features(
+            rf,
+            &self.slots,
+            self.body.as_ref(),
+            &self.config,
+            self.line_free,
+            self.noise_free,
+            self.vehicle_line_bins_hz.as_deref(),
+        )
+    }
+
     /// The limit of `kind` (infinite for a kind the model set has not).
     pub fn limit(&self, kind: Kind) -> f64 {
         self.limits
@@ -527,11 +551,15 @@ fn body_features(
 /// corner's own damper, spring or tyre stays. With a single corner the absolute value is kept.
 ///
 /// With `line_free`, the values with the periodic lines left out ([`RecordFeatures::line_free`],
-/// key `transh1lf`); a record without them gives none.
+/// key `transh1lf`); a record without them gives none. With `vehicle_lines` (a model set's
+/// [`ModelSet::vehicle_line_bins_hz`]), the values from the record's per-bin parts with its own
+/// lines' bins and those left out ([`crate::features::TransmissibilityBins::band_value`], key
+/// `transh1lu`); a record without the per-bin parts gives none.
 fn transmissibility_features(
     rf: &RecordFeatures,
     cfg: &FleetConfig,
     line_free: bool,
+    vehicle_lines: Option<&[f64]>,
 ) -> Vec<(FeatureMeta, f64)> {
     let mut out = Vec::new();
     for (k, b) in rf.bands_hz.iter().enumerate() {
@@ -543,6 +571,15 @@ fn transmissibility_features(
             .iter()
             .enumerate()
             .filter_map(|(i, t)| {
+                if let Some(vehicle) = vehicle_lines {
+                    let lf = rf.line_free.as_ref()?;
+                    let v = lf.bins.as_ref()?.band_value(
+                        i,
+                        *b,
+                        &[lf.line_bins_hz.as_slice(), vehicle],
+                    )?;
+                    return (v > 0.0).then(|| (t, "transh1lu", v.ln()));
+                }
                 if line_free {
                     let lf = rf.line_free.as_ref()?.h1.get(i)?;
                     let v = lf.get(k).copied().flatten()?;
@@ -598,6 +635,7 @@ pub fn scalar_features(
     cfg: &FleetConfig,
     line_free: bool,
     noise_free: bool,
+    vehicle_lines: Option<&[f64]>,
 ) -> Vec<(FeatureMeta, f64)> {
     let mut out = body.map_or_else(Vec::new, |b| body_features(rf, b, cfg));
     // Road level per band: the mean of ln(band RMS) over the unsprung channels that have it.
@@ -623,7 +661,7 @@ pub fn scalar_features(
             ));
         }
     }
-    out.extend(transmissibility_features(rf, cfg, line_free));
+    out.extend(transmissibility_features(rf, cfg, line_free, vehicle_lines));
     // Unsprung level ratios at and above wheel hop: left over right wheel of each axle, front
     // over rear wheel of each side. Both wheels of a pair roll on the same road class at the same
     // speed (on one side, on the same track), so the road level and its spectrum cancel.
@@ -966,13 +1004,22 @@ pub fn build_model_set(
                 .as_ref()
                 .is_some_and(|l| !l.noise_density.is_empty())
         });
+    let vehicle_lines = vehicle_line_bins(records);
     let mut notes = Vec::new();
     let body = fit_body(records, cfg, &mut notes);
     let values: Vec<Vec<(FeatureMeta, f64)>> = records
         .iter()
         .enumerate()
         .map(|(i, r)| {
-            let mut v = scalar_features(r, &slots, None, cfg, line_free, noise_free);
+            let mut v = scalar_features(
+                r,
+                &slots,
+                None,
+                cfg,
+                line_free,
+                noise_free,
+                vehicle_lines.as_deref(),
+            );
             if let Some((_, loo)) = &body {
                 v.extend(loo[i].iter().cloned());
             }
@@ -1059,7 +1106,39 @@ pub fn build_model_set(
         noise_free,
         suspension: None,
         held_out_drives: Vec::new(),
+        vehicle_line_bins_hz: vehicle_lines,
     })
+}
+
+/// A periodic line's bins found in at least this many nominal records are the vehicle's
+/// ([`ModelSet::vehicle_line_bins_hz`]): more than one, so that a false line of one record's
+/// analysis (1 % per pool and analysis, docs/analysis.md) does not enter.
+pub const VEHICLE_LINE_MIN_RECORDS: usize = 2;
+
+/// The bins (Hz) left out of the line-free transmissibility of at least
+/// [`VEHICLE_LINE_MIN_RECORDS`] of `records`, ascending; `None` unless every record keeps the
+/// transmissibility per bin ([`crate::features::LineFree::bins`]).
+fn vehicle_line_bins(records: &[RecordFeatures]) -> Option<Vec<f64>> {
+    let mut seen: Vec<(f64, usize)> = Vec::new();
+    for r in records {
+        let lf = r.line_free.as_ref().filter(|l| l.bins.is_some())?;
+        for &f in &lf.line_bins_hz {
+            match seen
+                .iter_mut()
+                .find(|(x, _)| (*x - f).abs() <= 1e-9 * f.abs().max(1.0))
+            {
+                Some((_, n)) => *n += 1,
+                None => seen.push((f, 1)),
+            }
+        }
+    }
+    let mut out: Vec<f64> = seen
+        .into_iter()
+        .filter(|(_, n)| *n >= VEHICLE_LINE_MIN_RECORDS)
+        .map(|(f, _)| f)
+        .collect();
+    out.sort_by(f64::total_cmp);
+    Some(out)
 }
 
 fn group_of(kind: Kind) -> Group {
@@ -1084,14 +1163,7 @@ fn score(f: &FeatureStat, x: f64, cfg: &FleetConfig) -> f64 {
 /// A record with a failed sensor is classed [`Classification::Sensor`] whatever its scores
 /// (which cover its working channels only); the summary names the channels first.
 pub fn assess(set: &ModelSet, rf: &RecordFeatures) -> Assessment {
-    let values = scalar_features(
-        rf,
-        &set.slots,
-        set.body.as_ref(),
-        &set.config,
-        set.line_free,
-        set.noise_free,
-    );
+    let values = set.record_features(rf);
     let mut a = score_values(set, &values, &[], None);
     if !rf.sensor_faults.is_empty() {
         a.classification = Classification::Sensor;
@@ -1147,14 +1219,7 @@ pub fn assess_drive_fitted(
         .collect();
     let mut by_key: BTreeMap<String, (FeatureMeta, Vec<f64>)> = BTreeMap::new();
     for rf in &usable {
-        for (m, x) in scalar_features(
-            rf,
-            &set.slots,
-            set.body.as_ref(),
-            &set.config,
-            set.line_free,
-            set.noise_free,
-        ) {
+        for (m, x) in set.record_features(rf) {
             by_key
                 .entry(m.key.clone())
                 .or_insert_with(|| (m, Vec::new()))
@@ -1689,6 +1754,138 @@ mod tests {
         build_model_set("bus", &names, &recs, &FleetConfig::default()).expect("model set")
     }
 
+    /// Two corners with per-bin transmissibility parts in 2-5 Hz (bins 2, 3, 4, 5 Hz): the
+    /// coherent power `t^2 S_uu` (transmissibility `t`) in every bin, except that a line at 4 Hz
+    /// adds `line` to the first corner's coherent power. `found`: the record's analysis found the
+    /// line (its bins left out of the line-free values).
+    fn lined(t: [f64; 2], line: f64, found: bool) -> RecordFeatures {
+        let mut r = record(1.0, 1.0);
+        let input = vec![1.0, 2.0, 2.0, 1.0];
+        let coherent = |k: usize| -> Vec<f64> {
+            input
+                .iter()
+                .enumerate()
+                .map(|(j, p)| t[k] * t[k] * p + if k == 0 && j == 2 { line } else { 0.0 })
+                .collect()
+        };
+        r.transmissibility = [Corner::RL, Corner::RR]
+            .into_iter()
+            .map(|corner| CornerTransmissibility {
+                corner,
+                sprung: format!("{corner}_sprung"),
+                unsprung: format!("{corner}_unsprung"),
+                values: vec![Some(1.0)],
+                h1: Vec::new(),
+            })
+            .collect();
+        let lines: Vec<f64> = if found { vec![4.0] } else { Vec::new() };
+        let bins = crate::features::TransmissibilityBins {
+            freq_hz: vec![2.0, 3.0, 4.0, 5.0],
+            coherent: vec![coherent(0), coherent(1)],
+            input: vec![input.clone(), input.clone()],
+        };
+        // The stored line-free value as feature extraction makes it (the record's own lines out).
+        let h1 = (0..2)
+            .map(|k| vec![bins.band_value(k, [2.0, 5.0], &[&lines])])
+            .collect();
+        r.line_free = Some(crate::features::LineFree {
+            line_bins_hz: lines,
+            h1,
+            bins: Some(bins),
+            ..crate::features::LineFree::default()
+        });
+        r
+    }
+
+    /// The vehicle's lines: bins left out in two or more nominal records, not one; none without
+    /// the per-bin parts in every record.
+    #[test]
+    fn vehicle_line_bins_are_those_of_two_or_more_records() {
+        let with = |bins: &[f64]| {
+            let mut r = lined([0.5, 0.5], 0.0, false);
+            if let Some(lf) = r.line_free.as_mut() {
+                lf.line_bins_hz = bins.to_vec();
+            }
+            r
+        };
+        let recs = vec![
+            with(&[7.0, 7.5, 12.0]),
+            with(&[12.0]),
+            with(&[7.5]),
+            with(&[]),
+        ];
+        assert_eq!(vehicle_line_bins(&recs), Some(vec![7.5, 12.0]));
+        assert_eq!(vehicle_line_bins(&recs[3..]), Some(vec![]));
+        let mut old = recs.clone();
+        if let Some(lf) = old[1].line_free.as_mut() {
+            lf.bins = None;
+        }
+        assert_eq!(vehicle_line_bins(&old), None);
+    }
+
+    /// A line that the analysis found in some nominal records and not in others, and in every
+    /// record checked: with the vehicle's lines left out of every record the checked record's
+    /// transmissibility is the nominal one (RL 0.6 against RR 0.3: ln 2), as without any line;
+    /// with each record's own lines only (the older key) the nominal records that kept the line
+    /// pull the model set's centre up and the checked record scores below it.
+    #[test]
+    fn a_line_found_in_some_records_does_not_move_the_transmissibility() {
+        let cfg = FleetConfig::default();
+        let nominal: Vec<RecordFeatures> = (0..6).map(|i| lined([0.6, 0.3], 4.0, i < 2)).collect();
+        let names: Vec<String> = (0..6).map(|i| format!("n{i}")).collect();
+        let set = build_model_set("bus", &names, &nominal, &cfg).expect("model set");
+        assert_eq!(set.vehicle_line_bins_hz, Some(vec![4.0]));
+        let key = "transh1lu:RL:2-5Hz";
+        let centre = set
+            .features
+            .iter()
+            .find(|f| f.meta.key == key)
+            .map(|f| f.centre)
+            .expect("feature");
+        assert!((centre - 2f64.ln()).abs() < 1e-12, "{centre}");
+        let checked = lined([0.6, 0.3], 4.0, true);
+        let value = set
+            .record_features(&checked)
+            .into_iter()
+            .find(|(m, _)| m.key == key)
+            .map(|(_, v)| v)
+            .expect("value");
+        assert!((value - 2f64.ln()).abs() < 1e-12, "{value}");
+        // Each record's own lines only: 4 of 6 nominal records keep the line (RL's coherent
+        // power 0.72 + 4 over 6 of input: 0.886 against RR's 0.3), the checked record not.
+        let old = scalar_features(&checked, &set.slots, None, &cfg, true, false, None)
+            .into_iter()
+            .find(|(m, _)| m.key == "transh1lf:RL:2-5Hz")
+            .map(|(_, v)| v)
+            .expect("old value");
+        let kept = ((0.36 * 6.0 + 4.0) / 6.0f64).sqrt() / 0.3;
+        assert!((old - 2f64.ln()).abs() < 1e-12, "{old}");
+        let old_set = {
+            let mut s = set.clone();
+            s.vehicle_line_bins_hz = None;
+            s
+        };
+        let old_nominal: Vec<f64> = nominal
+            .iter()
+            .map(|r| {
+                old_set
+                    .record_features(r)
+                    .into_iter()
+                    .find(|(m, _)| m.key == "transh1lf:RL:2-5Hz")
+                    .map(|(_, v)| v)
+                    .expect("nominal value")
+            })
+            .collect();
+        assert!(
+            (old_nominal[5] - kept.ln()).abs() < 1e-12,
+            "{old_nominal:?}"
+        );
+        assert!(
+            (old_nominal[0] - 2f64.ln()).abs() < 1e-12,
+            "{old_nominal:?}"
+        );
+    }
+
     /// Transmissibility of three corners relative to the other two, by hand: every corner
     /// scaled alike (a load) leaves the features unchanged; RL halved gives RL ln(0.5) and the
     /// others -ln(0.5)/2; the band below `transmissibility_min_hz` gives no feature.
@@ -1708,7 +1905,7 @@ mod tests {
                     h1: Vec::new(),
                 })
                 .collect();
-            transmissibility_features(&r, &cfg, false)
+            transmissibility_features(&r, &cfg, false, None)
         };
         let base = rec(0.2, 0.3, 0.4);
         assert_eq!(base.len(), 3, "one band of three corners: {base:?}");
@@ -1850,7 +2047,7 @@ mod tests {
         let z = slots[0].damping_ratio.expect("damping");
         assert!((z - 0.305).abs() < 1e-9, "{z}");
         let damping = |r: &RecordFeatures| {
-            scalar_features(r, &slots, None, &cfg, false, false)
+            scalar_features(r, &slots, None, &cfg, false, false, None)
                 .into_iter()
                 .find(|(m, _)| m.kind == Kind::ModeDamping)
                 .map(|(_, x)| x.exp())
@@ -1861,7 +2058,7 @@ mod tests {
         // A model set stored before the damping class matches any damping.
         let mut old = slots.clone();
         old[0].damping_ratio = None;
-        let any = scalar_features(&moded(9.1, 0.03), &old, None, &cfg, false, false);
+        let any = scalar_features(&moded(9.1, 0.03), &old, None, &cfg, false, false, None);
         assert!(any.iter().any(|(m, _)| m.kind == Kind::ModeDamping));
     }
 
@@ -2100,6 +2297,7 @@ mod tests {
             h1: Vec::new(),
             ratio_band_rms: l.iter().map(|v| Some(*v)).collect(),
             noise_density: d.to_vec(),
+            bins: None,
         });
         r
     }
@@ -2118,7 +2316,7 @@ mod tests {
         assert_eq!(noise_free_level(1.0, 0.6), None);
         let r = noisy_wheels([2.0, 1.0, 1.0, 1.0], [1.0 / 12.0, 0.6 / 12.0, 0.0, 0.0]);
         let get = |noise_free: bool, key: &str| {
-            scalar_features(&r, &[], None, &cfg, true, noise_free)
+            scalar_features(&r, &[], None, &cfg, true, noise_free, None)
                 .into_iter()
                 .find(|(m, _)| m.key == key)
                 .map(|(_, v)| v)
@@ -2137,7 +2335,7 @@ mod tests {
         if let Some(lf) = old.line_free.as_mut() {
             lf.noise_density.clear();
         }
-        let x = scalar_features(&old, &[], None, &cfg, true, true)
+        let x = scalar_features(&old, &[], None, &cfg, true, true, None)
             .into_iter()
             .find(|(m, _)| m.key == left)
             .map(|(_, v)| v);
@@ -2458,6 +2656,7 @@ mod tests {
                 cfg,
                 set.line_free,
                 set.noise_free,
+                set.vehicle_line_bins_hz.as_deref(),
             )
         };
         let lowered = [body_evidence(Corner::RL, -6.0)];

@@ -8,7 +8,7 @@ use vibmode_report::panels::grid;
 use vibmode_report::{HtmlReport, Marker, Panel, Series};
 
 use crate::error::{FleetError, Result};
-use crate::model::{scalar_features, Classification, Group, ModelSet};
+use crate::model::{Classification, Group, ModelSet};
 use crate::store::{Condition, Store};
 
 /// Most transmissibility / level trend panels drawn per vehicle (the features with the largest
@@ -241,17 +241,10 @@ fn trend_figure(html: &mut HtmlReport, set: &ModelSet, records: &[RecordEntry]) 
     let values: Vec<Vec<(String, f64)>> = records
         .iter()
         .map(|(_, f, _)| {
-            scalar_features(
-                f,
-                &set.slots,
-                set.body.as_ref(),
-                &set.config,
-                set.line_free,
-                set.noise_free,
-            )
-            .into_iter()
-            .map(|(m, v)| (m.key, v))
-            .collect()
+            set.record_features(f)
+                .into_iter()
+                .map(|(m, v)| (m.key, v))
+                .collect()
         })
         .collect();
     // Vehicle features, most-moved first (largest |z| seen in any record).

@@ -1632,6 +1632,7 @@ mod tests {
             h1: vec![vec![Some(t)]],
             ratio_band_rms: vec![None],
             noise_density: Vec::new(),
+            bins: None,
         });
         f
     }
