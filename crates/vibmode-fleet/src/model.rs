@@ -1234,6 +1234,7 @@ pub fn assess_drive_fitted(
         .filter_map(|(m, xs)| median(&xs).map(|x| (m, x)))
         .collect();
     let mut a = score_values(set, &values, fitted, trend);
+    rough_in_many_records(set, &usable, &mut a);
     let left_out = records.len() - usable.len();
     if left_out > 0 {
         let mut faults: Vec<String> = records
@@ -1266,6 +1267,58 @@ pub fn assess_drive_fitted(
         a.sensor_faults = sf;
     }
     a
+}
+
+/// A drive's road alarm from its records' own: a rough road raises the levels of every record,
+/// but a record's alarm may come from any of the road's bands (and the per-band medians then
+/// stay below the limit: busgen bus 11219's class D drive, 6 of 8 records `road`, was `normal`).
+/// When at least half of the drive's `usable` records (at least [`MIN_DRIVE_RECORDS`]) are
+/// `road` or `both` on their own, the drive has a road alarm too: the same rule as a feature's
+/// median (at least half of the records beyond a limit) and the same bound on its false-alarm
+/// rate. The drive's summary says how many records, and in which bands (the strongest of each).
+fn rough_in_many_records(set: &ModelSet, usable: &[&RecordFeatures], a: &mut Assessment) {
+    let road = |c: Classification| matches!(c, Classification::Road | Classification::Both);
+    if road(a.classification) || usable.len() < MIN_DRIVE_RECORDS {
+        return;
+    }
+    let rough: Vec<Assessment> = usable
+        .iter()
+        .map(|r| assess(set, r))
+        .filter(|x| road(x.classification))
+        .collect();
+    if 2 * rough.len() < usable.len() {
+        return;
+    }
+    let mut bands: BTreeMap<&str, usize> = BTreeMap::new();
+    for x in &rough {
+        if let Some(e) = x
+            .evidence
+            .iter()
+            .find(|e| e.meta.group == Group::Excitation)
+        {
+            *bands.entry(e.meta.label.as_str()).or_default() += 1;
+        }
+    }
+    let mut counts: Vec<(&str, usize)> = bands.into_iter().collect();
+    counts.sort_by_key(|x| std::cmp::Reverse(x.1));
+    let most = if counts.is_empty() {
+        String::new()
+    } else {
+        let parts: Vec<String> = counts.iter().map(|(l, n)| format!("{l} in {n}")).collect();
+        format!(" ({})", parts.join(", "))
+    };
+    let vehicle = matches!(a.classification, Classification::Vehicle);
+    a.classification = Classification::from_alarms(vehicle, true);
+    let line = format!(
+        "road: {} of {} records beyond the road's nominal levels on their own{most}",
+        rough.len(),
+        usable.len()
+    );
+    a.summary = if a.summary.is_empty() {
+        line
+    } else {
+        format!("{}; {line}", a.summary)
+    };
 }
 
 /// The evidence of a drive's suspension scores: every corner's spring and damper scored, and
@@ -2060,6 +2113,60 @@ mod tests {
         old[0].damping_ratio = None;
         let any = scalar_features(&moded(9.1, 0.03), &old, None, &cfg, false, false, None);
         assert!(any.iter().any(|(m, _)| m.kind == Kind::ModeDamping));
+    }
+
+    /// A rough road seen in a different band by each record: no band's median is beyond its
+    /// limit, but two of four records are `road` on their own, so the drive is `road` (and says
+    /// so); one of four leaves it `normal`; a vehicle alarm stays beside it (`both`).
+    #[test]
+    fn a_drive_whose_records_are_rough_in_different_bands_is_road() {
+        let two_band = |l: [f64; 2], t: f64| {
+            let mut r = record(1.0, t);
+            r.bands_hz = vec![[2.0, 5.0], [5.0, 8.0]];
+            r.channels[0].band_rms = vec![Some(l[0]), Some(l[1])];
+            r.transmissibility[0].values = vec![Some(t), Some(t)];
+            r
+        };
+        let recs: Vec<RecordFeatures> = (0..6)
+            .map(|i| two_band([1.0 + 0.04 * i as f64; 2], 0.20 + 0.004 * i as f64))
+            .collect();
+        let names: Vec<String> = (0..6).map(|i| format!("n{i}")).collect();
+        let set = build_model_set("bus", &names, &recs, &FleetConfig::default()).expect("set");
+        let rough = 2.0 * 1.2 * (5.0 * set.config.floor_level).exp();
+        let (a, b, ok) = (
+            two_band([rough, 1.1], 0.21),
+            two_band([1.1, rough], 0.21),
+            two_band([1.1, 1.1], 0.21),
+        );
+        assert_eq!(assess(&set, &a).classification, Classification::Road);
+        assert_eq!(assess(&set, &b).classification, Classification::Road);
+        let drive = assess_drive(&set, &[&a, &b, &ok, &ok]);
+        assert_eq!(drive.classification, Classification::Road, "{drive:?}");
+        assert!(drive.evidence.is_empty(), "no band's median: {drive:?}");
+        assert_eq!(
+            drive.summary,
+            "road: 2 of 4 records beyond the road's nominal levels on their own (road level 2-5 Hz in 1, road level 5-8 Hz in 1)"
+        );
+        let drive = assess_drive(&set, &[&a, &ok, &ok, &ok]);
+        assert_eq!(drive.classification, Classification::Normal, "{drive:?}");
+        // With a vehicle alarm of the medians: both.
+        let (va, vb, vok) = (
+            two_band([rough, 1.1], 0.105),
+            two_band([1.1, rough], 0.105),
+            two_band([1.1, 1.1], 0.105),
+        );
+        let drive = assess_drive(&set, &[&va, &vb, &vok, &vok]);
+        assert_eq!(drive.classification, Classification::Both, "{drive:?}");
+        assert!(
+            drive.summary.starts_with("RL: transmissibility"),
+            "{}",
+            drive.summary
+        );
+        assert!(
+            drive.summary.contains("; road: 2 of 4 records"),
+            "{}",
+            drive.summary
+        );
     }
 
     /// A drive's value of a feature is the median over its records: one record in five moved
