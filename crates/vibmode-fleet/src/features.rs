@@ -172,6 +172,14 @@ pub struct TransmissibilityBins {
     pub coherent: Vec<Vec<f64>>,
     /// Per entry of [`RecordFeatures::transmissibility`]: `S_uu` per bin, the unsprung PSD.
     pub input: Vec<Vec<f64>>,
+    /// Per entry of [`RecordFeatures::transmissibility`]: `S_ss` per bin, the sprung PSD (empty in
+    /// records stored before it existed).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub output: Vec<Vec<f64>>,
+    /// The Welch segments averaged into these spectra (over the file's records; 0 where not
+    /// known).
+    #[serde(default)]
+    pub segments: usize,
 }
 
 impl TransmissibilityBins {
@@ -196,6 +204,27 @@ impl TransmissibilityBins {
         (den > 0.0)
             .then(|| (num / den).sqrt())
             .filter(|v| v.is_finite())
+    }
+
+    /// The coherence of entry `entry` over `band` with the bins of `left_out` left out, weighted
+    /// by the output's power: `sum coherent / sum output`, the share of the sprung channel's power
+    /// coherent with its wheel, as estimated (biased up by about `(1 - gamma^2) / n` for `n`
+    /// averages). `None` without the output spectra or power.
+    pub fn band_coherence(&self, entry: usize, band: [f64; 2], left_out: &[&[f64]]) -> Option<f64> {
+        let (coherent, output) = (self.coherent.get(entry)?, self.output.get(entry)?);
+        let out = |f: f64| {
+            left_out
+                .iter()
+                .any(|l| l.iter().any(|&x| (x - f).abs() <= 1e-9 * f.abs().max(1.0)))
+        };
+        let (mut num, mut den) = (0.0, 0.0);
+        for ((&f, &c), &p) in self.freq_hz.iter().zip(coherent).zip(output) {
+            if f >= band[0] && f <= band[1] && !out(f) {
+                num += c;
+                den += p;
+            }
+        }
+        (den > 0.0).then(|| num / den).filter(|v| v.is_finite())
     }
 }
 
@@ -521,6 +550,8 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
         })
         .collect();
     let mut cross: Vec<Vec<(f64, f64)>> = vec![Vec::new(); pairs.len()];
+    // Welch segments averaged into the cross-spectra, over the records.
+    let mut csd_segments = 0usize;
     let mut body: Option<BodySpectra> = None;
     // Each record pre-processed once (in parallel): the spectra here and the analysis below
     // share it.
@@ -585,6 +616,9 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
                 ..WelchParams::default()
             };
             let c = vibmode_spectra::csd(xu, xs, pre.band.fs_hz, &wp).map_err(spectra)?;
+            if k == 0 {
+                csd_segments += c.n_segments;
+            }
             if cross[k].is_empty() {
                 cross[k] = vec![(0.0, 0.0); c.csd.len()];
             }
@@ -785,7 +819,11 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
             &cross,
             &psd,
             &cfg.bands_hz,
-        ),
+        )
+        .map(|b| TransmissibilityBins {
+            segments: csd_segments,
+            ..b
+        }),
     };
     if !channels.iter().any(|c| c.role == Role::Unsprung) {
         notes.push("no unsprung channel: no excitation levels".into());
@@ -838,11 +876,13 @@ fn transmissibility_bins(
     };
     for t in transmissibility {
         let uidx = channels.iter().position(|c| c.name == t.unsprung)?;
+        let sidx = channels.iter().position(|c| c.name == t.sprung)?;
         let k = pairs.iter().position(|(c, _, _)| *c == t.corner)?;
-        let (sx, suu) = (cross.get(k)?, psd.get(uidx)?);
-        if sx.len() != freq.len() || suu.len() != freq.len() {
+        let (sx, suu, sss) = (cross.get(k)?, psd.get(uidx)?, psd.get(sidx)?);
+        if sx.len() != freq.len() || suu.len() != freq.len() || sss.len() != freq.len() {
             return None;
         }
+        out.output.push(keep.iter().map(|&j| sss[j]).collect());
         out.coherent.push(
             keep.iter()
                 .map(|&j| {
@@ -911,6 +951,7 @@ mod tests {
             freq_hz: vec![1.0, 2.0, 3.0, 4.0],
             coherent: vec![vec![1.0, 4.0, 9.0, 16.0]],
             input: vec![vec![4.0; 4]],
+            ..TransmissibilityBins::default()
         };
         let v = |band, out: &[&[f64]]| b.band_value(0, band, out).unwrap_or(f64::NAN);
         assert!((v([1.0, 3.0], &[]) - (14.0f64 / 12.0).sqrt()).abs() < 1e-15);
@@ -919,6 +960,21 @@ mod tests {
         assert_eq!(v([3.5, 4.0], &[]), 2.0);
         assert_eq!(b.band_value(0, [3.5, 4.0], &[&[4.0]]), None);
         assert_eq!(b.band_value(1, [1.0, 4.0], &[]), None);
+        // Coherence: coherent power over output power (8 each): 1-3 Hz 14 / 24, without 2 Hz
+        // 10 / 16; without the output spectra, none.
+        let mut c = b.clone();
+        assert_eq!(c.band_coherence(0, [1.0, 3.0], &[]), None);
+        c.output = vec![vec![8.0; 4]];
+        assert!(
+            (c.band_coherence(0, [1.0, 3.0], &[]).unwrap_or(f64::NAN) - 14.0 / 24.0).abs() < 1e-15
+        );
+        assert!(
+            (c.band_coherence(0, [1.0, 3.0], &[&[2.0]])
+                .unwrap_or(f64::NAN)
+                - 10.0 / 16.0)
+                .abs()
+                < 1e-15
+        );
     }
 
     /// H1 band value by hand: a cross-spectrum `0.5 e^(i theta) S_uu` gives 0.5 in every band

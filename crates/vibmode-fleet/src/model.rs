@@ -1006,6 +1006,20 @@ pub fn build_model_set(
         });
     let vehicle_lines = vehicle_line_bins(records);
     let mut notes = Vec::new();
+    let low = match vehicle_lines.as_deref() {
+        Some(lines) if cfg.transmissibility_min_coherence > 0.0 => {
+            low_coherence(records, lines, cfg)
+        }
+        _ => Vec::new(),
+    };
+    for (_, corner, band, coherence) in &low {
+        notes.push(format!(
+            "{corner}: transmissibility {} left out: its sprung channel's coherence with its wheel there is {:.2} over the nominal records (median, the estimate's bias taken out), below transmissibility_min_coherence {}",
+            band_label(band),
+            coherence,
+            vibmode_core::Num(cfg.transmissibility_min_coherence)
+        ));
+    }
     let body = fit_body(records, cfg, &mut notes);
     let values: Vec<Vec<(FeatureMeta, f64)>> = records
         .iter()
@@ -1020,6 +1034,7 @@ pub fn build_model_set(
                 noise_free,
                 vehicle_lines.as_deref(),
             );
+            v.retain(|(m, _)| !low.iter().any(|(key, ..)| *key == m.key));
             if let Some((_, loo)) = &body {
                 v.extend(loo[i].iter().cloned());
             }
@@ -1108,6 +1123,63 @@ pub fn build_model_set(
         held_out_drives: Vec::new(),
         vehicle_line_bins_hz: vehicle_lines,
     })
+}
+
+/// Welch's variance ratio of averaged Hann-windowed segments overlapping by half (Welch 1967:
+/// `1 + 2 rho^2`, `rho` = 1/6 the window's correlation at half a segment): `n` segments average
+/// like `n / HANN_HALF_OVERLAP_VARIANCE` independent ones.
+pub const HANN_HALF_OVERLAP_VARIANCE: f64 = 1.0 + 2.0 / 36.0;
+
+/// A band's coherence as estimated from `segments` Welch segments (Hann, half overlap), with
+/// the finite-average bias taken out: `E[g] = gamma^2 + (1 - gamma^2) / n` for `n` independent
+/// averages, so `gamma^2 = (n g - 1) / (n - 1)` (may be below 0 where the estimate is at its
+/// floor). `None` with fewer than 2 averages.
+pub fn corrected_coherence(estimated: f64, segments: usize) -> Option<f64> {
+    let n = segments as f64 / HANN_HALF_OVERLAP_VARIANCE;
+    (n > 1.0 && estimated.is_finite()).then(|| (n * estimated - 1.0) / (n - 1.0))
+}
+
+/// The transmissibility features (key, corner, band, median corrected coherence) whose sprung
+/// channel's coherence with its wheel over `records` is below
+/// [`FleetConfig::transmissibility_min_coherence`], with `lines` (the vehicle's) and each
+/// record's own lines left out; a feature whose coherence no record gives is kept.
+fn low_coherence(
+    records: &[RecordFeatures],
+    lines: &[f64],
+    cfg: &FleetConfig,
+) -> Vec<(String, Corner, [f64; 2], f64)> {
+    let mut per: BTreeMap<String, (Corner, [f64; 2], Vec<f64>)> = BTreeMap::new();
+    for r in records {
+        let Some(lf) = r.line_free.as_ref() else {
+            continue;
+        };
+        let Some(bins) = lf.bins.as_ref() else {
+            continue;
+        };
+        for (i, t) in r.transmissibility.iter().enumerate() {
+            for b in r
+                .bands_hz
+                .iter()
+                .filter(|b| b[0] >= cfg.transmissibility_min_hz)
+            {
+                let g = bins
+                    .band_coherence(i, *b, &[lf.line_bins_hz.as_slice(), lines])
+                    .and_then(|g| corrected_coherence(g, bins.segments));
+                if let Some(g) = g {
+                    per.entry(format!("transh1lu:{}:{}", t.corner, band_key(b)))
+                        .or_insert_with(|| (t.corner, *b, Vec::new()))
+                        .2
+                        .push(g);
+                }
+            }
+        }
+    }
+    per.into_iter()
+        .filter_map(|(key, (corner, band, g))| {
+            let m = median(&g)?;
+            (m < cfg.transmissibility_min_coherence).then_some((key, corner, band, m))
+        })
+        .collect()
 }
 
 /// A periodic line's bins found in at least this many nominal records are the vehicle's
@@ -1836,6 +1908,7 @@ mod tests {
             freq_hz: vec![2.0, 3.0, 4.0, 5.0],
             coherent: vec![coherent(0), coherent(1)],
             input: vec![input.clone(), input.clone()],
+            ..crate::features::TransmissibilityBins::default()
         };
         // The stored line-free value as feature extraction makes it (the record's own lines out).
         let h1 = (0..2)
@@ -1848,6 +1921,77 @@ mod tests {
             ..crate::features::LineFree::default()
         });
         r
+    }
+
+    /// The coherence with its bias out, by hand: 7 Hann segments at half overlap average as
+    /// 7 / (1 + 2/36) = 6.63 independent ones; an estimate of 1 stays 1, the floor 1 / n gives
+    /// 0, 0.3 gives (6.63 * 0.3 - 1) / 5.63 = 0.1757; one segment gives none.
+    #[test]
+    fn corrected_coherence_by_hand() {
+        let n = 7.0 / (1.0 + 2.0 / 36.0);
+        let c = |g: f64| corrected_coherence(g, 7).unwrap_or(f64::NAN);
+        assert!((c(1.0) - 1.0).abs() < 1e-12);
+        assert!(c(1.0 / n).abs() < 1e-12);
+        assert!((c(0.3) - (n * 0.3 - 1.0) / (n - 1.0)).abs() < 1e-12);
+        assert!((c(0.3) - 0.1757).abs() < 1e-4, "{}", c(0.3));
+        assert_eq!(corrected_coherence(0.5, 1), None);
+        assert_eq!(corrected_coherence(f64::NAN, 7), None);
+    }
+
+    /// A corner whose sprung channel is barely coherent with its wheel in the band (estimated
+    /// 0.2 from 7 segments: 0.05 with the bias out) is left out of the model set at
+    /// `transmissibility_min_coherence` 0.1 and named in a note; the other corner (0.9) is kept;
+    /// at 0 both are kept.
+    #[test]
+    fn a_band_whose_coherence_is_at_its_floor_is_left_out() {
+        let coherent = |r: &mut RecordFeatures, g: [f64; 2]| {
+            if let Some(bins) = r.line_free.as_mut().and_then(|l| l.bins.as_mut()) {
+                bins.output = (0..2)
+                    .map(|k| bins.coherent[k].iter().map(|c| c / g[k]).collect())
+                    .collect();
+                bins.segments = 7;
+            }
+        };
+        let nominal: Vec<RecordFeatures> = (0..6)
+            .map(|i| {
+                let mut r = lined([0.6, 0.3 + 0.01 * i as f64], 0.0, false);
+                coherent(&mut r, [0.2, 0.9]);
+                r
+            })
+            .collect();
+        let names: Vec<String> = (0..6).map(|i| format!("n{i}")).collect();
+        let cfg = FleetConfig {
+            transmissibility_min_coherence: 0.1,
+            ..FleetConfig::default()
+        };
+        let set = build_model_set("bus", &names, &nominal, &cfg).expect("model set");
+        let keys: Vec<&str> = set
+            .features
+            .iter()
+            .filter(|f| f.meta.kind == Kind::Transmissibility)
+            .map(|f| f.meta.key.as_str())
+            .collect();
+        assert_eq!(keys, vec!["transh1lu:RR:2-5Hz"]);
+        let g = corrected_coherence(0.2, 7).unwrap_or(f64::NAN);
+        assert!(
+            set.notes.contains(&format!(
+                "RL: transmissibility 2-5 Hz left out: its sprung channel's coherence with its wheel there is {g:.2} over the nominal records (median, the estimate's bias taken out), below transmissibility_min_coherence 0.1"
+            )),
+            "{:?}",
+            set.notes
+        );
+        let off = FleetConfig {
+            transmissibility_min_coherence: 0.0,
+            ..FleetConfig::default()
+        };
+        let all = build_model_set("bus", &names, &nominal, &off).expect("set");
+        assert_eq!(
+            all.features
+                .iter()
+                .filter(|f| f.meta.kind == Kind::Transmissibility)
+                .count(),
+            2
+        );
     }
 
     /// The vehicle's lines: bins left out in two or more nominal records, not one; none without

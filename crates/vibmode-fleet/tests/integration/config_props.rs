@@ -37,6 +37,7 @@ const SCALARS: &[&str] = &[
     "floor_level",
     "floor_transmissibility",
     "transmissibility_min_hz",
+    "transmissibility_min_coherence",
     "floor_frequency",
     "floor_damping",
     "mode_group_tol",
@@ -152,6 +153,14 @@ fn the_settings_of_the_issue_are_refused() {
         ("false_alarm_rate = 1e-15", "false_alarm_rate"),
         ("false_alarm_rate = 1e-300", "false_alarm_rate"),
         ("transmissibility_min_hz = nan", "transmissibility_min_hz"),
+        (
+            "transmissibility_min_coherence = 1",
+            "transmissibility_min_coherence",
+        ),
+        (
+            "transmissibility_min_coherence = -0.1",
+            "transmissibility_min_coherence",
+        ),
         ("bands_hz = [[1e-300, 2]]", "bands_hz"),
         ("floor_damping = inf", "floor_damping"),
     ] {
