@@ -126,3 +126,30 @@ def test_the_third_drive_pools_its_springs_with_the_two_before(tmp_path):
         assert abs(s["z"]) <= abs(s["t"]) + 1e-12 and s["z"] * s["t"] >= 0, s
     # Phi^-1(1 - 0.01 / 8): the trend's half of the fit's 1 % over its 4 tests.
     assert abs(trend["limit"] - 3.0233414) < 1e-6
+
+
+def test_baseline_holds_each_nominal_drive_out(tmp_path):
+    """Nominal records of two folders are two drives: the baseline checks each against a model
+    set of the other's records (`held_out_drives`, both `normal` on two healthy drives of the
+    same road and speed), and the status states the measured rate per drive with its bound
+    (0 of 2: 1 - 0.05^(1/2) = 77.6 %). The coherence gate's setting is read from the store's
+    settings like every other key."""
+    db = tmp_path / "fleet.db"
+    vibmode.fleet.init(db, {"transmissibility_min_coherence": 0.1})
+    assert vibmode.fleet.settings(db)["transmissibility_min_coherence"] == 0.1
+    for name, seed in (("mon", 71), ("tue", 72)):
+        vibmode.simulate("city_bus", records=5, fs=200.0, effects="none", seed=seed,
+                         out_dir=tmp_path / name)
+    stored = vibmode.fleet.ingest(db, "bus-1", [tmp_path / "mon", tmp_path / "tue"],
+                                  condition="nominal")
+    assert len(stored) == 10, str(stored)
+    result = vibmode.fleet.baseline(db, "bus-1")
+    held = result["held_out_drives"]
+    assert [Path(h["drive"]).name for h in held] == ["mon", "tue"], held
+    assert [h["classification"] for h in held] == ["normal", "normal"], held
+    assert [h["reference_records"] for h in held] == [5, 5]
+    assert "leave-one-drive-out: 2 nominal drive(s)" in str(result)
+    status = vibmode.fleet.status(db)
+    assert "a rate of at most 77.6 %" in str(status), str(status)
+    with pytest.raises(ValueError, match="transmissibility_min_coherence"):
+        vibmode.fleet.init(tmp_path / "bad.db", {"transmissibility_min_coherence": 1.5})
