@@ -188,19 +188,7 @@ impl TransmissibilityBins {
     /// list, Hz) left out of both sums; `None` where no input power is left or the entry is
     /// absent.
     pub fn band_value(&self, entry: usize, band: [f64; 2], left_out: &[&[f64]]) -> Option<f64> {
-        let (coherent, input) = (self.coherent.get(entry)?, self.input.get(entry)?);
-        let out = |f: f64| {
-            left_out
-                .iter()
-                .any(|l| l.iter().any(|&x| (x - f).abs() <= 1e-9 * f.abs().max(1.0)))
-        };
-        let (mut num, mut den) = (0.0, 0.0);
-        for ((&f, &c), &p) in self.freq_hz.iter().zip(coherent).zip(input) {
-            if f >= band[0] && f <= band[1] && !out(f) {
-                num += c;
-                den += p;
-            }
-        }
+        let (num, den) = self.band_sums(self.input.get(entry)?, entry, band, left_out)?;
         (den > 0.0)
             .then(|| (num / den).sqrt())
             .filter(|v| v.is_finite())
@@ -211,20 +199,33 @@ impl TransmissibilityBins {
     /// coherent with its wheel, as estimated (biased up by about `(1 - gamma^2) / n` for `n`
     /// averages). `None` without the output spectra or power.
     pub fn band_coherence(&self, entry: usize, band: [f64; 2], left_out: &[&[f64]]) -> Option<f64> {
-        let (coherent, output) = (self.coherent.get(entry)?, self.output.get(entry)?);
+        let (num, den) = self.band_sums(self.output.get(entry)?, entry, band, left_out)?;
+        (den > 0.0).then(|| num / den).filter(|v| v.is_finite())
+    }
+
+    /// The sums over `band`'s bins, but those of `left_out`, of entry `entry`'s coherent power
+    /// and of `other` (its input or output spectrum).
+    fn band_sums(
+        &self,
+        other: &[f64],
+        entry: usize,
+        band: [f64; 2],
+        left_out: &[&[f64]],
+    ) -> Option<(f64, f64)> {
+        let coherent = self.coherent.get(entry)?;
         let out = |f: f64| {
             left_out
                 .iter()
                 .any(|l| l.iter().any(|&x| (x - f).abs() <= 1e-9 * f.abs().max(1.0)))
         };
         let (mut num, mut den) = (0.0, 0.0);
-        for ((&f, &c), &p) in self.freq_hz.iter().zip(coherent).zip(output) {
+        for ((&f, &c), &p) in self.freq_hz.iter().zip(coherent).zip(other) {
             if f >= band[0] && f <= band[1] && !out(f) {
                 num += c;
                 den += p;
             }
         }
-        (den > 0.0).then(|| num / den).filter(|v| v.is_finite())
+        Some((num, den))
     }
 }
 

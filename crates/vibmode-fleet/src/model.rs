@@ -1289,15 +1289,16 @@ pub fn assess_drive_fitted(
         .copied()
         .filter(|r| r.sensor_faults.is_empty())
         .collect();
+    // Each record's features once: for the medians and for the records' own road verdicts.
+    let per_record: Vec<Vec<(FeatureMeta, f64)>> =
+        usable.iter().map(|rf| set.record_features(rf)).collect();
     let mut by_key: BTreeMap<String, (FeatureMeta, Vec<f64>)> = BTreeMap::new();
-    for rf in &usable {
-        for (m, x) in set.record_features(rf) {
-            by_key
-                .entry(m.key.clone())
-                .or_insert_with(|| (m, Vec::new()))
-                .1
-                .push(x);
-        }
+    for (m, x) in per_record.iter().flatten() {
+        by_key
+            .entry(m.key.clone())
+            .or_insert_with(|| (m.clone(), Vec::new()))
+            .1
+            .push(*x);
     }
     let need = usable.len().div_ceil(2).max(1);
     let values: Vec<(FeatureMeta, f64)> = by_key
@@ -1306,7 +1307,7 @@ pub fn assess_drive_fitted(
         .filter_map(|(m, xs)| median(&xs).map(|x| (m, x)))
         .collect();
     let mut a = score_values(set, &values, fitted, trend);
-    rough_in_many_records(set, &usable, &mut a);
+    rough_in_many_records(set, &per_record, &mut a);
     let left_out = records.len() - usable.len();
     if left_out > 0 {
         let mut faults: Vec<String> = records
@@ -1344,21 +1345,26 @@ pub fn assess_drive_fitted(
 /// A drive's road alarm from its records' own: a rough road raises the levels of every record,
 /// but a record's alarm may come from any of the road's bands (and the per-band medians then
 /// stay below the limit: busgen bus 11219's class D drive, 6 of 8 records `road`, was `normal`).
-/// When at least half of the drive's `usable` records (at least [`MIN_DRIVE_RECORDS`]) are
-/// `road` or `both` on their own, the drive has a road alarm too: the same rule as a feature's
+/// When at least half of the drive's records without a failed sensor (`per_record`: their
+/// features, at least [`MIN_DRIVE_RECORDS`]) are `road` or `both` on their own (scored as
+/// [`assess`] scores a record), the drive has a road alarm too: the same rule as a feature's
 /// median (at least half of the records beyond a limit) and the same bound on its false-alarm
 /// rate. The drive's summary says how many records, and in which bands (the strongest of each).
-fn rough_in_many_records(set: &ModelSet, usable: &[&RecordFeatures], a: &mut Assessment) {
+fn rough_in_many_records(
+    set: &ModelSet,
+    per_record: &[Vec<(FeatureMeta, f64)>],
+    a: &mut Assessment,
+) {
     let road = |c: Classification| matches!(c, Classification::Road | Classification::Both);
-    if road(a.classification) || usable.len() < MIN_DRIVE_RECORDS {
+    if road(a.classification) || per_record.len() < MIN_DRIVE_RECORDS {
         return;
     }
-    let rough: Vec<Assessment> = usable
+    let rough: Vec<Assessment> = per_record
         .iter()
-        .map(|r| assess(set, r))
+        .map(|values| score_values(set, values, &[], None))
         .filter(|x| road(x.classification))
         .collect();
-    if 2 * rough.len() < usable.len() {
+    if 2 * rough.len() < per_record.len() {
         return;
     }
     let mut bands: BTreeMap<&str, usize> = BTreeMap::new();
@@ -1384,7 +1390,7 @@ fn rough_in_many_records(set: &ModelSet, usable: &[&RecordFeatures], a: &mut Ass
     let line = format!(
         "road: {} of {} records beyond the road's nominal levels on their own{most}",
         rough.len(),
-        usable.len()
+        per_record.len()
     );
     a.summary = if a.summary.is_empty() {
         line
