@@ -474,6 +474,19 @@ fn analyze_with_a_vehicle_updates_the_model() {
         "{err}"
     );
     assert!(!out4.exists());
+    // Which anti-roll bars are fitted: a name of the setting's two, else one line naming both.
+    std::fs::write(&cfg, "[model_update]\nanti_roll_bars = \"sometimes\"\n").unwrap();
+    let o = vibmode(&args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("sometimes")
+            && err.contains("both")
+            && err.contains("file")
+            && err.lines().count() == 1,
+        "{err}"
+    );
+    assert!(!out4.exists());
     // A wheel's channel left out: the analysis runs, the update says why it did not.
     let out2 = d.path().join("report2");
     let mut args: Vec<&str> = vec!["analyze", "-q", "--method", "ssi-cov", "--vehicle", file];

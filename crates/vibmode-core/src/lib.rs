@@ -42,10 +42,10 @@ pub use modes::{
     PoleObservation, ReferenceMode, SupportFailure, TruthRow, UncertaintyMethod,
 };
 pub use params::{
-    BandLimit, BodyFitParams, BodySsiParams, ClusterParams, IdentMethod, IdentMethods, LineParams,
-    PoleFilterParams, PreprocessParams, Robust, SpectrumParams, StopParams, SweepModel,
-    SweepParams, DEFAULT_HUBER_FACTOR, EDGE_SHARE, EMPTY_BAND_MAX_CUTOFF_SHARE,
-    SWEEP_MAX_ITERATIONS, SWEEP_TOLERANCE,
+    AntiRollBars, BandLimit, BodyFitParams, BodySsiParams, ClusterParams, IdentMethod,
+    IdentMethods, LineParams, PoleFilterParams, PreprocessParams, Robust, SpectrumParams,
+    StopParams, SweepModel, SweepParams, DEFAULT_HUBER_FACTOR, EDGE_SHARE,
+    EMPTY_BAND_MAX_CUTOFF_SHARE, SWEEP_MAX_ITERATIONS, SWEEP_TOLERANCE,
 };
 pub use placement::{Corner, Direction, Placement, Role};
 pub use record_meta::RecordMeta;

@@ -1208,6 +1208,24 @@ pub struct BodyFitParams {
     pub band_hz: Option<[f64; 2]>,
     /// Samples dropped at each end of a record, s (default 1.0; the band-pass rings there).
     pub edge_s: f64,
+    /// Which anti-roll bars are fitted (default [`AntiRollBars::Both`]: a front and a rear bar
+    /// whatever the vehicle file holds, so that the fit does not depend on whether the file
+    /// has a bar; one the bus does not have comes out as 0).
+    pub anti_roll_bars: AntiRollBars,
+}
+
+/// Which anti-roll bars the model update fits (`anti_roll_bars` in `[model_update]`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum AntiRollBars {
+    /// A front and a rear bar, whether or not the vehicle file has them: the body equations are
+    /// linear in the bars, so the fit is the same from a file with a bar or without one, and a
+    /// bar the bus lacks comes out as 0 (the bounded fit holds it there).
+    #[default]
+    Both,
+    /// Only the bars the vehicle file has (a stiffness above 0): one unknown fewer per bar the
+    /// file lacks, for a bus known to have none.
+    File,
 }
 
 impl Default for BodyFitParams {
@@ -1215,6 +1233,7 @@ impl Default for BodyFitParams {
         BodyFitParams {
             band_hz: None,
             edge_s: 1.0,
+            anti_roll_bars: AntiRollBars::Both,
         }
     }
 }

@@ -108,6 +108,15 @@ impl ReportSection {
                 r.absent.join(" and the ")
             )
         };
+        let found = r.found_bars(file);
+        let intro = if found.is_empty() {
+            intro
+        } else {
+            format!(
+                "{intro} The vehicle file has no {}; the records give one (both axles' bars are fitted whatever the file holds: anti_roll_bars in [model_update]), and the updated vehicle file has it.",
+                found.join(" and no ")
+            )
+        };
         let modes = ReportTable {
             headers: [
                 "mode",

@@ -6,7 +6,8 @@
 //! the body coordinates come from the sprung sensors (`z + x theta + y phi` at each sensor, least
 //! squares over three or more sensors), the wheel coordinates from the unsprung sensors. With the
 //! sprung mass fixed at the vehicle file's value, the rows are linear in the pitch and roll
-//! inertias, the four suspension springs and dampers and the anti-roll bars present in the file:
+//! inertias, the four suspension springs and dampers and the two anti-roll bars (by default
+//! whether or not the file has them; [`AntiRollBars`]):
 //! a least-squares problem whose normal equations are summed record by record, with the
 //! sensors' noise share taken out (every regressor is a measured, noisy signal; the noise
 //! densities come from each channel's spectrum above the band; as much of the share as leaves
@@ -34,10 +35,10 @@ use vibmode_core::{Channel, Corner, Direction, Placement, Recording, Role};
 // factors are the costly part of a plan at a record's length).
 use vibmode_fft::{forward as plan_forward, inverse as plan_inverse};
 
-pub use vibmode_core::BodyFitParams;
+pub use vibmode_core::{AntiRollBars, BodyFitParams};
 
 /// Unknowns (per unit sprung mass): pitch inertia, roll inertia, springs FL..RR, dampers FL..RR,
-/// then the anti-roll bars of the axles that have one.
+/// then the anti-roll bars fitted (both axles', or those the file has: [`AntiRollBars`]).
 const N_BASE: usize = 10;
 
 /// Where the fit takes each body and wheel coordinate from.
@@ -385,7 +386,8 @@ impl BodyFitResult {
             ("anti-roll bar front", &file.front, &self.vehicle.front),
             ("anti-roll bar rear", &file.rear, &self.vehicle.rear),
         ] {
-            if a.anti_roll_stiffness_nm_per_rad > 0.0 {
+            // Every bar fitted, including one the file lacks (file value 0).
+            if self.parameters.iter().any(|p| p.name == name) {
                 push(
                     name.into(),
                     "kN m/rad",
@@ -395,6 +397,26 @@ impl BodyFitResult {
             }
         }
         out
+    }
+
+    /// The anti-roll bars the vehicle file lacks and the records put above 0 (with
+    /// [`AntiRollBars::Both`]), e.g. "front anti-roll bar of 118 kN m/rad".
+    pub fn found_bars(&self, file: &VehicleParams) -> Vec<String> {
+        [
+            ("front", &file.front, &self.vehicle.front),
+            ("rear", &file.rear, &self.vehicle.rear),
+        ]
+        .into_iter()
+        .filter(|(_, f, u)| {
+            f.anti_roll_stiffness_nm_per_rad <= 0.0 && u.anti_roll_stiffness_nm_per_rad > 0.0
+        })
+        .map(|(name, _, u)| {
+            format!(
+                "{name} anti-roll bar of {:.0} kN m/rad",
+                u.anti_roll_stiffness_nm_per_rad / 1e3
+            )
+        })
+        .collect()
     }
 
     /// A plain-text summary: the body modes of the file and of the updated model, then the
@@ -468,6 +490,13 @@ impl BodyFitResult {
             self.vehicle.front.anti_roll_stiffness_nm_per_rad / 1e3,
             self.vehicle.rear.anti_roll_stiffness_nm_per_rad / 1e3
         ));
+        let found = self.found_bars(file);
+        if !found.is_empty() {
+            s.push_str(&format!(
+                "  the file has no {}; the records give one\n",
+                found.join(" and no ")
+            ));
+        }
         let sds: Vec<String> = self
             .parameters
             .iter()
@@ -719,10 +748,13 @@ impl BodyFit {
             Some(b) => b,
             None => body_band_hz(&nominal_modes, BAND_HIGH_FACTOR)?,
         };
-        let bars = [
-            vehicle.front.anti_roll_stiffness_nm_per_rad > 0.0,
-            vehicle.rear.anti_roll_stiffness_nm_per_rad > 0.0,
-        ];
+        let bars = match params.anti_roll_bars {
+            AntiRollBars::Both => [true, true],
+            AntiRollBars::File => [
+                vehicle.front.anti_roll_stiffness_nm_per_rad > 0.0,
+                vehicle.rear.anti_roll_stiffness_nm_per_rad > 0.0,
+            ],
+        };
         let n = N_BASE + bars.iter().filter(|&&b| b).count();
         let m = vehicle.body.mass_kg;
         Ok(BodyFit {
@@ -746,6 +778,12 @@ impl BodyFit {
     /// The band of the equations, Hz.
     pub fn band_hz(&self) -> [f64; 2] {
         self.band_hz
+    }
+
+    /// Unknowns of the fit: the pitch and roll inertias, four springs, four dampers and the
+    /// anti-roll bars fitted ([`AntiRollBars`]); a [`RecordEquations`] must have as many.
+    pub fn unknowns(&self) -> usize {
+        self.gram.nrows() - 1
     }
 
     /// Records added so far.

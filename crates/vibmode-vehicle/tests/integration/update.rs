@@ -2,7 +2,7 @@
 //! the demo's records when the vehicle file is not the vehicle that was measured; its errors.
 use vibmode_core::{Channel, Recording};
 use vibmode_modal::shapes::mac;
-use vibmode_vehicle::update::{BodyFit, BodyFitParams};
+use vibmode_vehicle::update::{AntiRollBars, BodyFit, BodyFitParams};
 use vibmode_vehicle::*;
 
 const SEEDS: [u64; 5] = [1, 2, 3, 4, 5];
@@ -381,6 +381,94 @@ fn a_bar_the_bus_does_not_have_comes_out_as_zero() {
     eprintln!("front bar held at 0 on {held} of 6 seeds");
 }
 
+/// A bar the bus has and the vehicle file lacks (half of the independent bus family's buses
+/// draw a front bar; issue 30): records of the rigid bus with its front bar, fitted with the
+/// file without one, over three seeds. Both axles' bars are fitted by default, so the bar is
+/// found (within 5 %, and named as found) with the springs within 1 %, the body modes within 1 %
+/// and the roll inertia within 5 %; fitting only the file's bars (`AntiRollBars::File`) cannot
+/// represent the bus: its roll mode comes out right only by a roll inertia 30-38 % too small
+/// (asserted: more than 20 %).
+#[test]
+fn a_bar_the_file_lacks_is_fitted() {
+    let truth = changed(VehicleParams::city_bus());
+    let bus_bar = truth.front.anti_roll_stiffness_nm_per_rad;
+    assert!(bus_bar > 0.0);
+    let mut file = VehicleParams::city_bus();
+    file.front.anti_roll_stiffness_nm_per_rad = 0.0;
+    let truth_modes = FullCar::new(&truth).unwrap().modes().unwrap();
+    let err = |res: &vibmode_vehicle::update::BodyFitResult, label: ModeLabel| {
+        let t = truth_modes.iter().find(|m| m.label == label).unwrap();
+        res.mode(label).unwrap().frequency_hz / t.frequency_hz - 1.0
+    };
+    for seed in 1..=3 {
+        let records = rigid_records(&truth, seed);
+        let fit_with = |bars: AntiRollBars| {
+            let params = BodyFitParams {
+                anti_roll_bars: bars,
+                ..BodyFitParams::default()
+            };
+            let mut fit = BodyFit::new(&file, params).unwrap();
+            for r in &records {
+                fit.add_record(r).unwrap();
+            }
+            (fit.unknowns(), fit.solve().unwrap())
+        };
+        let (n_both, both) = fit_with(AntiRollBars::Both);
+        let (n_file, only_file) = fit_with(AntiRollBars::File);
+        assert_eq!((n_both, n_file), (12, 11));
+        let bar = both.vehicle.front.anti_roll_stiffness_nm_per_rad;
+        eprintln!(
+            "seed {seed}: front bar {:.1} kN m/rad (bus {:.1}); roll {:+.2} % (file's bars only {:+.2} %)",
+            bar / 1e3,
+            bus_bar / 1e3,
+            100.0 * err(&both, ModeLabel::BodyRoll),
+            100.0 * err(&only_file, ModeLabel::BodyRoll)
+        );
+        assert!(
+            (bar / bus_bar - 1.0).abs() < 0.05,
+            "seed {seed}: front bar {bar:.1}"
+        );
+        assert!(both.absent.is_empty(), "seed {seed}: {:?}", both.absent);
+        assert_eq!(
+            both.found_bars(&file),
+            vec![format!("front anti-roll bar of {:.0} kN m/rad", bar / 1e3)]
+        );
+        assert!(both
+            .summary_text(&file)
+            .contains("the file has no front anti-roll bar"));
+        for c in Corner::ALL {
+            let (got, want) = (
+                both.vehicle.axle(c).spring_stiffness_n_per_m,
+                truth.axle(c).spring_stiffness_n_per_m,
+            );
+            assert!(
+                (got / want - 1.0).abs() < 0.01,
+                "seed {seed}: {c} spring {got:.1} against {want:.1}"
+            );
+        }
+        for label in BODY {
+            assert!(err(&both, label).abs() < 0.01, "seed {seed}: {label}");
+        }
+        assert!(only_file.found_bars(&file).is_empty());
+        let roll_inertia = |res: &vibmode_vehicle::update::BodyFitResult| {
+            res.vehicle.body.roll_inertia_kgm2 / truth.body.roll_inertia_kgm2 - 1.0
+        };
+        eprintln!(
+            "seed {seed}: roll inertia {:+.2} % (file's bars only {:+.2} %)",
+            100.0 * roll_inertia(&both),
+            100.0 * roll_inertia(&only_file)
+        );
+        assert!(
+            roll_inertia(&both).abs() < 0.05,
+            "seed {seed}: roll inertia"
+        );
+        assert!(
+            roll_inertia(&only_file).abs() > 0.2,
+            "seed {seed}: the file's bars alone fit the roll inertia"
+        );
+    }
+}
+
 /// A record's equations kept (through JSON, as the fleet store keeps them) and added later give
 /// the very fit of the records added directly; equations of another vehicle file's unknowns
 /// (one anti-roll bar fewer) are refused.
@@ -426,7 +514,11 @@ fn equations_kept_and_added_later_give_the_same_fit() {
     // One bar fewer: one unknown fewer.
     let mut no_front = file.clone();
     no_front.front.anti_roll_stiffness_nm_per_rad = 0.0;
-    let mut other = BodyFit::new(&no_front, BodyFitParams::default()).unwrap();
+    let file_bars = BodyFitParams {
+        anti_roll_bars: AntiRollBars::File,
+        ..BodyFitParams::default()
+    };
+    let mut other = BodyFit::new(&no_front, file_bars).unwrap();
     let eq = direct.record_equations(&records[0]).unwrap();
     let e = other.add_equations(&eq).unwrap_err().to_string();
     assert!(e.contains("unknowns"), "{e}");
