@@ -143,6 +143,9 @@ def score(folder: Path, front_bar: bool, out: Path, config: Optional[Path] = Non
         return row
     row["supported"] = mu.get("supported", True)
     sd_hz = {m["label"].replace("_", " "): m["frequency_hz_sd"] for m in mu.get("mode_sd", [])}
+    # Whether a front bar was fitted: the file's, or any with `anti_roll_bars = "both"`.
+    row["front_bar_fitted"] = any(p["name"] == "anti-roll bar front"
+                                  for p in mu.get("parameters", []))
     row["param_sd"] = {p["name"]: p["sd"] / p["value"] for p in mu.get("parameters", [])
                        if p.get("sd") is not None and p["value"] > 0}
     truth_modes = {m["label"]: m for m in t["modes"]}
@@ -165,9 +168,11 @@ NEGLIGIBLE_BAR_NM_PER_RAD = 10e3
 
 
 def represents_bus(r: Dict) -> bool:
-    """Whether the row's vehicle file can represent its bus: it has a front bar, or the bus has
-    none (a file without one cannot fit the roll stiffness of a bus that has one)."""
-    return r["front_bar"] or r.get("bus_front_bar_nm_per_rad", 0.0) < NEGLIGIBLE_BAR_NM_PER_RAD
+    """Whether the row's fit can represent its bus: a front bar was fitted (the file's, or with
+    `anti_roll_bars = "both"`, the default since 2026-11-29, whatever the file holds), or the bus
+    has none (a fit of the file's bars alone cannot hold the roll moment of a bar it lacks)."""
+    return (r.get("front_bar_fitted", r["front_bar"])
+            or r.get("bus_front_bar_nm_per_rad", 0.0) < NEGLIGIBLE_BAR_NM_PER_RAD)
 
 
 def fmt_row(r: Dict) -> str:
