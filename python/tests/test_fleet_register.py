@@ -153,3 +153,31 @@ def test_baseline_holds_each_nominal_drive_out(tmp_path):
     assert "a rate of at most 77.6 %" in str(status), str(status)
     with pytest.raises(ValueError, match="transmissibility_min_coherence"):
         vibmode.fleet.init(tmp_path / "bad.db", {"transmissibility_min_coherence": 1.5})
+
+
+def test_status_keeps_an_earlier_flagged_drive(tmp_path):
+    """A drive flagged `vehicle` (RL damper at 50 %) and a healthy drive after it: the status
+    keeps the flagged drive as `earlier_flag` beneath the latest `normal`, as `fleet status`
+    prints it (docs/fleet.md)."""
+    db = tmp_path / "fleet.db"
+    vibmode.fleet.init(db)
+    vibmode.simulate("city_bus", records=6, fs=200.0, seed=11, out_dir=tmp_path / "nominal",
+                     format="csv")
+    vibmode.fleet.ingest(db, "bus-1", tmp_path / "nominal", condition="nominal")
+    vibmode.fleet.baseline(db, "bus-1")
+    bus = Path(__file__).resolve().parents[2] / "examples" / "city_bus.toml"
+    worn = tmp_path / "worn.toml"
+    worn.write_text(bus.read_text()
+                    + '\n[[corner_condition]]\ncorner = "RL"\ndamper_factor = 0.5\n')
+    vibmode.simulate(worn, records=4, fs=200.0, seed=21, out_dir=tmp_path / "worn", format="csv")
+    first = vibmode.fleet.check(db, "bus-1", tmp_path / "worn", drive="day-1")
+    assert first["drives"][0]["classification"] == "vehicle", str(first)
+    vibmode.simulate("city_bus", records=4, fs=200.0, seed=22, out_dir=tmp_path / "ok",
+                     format="csv")
+    second = vibmode.fleet.check(db, "bus-1", tmp_path / "ok", drive="day-2")
+    assert second["drives"][0]["classification"] == "normal", str(second)
+    status = vibmode.fleet.status(db)
+    flag = status[0]["earlier_flag"]
+    assert flag["drive"]["drive"] == "day-1" and flag["later_drives"] == 1, flag
+    assert (flag["flagged_drives"], flag["baseline_drives"]) == (1, 2), flag
+    assert "earlier drive flagged vehicle (RL" in str(status), str(status)

@@ -599,3 +599,74 @@ fn baseline_drives_are_each_checked_against_the_other_nominal_records() {
     );
     assert!(!text.contains("leave-one-drive-out: 2"), "{text}");
 }
+
+/// A fault found on one drive and not on the next stays in the status' row of the vehicle
+/// (a fault near the limits is not found on every drive): the latest `normal` is followed by the
+/// earlier flagged drive, until a new baseline; the Python and JSON side get it as
+/// `earlier_flag`.
+#[test]
+fn a_drive_flagged_earlier_stays_in_the_status_until_a_new_baseline() {
+    let d = tempfile::tempdir().unwrap();
+    let db = store_with_baseline(d.path());
+    let db = db.as_str();
+    let worn = d.path().join("worn_rl.toml");
+    let bus = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/city_bus.toml");
+    std::fs::write(
+        &worn,
+        std::fs::read_to_string(bus).unwrap()
+            + "\n[[corner_condition]]\ncorner = \"RL\"\ndamper_factor = 0.5\n",
+    )
+    .unwrap();
+    let files = common::simulate_csv_of(
+        worn.to_str().unwrap(),
+        &d.path().join("worn"),
+        "B",
+        "30",
+        "21",
+        "4",
+    );
+    let v = check_json(db, Some("day-1"), &files);
+    assert_eq!(v["drives"][0]["classification"], "vehicle", "{v}");
+    assert_eq!(v["drives"][0]["corner"], "RL", "{v}");
+    let status =
+        || String::from_utf8_lossy(&ok(&["fleet", "status", "--db", db]).stdout).to_string();
+    assert!(!status().contains("earlier drive flagged"), "{}", status());
+
+    let healthy = simulate_csv(&d.path().join("healthy"), "B", "30", "22", "4");
+    let v = check_json(db, Some("day-2"), &healthy);
+    assert_eq!(v["drives"][0]["classification"], "normal", "{v}");
+    let text = status();
+    let row = text.lines().nth(1).unwrap_or("");
+    let next = text.lines().nth(2).unwrap_or("");
+    assert!(row.starts_with("bus-1") && row.contains("normal"), "{text}");
+    assert!(
+        next.trim_start()
+            .starts_with("earlier drive flagged vehicle (RL")
+            && next.contains("drive day-1 (checked ")
+            && next.contains(
+                "not on the 1 drive(s) after it; 1 of 2 drives against baseline version 1 flagged"
+            ),
+        "{text}"
+    );
+    let st = vibmode_fleet::Store::open(std::path::Path::new(db))
+        .unwrap()
+        .status(10)
+        .unwrap();
+    let f = st[0].earlier_flag.as_ref().expect("earlier_flag");
+    assert_eq!((f.drive.drive.as_str(), f.later_drives), ("day-1", 1));
+    // The report's verdict row says the same.
+    let rep = d.path().join("report");
+    ok(&["fleet", "report", "--db", db, "-o", rep.to_str().unwrap()]);
+    let page = std::fs::read_to_string(rep.join("index.html")).unwrap();
+    assert!(
+        page.contains("earlier drive flagged vehicle (RL"),
+        "no earlier flag in the report"
+    );
+
+    // A new baseline (after a repair): the drives against it only.
+    ok(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
+    let again = simulate_csv(&d.path().join("again"), "B", "30", "23", "4");
+    let v = check_json(db, Some("day-3"), &again);
+    assert_eq!(v["drives"][0]["classification"], "normal", "{v}");
+    assert!(!status().contains("earlier drive flagged"), "{}", status());
+}

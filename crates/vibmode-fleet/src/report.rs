@@ -56,7 +56,12 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
                     "{} ({} records; false alarms <= {} per drive)",
                     d.drive, d.n_records, d.false_alarm_rate
                 ),
-                d.summary.clone(),
+                // A fault found on an earlier drive against the same baseline stays in sight.
+                match &s.earlier_flag {
+                    Some(f) if d.summary.is_empty() => crate::text::earlier_flag_line(f),
+                    Some(f) => format!("{}; {}", d.summary, crate::text::earlier_flag_line(f)),
+                    None => d.summary.clone(),
+                },
             ],
             // Records checked one by one only: the latest one's verdict in the evidence, so a
             // flagged record is not hidden behind "no drive checked".

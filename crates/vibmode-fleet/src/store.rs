@@ -182,6 +182,53 @@ pub struct VehicleStatus {
     /// ([`crate::model::ModelSet::held_out_drives`]); absent without one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub held_out: Option<HeldOutCount>,
+    /// When the latest drive is not flagged `vehicle` or `both`: the newest earlier drive
+    /// against the same baseline that was, so that a fault found once and not on the drives
+    /// after it (a fault near the limits is not found on every drive) is not hidden behind the
+    /// latest `normal`; absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub earlier_flag: Option<EarlierFlag>,
+}
+
+/// A vehicle fault found on an earlier drive and not on the latest ([`VehicleStatus::earlier_flag`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EarlierFlag {
+    /// The newest flagged drive against the latest drive's baseline.
+    pub drive: DriveStatus,
+    /// Drives after it against the same baseline (none of them flagged `vehicle` or `both`).
+    pub later_drives: usize,
+    /// Drives against that baseline flagged `vehicle` or `both`, of `baseline_drives`.
+    pub flagged_drives: usize,
+    /// Drives checked against that baseline.
+    pub baseline_drives: usize,
+}
+
+impl EarlierFlag {
+    /// The newest drive flagged `vehicle` or `both` among `drives` (newest first) against the
+    /// newest drive's baseline, when the newest drive itself is not.
+    pub fn of(drives: &[DriveStatus]) -> Option<EarlierFlag> {
+        let latest = drives.first()?;
+        let faulty = |d: &DriveStatus| {
+            matches!(
+                d.classification,
+                Classification::Vehicle | Classification::Both
+            )
+        };
+        if faulty(latest) {
+            return None;
+        }
+        let same: Vec<&DriveStatus> = drives
+            .iter()
+            .filter(|d| d.model_version == latest.model_version)
+            .collect();
+        let at = same.iter().position(|d| faulty(d))?;
+        Some(EarlierFlag {
+            drive: same[at].clone(),
+            later_drives: at,
+            flagged_drives: same.iter().filter(|d| faulty(d)).count(),
+            baseline_drives: same.len(),
+        })
+    }
 }
 
 /// How many of a baseline's nominal drives, held out against its other nominal records, were
@@ -226,6 +273,9 @@ pub struct DriveStatus {
     /// drives with this classification, by when it was driven (`driven`), or by when it was
     /// checked where that is unknown.
     pub since: String,
+    /// The version of the vehicle's model set (baseline) it was checked against.
+    #[serde(default)]
+    pub model_version: i64,
 }
 
 /// A Unix time (s) as UTC RFC 3339 to the second, as [`now_utc`] writes it; `None` outside
@@ -1299,6 +1349,7 @@ impl Store {
                 baseline_version,
                 last_checks,
                 latest_drive: drives.first().cloned(),
+                earlier_flag: EarlierFlag::of(&drives),
                 drives: drives.into_iter().take(last).collect(),
                 suspension,
                 held_out,
@@ -1346,7 +1397,8 @@ impl Store {
             .conn
             .prepare(
                 "SELECT d.drive, d.checked, d.json,
-                        (SELECT COUNT(*) FROM drive_records r WHERE r.drive_id = d.id)
+                        (SELECT COUNT(*) FROM drive_records r WHERE r.drive_id = d.id),
+                        d.model_version
                  FROM drives d WHERE d.vehicle_id = ?1 ORDER BY d.id",
             )
             .map_err(self.sql("reading drives"))?;
@@ -1357,17 +1409,18 @@ impl Store {
                     r.get::<_, String>(1)?,
                     r.get::<_, String>(2)?,
                     r.get::<_, i64>(3)?,
+                    r.get::<_, i64>(4)?,
                 ))
             })
             .map_err(self.sql("reading drives"))?
             .collect::<rusqlite::Result<Vec<_>>>()
             .map_err(self.sql("reading drives"))?;
         let mut parsed = Vec::with_capacity(rows.len());
-        for (drive, checked, json, n) in rows {
+        for (drive, checked, json, n, version) in rows {
             let d: crate::model::Drive = serde_json::from_str(&json)
                 .map_err(|e| self.corrupt(&format!("drive {drive} of {vehicle}"), e))?;
             let driven = d.start_unix_s.and_then(utc_of_unix);
-            parsed.push((drive, checked, d, n, driven));
+            parsed.push((drive, checked, d, n, driven, version));
         }
         // Stable: drives of equal time stay in the order they were stored.
         parsed.sort_by(|a, b| {
@@ -1376,7 +1429,7 @@ impl Store {
             at.cmp(bt)
         });
         let mut out: Vec<DriveStatus> = Vec::with_capacity(parsed.len());
-        for (drive, checked, d, n, driven) in parsed {
+        for (drive, checked, d, n, driven, model_version) in parsed {
             let class = d.assessment.classification;
             let since = match out.last() {
                 Some(prev) if prev.classification == class => prev.since.clone(),
@@ -1403,6 +1456,7 @@ impl Store {
                 n_records: n.max(0) as usize,
                 driven,
                 since,
+                model_version,
             });
         }
         out.reverse();

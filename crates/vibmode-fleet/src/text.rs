@@ -4,7 +4,7 @@
 
 use crate::fleet::{Checked, Ingested, Registered};
 use crate::model::{Classification, Drive, ModelSet, MIN_DRIVE_RECORDS};
-use crate::store::{Condition, VehicleStatus};
+use crate::store::{Condition, EarlierFlag, VehicleStatus};
 use std::fmt::Write as _;
 
 /// What `fleet ingest` says of the records it was given, one line per file, each record's own
@@ -315,6 +315,9 @@ pub fn status_text(st: &[VehicleStatus]) -> String {
                     d.n_records,
                     d.false_alarm_rate
                 );
+                if let Some(f) = &v.earlier_flag {
+                    let _ = writeln!(text, "{:<16} {}", "", earlier_flag_line(f));
+                }
             }
             // Records checked one by one only: the latest one's verdict, so that a flagged
             // record is not hidden behind "no drive".
@@ -378,6 +381,27 @@ pub fn status_text(st: &[VehicleStatus]) -> String {
         }
     }
     text
+}
+
+/// A vehicle fault found on an earlier drive and not on the latest, one line: which drive, how
+/// many drives since, and how many of the baseline's drives were flagged.
+pub fn earlier_flag_line(f: &EarlierFlag) -> String {
+    let d = &f.drive;
+    format!(
+        "earlier drive flagged {} ({}): drive {} ({}): {}; not on the {} drive(s) after it; {} of {} drives against baseline version {} flagged (a fault near the limits is not found on every drive: it stays listed until a new baseline)",
+        d.classification,
+        d.place(),
+        d.drive,
+        match &d.driven {
+            Some(t) => format!("driven {t}"),
+            None => format!("checked {}", d.checked),
+        },
+        or_dash(&d.summary),
+        f.later_drives,
+        f.flagged_drives,
+        f.baseline_drives,
+        d.model_version
+    )
 }
 
 /// The fleet's measured false-alarm rate per drive, one line: the baselines' nominal drives held
@@ -579,6 +603,7 @@ mod tests {
             drives: vec![],
             suspension: None,
             held_out: None,
+            earlier_flag: None,
         };
         let checked = v(vec![
             (
@@ -624,6 +649,7 @@ mod tests {
             n_records: 8,
             driven: None,
             since: "2026-11-28T02:30:12Z".into(),
+            model_version: 1,
         };
         let long = "/data/fleet/bus-017/2026-11-26";
         let v = VehicleStatus {
@@ -643,6 +669,7 @@ mod tests {
             ],
             suspension: None,
             held_out: None,
+            earlier_flag: None,
         };
         let text = status_text(&[v]);
         let lines: Vec<&str> = text.lines().collect();
@@ -679,6 +706,7 @@ mod tests {
             drives: vec![],
             suspension: None,
             held_out,
+            earlier_flag: None,
         };
         let count = |drives, flagged| Some(crate::store::HeldOutCount { drives, flagged });
         let text = status_text(&[v("a", count(2, 0)), v("b", count(3, 1)), v("c", None)]);
@@ -694,6 +722,77 @@ mod tests {
         let text = status_text(&[v("c", None)]);
         assert!(
             text.contains("false alarms per drive, measured: not yet"),
+            "{text}"
+        );
+    }
+    /// A fault found on an earlier drive and not on the latest stays in sight: the newest
+    /// flagged drive against the latest drive's baseline, the drives after it, and how many of
+    /// that baseline's drives were flagged; none when the latest is flagged itself or the
+    /// flagged drive was against an earlier baseline (a new one after a repair clears it).
+    #[test]
+    fn an_earlier_flagged_drive_stays_in_the_status() {
+        use crate::store::{DriveStatus, EarlierFlag};
+        let drive = |name: &str, class: Classification, version: i64| DriveStatus {
+            drive: name.into(),
+            checked: format!("2026-11-2{}T08:00:00Z", name.len()),
+            classification: class,
+            corner: (class == Classification::Vehicle).then(|| "FR".to_string()),
+            component: (class == Classification::Vehicle)
+                .then_some(crate::model::Component::Spring),
+            summary: if class == Classification::Vehicle {
+                "FR: spring (fitted) vs the other corners -29 %".into()
+            } else {
+                String::new()
+            },
+            vehicle_z_over_limit: None,
+            false_alarm_rate: 0.01,
+            n_records: 8,
+            driven: None,
+            since: "2026-11-28T02:30:12Z".into(),
+            model_version: version,
+        };
+        use Classification::{Both, Normal, Road, Vehicle};
+        // Newest first.
+        let drives = [
+            drive("d4", Normal, 2),
+            drive("d33", Road, 2),
+            drive("d222", Vehicle, 2),
+            drive("d1111", Normal, 2),
+            drive("d0", Vehicle, 1),
+        ];
+        let f = EarlierFlag::of(&drives).expect("an earlier flag");
+        assert_eq!(f.drive.drive, "d222");
+        assert_eq!(
+            (f.later_drives, f.flagged_drives, f.baseline_drives),
+            (2, 1, 4)
+        );
+        assert!(
+            EarlierFlag::of(&drives[3..]).is_none(),
+            "d0 was against baseline 1"
+        );
+        assert!(
+            EarlierFlag::of(&drives[2..]).is_none(),
+            "the latest is flagged"
+        );
+        assert!(EarlierFlag::of(&[]).is_none());
+        let both = [drive("a", Normal, 1), drive("b", Both, 1)];
+        assert_eq!(EarlierFlag::of(&both).map(|f| f.later_drives), Some(1));
+        let v = VehicleStatus {
+            vehicle: "bus-017".into(),
+            n_nominal: 16,
+            n_test: 40,
+            baseline_version: Some(2),
+            last_checks: vec![],
+            latest_drive: Some(drives[0].clone()),
+            drives: drives.to_vec(),
+            suspension: None,
+            held_out: None,
+            earlier_flag: Some(f),
+        };
+        let text = status_text(&[v]);
+        assert_eq!(
+            text.lines().nth(2),
+            Some("                 earlier drive flagged vehicle (FR spring): drive d222 (checked 2026-11-24T08:00:00Z): FR: spring (fitted) vs the other corners -29 %; not on the 2 drive(s) after it; 1 of 4 drives against baseline version 2 flagged (a fault near the limits is not found on every drive: it stays listed until a new baseline)"),
             "{text}"
         );
     }
