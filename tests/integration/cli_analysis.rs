@@ -487,6 +487,16 @@ fn analyze_with_a_vehicle_updates_the_model() {
         "{err}"
     );
     assert!(!out4.exists());
+    // A number where a name belongs: said in words, with the key.
+    std::fs::write(&cfg, "[model_update]\nanti_roll_bars = 3\n").unwrap();
+    let o = vibmode(&args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("expected a name in quotes (key = \"name\") in `model_update.anti_roll_bars`"),
+        "{err}"
+    );
+    assert!(!out4.exists());
     // A wheel's channel left out: the analysis runs, the update says why it did not.
     let out2 = d.path().join("report2");
     let mut args: Vec<&str> = vec!["analyze", "-q", "--method", "ssi-cov", "--vehicle", file];

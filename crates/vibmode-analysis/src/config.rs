@@ -324,7 +324,7 @@ impl AnalysisConfig {
             base.try_into()
                 .map_err(|e: toml::de::Error| AnalysisError::Config {
                     key: None,
-                    message: e.to_string().replace('\n', " "),
+                    message: vibmode_core::settings_message(&e.to_string().replace('\n', " ")),
                 })?;
         cfg.validate()?;
         Ok(cfg)

@@ -142,9 +142,29 @@ pub fn cap_message(msg: &str, max_bytes: usize) -> String {
     format!("{}...", &msg[..end])
 }
 
+/// A settings file's deserialisation message in words a user acts on. The TOML reader reports a
+/// number, boolean or table given where a name (an enum of settings such as `model = "arma"`)
+/// belongs as "invalid type: unit variant, expected string only"; that phrase is replaced by
+/// what the key takes. Other messages are returned as they are.
+pub fn settings_message(msg: &str) -> String {
+    msg.replace(
+        "invalid type: unit variant, expected string only",
+        "expected a name in quotes (key = \"name\")",
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn settings_messages_say_what_a_key_takes() {
+        assert_eq!(
+            settings_message("invalid type: unit variant, expected string only in `sweep.model`"),
+            "expected a name in quotes (key = \"name\") in `sweep.model`"
+        );
+        assert_eq!(settings_message("unknown field `x`"), "unknown field `x`");
+    }
 
     #[test]
     fn num_is_short() {

@@ -189,12 +189,18 @@ pub const FLOOR_MIN: f64 = 1e-6;
 /// The parser's message, short: serde's "expected one of `a`, `b`, ..." list of every key is
 /// dropped (docs/fleet.md lists them), and what remains is cut to 160 bytes.
 fn short_reason(message: &str) -> String {
-    let one_line = message.replace('\n', " ");
+    let one_line = vibmode_core::settings_message(&message.replace('\n', " "));
     let trimmed = one_line.trim();
     let head = trimmed
         .split_once(", expected one of")
         .map_or(trimmed, |(head, _)| head);
-    vibmode_core::cap_message(&vibmode_core::Quoted(head).to_string(), 160)
+    // Control characters of a value quoted in the message shown as '?', the whole cut at its
+    // end (the key it names comes last).
+    let clean: String = head
+        .chars()
+        .map(|c| if c.is_control() { '?' } else { c })
+        .collect();
+    vibmode_core::cap_message(&clean, 240)
 }
 
 impl FleetConfig {
