@@ -146,7 +146,10 @@ def check(
 def status(db: PathLike, last: int = 10) -> List[Dict[str, Any]]:
     """Status of every vehicle in the store, with its last ``last`` records: a list of dicts (a
     :class:`FleetList`); ``print(result)`` shows what ``vibmode fleet status`` prints (one
-    row per vehicle with its latest drive verdict first), also in ``result.text``."""
+    row per vehicle with its latest drive verdict first), also in ``result.text``. A vehicle
+    whose latest drive is not flagged ``vehicle`` or ``both`` while an earlier drive against the
+    same baseline was has ``earlier_flag`` (that drive, ``later_drives``, ``flagged_drives``,
+    ``baseline_drives``): a fault near the limits is not found on every drive."""
     data, text = _native.fleet_status(os.fspath(db), int(last))
     return FleetList(json.loads(data), text)
 
