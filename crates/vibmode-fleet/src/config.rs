@@ -187,7 +187,8 @@ pub const FLOOR_MAX: f64 = 10.0;
 pub const FLOOR_MIN: f64 = 1e-6;
 
 /// The parser's message, short: serde's "expected one of `a`, `b`, ..." list of every key is
-/// dropped (docs/fleet.md lists them), and what remains is cut to 160 bytes.
+/// dropped (docs/fleet.md lists them), a number given for a name is said in words
+/// ([`vibmode_core::settings_message`]), and what remains is cut at its end to 240 bytes.
 fn short_reason(message: &str) -> String {
     let one_line = vibmode_core::settings_message(&message.replace('\n', " "));
     let trimmed = one_line.trim();

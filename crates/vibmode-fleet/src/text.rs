@@ -725,6 +725,7 @@ mod tests {
             "{text}"
         );
     }
+
     /// A fault found on an earlier drive and not on the latest stays in sight: the newest
     /// flagged drive against the latest drive's baseline, the drives after it, and how many of
     /// that baseline's drives were flagged; none when the latest is flagged itself or the
