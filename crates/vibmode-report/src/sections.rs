@@ -100,12 +100,15 @@ impl ReportSection {
             Some(c) => format!("{intro} Band: {}.", c.reason),
             None => intro,
         };
+        // What the updated vehicle file holds is said only where one is written.
+        let written = not_used.is_none();
         let intro = if r.absent.is_empty() {
             intro
         } else {
             format!(
-                "{intro} The records put the {} at 0 (held there by the bounded fit, every parameter >= 0): the measured vehicle has none, and the updated vehicle file has none.",
-                r.absent.join(" and the ")
+                "{intro} The records put the {} at 0 (held there by the bounded fit, every parameter >= 0): the measured vehicle has none{}.",
+                r.absent.join(" and the "),
+                if written { ", and the updated vehicle file has none" } else { "" }
             )
         };
         let found = r.found_bars(file);
@@ -113,8 +116,9 @@ impl ReportSection {
             intro
         } else {
             format!(
-                "{intro} The vehicle file has no {}; the records give one (both axles' bars are fitted whatever the file holds: anti_roll_bars in [model_update]), and the updated vehicle file has it.",
-                found.join(" and no ")
+                "{intro} The records give a {}, which the vehicle file lacks (both axles' bars are fitted whatever the file holds: anti_roll_bars in [model_update]){}.",
+                found.join(" and a "),
+                if written { "; the updated vehicle file has it" } else { "" }
             )
         };
         let modes = ReportTable {

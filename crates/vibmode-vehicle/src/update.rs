@@ -493,8 +493,8 @@ impl BodyFitResult {
         let found = self.found_bars(file);
         if !found.is_empty() {
             s.push_str(&format!(
-                "  the file has no {}; the records give one\n",
-                found.join(" and no ")
+                "  found where the file has none: {}\n",
+                found.join(", ")
             ));
         }
         let sds: Vec<String> = self

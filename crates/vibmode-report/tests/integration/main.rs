@@ -7,3 +7,4 @@ mod axes;
 mod figures;
 mod html;
 mod reference;
+mod update_section;

@@ -435,7 +435,7 @@ fn a_bar_the_file_lacks_is_fitted() {
         );
         assert!(both
             .summary_text(&file)
-            .contains("the file has no front anti-roll bar"));
+            .contains("found where the file has none: front anti-roll bar of"));
         for c in Corner::ALL {
             let (got, want) = (
                 both.vehicle.axle(c).spring_stiffness_n_per_m,
