@@ -212,6 +212,9 @@ struct CheckJson<'a> {
     model_version: i64,
     records: &'a [Checked],
     drives: Vec<&'a Drive>,
+    /// An earlier drive flagged against the same baseline, when the latest drive is not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    earlier_flag: Option<vibmode_fleet::store::EarlierFlag>,
 }
 
 fn check(a: &CheckArgs) -> Result<()> {
@@ -236,7 +239,14 @@ fn check(a: &CheckArgs) -> Result<()> {
     );
     pb.finish_and_clear();
     let (out, drives) = out?;
-    let text = vibmode_fleet::text::check_text(&a.vehicle, set.version, &out, &drives);
+    // A fault found on an earlier drive stays in sight after a drive that does not show it.
+    let earlier = if drives.is_empty() {
+        None
+    } else {
+        store.earlier_flag(&a.vehicle)?
+    };
+    let text = vibmode_fleet::text::check_text(&a.vehicle, set.version, &out, &drives)
+        + &vibmode_fleet::text::earlier_flag_note(earlier.as_ref());
     match a.json.as_deref() {
         Some("-") => {
             eprint!("{text}");
@@ -251,6 +261,7 @@ fn check(a: &CheckArgs) -> Result<()> {
                 model_version: set.version,
                 records: &out,
                 drives: drives.iter().collect(),
+                earlier_flag: earlier,
             },
         )?;
     }

@@ -176,6 +176,8 @@ def test_status_keeps_an_earlier_flagged_drive(tmp_path):
                      format="csv")
     second = vibmode.fleet.check(db, "bus-1", tmp_path / "ok", drive="day-2")
     assert second["drives"][0]["classification"] == "normal", str(second)
+    assert second["earlier_flag"]["drive"]["drive"] == "day-1", str(second)
+    assert "note: earlier drive flagged vehicle (RL" in str(second), str(second)
     status = vibmode.fleet.status(db)
     flag = status[0]["earlier_flag"]
     assert flag["drive"]["drive"] == "day-1" and flag["later_drives"] == 1, flag

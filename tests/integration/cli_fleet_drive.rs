@@ -628,6 +628,7 @@ fn a_drive_flagged_earlier_stays_in_the_status_until_a_new_baseline() {
     let v = check_json(db, Some("day-1"), &files);
     assert_eq!(v["drives"][0]["classification"], "vehicle", "{v}");
     assert_eq!(v["drives"][0]["corner"], "RL", "{v}");
+    assert!(v.get("earlier_flag").is_none(), "{v}");
     let status =
         || String::from_utf8_lossy(&ok(&["fleet", "status", "--db", db]).stdout).to_string();
     assert!(!status().contains("earlier drive flagged"), "{}", status());
@@ -635,6 +636,9 @@ fn a_drive_flagged_earlier_stays_in_the_status_until_a_new_baseline() {
     let healthy = simulate_csv(&d.path().join("healthy"), "B", "30", "22", "4");
     let v = check_json(db, Some("day-2"), &healthy);
     assert_eq!(v["drives"][0]["classification"], "normal", "{v}");
+    // The check says it too, beneath its drive (and its JSON keeps it).
+    assert_eq!(v["earlier_flag"]["drive"]["drive"], "day-1", "{v}");
+    assert_eq!(v["earlier_flag"]["later_drives"], 1, "{v}");
     let text = status();
     let row = text.lines().nth(1).unwrap_or("");
     let next = text.lines().nth(2).unwrap_or("");
@@ -666,7 +670,32 @@ fn a_drive_flagged_earlier_stays_in_the_status_until_a_new_baseline() {
     // A new baseline (after a repair): the drives against it only.
     ok(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
     let again = simulate_csv(&d.path().join("again"), "B", "30", "23", "4");
-    let v = check_json(db, Some("day-3"), &again);
+    let json = d.path().join("day3.json");
+    let o = ok(&[
+        "fleet",
+        "check",
+        "--db",
+        db,
+        "--vehicle",
+        "bus-1",
+        "-q",
+        "--drive",
+        "day-3",
+        "--json",
+        json.to_str().unwrap(),
+        &again[0],
+        &again[1],
+        &again[2],
+        &again[3],
+    ]);
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(v["drives"][0]["classification"], "normal", "{v}");
+    assert!(v.get("earlier_flag").is_none(), "{v}");
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("day-3") && !text.contains("earlier drive flagged"),
+        "{text}"
+    );
     assert!(!status().contains("earlier drive flagged"), "{}", status());
 }

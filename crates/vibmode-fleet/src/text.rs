@@ -404,6 +404,14 @@ pub fn earlier_flag_line(f: &EarlierFlag) -> String {
     )
 }
 
+/// The note `fleet check` adds after a drive when an earlier drive against the same baseline
+/// was flagged and the vehicle's latest drive is not ([`EarlierFlag`]); empty otherwise.
+pub fn earlier_flag_note(f: Option<&EarlierFlag>) -> String {
+    f.map_or(String::new(), |f| {
+        format!("  note: {}\n", earlier_flag_line(f))
+    })
+}
+
 /// The fleet's measured false-alarm rate per drive, one line: the baselines' nominal drives held
 /// out, summed over the vehicles, with the one-sided upper bound of the rate they measure
 /// ([`HELD_OUT_CONFIDENCE`]), or that none was held out yet.
