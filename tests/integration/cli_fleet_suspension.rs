@@ -35,6 +35,22 @@ fn check_drive(db: &str, id: &str, files: &[String]) -> serde_json::Value {
     ];
     args.extend(files.iter().map(String::as_str));
     let o = ok(&args);
+    // The text (on stderr beside the JSON) says at which losses the drive's fit reaches its
+    // limit, per corner, each in 10-100 %.
+    let text = String::from_utf8_lossy(&o.stderr);
+    let line = text
+        .lines()
+        .find(|l| l.contains("this drive's fit reaches its limit at a loss of about: springs FL "))
+        .unwrap_or_else(|| panic!("no losses line: {text}"));
+    let percents: Vec<f64> = line
+        .split(" %")
+        .filter_map(|p| p.rsplit(' ').next()?.parse().ok())
+        .collect();
+    assert_eq!(percents.len(), 8, "{line}");
+    assert!(
+        percents.iter().all(|p| (10.0..=100.0).contains(p)),
+        "{line}"
+    );
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     v["drives"][0].clone()
 }

@@ -489,6 +489,26 @@ impl CornerScore {
         self.value / self.centre - 1.0
     }
 
+    /// The smallest loss of this corner's part (a fraction: 0.2 for 20 %) that the same fits
+    /// would flag at `limit`, about: the difference's standard deviation `ln(value / centre) / t`
+    /// times Student's t quantile, with the score's Welch degrees of freedom, of the normal tail
+    /// at `-limit` (the score itself is the Behrens-Fisher fiducial one, which this
+    /// approximates), and at least [`MIN_FLAGGED_LOSS`]. `None` for scores stored without `t`
+    /// and `df`, or with a zero difference (no spread to read).
+    pub fn smallest_flagged_loss(&self, limit: f64) -> Option<f64> {
+        use statrs::distribution::{ContinuousCDF, StudentsT};
+        let (t, df) = (self.t?, self.df?);
+        let d = (self.value / self.centre).ln();
+        let se = d / t;
+        if !(se.is_finite() && se > 0.0 && limit.is_finite() && limit > 0.0 && df > 0.0) {
+            return None;
+        }
+        let tail = 0.5 * statrs::function::erf::erfc(limit / std::f64::consts::SQRT_2);
+        let t_at_limit = StudentsT::new(0.0, 1.0, df).ok()?.inverse_cdf(tail);
+        let loss = 1.0 - (t_at_limit * se).exp();
+        loss.is_finite().then(|| loss.max(MIN_FLAGGED_LOSS))
+    }
+
     /// Whether this score is vehicle evidence: below `-limit` and a loss of at least
     /// [`MIN_FLAGGED_LOSS`].
     pub fn flagged(&self, limit: f64) -> bool {
@@ -1318,6 +1338,66 @@ mod tests {
     /// chi^2_k), to the Monte Carlo's 0.03; a known variance (over 1000 degrees of freedom) is
     /// the normal exactly; the sign follows `d`; parts of variance 0 add nothing; no score for
     /// d = 0, NaN, no positive variance or a part without degrees of freedom.
+    /// The loss at which a score reaches its limit: by hand (against scipy 1.14.1's
+    /// `stats.t.ppf(stats.norm.cdf(-3), df)`: -5.50708 at df 5, -3.0000075 at df 1e6), at the
+    /// floor, without `t`; and over seeded spreads, limits and degrees of freedom, a drive whose
+    /// difference is that loss scores exactly the limit (`t_as_normal`).
+    #[test]
+    fn smallest_flagged_loss_by_hand_and_at_the_limit_over_seeds() {
+        let score = |value: f64, t: Option<f64>, df: Option<f64>| CornerScore {
+            corner: Corner::FL,
+            part: Part::Spring,
+            value,
+            centre: 1.0,
+            z: 0.0,
+            t,
+            df,
+        };
+        let se = -(0.95f64.ln());
+        let by_hand = |t_at: f64| 1.0 - (t_at * se).exp();
+        let got = score(0.95, Some(-1.0), Some(5.0))
+            .smallest_flagged_loss(3.0)
+            .unwrap();
+        assert!((got - by_hand(-5.507_079_712_469_29)).abs() < 1e-9, "{got}");
+        assert!((got - 0.246_085_461).abs() < 1e-6, "{got}");
+        let got = score(0.95, Some(-1.0), Some(1e6))
+            .smallest_flagged_loss(3.0)
+            .unwrap();
+        assert!((got - 0.142_625_330).abs() < 1e-6, "{got}");
+        // A tiny spread: the floor.
+        let got = score(0.999, Some(-10.0), Some(7.0)).smallest_flagged_loss(3.0);
+        assert_eq!(got, Some(MIN_FLAGGED_LOSS));
+        assert_eq!(score(0.95, None, None).smallest_flagged_loss(3.0), None);
+        assert_eq!(
+            score(1.0, Some(0.0), Some(7.0)).smallest_flagged_loss(3.0),
+            None
+        );
+        let mut rng = XorShift(0x5eed_0046_d1ce_f00d);
+        for _ in 0..300 {
+            let (sd, df, limit) = (
+                0.05 + 0.25 * rng.uniform(),
+                2.0 + 38.0 * rng.uniform(),
+                2.0 + 2.0 * rng.uniform(),
+            );
+            let t0 = -3.0 + 6.0 * rng.uniform();
+            if t0.abs() < 1e-3 {
+                continue;
+            }
+            let s = score((t0 * sd).exp(), Some(t0), Some(df));
+            let Some(loss) = s.smallest_flagged_loss(limit) else {
+                panic!("no loss for sd {sd} df {df}")
+            };
+            if loss > MIN_FLAGGED_LOSS {
+                let t = (1.0 - loss).ln() / sd;
+                assert!(
+                    (t_as_normal(t, df) + limit).abs() < 1e-6,
+                    "sd {sd} df {df} limit {limit}: {}",
+                    t_as_normal(t, df)
+                );
+            }
+        }
+    }
+
     #[test]
     fn fiducial_z_by_hand() {
         for k in [3.0, 7.0, 15.0] {

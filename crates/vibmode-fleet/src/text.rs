@@ -255,6 +255,12 @@ pub fn check_text(vehicle: &str, model_version: i64, out: &[Checked], drives: &[
                 vibmode_core::cap_message(&s.reference_drives.join(", "), 120)
             );
         }
+        // What the drive's fit could have shown: a normal drive is not a verdict on a smaller loss.
+        if let Some(s) = &d.suspension {
+            if let Some(line) = smallest_losses_line(s) {
+                let _ = writeln!(text, "  note: {line}");
+            }
+        }
         if !d.in_baseline.is_empty() {
             let _ = writeln!(
                 text,
@@ -381,6 +387,38 @@ pub fn status_text(st: &[VehicleStatus]) -> String {
         }
     }
     text
+}
+
+/// The losses at which a drive's suspension fit reaches its limit per corner, one line (e.g.
+/// "this drive's fit reaches its limit at a loss of about: springs FL 31 %, ...; dampers ...");
+/// `None` when no score gives one ([`crate::suspension::CornerScore::smallest_flagged_loss`]).
+pub fn smallest_losses_line(s: &crate::suspension::DriveSuspension) -> Option<String> {
+    use crate::suspension::Part;
+    let part = |p: Part| -> Option<String> {
+        let cells: Vec<String> = crate::suspension::CORNERS
+            .iter()
+            .map(|c| {
+                let loss = s
+                    .scores
+                    .iter()
+                    .find(|x| x.corner == *c && x.part == p)
+                    .and_then(|x| x.smallest_flagged_loss(s.limit));
+                format!(
+                    "{c} {}",
+                    loss.map_or("-".to_string(), |l| format!("{:.0} %", 100.0 * l))
+                )
+            })
+            .collect();
+        cells
+            .iter()
+            .any(|c| !c.ends_with(" -"))
+            .then(|| cells.join(", "))
+    };
+    let (springs, dampers) = (part(Part::Spring)?, part(Part::Damper)?);
+    Some(format!(
+        "this drive's fit reaches its limit at a loss of about: springs {springs}; dampers {dampers} (a loss of that size is flagged on about half of such drives, a smaller one seldom; a spring's slow loss is also judged over the last {} drives)",
+        crate::suspension::TREND_DRIVES
+    ))
 }
 
 /// A vehicle fault found on an earlier drive and not on the latest, one line: which drive, how
@@ -519,6 +557,59 @@ mod tests {
             Some("  note: suspension fit scored against the baseline's fit pooled with the vehicle's first 2 normal drive(s): d1, d2")
         );
         assert_eq!(note(drive(&[])), None);
+    }
+
+    /// `fleet check`: a drive with a suspension fit says at which loss per corner its fit
+    /// reaches the limit; a corner whose score gives none shows a dash, and scores without `t`
+    /// and `df` (stored before them) give no line.
+    #[test]
+    fn a_drive_says_which_losses_its_fit_would_flag() {
+        use crate::suspension::{CornerScore, DriveSuspension, Part, CORNERS};
+        // ln(0.95) over t = -1: a standard deviation of 0.0513; at limit 3 with df 1e6 the
+        // loss is 1 - exp(-3.0000075 * 0.0513) = 14.26 % (scipy 1.14.1, stats.t.ppf).
+        let score = |corner, part, t: Option<f64>| CornerScore {
+            corner,
+            part,
+            value: 0.95,
+            centre: 1.0,
+            z: -1.0,
+            t,
+            df: t.map(|_| 1e6),
+        };
+        let mut scores: Vec<CornerScore> = CORNERS
+            .iter()
+            .flat_map(|&c| {
+                [
+                    score(c, Part::Spring, Some(-1.0)),
+                    score(c, Part::Damper, Some(-1.0)),
+                ]
+            })
+            .collect();
+        scores[7] = score(CORNERS[3], Part::Damper, None);
+        let s = DriveSuspension {
+            fit: crate::suspension::CornerFit::even_for_tests(),
+            scores,
+            limit: 3.0,
+            trend: None,
+            reference_drives: vec![],
+        };
+        assert_eq!(
+            smallest_losses_line(&s).as_deref(),
+            Some("this drive's fit reaches its limit at a loss of about: springs FL 14 %, FR 14 %, RL 14 %, RR 14 %; dampers FL 14 %, FR 14 %, RL 14 %, RR - (a loss of that size is flagged on about half of such drives, a smaller one seldom; a spring's slow loss is also judged over the last 3 drives)")
+        );
+        let old = DriveSuspension {
+            scores: s
+                .scores
+                .iter()
+                .map(|x| CornerScore {
+                    t: None,
+                    df: None,
+                    ..x.clone()
+                })
+                .collect(),
+            ..s
+        };
+        assert_eq!(smallest_losses_line(&old), None);
     }
 
     /// `fleet check`: records that form no drive (too few, or a day of too few) are named in a
