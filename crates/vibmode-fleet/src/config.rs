@@ -121,8 +121,14 @@ pub fn fleet_analysis(preset: vibmode_analysis::Preset) -> AnalysisConfig {
         // The suspension fitted per drive (a registered vehicle model file): the body
         // still rigid, the manoeuvres below (docs/fleet.md, "The suspension fitted per
         // drive": healthy drives scattered least with 0.7-5 Hz on busgen's buses).
+        // The model file's anti-roll bars only: each record's equations are stored and a
+        // drive's fit is compared with the baseline's, so every fit of a store keeps the
+        // unknowns its first records were stored with (stores made before both bars became
+        // the standalone update's default have them), and the comparisons are relative, so
+        // a bar the file lacks moves the baseline and the drives alike.
         model_update: vibmode_core::BodyFitParams {
             band_hz: Some(SUSPENSION_BAND_HZ),
+            anti_roll_bars: vibmode_core::AntiRollBars::File,
             ..vibmode_core::BodyFitParams::default()
         },
         ..base

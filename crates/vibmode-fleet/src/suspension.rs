@@ -131,16 +131,6 @@ impl VehicleModel {
             ));
         }
         let mut fit = self.fit(analysis)?;
-        // Equations stored before both axles' bars were always fitted (2026-11-29) have only
-        // the bars of the model file: fitted together with the file's bars alone.
-        if equations.iter().all(|e| e.unknowns != fit.unknowns()) {
-            let mut params = analysis.model_update.clone();
-            params.anti_roll_bars = vibmode_vehicle::update::AntiRollBars::File;
-            let file_bars = BodyFit::new(&self.params, params).map_err(|e| e.to_string())?;
-            if equations.iter().all(|e| e.unknowns == file_bars.unknowns()) {
-                fit = file_bars;
-            }
-        }
         for e in equations {
             fit.add_equations(e).map_err(|e| e.to_string())?;
         }

@@ -145,12 +145,13 @@ fn springs_and_dampers_fitted_per_drive_over_seeds() {
     );
 }
 
-/// A registered model file without a front bar: equations stored before both axles' bars were
-/// always fitted (the file's bars only: one unknown fewer) are still fitted, and give the fit
-/// of the file's bars alone, bit for bit; new equations have both bars' unknowns; a mix of the
-/// two is refused with one line naming the unknowns.
+/// A registered model file without a front bar: the fleet fits the file's bars only (its
+/// default `anti_roll_bars = "file"`), so records stored before both bars became the standalone
+/// update's default and records stored now have the same unknowns, and one fit takes them all;
+/// equations of the other layout (a store set up with "both") are refused with one line naming
+/// the unknowns, not fitted together.
 #[test]
-fn equations_of_the_files_bars_alone_are_still_fitted() {
+fn the_fleet_fits_the_model_files_bars_and_refuses_a_mix() {
     use vibmode_vehicle::update::{AntiRollBars, BodyFit};
     let no_front = CITY_BUS.replace(
         "anti_roll_stiffness_nm_per_rad = 300000.0",
@@ -159,6 +160,7 @@ fn equations_of_the_files_bars_alone_are_still_fitted() {
     assert_ne!(no_front, CITY_BUS, "the example's front bar was not found");
     let model = VehicleModel::from_toml(&no_front, "no front bar").unwrap();
     let cfg = FleetConfig::default();
+    assert_eq!(cfg.analysis.model_update.anti_roll_bars, AntiRollBars::File);
     let recs = records(
         &VehicleParams::city_bus(),
         RoadClass::B,
@@ -167,31 +169,21 @@ fn equations_of_the_files_bars_alone_are_still_fitted() {
         4,
         Disturbances::in_service(),
     );
-    let mut file_bars = cfg.analysis.clone();
-    file_bars.model_update.anti_roll_bars = AntiRollBars::File;
-    let old = BodyFit::new(&model.params, file_bars.model_update.clone()).unwrap();
-    let old_eqs: Vec<_> = recs
-        .iter()
-        .map(|r| {
-            old.record_equations_placed(r, |c| cfg.analysis.placement_for_update(c))
-                .unwrap()
-        })
-        .collect();
-    let old_refs: Vec<_> = old_eqs.iter().collect();
-    assert_eq!(old_refs[0].unknowns, 11);
-    assert_eq!(
-        model.fit_corners(&cfg.analysis, &old_refs).unwrap(),
-        model.fit_corners(&file_bars, &old_refs).unwrap()
-    );
-
-    let new_eqs: Vec<_> = recs
+    let stored: Vec<_> = recs
         .iter()
         .map(|r| model.record_equations(r, &cfg.analysis).unwrap().equations)
         .collect();
-    assert_eq!(new_eqs[0].unknowns, 12);
-    let new_refs: Vec<_> = new_eqs.iter().collect();
-    assert!(model.fit_corners(&cfg.analysis, &new_refs).is_ok());
-    let mixed = vec![old_refs[0], old_refs[1], new_refs[2], new_refs[3]];
+    assert_eq!(stored[0].unknowns, 11, "10 and the rear bar");
+    let refs: Vec<_> = stored.iter().collect();
+    assert!(model.fit_corners(&cfg.analysis, &refs).is_ok());
+    let mut both = cfg.analysis.clone();
+    both.model_update.anti_roll_bars = AntiRollBars::Both;
+    let fit_both = BodyFit::new(&model.params, both.model_update.clone()).unwrap();
+    let other = fit_both
+        .record_equations_placed(&recs[0], |c| cfg.analysis.placement_for_update(c))
+        .unwrap();
+    assert_eq!(other.unknowns, 12);
+    let mixed = vec![refs[0], refs[1], refs[2], &other];
     let e = model.fit_corners(&cfg.analysis, &mixed).unwrap_err();
-    assert!(e.contains("unknowns"), "{e}");
+    assert!(e.contains("unknowns") && e.lines().count() == 1, "{e}");
 }
