@@ -2,11 +2,10 @@
 
 use anyhow::Result;
 use clap::{Args, Subcommand};
-use serde::Serialize;
 use std::path::PathBuf;
 use vibmode_fleet::{
-    build_baseline, check_drive_files_progress, ingest_files_progress, require_baseline, Checked,
-    Condition, Drive, FleetConfig, IngestLabels, Store,
+    build_baseline, check_drive_files_progress, ingest_files_progress, require_baseline, Condition,
+    FleetConfig, IngestLabels, Store,
 };
 
 /// Arguments of `vibmode fleet`.
@@ -206,17 +205,6 @@ fn baseline(db: &std::path::Path, vehicle: &str) -> Result<()> {
     crate::output::print_stdout(&vibmode_fleet::text::baseline_text(&set))
 }
 
-#[derive(Serialize)]
-struct CheckJson<'a> {
-    vehicle: &'a str,
-    model_version: i64,
-    records: &'a [Checked],
-    drives: Vec<&'a Drive>,
-    /// An earlier drive flagged against the same baseline, when the latest drive is not.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    earlier_flag: Option<vibmode_fleet::store::EarlierFlag>,
-}
-
 fn check(a: &CheckArgs) -> Result<()> {
     let files = vibmode_signal::expand_folders(&a.files)?;
     // The store is an input too: JSON written over it would destroy it.
@@ -239,14 +227,8 @@ fn check(a: &CheckArgs) -> Result<()> {
     );
     pb.finish_and_clear();
     let (out, drives) = out?;
-    // A fault found on an earlier drive stays in sight after a drive that does not show it.
-    let earlier = if drives.is_empty() {
-        None
-    } else {
-        store.earlier_flag(&a.vehicle)?
-    };
-    let text = vibmode_fleet::text::check_text(&a.vehicle, set.version, &out, &drives)
-        + &vibmode_fleet::text::earlier_flag_note(earlier.as_ref());
+    let report = vibmode_fleet::CheckReport::new(&store, &a.vehicle, set.version, out, drives)?;
+    let text = report.text();
     match a.json.as_deref() {
         Some("-") => {
             eprint!("{text}");
@@ -254,16 +236,7 @@ fn check(a: &CheckArgs) -> Result<()> {
         _ => crate::output::print_stdout(&text)?,
     }
     if let Some(dest) = &a.json {
-        crate::output::write_json(
-            dest,
-            &CheckJson {
-                vehicle: &a.vehicle,
-                model_version: set.version,
-                records: &out,
-                drives: drives.iter().collect(),
-                earlier_flag: earlier,
-            },
-        )?;
+        crate::output::write_json(dest, &report)?;
     }
     Ok(())
 }

@@ -161,17 +161,6 @@ fn fleet_baseline(py: Python<'_>, db: PathBuf, vehicle: &str) -> PyResult<(Strin
     Ok((serde_json::to_string(&set).map_err(json_err)?, text))
 }
 
-#[derive(Serialize)]
-struct CheckOut {
-    vehicle: String,
-    model_version: i64,
-    records: Vec<vibmode_fleet::Checked>,
-    drives: Vec<vibmode_fleet::Drive>,
-    /// As `vibmode fleet check --json`: an earlier drive flagged against the same baseline.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    earlier_flag: Option<vibmode_fleet::store::EarlierFlag>,
-}
-
 /// Checks files against the vehicle's latest model set; JSON as `vibmode fleet check --json`,
 /// and the table `vibmode fleet check` prints.
 #[pyfunction]
@@ -200,23 +189,10 @@ fn fleet_check(
             let paths: Vec<&std::path::Path> = files.iter().map(|f| f.as_path()).collect();
             let (records, drives) =
                 check_drive_files_progress(&mut store, &set, &paths, &opts, drive, &|_| ())?;
-            let earlier_flag = if drives.is_empty() {
-                None
-            } else {
-                store.earlier_flag(vehicle)?
-            };
-            Ok::<_, vibmode_fleet::FleetError>(CheckOut {
-                vehicle: vehicle.to_string(),
-                model_version: set.version,
-                records,
-                drives,
-                earlier_flag,
-            })
+            vibmode_fleet::CheckReport::new(&store, vehicle, set.version, records, drives)
         })
         .map_err(fleet_err)?;
-    let text =
-        vibmode_fleet::text::check_text(&out.vehicle, out.model_version, &out.records, &out.drives)
-            + &vibmode_fleet::text::earlier_flag_note(out.earlier_flag.as_ref());
+    let text = out.text();
     Ok((serde_json::to_string(&out).map_err(json_err)?, text))
 }
 

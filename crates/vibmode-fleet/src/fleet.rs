@@ -786,6 +786,60 @@ pub struct Checked {
     pub same_as: Option<String>,
 }
 
+/// What `fleet check` reports (its text and JSON, for the CLI and Python alike): the records'
+/// verdicts, the drives', and a fault found on an earlier drive against the same baseline when
+/// the vehicle's latest drive does not show it ([`crate::store::EarlierFlag`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct CheckReport {
+    /// The vehicle.
+    pub vehicle: String,
+    /// The model-set version the records were scored against.
+    pub model_version: i64,
+    /// Each record's verdict.
+    pub records: Vec<Checked>,
+    /// Each drive's verdict.
+    pub drives: Vec<crate::model::Drive>,
+    /// An earlier drive flagged `vehicle` or `both` against the latest drive's baseline, when the
+    /// latest drive is not (only where this check made a drive); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub earlier_flag: Option<crate::store::EarlierFlag>,
+}
+
+impl CheckReport {
+    /// The report of a check of `vehicle` just stored in `store`.
+    pub fn new(
+        store: &Store,
+        vehicle: &str,
+        model_version: i64,
+        records: Vec<Checked>,
+        drives: Vec<crate::model::Drive>,
+    ) -> Result<Self> {
+        let earlier_flag = if drives.is_empty() {
+            None
+        } else {
+            store.earlier_flag(vehicle)?
+        };
+        Ok(CheckReport {
+            vehicle: vehicle.to_string(),
+            model_version,
+            records,
+            drives,
+            earlier_flag,
+        })
+    }
+
+    /// The text `fleet check` prints: the records' and drives' table
+    /// ([`crate::text::check_text`]) and the earlier flag's note.
+    pub fn text(&self) -> String {
+        crate::text::check_text(
+            &self.vehicle,
+            self.model_version,
+            &self.records,
+            &self.drives,
+        ) + &crate::text::earlier_flag_note(self.earlier_flag.as_ref())
+    }
+}
+
 /// The file name of a model set's record with the content of `p`, if the set holds it.
 fn in_baseline(set: &ModelSet, p: &Prepared) -> Option<String> {
     p.known_nominal
