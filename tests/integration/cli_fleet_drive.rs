@@ -671,23 +671,14 @@ fn a_drive_flagged_earlier_stays_in_the_status_until_a_new_baseline() {
     ok(&["fleet", "baseline", "--db", db, "--vehicle", "bus-1"]);
     let again = simulate_csv(&d.path().join("again"), "B", "30", "23", "4");
     let json = d.path().join("day3.json");
-    let o = ok(&[
-        "fleet",
+    let mut args = common::fleet_args(
         "check",
-        "--db",
         db,
-        "--vehicle",
         "bus-1",
-        "-q",
-        "--drive",
-        "day-3",
-        "--json",
-        json.to_str().unwrap(),
-        &again[0],
-        &again[1],
-        &again[2],
-        &again[3],
-    ]);
+        &["-q", "--drive", "day-3", "--json", json.to_str().unwrap()],
+    );
+    args.extend(again.iter().map(String::as_str));
+    let o = ok(&args);
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(v["drives"][0]["classification"], "normal", "{v}");

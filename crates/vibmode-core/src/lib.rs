@@ -36,7 +36,7 @@ pub use error::{ParamError, RecordingError};
 pub use identify::{
     Identifier, MultichannelIdentifier, PoleOut, PooledIdentification, ShapedPole, SignalFits,
 };
-pub use limits::{cap_message, num, quoted, settings_message, Num, Quoted};
+pub use limits::{cap_message, num, printable, quoted, settings_message, Num, Quoted};
 pub use modes::{
     FitSummary, InvariantMode, ModeClass, ModeMatch, ModeUncertainty, ModelCoefficients,
     PoleObservation, ReferenceMode, SupportFailure, TruthRow, UncertaintyMethod,

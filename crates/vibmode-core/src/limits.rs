@@ -100,13 +100,7 @@ impl fmt::Display for Quoted<'_> {
     /// Longer than [`QUOTE_CHARS_MAX`]: its first and last characters (half each) around
     /// `...`, so a long path keeps its file name.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let shown = |c: char| {
-            if c.is_control() || c == char::REPLACEMENT_CHARACTER {
-                '?'
-            } else {
-                c
-            }
-        };
+        let shown = printable;
         let n = self.0.chars().count();
         if n <= QUOTE_CHARS_MAX {
             return self.0.chars().try_for_each(|c| write!(f, "{}", shown(c)));
@@ -122,6 +116,16 @@ impl fmt::Display for Quoted<'_> {
             .chars()
             .skip(n - tail)
             .try_for_each(|c| write!(f, "{}", shown(c)))
+    }
+}
+
+/// A character of user input as messages show it: a control character (escape sequences
+/// included) or the replacement character as `?`, any other as it is ([`Quoted`]).
+pub fn printable(c: char) -> char {
+    if c.is_control() || c == char::REPLACEMENT_CHARACTER {
+        '?'
+    } else {
+        c
     }
 }
 

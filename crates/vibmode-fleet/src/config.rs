@@ -201,12 +201,9 @@ fn short_reason(message: &str) -> String {
     let head = trimmed
         .split_once(", expected one of")
         .map_or(trimmed, |(head, _)| head);
-    // Control characters of a value quoted in the message shown as '?', the whole cut at its
+    // A value quoted in the message shown as messages show user input, the whole cut at its
     // end (the key it names comes last).
-    let clean: String = head
-        .chars()
-        .map(|c| if c.is_control() { '?' } else { c })
-        .collect();
+    let clean: String = head.chars().map(vibmode_core::printable).collect();
     vibmode_core::cap_message(&clean, 240)
 }
 

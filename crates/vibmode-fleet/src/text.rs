@@ -395,24 +395,26 @@ pub fn status_text(st: &[VehicleStatus]) -> String {
 pub fn smallest_losses_line(s: &crate::suspension::DriveSuspension) -> Option<String> {
     use crate::suspension::Part;
     let part = |p: Part| -> Option<String> {
-        let cells: Vec<String> = crate::suspension::CORNERS
+        let losses: Vec<Option<f64>> = crate::suspension::CORNERS
             .iter()
             .map(|c| {
-                let loss = s
-                    .scores
+                s.scores
                     .iter()
                     .find(|x| x.corner == *c && x.part == p)
-                    .and_then(|x| x.smallest_flagged_loss(s.limit));
-                format!(
-                    "{c} {}",
-                    loss.map_or("-".to_string(), |l| format!("{:.0} %", 100.0 * l))
-                )
+                    .and_then(|x| x.smallest_flagged_loss(s.limit))
             })
             .collect();
-        cells
-            .iter()
-            .any(|c| !c.ends_with(" -"))
-            .then(|| cells.join(", "))
+        losses.iter().any(Option::is_some).then(|| {
+            crate::suspension::CORNERS
+                .iter()
+                .zip(&losses)
+                .map(|(c, l)| match l {
+                    Some(l) => format!("{c} {:.0} %", 100.0 * l),
+                    None => format!("{c} -"),
+                })
+                .collect::<Vec<_>>()
+                .join(", ")
+        })
     };
     let (springs, dampers) = (part(Part::Spring)?, part(Part::Damper)?);
     Some(format!(
