@@ -24,6 +24,7 @@ impl SweepIdentifier {
             robust: self.sweep.robust,
             max_iterations: self.sweep.max_iterations,
             tolerance: self.sweep.tolerance,
+            starts: self.sweep.starts,
             band: Some(*band),
             ..ArmaParams::default()
         }

@@ -43,8 +43,8 @@ pub use modes::{
 };
 pub use params::{
     AntiRollBars, BandLimit, BodyFitParams, BodySsiParams, ClusterParams, IdentMethod,
-    IdentMethods, LineParams, PoleFilterParams, PreprocessParams, Robust, SpectrumParams,
-    StopParams, SweepModel, SweepParams, DEFAULT_HUBER_FACTOR, EDGE_SHARE,
+    IdentMethods, LineParams, PoleFilterParams, PreprocessParams, Robust, SearchStarts,
+    SpectrumParams, StopParams, SweepModel, SweepParams, DEFAULT_HUBER_FACTOR, EDGE_SHARE,
     EMPTY_BAND_MAX_CUTOFF_SHARE, SWEEP_MAX_ITERATIONS, SWEEP_TOLERANCE,
 };
 pub use placement::{Corner, Direction, Placement, Role};

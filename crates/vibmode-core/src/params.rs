@@ -437,6 +437,27 @@ pub struct SweepParams {
     /// Stopping tolerance of each fit: relative predicted improvement of the next Gauss-Newton
     /// step below which the search stops (default [`SWEEP_TOLERANCE`]).
     pub tolerance: f64,
+    /// Where each ARMA fit's search starts (default [`SearchStarts::Multi`]; the fleet's
+    /// records use [`SearchStarts::Single`]).
+    pub starts: SearchStarts,
+}
+
+/// Where a prediction-error fit's Gauss-Newton search starts. The candidates are the
+/// Hannan-Rissanen estimate, Burg's AR(p) with `C = 1` and, in a sweep, the previous order's
+/// model (the warm start).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+#[non_exhaustive]
+pub enum SearchStarts {
+    /// Models with `p + q <= 16` are searched from every candidate and the lowest end point is
+    /// kept (a guard against neighbouring local minima); larger ones from the best-scored
+    /// candidate only. The default.
+    #[default]
+    Multi,
+    /// Every model from the best-scored candidate only (in a sweep, again from the warm start
+    /// when the search ends above the warm start's own loss). About a third of the cost of a
+    /// small model's fit; the fleet's records use it (docs/fleet.md, "The fleet's order sweep").
+    Single,
 }
 
 /// Default [`SweepParams::max_iterations`]: 20, MATLAB's `MaxIterations`. The sweep's fits are
@@ -457,6 +478,7 @@ impl Default for SweepParams {
             robust: Robust::default(),
             max_iterations: SWEEP_MAX_ITERATIONS,
             tolerance: SWEEP_TOLERANCE,
+            starts: SearchStarts::Multi,
         }
     }
 }

@@ -102,18 +102,27 @@ pub struct FleetConfig {
 /// sweep was 60 % of a record's CPU in `fleet ingest`.
 pub const FLEET_SWEEP_ORDER_MAX: usize = 8;
 
+/// Where each fit of the fleet's sweep starts with vibmode's preset: from the best-scored
+/// candidate only (a standalone analysis searches its small models from every candidate).
+/// Measured (docs/fleet.md, "The fleet's order sweep"): on 36 busgen buses every drive's
+/// verdict, corner and component the same as with every candidate, and on vibmode's own
+/// simulator the acceptance's figures the same; the multi-start was about 80 % of the sweep's
+/// CPU at orders 2..8.
+pub const FLEET_SEARCH_STARTS: vibmode_core::SearchStarts = vibmode_core::SearchStarts::Single;
+
 /// The fleet's per-record analysis: the `preset`'s, with ARMA only, the fleet's model-update
-/// band and, with vibmode's preset, orders up to [`FLEET_SWEEP_ORDER_MAX`] (the paper's preset
-/// keeps its own). An `[analysis]` table in the fleet's settings overrides these, key by key.
+/// band and, with vibmode's preset, orders up to [`FLEET_SWEEP_ORDER_MAX`] searched from one
+/// start each ([`FLEET_SEARCH_STARTS`]; the paper's preset keeps its own). An `[analysis]` table in the fleet's settings overrides these, key by key.
 pub fn fleet_analysis(preset: vibmode_analysis::Preset) -> AnalysisConfig {
     let base = AnalysisConfig::preset(preset);
-    let order_max = match preset {
-        vibmode_analysis::Preset::Vibmode => FLEET_SWEEP_ORDER_MAX,
-        _ => base.sweep.order_max,
+    let (order_max, starts) = match preset {
+        vibmode_analysis::Preset::Vibmode => (FLEET_SWEEP_ORDER_MAX, FLEET_SEARCH_STARTS),
+        _ => (base.sweep.order_max, base.sweep.starts),
     };
     AnalysisConfig {
         sweep: vibmode_core::SweepParams {
             order_max,
+            starts,
             ..base.sweep.clone()
         },
         // The features use the per-channel modes only: no multichannel identification.

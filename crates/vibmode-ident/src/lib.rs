@@ -67,7 +67,7 @@ pub use model::{
 };
 pub use num_complex::Complex64;
 pub use outliers::{clean_additive_outliers, CleanedSignal, CleanerParams, OutlierCleaning};
-pub use params::{ArmaParams, Robust, FIT_MAX_ITERATIONS, FIT_TOLERANCE};
+pub use params::{ArmaParams, Robust, SearchStarts, FIT_MAX_ITERATIONS, FIT_TOLERANCE};
 pub use poles::{cancelled_by_zero, filter_mode_set, filter_modes, FilteredMode, PoleRejection};
 pub use roots::polynomial_roots;
 pub use sweep::sweep_fits;

@@ -11,6 +11,8 @@ use crate::IdentError;
 /// Robustification of the prediction-error criterion: defined once, in `vibmode-core` (a Huber
 /// factor or `off`, one spelling in TOML, JSON, the command line and Python).
 pub use vibmode_core::Robust;
+/// Where each fit's search starts: defined once, in `vibmode-core`.
+pub use vibmode_core::SearchStarts;
 use vibmode_core::{BandLimit, ParamError};
 
 /// Settings of the prediction-error search.
@@ -66,6 +68,10 @@ pub struct ArmaParams {
     /// periodogram bins below 1e-20 of the largest, which is what an ideal DFT low-pass leaves).
     #[serde(default)]
     pub band: Option<BandLimit>,
+    /// Where the search starts: from every candidate for small models
+    /// ([`SearchStarts::Multi`], the default) or from the best-scored one only.
+    #[serde(default)]
+    pub starts: SearchStarts,
 }
 
 /// Default [`ArmaParams::max_iterations`] of a single fit (`vibmode fit`, Python's `fit_arma`):
@@ -101,6 +107,7 @@ impl Default for ArmaParams {
             outlier_cleaning: OutlierCleaning::default(),
             noise_floor: default_noise_floor(),
             band: None,
+            starts: SearchStarts::Multi,
         }
     }
 }

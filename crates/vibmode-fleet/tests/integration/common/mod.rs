@@ -42,13 +42,18 @@ pub fn record(v: &VehicleParams, road: RoadClass, kmh: f64, seed: u64) -> vibmod
 pub fn config() -> FleetConfig {
     let mut c = FleetConfig::default();
     // AR(16) by Burg for speed; `FLEET_ARMA=1` keeps the fleet's own sweep (ARMA, orders
-    // 2..FLEET_SWEEP_ORDER_MAX; `FLEET_OM=N` sets its highest order), as measured in
+    // 2..FLEET_SWEEP_ORDER_MAX from one start each; `FLEET_OM=N` sets its highest order), as measured in
     // docs/fleet.md, "The fleet's order sweep".
     if std::env::var("FLEET_ARMA").is_err() {
         c.analysis.sweep.model = vibmode_analysis::SweepModel::Ar;
         c.analysis.sweep.order_max = 16;
     } else if let Some(om) = std::env::var("FLEET_OM").ok().and_then(|v| v.parse().ok()) {
         c.analysis.sweep.order_max = om;
+    }
+    // `FLEET_STARTS=multi` searches the small models from every candidate (the standalone
+    // analysis's default) instead of the fleet's single start.
+    if std::env::var("FLEET_STARTS").is_ok_and(|v| v == "multi") {
+        c.analysis.sweep.starts = vibmode_core::SearchStarts::Multi;
     }
     if let Some(v) = std::env::var("FAR").ok().and_then(|v| v.parse().ok()) {
         c.false_alarm_rate = v;
