@@ -6,7 +6,7 @@ use crate::output::write_json;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::PathBuf;
-use vibmode_core::{BandLimit, SweepModel, SweepParams};
+use vibmode_core::{BandLimit, SearchStarts, SweepModel, SweepParams};
 use vibmode_ident::{ArMethod, ArmaParams, Estimator, Robust};
 use vibmode_run::sweep::SweepOutput;
 
@@ -35,6 +35,11 @@ pub struct SweepArgs {
     /// Stopping tolerance of each fit (default 1e-4, the analysis sweep's).
     #[arg(long)]
     pub tolerance: Option<f64>,
+    /// Where each ARMA fit's search starts: multi (small models, p + q <= 16, from every
+    /// starting candidate; the analysis's default) or single (from the best-scored one only,
+    /// as the fleet's records).
+    #[arg(long, value_enum)]
+    pub starts: Option<StartsArg>,
     /// Write JSON results to this path (`-` for standard output).
     #[arg(long)]
     pub json: Option<String>,
@@ -42,6 +47,24 @@ pub struct SweepArgs {
     /// beside it with `-damping` appended to the file stem.
     #[arg(long)]
     pub plot: Option<PathBuf>,
+}
+
+/// `--starts`: [`SearchStarts`] on the command line.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StartsArg {
+    /// From every starting candidate for small models (the default).
+    Multi,
+    /// From the best-scored candidate only.
+    Single,
+}
+
+impl From<StartsArg> for SearchStarts {
+    fn from(s: StartsArg) -> Self {
+        match s {
+            StartsArg::Multi => SearchStarts::Multi,
+            StartsArg::Single => SearchStarts::Single,
+        }
+    }
 }
 
 /// Highest model order (and most orders) `--orders` takes, for every command.
@@ -108,6 +131,7 @@ fn sweep_settings(a: &SweepArgs, band: Option<BandLimit>) -> Result<(Vec<usize>,
         robust,
         max_iterations: a.max_iterations.unwrap_or(defaults.max_iterations),
         tolerance: a.tolerance.unwrap_or(defaults.tolerance),
+        starts: a.starts.map_or(defaults.starts, SearchStarts::from),
         ..defaults
     };
     sweep.validate()?;
@@ -115,6 +139,7 @@ fn sweep_settings(a: &SweepArgs, band: Option<BandLimit>) -> Result<(Vec<usize>,
         robust: sweep.robust,
         max_iterations: sweep.max_iterations,
         tolerance: sweep.tolerance,
+        starts: sweep.starts,
         band,
         ..ArmaParams::default()
     };

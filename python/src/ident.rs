@@ -47,6 +47,7 @@ fn ident_defaults() -> PyResult<String> {
             "robust": huber_factor(sweep.robust),
             "max_iterations": sweep.max_iterations,
             "tolerance": sweep.tolerance,
+            "starts": sweep.starts,
         },
     }))
     .map_err(json_err)
@@ -185,7 +186,7 @@ struct SweepOut {
 /// Order sweep of one signal (`vibmode sweep`): every order's fit and modes, split by the
 /// analysis' pole filters. Returns JSON.
 #[pyfunction]
-#[pyo3(signature = (y, fs, orders, model, method, robust, max_iterations, tolerance))]
+#[pyo3(signature = (y, fs, orders, model, method, robust, max_iterations, tolerance, starts))]
 #[allow(clippy::too_many_arguments)]
 fn sweep(
     py: Python<'_>,
@@ -197,6 +198,7 @@ fn sweep(
     robust: Option<f64>,
     max_iterations: usize,
     tolerance: f64,
+    starts: &str,
 ) -> PyResult<String> {
     check_fs(fs)?;
     if orders.is_empty() || orders.contains(&0) {
@@ -205,10 +207,18 @@ fn sweep(
         )));
     }
     let y = samples(&y);
+    // One spelling with the analysis config's `[sweep] starts` (serde's).
+    let starts: vibmode_core::SearchStarts =
+        serde_json::from_value(serde_json::Value::String(starts.to_string())).map_err(|_| {
+            PyValueError::new_err(format!(
+                "starts = '{starts}' is unknown; use 'multi' (every starting candidate for small models) or 'single'"
+            ))
+        })?;
     let params = ArmaParams {
         robust: robust_of(robust),
         max_iterations,
         tolerance,
+        starts,
         ..ArmaParams::default()
     };
     let (kind, ar_method) = match model {

@@ -149,6 +149,31 @@ def test_sweep_stabilises_on_the_mode(ar2_data):
     assert isinstance(s2.modes, dict) and set(s2.modes["order"]) <= {2, 4}
 
 
+def test_sweep_starts(arma21_data):
+    """``starts``: 'multi' by default (the analysis config's); at a sweep's first order (no warm
+    start) the multi-start keeps the lowest end point of the single start's candidates and more,
+    so its loss is never above and its iterations are the single start's and more; ARMA(9, 9)
+    (p + q = 18, one start either way) is the same with both; an unknown value is refused."""
+    y = arma21_data[:2000]
+
+    def same(a, b):
+        return a.keys() == b.keys() and all(
+            np.array_equal(np.asarray(a[k], dtype=object), np.asarray(b[k], dtype=object)) for k in a
+        )
+
+    assert vibmode.analysis_config()["sweep"]["starts"] == "multi"
+    multi = vibmode.sweep(y, FS, orders=range(2, 6), as_frame=False).fits
+    assert same(vibmode.sweep(y, FS, orders=range(2, 6), starts="multi", as_frame=False).fits, multi)
+    single = vibmode.sweep(y, FS, orders=range(2, 6), starts="single", as_frame=False).fits
+    assert single["loss"][0] >= multi["loss"][0]
+    assert single["iterations"][0] <= multi["iterations"][0]
+    assert sum(single["iterations"]) < sum(multi["iterations"])
+    nine = [vibmode.sweep(y, FS, orders=[9], starts=s, as_frame=False).fits for s in ("multi", "single")]
+    assert same(nine[0], nine[1])
+    with pytest.raises(ValueError, match="starts"):
+        vibmode.sweep(y, FS, orders=[2], starts="some")
+
+
 @pytest.mark.parametrize(
     "call,match",
     [

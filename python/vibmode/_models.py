@@ -227,12 +227,15 @@ def sweep(
     robust: Any = _SWEEP["robust"],
     max_iterations: int = _SWEEP["max_iterations"],
     tolerance: float = _SWEEP["tolerance"],
+    starts: str = _SWEEP["starts"],
     as_frame: Optional[bool] = None,
 ) -> SweepResult:
     """Fits every order of ``orders`` to ``y`` (sampled at ``fs`` Hz) and collects every mode:
     the stabilisation diagram of ``vibmode sweep``. ``model``: 'arma' (ARMA(p, p), warm-started
-    from order to order) or 'ar' (with ``method``). Defaults are the analysis sweep's
-    (p = 2..30, Huber 1.6, 20 iterations, tolerance 1e-4)."""
+    from order to order) or 'ar' (with ``method``). ``starts``: 'multi' (models with p + q <= 16
+    searched from every starting candidate) or 'single' (from the best-scored one only, as the
+    fleet's records). Defaults are the analysis sweep's (p = 2..30, Huber 1.6, 20 iterations,
+    tolerance 1e-4, 'multi')."""
     fs = _check_fs(fs)
     ords = [_order("order", o, 1) for o in orders]
     if not ords:
@@ -241,6 +244,6 @@ def sweep(
         raise ValueError(f"model = {model!r} is unknown; use 'arma' (ARMA(p, p)) or 'ar'")
     s = _native.sweep(
         _signal(y), fs, ords, model, str(method), _robust(robust),
-        _order("max_iterations", max_iterations, 1), float(tolerance),
+        _order("max_iterations", max_iterations, 1), float(tolerance), str(starts),
     )
     return SweepResult(json.loads(s), as_frame)
