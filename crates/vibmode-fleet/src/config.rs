@@ -106,13 +106,14 @@ pub const FLEET_SWEEP_ORDER_MAX: usize = 8;
 /// candidate only (a standalone analysis searches its small models from every candidate).
 /// Measured (docs/fleet.md, "The fleet's order sweep"): on 36 busgen buses every drive's
 /// verdict, corner and component the same as with every candidate, and on vibmode's own
-/// simulator the acceptance's figures the same; the multi-start was about 80 % of the sweep's
-/// CPU at orders 2..8.
+/// simulator the acceptance's figures the same; the two extra starts were about three
+/// quarters of the sweep's CPU at orders 2..8.
 pub const FLEET_SEARCH_STARTS: vibmode_core::SearchStarts = vibmode_core::SearchStarts::Single;
 
 /// The fleet's per-record analysis: the `preset`'s, with ARMA only, the fleet's model-update
 /// band and, with vibmode's preset, orders up to [`FLEET_SWEEP_ORDER_MAX`] searched from one
-/// start each ([`FLEET_SEARCH_STARTS`]; the paper's preset keeps its own). An `[analysis]` table in the fleet's settings overrides these, key by key.
+/// start each ([`FLEET_SEARCH_STARTS`]; the paper's preset keeps its own). An `[analysis]`
+/// table in the fleet's settings overrides these, key by key.
 pub fn fleet_analysis(preset: vibmode_analysis::Preset) -> AnalysisConfig {
     let base = AnalysisConfig::preset(preset);
     let (order_max, starts) = match preset {

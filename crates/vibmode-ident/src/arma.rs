@@ -1398,8 +1398,8 @@ mod tests {
     /// `SearchStarts::Single` searches from the best-scored candidate only: over 40 seeded
     /// ARMA(2,2) fits (two resonances in noise) the multi-start's loss is never above the single
     /// start's (it keeps the lowest end point of all starts, the single start's among them), at
-    /// most 1e-4 below it (one minimum), and it takes more iterations in all; ARMA(9,9) (p + q = 18 > 16, one start either way) is the
-    /// same bit for bit.
+    /// most 1e-4 below it (one minimum), and it takes more iterations in all; ARMA(9,9)
+    /// (p + q = 18 > 16, one start either way) is the same bit for bit.
     #[test]
     fn a_single_start_searches_from_the_best_candidate_only() {
         let single = ArmaParams {

@@ -669,9 +669,8 @@ fn choose_band_by_hand() {
 /// Records sampled at twice `EQUATION_RATE_HZ` (5 kHz) or more are brought down by an integer
 /// factor with the paper's ideal filter before their equations are formed: 3 of the demo's
 /// records of the changed bus at 20 kHz give exactly the fit of the same records brought down
-/// to 5 kHz by
-/// `vibmode_signal::resample` (same equations, noise densities and parameters), and that fit
-/// finds the measured bus: heave, pitch and roll within 3 % of its modes.
+/// to 5 kHz by `vibmode_signal::resample` (same equations, noise densities and parameters),
+/// and that fit finds the measured bus: heave, pitch and roll within 3 % of its modes.
 #[test]
 fn records_above_the_equation_rate_are_fitted_at_it() {
     use vibmode_vehicle::update::{decimation_factor, EQUATION_RATE_HZ};

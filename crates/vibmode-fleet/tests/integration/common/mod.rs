@@ -42,8 +42,8 @@ pub fn record(v: &VehicleParams, road: RoadClass, kmh: f64, seed: u64) -> vibmod
 pub fn config() -> FleetConfig {
     let mut c = FleetConfig::default();
     // AR(16) by Burg for speed; `FLEET_ARMA=1` keeps the fleet's own sweep (ARMA, orders
-    // 2..FLEET_SWEEP_ORDER_MAX from one start each; `FLEET_OM=N` sets its highest order), as measured in
-    // docs/fleet.md, "The fleet's order sweep".
+    // 2..FLEET_SWEEP_ORDER_MAX from one start each; `FLEET_OM=N` sets its highest order), as
+    // measured in docs/fleet.md, "The fleet's order sweep".
     if std::env::var("FLEET_ARMA").is_err() {
         c.analysis.sweep.model = vibmode_analysis::SweepModel::Ar;
         c.analysis.sweep.order_max = 16;
