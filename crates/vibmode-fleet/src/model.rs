@@ -1474,15 +1474,29 @@ fn score_values(
         n_vehicle: 0,
         n_excitation: 0,
     };
+    let quiet = quiet_bands(set, &by_key);
+    let mut not_judged = 0usize;
     for f in &set.features {
-        let Some(&x) = by_key.get(f.meta.key.as_str()) else {
-            let where_ = f
-                .meta
+        let where_ = || {
+            f.meta
                 .corner
-                .map_or(f.meta.channel.clone(), |c| c.to_string());
-            missing.push(format!("{where_}: {}", f.meta.label));
+                .map_or(f.meta.channel.clone(), |c| c.to_string())
+        };
+        let Some(&x) = by_key.get(f.meta.key.as_str()) else {
+            missing.push(format!("{}: {}", where_(), f.meta.label));
             continue;
         };
+        if let Some(q) = quiet_for(f, &quiet) {
+            missing.push(format!(
+                "{}: {} (little road input: the road level {} is {:.0} % of the nominal records' lowest)",
+                where_(),
+                f.meta.label,
+                q.band,
+                100.0 * (q.x - q.lo).exp()
+            ));
+            not_judged += 1;
+            continue;
+        }
         let z = score(f, x, &set.config);
         let (n, max) = match f.meta.group {
             Group::Vehicle => (&mut scores.n_vehicle, &mut scores.vehicle_max_abs_z),
@@ -1508,15 +1522,85 @@ fn score_values(
     evidence.sort_by(|a, b| b.z.abs().total_cmp(&a.z.abs()));
     let vehicle = evidence.iter().any(|e| e.meta.group == Group::Vehicle);
     let road = evidence.iter().any(|e| e.meta.group == Group::Excitation);
+    let mut summary = summary(&evidence);
+    if not_judged > 0 {
+        let bands: Vec<&str> = quiet.iter().map(|q| q.band.as_str()).collect();
+        let note = format!(
+            "little road input (road level {} below half the nominal records' lowest): {not_judged} vehicle feature(s) not judged",
+            bands.join(", ")
+        );
+        summary = if summary.is_empty() {
+            note
+        } else {
+            format!("{summary}; {note}")
+        };
+    }
     Assessment {
         classification: Classification::from_alarms(vehicle, road),
         scores,
-        summary: summary(&evidence),
+        summary,
         component: component(set, values, &evidence),
         evidence,
         missing,
         sensor_faults: Vec::new(),
     }
+}
+
+/// A road-level band in which the record (or drive) had too little road input to judge the
+/// vehicle features that depend on it: its level `x` (ln) more than `road_margin` (ln 2) below
+/// the nominal records' lowest `lo`, the mirror of a road rougher than `hi + road_margin`.
+#[derive(Clone, Debug)]
+struct QuietBand {
+    band: String,
+    hz: [f64; 2],
+    x: f64,
+    lo: f64,
+}
+
+/// The road-level bands with too little road input ([`QuietBand`]).
+fn quiet_bands(set: &ModelSet, by_key: &BTreeMap<&str, f64>) -> Vec<QuietBand> {
+    set.features
+        .iter()
+        .filter(|f| f.meta.kind == Kind::Level)
+        .filter_map(|f| {
+            let x = *by_key.get(f.meta.key.as_str())?;
+            let hz = key_band(&f.meta.key)?;
+            (x < f.lo - set.config.road_margin).then(|| QuietBand {
+                band: band_label(&hz),
+                hz,
+                x,
+                lo: f.lo,
+            })
+        })
+        .collect()
+}
+
+/// The quiet band that leaves `f` unjudged, if any: the transmissibility, the body's response
+/// to wheel motion and the wheels' level ratios are ratios of motions whose sensor noise and
+/// engine share (the same at any road) weigh more as the road's input falls, and their spread
+/// was measured only over the nominal records' road levels (docs/fleet.md, "Little road
+/// input"). Of the quiet bands overlapping the feature's own, the one furthest below.
+fn quiet_for<'q>(f: &FeatureStat, quiet: &'q [QuietBand]) -> Option<&'q QuietBand> {
+    if !matches!(
+        f.meta.kind,
+        Kind::Transmissibility | Kind::BodyResponse | Kind::SideRatio | Kind::TrackRatio
+    ) {
+        return None;
+    }
+    let [a, b] = key_band(&f.meta.key)?;
+    quiet
+        .iter()
+        .filter(|q| q.hz[0] < b && a < q.hz[1])
+        .min_by(|p, q| (p.x - p.lo).total_cmp(&(q.x - q.lo)))
+}
+
+/// The band `[a, b]` Hz a feature key carries (`transh1lu:FR:12-20Hz`, `level:unsprung:2-5Hz`,
+/// `body:FR_sprung:2-4Hz`), if any.
+fn key_band(key: &str) -> Option<[f64; 2]> {
+    key.split(':').find_map(|part| {
+        let (a, b) = part.strip_suffix("Hz")?.split_once('-')?;
+        Some([a.parse().ok()?, b.parse().ok()?])
+    })
 }
 
 /// Signed score of the level ratio of `kind` that `corner` takes part in, read from that corner
@@ -2206,6 +2290,50 @@ mod tests {
         let a = assess(&set, &record(level, 0.21));
         assert!((a.scores.excitation_max_abs_z - 3.0).abs() < 1e-9, "{a:?}");
         assert_eq!(a.classification, Classification::Road);
+    }
+
+    /// Little road input, by hand: the nominal levels are 1.0-1.2 in 2-5 Hz, so below half the
+    /// lowest (0.5, `road_margin` ln 2 below `lo` = ln 1.0) the transmissibility of 2-5 Hz is not
+    /// judged: a record at 0.45 whose transmissibility is 2.3 times the nominal is `normal`,
+    /// the feature listed under `missing` with the level's share (45 %) and the summary saying
+    /// why; at 0.55 the same transmissibility is `vehicle`. The excitation is never scored
+    /// below the range (a smoother road is normal).
+    #[test]
+    fn little_road_input_leaves_the_transmissibility_unjudged() {
+        let set = baseline();
+        let quiet = assess(&set, &record(0.45, 0.5));
+        assert_eq!(quiet.classification, Classification::Normal, "{quiet:?}");
+        assert!(quiet.evidence.is_empty(), "{quiet:?}");
+        assert_eq!(
+            quiet.missing,
+            vec![
+                "RL: transmissibility 2-5 Hz (little road input: the road level 2-5 Hz is 45 % of the nominal records' lowest)"
+                    .to_string()
+            ]
+        );
+        assert_eq!(
+            quiet.summary,
+            "little road input (road level 2-5 Hz below half the nominal records' lowest): 1 vehicle feature(s) not judged"
+        );
+        assert_eq!(quiet.scores.excitation_max_abs_z, 0.0);
+        let judged = assess(&set, &record(0.55, 0.5));
+        assert_eq!(judged.classification, Classification::Vehicle, "{judged:?}");
+        assert!(judged.missing.is_empty(), "{judged:?}");
+        // The same for a drive of such records (its medians).
+        let recs: Vec<RecordFeatures> = (0..3).map(|_| record(0.45, 0.5)).collect();
+        let refs: Vec<&RecordFeatures> = recs.iter().collect();
+        let d = assess_drive(&set, &refs);
+        assert_eq!(d.classification, Classification::Normal, "{d:?}");
+        assert_eq!(d.missing.len(), 1, "{d:?}");
+    }
+
+    #[test]
+    fn key_band_by_hand() {
+        assert_eq!(key_band("transh1lu:FR:12-20Hz"), Some([12.0, 20.0]));
+        assert_eq!(key_band("level:unsprung:0.5-2Hz"), Some([0.5, 2.0]));
+        assert_eq!(key_band("track:left:8-20Hz:lf"), Some([8.0, 20.0]));
+        assert_eq!(key_band("body:FR_sprung:2-4Hz"), Some([2.0, 4.0]));
+        assert_eq!(key_band("mode:RL_unsprung:1:damping"), None);
     }
 
     /// A record with one mode of `RL_unsprung`.
