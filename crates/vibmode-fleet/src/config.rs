@@ -34,6 +34,9 @@ pub struct FleetConfig {
     /// before its excitation is scored (default 0.69 = ln 2: one ISO 8608 road class, a factor
     /// 2 in amplitude, as between a class B baseline and a class C road). A road the baseline's
     /// roads or up to one class rougher drive is normal; a smoother road is never an alarm.
+    /// The same margin below the range's bottom is too little road input: the vehicle
+    /// features that input biases are not judged in that band (docs/fleet.md, "Little road
+    /// input").
     pub road_margin: f64,
     /// Floor of the spread of ln(transmissibility) (default 0.10).
     pub floor_transmissibility: f64,
