@@ -1575,16 +1575,15 @@ fn quiet_bands(set: &ModelSet, by_key: &BTreeMap<&str, f64>) -> Vec<QuietBand> {
         .collect()
 }
 
-/// The quiet band that leaves `f` unjudged, if any: the transmissibility, the body's response
-/// to wheel motion and the wheels' level ratios are ratios of motions whose sensor noise and
-/// engine share (the same at any road) weigh more as the road's input falls, and their spread
-/// was measured only over the nominal records' road levels (docs/fleet.md, "Little road
-/// input"). Of the quiet bands overlapping the feature's own, the one furthest below.
+/// The quiet band that leaves `f` unjudged, if any: the transmissibility and the body's
+/// response to wheel motion are ratios of the body's motion to the wheels', whose sensor noise
+/// and engine share (the same on any road) weigh more as the road's input falls, and their
+/// spread was measured only over the nominal records' road levels (docs/fleet.md, "Little
+/// road input"). The wheels' level ratios stay judged: a worn damper raises its wheel's level
+/// by 25-40 % on a smooth road too, and that is how such a drive is found. Of the quiet bands
+/// overlapping the feature's own, the one furthest below.
 fn quiet_for<'q>(f: &FeatureStat, quiet: &'q [QuietBand]) -> Option<&'q QuietBand> {
-    if !matches!(
-        f.meta.kind,
-        Kind::Transmissibility | Kind::BodyResponse | Kind::SideRatio | Kind::TrackRatio
-    ) {
+    if !matches!(f.meta.kind, Kind::Transmissibility | Kind::BodyResponse) {
         return None;
     }
     let [a, b] = key_band(&f.meta.key)?;
