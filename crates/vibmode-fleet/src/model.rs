@@ -1476,6 +1476,8 @@ fn score_values(
     };
     let quiet = quiet_bands(set, &by_key);
     let mut not_judged = 0usize;
+    // The quiet bands that left a feature unjudged, for the summary.
+    let mut quiet_used: Vec<&QuietBand> = Vec::new();
     for f in &set.features {
         let where_ = || {
             f.meta
@@ -1495,6 +1497,9 @@ fn score_values(
                 100.0 * (q.x - q.lo).exp()
             ));
             not_judged += 1;
+            if !quiet_used.iter().any(|u| u.hz == q.hz) {
+                quiet_used.push(q);
+            }
             continue;
         }
         let z = score(f, x, &set.config);
@@ -1524,7 +1529,8 @@ fn score_values(
     let road = evidence.iter().any(|e| e.meta.group == Group::Excitation);
     let mut summary = summary(&evidence);
     if not_judged > 0 {
-        let bands: Vec<&str> = quiet.iter().map(|q| q.band.as_str()).collect();
+        quiet_used.sort_by(|p, q| p.hz[0].total_cmp(&q.hz[0]));
+        let bands: Vec<&str> = quiet_used.iter().map(|q| q.band.as_str()).collect();
         let note = format!(
             "little road input (road level {} below half the nominal records' lowest): {not_judged} vehicle feature(s) not judged",
             bands.join(", ")
