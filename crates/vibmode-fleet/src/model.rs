@@ -1493,7 +1493,7 @@ fn score_values(
                 "{}: {} (little road input: the road level {} is {:.0} % of the nominal records' lowest)",
                 where_(),
                 f.meta.label,
-                q.band,
+                band_label(&q.hz),
                 100.0 * (q.x - q.lo).exp()
             ));
             not_judged += 1;
@@ -1530,7 +1530,7 @@ fn score_values(
     let mut summary = summary(&evidence);
     if not_judged > 0 {
         quiet_used.sort_by(|p, q| p.hz[0].total_cmp(&q.hz[0]));
-        let bands: Vec<&str> = quiet_used.iter().map(|q| q.band.as_str()).collect();
+        let bands: Vec<String> = quiet_used.iter().map(|q| band_label(&q.hz)).collect();
         let note = format!(
             "little road input (road level {} below half the nominal records' lowest): {not_judged} vehicle feature(s) not judged",
             bands.join(", ")
@@ -1557,7 +1557,6 @@ fn score_values(
 /// the nominal records' lowest `lo`, the mirror of a road rougher than `hi + road_margin`.
 #[derive(Clone, Debug)]
 struct QuietBand {
-    band: String,
     hz: [f64; 2],
     x: f64,
     lo: f64,
@@ -1571,12 +1570,7 @@ fn quiet_bands(set: &ModelSet, by_key: &BTreeMap<&str, f64>) -> Vec<QuietBand> {
         .filter_map(|f| {
             let x = *by_key.get(f.meta.key.as_str())?;
             let hz = key_band(&f.meta.key)?;
-            (x < f.lo - set.config.road_margin).then(|| QuietBand {
-                band: band_label(&hz),
-                hz,
-                x,
-                lo: f.lo,
-            })
+            (x < f.lo - set.config.road_margin).then_some(QuietBand { hz, x, lo: f.lo })
         })
         .collect()
 }
@@ -1600,7 +1594,7 @@ fn quiet_for<'q>(f: &FeatureStat, quiet: &'q [QuietBand]) -> Option<&'q QuietBan
 }
 
 /// The band `[a, b]` Hz a feature key carries (`transh1lu:FR:12-20Hz`, `level:unsprung:2-5Hz`,
-/// `body:FR_sprung:2-4Hz`), if any.
+/// `body:FR_sprung:2-4Hz`), if any: the inverse of [`band_key`], which writes it.
 fn key_band(key: &str) -> Option<[f64; 2]> {
     key.split(':').find_map(|part| {
         let (a, b) = part.strip_suffix("Hz")?.split_once('-')?;

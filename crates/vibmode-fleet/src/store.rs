@@ -1388,10 +1388,6 @@ fn same_drive(
 }
 
 impl Store {
-    /// Every drive verdict of the vehicle `vid`, newest first, each with the start of its run
-    /// of equal verdicts. A drive's time is when it was driven where its records' starts are
-    /// known, else when it was checked (checked in the order stored where times are equal), so
-    /// a drive of last week checked today takes its place in last week.
     /// The vehicle's [`EarlierFlag`]: a drive flagged `vehicle` or `both` against the baseline
     /// of its latest drive, when the latest is not (what `status` shows beneath its row).
     pub fn earlier_flag(&self, vehicle: &str) -> Result<Option<EarlierFlag>> {
@@ -1399,6 +1395,10 @@ impl Store {
         Ok(EarlierFlag::of(&self.drive_statuses(vid, vehicle)?))
     }
 
+    /// Every drive verdict of the vehicle `vid`, newest first, each with the start of its run
+    /// of equal verdicts. A drive's time is when it was driven where its records' starts are
+    /// known, else when it was checked (checked in the order stored where times are equal), so
+    /// a drive of last week checked today takes its place in last week.
     fn drive_statuses(&self, vid: i64, vehicle: &str) -> Result<Vec<DriveStatus>> {
         let mut st = self
             .conn

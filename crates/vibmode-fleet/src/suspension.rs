@@ -1324,10 +1324,6 @@ mod tests {
         }
     }
 
-    /// By hand: one part is Student's t (the t is the normal's scale mixture over k /
-    /// chi^2_k), to the Monte Carlo's 0.03; a known variance (over 1000 degrees of freedom) is
-    /// the normal exactly; the sign follows `d`; parts of variance 0 add nothing; no score for
-    /// d = 0, NaN, no positive variance or a part without degrees of freedom.
     /// The loss at which a score reaches its limit: by hand (against scipy 1.14.1's
     /// `stats.t.ppf(stats.norm.cdf(-3), df)`: -5.50708 at df 5, -3.0000075 at df 1e6), at the
     /// floor, without `t`; and over seeded spreads, limits and degrees of freedom, a drive whose
@@ -1388,6 +1384,10 @@ mod tests {
         }
     }
 
+    /// By hand: one part is Student's t (the t is the normal's scale mixture over k /
+    /// chi^2_k), to the Monte Carlo's 0.03; a known variance (over 1000 degrees of freedom) is
+    /// the normal exactly; the sign follows `d`; parts of variance 0 add nothing; no score for
+    /// d = 0, NaN, no positive variance or a part without degrees of freedom.
     #[test]
     fn fiducial_z_by_hand() {
         for k in [3.0, 7.0, 15.0] {
