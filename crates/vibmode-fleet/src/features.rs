@@ -203,6 +203,51 @@ impl TransmissibilityBins {
         (den > 0.0).then(|| num / den).filter(|v| v.is_finite())
     }
 
+    /// The transmissibility of entry `entry` in `band` as [`TransmissibilityBins::band_value`]
+    /// with the input's white noise of one-sided density `noise_density` (the unsprung sensor's
+    /// floor, [`LineFree::noise_density`]) taken out: the H1 estimate's input power holds the
+    /// noise and its coherent power is the output's over the noisy input, so each is divided by
+    /// `1 - noise share` of the band's input power (`sum S_uu / (sum S_uu - m N)` over the `m`
+    /// bins used): `|H|` itself where the noise share is the same in every bin of the band, not
+    /// `|H|` lowered by the share, which grows as the road gets smoother. `None` where more than
+    /// `max_share` of the band's input power is the noise, or as `band_value`.
+    pub fn band_value_noise_free(
+        &self,
+        entry: usize,
+        band: [f64; 2],
+        left_out: &[&[f64]],
+        noise_density: f64,
+        max_share: f64,
+    ) -> Option<f64> {
+        let (num, den, m) =
+            self.band_sums_counted(self.input.get(entry)?, entry, band, left_out)?;
+        let noise = noise_density.max(0.0) * m as f64;
+        if !(den > 0.0 && noise <= max_share * den) {
+            return None;
+        }
+        let keep = den - noise;
+        let v = (num * den / keep / keep).sqrt();
+        v.is_finite().then_some(v)
+    }
+
+    /// The number of bins of `band` that the band sums use (those of `left_out` left out).
+    pub fn band_bins(&self, band: [f64; 2], left_out: &[&[f64]]) -> usize {
+        self.freq_hz
+            .iter()
+            .filter(|&&f| Self::kept(f, band, left_out))
+            .count()
+    }
+
+    /// Whether the bin at `f` is summed over `band`: inside it (edges included) and not at a
+    /// frequency of `left_out`.
+    fn kept(f: f64, band: [f64; 2], left_out: &[&[f64]]) -> bool {
+        f >= band[0]
+            && f <= band[1]
+            && !left_out
+                .iter()
+                .any(|l| l.iter().any(|&x| (x - f).abs() <= 1e-9 * f.abs().max(1.0)))
+    }
+
     /// The sums over `band`'s bins, but those of `left_out`, of entry `entry`'s coherent power
     /// and of `other` (its input or output spectrum).
     fn band_sums(
@@ -212,20 +257,28 @@ impl TransmissibilityBins {
         band: [f64; 2],
         left_out: &[&[f64]],
     ) -> Option<(f64, f64)> {
+        self.band_sums_counted(other, entry, band, left_out)
+            .map(|(num, den, _)| (num, den))
+    }
+
+    /// [`TransmissibilityBins::band_sums`] and the number of bins summed.
+    pub fn band_sums_counted(
+        &self,
+        other: &[f64],
+        entry: usize,
+        band: [f64; 2],
+        left_out: &[&[f64]],
+    ) -> Option<(f64, f64, usize)> {
         let coherent = self.coherent.get(entry)?;
-        let out = |f: f64| {
-            left_out
-                .iter()
-                .any(|l| l.iter().any(|&x| (x - f).abs() <= 1e-9 * f.abs().max(1.0)))
-        };
-        let (mut num, mut den) = (0.0, 0.0);
+        let (mut num, mut den, mut m) = (0.0, 0.0, 0usize);
         for ((&f, &c), &p) in self.freq_hz.iter().zip(coherent).zip(other) {
-            if f >= band[0] && f <= band[1] && !out(f) {
+            if Self::kept(f, band, left_out) {
                 num += c;
                 den += p;
+                m += 1;
             }
         }
-        Some((num, den))
+        Some((num, den, m))
     }
 }
 

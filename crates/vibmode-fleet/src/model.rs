@@ -122,6 +122,105 @@ pub fn noise_free_level(level: f64, noise_power: f64) -> Option<f64> {
     (noise_power <= NOISE_SHARE_MAX * power).then(|| (power - noise_power.max(0.0)).sqrt())
 }
 
+/// A widening of a vehicle feature's spread by the record's own noise
+/// ([`FeatureStat::spread`]) at least this large is said in the summary.
+pub const NOISE_WIDENING_NOTED: f64 = 1.2;
+
+/// Per feature key, the variance (ln units squared) of the feature's value as the record
+/// itself estimates it: its sensors' noise for the level ratios ([`ratio_noise_variances`]),
+/// its coherence and averages for the transmissibility ([`transmissibility_variances`])
+/// ([`ModelSet::record_variances`]); features without an estimate are absent.
+pub type EstimateVariances = BTreeMap<String, f64>;
+
+/// The variance of `ln` of a noise-free band level ([`noise_free_level`]) from the sensor's
+/// white noise: the band power `P = level^2` of `cells` independent time-frequency cells
+/// ([`welch_band_cells`]) holds the noise power `Pn` and the wheel's `Ps = P - Pn`; the noise's
+/// own fluctuation (`Pn^2 / cells`) and its beat with the wheel's motion (`2 Ps Pn / cells`)
+/// remain after `Pn` is taken out, so `var ln sqrt(Ps) = (Pn^2 + 2 Ps Pn) / (4 cells Ps^2)`.
+/// The wheel's own part is left out: the two wheels of a level ratio roll over the same road
+/// (a side's on one track), so it largely cancels in the ratio, and the nominal records' spread
+/// holds it. `None` where the noise is more than [`NOISE_SHARE_MAX`] of the band's power or
+/// the arguments are not finite and positive.
+pub fn noise_free_level_variance(level: f64, noise_power: f64, cells: f64) -> Option<f64> {
+    let power = level * level;
+    let pn = noise_power.max(0.0);
+    if !(power.is_finite() && power > 0.0 && cells.is_finite() && cells > 0.0)
+        || pn > NOISE_SHARE_MAX * power
+    {
+        return None;
+    }
+    let ps = power - pn;
+    Some((pn * pn + 2.0 * ps * pn) / (4.0 * cells * ps * ps))
+}
+
+/// The number of independent cells a band power of the fleet's Welch spectra (Hann window,
+/// 50 % overlap, `segments` segments averaged) over `bins` frequency bins is worth: its
+/// relative variance for white noise is `1 / cells`. Adjacent Hann bins are correlated
+/// (complex correlation -2/3, two apart 1/6: a band sum's variance is `35 / 18` times that of
+/// independent bins) and so are half-overlapping segments (each bin's variance is
+/// [`HANN_HALF_OVERLAP_VARIANCE`] times `S^2 / K`). Three segments (one 10.24 s record at 50 Hz,
+/// `nperseg` 256) over 8-20 Hz: 91 cells, where duration x bandwidth would say 123 (scipy's
+/// Welch over 4000 seeds: relative variance 0.0111, this formula 0.0110).
+pub fn welch_band_cells(bins: usize, segments: usize) -> f64 {
+    let k = segments.max(1) as f64;
+    let m = bins as f64;
+    m * k / (35.0 / 18.0 * HANN_HALF_OVERLAP_VARIANCE)
+}
+
+/// The variances the unsprung sensors' noise gives a record's level ratios (the sum of its two
+/// wheels' [`noise_free_level_variance`] over the [`welch_band_cells`] of the ratio band),
+/// keyed as [`scalar_features`] keys them; empty unless the ratios are noise-free (`line_free`
+/// and `noise_free`) and the record keeps its spectra per bin
+/// ([`crate::features::LineFree::bins`], for the bins and segments).
+pub fn ratio_noise_variances(
+    rf: &RecordFeatures,
+    cfg: &FleetConfig,
+    line_free: bool,
+    noise_free: bool,
+) -> EstimateVariances {
+    let mut out = EstimateVariances::new();
+    let Some(lf) = rf.line_free.as_ref().filter(|_| line_free && noise_free) else {
+        return out;
+    };
+    let [lo, hi] = cfg.ratio_band_hz;
+    let Some(bins) = lf.bins.as_ref().filter(|b| b.segments > 0) else {
+        return out;
+    };
+    // The bins must span the ratio band (they span the level bands, which a configuration
+    // may end below it).
+    let df = match bins.freq_hz.as_slice() {
+        [a, b, ..] => b - a,
+        _ => return out,
+    };
+    let spans = bins.freq_hz.first().is_some_and(|&f| f <= lo + df)
+        && bins.freq_hz.last().is_some_and(|&f| f >= hi - df);
+    let in_band = bins.freq_hz.iter().filter(|&&f| f >= lo && f <= hi).count();
+    if !spans || in_band == 0 {
+        return out;
+    }
+    let cells = welch_band_cells(in_band, bins.segments);
+    let var = |corner: Corner| {
+        let i = rf
+            .channels
+            .iter()
+            .position(|c| c.role == Role::Unsprung && c.corner == Some(corner))?;
+        let level = lf.ratio_band_rms.get(i).copied().flatten()?;
+        let density = lf.noise_density.get(i).copied().unwrap_or(0.0);
+        noise_free_level_variance(level, density * (hi - lo), cells)
+    };
+    for (kind, pairs) in [(Kind::SideRatio, AXLES), (Kind::TrackRatio, TRACKS)] {
+        for (name, a, b) in pairs {
+            if let (Some(va), Some(vb)) = (var(a), var(b)) {
+                out.insert(
+                    ratio_key(kind, name, &cfg.ratio_band_hz, line_free),
+                    va + vb,
+                );
+            }
+        }
+    }
+    out
+}
+
 /// Where a feature comes from, and its name in tables.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FeatureMeta {
@@ -155,6 +254,27 @@ pub struct FeatureStat {
     pub hi: f64,
     /// Nominal records that have the feature.
     pub n: usize,
+    /// The mean over the nominal records of the variance their sensors' noise gives ln(value)
+    /// ([`EstimateVariances`]; pooled over the kind where `sigma` is), which `sigma` holds. Absent
+    /// for features without such an estimate and in model sets stored before it existed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub estimate_var: Option<f64>,
+}
+
+impl FeatureStat {
+    /// The spread a value is scored against when its own noise variance is `v` (ln units
+    /// squared): `sigma` widened by the excess of `v` over the nominal records' mean,
+    /// `sqrt(sigma^2 + max(0, v - estimate_var))`. A record on a smoother road than the nominal
+    /// records', whose wheels' band power is nearer their sensors' noise floor, is judged
+    /// against the scatter its own noise gives it; never narrower than `sigma`.
+    pub fn spread(&self, v: Option<f64>) -> f64 {
+        match (v, self.estimate_var) {
+            (Some(v), Some(nominal)) if v.is_finite() && v > nominal => {
+                (self.sigma * self.sigma + (v - nominal)).sqrt()
+            }
+            _ => self.sigma,
+        }
+    }
 }
 
 /// A mode of the model set: one channel's mode found in most nominal records.
@@ -250,6 +370,13 @@ pub struct ModelSet {
     /// built from records stored before it; their checks keep the ratios as they were.
     #[serde(default)]
     pub noise_free: bool,
+    /// Built from the transmissibility with each unsprung channel's noise taken out of its
+    /// input power ([`crate::features::TransmissibilityBins::band_value_noise_free`], with
+    /// `noise_free` and `vehicle_line_bins_hz`): the H1 estimate is lowered by the input's noise
+    /// share, which grows as the road gets smoother and differs between corners. False in
+    /// model sets stored before it existed; their checks keep the transmissibility as it was.
+    #[serde(default)]
+    pub input_noise_free: bool,
     /// The suspension fitted to the nominal records together, when the vehicle has a
     /// registered model file and at least three nominal records carry its equations
     /// ([`crate::suspension`]); else absent and `notes` says why.
@@ -303,10 +430,30 @@ impl ModelSet {
             &self.slots,
             self.body.as_ref(),
             &self.config,
-            self.line_free,
-            self.noise_free,
-            self.vehicle_line_bins_hz.as_deref(),
+            self.variants(),
         )
+    }
+
+    /// The variants this model set reads records with.
+    pub fn variants(&self) -> Variants<'_> {
+        Variants {
+            line_free: self.line_free,
+            noise_free: self.noise_free,
+            input_noise_free: self.input_noise_free,
+            vehicle_lines: self.vehicle_line_bins_hz.as_deref(),
+        }
+    }
+
+    /// The variances a record's own sensor noise gives its features as this model set reads
+    /// them ([`ratio_noise_variances`]).
+    pub fn record_variances(&self, rf: &RecordFeatures) -> EstimateVariances {
+        let mut v = ratio_noise_variances(rf, &self.config, self.line_free, self.noise_free);
+        if self.input_noise_free {
+            if let Some(lines) = self.vehicle_line_bins_hz.as_deref() {
+                v.extend(transmissibility_variances(rf, &self.config, lines));
+            }
+        }
+        v
     }
 
     /// The limit of `kind` (infinite for a kind the model set has not).
@@ -548,18 +695,22 @@ fn body_features(
 /// `transmissibility_min_hz`): ln(sprung / unsprung band RMS) minus its mean over the other
 /// corners that have the band, so that what moves every corner alike (the load, whose extra
 /// mass lowers every corner's damping per mass; the speed; the road's spectrum) cancels and a
-/// corner's own damper, spring or tyre stays. With a single corner the absolute value is kept.
+/// corner's own damper, spring or tyre stays. With a single corner the absolute value is kept (a vehicle with one corner pair; a record of
+/// more corners with one value left in the band gives none there).
 ///
 /// With `line_free`, the values with the periodic lines left out ([`RecordFeatures::line_free`],
 /// key `transh1lf`); a record without them gives none. With `vehicle_lines` (a model set's
 /// [`ModelSet::vehicle_line_bins_hz`]), the values from the record's per-bin parts with its own
 /// lines' bins and those left out ([`crate::features::TransmissibilityBins::band_value`], key
-/// `transh1lu`); a record without the per-bin parts gives none.
+/// `transh1lu`); a record without the per-bin parts gives none. With `vehicle_lines`' flag
+/// true, those values with the unsprung channel's noise taken out of the input power
+/// ([`crate::features::TransmissibilityBins::band_value_noise_free`]); a record without the
+/// noise density, or whose band is more than [`NOISE_SHARE_MAX`] noise, gives none.
 fn transmissibility_features(
     rf: &RecordFeatures,
     cfg: &FleetConfig,
     line_free: bool,
-    vehicle_lines: Option<&[f64]>,
+    vehicle_lines: Option<(&[f64], bool)>,
 ) -> Vec<(FeatureMeta, f64)> {
     let mut out = Vec::new();
     for (k, b) in rf.bands_hz.iter().enumerate() {
@@ -571,13 +722,20 @@ fn transmissibility_features(
             .iter()
             .enumerate()
             .filter_map(|(i, t)| {
-                if let Some(vehicle) = vehicle_lines {
+                if let Some((vehicle, input_noise_free)) = vehicle_lines {
                     let lf = rf.line_free.as_ref()?;
-                    let v = lf.bins.as_ref()?.band_value(
-                        i,
-                        *b,
-                        &[lf.line_bins_hz.as_slice(), vehicle],
-                    )?;
+                    let bins = lf.bins.as_ref()?;
+                    let left_out = [lf.line_bins_hz.as_slice(), vehicle];
+                    let v = if input_noise_free {
+                        let density = unsprung_noise_density(rf, lf, t)?;
+                        if std::env::var_os("VIBMODE_DEBUG_T").is_some() {
+                            let (num, den, m) = bins.band_sums_counted(&bins.input[i], i, *b, &left_out).unwrap_or_default();
+                            eprintln!("DBGT {} {:?} raw {:?} nf {:?} num {num:.3e} den {den:.3e} noise {:.3e} m {m}", t.corner, b, bins.band_value(i, *b, &left_out), bins.band_value_noise_free(i, *b, &left_out, density, NOISE_SHARE_MAX), density * m as f64);
+                        }
+                        bins.band_value_noise_free(i, *b, &left_out, density, NOISE_SHARE_MAX)?
+                    } else {
+                        bins.band_value(i, *b, &left_out)?
+                    };
                     return (v > 0.0).then(|| (t, "transh1lu", v.ln()));
                 }
                 if line_free {
@@ -596,6 +754,12 @@ fn transmissibility_features(
                 (v.is_finite() && v > 0.0).then(|| (t, key, v.ln()))
             })
             .collect();
+        // A record whose other corners give no value in this band (their input below the
+        // noise share) gives no relative value: the one corner's own would be scored against
+        // the nominal records' relative ones.
+        if logs.len() == 1 && rf.transmissibility.len() > 1 {
+            continue;
+        }
         let total: f64 = logs.iter().map(|(_, _, v)| v).sum();
         for (t, key, v) in &logs {
             let (value, against) = if logs.len() > 1 {
@@ -620,23 +784,139 @@ fn transmissibility_features(
     out
 }
 
+/// The noise density of the unsprung channel of transmissibility entry `t`
+/// ([`crate::features::LineFree::noise_density`]); `None` where the record has none.
+fn unsprung_noise_density(
+    rf: &RecordFeatures,
+    lf: &crate::features::LineFree,
+    t: &crate::features::CornerTransmissibility,
+) -> Option<f64> {
+    let i = rf.channels.iter().position(|c| c.name == t.unsprung)?;
+    lf.noise_density.get(i).copied().filter(|d| d.is_finite())
+}
+
+/// The variance of `ln |H|` of a band's H1 estimate (`sqrt(sum |S_us|^2 / S_uu / sum S_uu)`,
+/// [`crate::features::h1_band_values`]) at coherence `gamma2` (the bias taken out), from
+/// `segments` Welch segments (Hann, half overlap: `K = segments / HANN_HALF_OVERLAP_VARIANCE`
+/// independent averages per bin) over `cells` ([`welch_band_cells`]). With `q = (1 - gamma^2) /
+/// gamma^2`, the incoherent output power over the coherent: the estimate's power ratio is
+/// `|H|^2 (1 + q / K)` on average (the incoherent part leaks in as `1 / K` of itself) and
+/// scatters by `|H|^4 (2 q + q^2 / K) / cells` (the cross term of the wheel's motion with the
+/// incoherent part, and that part's own scatter), so `var ln |H| = (2 q + q^2 / K) / (4 cells
+/// (1 + q / K)^2)`, written in `gamma^2` so that it holds down to 0 (`K / (4 cells)`). For
+/// many averages it is Bendat and Piersol's `(1 - gamma^2) / (2 gamma^2 cells)` (Random Data,
+/// the random error of a frequency response's magnitude); with the fleet's 3 segments per
+/// 10.24 s record the second term and the leak matter: over 600 seeds of one record at 50 Hz
+/// the scatter is this within 5 % at coherences 0.2 and 0.8, where Bendat and Piersol's
+/// formula is 3.6 times too large at 0.2 (numpy and scipy's welch and csd, 1000 seeds: 0.0047
+/// and 0.00081, this formula 0.0044 and 0.00082).
+pub fn h1_log_variance(gamma2: f64, segments: usize, cells: f64) -> Option<f64> {
+    if !(gamma2.is_finite() && cells.is_finite() && cells > 0.0 && segments > 0) {
+        return None;
+    }
+    let g = gamma2.clamp(0.0, 1.0);
+    let k = segments as f64 / HANN_HALF_OVERLAP_VARIANCE;
+    let num = 2.0 * (1.0 - g) * g + (1.0 - g) * (1.0 - g) / k;
+    let den = g + (1.0 - g) / k;
+    Some(num / (4.0 * cells * den * den))
+}
+
+/// The estimate variances of a record's transmissibility features as
+/// [`transmissibility_features`] computes them with the vehicle's lines left out and the input
+/// noise taken out (key `transh1lu`): a corner's value is its `ln |H|` less the mean over the
+/// other corners with the band, so its variance is its own [`h1_log_variance`] plus the
+/// others' over `(k - 1)^2`. Corners without a coherence give the feature none.
+pub fn transmissibility_variances(
+    rf: &RecordFeatures,
+    cfg: &FleetConfig,
+    vehicle_lines: &[f64],
+) -> EstimateVariances {
+    let mut out = EstimateVariances::new();
+    let Some(lf) = rf.line_free.as_ref() else {
+        return out;
+    };
+    let Some(bins) = lf.bins.as_ref().filter(|b| b.segments > 0) else {
+        return out;
+    };
+    let left_out = [lf.line_bins_hz.as_slice(), vehicle_lines];
+    let values = transmissibility_features(rf, cfg, true, Some((vehicle_lines, true)));
+    for b in rf
+        .bands_hz
+        .iter()
+        .filter(|b| b[0] >= cfg.transmissibility_min_hz)
+    {
+        let cells = welch_band_cells(bins.band_bins(*b, &left_out), bins.segments);
+        // Per corner with a value in this band, its variance (None: no coherence).
+        let per: Vec<(Corner, Option<f64>)> = rf
+            .transmissibility
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| {
+                let key = format!("transh1lu:{}:{}", t.corner, band_key(b));
+                values.iter().any(|(m, _)| m.key == key)
+            })
+            .map(|(i, t)| {
+                let v = bins
+                    .band_coherence(i, *b, &left_out)
+                    .and_then(|g| corrected_coherence(g, bins.segments))
+                    .and_then(|g| h1_log_variance(g, bins.segments, cells));
+                (t.corner, v)
+            })
+            .collect();
+        let k = per.len();
+        if k < 2 {
+            continue;
+        }
+        for (corner, v) in &per {
+            let others: Option<f64> = per
+                .iter()
+                .filter(|(c, _)| c != corner)
+                .map(|(_, w)| *w)
+                .sum();
+            if let (Some(v), Some(o)) = (v, others) {
+                out.insert(
+                    format!("transh1lu:{corner}:{}", band_key(b)),
+                    v + o / ((k - 1) * (k - 1)) as f64,
+                );
+            }
+        }
+    }
+    out
+}
+
+/// How a model set reads a record's features ([`ModelSet::variants`]): the variants its
+/// nominal records were read with, so that every record it scores is read alike.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Variants<'a> {
+    /// [`ModelSet::line_free`]: the transmissibility with the periodic lines left out and the
+    /// level ratios with the unsprung lines replaced by their continuum, under their own keys.
+    pub line_free: bool,
+    /// [`ModelSet::noise_free`] (with `line_free`): each unsprung channel's noise power in the
+    /// band taken out of its band power before the level ratios ([`noise_free_level`]).
+    pub noise_free: bool,
+    /// [`ModelSet::input_noise_free`] (with `vehicle_lines`): the transmissibility with the
+    /// unsprung channel's noise taken out of its input power.
+    pub input_noise_free: bool,
+    /// [`ModelSet::vehicle_line_bins_hz`]: the vehicle's own lines, left out of every record's
+    /// transmissibility.
+    pub vehicle_lines: Option<&'a [f64]>,
+}
+
 /// Scalar features of a record, as ln(value), given the model set's modes and nominal body
-/// response.
-///
-/// `line_free` (the model set's [`ModelSet::line_free`]): the transmissibility with the periodic
-/// lines left out and the level ratios with the unsprung lines replaced by their continuum,
-/// under their own keys. `noise_free` (the model set's [`ModelSet::noise_free`], with
-/// `line_free`): each unsprung channel's noise power in the band taken out of its band power
-/// before the level ratios ([`noise_free_level`]).
+/// response, read as `variants` says.
 pub fn scalar_features(
     rf: &RecordFeatures,
     slots: &[ModeSlot],
     body: Option<&BodyModel>,
     cfg: &FleetConfig,
-    line_free: bool,
-    noise_free: bool,
-    vehicle_lines: Option<&[f64]>,
+    variants: Variants<'_>,
 ) -> Vec<(FeatureMeta, f64)> {
+    let Variants {
+        line_free,
+        noise_free,
+        input_noise_free,
+        vehicle_lines,
+    } = variants;
     let mut out = body.map_or_else(Vec::new, |b| body_features(rf, b, cfg));
     // Road level per band: the mean of ln(band RMS) over the unsprung channels that have it.
     for (k, b) in rf.bands_hz.iter().enumerate() {
@@ -661,7 +941,12 @@ pub fn scalar_features(
             ));
         }
     }
-    out.extend(transmissibility_features(rf, cfg, line_free, vehicle_lines));
+    out.extend(transmissibility_features(
+        rf,
+        cfg,
+        line_free,
+        vehicle_lines.map(|l| (l, input_noise_free)),
+    ));
     // Unsprung level ratios at and above wheel hop: left over right wheel of each axle, front
     // over rear wheel of each side. Both wheels of a pair roll on the same road class at the same
     // speed (on one side, on the same track), so the road level and its spectrum cancel.
@@ -927,18 +1212,36 @@ fn fit_body(
     Some((model, loo))
 }
 
-/// Statistics of every feature present in at least `max(3, mode_min_share * n)` records.
-fn feature_stats(values: &[Vec<(FeatureMeta, f64)>], cfg: &FleetConfig) -> Vec<FeatureStat> {
+/// Statistics of every feature present in at least `max(3, mode_min_share * n)` records;
+/// `noise` holds each record's [`EstimateVariances`] (same order as `values`; may be shorter).
+fn feature_stats(
+    values: &[Vec<(FeatureMeta, f64)>],
+    noise: &[EstimateVariances],
+    cfg: &FleetConfig,
+) -> Vec<FeatureStat> {
     let mut by_key: BTreeMap<String, (FeatureMeta, Vec<f64>)> = BTreeMap::new();
-    for rec in values {
+    // Per key, the noise variances of the records that have the feature (None: one lacks it).
+    let mut var_of: BTreeMap<String, Option<Vec<f64>>> = BTreeMap::new();
+    for (i, rec) in values.iter().enumerate() {
         for (meta, v) in rec {
             by_key
                 .entry(meta.key.clone())
                 .or_insert_with(|| (meta.clone(), Vec::new()))
                 .1
                 .push(*v);
+            let nv = noise.get(i).and_then(|n| n.get(&meta.key)).copied();
+            let e = var_of
+                .entry(meta.key.clone())
+                .or_insert_with(|| Some(Vec::new()));
+            match (e.as_mut(), nv) {
+                (Some(list), Some(x)) => list.push(x),
+                _ => *e = None,
+            }
         }
     }
+    let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
+    // Pooled kinds: every record variance of the kind's features, or none if one lacks it.
+    let mut pooled_var: BTreeMap<Kind, Option<Vec<f64>>> = BTreeMap::new();
     let need = ((cfg.mode_min_share * values.len() as f64).ceil() as usize).max(3);
     let mut out = Vec::new();
     // Deviations from the feature's median, per pooled kind.
@@ -951,11 +1254,19 @@ fn feature_stats(values: &[Vec<(FeatureMeta, f64)>], cfg: &FleetConfig) -> Vec<F
         let (Some(centre), Some(sigma)) = (median(&v), robust_sigma(&v, floor)) else {
             continue;
         };
+        let own_var = var_of.get(&meta.key).cloned().flatten();
         if pooled(meta.kind) {
             deviations
                 .entry(meta.kind)
                 .or_default()
                 .extend(v.iter().filter(|x| x.is_finite()).map(|x| x - centre));
+            let e = pooled_var
+                .entry(meta.kind)
+                .or_insert_with(|| Some(Vec::new()));
+            match (e.as_mut(), &own_var) {
+                (Some(all), Some(list)) => all.extend_from_slice(list),
+                _ => *e = None,
+            }
         }
         let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
@@ -966,6 +1277,7 @@ fn feature_stats(values: &[Vec<(FeatureMeta, f64)>], cfg: &FleetConfig) -> Vec<F
             lo,
             hi,
             n: v.len(),
+            estimate_var: own_var.as_deref().and_then(mean),
         });
     }
     for f in out.iter_mut().filter(|f| pooled(f.meta.kind)) {
@@ -975,6 +1287,12 @@ fn feature_stats(values: &[Vec<(FeatureMeta, f64)>], cfg: &FleetConfig) -> Vec<F
         {
             f.sigma = s;
         }
+        f.estimate_var = pooled_var
+            .get(&f.meta.kind)
+            .cloned()
+            .flatten()
+            .as_deref()
+            .and_then(mean);
     }
     out
 }
@@ -1005,6 +1323,7 @@ pub fn build_model_set(
                 .is_some_and(|l| !l.noise_density.is_empty())
         });
     let vehicle_lines = vehicle_line_bins(records);
+    let input_noise_free = noise_free && vehicle_lines.is_some();
     let mut notes = Vec::new();
     let low = match vehicle_lines.as_deref() {
         Some(lines) if cfg.transmissibility_min_coherence > 0.0 => {
@@ -1030,9 +1349,12 @@ pub fn build_model_set(
                 &slots,
                 None,
                 cfg,
-                line_free,
-                noise_free,
-                vehicle_lines.as_deref(),
+                Variants {
+                    line_free,
+                    noise_free,
+                    input_noise_free,
+                    vehicle_lines: vehicle_lines.as_deref(),
+                },
             );
             v.retain(|(m, _)| !low.iter().any(|(key, ..)| *key == m.key));
             if let Some((_, loo)) = &body {
@@ -1041,7 +1363,17 @@ pub fn build_model_set(
             v
         })
         .collect();
-    let features = feature_stats(&values, cfg);
+    let noise: Vec<EstimateVariances> = records
+        .iter()
+        .map(|r| {
+            let mut v = ratio_noise_variances(r, cfg, line_free, noise_free);
+            if let (true, Some(lines)) = (input_noise_free, vehicle_lines.as_deref()) {
+                v.extend(transmissibility_variances(r, cfg, lines));
+            }
+            v
+        })
+        .collect();
+    let features = feature_stats(&values, &noise, cfg);
     if !features.iter().any(|f| f.meta.group == Group::Vehicle) {
         return Err(FleetError::NoVehicleFeature {
             vehicle: vehicle.to_string(),
@@ -1057,14 +1389,20 @@ pub fn build_model_set(
             .filter(|(j, _)| *j != i)
             .map(|(_, v)| v.clone())
             .collect();
-        let stats = feature_stats(&others, cfg);
+        let others_noise: Vec<EstimateVariances> = noise
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| *j != i)
+            .map(|(_, v)| v.clone())
+            .collect();
+        let stats = feature_stats(&others, &others_noise, cfg);
         let by_key: BTreeMap<&str, f64> = values[i]
             .iter()
             .map(|(m, v)| (m.key.as_str(), *v))
             .collect();
         for f in &stats {
             if let Some(&x) = by_key.get(f.meta.key.as_str()) {
-                let z = score(f, x, cfg).abs();
+                let z = score(f, x, noise[i].get(&f.meta.key).copied(), cfg).abs();
                 let e = loo_max.entry(f.meta.kind).or_insert(0.0);
                 *e = e.max(z);
             }
@@ -1119,6 +1457,7 @@ pub fn build_model_set(
         notes,
         line_free,
         noise_free,
+        input_noise_free,
         suspension: None,
         held_out_drives: Vec::new(),
         vehicle_line_bins_hz: vehicle_lines,
@@ -1220,12 +1559,13 @@ fn group_of(kind: Kind) -> Group {
     }
 }
 
-/// The score of ln-value `x` against `f`: the robust z for vehicle features; for excitation
+/// The score of ln-value `x` against `f`: the robust z for vehicle features (against
+/// [`FeatureStat::spread`] of the value's own estimate variance `var`); for excitation
 /// features the distance above the nominal range's top `hi` plus `road_margin`, in units of
 /// `floor_level` (0 below it: a smoother road, or one up to a road class rougher, is normal).
-fn score(f: &FeatureStat, x: f64, cfg: &FleetConfig) -> f64 {
+fn score(f: &FeatureStat, x: f64, var: Option<f64>, cfg: &FleetConfig) -> f64 {
     match f.meta.group {
-        Group::Vehicle => (x - f.centre) / f.sigma,
+        Group::Vehicle => (x - f.centre) / f.spread(var),
         Group::Excitation => (x - f.hi - cfg.road_margin).max(0.0) / cfg.floor_level,
     }
 }
@@ -1236,7 +1576,8 @@ fn score(f: &FeatureStat, x: f64, cfg: &FleetConfig) -> f64 {
 /// (which cover its working channels only); the summary names the channels first.
 pub fn assess(set: &ModelSet, rf: &RecordFeatures) -> Assessment {
     let values = set.record_features(rf);
-    let mut a = score_values(set, &values, &[], None);
+    let noise = set.record_variances(rf);
+    let mut a = score_values(set, &values, &noise, &[], None);
     if !rf.sensor_faults.is_empty() {
         a.classification = Classification::Sensor;
         let faults: Vec<String> = rf.sensor_faults.iter().map(|f| f.to_string()).collect();
@@ -1292,6 +1633,8 @@ pub fn assess_drive_fitted(
     // Each record's features once: for the medians and for the records' own road verdicts.
     let per_record: Vec<Vec<(FeatureMeta, f64)>> =
         usable.iter().map(|rf| set.record_features(rf)).collect();
+    let per_record_noise: Vec<EstimateVariances> =
+        usable.iter().map(|rf| set.record_variances(rf)).collect();
     let mut by_key: BTreeMap<String, (FeatureMeta, Vec<f64>)> = BTreeMap::new();
     for (m, x) in per_record.iter().flatten() {
         by_key
@@ -1306,8 +1649,9 @@ pub fn assess_drive_fitted(
         .filter(|(_, xs)| xs.len() >= need)
         .filter_map(|(m, xs)| median(&xs).map(|x| (m, x)))
         .collect();
-    let mut a = score_values(set, &values, fitted, trend);
-    rough_in_many_records(set, &per_record, &mut a);
+    let noise = drive_noise(&values, &per_record, &per_record_noise);
+    let mut a = score_values(set, &values, &noise, fitted, trend);
+    rough_in_many_records(set, &per_record, &per_record_noise, &mut a);
     let left_out = records.len() - usable.len();
     if left_out > 0 {
         let mut faults: Vec<String> = records
@@ -1342,6 +1686,38 @@ pub fn assess_drive_fitted(
     a
 }
 
+/// The noise variance of a drive's median of each feature that its records have one for: the
+/// median of a sample of `n` values whose noise variance is `v` has about `pi / 2 * v / n`
+/// (the records' median `v`); a feature some of whose records lack one gets none.
+fn drive_noise(
+    values: &[(FeatureMeta, f64)],
+    per_record: &[Vec<(FeatureMeta, f64)>],
+    per_record_noise: &[EstimateVariances],
+) -> EstimateVariances {
+    let mut out = EstimateVariances::new();
+    for (m, _) in values {
+        let mut vars = Vec::new();
+        for (rec, noise) in per_record.iter().zip(per_record_noise) {
+            if rec.iter().any(|(k, _)| k.key == m.key) {
+                match noise.get(&m.key) {
+                    Some(v) => vars.push(*v),
+                    None => {
+                        vars.clear();
+                        break;
+                    }
+                }
+            }
+        }
+        if let Some(v) = median(&vars) {
+            out.insert(
+                m.key.clone(),
+                std::f64::consts::FRAC_PI_2 * v / vars.len() as f64,
+            );
+        }
+    }
+    out
+}
+
 /// A drive's road alarm from its records' own: a rough road raises the levels of every record,
 /// but a record's alarm may come from any of the road's bands (and the per-band medians then
 /// stay below the limit: busgen bus 11219's class D drive, 6 of 8 records `road`, was `normal`).
@@ -1353,6 +1729,7 @@ pub fn assess_drive_fitted(
 fn rough_in_many_records(
     set: &ModelSet,
     per_record: &[Vec<(FeatureMeta, f64)>],
+    per_record_noise: &[EstimateVariances],
     a: &mut Assessment,
 ) {
     let road = |c: Classification| matches!(c, Classification::Road | Classification::Both);
@@ -1361,7 +1738,8 @@ fn rough_in_many_records(
     }
     let rough: Vec<Assessment> = per_record
         .iter()
-        .map(|values| score_values(set, values, &[], None))
+        .zip(per_record_noise)
+        .map(|(values, noise)| score_values(set, values, noise, &[], None))
         .filter(|x| road(x.classification))
         .collect();
     if 2 * rough.len() < per_record.len() {
@@ -1462,6 +1840,7 @@ fn fitted_evidence(
 fn score_values(
     set: &ModelSet,
     values: &[(FeatureMeta, f64)],
+    noise: &EstimateVariances,
     fitted: &[crate::suspension::CornerScore],
     trend: Option<&crate::suspension::SpringTrend>,
 ) -> Assessment {
@@ -1478,6 +1857,8 @@ fn score_values(
     let mut not_judged = 0usize;
     // The quiet bands that left a feature unjudged, for the summary.
     let mut quiet_used: Vec<&QuietBand> = Vec::new();
+    // The largest widening of a vehicle feature's spread by the record's own noise.
+    let mut widest: f64 = 1.0;
     for f in &set.features {
         let where_ = || {
             f.meta
@@ -1502,7 +1883,11 @@ fn score_values(
             }
             continue;
         }
-        let z = score(f, x, &set.config);
+        let var = noise.get(f.meta.key.as_str()).copied();
+        let z = score(f, x, var, &set.config);
+        if f.meta.group == Group::Vehicle {
+            widest = widest.max(f.spread(var) / f.sigma);
+        }
         let (n, max) = match f.meta.group {
             Group::Vehicle => (&mut scores.n_vehicle, &mut scores.vehicle_max_abs_z),
             Group::Excitation => (&mut scores.n_excitation, &mut scores.excitation_max_abs_z),
@@ -1522,7 +1907,7 @@ fn score_values(
             });
         }
     }
-    attribute_ratios(set, values, &mut evidence);
+    attribute_ratios(set, values, noise, &mut evidence);
     evidence.extend(fitted_evidence(set, fitted, trend, &mut scores));
     evidence.sort_by(|a, b| b.z.abs().total_cmp(&a.z.abs()));
     let vehicle = evidence.iter().any(|e| e.meta.group == Group::Vehicle);
@@ -1541,11 +1926,21 @@ fn score_values(
             format!("{summary}; {note}")
         };
     }
+    if widest >= NOISE_WIDENING_NOTED {
+        let note = format!(
+            "wheels near their sensors' noise floor: level ratios judged with their spread widened up to {widest:.1}x by the noise"
+        );
+        summary = if summary.is_empty() {
+            note
+        } else {
+            format!("{summary}; {note}")
+        };
+    }
     Assessment {
         classification: Classification::from_alarms(vehicle, road),
         scores,
         summary,
-        component: component(set, values, &evidence),
+        component: component(set, values, noise, &evidence),
         evidence,
         missing,
         sensor_faults: Vec::new(),
@@ -1607,6 +2002,7 @@ fn key_band(key: &str) -> Option<[f64; 2]> {
 fn corner_ratio_z(
     set: &ModelSet,
     values: &[(FeatureMeta, f64)],
+    noise: &EstimateVariances,
     kind: Kind,
     corner: Corner,
 ) -> Option<f64> {
@@ -1621,7 +2017,7 @@ fn corner_ratio_z(
     let key = ratio_key(kind, name, &set.config.ratio_band_hz, set.line_free);
     let f = set.features.iter().find(|f| f.meta.key == key)?;
     let x = values.iter().find(|(m, _)| m.key == key).map(|(_, v)| *v)?;
-    let z = score(f, x, &set.config);
+    let z = score(f, x, noise.get(&key).copied(), &set.config);
     Some(if *first == corner { z } else { -z })
 }
 
@@ -1647,6 +2043,7 @@ fn corner_ratio_z(
 fn component(
     set: &ModelSet,
     values: &[(FeatureMeta, f64)],
+    noise: &EstimateVariances,
     evidence: &[Evidence],
 ) -> Option<Component> {
     let corner = evidence
@@ -1684,7 +2081,7 @@ fn component(
         (false, false) if body_lowered => {
             let levels: Vec<f64> = [Kind::SideRatio, Kind::TrackRatio]
                 .into_iter()
-                .filter_map(|k| corner_ratio_z(set, values, k, corner))
+                .filter_map(|k| corner_ratio_z(set, values, noise, k, corner))
                 .collect();
             if !levels.is_empty() && levels.iter().all(|z| *z <= SPRING_MAX_LEVEL_Z) {
                 Component::Spring
@@ -1747,12 +2144,17 @@ fn charge_to_first(a: WheelEvidence, b: WheelEvidence, shift: f64) -> bool {
 /// transmissibility 5-8 Hz vs the other corners -37 %"). A flagged ratio is charged to a wheel of
 /// its pair by [`charge_to_first`] and turned to read from that wheel (`FL: level vs FR 8-20 Hz
 /// -40 %`). Without either other ratio it stays on its channel pair.
-fn attribute_ratios(set: &ModelSet, values: &[(FeatureMeta, f64)], evidence: &mut [Evidence]) {
+fn attribute_ratios(
+    set: &ModelSet,
+    values: &[(FeatureMeta, f64)],
+    noise: &EstimateVariances,
+    evidence: &mut [Evidence],
+) {
     let band = set.config.ratio_band_hz;
     let signed_z = |key: &str| -> Option<f64> {
         let f = set.features.iter().find(|f| f.meta.key == key)?;
         let x = values.iter().find(|(m, _)| m.key == key).map(|(_, v)| *v)?;
-        Some(score(f, x, &set.config))
+        Some(score(f, x, noise.get(key).copied(), &set.config))
     };
     // The spread of a ratio kind (pooled: one per kind).
     let sigma_of = |kind: Kind| -> Option<f64> {
@@ -2139,11 +2541,21 @@ mod tests {
         assert!((value - 2f64.ln()).abs() < 1e-12, "{value}");
         // Each record's own lines only: 4 of 6 nominal records keep the line (RL's coherent
         // power 0.72 + 4 over 6 of input: 0.886 against RR's 0.3), the checked record not.
-        let old = scalar_features(&checked, &set.slots, None, &cfg, true, false, None)
-            .into_iter()
-            .find(|(m, _)| m.key == "transh1lf:RL:2-5Hz")
-            .map(|(_, v)| v)
-            .expect("old value");
+        let old = scalar_features(
+            &checked,
+            &set.slots,
+            None,
+            &cfg,
+            Variants {
+                line_free: true,
+                noise_free: false,
+                ..Variants::default()
+            },
+        )
+        .into_iter()
+        .find(|(m, _)| m.key == "transh1lf:RL:2-5Hz")
+        .map(|(_, v)| v)
+        .expect("old value");
         let kept = ((0.36 * 6.0 + 4.0) / 6.0f64).sqrt() / 0.3;
         assert!((old - 2f64.ln()).abs() < 1e-12, "{old}");
         let old_set = {
@@ -2377,10 +2789,20 @@ mod tests {
         let z = slots[0].damping_ratio.expect("damping");
         assert!((z - 0.305).abs() < 1e-9, "{z}");
         let damping = |r: &RecordFeatures| {
-            scalar_features(r, &slots, None, &cfg, false, false, None)
-                .into_iter()
-                .find(|(m, _)| m.kind == Kind::ModeDamping)
-                .map(|(_, x)| x.exp())
+            scalar_features(
+                r,
+                &slots,
+                None,
+                &cfg,
+                Variants {
+                    line_free: false,
+                    noise_free: false,
+                    ..Variants::default()
+                },
+            )
+            .into_iter()
+            .find(|(m, _)| m.kind == Kind::ModeDamping)
+            .map(|(_, x)| x.exp())
         };
         assert_eq!(damping(&moded(9.1, 0.03)), None);
         let weaker = damping(&moded(9.1, 0.18)).expect("matched");
@@ -2388,7 +2810,17 @@ mod tests {
         // A model set stored before the damping class matches any damping.
         let mut old = slots.clone();
         old[0].damping_ratio = None;
-        let any = scalar_features(&moded(9.1, 0.03), &old, None, &cfg, false, false, None);
+        let any = scalar_features(
+            &moded(9.1, 0.03),
+            &old,
+            None,
+            &cfg,
+            Variants {
+                line_free: false,
+                noise_free: false,
+                ..Variants::default()
+            },
+        );
         assert!(any.iter().any(|(m, _)| m.kind == Kind::ModeDamping));
     }
 
@@ -2700,10 +3132,20 @@ mod tests {
         assert_eq!(noise_free_level(1.0, 0.6), None);
         let r = noisy_wheels([2.0, 1.0, 1.0, 1.0], [1.0 / 12.0, 0.6 / 12.0, 0.0, 0.0]);
         let get = |noise_free: bool, key: &str| {
-            scalar_features(&r, &[], None, &cfg, true, noise_free, None)
-                .into_iter()
-                .find(|(m, _)| m.key == key)
-                .map(|(_, v)| v)
+            scalar_features(
+                &r,
+                &[],
+                None,
+                &cfg,
+                Variants {
+                    line_free: true,
+                    noise_free,
+                    ..Variants::default()
+                },
+            )
+            .into_iter()
+            .find(|(m, _)| m.key == key)
+            .map(|(_, v)| v)
         };
         let left = ratio_key(Kind::TrackRatio, "left", &cfg.ratio_band_hz, true);
         let right = ratio_key(Kind::TrackRatio, "right", &cfg.ratio_band_hz, true);
@@ -2719,10 +3161,20 @@ mod tests {
         if let Some(lf) = old.line_free.as_mut() {
             lf.noise_density.clear();
         }
-        let x = scalar_features(&old, &[], None, &cfg, true, true, None)
-            .into_iter()
-            .find(|(m, _)| m.key == left)
-            .map(|(_, v)| v);
+        let x = scalar_features(
+            &old,
+            &[],
+            None,
+            &cfg,
+            Variants {
+                line_free: true,
+                noise_free: true,
+                ..Variants::default()
+            },
+        )
+        .into_iter()
+        .find(|(m, _)| m.key == left)
+        .map(|(_, v)| v);
         assert_eq!(x, Some(2f64.ln()));
     }
 
@@ -3032,21 +3484,12 @@ mod tests {
     fn a_lowered_body_response_is_the_spring_only_when_the_wheel_level_is_not_raised() {
         let set = wheel_set();
         let cfg = &set.config;
-        let values = |l: [f64; 4]| {
-            scalar_features(
-                &wheels(l),
-                &set.slots,
-                None,
-                cfg,
-                set.line_free,
-                set.noise_free,
-                set.vehicle_line_bins_hz.as_deref(),
-            )
-        };
+        let values =
+            |l: [f64; 4]| scalar_features(&wheels(l), &set.slots, None, cfg, set.variants());
         let lowered = [body_evidence(Corner::RL, -6.0)];
         // The wheel levels as nominal: the spring.
         assert_eq!(
-            component(&set, &values([1.0; 4]), &lowered),
+            component(&set, &values([1.0; 4]), &EstimateVariances::new(), &lowered),
             Some(Component::Spring)
         );
         // RL's level 8 % up: against FL (nominal centre ln(FL/RL) = -0.020, pooled spread
@@ -3057,22 +3500,451 @@ mod tests {
             Classification::Normal
         );
         assert_eq!(
-            component(&set, &values([1.0, 1.0, 1.08, 1.0]), &lowered),
+            component(
+                &set,
+                &values([1.0, 1.0, 1.08, 1.0]),
+                &EstimateVariances::new(),
+                &lowered
+            ),
             Some(Component::Suspension)
         );
         // RL's level 2 % down (within the scatter): still the spring.
         assert_eq!(
-            component(&set, &values([1.0, 1.0, 0.98, 1.0]), &lowered),
+            component(
+                &set,
+                &values([1.0, 1.0, 0.98, 1.0]),
+                &EstimateVariances::new(),
+                &lowered
+            ),
             Some(Component::Spring)
         );
         // Without the wheel levels it cannot tell the spring from the damper.
-        assert_eq!(component(&set, &[], &lowered), Some(Component::Suspension));
+        assert_eq!(
+            component(&set, &[], &EstimateVariances::new(), &lowered),
+            Some(Component::Suspension)
+        );
         // A raised body response is no spring sign.
         assert_eq!(
-            component(&set, &values([1.0; 4]), &[body_evidence(Corner::RL, 6.0)]),
+            component(
+                &set,
+                &values([1.0; 4]),
+                &EstimateVariances::new(),
+                &[body_evidence(Corner::RL, 6.0)]
+            ),
             Some(Component::Suspension)
         );
         // Nothing flagged: nothing named.
-        assert_eq!(component(&set, &values([1.0; 4]), &[]), None);
+        assert_eq!(
+            component(&set, &values([1.0; 4]), &EstimateVariances::new(), &[]),
+            None
+        );
+    }
+}
+
+/// The estimate variances of the level ratios and the transmissibility (records judged against
+/// the scatter their own noise gives them).
+#[cfg(test)]
+mod variance_tests {
+    use super::*;
+    use vibmode_spectra::{band_rms, WelchParams, Window};
+
+    /// A seeded standard normal generator (xorshift64 and Box-Muller).
+    fn normal_source(seed: u64) -> impl FnMut() -> f64 {
+        let mut state: u64 = 0x9e37_79b9_7f4a_7c15 ^ seed.wrapping_mul(0x2545_f491_4f6c_dd1d);
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        move || {
+            let (a, b) = (uniform().max(1e-300), uniform());
+            (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
+        }
+    }
+
+    fn welch_params() -> WelchParams {
+        WelchParams {
+            window: Window::Hann,
+            nperseg: Some(256),
+            ..WelchParams::default()
+        }
+    }
+
+    fn var(x: &[f64]) -> f64 {
+        let m = x.iter().sum::<f64>() / x.len() as f64;
+        x.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (x.len() - 1) as f64
+    }
+
+    /// By hand: 62 bins (8-20 Hz at 50/256 Hz) of 3 segments: 62 x 3 / (35/18 x (1 + 2/36))
+    /// = 90.62; one segment of one bin: 18/35 / (1 + 1/18).
+    #[test]
+    fn welch_band_cells_by_hand() {
+        assert!(
+            (welch_band_cells(62, 3) - 186.0 / (35.0 / 18.0 * (1.0 + 2.0 / 36.0))).abs() < 1e-9
+        );
+        assert!((welch_band_cells(62, 3) - 90.62).abs() < 0.01);
+        assert!((welch_band_cells(1, 0) - welch_band_cells(1, 1)).abs() < 1e-15);
+    }
+
+    /// Over 1500 seeds of white noise (512 samples at 50 Hz, one 10.24 s record of the fleet's
+    /// analysis): the relative variance of the Welch band sum over 8-20 Hz is `1 / cells`
+    /// within 12 % (the estimate's own sampling error is about 4 %); duration x bandwidth
+    /// would be 36 % low. scipy.signal.welch gives 0.0111 over 4000 seeds
+    /// (tools/reference/welch_band_variance.py).
+    #[test]
+    fn welch_band_cells_match_the_band_sums_variance_over_seeds() {
+        let mut normal = normal_source(1);
+        let wp = welch_params();
+        let mut sums = Vec::new();
+        let mut bins = 0;
+        for _ in 0..1500 {
+            let x: Vec<f64> = (0..512).map(|_| normal()).collect();
+            let w = vibmode_spectra::welch(&x, 50.0, &wp).unwrap();
+            let keep: Vec<usize> = (0..w.freq_hz.len())
+                .filter(|&k| w.freq_hz[k] >= 8.0 && w.freq_hz[k] <= 20.0)
+                .collect();
+            bins = keep.len();
+            sums.push(keep.iter().map(|&k| w.psd[k]).sum::<f64>());
+        }
+        let mean = sums.iter().sum::<f64>() / sums.len() as f64;
+        let rel = var(&sums) / (mean * mean);
+        assert_eq!(bins, 62);
+        let want = 1.0 / welch_band_cells(bins, 3);
+        assert!(
+            (rel / want - 1.0).abs() < 0.12,
+            "relative variance {rel}, formula {want}"
+        );
+        assert!(rel > 1.2 / (10.24 * 12.0), "{rel}");
+    }
+
+    /// By hand: level 2 (power 4), noise power 1, 100 cells: Ps = 3, (1 + 6) / (4 x 100 x 9)
+    /// = 7/3600; without noise 0; noise above half the power, or no cells: none.
+    #[test]
+    fn noise_free_level_variance_by_hand() {
+        let v = noise_free_level_variance(2.0, 1.0, 100.0).unwrap_or(f64::NAN);
+        assert!((v - 7.0 / 3600.0).abs() < 1e-15, "{v}");
+        assert_eq!(noise_free_level_variance(2.0, 0.0, 100.0), Some(0.0));
+        assert_eq!(noise_free_level_variance(2.0, 2.5, 100.0), None);
+        assert_eq!(noise_free_level_variance(2.0, 1.0, 0.0), None);
+        assert_eq!(noise_free_level_variance(f64::NAN, 1.0, 10.0), None);
+    }
+
+    /// One wheel signal (a fixed realisation) with fresh sensor noise per seed, 600 seeds, at
+    /// noise shares of 10 % and 33 % of the 8-20 Hz band power: the spread of ln(noise-free
+    /// level) over the seeds is [`noise_free_level_variance`]'s within 20 %, so a smoother
+    /// road's record is judged against the scatter its noise gives it. The noise-free level's
+    /// mean stays within 2 % of the wheel's own level (no bias).
+    #[test]
+    fn noise_free_level_variance_matches_the_scatter_over_seeds() {
+        let wp = welch_params();
+        let mut wheel_source = normal_source(99);
+        let wheel: Vec<f64> = (0..512).map(|_| wheel_source()).collect();
+        let ww = vibmode_spectra::welch(&wheel, 50.0, &wp).unwrap();
+        let ps = band_rms(&ww.freq_hz, &ww.psd, 8.0, 20.0).powi(2);
+        for (seed, noise_sd) in [(7u64, 0.33), (8, 0.7)] {
+            let density = 2.0 * noise_sd * noise_sd / 50.0;
+            let pn = density * 12.0;
+            let mut normal = normal_source(seed);
+            let mut logs = Vec::new();
+            let mut predicted = Vec::new();
+            for _ in 0..600 {
+                let x: Vec<f64> = wheel.iter().map(|w| w + noise_sd * normal()).collect();
+                let w = vibmode_spectra::welch(&x, 50.0, &wp).unwrap();
+                let level = band_rms(&w.freq_hz, &w.psd, 8.0, 20.0);
+                let Some(l) = noise_free_level(level, pn) else {
+                    continue;
+                };
+                logs.push(l.ln());
+                predicted
+                    .push(noise_free_level_variance(level, pn, welch_band_cells(62, 3)).unwrap());
+            }
+            assert!(logs.len() > 590);
+            let got = var(&logs);
+            let want = predicted.iter().sum::<f64>() / predicted.len() as f64;
+            assert!(
+                (got / want - 1.0).abs() < 0.2,
+                "noise sd {noise_sd}: scatter {got}, formula {want}"
+            );
+            let mean = logs.iter().sum::<f64>() / logs.len() as f64;
+            assert!(
+                (mean - 0.5 * ps.ln()).abs() < 0.02,
+                "noise sd {noise_sd}: mean {mean}, wheel {}",
+                0.5 * ps.ln()
+            );
+        }
+    }
+
+    /// Two corners (RL, RR) with per-bin parts in 2-5 Hz (bins 2, 3, 4, 5 Hz, 3 segments): input
+    /// `[1, 2, 2, 1]` and coherent power `t^2` times it, the unsprung channels' noise densities
+    /// `density`.
+    fn two_corners(t: [f64; 2], density: [f64; 2]) -> RecordFeatures {
+        let input = vec![1.0, 2.0, 2.0, 1.0];
+        let corners = [Corner::RL, Corner::RR];
+        let bins = crate::features::TransmissibilityBins {
+            freq_hz: vec![2.0, 3.0, 4.0, 5.0],
+            coherent: t
+                .iter()
+                .map(|t| input.iter().map(|p| t * t * p).collect())
+                .collect(),
+            input: vec![input.clone(), input.clone()],
+            output: Vec::new(),
+            segments: 3,
+        };
+        RecordFeatures {
+            analysis_fs_hz: 50.0,
+            duration_s: 10.24,
+            n_segments: 1,
+            bands_hz: vec![[2.0, 5.0]],
+            channels: corners
+                .iter()
+                .map(|c| crate::features::ChannelFeatures {
+                    name: format!("{c}_unsprung"),
+                    role: Role::Unsprung,
+                    corner: Some(*c),
+                    band_rms: vec![Some(1.0)],
+                    modes: Vec::new(),
+                    ratio_band_rms: None,
+                })
+                .collect(),
+            transmissibility: corners
+                .iter()
+                .map(|c| crate::features::CornerTransmissibility {
+                    corner: *c,
+                    sprung: format!("{c}_sprung"),
+                    unsprung: format!("{c}_unsprung"),
+                    values: vec![Some(1.0)],
+                    h1: Vec::new(),
+                })
+                .collect(),
+            notes: Vec::new(),
+            body_spectra: None,
+            sensor_faults: Vec::new(),
+            line_free: Some(crate::features::LineFree {
+                noise_density: density.to_vec(),
+                bins: Some(bins),
+                ..crate::features::LineFree::default()
+            }),
+            suspension: None,
+            start_unix_s: None,
+        }
+    }
+
+    /// By hand: input sums to 6 over the four bins, coherent power 0.25 x 6 = 1.5: H1 =
+    /// sqrt(1.5 / 6) = 0.5. With a noise density 0.5 the band's noise is 4 x 0.5 = 2 of the 6
+    /// (a third): sqrt(1.5 x 6 / 4 / 4) = 0.75; with 1 (4 of 6, above half): none.
+    #[test]
+    fn band_value_noise_free_by_hand() {
+        let r = two_corners([0.5, 0.5], [0.5, 0.5]);
+        let bins = r.line_free.as_ref().and_then(|l| l.bins.as_ref()).unwrap();
+        assert_eq!(bins.band_value(0, [2.0, 5.0], &[]), Some(0.5));
+        let v = bins.band_value_noise_free(0, [2.0, 5.0], &[], 0.5, NOISE_SHARE_MAX);
+        assert!((v.unwrap_or(f64::NAN) - 0.75).abs() < 1e-15, "{v:?}");
+        assert_eq!(
+            bins.band_value_noise_free(0, [2.0, 5.0], &[], 0.0, 0.5),
+            Some(0.5)
+        );
+        assert_eq!(
+            bins.band_value_noise_free(0, [2.0, 5.0], &[], 1.0, 0.5),
+            None
+        );
+        assert_eq!(bins.band_bins([2.0, 5.0], &[&[3.0]]), 3);
+    }
+
+    /// A record whose other corner's wheel is below its noise (RR: density 1, two thirds of
+    /// its input) gives no relative transmissibility in the band, not RL's own value under the
+    /// relative feature's key (ln 0.75 scored against relative values near 0: -93 % on busgen's
+    /// slow drives before); with both corners' inputs above their noise both are relative.
+    #[test]
+    fn one_corner_left_in_a_band_gives_no_relative_transmissibility() {
+        let cfg = FleetConfig::default();
+        let features = |r: &RecordFeatures, input_noise_free: bool| {
+            transmissibility_features(r, &cfg, true, Some((&[], input_noise_free)))
+        };
+        let quiet = two_corners([0.5, 0.5], [0.5, 1.0]);
+        assert!(
+            features(&quiet, true).is_empty(),
+            "{:?}",
+            features(&quiet, true)
+        );
+        assert_eq!(features(&quiet, false).len(), 2);
+        let both = two_corners([0.5, 0.25], [0.5, 0.0]);
+        let got = features(&both, true);
+        assert_eq!(got.len(), 2);
+        // RL 0.75, RR 0.25: RL is ln 3 above the other corner, RR ln 3 below.
+        assert!((got[0].1 - 3f64.ln()).abs() < 1e-12, "{got:?}");
+        assert!((got[1].1 + 3f64.ln()).abs() < 1e-12, "{got:?}");
+    }
+
+    /// Over 100 seeds of 102.4 s (39 segments, so that the finite-average leak of
+    /// [`h1_log_variance`] is small): the wheel's input white (sd 1) measured with sensor noise
+    /// of sd 0.7 (a third of the measured input), the body's `y = 0.5 u + e` (e of sd 0.05).
+    /// The H1 estimate over 2-20 Hz comes out about 0.5 / (1 + 0.49) = 0.34 (the noise share
+    /// lowers it); with the known noise density taken out of the input, its mean of ln is
+    /// within 5 % of ln 0.5.
+    #[test]
+    fn the_input_noise_comes_out_of_the_transmissibility_over_seeds() {
+        let wp = welch_params();
+        let mut normal = normal_source(3);
+        let (mut raw, mut free) = (Vec::new(), Vec::new());
+        let density = 2.0 * 0.49 / 50.0;
+        for _ in 0..100 {
+            let u: Vec<f64> = (0..5120).map(|_| normal()).collect();
+            let um: Vec<f64> = u.iter().map(|x| x + 0.7 * normal()).collect();
+            let y: Vec<f64> = u.iter().map(|x| 0.5 * x + 0.05 * normal()).collect();
+            let pu = vibmode_spectra::welch(&um, 50.0, &wp).unwrap();
+            let c = vibmode_spectra::csd(&um, &y, 50.0, &wp).unwrap();
+            let bins = crate::features::TransmissibilityBins {
+                freq_hz: pu.freq_hz.clone(),
+                coherent: vec![c
+                    .csd
+                    .iter()
+                    .zip(&pu.psd)
+                    .map(|(z, p)| z.norm_sqr() / p)
+                    .collect()],
+                input: vec![pu.psd.clone()],
+                output: Vec::new(),
+                segments: 39,
+            };
+            raw.push(bins.band_value(0, [2.0, 20.0], &[]).unwrap().ln());
+            free.push(
+                bins.band_value_noise_free(0, [2.0, 20.0], &[], density, NOISE_SHARE_MAX)
+                    .unwrap()
+                    .ln(),
+            );
+        }
+        let mean = |x: &[f64]| x.iter().sum::<f64>() / x.len() as f64;
+        assert!(
+            (mean(&raw) - (0.5f64 / 1.49).ln()).abs() < 0.05,
+            "raw {}",
+            mean(&raw).exp()
+        );
+        assert!(
+            (mean(&free) - 0.5f64.ln()).abs() < 0.05,
+            "noise-free {}",
+            mean(&free).exp()
+        );
+    }
+
+    /// By hand: coherence 0.5 from 19 segments (K = 18 averages) over 100 cells: q = 1,
+    /// (2 + 1/18) / (400 (1 + 1/18)^2) = 0.0046122; coherence 1: 0; coherence 0: K / (4 x 100)
+    /// = 0.045; no cells, no segments or a NaN: none.
+    #[test]
+    fn h1_log_variance_by_hand() {
+        let k = 19.0 / HANN_HALF_OVERLAP_VARIANCE;
+        assert!((k - 18.0).abs() < 1e-12);
+        let v = h1_log_variance(0.5, 19, 100.0).unwrap_or(f64::NAN);
+        let want = (2.0 + 1.0 / 18.0) / (400.0 * (1.0f64 + 1.0 / 18.0).powi(2));
+        assert!(
+            (v - want).abs() < 1e-15 && (v - 0.0046122).abs() < 1e-7,
+            "{v}"
+        );
+        assert_eq!(h1_log_variance(1.0, 19, 100.0), Some(0.0));
+        assert!((h1_log_variance(0.0, 19, 100.0).unwrap_or(f64::NAN) - 0.045).abs() < 1e-15);
+        assert_eq!(h1_log_variance(0.5, 19, 0.0), None);
+        assert_eq!(h1_log_variance(0.5, 0, 10.0), None);
+        assert_eq!(h1_log_variance(f64::NAN, 19, 10.0), None);
+    }
+
+    /// Over 600 seeds of one 10.24 s record at 50 Hz (3 Welch segments): `y = 0.5 u + e` at
+    /// coherences 0.2 and 0.8; the scatter of ln H1 over 2-20 Hz is [`h1_log_variance`]'s at
+    /// the band's [`welch_band_cells`] within 20 % (sampling error of the scatter about 6 %);
+    /// Bendat and Piersol's large-sample formula would be 3.6 times too large at 0.2.
+    #[test]
+    fn h1_log_variance_matches_the_scatter_over_seeds() {
+        let wp = welch_params();
+        for (seed, e_sd) in [(11u64, 1.0), (12, 0.25)] {
+            let gamma2 = 0.25 / (0.25 + e_sd * e_sd);
+            let mut normal = normal_source(seed);
+            let mut logs = Vec::new();
+            let mut bins_in = 0;
+            for _ in 0..600 {
+                let u: Vec<f64> = (0..512).map(|_| normal()).collect();
+                let y: Vec<f64> = u.iter().map(|x| 0.5 * x + e_sd * normal()).collect();
+                let pu = vibmode_spectra::welch(&u, 50.0, &wp).unwrap();
+                let c = vibmode_spectra::csd(&u, &y, 50.0, &wp).unwrap();
+                let sus: Vec<(f64, f64)> = c.csd.iter().map(|z| (z.re, z.im)).collect();
+                let h = crate::features::h1_band_values(&pu.freq_hz, &sus, &pu.psd, &[[2.0, 20.0]]);
+                logs.push(h[0].unwrap().ln());
+                bins_in = pu
+                    .freq_hz
+                    .iter()
+                    .filter(|&&f| (2.0..=20.0).contains(&f))
+                    .count();
+            }
+            let got = var(&logs);
+            let want = h1_log_variance(gamma2, 3, welch_band_cells(bins_in, 3)).unwrap();
+            assert!(
+                (got / want - 1.0).abs() < 0.2,
+                "coherence {gamma2}: scatter {got}, formula {want}"
+            );
+            let bendat_piersol = (1.0 - gamma2) / (2.0 * gamma2 * welch_band_cells(bins_in, 3));
+            if gamma2 < 0.5 {
+                assert!(bendat_piersol > 2.5 * got, "{bendat_piersol} {got}");
+            }
+        }
+    }
+
+    /// By hand: sigma 0.05 and a nominal estimate variance 0.001; a record's 0.01 widens it to
+    /// sqrt(0.0025 + 0.009) = 0.1072; one below the nominal's, or none, keeps 0.05; a model set
+    /// without the nominal variance keeps 0.05 for any record.
+    #[test]
+    fn spread_by_hand() {
+        let mut f = FeatureStat {
+            meta: FeatureMeta {
+                key: "k".into(),
+                group: Group::Vehicle,
+                kind: Kind::TrackRatio,
+                corner: None,
+                channel: "c".into(),
+                label: "l".into(),
+            },
+            centre: 0.0,
+            sigma: 0.05,
+            lo: -0.1,
+            hi: 0.1,
+            n: 8,
+            estimate_var: Some(0.001),
+        };
+        assert!((f.spread(Some(0.01)) - 0.0115f64.sqrt()).abs() < 1e-15);
+        assert_eq!(f.spread(Some(0.0005)), 0.05);
+        assert_eq!(f.spread(None), 0.05);
+        assert_eq!(f.spread(Some(f64::NAN)), 0.05);
+        f.estimate_var = None;
+        assert_eq!(f.spread(Some(0.01)), 0.05);
+    }
+
+    /// By hand: a drive of 4 records with a feature's variances 0.01, 0.02, 0.03, 0.05 has the
+    /// median's `pi / 2 x 0.025 / 4`; a feature one of whose records has no variance gets none.
+    #[test]
+    fn drive_noise_by_hand() {
+        let meta = |key: &str| FeatureMeta {
+            key: key.into(),
+            group: Group::Vehicle,
+            kind: Kind::TrackRatio,
+            corner: None,
+            channel: "c".into(),
+            label: "l".into(),
+        };
+        let per_record: Vec<Vec<(FeatureMeta, f64)>> = (0..4)
+            .map(|_| vec![(meta("a"), 0.0), (meta("b"), 0.0)])
+            .collect();
+        let noise: Vec<EstimateVariances> = [0.01, 0.02, 0.03, 0.05]
+            .iter()
+            .enumerate()
+            .map(|(i, v)| {
+                let mut m = EstimateVariances::new();
+                m.insert("a".into(), *v);
+                if i != 2 {
+                    m.insert("b".into(), *v);
+                }
+                m
+            })
+            .collect();
+        let values = vec![(meta("a"), 0.0), (meta("b"), 0.0)];
+        let d = drive_noise(&values, &per_record, &noise);
+        let want = std::f64::consts::FRAC_PI_2 * 0.025 / 4.0;
+        assert!((d["a"] - want).abs() < 1e-15, "{d:?}");
+        assert!(!d.contains_key("b"));
     }
 }
