@@ -553,6 +553,11 @@ pub struct Evidence {
     pub limit: f64,
     /// |z| above the limit.
     pub flagged: bool,
+    /// Where the record's (or drive's) own estimate variance widened the feature's spread
+    /// ([`FeatureStat::spread`]), the factor (above 1); absent otherwise and in checks stored
+    /// before it existed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spread_widened_by: Option<f64>,
 }
 
 /// Summary scores of a record.
@@ -1831,6 +1836,7 @@ fn fitted_evidence(
                 change_pct: 100.0 * f.change(),
                 limit,
                 flagged: true,
+                spread_widened_by: None,
             });
         }
     }
@@ -1896,6 +1902,7 @@ fn score_values(
         *max = max.max(z.abs());
         let limit = set.limit(f.meta.kind);
         if z.abs() > limit {
+            let widened = f.spread(var) / f.sigma;
             evidence.push(Evidence {
                 meta: f.meta.clone(),
                 value: x.exp(),
@@ -1904,6 +1911,8 @@ fn score_values(
                 change_pct: 100.0 * ((x - f.centre).exp() - 1.0),
                 limit,
                 flagged: true,
+                spread_widened_by: (f.meta.group == Group::Vehicle && widened > 1.0)
+                    .then_some(widened),
             });
         }
     }
@@ -3477,6 +3486,7 @@ mod tests {
             change_pct: 0.0,
             limit: 4.0,
             flagged: true,
+            spread_widened_by: None,
         }
     }
 
@@ -3946,5 +3956,112 @@ mod variance_tests {
         let want = std::f64::consts::FRAC_PI_2 * 0.025 / 4.0;
         assert!((d["a"] - want).abs() < 1e-15, "{d:?}");
         assert!(!d.contains_key("b"));
+    }
+
+    /// Four unsprung wheels whose noise-free band powers in 8-20 Hz are `p` (FL, FR, RL, RR),
+    /// measured with sensor noise of density `d` (noise power `12 d` added to each), one 10.24 s
+    /// record at 50 Hz (3 Welch segments, the bins of 0.5-20 Hz).
+    fn wheels_with_noise(p: [f64; 4], d: f64) -> RecordFeatures {
+        let corners = [Corner::FL, Corner::FR, Corner::RL, Corner::RR];
+        let measured: Vec<Option<f64>> = p.iter().map(|p| Some((p + 12.0 * d).sqrt())).collect();
+        RecordFeatures {
+            analysis_fs_hz: 50.0,
+            duration_s: 10.24,
+            n_segments: 1,
+            bands_hz: vec![[2.0, 5.0]],
+            channels: corners
+                .iter()
+                .zip(&measured)
+                .map(|(c, m)| crate::features::ChannelFeatures {
+                    name: format!("{c}_unsprung"),
+                    role: Role::Unsprung,
+                    corner: Some(*c),
+                    band_rms: vec![Some(1.0)],
+                    modes: Vec::new(),
+                    ratio_band_rms: *m,
+                })
+                .collect(),
+            transmissibility: Vec::new(),
+            notes: Vec::new(),
+            body_spectra: None,
+            sensor_faults: Vec::new(),
+            line_free: Some(crate::features::LineFree {
+                ratio_band_rms: measured,
+                noise_density: vec![d; 4],
+                bins: Some(crate::features::TransmissibilityBins {
+                    freq_hz: (3..=102).map(|k| k as f64 * 50.0 / 256.0).collect(),
+                    segments: 3,
+                    ..crate::features::TransmissibilityBins::default()
+                }),
+                ..crate::features::LineFree::default()
+            }),
+            suspension: None,
+            start_unix_s: None,
+        }
+    }
+
+    /// A baseline of 8 records with little sensor noise (1.2 % of the band power) keeps its
+    /// records' mean estimate variance; a record whose left front wheel is 0.4 (ln level) above
+    /// its rear one is flagged at z = 0.4 / 0.03 = 13 without noise and, with the noise power
+    /// 0.8 in every wheel (44 % of the rear wheel's measured band power), at 0.4 over the
+    /// spread widened by its own variance (`sqrt(0.03^2 + v - v_nominal)`, about 3.2 times: z
+    /// 4.1), which its evidence and summary state.
+    #[test]
+    fn a_record_near_its_noise_floor_is_judged_against_its_own_scatter() {
+        let cfg = FleetConfig::default();
+        let recs: Vec<RecordFeatures> = (0..8)
+            .map(|i| wheels_with_noise([1.0 + 0.002 * (i % 3) as f64, 1.0, 1.0, 1.0], 0.001))
+            .collect();
+        let names: Vec<String> = (0..8).map(|i| format!("n{i}")).collect();
+        let set = build_model_set("bus", &names, &recs, &cfg).expect("model set");
+        assert!(set.noise_free);
+        let key = ratio_key(Kind::TrackRatio, "left", &cfg.ratio_band_hz, true);
+        let f = set
+            .features
+            .iter()
+            .find(|f| f.meta.key == key)
+            .expect("left track ratio");
+        assert_eq!(f.sigma, cfg.floor_track_ratio);
+        let cells = welch_band_cells(62, 3);
+        let v_nominal = 2.0 * noise_free_level_variance(1.012f64.sqrt(), 0.012, cells).unwrap();
+        let nominal = f.estimate_var.unwrap_or(f64::NAN);
+        assert!(
+            (nominal / v_nominal - 1.0).abs() < 0.01,
+            "{nominal} {v_nominal}"
+        );
+        let raised = [0.8f64.exp(), 1.0, 1.0, 1.0];
+        let clean = assess(&set, &wheels_with_noise(raised, 0.001));
+        let e = clean
+            .evidence
+            .iter()
+            .find(|e| e.meta.key == key)
+            .expect("flagged");
+        assert!(
+            e.z > 12.0 && e.spread_widened_by.is_none_or(|w| w < 1.01),
+            "{e:?}"
+        );
+        let noisy = assess(&set, &wheels_with_noise(raised, 0.8 / 12.0));
+        let v = noise_free_level_variance((raised[0] + 0.8).sqrt(), 0.8, cells).unwrap()
+            + noise_free_level_variance(1.8f64.sqrt(), 0.8, cells).unwrap();
+        let spread = (0.03f64 * 0.03 + v - nominal).sqrt();
+        // z about 4.1, still beyond the limit (3.02, Bonferroni over the vehicle features).
+        let e = noisy
+            .evidence
+            .iter()
+            .find(|e| e.meta.key == key)
+            .expect("flagged");
+        let z = (0.4 - f.centre) / spread;
+        assert!(
+            (e.z - z).abs() < 1e-9 && z > set.limit(Kind::TrackRatio),
+            "{} {z}",
+            e.z
+        );
+        let w = e.spread_widened_by.unwrap_or(f64::NAN);
+        assert!((w - spread / 0.03).abs() < 1e-9 && w > 3.0, "{w}");
+        assert!(
+            noisy.summary.contains("spread widened up to"),
+            "{}",
+            noisy.summary
+        );
     }
 }
