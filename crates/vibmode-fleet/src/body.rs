@@ -50,6 +50,51 @@ impl BodySpectra {
         }
     }
 
+    /// These spectra with white noise of one-sided density `densities[j]` (the unsprung
+    /// sensors' floors, in the order of `unsprung`) taken out of each input's auto-spectrum: the
+    /// sensors' noise is independent of everything else, so it sits on the diagonal of `S_uu`
+    /// alone. `None` if `densities` does not match the inputs or is not finite.
+    pub fn without_input_noise(&self, densities: &[f64]) -> Option<Self> {
+        let nu = self.unsprung.len();
+        if densities.len() != nu || !densities.iter().all(|d| d.is_finite()) || !self.consistent() {
+            return None;
+        }
+        let mut out = self.clone();
+        for bin in &mut out.s_uu {
+            for (j, d) in densities.iter().enumerate() {
+                bin[j * nu + j] -= d.max(0.0);
+            }
+        }
+        Some(out)
+    }
+
+    /// The largest share of an input's power in `[lo, hi)` Hz that is its sensor's noise of
+    /// density `densities[j]` (the bins' count times the density over the bins' sum of `S_uu`);
+    /// `None` without such a bin or if `densities` does not match the inputs.
+    pub fn input_noise_share(&self, densities: &[f64], band_hz: [f64; 2]) -> Option<f64> {
+        let nu = self.unsprung.len();
+        if densities.len() != nu || !self.consistent() {
+            return None;
+        }
+        let bins: Vec<usize> = (0..self.freq_hz.len())
+            .filter(|&b| self.freq_hz[b] >= band_hz[0] && self.freq_hz[b] < band_hz[1])
+            .collect();
+        if bins.is_empty() {
+            return None;
+        }
+        let mut worst: f64 = 0.0;
+        for (j, d) in densities.iter().enumerate() {
+            let power: f64 = bins.iter().map(|&b| self.s_uu[b][j * nu + j].re).sum();
+            let noise = d.max(0.0) * bins.len() as f64;
+            worst = worst.max(if power > 0.0 {
+                noise / power
+            } else {
+                f64::INFINITY
+            });
+        }
+        Some(worst)
+    }
+
     /// These spectra times `w`.
     pub fn scaled(mut self, w: f64) -> Self {
         self.s_uu.iter_mut().flatten().for_each(|z| *z *= w);
@@ -173,7 +218,8 @@ pub struct BodyModel {
     pub sprung: Vec<String>,
     /// Per bin, `H = (sum S_yu) (sum S_uu)^-1` row-major (`n_y x n_u`).
     pub h: Vec<Vec<Complex64>>,
-    /// Per bin, the condition number of the pooled `S_uu` (largest over smallest eigenvalue).
+    /// Per bin, the condition number of the pooled `S_uu` (largest over smallest eigenvalue;
+    /// `f64::MAX` where it is not positive definite).
     pub condition: Vec<f64>,
 }
 
@@ -229,7 +275,10 @@ pub fn fit_body_model(spectra: &[&BodySpectra]) -> Result<BodyModel> {
         let (lo, hi) = eig.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &e| {
             (lo.min(e), hi.max(e))
         });
-        let cond = if lo > 0.0 { hi / lo } else { f64::INFINITY };
+        // Not positive definite (the wheels' noise taken out where their motion is below it,
+        // or no power at all): no H, and the largest finite number as the condition (an
+        // infinity would not be stored).
+        let cond = if lo > 0.0 { hi / lo } else { f64::MAX };
         condition.push(cond);
         // H S_uu = S_yu  =>  S_uu H^H = S_yu^H.
         let solved = (cond <= MAX_CONDITION)
@@ -349,6 +398,61 @@ pub(crate) mod tests {
             s_yu: vec![syu],
             s_yy: vec![syy],
         }
+    }
+
+    /// By hand: S_uu = [[2, 0.5], [0.5, 5]] at 1 Hz with noise densities 1 and 1: the diagonal
+    /// becomes 1 and 4, the cross term and the outputs stay; the noise shares are 1/2 and 1/5
+    /// (the largest 0.5); a band without a bin, or a density per input missing: none.
+    #[test]
+    fn input_noise_comes_off_the_diagonal_by_hand() {
+        let s = one_bin(
+            2,
+            1,
+            vec![c(2.0, 0.0), c(0.5, 0.0), c(0.5, 0.0), c(5.0, 0.0)],
+            vec![c(2.0, 0.0), c(0.0, 4.0)],
+            vec![9.0],
+        );
+        let out = s.without_input_noise(&[1.0, 1.0]).expect("two densities");
+        assert_eq!(
+            out.s_uu[0],
+            vec![c(1.0, 0.0), c(0.5, 0.0), c(0.5, 0.0), c(4.0, 0.0)]
+        );
+        assert_eq!((out.s_yu, out.s_yy), (s.s_yu.clone(), s.s_yy.clone()));
+        assert_eq!(s.input_noise_share(&[1.0, 1.0], [0.5, 2.0]), Some(0.5));
+        assert_eq!(s.input_noise_share(&[0.2, 1.0], [0.5, 2.0]), Some(0.2));
+        assert_eq!(s.input_noise_share(&[1.0, 1.0], [2.0, 4.0]), None);
+        assert!(s.without_input_noise(&[1.0]).is_none());
+        assert!(s.without_input_noise(&[1.0, f64::NAN]).is_none());
+    }
+
+    /// Spectra whose wheels' noise leaves `S_uu` not positive definite in a bin give no `H` there
+    /// and a finite condition number (an infinity would make the model set unstorable).
+    #[test]
+    fn a_bin_that_is_not_positive_definite_has_a_finite_condition() {
+        let s = one_bin(
+            2,
+            1,
+            vec![c(1.0, 0.0), c(1.0, 0.0), c(1.0, 0.0), c(1.0, 0.0)],
+            vec![c(1.0, 0.0), c(1.0, 0.0)],
+            vec![1.0],
+        );
+        let err = fit_body_model(&[&s]);
+        assert!(err.is_err());
+        let two = BodySpectra {
+            freq_hz: vec![1.0, 2.0],
+            s_uu: vec![
+                s.s_uu[0].clone(),
+                vec![c(2.0, 0.0), c(0.0, 0.0), c(0.0, 0.0), c(2.0, 0.0)],
+            ],
+            s_yu: vec![s.s_yu[0].clone(); 2],
+            s_yy: vec![s.s_yy[0].clone(); 2],
+            ..s.clone()
+        };
+        let m = fit_body_model(&[&two]).expect("one good bin");
+        assert!(m.h[0].is_empty() && !m.h[1].is_empty());
+        assert_eq!(m.condition[0], f64::MAX);
+        let json = serde_json::to_string(&m).unwrap();
+        assert!(serde_json::from_str::<BodyModel>(&json).is_ok());
     }
 
     #[test]
