@@ -1919,6 +1919,8 @@ fn score_values(
     let mut quiet_used: Vec<&QuietBand> = Vec::new();
     // The largest widening of a vehicle feature's spread by the record's own noise.
     let mut widest: f64 = 1.0;
+    // The features (as named in the note) whose spread was widened that much.
+    let mut widened: Vec<&str> = Vec::new();
     for f in &set.features {
         let where_ = || {
             f.meta
@@ -1946,7 +1948,16 @@ fn score_values(
         let var = noise.get(f.meta.key.as_str()).copied();
         let z = score(f, x, var, &set.config);
         if f.meta.group == Group::Vehicle {
-            widest = widest.max(f.spread(var) / f.sigma);
+            let w = f.spread(var) / f.sigma;
+            widest = widest.max(w);
+            let name = match f.meta.kind {
+                Kind::SideRatio | Kind::TrackRatio => "level ratios",
+                Kind::Transmissibility => "transmissibility",
+                _ => "other features",
+            };
+            if w >= NOISE_WIDENING_NOTED && !widened.contains(&name) {
+                widened.push(name);
+            }
         }
         let (n, max) = match f.meta.group {
             Group::Vehicle => (&mut scores.n_vehicle, &mut scores.vehicle_max_abs_z),
@@ -1990,8 +2001,10 @@ fn score_values(
         };
     }
     if widest >= NOISE_WIDENING_NOTED {
+        widened.sort_unstable();
         let note = format!(
-            "wheels near their sensors' noise floor: level ratios judged with their spread widened up to {widest:.1}x by the noise"
+            "noisy estimates (the road's input near the sensors' noise): {} judged against their own scatter, spread widened up to {widest:.1}x",
+            widened.join(" and ")
         );
         summary = if summary.is_empty() {
             note
