@@ -110,3 +110,59 @@ fn rate_upper_bound_matches_scipy() {
         );
     }
 }
+
+const ESTIMATE_VARIANCE: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../tools/reference/data/estimate_variance.json"
+));
+
+/// The variances a record's own estimate gives its level ratios and transmissibility, against
+/// scipy.signal's welch and csd over 4000 seeded draws each (tools/reference/estimate_variance.py,
+/// numpy 2.1.3, scipy 1.14.1; one 10.24 s record at 50 Hz, Hann, nperseg 256, 3 segments): a
+/// band sum's relative variance is `1 / welch_band_cells` within 10 % (8-20, 2-5 and 12-20 Hz),
+/// the noise-free level's `noise_free_level_variance` and the H1 estimate's `h1_log_variance`
+/// within 15 % (noise shares 9 and 31 %, coherences 0.2 and 0.8). The Monte Carlo's own
+/// standard error is about 2-3 %; the tolerances are the formulas' (approximations).
+#[test]
+fn estimate_variances_match_scipy_monte_carlo() {
+    use vibmode_fleet::model::{h1_log_variance, noise_free_level_variance, welch_band_cells};
+    let r: Value = serde_json::from_str(ESTIMATE_VARIANCE).unwrap();
+    assert_eq!(r["versions"]["scipy"], "1.14.1");
+    let segments = r["segments"].as_u64().unwrap() as usize;
+    assert_eq!(segments, 3);
+    let within = |got: f64, want: f64, tol: f64, what: &str| {
+        assert!(
+            (got / want - 1.0).abs() < tol,
+            "{what}: formula {got}, scipy {want}"
+        );
+    };
+    for c in r["band_sum"].as_array().unwrap() {
+        let bins = c["bins"].as_u64().unwrap() as usize;
+        let got = 1.0 / welch_band_cells(bins, segments);
+        within(
+            got,
+            c["relative_variance"].as_f64().unwrap(),
+            0.10,
+            "band sum",
+        );
+    }
+    let cells = welch_band_cells(62, segments);
+    for c in r["noise_free_level"].as_array().unwrap() {
+        assert_eq!(c["kept"].as_u64(), r["draws"].as_u64());
+        let level = c["mean_measured_power"].as_f64().unwrap().sqrt();
+        let pn = c["noise_power"].as_f64().unwrap();
+        let got = noise_free_level_variance(level, pn, cells).unwrap();
+        within(
+            got,
+            c["log_level_variance"].as_f64().unwrap(),
+            0.15,
+            "noise-free level",
+        );
+    }
+    for c in r["h1"].as_array().unwrap() {
+        let bins = c["bins"].as_u64().unwrap() as usize;
+        let g = c["coherence"].as_f64().unwrap();
+        let got = h1_log_variance(g, segments, welch_band_cells(bins, segments)).unwrap();
+        within(got, c["log_variance"].as_f64().unwrap(), 0.15, "H1");
+    }
+}
