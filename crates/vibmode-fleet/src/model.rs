@@ -746,8 +746,9 @@ fn body_features(
 /// `transmissibility_min_hz`): ln(sprung / unsprung band RMS) minus its mean over the other
 /// corners that have the band, so that what moves every corner alike (the load, whose extra
 /// mass lowers every corner's damping per mass; the speed; the road's spectrum) cancels and a
-/// corner's own damper, spring or tyre stays. With a single corner the absolute value is kept (a vehicle with one corner pair; a record of
-/// more corners with one value left in the band gives none there).
+/// corner's own damper, spring or tyre stays. With a single corner the absolute value is kept
+/// (a vehicle with one corner pair; a record of more corners with one value left in the band
+/// gives none there).
 ///
 /// With `line_free`, the values with the periodic lines left out ([`RecordFeatures::line_free`],
 /// key `transh1lf`); a record without them gives none. With `vehicle_lines` (a model set's
@@ -779,10 +780,6 @@ fn transmissibility_features(
                     let left_out = [lf.line_bins_hz.as_slice(), vehicle];
                     let v = if input_noise_free {
                         let density = unsprung_noise_density(rf, lf, t)?;
-                        if std::env::var_os("VIBMODE_DEBUG_T").is_some() {
-                            let (num, den, m) = bins.band_sums_counted(&bins.input[i], i, *b, &left_out).unwrap_or_default();
-                            eprintln!("DBGT {} {:?} raw {:?} nf {:?} num {num:.3e} den {den:.3e} noise {:.3e} m {m}", t.corner, b, bins.band_value(i, *b, &left_out), bins.band_value_noise_free(i, *b, &left_out, density, NOISE_SHARE_MAX), density * m as f64);
-                        }
                         bins.band_value_noise_free(i, *b, &left_out, density, NOISE_SHARE_MAX)?
                     } else {
                         bins.band_value(i, *b, &left_out)?
