@@ -262,7 +262,7 @@ impl TransmissibilityBins {
     }
 
     /// [`TransmissibilityBins::band_sums`] and the number of bins summed.
-    fn band_sums_counted(
+    pub(crate) fn band_sums_counted(
         &self,
         other: &[f64],
         entry: usize,

@@ -436,6 +436,11 @@ impl ModelSet {
         )
     }
 
+    /// Why a record gives no value of some features ([`noise_unjudged`]).
+    pub fn record_unjudged(&self, rf: &RecordFeatures) -> BTreeMap<String, String> {
+        noise_unjudged(rf, &self.config, self.variants(), self.body.as_ref())
+    }
+
     /// The variants this model set reads records with.
     pub fn variants(&self) -> Variants<'_> {
         Variants {
@@ -926,6 +931,98 @@ pub fn transmissibility_variances(
                     format!("transh1lu:{corner}:{}", band_key(b)),
                     v + o / ((k - 1) * (k - 1)) as f64,
                 );
+            }
+        }
+    }
+    out
+}
+
+/// Per feature key, why a record gives no value of it although it has the spectra: its wheels'
+/// motion in the band is more than [`NOISE_SHARE_MAX`] sensor noise (transmissibility and body
+/// response, with `variants.input_noise_free`), or, for a transmissibility, the other corners'
+/// are, so that no relative value is left. Keys are those of [`scalar_features`] (body keys
+/// for the sprung channels of `body`).
+pub fn noise_unjudged(
+    rf: &RecordFeatures,
+    cfg: &FleetConfig,
+    variants: Variants<'_>,
+    body: Option<&BodyModel>,
+) -> BTreeMap<String, String> {
+    let mut out = BTreeMap::new();
+    if !variants.input_noise_free {
+        return out;
+    }
+    let pct = |share: f64| format!("{:.0} %", 100.0 * share);
+    if let (Some(lf), Some(vehicle)) = (rf.line_free.as_ref(), variants.vehicle_lines) {
+        if let Some(bins) = lf.bins.as_ref() {
+            let left_out = [lf.line_bins_hz.as_slice(), vehicle];
+            for b in rf
+                .bands_hz
+                .iter()
+                .filter(|b| b[0] >= cfg.transmissibility_min_hz)
+            {
+                // (corner, the noise share of its wheel's input in the band)
+                let shares: Vec<(Corner, Option<f64>)> = rf
+                    .transmissibility
+                    .iter()
+                    .enumerate()
+                    .map(|(i, t)| {
+                        let share = (|| {
+                            let density = unsprung_noise_density(rf, lf, t)?;
+                            let (_, den, m) =
+                                bins.band_sums_counted(bins.input.get(i)?, i, *b, &left_out)?;
+                            (den > 0.0).then(|| density.max(0.0) * m as f64 / den)
+                        })();
+                        (t.corner, share)
+                    })
+                    .collect();
+                let quiet = |s: &Option<f64>| s.is_some_and(|s| s > NOISE_SHARE_MAX);
+                let kept = shares
+                    .iter()
+                    .filter(|(_, s)| s.is_some() && !quiet(s))
+                    .count();
+                for (corner, share) in &shares {
+                    let key = format!("transh1lu:{corner}:{}", band_key(b));
+                    if let Some(s) = share.filter(|s| *s > NOISE_SHARE_MAX) {
+                        out.insert(
+                            key,
+                            format!(
+                                "its wheel's motion in {} is {} sensor noise",
+                                band_label(b),
+                                pct(s)
+                            ),
+                        );
+                    } else if share.is_some() && kept == 1 && shares.len() > 1 {
+                        out.insert(
+                            key,
+                            format!(
+                                "the other corners' wheels' motion in {} is more than half sensor noise: nothing to compare with",
+                                band_label(b)
+                            ),
+                        );
+                    }
+                }
+            }
+        }
+    }
+    if let (Some(model), Some(raw)) = (body, rf.body_spectra.as_ref()) {
+        if let Some(d) = body_input_densities(rf, raw) {
+            for band in &cfg.body_response_bands_hz {
+                if let Some(s) = raw
+                    .input_noise_share(&d, *band)
+                    .filter(|s| *s > NOISE_SHARE_MAX)
+                {
+                    for name in &model.sprung {
+                        out.insert(
+                            format!("body:{name}:{}", band_key(band)),
+                            format!(
+                                "a wheel's motion in {} is {} sensor noise",
+                                band_label(band),
+                                pct(s)
+                            ),
+                        );
+                    }
+                }
             }
         }
     }
@@ -1633,7 +1730,8 @@ fn score(f: &FeatureStat, x: f64, var: Option<f64>, cfg: &FleetConfig) -> f64 {
 pub fn assess(set: &ModelSet, rf: &RecordFeatures) -> Assessment {
     let values = set.record_features(rf);
     let noise = set.record_variances(rf);
-    let mut a = score_values(set, &values, &noise, &[], None);
+    let unjudged = set.record_unjudged(rf);
+    let mut a = score_values(set, &values, &noise, &unjudged, &[], None);
     if !rf.sensor_faults.is_empty() {
         a.classification = Classification::Sensor;
         let faults: Vec<String> = rf.sensor_faults.iter().map(|f| f.to_string()).collect();
@@ -1706,7 +1804,8 @@ pub fn assess_drive_fitted(
         .filter_map(|(m, xs)| median(&xs).map(|x| (m, x)))
         .collect();
     let noise = drive_noise(&values, &per_record, &per_record_noise);
-    let mut a = score_values(set, &values, &noise, fitted, trend);
+    let unjudged = drive_unjudged(usable.iter().map(|rf| set.record_unjudged(rf)));
+    let mut a = score_values(set, &values, &noise, &unjudged, fitted, trend);
     rough_in_many_records(set, &per_record, &per_record_noise, &mut a);
     let left_out = records.len() - usable.len();
     if left_out > 0 {
@@ -1774,6 +1873,25 @@ fn drive_noise(
     out
 }
 
+/// Why a drive gives no value of a feature: the records' reasons ([`noise_unjudged`]),
+/// "in N of M records: <the first record's reason>".
+fn drive_unjudged(
+    per_record: impl Iterator<Item = BTreeMap<String, String>>,
+) -> BTreeMap<String, String> {
+    let mut count: BTreeMap<String, (usize, String)> = BTreeMap::new();
+    let mut n = 0usize;
+    for reasons in per_record {
+        n += 1;
+        for (key, why) in reasons {
+            count.entry(key).or_insert((0, why)).0 += 1;
+        }
+    }
+    count
+        .into_iter()
+        .map(|(key, (k, why))| (key, format!("in {k} of {n} records: {why}")))
+        .collect()
+}
+
 /// A drive's road alarm from its records' own: a rough road raises the levels of every record,
 /// but a record's alarm may come from any of the road's bands (and the per-band medians then
 /// stay below the limit: busgen bus 11219's class D drive, 6 of 8 records `road`, was `normal`).
@@ -1795,7 +1913,7 @@ fn rough_in_many_records(
     let rough: Vec<Assessment> = per_record
         .iter()
         .zip(per_record_noise)
-        .map(|(values, noise)| score_values(set, values, noise, &[], None))
+        .map(|(values, noise)| score_values(set, values, noise, &BTreeMap::new(), &[], None))
         .filter(|x| road(x.classification))
         .collect();
     if 2 * rough.len() < per_record.len() {
@@ -1898,6 +2016,7 @@ fn score_values(
     set: &ModelSet,
     values: &[(FeatureMeta, f64)],
     noise: &EstimateVariances,
+    unjudged: &BTreeMap<String, String>,
     fitted: &[crate::suspension::CornerScore],
     trend: Option<&crate::suspension::SpringTrend>,
 ) -> Assessment {
@@ -1912,6 +2031,8 @@ fn score_values(
     };
     let quiet = quiet_bands(set, &by_key);
     let mut not_judged = 0usize;
+    // Vehicle features not given because their wheels' motion is mostly sensor noise.
+    let mut noisy_unjudged = 0usize;
     // The quiet bands that left a feature unjudged, for the summary.
     let mut quiet_used: Vec<&QuietBand> = Vec::new();
     // The largest widening of a vehicle feature's spread by the record's own noise.
@@ -1925,7 +2046,17 @@ fn score_values(
                 .map_or(f.meta.channel.clone(), |c| c.to_string())
         };
         let Some(&x) = by_key.get(f.meta.key.as_str()) else {
-            missing.push(format!("{}: {}", where_(), f.meta.label));
+            match unjudged.get(&f.meta.key) {
+                Some(why) => {
+                    missing.push(format!(
+                        "{}: {} (not judged: {why})",
+                        where_(),
+                        f.meta.label
+                    ));
+                    noisy_unjudged += 1;
+                }
+                None => missing.push(format!("{}: {}", where_(), f.meta.label)),
+            }
             continue;
         };
         if let Some(q) = quiet_for(f, &quiet) {
@@ -1990,6 +2121,16 @@ fn score_values(
         let note = format!(
             "little road input (road level {} below half the nominal records' lowest): {not_judged} vehicle feature(s) not judged",
             bands.join(", ")
+        );
+        summary = if summary.is_empty() {
+            note
+        } else {
+            format!("{summary}; {note}")
+        };
+    }
+    if noisy_unjudged > 0 {
+        let note = format!(
+            "wheels' motion more than half sensor noise: {noisy_unjudged} vehicle feature(s) not judged"
         );
         summary = if summary.is_empty() {
             note
@@ -4126,6 +4267,57 @@ mod variance_tests {
             noisy.summary.contains("spread widened up to"),
             "{}",
             noisy.summary
+        );
+    }
+
+    /// A baseline of 6 records of two corners with little noise; a record whose RR wheel is
+    /// two thirds sensor noise in 2-5 Hz (density 1 over 4 bins of input 6) gives neither
+    /// corner's transmissibility, and its check says why: RR's wheel is 67 % noise, RL has
+    /// nothing to compare with; the summary counts them. A drive of such records says in how
+    /// many of its records.
+    #[test]
+    fn features_not_given_for_their_wheels_noise_say_why() {
+        let cfg = FleetConfig::default();
+        let recs: Vec<RecordFeatures> = (0..6)
+            .map(|i| two_corners([0.5, 0.5 + 0.01 * i as f64], [0.01, 0.01]))
+            .collect();
+        let names: Vec<String> = (0..6).map(|i| format!("n{i}")).collect();
+        let set = build_model_set("bus", &names, &recs, &cfg).expect("model set");
+        assert!(set.input_noise_free);
+        let quiet = two_corners([0.5, 0.5], [0.01, 1.0]);
+        let why = set.record_unjudged(&quiet);
+        assert_eq!(
+            why.get("transh1lu:RR:2-5Hz").map(String::as_str),
+            Some("its wheel's motion in 2-5 Hz is 67 % sensor noise")
+        );
+        assert!(why["transh1lu:RL:2-5Hz"].contains("nothing to compare with"));
+        let a = assess(&set, &quiet);
+        assert!(
+            a.missing.iter().any(|m| m
+                == "RR: transmissibility 2-5 Hz vs the other corners (not judged: its wheel's motion in 2-5 Hz is 67 % sensor noise)"),
+            "{:?}",
+            a.missing
+        );
+        assert!(
+            a.summary.contains(
+                "wheels' motion more than half sensor noise: 2 vehicle feature(s) not judged"
+            ),
+            "{}",
+            a.summary
+        );
+        let d = assess_drive(&set, &[&quiet, &quiet, &quiet]);
+        assert!(
+            d.missing
+                .iter()
+                .any(|m| m.contains("(not judged: in 3 of 3 records: its wheel's")),
+            "{:?}",
+            d.missing
+        );
+        // The same record with the wheel's noise as the baseline's: both judged, no reason.
+        let clean = assess(&set, &two_corners([0.5, 0.5], [0.01, 0.01]));
+        assert!(
+            clean.missing.is_empty() && !clean.summary.contains("sensor noise"),
+            "{clean:?}"
         );
     }
 }
