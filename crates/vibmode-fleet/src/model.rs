@@ -2141,7 +2141,7 @@ fn score_values(
     if widest >= NOISE_WIDENING_NOTED {
         widened.sort_unstable();
         let note = format!(
-            "noisy estimates (the road's input near the sensors' noise): {} judged against their own scatter, spread widened up to {widest:.1}x",
+            "noisy estimates (the road's input near the sensors' noise): {} judged against the scatter of the estimates themselves, spread widened up to {widest:.1}x",
             widened.join(" and ")
         );
         summary = if summary.is_empty() {
@@ -4264,7 +4264,9 @@ mod variance_tests {
         let w = e.spread_widened_by.unwrap_or(f64::NAN);
         assert!((w - spread / 0.03).abs() < 1e-9 && w > 3.0, "{w}");
         assert!(
-            noisy.summary.contains("spread widened up to"),
+            noisy.summary.contains(
+                "level ratios judged against the scatter of the estimates themselves, spread widened up to 3."
+            ),
             "{}",
             noisy.summary
         );
