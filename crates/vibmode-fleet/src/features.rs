@@ -221,13 +221,32 @@ impl TransmissibilityBins {
     ) -> Option<f64> {
         let (num, den, m) =
             self.band_sums_counted(self.input.get(entry)?, entry, band, left_out)?;
-        let noise = noise_density.max(0.0) * m as f64;
-        if !(den > 0.0 && noise <= max_share * den) {
+        let share = Self::noise_share(den, m, noise_density)?;
+        if share > max_share {
             return None;
         }
-        let keep = den - noise;
+        let keep = den * (1.0 - share);
         let v = (num * den / keep / keep).sqrt();
         v.is_finite().then_some(v)
+    }
+
+    /// The share of entry `entry`'s input power in `band` (the bins of `left_out` left out) that
+    /// is white noise of one-sided density `noise_density`: `m N / sum S_uu` over the `m` bins
+    /// summed; `None` where the band holds no input power or the entry is absent.
+    pub fn band_noise_share(
+        &self,
+        entry: usize,
+        band: [f64; 2],
+        left_out: &[&[f64]],
+        noise_density: f64,
+    ) -> Option<f64> {
+        let (_, den, m) = self.band_sums_counted(self.input.get(entry)?, entry, band, left_out)?;
+        Self::noise_share(den, m, noise_density)
+    }
+
+    /// `m N / power`, `None` without power.
+    fn noise_share(power: f64, bins: usize, noise_density: f64) -> Option<f64> {
+        (power > 0.0).then(|| noise_density.max(0.0) * bins as f64 / power)
     }
 
     /// The number of bins of `band` that the band sums use (those of `left_out` left out).
@@ -262,7 +281,7 @@ impl TransmissibilityBins {
     }
 
     /// [`TransmissibilityBins::band_sums`] and the number of bins summed.
-    pub(crate) fn band_sums_counted(
+    fn band_sums_counted(
         &self,
         other: &[f64],
         entry: usize,

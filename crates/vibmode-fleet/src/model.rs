@@ -451,16 +451,14 @@ impl ModelSet {
         }
     }
 
-    /// The variances a record's own sensor noise gives its features as this model set reads
-    /// them ([`ratio_noise_variances`]).
-    pub fn record_variances(&self, rf: &RecordFeatures) -> EstimateVariances {
-        let mut v = ratio_noise_variances(rf, &self.config, self.line_free, self.noise_free);
-        if self.input_noise_free {
-            if let Some(lines) = self.vehicle_line_bins_hz.as_deref() {
-                v.extend(transmissibility_variances(rf, &self.config, lines));
-            }
-        }
-        v
+    /// The variances of a record's features as this model set reads them
+    /// ([`estimate_variances`]); `values` are its features ([`ModelSet::record_features`]).
+    pub fn record_variances(
+        &self,
+        rf: &RecordFeatures,
+        values: &[(FeatureMeta, f64)],
+    ) -> EstimateVariances {
+        estimate_variances(rf, &self.config, self.variants(), values)
     }
 
     /// The limit of `kind` (infinite for a kind the model set has not).
@@ -874,15 +872,35 @@ pub fn h1_log_variance(gamma2: f64, segments: usize, cells: f64) -> Option<f64> 
     Some(num / (4.0 * cells * den * den))
 }
 
+/// The estimate variances of a record's features read with `variants` ([`EstimateVariances`]):
+/// its level ratios' ([`ratio_noise_variances`]) and, with `input_noise_free`, its
+/// transmissibility's ([`transmissibility_variances`]); `values` are the record's features as
+/// [`scalar_features`] gave them with the same variants.
+pub fn estimate_variances(
+    rf: &RecordFeatures,
+    cfg: &FleetConfig,
+    variants: Variants<'_>,
+    values: &[(FeatureMeta, f64)],
+) -> EstimateVariances {
+    let mut v = ratio_noise_variances(rf, cfg, variants.line_free, variants.noise_free);
+    if let (true, Some(lines)) = (variants.input_noise_free, variants.vehicle_lines) {
+        v.extend(transmissibility_variances(rf, cfg, lines, values));
+    }
+    v
+}
+
 /// The estimate variances of a record's transmissibility features as
 /// [`transmissibility_features`] computes them with the vehicle's lines left out and the input
 /// noise taken out (key `transh1lu`): a corner's value is its `ln |H|` less the mean over the
 /// other corners with the band, so its variance is its own [`h1_log_variance`] plus the
-/// others' over `(k - 1)^2`. Corners without a coherence give the feature none.
+/// others' over `(k - 1)^2`. Corners without a coherence give the feature none. `values` are
+/// the record's features ([`scalar_features`] with `input_noise_free` and `vehicle_lines`): the
+/// corners they hold a value of in a band are the `k`.
 pub fn transmissibility_variances(
     rf: &RecordFeatures,
     cfg: &FleetConfig,
     vehicle_lines: &[f64],
+    values: &[(FeatureMeta, f64)],
 ) -> EstimateVariances {
     let mut out = EstimateVariances::new();
     let Some(lf) = rf.line_free.as_ref() else {
@@ -892,7 +910,6 @@ pub fn transmissibility_variances(
         return out;
     };
     let left_out = [lf.line_bins_hz.as_slice(), vehicle_lines];
-    let values = transmissibility_features(rf, cfg, true, Some((vehicle_lines, true)));
     for b in rf
         .bands_hz
         .iter()
@@ -967,12 +984,8 @@ pub fn noise_unjudged(
                     .iter()
                     .enumerate()
                     .map(|(i, t)| {
-                        let share = (|| {
-                            let density = unsprung_noise_density(rf, lf, t)?;
-                            let (_, den, m) =
-                                bins.band_sums_counted(bins.input.get(i)?, i, *b, &left_out)?;
-                            (den > 0.0).then(|| density.max(0.0) * m as f64 / den)
-                        })();
+                        let share = unsprung_noise_density(rf, lf, t)
+                            .and_then(|density| bins.band_noise_share(i, *b, &left_out, density));
                         (t.corner, share)
                     })
                     .collect();
@@ -1493,35 +1506,24 @@ pub fn build_model_set(
         ));
     }
     let body = fit_body(records, cfg, input_noise_free, &mut notes);
+    let variants = Variants {
+        line_free,
+        noise_free,
+        input_noise_free,
+        vehicle_lines: vehicle_lines.as_deref(),
+    };
+    // Each record's features and their estimate variances (from the features as read, before
+    // the low-coherence ones are dropped: a corner's relative value counts every corner).
+    let mut noise: Vec<EstimateVariances> = Vec::with_capacity(records.len());
     let values: Vec<Vec<(FeatureMeta, f64)>> = records
         .iter()
         .enumerate()
         .map(|(i, r)| {
-            let mut v = scalar_features(
-                r,
-                &slots,
-                None,
-                cfg,
-                Variants {
-                    line_free,
-                    noise_free,
-                    input_noise_free,
-                    vehicle_lines: vehicle_lines.as_deref(),
-                },
-            );
+            let mut v = scalar_features(r, &slots, None, cfg, variants);
+            noise.push(estimate_variances(r, cfg, variants, &v));
             v.retain(|(m, _)| !low.iter().any(|(key, ..)| *key == m.key));
             if let Some((_, loo)) = &body {
                 v.extend(loo[i].iter().cloned());
-            }
-            v
-        })
-        .collect();
-    let noise: Vec<EstimateVariances> = records
-        .iter()
-        .map(|r| {
-            let mut v = ratio_noise_variances(r, cfg, line_free, noise_free);
-            if let (true, Some(lines)) = (input_noise_free, vehicle_lines.as_deref()) {
-                v.extend(transmissibility_variances(r, cfg, lines));
             }
             v
         })
@@ -1729,7 +1731,7 @@ fn score(f: &FeatureStat, x: f64, var: Option<f64>, cfg: &FleetConfig) -> f64 {
 /// (which cover its working channels only); the summary names the channels first.
 pub fn assess(set: &ModelSet, rf: &RecordFeatures) -> Assessment {
     let values = set.record_features(rf);
-    let noise = set.record_variances(rf);
+    let noise = set.record_variances(rf, &values);
     let unjudged = set.record_unjudged(rf);
     let mut a = score_values(set, &values, &noise, &unjudged, &[], None);
     if !rf.sensor_faults.is_empty() {
@@ -1787,8 +1789,11 @@ pub fn assess_drive_fitted(
     // Each record's features once: for the medians and for the records' own road verdicts.
     let per_record: Vec<Vec<(FeatureMeta, f64)>> =
         usable.iter().map(|rf| set.record_features(rf)).collect();
-    let per_record_noise: Vec<EstimateVariances> =
-        usable.iter().map(|rf| set.record_variances(rf)).collect();
+    let per_record_noise: Vec<EstimateVariances> = usable
+        .iter()
+        .zip(&per_record)
+        .map(|(rf, values)| set.record_variances(rf, values))
+        .collect();
     let mut by_key: BTreeMap<String, (FeatureMeta, Vec<f64>)> = BTreeMap::new();
     for (m, x) in per_record.iter().flatten() {
         by_key
