@@ -40,7 +40,7 @@ pub use hash::ContentHash;
 pub use model::{
     assess, assess_drive, assess_drive_fitted, build_model_set, Assessment, Classification,
     Component, Drive, Evidence, FeatureMeta, FeatureStat, Group, Kind, KindLimit, ModeSlot,
-    ModelSet, Scores, LOO_MARGIN, MIN_DRIVE_RECORDS,
+    ModelSet, NotJudged, Scores, LOO_MARGIN, MIN_DRIVE_RECORDS,
 };
 #[cfg(feature = "report")]
 pub use report::write_fleet_report;

@@ -590,8 +590,15 @@ pub struct Assessment {
     /// One line: the flagged vehicle features per corner, e.g.
     /// `RL: transmissibility 8-12 Hz +35 %, wheel-hop 10.9 Hz damping -40 %`.
     pub summary: String,
-    /// Features of the model set the record lacks (e.g. a mode not identified in it).
+    /// Features of the model set the record lacks (e.g. a mode not identified in it), and for a
+    /// drive why its suspension fit or spring trend is absent. The features the record has but
+    /// that were not scored are in `not_judged`, each with its reason (checks stored before it
+    /// existed list them here, as "feature (not judged: reason)").
     pub missing: Vec<String>,
+    /// Features of the model set given no score, and why: too little road input in their band,
+    /// or their wheels' motion mostly sensor noise. Empty in checks stored before it existed.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub not_judged: Vec<NotJudged>,
     /// The record's failed sensors (the class is then `sensor`); empty in checks stored
     /// before it existed.
     #[serde(default)]
@@ -600,6 +607,22 @@ pub struct Assessment {
     /// when a vehicle feature is flagged; absent in checks stored before it existed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub component: Option<Component>,
+}
+
+/// A feature of the model set that a record or drive was not scored on ([`Assessment::not_judged`]).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct NotJudged {
+    /// The feature as the evidence names it, e.g. `RR: transmissibility 2-5 Hz vs the other corners`.
+    pub feature: String,
+    /// Why, e.g. `its wheel's motion in 2-5 Hz is 67 % sensor noise`; for a drive prefixed with
+    /// the share of its records (`in 8 of 8 records: ...`).
+    pub reason: String,
+}
+
+impl std::fmt::Display for NotJudged {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} (not judged: {})", self.feature, self.reason)
+    }
 }
 
 #[cfg(test)]
@@ -617,6 +640,7 @@ impl Assessment {
             evidence: Vec::new(),
             summary: String::new(),
             missing: Vec::new(),
+            not_judged: Vec::new(),
             sensor_faults: Vec::new(),
             component: None,
         }
@@ -2028,6 +2052,7 @@ fn score_values(
     let by_key: BTreeMap<&str, f64> = values.iter().map(|(m, v)| (m.key.as_str(), *v)).collect();
     let mut evidence = Vec::new();
     let mut missing = Vec::new();
+    let mut unscored: Vec<NotJudged> = Vec::new();
     let mut scores = Scores {
         vehicle_max_abs_z: 0.0,
         excitation_max_abs_z: 0.0,
@@ -2053,11 +2078,10 @@ fn score_values(
         let Some(&x) = by_key.get(f.meta.key.as_str()) else {
             match unjudged.get(&f.meta.key) {
                 Some(why) => {
-                    missing.push(format!(
-                        "{}: {} (not judged: {why})",
-                        where_(),
-                        f.meta.label
-                    ));
+                    unscored.push(NotJudged {
+                        feature: format!("{}: {}", where_(), f.meta.label),
+                        reason: why.clone(),
+                    });
                     noisy_unjudged += 1;
                 }
                 None => missing.push(format!("{}: {}", where_(), f.meta.label)),
@@ -2065,13 +2089,14 @@ fn score_values(
             continue;
         };
         if let Some(q) = quiet_for(f, &quiet) {
-            missing.push(format!(
-                "{}: {} (little road input: the road level {} is {:.0} % of the nominal records' lowest)",
-                where_(),
-                f.meta.label,
-                band_label(&q.hz),
-                100.0 * (q.x - q.lo).exp()
-            ));
+            unscored.push(NotJudged {
+                feature: format!("{}: {}", where_(), f.meta.label),
+                reason: format!(
+                    "little road input: the road level {} is {:.0} % of the nominal records' lowest",
+                    band_label(&q.hz),
+                    100.0 * (q.x - q.lo).exp()
+                ),
+            });
             not_judged += 1;
             if !quiet_used.iter().any(|u| u.hz == q.hz) {
                 quiet_used.push(q);
@@ -2162,6 +2187,7 @@ fn score_values(
         component: component(set, values, noise, &evidence),
         evidence,
         missing,
+        not_judged: unscored,
         sensor_faults: Vec::new(),
     }
 }
@@ -2925,7 +2951,7 @@ mod tests {
     /// Little road input, by hand: the nominal levels are 1.0-1.2 in 2-5 Hz, so below half the
     /// lowest (0.5, `road_margin` ln 2 below `lo` = ln 1.0) the transmissibility of 2-5 Hz is not
     /// judged: a record at 0.45 whose transmissibility is 2.3 times the nominal is `normal`,
-    /// the feature listed under `missing` with the level's share (45 %) and the summary saying
+    /// the feature listed under `not_judged` with the level's share (45 %) and the summary saying
     /// why; at 0.55 the same transmissibility is `vehicle`. The excitation is never scored
     /// below the range (a smoother road is normal).
     #[test]
@@ -2934,12 +2960,14 @@ mod tests {
         let quiet = assess(&set, &record(0.45, 0.5));
         assert_eq!(quiet.classification, Classification::Normal, "{quiet:?}");
         assert!(quiet.evidence.is_empty(), "{quiet:?}");
+        assert!(quiet.missing.is_empty(), "{quiet:?}");
         assert_eq!(
-            quiet.missing,
-            vec![
-                "RL: transmissibility 2-5 Hz (little road input: the road level 2-5 Hz is 45 % of the nominal records' lowest)"
+            quiet.not_judged,
+            vec![NotJudged {
+                feature: "RL: transmissibility 2-5 Hz".to_string(),
+                reason: "little road input: the road level 2-5 Hz is 45 % of the nominal records' lowest"
                     .to_string()
-            ]
+            }]
         );
         assert_eq!(
             quiet.summary,
@@ -2948,13 +2976,18 @@ mod tests {
         assert_eq!(quiet.scores.excitation_max_abs_z, 0.0);
         let judged = assess(&set, &record(0.55, 0.5));
         assert_eq!(judged.classification, Classification::Vehicle, "{judged:?}");
-        assert!(judged.missing.is_empty(), "{judged:?}");
+        assert!(
+            judged.missing.is_empty() && judged.not_judged.is_empty(),
+            "{judged:?}"
+        );
         // The same for a drive of such records (its medians).
         let recs: Vec<RecordFeatures> = (0..3).map(|_| record(0.45, 0.5)).collect();
         let refs: Vec<&RecordFeatures> = recs.iter().collect();
         let d = assess_drive(&set, &refs);
         assert_eq!(d.classification, Classification::Normal, "{d:?}");
-        assert_eq!(d.missing.len(), 1, "{d:?}");
+        assert!(d.missing.is_empty(), "{d:?}");
+        assert_eq!(d.not_judged.len(), 1, "{d:?}");
+        assert_eq!(d.not_judged[0].feature, "RL: transmissibility 2-5 Hz");
     }
 
     #[test]
@@ -4299,11 +4332,13 @@ mod variance_tests {
         );
         assert!(why["transh1lu:RL:2-5Hz"].contains("nothing to compare with"));
         let a = assess(&set, &quiet);
+        // Given no score, with the reason: under `not_judged`, not `missing`.
+        assert!(a.missing.is_empty(), "{:?}", a.missing);
         assert!(
-            a.missing.iter().any(|m| m
+            a.not_judged.iter().any(|m| m.to_string()
                 == "RR: transmissibility 2-5 Hz vs the other corners (not judged: its wheel's motion in 2-5 Hz is 67 % sensor noise)"),
             "{:?}",
-            a.missing
+            a.not_judged
         );
         assert!(
             a.summary.contains(
@@ -4314,16 +4349,18 @@ mod variance_tests {
         );
         let d = assess_drive(&set, &[&quiet, &quiet, &quiet]);
         assert!(
-            d.missing
+            d.not_judged
                 .iter()
-                .any(|m| m.contains("(not judged: in 3 of 3 records: its wheel's")),
+                .any(|m| m.reason.starts_with("in 3 of 3 records: its wheel's")),
             "{:?}",
-            d.missing
+            d.not_judged
         );
         // The same record with the wheel's noise as the baseline's: both judged, no reason.
         let clean = assess(&set, &two_corners([0.5, 0.5], [0.01, 0.01]));
         assert!(
-            clean.missing.is_empty() && !clean.summary.contains("sensor noise"),
+            clean.missing.is_empty()
+                && clean.not_judged.is_empty()
+                && !clean.summary.contains("sensor noise"),
             "{clean:?}"
         );
     }
