@@ -122,9 +122,10 @@ pub fn noise_free_level(level: f64, noise_power: f64) -> Option<f64> {
     (noise_power <= NOISE_SHARE_MAX * power).then(|| (power - noise_power.max(0.0)).sqrt())
 }
 
-/// A widening of a vehicle feature's spread by the record's own noise
-/// ([`FeatureStat::spread`]) at least this large is said in the summary.
-pub const NOISE_WIDENING_NOTED: f64 = 1.2;
+/// Vehicle features that the widening of their spread by the record's own noise
+/// ([`FeatureStat::spread`]) kept from being flagged are named in the summary, at most this many
+/// (then "and N more").
+pub const SPARED_NAMED_MAX: usize = 3;
 
 /// Per feature key, the variance (ln units squared) of the feature's value as the record
 /// itself estimates it: its sensors' noise for the level ratios ([`ratio_noise_variances`]),
@@ -2065,10 +2066,9 @@ fn score_values(
     let mut noisy_unjudged = 0usize;
     // The quiet bands that left a feature unjudged, for the summary.
     let mut quiet_used: Vec<&QuietBand> = Vec::new();
-    // The largest widening of a vehicle feature's spread by the record's own noise.
-    let mut widest: f64 = 1.0;
-    // The features (as named in the note) whose spread was widened that much.
-    let mut widened: Vec<&str> = Vec::new();
+    // Vehicle features beyond their limit on the nominal spread and within it on the spread
+    // widened by the record's own noise: (name, change %, z on the nominal spread, z).
+    let mut spared: Vec<(String, f64, f64, f64)> = Vec::new();
     for f in &set.features {
         let where_ = || {
             f.meta
@@ -2105,16 +2105,16 @@ fn score_values(
         }
         let var = noise.get(f.meta.key.as_str()).copied();
         let z = score(f, x, var, &set.config);
-        if f.meta.group == Group::Vehicle {
-            let w = f.spread(var) / f.sigma;
-            widest = widest.max(w);
-            let name = match f.meta.kind {
-                Kind::SideRatio | Kind::TrackRatio => "level ratios",
-                Kind::Transmissibility => "transmissibility",
-                _ => "other features",
-            };
-            if w >= NOISE_WIDENING_NOTED && !widened.contains(&name) {
-                widened.push(name);
+        let limit = set.limit(f.meta.kind);
+        if f.meta.group == Group::Vehicle && z.abs() <= limit {
+            let z_nominal = score(f, x, None, &set.config);
+            if z_nominal.abs() > limit {
+                // A level ratio's label names its wheels.
+                let name = match f.meta.kind {
+                    Kind::SideRatio | Kind::TrackRatio => f.meta.label.clone(),
+                    _ => format!("{}: {}", where_(), f.meta.label),
+                };
+                spared.push((name, 100.0 * ((x - f.centre).exp() - 1.0), z_nominal, z));
             }
         }
         let (n, max) = match f.meta.group {
@@ -2123,7 +2123,6 @@ fn score_values(
         };
         *n += 1;
         *max = max.max(z.abs());
-        let limit = set.limit(f.meta.kind);
         if z.abs() > limit {
             let widened = f.spread(var) / f.sigma;
             evidence.push(Evidence {
@@ -2168,11 +2167,21 @@ fn score_values(
             format!("{summary}; {note}")
         };
     }
-    if widest >= NOISE_WIDENING_NOTED {
-        widened.sort_unstable();
+    if !spared.is_empty() {
+        spared.sort_by(|a, b| b.2.abs().total_cmp(&a.2.abs()));
+        let mut named: Vec<String> = spared
+            .iter()
+            .take(SPARED_NAMED_MAX)
+            .map(|(name, pct, z0, z)| {
+                format!("{name} {pct:+.0} % (z {z0:.1} on the nominal spread, {z:.1} on its own)")
+            })
+            .collect();
+        if spared.len() > SPARED_NAMED_MAX {
+            named.push(format!("and {} more", spared.len() - SPARED_NAMED_MAX));
+        }
         let note = format!(
-            "noisy estimates (the road's input near the sensors' noise): {} judged against the scatter of the estimates themselves, spread widened up to {widest:.1}x",
-            widened.join(" and ")
+            "within the scatter of their own noisy estimates (the road's input near the sensors' noise), not flagged: {}",
+            named.join(", ")
         );
         summary = if summary.is_empty() {
             note
@@ -4301,12 +4310,44 @@ mod variance_tests {
         );
         let w = e.spread_widened_by.unwrap_or(f64::NAN);
         assert!((w - spread / 0.03).abs() < 1e-9 && w > 3.0, "{w}");
+        // Flagged either way: the summary names it as evidence, not as spared (the FL/FR ratio,
+        // which the raised wheel moves too, may be spared).
+        let label = &f.meta.label;
         assert!(
-            noisy.summary.contains(
-                "level ratios judged against the scatter of the estimates themselves, spread widened up to 3."
-            ),
+            !noisy.summary.contains(&format!("{label} +")),
             "{}",
             noisy.summary
+        );
+        // Half the change (0.2): z 6.7 on the nominal spread (0.03), about 2 on the record's own,
+        // within the limit. Not flagged, and the summary names it with both scores.
+        let half = [0.4f64.exp(), 1.0, 1.0, 1.0];
+        let spared = assess(&set, &wheels_with_noise(half, 0.8 / 12.0));
+        assert!(
+            !spared.evidence.iter().any(|e| e.meta.key == key),
+            "{spared:?}"
+        );
+        let v = noise_free_level_variance((half[0] + 0.8).sqrt(), 0.8, cells).unwrap()
+            + noise_free_level_variance(1.8f64.sqrt(), 0.8, cells).unwrap();
+        let z0 = (0.2 - f.centre) / 0.03;
+        let z = (0.2 - f.centre) / (0.03f64 * 0.03 + v - nominal).sqrt();
+        assert!(z0 > 6.0 && z < set.limit(Kind::TrackRatio), "{z0} {z}");
+        let expected = format!(
+            "{label} +{:.0} % (z {z0:.1} on the nominal spread, {z:.1} on its own)",
+            100.0 * ((0.2 - f.centre).exp() - 1.0)
+        );
+        assert!(
+            spared.summary.contains(
+                "within the scatter of their own noisy estimates (the road's input near the sensors' noise), not flagged: "
+            ) && spared.summary.contains(&expected),
+            "{}\n{expected}",
+            spared.summary
+        );
+        // The clean record with the same change is flagged: it is not named as spared.
+        let flagged = assess(&set, &wheels_with_noise(half, 0.001));
+        assert!(
+            flagged.evidence.iter().any(|e| e.meta.key == key)
+                && !flagged.summary.contains(&format!("{label} +")),
+            "{flagged:?}"
         );
     }
 
