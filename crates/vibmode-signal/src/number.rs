@@ -1,285 +1,75 @@
-//! Fast scanning of decimal numbers in delimited text, bit-identical to `str::parse::<f64>`.
+//! Scanning of decimal numbers in delimited text, bit-identical to `str::parse::<f64>`.
 //!
 //! [`scan_number`] reads one number (`[+-]digits[.digits][(e|E)[+-]digits]`, at least one digit
 //! before the exponent; with `decimal_comma` a `,` may stand for the point) and returns where it
-//! ends. Most sensor values (`-0.012345`, `1.5e-3`) have a decimal mantissa `m < 2^53` and a
-//! power of ten `10^k` with `|k| <= 22`: both are exact `f64`s, so one IEEE multiplication or
-//! division gives the correctly rounded value (Clinger's fast path), which is what
-//! `str::parse::<f64>` returns too. Digits are read eight at a time (SWAR). A mantissa above
-//! 2^53 of at most 19 digits over `10^k`, `1 <= k <= 22` (shortest round-trip output such as
-//! `0.44836338772330214` has 16-17 digits), is the floating-point quotient moved to the correctly
-//! rounded neighbour by exact 128-bit comparisons with the midpoints beside it. More than 19
-//! digits (leading zeros included), other large mantissas and larger exponents are handed to
-//! `str::parse::<f64>` (Eisel-Lemire and big-number fallback). Words such as `inf` or `NaN`,
-//! quotes and other text are [`Scan::Invalid`] here; the caller then uses the general cell
-//! parser, which accepts everything Rust's `f64` parser does.
+//! ends. The conversion is the `fast-float2` crate's (Eisel-Lemire with the big-number fallback,
+//! correctly rounded as `str::parse::<f64>` is, the same syntax); this module only restricts
+//! what it is given to plain decimal numbers and maps a decimal comma to the point. Words such as
+//! `inf` or `NaN`, quotes and other text are [`Scan::Invalid`] here; the caller then uses the
+//! general cell parser, which accepts everything Rust's `f64` parser does.
 
-/// Exact powers of ten `10^0 ..= 10^22` (all exactly representable in `f64`).
-const POW10: [f64; 23] = [
-    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
-    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
-];
-
-/// Largest mantissa that converts to `f64` exactly on every path (2^53).
-const MAX_EXACT_MANTISSA: u64 = 1 << 53;
+/// Longest number (in bytes) of a decimal-comma file converted on the stack; a longer one goes
+/// to [`parse_slow`] ([`Scan::Slow`]).
+const COMMA_NUMBER_BYTES_MAX: usize = 64;
 
 /// Outcome of [`scan_number`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Scan {
-    /// A number, converted exactly by the fast path (always finite).
+    /// A number, converted (infinite only where the text overflows, as `str::parse` gives it).
     Fast(f64),
-    /// A syntactically valid number that needs `str::parse::<f64>` (more than 19 digits, a
-    /// mantissa above 2^53 not over a power of ten 10^-1 ..= 10^-22, or a power of ten outside
-    /// 10^-22 ..= 10^22).
+    /// A syntactically valid number that needs `str::parse::<f64>` (a decimal-comma number
+    /// longer than [`COMMA_NUMBER_BYTES_MAX`] bytes).
     Slow,
     /// Not a plain decimal number at this position.
     Invalid,
 }
 
-/// `10^k` for `k = 0..=8`.
-const POW10_U64: [u64; 9] = [
-    1,
-    10,
-    100,
-    1_000,
-    10_000,
-    100_000,
-    1_000_000,
-    10_000_000,
-    100_000_000,
-];
-
-/// The value of 8 decimal digits given as bytes `0..=9` in a little-endian word (first digit in
-/// the lowest byte), by three multiplications (the SWAR method of fast_float / simdjson).
+/// Whether `b` may continue a number once it has begun (digits, the point, an exponent and its
+/// sign; the comma where it is the decimal mark).
 #[inline(always)]
-fn eight_digits(t: u64) -> u64 {
-    const MASK: u64 = 0x0000_00FF_0000_00FF;
-    const MUL1: u64 = 100 + (1_000_000 << 32);
-    const MUL2: u64 = 1 + (10_000 << 32);
-    let v = t.wrapping_mul(10).wrapping_add(t >> 8);
-    (v & MASK)
-        .wrapping_mul(MUL1)
-        .wrapping_add(((v >> 16) & MASK).wrapping_mul(MUL2))
-        >> 32
-}
-
-/// `5^k` for `k = 0..=22` (all below 2^52).
-const POW5: [u64; 23] = {
-    let mut t = [1u64; 23];
-    let mut k = 1;
-    while k < 23 {
-        t[k] = t[k - 1] * 5;
-        k += 1;
-    }
-    t
-};
-
-/// How `m` compares with `c 5^k 2^s` (exact, in 128-bit integers; `c < 2^55`, `5^k < 2^52`).
-#[inline(always)]
-fn cmp_scaled(m: u64, c: u64, p5: u64, s: i32) -> std::cmp::Ordering {
-    let rhs = c as u128 * p5 as u128; // < 2^107
-    if s >= 0 {
-        if s as u32 > rhs.leading_zeros() {
-            return std::cmp::Ordering::Less; // rhs 2^s >= 2^128 > m
-        }
-        (m as u128).cmp(&(rhs << s))
-    } else {
-        let t = (-s) as u32;
-        if t > (m as u128).leading_zeros() {
-            return std::cmp::Ordering::Greater; // m 2^t >= 2^128 > rhs
-        }
-        ((m as u128) << t).cmp(&rhs)
-    }
-}
-
-/// `m / 10^k` correctly rounded (to nearest, ties to even) for `m < 2^64` and `1 <= k <= 22`:
-/// the floating-point quotient (within two units in the last place of it) moved to the right
-/// neighbour by comparing the exact value `m / (5^k 2^k)` with the midpoints beside it. `None`
-/// if that takes more than a few steps (never expected; the caller then uses `str::parse`).
-#[inline]
-fn quotient_pow10(m: u64, k: usize) -> Option<f64> {
-    use std::cmp::Ordering::{Equal, Greater, Less};
-    const HIDDEN: u64 = 1 << 52;
-    let q = m as f64 / POW10[k];
-    // A normal double: m / 10^k lies between 2^53 / 10^22 and 2^64 / 10.
-    let bits = q.to_bits();
-    let mut mant = (bits & (HIDDEN - 1)) | HIDDEN;
-    let mut e = ((bits >> 52) & 0x7ff) as i32 - 1075; // q = mant 2^e
-    let p5 = POW5[k];
-    let k = k as i32;
-    for _ in 0..4 {
-        // Upper midpoint (2 mant + 1) 2^(e-1); lower one (2 mant - 1) 2^(e-1), or
-        // (4 mant - 1) 2^(e-2) at the bottom of the binade. v = m / (5^k 2^k).
-        let upper = cmp_scaled(m, 2 * mant + 1, p5, e - 1 + k);
-        let lower = if mant == HIDDEN {
-            cmp_scaled(m, 4 * mant - 1, p5, e - 2 + k)
-        } else {
-            cmp_scaled(m, 2 * mant - 1, p5, e - 1 + k)
-        };
-        match (upper, lower) {
-            (Greater, _) => {
-                mant += 1;
-                if mant == 2 * HIDDEN {
-                    mant = HIDDEN;
-                    e += 1;
-                }
-            }
-            (Less, Less) => {
-                mant -= 1;
-                if mant < HIDDEN {
-                    mant = 2 * HIDDEN - 1;
-                    e -= 1;
-                }
-            }
-            (Equal, _) => {
-                if mant & 1 == 1 {
-                    mant += 1;
-                    if mant == 2 * HIDDEN {
-                        mant = HIDDEN;
-                        e += 1;
-                    }
-                }
-                return Some(f64::from_bits(((e + 1075) as u64) << 52 | (mant - HIDDEN)));
-            }
-            (Less, Equal) => {
-                if mant & 1 == 1 {
-                    mant -= 1;
-                    if mant < HIDDEN {
-                        mant = 2 * HIDDEN - 1;
-                        e -= 1;
-                    }
-                }
-                return Some(f64::from_bits(((e + 1075) as u64) << 52 | (mant - HIDDEN)));
-            }
-            (Less, Greater) => {
-                return Some(f64::from_bits(((e + 1075) as u64) << 52 | (mant - HIDDEN)));
-            }
-        }
-    }
-    None
-}
-
-/// Reads the run of ASCII digits at `s[i..]` into `m` (`m = m * 10^count + digits`, wrapping:
-/// only meaningful while the total count stays <= 19) and adds their number to `n`; returns the
-/// index after the run. Eight bytes at a time where the slice is long enough.
-#[inline(always)]
-fn eat_digits(s: &[u8], mut i: usize, m: &mut u64, n: &mut u32) -> usize {
-    while let Some(word) = s.get(i..i + 8).and_then(|w| <[u8; 8]>::try_from(w).ok()) {
-        let t = u64::from_le_bytes(word) ^ 0x3030_3030_3030_3030;
-        // A byte is a digit iff its high nibble was 3 (now 0) and its low nibble is <= 9.
-        let not_digit = (t & 0xF0F0_F0F0_F0F0_F0F0)
-            | ((t & 0x0F0F_0F0F_0F0F_0F0F).wrapping_add(0x0606_0606_0606_0606)
-                & 0xF0F0_F0F0_F0F0_F0F0);
-        let k = (not_digit.trailing_zeros() / 8) as usize;
-        if k == 0 {
-            return i;
-        }
-        // Keep the k digits, as the last k of 8 (leading zeros in front).
-        let digits = t << (8 * (8 - k) as u32);
-        *m = m
-            .wrapping_mul(POW10_U64[k])
-            .wrapping_add(eight_digits(digits));
-        *n += k as u32;
-        i += k;
-        if k < 8 {
-            return i;
-        }
-    }
-    while let Some(&b) = s.get(i) {
-        let d = b.wrapping_sub(b'0');
-        if d > 9 {
-            break;
-        }
-        *m = m.wrapping_mul(10).wrapping_add(d as u64);
-        *n += 1;
-        i += 1;
-    }
-    i
+fn number_byte(b: u8, decimal_comma: bool) -> bool {
+    matches!(b, b'0'..=b'9' | b'.' | b'e' | b'E' | b'+' | b'-') || (decimal_comma && b == b',')
 }
 
 /// Scans a decimal number starting at `s[i]`; returns the outcome and the index just after the
 /// number (the caller checks what follows). With `decimal_comma`, `,` is accepted as the decimal
 /// point as well as `.`.
 #[inline(always)]
-pub(crate) fn scan_number(s: &[u8], mut i: usize, decimal_comma: bool) -> (Scan, usize) {
-    // Signs are random in sensor data: no branches on them (mispredictions cost more than the
-    // rest of the number).
-    let first = s.get(i).copied().unwrap_or(0);
-    let neg = first == b'-';
-    i += (neg | (first == b'+')) as usize;
-    let sign_bit = (neg as u64) << 63;
-    // Mantissa: all digits (leading zeros included) while there are at most 19 of them.
-    let mut m: u64 = 0;
-    let mut n_digits = 0u32;
-    i = eat_digits(s, i, &mut m, &mut n_digits);
-    let mut exp10: i64 = 0;
-    if let Some(&b) = s.get(i) {
-        if b == b'.' || (decimal_comma && b == b',') {
-            let n_int = n_digits;
-            i = eat_digits(s, i + 1, &mut m, &mut n_digits);
-            exp10 = -((n_digits - n_int) as i64);
-        }
-    }
-    if n_digits == 0 {
-        return (Scan::Invalid, i);
-    }
-    if let Some(b'e' | b'E') = s.get(i) {
-        i += 1;
-        let mut eneg = false;
-        match s.get(i) {
-            Some(b'-') => {
-                eneg = true;
-                i += 1;
-            }
-            Some(b'+') => i += 1,
-            _ => {}
-        }
-        let mut e: i64 = 0;
-        let mut e_digits = 0u32;
-        while let Some(&b) = s.get(i) {
-            let d = b.wrapping_sub(b'0');
-            if d > 9 {
-                break;
-            }
-            if e < 1_000_000 {
-                e = e * 10 + d as i64;
-            }
-            e_digits += 1;
-            i += 1;
-        }
-        if e_digits == 0 {
-            return (Scan::Invalid, i);
-        }
-        exp10 += if eneg { -e } else { e };
-    }
-    if n_digits > 19 {
-        return (Scan::Slow, i);
-    }
-    if m == 0 {
-        return (Scan::Fast(f64::from_bits(sign_bit)), i);
-    }
-    if m > MAX_EXACT_MANTISSA {
-        // Up to 19 digits (the simulator's and most loggers' shortest round-trip output has
-        // 16-17) and a decimal fraction: the quotient by a power of ten, checked exactly.
-        if (-22..=-1).contains(&exp10) {
-            if let Some(v) = quotient_pow10(m, (-exp10) as usize) {
-                return (Scan::Fast(f64::from_bits(v.to_bits() | sign_bit)), i);
-            }
-        }
-        return (Scan::Slow, i);
-    }
-    if !(-22..=22).contains(&exp10) {
-        return (Scan::Slow, i);
-    }
-    // Both m and 10^|exp10| are exact doubles: one correctly rounded operation. (m <= 2^53, so
-    // the conversion through i64 is exact and a single instruction.)
-    let mf = m as i64 as f64;
-    let v = if exp10 >= 0 {
-        mf * POW10[exp10 as usize]
-    } else {
-        mf / POW10[(-exp10) as usize]
+pub(crate) fn scan_number(s: &[u8], i: usize, decimal_comma: bool) -> (Scan, usize) {
+    let rest = s.get(i..).unwrap_or_default();
+    // A plain number starts with a digit or a point, after at most one sign: words (`inf`,
+    // `NaN`, `-infinity`) are left to the general cell parser.
+    let body = match rest.first() {
+        Some(b'+' | b'-') => 1,
+        _ => 0,
     };
-    (Scan::Fast(f64::from_bits(v.to_bits() | sign_bit)), i)
+    let point = |b: u8| b == b'.' || (decimal_comma && b == b',');
+    match rest.get(body) {
+        Some(b) if b.is_ascii_digit() || point(*b) => {}
+        _ => return (Scan::Invalid, i),
+    }
+    let parsed = if decimal_comma {
+        // The number's extent, its commas turned into points on the stack (the same length, so
+        // the parsed length indexes `s` too).
+        let len = rest
+            .iter()
+            .position(|&b| !number_byte(b, true))
+            .unwrap_or(rest.len());
+        if len > COMMA_NUMBER_BYTES_MAX {
+            return (Scan::Slow, i + len);
+        }
+        let mut buf = [0u8; COMMA_NUMBER_BYTES_MAX];
+        for (d, &b) in buf.iter_mut().zip(&rest[..len]) {
+            *d = if b == b',' { b'.' } else { b };
+        }
+        fast_float2::parse_partial::<f64, _>(&buf[..len])
+    } else {
+        fast_float2::parse_partial::<f64, _>(rest)
+    };
+    match parsed {
+        Ok((v, n)) => (Scan::Fast(v), i + n),
+        Err(_) => (Scan::Invalid, i),
+    }
 }
 
 /// `str::parse::<f64>` of an ASCII cell already accepted by [`scan_number`] (with a decimal
@@ -360,34 +150,38 @@ mod tests {
 
     #[test]
     fn hand_cases() {
-        // (text, value by hand, fast path expected)
-        let cases: [(&str, f64, bool); 19] = [
-            ("0.1", 0.1, true),
-            ("-0", -0.0, true),
-            ("-0.000", -0.0, true),
-            ("+0", 0.0, true),
-            ("1e-7", 1e-7, true),
-            (".5", 0.5, true),
-            ("5.", 5.0, true),
-            ("+3", 3.0, true),
-            ("-.25", -0.25, true),
-            ("007.50", 7.5, true),
-            ("1E+06", 1e6, true),
-            ("-0.012345", -0.012345, true),
-            ("0.000000000000000000000000001", 1e-27, false),
-            ("0.000000000000000001", 1e-18, true),
-            ("123456789012345.0", 123456789012345.0, true),
-            ("9007199254740992", 9007199254740992.0, true),
-            ("9007199254740993", 9007199254740992.0, false),
-            ("123456789012345678", 123456789012345678.0, false),
-            ("1e300", 1e300, false),
+        // (text, value by hand): every plain decimal number is converted here, none handed on.
+        let cases: [(&str, f64); 19] = [
+            ("0.1", 0.1),
+            ("-0", -0.0),
+            ("-0.000", -0.0),
+            ("+0", 0.0),
+            ("1e-7", 1e-7),
+            (".5", 0.5),
+            ("5.", 5.0),
+            ("+3", 3.0),
+            ("-.25", -0.25),
+            ("007.50", 7.5),
+            ("1E+06", 1e6),
+            ("-0.012345", -0.012345),
+            ("0.000000000000000000000000001", 1e-27),
+            ("0.000000000000000001", 1e-18),
+            ("123456789012345.0", 123456789012345.0),
+            ("9007199254740992", 9007199254740992.0),
+            ("9007199254740993", 9007199254740992.0),
+            ("123456789012345678", 123456789012345678.0),
+            ("1e300", 1e300),
         ];
-        for (t, v, fast) in cases {
+        for (t, v) in cases {
             let (got, was_fast) = parse_cell(t.as_bytes(), false);
             assert_eq!(got.map(f64::to_bits), Some(v.to_bits()), "{t}");
-            assert_eq!(was_fast, fast, "{t}: fast path taken?");
+            assert!(was_fast, "{t}: handed on");
             check(t);
         }
+        // A decimal-comma number longer than the stack buffer is handed to str::parse, with the
+        // same value.
+        let long = format!("1,{}", "0".repeat(COMMA_NUMBER_BYTES_MAX));
+        assert_eq!(parse_cell(long.as_bytes(), true), (Some(1.0), false));
         assert_eq!(parse_cell(b"1,5", true).0, Some(1.5));
         assert_eq!(parse_cell(b"1,5", false).0, None);
         for bad in [
@@ -486,8 +280,8 @@ mod tests {
         assert!(n_fast > n, "fast path taken for only {n_fast} of {}", 2 * n);
     }
 
-    /// Mantissas above 2^53 with up to 19 digits divided by 10^1 ..= 10^22 (the quotient
-    /// checked against its midpoints) agree with `str::parse` bit for bit, and take that path.
+    /// Mantissas above 2^53 with up to 19 digits divided by 10^1 ..= 10^22 (not exact in
+    /// `f64`: the conversion must round) agree with `str::parse` bit for bit.
     #[test]
     fn long_mantissas_over_powers_of_ten_match_str_parse() {
         let mut rng = ChaCha8Rng::seed_from_u64(20261126);
@@ -497,7 +291,7 @@ mod tests {
             for _ in 1..digits {
                 m = m * 10 + rng.gen_range(0..10);
             }
-            if m <= MAX_EXACT_MANTISSA {
+            if m <= 1 << 53 {
                 continue;
             }
             let k = rng.gen_range(1..=22usize);
@@ -507,20 +301,17 @@ mod tests {
             } else {
                 format!("{}.{}", &d[..d.len() - k], &d[d.len() - k..])
             };
-            // Leading zeros count towards the 19 digits of the fast paths.
-            let n_digits = t.bytes().filter(u8::is_ascii_digit).count();
             let t = if rng.gen_bool(0.5) {
                 format!("-{t}")
             } else {
                 t
             };
-            assert!(check(&t) || n_digits > 19, "{t}: not the fast path");
+            assert!(check(&t), "{t}: handed on");
         }
         // Shortest round-trip output of doubles of sensor size (16-17 digits).
         for _ in 0..100_000 {
             let v: f64 = rng.gen_range(-20.0..20.0);
-            // Below 1 the leading zeros may make more than 19 digits (str::parse then).
-            assert!(check(&v.to_string()) || v.abs() < 1.0, "{v}");
+            assert!(check(&v.to_string()), "{v}");
         }
     }
 
