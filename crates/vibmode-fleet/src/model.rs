@@ -2144,23 +2144,28 @@ fn score_values(
     let vehicle = evidence.iter().any(|e| e.meta.group == Group::Vehicle);
     let road = evidence.iter().any(|e| e.meta.group == Group::Excitation);
     let mut summary = summary(&evidence);
+    // One note for the features given no score, by reason (the JSON's `not_judged` lists them).
+    let mut unjudged_parts: Vec<String> = Vec::new();
     if not_judged > 0 {
         quiet_used.sort_by(|p, q| p.hz[0].total_cmp(&q.hz[0]));
         let bands: Vec<String> = quiet_used.iter().map(|q| band_label(&q.hz)).collect();
-        let note = format!(
-            "little road input (road level {} below half the nominal records' lowest): {not_judged} vehicle feature(s) not judged",
+        unjudged_parts.push(format!(
+            "{not_judged} vehicle feature(s) for little road input ({})",
             bands.join(", ")
-        );
-        summary = if summary.is_empty() {
-            note
-        } else {
-            format!("{summary}; {note}")
-        };
+        ));
     }
     if noisy_unjudged > 0 {
-        let note = format!(
-            "wheels' motion more than half sensor noise: {noisy_unjudged} vehicle feature(s) not judged"
-        );
+        unjudged_parts.push(format!(
+            "{noisy_unjudged}{} for the wheels' sensor noise",
+            if unjudged_parts.is_empty() {
+                " vehicle feature(s)"
+            } else {
+                ""
+            }
+        ));
+    }
+    if !unjudged_parts.is_empty() {
+        let note = format!("not judged: {}", unjudged_parts.join(" and "));
         summary = if summary.is_empty() {
             note
         } else {
@@ -2180,7 +2185,7 @@ fn score_values(
             named.push(format!("and {} more", spared.len() - SPARED_NAMED_MAX));
         }
         let note = format!(
-            "within the scatter of their own noisy estimates (the road's input near the sensors' noise), not flagged: {}",
+            "not flagged, within their own noisy estimates' scatter: {}",
             named.join(", ")
         );
         summary = if summary.is_empty() {
@@ -2980,7 +2985,7 @@ mod tests {
         );
         assert_eq!(
             quiet.summary,
-            "little road input (road level 2-5 Hz below half the nominal records' lowest): 1 vehicle feature(s) not judged"
+            "not judged: 1 vehicle feature(s) for little road input (2-5 Hz)"
         );
         assert_eq!(quiet.scores.excitation_max_abs_z, 0.0);
         let judged = assess(&set, &record(0.55, 0.5));
@@ -4336,9 +4341,10 @@ mod variance_tests {
             100.0 * ((0.2 - f.centre).exp() - 1.0)
         );
         assert!(
-            spared.summary.contains(
-                "within the scatter of their own noisy estimates (the road's input near the sensors' noise), not flagged: "
-            ) && spared.summary.contains(&expected),
+            spared
+                .summary
+                .contains("not flagged, within their own noisy estimates' scatter: ")
+                && spared.summary.contains(&expected),
             "{}\n{expected}",
             spared.summary
         );
@@ -4382,9 +4388,8 @@ mod variance_tests {
             a.not_judged
         );
         assert!(
-            a.summary.contains(
-                "wheels' motion more than half sensor noise: 2 vehicle feature(s) not judged"
-            ),
+            a.summary
+                .contains("not judged: 2 vehicle feature(s) for the wheels' sensor noise"),
             "{}",
             a.summary
         );
