@@ -2061,7 +2061,7 @@ fn score_values(
         n_excitation: 0,
     };
     let quiet = quiet_bands(set, &by_key);
-    let mut not_judged = 0usize;
+    let mut quiet_unjudged = 0usize;
     // Vehicle features not given because their wheels' motion is mostly sensor noise.
     let mut noisy_unjudged = 0usize;
     // The quiet bands that left a feature unjudged, for the summary.
@@ -2097,7 +2097,7 @@ fn score_values(
                     100.0 * (q.x - q.lo).exp()
                 ),
             });
-            not_judged += 1;
+            quiet_unjudged += 1;
             if !quiet_used.iter().any(|u| u.hz == q.hz) {
                 quiet_used.push(q);
             }
@@ -2146,11 +2146,11 @@ fn score_values(
     let mut summary = summary(&evidence);
     // One note for the features given no score, by reason (the JSON's `not_judged` lists them).
     let mut unjudged_parts: Vec<String> = Vec::new();
-    if not_judged > 0 {
+    if quiet_unjudged > 0 {
         quiet_used.sort_by(|p, q| p.hz[0].total_cmp(&q.hz[0]));
         let bands: Vec<String> = quiet_used.iter().map(|q| band_label(&q.hz)).collect();
         unjudged_parts.push(format!(
-            "{not_judged} vehicle feature(s) for little road input ({})",
+            "{quiet_unjudged} vehicle feature(s) for little road input ({})",
             bands.join(", ")
         ));
     }
@@ -4262,7 +4262,8 @@ mod variance_tests {
     /// its rear one is flagged at z = 0.4 / 0.03 = 13 without noise and, with the noise power
     /// 0.8 in every wheel (44 % of the rear wheel's measured band power), at 0.4 over the
     /// spread widened by its own variance (`sqrt(0.03^2 + v - v_nominal)`, about 3.2 times: z
-    /// 4.1), which its evidence and summary state.
+    /// 4.1), which its evidence states. Half that change is within the widened spread but not
+    /// the nominal one: not flagged, and the summary names it with both scores.
     #[test]
     fn a_record_near_its_noise_floor_is_judged_against_its_own_scatter() {
         let cfg = FleetConfig::default();
