@@ -348,9 +348,31 @@ pub fn check_finite(channels: &[Channel]) -> Result<(), RecordingError> {
             max: CHANNELS_MAX,
         });
     }
+    /// Samples per block of the scan: a block is checked without a branch per sample (its
+    /// lanes' peaks and one flag), and only a bad block is looked at sample by sample.
+    const BLOCK: usize = 8;
     for c in channels {
-        let mut peak = 0.0f64;
-        for (i, &v) in c.samples.iter().enumerate() {
+        let mut lanes = [0.0f64; BLOCK];
+        let mut blocks = c.samples.chunks_exact(BLOCK);
+        let mut bad_from = None;
+        for (b, block) in blocks.by_ref().enumerate() {
+            // `!(|v| <= max)` holds for a NaN as well as for an infinity or a huge value.
+            let mut ok = true;
+            for (lane, &v) in lanes.iter_mut().zip(block) {
+                ok &= v.abs() <= SAMPLE_ABS_MAX;
+                *lane = lane.max(v.abs());
+            }
+            if !ok {
+                bad_from = Some(b * BLOCK);
+                break;
+            }
+        }
+        let tail_from = c.samples.len() - blocks.remainder().len();
+        // The first bad sample, in the bad block or the tail (maximum is exact in any order, so
+        // the peak is the same as one running maximum's).
+        let mut peak = lanes.iter().fold(0.0f64, |m, &v| m.max(v));
+        let from = bad_from.unwrap_or(tail_from);
+        for (i, &v) in c.samples.iter().enumerate().skip(from) {
             if !v.is_finite() {
                 return Err(RecordingError::NonFinite {
                     channel: c.name.clone(),
@@ -465,6 +487,80 @@ impl Recording {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The check one sample at a time, in order: what the blocked scan must give.
+    fn check_one_by_one(c: &Channel) -> Result<(), RecordingError> {
+        use crate::limits::{SAMPLE_ABS_MAX, SAMPLE_PEAK_MIN};
+        let mut peak = 0.0f64;
+        for (i, &v) in c.samples.iter().enumerate() {
+            let (channel, index, value) = (c.name.clone(), i, v);
+            if !v.is_finite() {
+                return Err(RecordingError::NonFinite {
+                    channel,
+                    index,
+                    value,
+                });
+            }
+            if v.abs() > SAMPLE_ABS_MAX {
+                return Err(RecordingError::SampleTooLarge {
+                    channel,
+                    index,
+                    value,
+                });
+            }
+            peak = peak.max(v.abs());
+        }
+        if peak > 0.0 && peak < SAMPLE_PEAK_MIN {
+            return Err(RecordingError::SamplesTooSmall {
+                channel: c.name.clone(),
+                peak,
+            });
+        }
+        Ok(())
+    }
+
+    /// The blocked scan of `check_finite` names the first bad sample (NaN, infinity, too large)
+    /// wherever it lies (in a block, the tail, before a second bad one) and the peak of a
+    /// too-small channel, as one sample at a time does: 400 seeded channels of 0 to 40 samples.
+    #[test]
+    fn blocked_scan_names_the_first_bad_sample_as_one_at_a_time() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let bad = [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 2e60, -1e61];
+        let (mut errors, mut small) = (0, 0);
+        for _ in 0..400 {
+            let n = (next() % 41) as usize;
+            let scale = if next() % 4 == 0 { 1e-64 } else { 1.0 };
+            let mut x: Vec<f64> = (0..n)
+                .map(|_| scale * ((next() % 2001) as f64 - 1000.0) / 7.0)
+                .collect();
+            for _ in 0..(next() % 3) {
+                if n > 0 {
+                    let i = (next() as usize) % n;
+                    x[i] = bad[(next() as usize) % bad.len()];
+                }
+            }
+            let c = Channel::new("z", "m/s^2", x);
+            let want = check_one_by_one(&c);
+            let got = check_finite(std::slice::from_ref(&c));
+            // NaN != NaN: compare the messages, which carry index and value.
+            assert_eq!(
+                got.as_ref().map_err(|e| e.to_string()),
+                want.as_ref().map_err(|e| e.to_string()),
+                "{:?}",
+                c.samples
+            );
+            errors += usize::from(want.is_err());
+            small += usize::from(matches!(want, Err(RecordingError::SamplesTooSmall { .. })));
+        }
+        // The draw covers every branch.
+        assert!(errors > 100 && small > 20, "{errors} {small}");
+    }
 
     /// Issue 28: `-c 0 -c 0` analysed the same channel twice without a word.
     #[test]

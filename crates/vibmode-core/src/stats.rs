@@ -290,32 +290,67 @@ impl HealthScan {
         }
         // The current run in locals (NaN equals no sample: a first sample starts a run).
         let (mut value, mut len) = self.run.take().unwrap_or((f64::NAN, 0));
-        for &v in x {
-            // Most samples lie strictly between the extremes: one test, and the extremes' runs
-            // (if any) end.
-            if v < self.hi && v > self.lo {
+        // Most blocks of samples lie strictly between the extremes with no two neighbours
+        // equal: such a block only ends the runs before it (the extremes' and the current one)
+        // and starts a run of its last sample; its runs of one sample are never counted
+        // (`min_run` >= 2). That is tested without a branch per sample; any other block is
+        // taken sample by sample.
+        const BLOCK: usize = 8;
+        let mut blocks = x.chunks_exact(BLOCK);
+        for block in blocks.by_ref() {
+            let (hi, lo) = (self.hi, self.lo);
+            let inside = block.iter().fold(true, |ok, &v| ok & (v < hi) & (v > lo));
+            let distinct = block[1..]
+                .iter()
+                .zip(block)
+                .fold(block[0] != value, |ok, (&v, &before)| ok & (v != before));
+            let plain = inside & distinct;
+            if plain {
                 if self.run_at != [0, 0] {
                     self.end_extreme_run(0);
                     self.end_extreme_run(1);
                 }
+                self.count_run(value, len);
+                (value, len) = (block[BLOCK - 1], 1);
             } else {
-                for (k, at) in [v >= self.hi, v <= self.lo].into_iter().enumerate() {
-                    if at {
-                        self.at[k] += 1;
-                        self.run_at[k] += 1;
-                    } else {
-                        self.end_extreme_run(k);
-                    }
+                for &v in block {
+                    self.step(v, &mut value, &mut len);
                 }
             }
-            if v == value {
-                len += 1;
-            } else {
-                self.count_run(value, len);
-                (value, len) = (v, 1);
-            }
+        }
+        for &v in blocks.remainder() {
+            self.step(v, &mut value, &mut len);
         }
         self.run = (len > 0).then_some((value, len));
+    }
+
+    /// One sample `v` of [`HealthScan::push`], the current run (`value`, `len`) in the caller's
+    /// locals.
+    #[inline(always)]
+    fn step(&mut self, v: f64, value: &mut f64, len: &mut usize) {
+        // Most samples lie strictly between the extremes: one test, and the extremes' runs (if
+        // any) end.
+        if v < self.hi && v > self.lo {
+            if self.run_at != [0, 0] {
+                self.end_extreme_run(0);
+                self.end_extreme_run(1);
+            }
+        } else {
+            for (k, at) in [v >= self.hi, v <= self.lo].into_iter().enumerate() {
+                if at {
+                    self.at[k] += 1;
+                    self.run_at[k] += 1;
+                } else {
+                    self.end_extreme_run(k);
+                }
+            }
+        }
+        if v == *value {
+            *len += 1;
+        } else {
+            self.count_run(*value, *len);
+            (*value, *len) = (v, 1);
+        }
     }
 
     /// What [`channel_health`] gives for the channel fed.
