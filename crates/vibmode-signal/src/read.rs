@@ -361,13 +361,19 @@ pub fn read_delimited<R: BufRead>(reader: R, path: &str, opts: &ReadOptions) -> 
     finish_delimited(path, opts, &cols, data, lines)
 }
 
-/// Reads delimited text held in memory, parsing with several threads for large files.
+/// Reads delimited text held in memory, parsing with several threads for large files (one
+/// when called on a thread of rayon's pool: a parallel loop over files keeps the cores busy
+/// already, and a file cut into parts costs a copy of its columns).
 pub fn read_delimited_bytes(bytes: &[u8], path: &str, opts: &ReadOptions) -> Result<Recording> {
     let mut r = DelimitedReader::new(bytes, path)?;
     let mut data: Vec<Vec<f64>> = vec![Vec::new(); r.columns().len()];
     let mut lines: Vec<usize> = Vec::new();
     let keep_lines = r.needs_lines();
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get().min(8));
+    let threads = if rayon::current_thread_index().is_some() {
+        1
+    } else {
+        std::thread::available_parallelism().map_or(1, |n| n.get().min(8))
+    };
     if let Some(block) = r.read_all_parallel(threads)? {
         append_block(&mut data, &mut lines, block, keep_lines);
     }

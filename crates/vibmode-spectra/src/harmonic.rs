@@ -219,9 +219,42 @@ pub struct HarmonicPlan {
     n: usize,
     nfft: usize,
     nw: f64,
-    tapers: Vec<Vec<f64>>,
+    tapers: Arc<Vec<Vec<f64>>>,
     sums: Vec<f64>,
     fft: Arc<dyn RealToComplex<f64>>,
+}
+
+/// The tapers made by [`HarmonicPlan::new`] in this process, by `(n, nw's bits, k)`, newest
+/// last: a fleet makes one plan per record of the same length, and the tapers (a bisection for
+/// each eigenvalue) cost more than the F-test of a short record.
+static TAPERS: std::sync::LazyLock<std::sync::Mutex<Vec<TapersKey>>> =
+    std::sync::LazyLock::new(|| std::sync::Mutex::new(Vec::new()));
+
+type TapersKey = ((usize, u64, usize), Arc<Vec<Vec<f64>>>);
+
+/// The most taper sets [`TAPERS`] keeps (the oldest is dropped first).
+const TAPERS_KEPT: usize = 8;
+
+/// [`dpss`] of `(n, nw, k)`, made once per process for the last [`TAPERS_KEPT`] settings.
+fn shared_dpss(n: usize, nw: f64, k: usize) -> Result<Arc<Vec<Vec<f64>>>, SpectraError> {
+    let key = (n, nw.to_bits(), k);
+    // A poisoned lock only means another thread panicked while holding it: the list is whole.
+    let find = || {
+        let kept = TAPERS.lock().unwrap_or_else(|e| e.into_inner());
+        kept.iter().find(|(k, _)| *k == key).map(|(_, t)| t.clone())
+    };
+    if let Some(t) = find() {
+        return Ok(t);
+    }
+    let tapers = Arc::new(dpss(n, nw, k)?);
+    let mut kept = TAPERS.lock().unwrap_or_else(|e| e.into_inner());
+    if !kept.iter().any(|(k, _)| *k == key) {
+        if kept.len() >= TAPERS_KEPT {
+            kept.remove(0);
+        }
+        kept.push((key, tapers.clone()));
+    }
+    Ok(tapers)
 }
 
 impl std::fmt::Debug for HarmonicPlan {
@@ -243,7 +276,7 @@ impl HarmonicPlan {
         if k < 2 {
             return Err(SpectraError::InvalidTapers { n, nw, k });
         }
-        let tapers = dpss(n, nw, k)?;
+        let tapers = shared_dpss(n, nw, k)?;
         let sums = tapers.iter().map(|v| v.iter().sum()).collect();
         let nfft = n * pad.max(1);
         let fft = vibmode_fft::Planner::new().forward(nfft);
@@ -285,7 +318,7 @@ impl HarmonicPlan {
         let mut spec = self.fft.make_output_vec();
         // y[k][j]
         let mut y = Vec::with_capacity(k);
-        for v in &self.tapers {
+        for v in self.tapers.iter() {
             buf.iter_mut().for_each(|b| *b = 0.0);
             for ((b, xv), vv) in buf.iter_mut().zip(x).zip(v) {
                 *b = (xv - mean) * vv;
@@ -382,6 +415,30 @@ pub fn f_test_peaks(h: &HarmonicF, alpha: f64, lo_hz: f64, hi_hz: f64) -> Vec<(f
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A plan's tapers are `dpss` of its settings bit for bit, whether made now, kept from an
+    /// earlier plan, or made again after more settings than the process keeps pushed them out.
+    #[test]
+    fn plans_share_their_tapers_and_they_are_dpss_of_their_settings() {
+        let settings: Vec<(usize, f64, usize)> = (0..TAPERS_KEPT + 3)
+            .map(|i| (64 + 7 * i, 2.5 + 0.25 * (i % 3) as f64, 3 + i % 4))
+            .collect();
+        for round in 0..2 {
+            for &(n, nw, k) in &settings {
+                let plan = HarmonicPlan::new(n, nw, k, 2).unwrap();
+                assert_eq!(
+                    *plan.tapers,
+                    dpss(n, nw, k).unwrap(),
+                    "round {round}: {n} {nw} {k}"
+                );
+                let again = HarmonicPlan::new(n, nw, k, 4).unwrap();
+                assert!(Arc::ptr_eq(&plan.tapers, &again.tapers), "{n} {nw} {k}");
+            }
+        }
+        assert!(TAPERS.lock().unwrap_or_else(|e| e.into_inner()).len() <= TAPERS_KEPT);
+        // Bad settings are refused as dpss refuses them, and nothing is kept for them.
+        assert!(HarmonicPlan::new(10, 6.0, 3, 1).is_err());
+    }
 
     #[test]
     fn the_p_value_of_f_2_nu_by_hand() {
