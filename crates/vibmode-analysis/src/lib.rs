@@ -44,7 +44,7 @@ pub use lines::{LineSweep, LineTrack};
 pub use multichannel::{ShapedPole, SsiAnalysis};
 pub use pipeline::{
     analyze, analyze_keeping_first, analyze_prepared, analyze_with, check_channels_vary,
-    check_records, preprocess_records, RecordFacts,
+    check_records, preprocess_recordings, preprocess_records, RecordFacts,
 };
 pub use results::{
     sensor_notes, AnalysisResults, ChannelAnalysis, ClippedChannel, HeldChannel, RecordSummary,

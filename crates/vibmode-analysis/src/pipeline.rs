@@ -166,9 +166,19 @@ pub fn preprocess_records(
     records: &[RecordInput],
     cfg: &AnalysisConfig,
 ) -> Result<Vec<Preprocessed>, AnalysisError> {
-    records
+    let recordings: Vec<&vibmode_core::Recording> = records.iter().map(|r| &r.recording).collect();
+    preprocess_recordings(&recordings, cfg)
+}
+
+/// [`preprocess_records`] of recordings borrowed (a record that is a whole recording needs no
+/// [`RecordInput`] owning a copy of its samples).
+pub fn preprocess_recordings(
+    recordings: &[&vibmode_core::Recording],
+    cfg: &AnalysisConfig,
+) -> Result<Vec<Preprocessed>, AnalysisError> {
+    recordings
         .par_iter()
-        .map(|r| preprocess(&r.recording, &cfg.preprocess).map_err(AnalysisError::from))
+        .map(|r| preprocess(r, &cfg.preprocess).map_err(AnalysisError::from))
         .collect()
 }
 
@@ -243,8 +253,21 @@ pub struct RecordFacts {
 impl RecordFacts {
     /// The facts of `r` (no segmentation facts).
     pub fn of(r: &RecordInput) -> RecordFacts {
-        let (clipped, held) = sensor_notes(&r.recording);
-        Self::with_notes(r, clipped, held)
+        Self::of_recording(&r.name, &r.recording)
+    }
+
+    /// The facts of the record `name` whose samples are `rec` (no segmentation facts): as
+    /// [`RecordFacts::of`] without a [`RecordInput`] that owns them.
+    pub fn of_recording(name: &str, rec: &vibmode_core::Recording) -> RecordFacts {
+        let (clipped, held) = sensor_notes(rec);
+        RecordFacts {
+            name: name.to_string(),
+            fs_hz: rec.fs_hz,
+            n_samples: rec.len(),
+            meta: None,
+            clipped,
+            held,
+        }
     }
 
     /// As [`RecordFacts::of`], refusing a channel that carries no vibration

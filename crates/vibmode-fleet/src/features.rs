@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 use vibmode_analysis::{
-    analyze_prepared, check_records, cut_records, preprocess_records, AnalysisConfig, Corner,
+    analyze_prepared, cut_records, preprocess_recordings, AnalysisConfig, Corner, CutRecords,
     RecordFacts, Role, SweepIdentifier,
 };
 use vibmode_core::{ModeClass, Recording};
@@ -572,9 +572,34 @@ fn compute_features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result
     Ok(f)
 }
 
+/// A record of [`features_of`]: its name and samples, borrowed.
+struct Borrowed<'a> {
+    name: &'a str,
+    recording: &'a Recording,
+}
+
 fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordFeatures> {
     let acfg: &AnalysisConfig = &cfg.analysis;
-    let records = cut_records(name, rec, acfg.record_length_s);
+    // A recording of one record's length is that record, borrowed (`cut_records` would copy
+    // its samples); a longer one is cut.
+    let cuts = if CutRecords::new(name, rec, acfg.record_length_s).len() > 1 {
+        cut_records(name, rec, acfg.record_length_s)
+    } else {
+        Vec::new()
+    };
+    let records: Vec<Borrowed> = if cuts.is_empty() {
+        vec![Borrowed {
+            name,
+            recording: rec,
+        }]
+    } else {
+        cuts.iter()
+            .map(|r| Borrowed {
+                name: &r.name,
+                recording: &r.recording,
+            })
+            .collect()
+    };
     let analysis = |source: vibmode_analysis::AnalysisError| FleetError::FeaturesAnalysis {
         record: name.to_string(),
         source,
@@ -628,9 +653,10 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
     let mut body: Option<BodySpectra> = None;
     // Each record pre-processed once (in parallel): the spectra here and the analysis below
     // share it.
+    // (The records cut from one recording share its channels and rate: no layout check.)
     acfg.validate().map_err(analysis)?;
-    check_records(&records).map_err(analysis)?;
-    let pres = preprocess_records(&records, acfg).map_err(analysis)?;
+    let recordings: Vec<&Recording> = records.iter().map(|r| r.recording).collect();
+    let pres = preprocess_recordings(&recordings, acfg).map_err(analysis)?;
     for pre in &pres {
         fs = pre.band.fs_hz;
         if !body_u.is_empty() && !body_y.is_empty() {
@@ -709,7 +735,10 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
         sweep: acfg.sweep.clone(),
         poles: acfg.poles.clone(),
     };
-    let facts = records.iter().map(RecordFacts::of).collect();
+    let facts = records
+        .iter()
+        .map(|r| RecordFacts::of_recording(r.name, r.recording))
+        .collect();
     let results = analyze_prepared(
         facts,
         pres,

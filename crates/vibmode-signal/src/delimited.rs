@@ -1151,12 +1151,14 @@ impl<R: BufRead> DelimitedReader<R> {
                 fix: "ask for at least 1 row per block".into(),
             });
         }
+        self.next_block_reserved(max_rows, 0)
+    }
+
+    /// [`Self::next_block`] with room for `rows` rows reserved in the block's vectors (a
+    /// reader that knows how many rows are coming grows them once, not by doubling).
+    fn next_block_reserved(&mut self, max_rows: usize, rows: usize) -> Result<Option<Block>> {
         let nc = self.columns.len();
-        let mut block = Block {
-            first_line: 0,
-            columns: vec![Vec::new(); nc],
-            lines: Vec::new(),
-        };
+        let mut block = Block::with_capacity(nc, rows.min(max_rows));
         let mut ctx = RowCtx {
             path: &self.path,
             sep: self.sep,
@@ -1260,7 +1262,7 @@ impl<'s> DelimitedReader<&'s [u8]> {
         let rest: &'s [u8] = self.reader;
         let threads = threads.clamp(1, 64);
         if threads == 1 || rest.len() < (1 << 20) {
-            return self.next_block(usize::MAX);
+            return self.next_block_reserved(usize::MAX, estimate_rows(rest) + 1);
         }
         // Cut points just after a newline.
         let mut cuts = vec![0usize];
