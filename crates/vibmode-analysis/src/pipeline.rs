@@ -260,6 +260,28 @@ impl RecordFacts {
     /// [`RecordFacts::of`] without a [`RecordInput`] that owns them.
     pub fn of_recording(name: &str, rec: &vibmode_core::Recording) -> RecordFacts {
         let (clipped, held) = sensor_notes(rec);
+        Self::of_recording_notes(name, rec, clipped, held)
+    }
+
+    /// As [`RecordFacts::of_recording`], from each channel's health already taken
+    /// (`health[i]` the [`vibmode_core::stats::channel_health`] of `rec.channels[i]` at
+    /// [`vibmode_core::stats::held_min_run`] of its rate): one look at the samples for the
+    /// caller's checks and these facts.
+    pub fn of_recording_health(
+        name: &str,
+        rec: &vibmode_core::Recording,
+        health: &[vibmode_core::stats::ChannelHealth],
+    ) -> RecordFacts {
+        let (clipped, held) = crate::results::sensor_notes_of(rec, health);
+        Self::of_recording_notes(name, rec, clipped, held)
+    }
+
+    fn of_recording_notes(
+        name: &str,
+        rec: &vibmode_core::Recording,
+        clipped: Vec<ClippedChannel>,
+        held: Vec<HeldChannel>,
+    ) -> RecordFacts {
         RecordFacts {
             name: name.to_string(),
             fs_hz: rec.fs_hz,

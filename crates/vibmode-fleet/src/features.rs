@@ -7,6 +7,7 @@ use vibmode_analysis::{
     analyze_prepared, cut_records, preprocess_recordings, AnalysisConfig, Corner, CutRecords,
     RecordFacts, Role, SweepIdentifier,
 };
+use vibmode_core::stats::ChannelHealth;
 use vibmode_core::{ModeClass, Recording};
 use vibmode_spectra::{band_rms, SpectraError, WelchParams, Window};
 
@@ -437,9 +438,27 @@ pub use vibmode_core::stats::{CLIPPED_MIN_SAMPLES, CLIPPED_SHARE};
 /// The sensor faults of the channels of `rec` that have a role (sprung or unsprung; other
 /// columns, such as a speed, are not sensors of the features).
 pub fn sensor_faults(rec: &Recording, acfg: &AnalysisConfig) -> Vec<SensorFault> {
-    let mut out = Vec::new();
+    sensor_faults_of(rec, acfg, &channel_healths(rec))
+}
+
+/// The [`vibmode_core::stats::channel_health`] of every channel of `rec`, as the analysis
+/// takes it (runs held at [`vibmode_core::stats::held_min_run`] of the rate).
+fn channel_healths(rec: &Recording) -> Vec<ChannelHealth> {
     let min_run = vibmode_core::stats::held_min_run(rec.fs_hz);
-    for ch in &rec.channels {
+    rec.channels
+        .iter()
+        .map(|ch| vibmode_core::stats::channel_health(&ch.samples, min_run))
+        .collect()
+}
+
+/// [`sensor_faults`] from each channel's health (`health[i]` of `rec.channels[i]`).
+fn sensor_faults_of(
+    rec: &Recording,
+    acfg: &AnalysisConfig,
+    health: &[ChannelHealth],
+) -> Vec<SensorFault> {
+    let mut out = Vec::new();
+    for (ch, h) in rec.channels.iter().zip(health) {
         if acfg.placement_of(ch).role == Role::Other || ch.samples.is_empty() {
             continue;
         }
@@ -449,7 +468,6 @@ pub fn sensor_faults(rec: &Recording, acfg: &AnalysisConfig) -> Vec<SensorFault>
             fault,
             detail,
         };
-        let h = vibmode_core::stats::channel_health(x, min_run);
         if let Some(v) = h.constant {
             out.push(if v == 0.0 {
                 fault(FaultKind::Dead, "every sample is 0".into())
@@ -533,9 +551,10 @@ pub fn compute_features(name: &str, rec: &Recording, cfg: &FleetConfig) -> Resul
 fn compute_features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordFeatures> {
     cfg.validate()?;
     check_sampling(name, rec, cfg)?;
-    let faults = sensor_faults(rec, &cfg.analysis);
+    let health = channel_healths(rec);
+    let faults = sensor_faults_of(rec, &cfg.analysis, &health);
     if faults.is_empty() {
-        return features_of(name, rec, cfg);
+        return features_of(name, rec, Some(&health), cfg);
     }
     let mut healthy = rec.clone();
     healthy
@@ -560,7 +579,7 @@ fn compute_features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result
     }
     // The working channels alone may give no feature (or the analysis fails on them): the
     // record is still one with failed sensors, not an error.
-    let mut f = match features_of(name, &healthy, cfg) {
+    let mut f = match features_of(name, &healthy, None, cfg) {
         Ok(f) => f,
         Err(e) => {
             return Ok(only_faults(format!(
@@ -578,7 +597,13 @@ struct Borrowed<'a> {
     recording: &'a Recording,
 }
 
-fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordFeatures> {
+/// The features of `rec`; `health`, where given, is [`channel_healths`] of `rec`.
+fn features_of(
+    name: &str,
+    rec: &Recording,
+    health: Option<&[ChannelHealth]>,
+    cfg: &FleetConfig,
+) -> Result<RecordFeatures> {
     let acfg: &AnalysisConfig = &cfg.analysis;
     // A recording of one record's length is that record, borrowed (`cut_records` would copy
     // its samples); a longer one is cut.
@@ -735,10 +760,14 @@ fn features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordF
         sweep: acfg.sweep.clone(),
         poles: acfg.poles.clone(),
     };
-    let facts = records
-        .iter()
-        .map(|r| RecordFacts::of_recording(r.name, r.recording))
-        .collect();
+    let facts = match (health, cuts.is_empty()) {
+        // The record is the recording whose health was taken.
+        (Some(h), true) => vec![RecordFacts::of_recording_health(name, rec, h)],
+        _ => records
+            .iter()
+            .map(|r| RecordFacts::of_recording(r.name, r.recording))
+            .collect(),
+    };
     let results = analyze_prepared(
         facts,
         pres,
