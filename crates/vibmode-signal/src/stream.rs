@@ -192,13 +192,27 @@ pub(crate) fn deinterleave<const W: usize>(
     scale: f64,
     decode: impl Fn([u8; W]) -> f64,
 ) -> Vec<Vec<f64>> {
-    let n = buf.len() / (W * nch);
-    let mut out: Vec<Vec<f64>> = (0..nch).map(|_| Vec::with_capacity(n)).collect();
-    for frame in buf.chunks_exact(W * nch) {
-        for (ch, v) in out.iter_mut().zip(frame.chunks_exact(W)) {
-            let mut b = [0u8; W];
-            b.copy_from_slice(v);
-            ch.push(decode(b) * scale);
+    let frame = W * nch;
+    if frame == 0 {
+        return vec![Vec::new(); nch];
+    }
+    let n = buf.len() / frame;
+    let mut out: Vec<Vec<f64>> = (0..nch).map(|_| vec![0.0; n]).collect();
+    // Blocks of frames small enough to stay in the cache while each channel takes its values
+    // out of them: one pass per channel over a block, writing that channel in order.
+    const FRAMES_PER_BLOCK: usize = 1024;
+    for (b, block) in buf[..n * frame]
+        .chunks(FRAMES_PER_BLOCK * frame)
+        .enumerate()
+    {
+        let start = b * FRAMES_PER_BLOCK;
+        for (c, ch) in out.iter_mut().enumerate() {
+            let dst = &mut ch[start..start + block.len() / frame];
+            for (d, f) in dst.iter_mut().zip(block.chunks_exact(frame)) {
+                let mut v = [0u8; W];
+                v.copy_from_slice(&f[c * W..(c + 1) * W]);
+                *d = decode(v) * scale;
+            }
         }
     }
     out
