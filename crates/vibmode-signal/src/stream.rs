@@ -1085,6 +1085,57 @@ impl FrameStream {
 pub(crate) mod tests {
     use super::*;
 
+    /// Frames taken apart in blocks give each channel its values in order, as one frame at a
+    /// time does: 1-7 channels of 16-, 32- and 64-bit samples, lengths around and across the
+    /// block size, with a scale and with trailing bytes of a partial frame.
+    #[test]
+    fn blocks_of_frames_give_the_frames_values_in_order() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut byte = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 56) as u8
+        };
+        for nch in 1..=7 {
+            for frames in [0usize, 1, 1023, 1024, 1025, 2500] {
+                let bytes: Vec<u8> = (0..frames * 8 * nch + 3).map(|_| byte()).collect();
+                let one_by_one = |w: usize, decode: &dyn Fn(&[u8]) -> f64| -> Vec<Vec<f64>> {
+                    let mut out = vec![Vec::new(); nch];
+                    for f in bytes.chunks_exact(w * nch) {
+                        for (c, ch) in out.iter_mut().enumerate() {
+                            ch.push(decode(&f[c * w..(c + 1) * w]) * 0.5);
+                        }
+                    }
+                    out
+                };
+                let bits = |v: Vec<Vec<f64>>| -> Vec<Vec<u64>> {
+                    v.into_iter()
+                        .map(|c| c.into_iter().map(f64::to_bits).collect())
+                        .collect()
+                };
+                let cut2 = |b: &[u8]| [b[0], b[1]];
+                let cut4 = |b: &[u8]| [b[0], b[1], b[2], b[3]];
+                let cut8 = |b: &[u8]| [b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]];
+                assert_eq!(
+                    bits(deinterleave(&bytes, nch, 0.5, i16_le)),
+                    bits(one_by_one(2, &|b| i16_le(cut2(b)))),
+                    "i16 {nch} x {frames}"
+                );
+                assert_eq!(
+                    bits(deinterleave(&bytes, nch, 0.5, f32_le)),
+                    bits(one_by_one(4, &|b| f32_le(cut4(b)))),
+                    "f32 {nch} x {frames}"
+                );
+                assert_eq!(
+                    bits(deinterleave(&bytes, nch, 0.5, f64::from_le_bytes)),
+                    bits(one_by_one(8, &|b| f64::from_le_bytes(cut8(b)))),
+                    "f64 {nch} x {frames}"
+                );
+            }
+        }
+    }
+
     /// The message of the error that streaming `path` in blocks of `max_frames` ends with
     /// (a file cut off mid-write); panics when it streams to its end.
     pub(crate) fn stream_error(path: &Path, opts: &ReadOptions, max_frames: usize) -> String {
