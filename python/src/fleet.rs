@@ -11,7 +11,7 @@ use vibmode_fleet::{
     build_baseline, check_drive_files_progress, ingest_files, require_baseline, Condition,
     FleetConfig, IngestLabels, Store,
 };
-use vibmode_fleet::{compute_features, ContentHash, FleetError, Ingested, RecordFeatures};
+use vibmode_fleet::{ContentHash, FleetError, Ingested, RecordFeatures};
 
 use crate::errors::{fleet_err, json_err};
 
@@ -259,8 +259,7 @@ fn fleet_features(
             let rec = vibmode_signal::read_path_bytes(&path, &bytes, &opts)?;
             drop(bytes);
             let file = vibmode_fleet::record_file_name(&path);
-            let mut features = compute_features(&file, &rec, &cfg)?;
-            vibmode_fleet::add_body_equations(&mut features, &rec, model.as_ref(), &cfg);
+            let features = vibmode_fleet::record_features(&file, &rec, model.as_ref(), &cfg)?;
             Ok::<_, FleetError>(FeaturesOut {
                 file,
                 content_hash: key,

@@ -9,6 +9,7 @@ use vibmode_analysis::{
 };
 use vibmode_core::stats::ChannelHealth;
 use vibmode_core::{ModeClass, Recording};
+use vibmode_signal::ChannelSpectrum;
 use vibmode_spectra::{band_rms, SpectraError, WelchParams, Window};
 
 use crate::body::{body_spectra, BodySpectra};
@@ -543,18 +544,35 @@ fn finite(x: f64) -> Option<f64> {
 /// feature can be computed (no channel with a role: name channels like `FL_unsprung`,
 /// `RR_sprung`).
 pub fn compute_features(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordFeatures> {
-    let mut features = compute_features_of(name, rec, cfg)?;
+    compute_features_spectra(name, rec, cfg, None)
+}
+
+/// [`compute_features`] with each channel's forward transform taken from `spectra[i]` (of
+/// `rec.channels[i]`) where given and where the pre-processing resamples the whole recording:
+/// the same features bit for bit.
+pub(crate) fn compute_features_spectra(
+    name: &str,
+    rec: &Recording,
+    cfg: &FleetConfig,
+    spectra: Option<&[ChannelSpectrum]>,
+) -> Result<RecordFeatures> {
+    let mut features = compute_features_of(name, rec, cfg, spectra)?;
     features.start_unix_s = rec.time_axis.as_ref().and_then(|t| t.start_unix_s());
     Ok(features)
 }
 
-fn compute_features_of(name: &str, rec: &Recording, cfg: &FleetConfig) -> Result<RecordFeatures> {
+fn compute_features_of(
+    name: &str,
+    rec: &Recording,
+    cfg: &FleetConfig,
+    spectra: Option<&[ChannelSpectrum]>,
+) -> Result<RecordFeatures> {
     cfg.validate()?;
     check_sampling(name, rec, cfg)?;
     let health = channel_healths(rec);
     let faults = sensor_faults_of(rec, &cfg.analysis, &health);
     if faults.is_empty() {
-        return features_of(name, rec, Some(&health), cfg);
+        return features_of(name, rec, Some((&health, spectra)), cfg);
     }
     let mut healthy = rec.clone();
     healthy
@@ -597,13 +615,15 @@ struct Borrowed<'a> {
     recording: &'a Recording,
 }
 
-/// The features of `rec`; `health`, where given, is [`channel_healths`] of `rec`.
+/// The features of `rec`; `whole`, where given, is [`channel_healths`] of `rec` and the
+/// spectra of its channels, if taken.
 fn features_of(
     name: &str,
     rec: &Recording,
-    health: Option<&[ChannelHealth]>,
+    whole: Option<(&[ChannelHealth], Option<&[ChannelSpectrum]>)>,
     cfg: &FleetConfig,
 ) -> Result<RecordFeatures> {
+    let health = whole.map(|w| w.0);
     let acfg: &AnalysisConfig = &cfg.analysis;
     // A recording of one record's length is that record, borrowed (`cut_records` would copy
     // its samples); a longer one is cut.
@@ -680,8 +700,19 @@ fn features_of(
     // share it.
     // (The records cut from one recording share its channels and rate: no layout check.)
     acfg.validate().map_err(analysis)?;
-    let recordings: Vec<&Recording> = records.iter().map(|r| r.recording).collect();
-    let pres = preprocess_recordings(&recordings, acfg).map_err(analysis)?;
+    let pres = match (whole.and_then(|w| w.1), cuts.is_empty()) {
+        // The record is the recording whose channels' spectra were taken.
+        (Some(spectra), true) => {
+            vec![
+                vibmode_signal::preprocess_with_spectra(rec, &acfg.preprocess, Some(spectra))
+                    .map_err(|e| analysis(e.into()))?,
+            ]
+        }
+        _ => {
+            let recordings: Vec<&Recording> = records.iter().map(|r| r.recording).collect();
+            preprocess_recordings(&recordings, acfg).map_err(analysis)?
+        }
+    };
     for pre in &pres {
         fs = pre.band.fs_hz;
         if !body_u.is_empty() && !body_y.is_empty() {

@@ -8,7 +8,7 @@ use vibmode_signal::ReadOptions;
 
 use crate::config::FleetConfig;
 use crate::error::{FleetError, Result};
-use crate::features::{compute_features, RecordFeatures};
+use crate::features::RecordFeatures;
 use crate::hash::ContentHash;
 use crate::model::{
     assess, assess_drive_fitted, build_model_set, Assessment, Classification, Drive, ModelSet,
@@ -171,6 +171,46 @@ pub fn add_body_equations(
     model: Option<&VehicleModel>,
     cfg: &FleetConfig,
 ) {
+    add_body_equations_spectra(features, rec, model, cfg, None);
+}
+
+/// The features of the record `rec` read from a file ([`crate::compute_features`]) with the body
+/// equations of the vehicle's registered `model`, if any ([`add_body_equations`]). Where both
+/// resample a channel (the analysis to its rate, the equations to
+/// `vibmode_vehicle::update::EQUATION_RATE_HZ`), each channel is transformed once for both
+/// (`vibmode_signal::ChannelSpectrum`): the same features and equations bit for bit as the two
+/// calls.
+///
+/// Errors: as [`crate::compute_features`].
+pub fn record_features(
+    name: &str,
+    rec: &Recording,
+    model: Option<&VehicleModel>,
+    cfg: &FleetConfig,
+) -> Result<RecordFeatures> {
+    // Spectra only where the equations bring the channels down too (a 2 kHz record is not),
+    // up to the bin of their new Nyquist frequency (and one beyond), which the analysis's
+    // lower rate lies below.
+    let factor = vibmode_vehicle::update::decimation_factor(rec.fs_hz);
+    let spectra: Option<Vec<vibmode_signal::ChannelSpectrum>> =
+        model.filter(|_| factor > 1).and_then(|_| {
+            let bins = rec.len() / (2 * factor) + 2;
+            let channels = rec.channels.iter().map(|c| &c.samples[..]);
+            vibmode_signal::ChannelSpectrum::of_each(channels, bins).ok()
+        });
+    let mut features =
+        crate::features::compute_features_spectra(name, rec, cfg, spectra.as_deref())?;
+    add_body_equations_spectra(&mut features, rec, model, cfg, spectra.as_deref());
+    Ok(features)
+}
+
+fn add_body_equations_spectra(
+    features: &mut RecordFeatures,
+    rec: &Recording,
+    model: Option<&VehicleModel>,
+    cfg: &FleetConfig,
+    spectra: Option<&[vibmode_signal::ChannelSpectrum]>,
+) {
     let Some(model) = model else {
         return;
     };
@@ -180,7 +220,7 @@ pub fn add_body_equations(
             .push("suspension fit: no body equations from a record with a failed sensor".into());
         return;
     }
-    match model.record_equations(rec, &cfg.analysis) {
+    match model.record_equations_spectra(rec, &cfg.analysis, spectra) {
         Ok(e) => features.suspension = Some(e),
         Err(why) => features.notes.push(format!(
             "suspension fit: no body equations ({})",
@@ -211,14 +251,9 @@ fn prepare_recording(
             refreshed: false,
         });
     }
-    let mut features = compute_features(name, rec, cfg)?;
+    let model = registered_model(store, labels.vehicle)?;
+    let features = record_features(name, rec, model.as_ref(), cfg)?;
     check_nominal_sensors(labels.condition, name, &features)?;
-    add_body_equations(
-        &mut features,
-        rec,
-        registered_model(store, labels.vehicle)?.as_ref(),
-        cfg,
-    );
     Ok(Prepared {
         file: name.to_string(),
         content_hash: content_hash.to_string(),
@@ -423,9 +458,8 @@ fn prepare_files(
                 let rec = vibmode_signal::read_path_bytes(path, &bytes, opts)?;
                 drop(bytes);
                 layout(name, &rec)?;
-                let mut features = compute_features(name, &rec, cfg)?;
+                let features = record_features(name, &rec, model, cfg)?;
                 check_nominal_sensors(labels.condition, name, &features)?;
-                add_body_equations(&mut features, &rec, model, cfg);
                 Ok(Some(Prepared {
                     file: name.to_string(),
                     content_hash: sha.to_string(),

@@ -32,9 +32,10 @@ pub use features::{
 pub use fleet::{
     add_body_equations, build_baseline, check_drive_files_progress, check_file, check_files,
     check_files_progress, check_recording, check_vehicle_id, drive_of_day, drive_of_folder,
-    ingest_file, ingest_files, ingest_files_progress, ingest_recording, record_file_name,
-    register_vehicle_model, register_vehicle_model_file, registered_model, require_baseline,
-    sha256_hex, CheckReport, Checked, IngestLabels, Ingested, Registered, DEFAULT_DRIVE_ID,
+    ingest_file, ingest_files, ingest_files_progress, ingest_recording, record_features,
+    record_file_name, register_vehicle_model, register_vehicle_model_file, registered_model,
+    require_baseline, sha256_hex, CheckReport, Checked, IngestLabels, Ingested, Registered,
+    DEFAULT_DRIVE_ID,
 };
 pub use hash::ContentHash;
 pub use model::{

@@ -107,9 +107,20 @@ impl VehicleModel {
         rec: &Recording,
         analysis: &AnalysisConfig,
     ) -> std::result::Result<StoredEquations, String> {
+        self.record_equations_spectra(rec, analysis, None)
+    }
+
+    /// As [`VehicleModel::record_equations`], each channel brought down from its spectrum
+    /// `spectra[i]` where given (`BodyFit::record_equations_spectra`): the same equations.
+    pub fn record_equations_spectra(
+        &self,
+        rec: &Recording,
+        analysis: &AnalysisConfig,
+        spectra: Option<&[vibmode_signal::ChannelSpectrum]>,
+    ) -> std::result::Result<StoredEquations, String> {
         let fit = self.fit(analysis)?;
         let equations = fit
-            .record_equations_placed(rec, |c| analysis.placement_for_update(c))
+            .record_equations_spectra(rec, |c| analysis.placement_for_update(c), spectra)
             .map_err(|e| e.to_string())?;
         Ok(StoredEquations {
             model_sha256: self.sha256.clone(),

@@ -58,7 +58,7 @@ pub mod write;
 pub use delimited::{Block, ColumnInfo, DateOrder, DelimitedReader, Separator, TimeText};
 pub use error::{BinaryFormat, NpyProblem, SidecarProblem, SignalError, WavProblem};
 pub use npy::NPY_MAGIC;
-pub use preprocess::{preprocess, Preprocessed};
+pub use preprocess::{preprocess, preprocess_with_spectra, Preprocessed};
 pub use read::{
     expand_folders, read_delimited, read_delimited_bytes, read_path, read_path_bytes,
     recordings_in_folder, sidecar_candidates, time_unit_scale, Format, ReadOptions, Sidecar,
@@ -66,7 +66,10 @@ pub use read::{
 };
 pub use records::{ChainedRecords, StreamRecords};
 pub use resample::ResampleRecording;
-pub use resample::{planned_fs_out_hz, resample, ResampleMethod, ResampleParams, Resampler};
+pub use resample::{
+    planned_fs_out_hz, resample, resample_recording, ChannelSpectrum, ResampleMethod,
+    ResampleParams, Resampler,
+};
 pub use stream::{
     open_stream, FrameBlock, FrameStream, StreamInfo, DEFAULT_BLOCK_FRAMES, KEEP_PARSED_MAX_VALUES,
 };

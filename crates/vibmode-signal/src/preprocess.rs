@@ -4,7 +4,7 @@
 use vibmode_core::{BandLimit, PreprocessParams, Recording};
 
 use crate::error::Result;
-use crate::resample::{planned_fs_out_hz, ResampleParams, ResampleRecording};
+use crate::resample::{planned_fs_out_hz, resample_recording, ChannelSpectrum, ResampleParams};
 
 /// A record at the analysis rate and the band it carries.
 #[derive(Clone, Debug, PartialEq)]
@@ -28,6 +28,17 @@ pub struct Preprocessed {
 /// [`UPSAMPLE_RATIO_MAX`](vibmode_core::limits::UPSAMPLE_RATIO_MAX) times the record's, non-finite
 /// samples, a record too short to resample.
 pub fn preprocess(rec: &Recording, p: &PreprocessParams) -> Result<Preprocessed> {
+    preprocess_with_spectra(rec, p, None)
+}
+
+/// [`preprocess`] of `rec`, each channel's forward transform taken from `spectra[i]` (of
+/// `rec.channels[i]`, [`ChannelSpectrum::of`]) where given (a caller that resamples the channels
+/// to another rate too transforms them once): the same result bit for bit.
+pub fn preprocess_with_spectra(
+    rec: &Recording,
+    p: &PreprocessParams,
+    spectra: Option<&[ChannelSpectrum]>,
+) -> Result<Preprocessed> {
     let ratio = p.analysis_fs_hz / rec.fs_hz;
     if ratio > vibmode_core::limits::UPSAMPLE_RATIO_MAX {
         return Err(crate::SignalError::InvalidParam {
@@ -56,7 +67,7 @@ pub fn preprocess(rec: &Recording, p: &PreprocessParams) -> Result<Preprocessed>
         cutoff_hz: Some(cutoff_hz),
         ..wanted
     };
-    let recording = rec.resample(&params)?;
+    let recording = resample_recording(rec, &params, spectra)?;
     let band = BandLimit::ideal_lowpass(recording.fs_hz, cutoff_hz);
     Ok(Preprocessed { recording, band })
 }

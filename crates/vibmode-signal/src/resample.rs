@@ -383,24 +383,7 @@ impl Resampler {
     ///
     /// Errors: wrong slice lengths, non-finite input.
     pub fn process(&mut self, x: &[f64], out: &mut [f64]) -> Result<()> {
-        if x.len() != self.n_in || out.len() != self.n_out {
-            return Err(SignalError::InvalidParam {
-                name: "buffer lengths",
-                value: format!("{} in, {} out", x.len(), out.len()),
-                fix: format!(
-                    "this Resampler was planned for {} in, {} out; plan a new one with Resampler::new",
-                    self.n_in, self.n_out
-                ),
-            });
-        }
-        if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-            return Err(RecordingError::NonFinite {
-                channel: "input".into(),
-                index: i,
-                value: x[i],
-            }
-            .into());
-        }
+        self.check_buffers(x, out)?;
         match self.kind {
             Kind::Pick => {
                 for (o, v) in out.iter_mut().zip(x.iter().step_by(self.factor)) {
@@ -422,22 +405,102 @@ impl Resampler {
         }
     }
 
+    /// The buffers' lengths against the plan, and every input sample finite.
+    fn check_buffers(&self, x: &[f64], out: &[f64]) -> Result<()> {
+        if x.len() != self.n_in || out.len() != self.n_out {
+            return Err(SignalError::InvalidParam {
+                name: "buffer lengths",
+                value: format!("{} in, {} out", x.len(), out.len()),
+                fix: format!(
+                    "this Resampler was planned for {} in, {} out; plan a new one with Resampler::new",
+                    self.n_in, self.n_out
+                ),
+            });
+        }
+        if let Some(i) = x.iter().position(|v| !v.is_finite()) {
+            return Err(RecordingError::NonFinite {
+                channel: "input".into(),
+                index: i,
+                value: x[i],
+            }
+            .into());
+        }
+        Ok(())
+    }
+
     fn process_fft(&mut self, x: &[f64], out: &mut [f64]) -> Result<()> {
-        let (Some(fwd), Some(inv)) = (self.fwd.clone(), self.inv.clone()) else {
+        let Some(fwd) = self.fwd.clone() else {
             return Err(fft_err(vibmode_fft::FftError::InputBuffer(0, 0)));
         };
-        let n = self.n_in;
         self.buf_in.copy_from_slice(x);
         fwd.process_with_scratch(&mut self.buf_in, &mut self.spec_in, &mut self.scratch)
             .map_err(fft_err)?;
+        self.resample_spectrum(None, out)
+    }
+
+    /// As [`Resampler::process`], with `x`'s spectrum taken before by [`ChannelSpectrum::of`]
+    /// (for one channel resampled to several rates: the forward transform is the costly part).
+    /// The output is [`Resampler::process`]'s bit for bit. A spectrum of another length than
+    /// the resampler's input, or a resampler that takes no transform (plain decimation or
+    /// interpolation), resamples `x` itself.
+    ///
+    /// Errors: as [`Resampler::process`].
+    pub fn process_spectrum(
+        &mut self,
+        x: &[f64],
+        spectrum: &ChannelSpectrum,
+        out: &mut [f64],
+    ) -> Result<()> {
+        // The decimation reads the bins up to the cutoff's, the other transforms all of them.
+        let enough = match self.kind {
+            Kind::Fold => spectrum.bins.len() > self.kc,
+            Kind::Full | Kind::Fourier => spectrum.bins.len() == self.spec_in.len(),
+            Kind::Pick | Kind::Linear => false,
+        };
+        if !enough || spectrum.n != self.n_in {
+            return self.process(x, out);
+        }
+        // `x` itself is not read (its spectrum is), and was checked finite by
+        // `ChannelSpectrum::of`: only the lengths are checked here.
+        if x.len() != self.n_in {
+            return self.check_buffers(x, out);
+        }
+        self.resample_spectrum(Some(&spectrum.bins), out)
+    }
+
+    /// The low-pass, decimation or truncation and inverse transform of the input's spectrum:
+    /// `given`, or the one held in `spec_in`.
+    fn resample_spectrum(&mut self, given: Option<&[Complex<f64>]>, out: &mut [f64]) -> Result<()> {
+        let Some(inv) = self.inv.clone() else {
+            return Err(fft_err(vibmode_fft::FftError::InputBuffer(0, 0)));
+        };
+        if out.len() != self.n_out {
+            return Err(SignalError::InvalidParam {
+                name: "buffer lengths",
+                value: format!("{} out", out.len()),
+                fix: format!(
+                    "this Resampler was planned for {} out; plan a new one with Resampler::new",
+                    self.n_out
+                ),
+            });
+        }
+        let n = self.n_in;
         let zero = Complex::new(0.0, 0.0);
         let scale = 1.0 / n as f64;
         if !matches!(self.kind, Kind::Fold) {
+            if let Some(g) = given {
+                self.spec_in.copy_from_slice(g);
+            }
             // Ideal low-pass: zero every bin above the cutoff bin.
             for v in self.spec_in.iter_mut().skip(self.kc + 1) {
                 *v = zero;
             }
         }
+        // The decimation reads the spectrum without changing it.
+        let spec_in: &[Complex<f64>] = match given {
+            Some(g) if matches!(self.kind, Kind::Fold) => g,
+            _ => &self.spec_in,
+        };
         match self.kind {
             Kind::Fold => {
                 // y[m] = x_f[m D] = (1/N) sum_j (sum_l X[j + l num]) e^{2 pi i j m / num}, X the
@@ -453,14 +516,14 @@ impl Resampler {
                     let mut s = zero;
                     let mut m = j;
                     while m <= low_last {
-                        s += self.spec_in[m];
+                        s += spec_in[m];
                         m += num;
                     }
                     if m < high_first {
                         m += (high_first - m).div_ceil(num) * num;
                     }
                     while m < n {
-                        s += self.spec_in[n - m].conj();
+                        s += spec_in[n - m].conj();
                         m += num;
                     }
                     *o = s;
@@ -517,6 +580,166 @@ impl Resampler {
     }
 }
 
+/// The real DFT of one channel (its `n / 2 + 1` bins, unscaled, or the first of them), taken
+/// once so that the channel can be resampled to several rates without transforming it again
+/// ([`Resampler::process_spectrum`], [`resample_recording`]); the transform a [`Resampler`]
+/// takes, bit for bit. Whole, it holds as many values as the channel (complex, half as many).
+#[derive(Clone, Debug)]
+pub struct ChannelSpectrum {
+    n: usize,
+    bins: Vec<Complex<f64>>,
+}
+
+impl ChannelSpectrum {
+    /// The spectrum of `x` (at least 2 samples).
+    ///
+    /// Errors: fewer than 2 samples, a non-finite sample.
+    pub fn of(x: &[f64]) -> Result<ChannelSpectrum> {
+        if x.len() < 2 {
+            return Err(SignalError::TooShort {
+                what: "a channel's spectrum".into(),
+                n: x.len(),
+                fix: "give at least 2 samples".into(),
+            });
+        }
+        if let Some(i) = x.iter().position(|v| !v.is_finite()) {
+            return Err(RecordingError::NonFinite {
+                channel: "input".into(),
+                index: i,
+                value: x[i],
+            }
+            .into());
+        }
+        let fwd = vibmode_fft::forward(x.len());
+        let mut buf = fwd.make_input_vec();
+        buf.copy_from_slice(x);
+        let mut bins = fwd.make_output_vec();
+        let mut scratch = fwd.make_scratch_vec();
+        fwd.process_with_scratch(&mut buf, &mut bins, &mut scratch)
+            .map_err(fft_err)?;
+        Ok(ChannelSpectrum { n: x.len(), bins })
+    }
+
+    /// [`ChannelSpectrum::of`] of each channel, keeping its first `bins` bins (all of them
+    /// with `usize::MAX`; a decimation to `fs_out` with the cutoff at most `fs_out / 2` reads
+    /// the bins up to `n fs_out / (2 fs)`, [`Resampler::process_spectrum`] resamples a channel
+    /// itself where its spectrum holds too few); the transform's buffers shared. The bins kept
+    /// are [`ChannelSpectrum::of`]'s bit for bit.
+    ///
+    /// Errors: as [`ChannelSpectrum::of`], for the first channel that has one.
+    pub fn of_each<'a>(
+        channels: impl IntoIterator<Item = &'a [f64]>,
+        bins: usize,
+    ) -> Result<Vec<ChannelSpectrum>> {
+        type Planned = (
+            usize,
+            Arc<dyn RealToComplex<f64>>,
+            Vec<f64>,
+            Vec<Complex<f64>>,
+            Vec<Complex<f64>>,
+        );
+        let mut out = Vec::new();
+        let mut planned: Option<Planned> = None;
+        for x in channels {
+            if x.len() < 2 || x.iter().any(|v| !v.is_finite()) {
+                // The one-channel path words the error.
+                out.push(ChannelSpectrum::of(x)?);
+                continue;
+            }
+            let (_, fwd, buf, spec, scratch) = match &mut planned {
+                Some(p) if p.0 == x.len() => p,
+                _ => {
+                    let fwd = vibmode_fft::forward(x.len());
+                    let buffers = (
+                        fwd.make_input_vec(),
+                        fwd.make_output_vec(),
+                        fwd.make_scratch_vec(),
+                    );
+                    planned.insert((x.len(), fwd, buffers.0, buffers.1, buffers.2))
+                }
+            };
+            buf.copy_from_slice(x);
+            fwd.process_with_scratch(buf, spec, scratch)
+                .map_err(fft_err)?;
+            out.push(ChannelSpectrum {
+                n: x.len(),
+                bins: spec[..bins.min(spec.len())].to_vec(),
+            });
+        }
+        Ok(out)
+    }
+
+    /// Number of samples of the channel it is the spectrum of.
+    pub fn len(&self) -> usize {
+        self.n
+    }
+
+    /// Always false (a spectrum is of 2 samples or more).
+    pub fn is_empty(&self) -> bool {
+        self.n == 0
+    }
+}
+
+/// [`ResampleRecording::resample`] of `rec`, each channel's forward transform taken from
+/// `spectra[i]` (of `rec.channels[i]`, [`ChannelSpectrum::of`]) where given: the same
+/// recording bit for bit. `spectra` of another number of channels than `rec` is not used.
+///
+/// Errors: as [`ResampleRecording::resample`].
+pub fn resample_recording(
+    rec: &Recording,
+    p: &ResampleParams,
+    spectra: Option<&[ChannelSpectrum]>,
+) -> Result<Recording> {
+    let spectra = spectra.filter(|s| s.len() == rec.channels.len());
+    let mut r = Resampler::new(rec.len(), rec.fs_hz, p)?;
+    let total = r.n_out() as u64 * rec.channels.len() as u64;
+    if total > SAMPLES_OUT_MAX {
+        return Err(invalid(
+            "fs_out_hz",
+            p.fs_out_hz,
+            format!(
+                "{} channels of {} samples each are more than the {SAMPLES_OUT_MAX} samples vibmode makes at once; cut the recording into parts",
+                rec.channels.len(),
+                r.n_out()
+            ),
+        ));
+    }
+    let mut channels = Vec::with_capacity(rec.channels.len());
+    for (i, c) in rec.channels.iter().enumerate() {
+        let mut out = vec![0.0; r.n_out()];
+        match spectra {
+            Some(s) => r.process_spectrum(&c.samples, &s[i], &mut out),
+            None => r.process(&c.samples, &mut out),
+        }
+        .map_err(|e| match e {
+            SignalError::Recording(RecordingError::NonFinite { index, value, .. }) => {
+                RecordingError::NonFinite {
+                    channel: c.name.clone(),
+                    index,
+                    value,
+                }
+                .into()
+            }
+            other => other,
+        })?;
+        channels.push(Channel {
+            samples: out,
+            ..Channel::new(c.name.clone(), c.unit.clone(), Vec::new()).with_placement(c.placement)
+        });
+    }
+    Ok(Recording {
+        fs_hz: r.fs_out_hz(),
+        channels,
+        time_axis: rec.time_axis.as_ref().map(|t| TimeAxis {
+            column: t.column.clone(),
+            fs_hz: r.fs_out_hz(),
+            jitter_rel: 0.0,
+            start_s: t.start_s,
+            origin_unix_s: t.origin_unix_s,
+        }),
+    })
+}
+
 /// Resamples one signal `x` sampled at `fs_hz` (see the module documentation).
 ///
 /// ```
@@ -548,50 +771,7 @@ impl ResampleRecording for Recording {
     /// `fs_hz` is [`Resampler::fs_out_hz`]; a time axis keeps its start time and column name,
     /// with `fs_hz` the new rate and `jitter_rel` 0.
     fn resample(&self, p: &ResampleParams) -> Result<Recording> {
-        let mut r = Resampler::new(self.len(), self.fs_hz, p)?;
-        let total = r.n_out() as u64 * self.channels.len() as u64;
-        if total > SAMPLES_OUT_MAX {
-            return Err(invalid(
-                "fs_out_hz",
-                p.fs_out_hz,
-                format!(
-                    "{} channels of {} samples each are more than the {SAMPLES_OUT_MAX} samples vibmode makes at once; cut the recording into parts",
-                    self.channels.len(),
-                    r.n_out()
-                ),
-            ));
-        }
-        let mut channels = Vec::with_capacity(self.channels.len());
-        for c in &self.channels {
-            let mut out = vec![0.0; r.n_out()];
-            r.process(&c.samples, &mut out).map_err(|e| match e {
-                SignalError::Recording(RecordingError::NonFinite { index, value, .. }) => {
-                    RecordingError::NonFinite {
-                        channel: c.name.clone(),
-                        index,
-                        value,
-                    }
-                    .into()
-                }
-                other => other,
-            })?;
-            channels.push(Channel {
-                samples: out,
-                ..Channel::new(c.name.clone(), c.unit.clone(), Vec::new())
-                    .with_placement(c.placement)
-            });
-        }
-        Ok(Recording {
-            fs_hz: r.fs_out_hz(),
-            channels,
-            time_axis: self.time_axis.as_ref().map(|t| TimeAxis {
-                column: t.column.clone(),
-                fs_hz: r.fs_out_hz(),
-                jitter_rel: 0.0,
-                start_s: t.start_s,
-                origin_unix_s: t.origin_unix_s,
-            }),
-        })
+        resample_recording(self, p, None)
     }
 }
 
@@ -683,6 +863,84 @@ mod tests {
             }
         }
         assert!(folds >= 20, "{folds}");
+    }
+
+    /// A resampler given the channel's spectrum (whole, or its first bins where it decimates)
+    /// gives `process`'s samples bit for bit, for every method, and resamples the channel itself
+    /// where the spectrum holds too few bins or is of another length; `resample_recording` with
+    /// the spectra is `resample`'s recording.
+    #[test]
+    fn resampling_from_a_spectrum_is_resampling_the_channel() {
+        let mut state = 0x5851_f42d_4c95_7f2du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        let mut kinds = Vec::new();
+        for &(n, fs_out_hz, cutoff) in &[
+            (2000, 250.0, None),       // fold by 4
+            (2001, 250.0, Some(60.0)), // full (4 does not divide 2001)
+            (2000, 300.0, None),       // Fourier
+            (1500, 2500.0, None),      // Fourier, upsampling
+        ] {
+            let p = ResampleParams {
+                fs_out_hz,
+                cutoff_hz: cutoff,
+                filter: true,
+            };
+            let chans: Vec<Vec<f64>> = (0..3).map(|_| (0..n).map(|_| next()).collect()).collect();
+            let mut r = Resampler::new(n, 1000.0, &p).unwrap();
+            kinds.push(format!("{:?}", r.kind));
+            let whole = ChannelSpectrum::of_each(chans.iter().map(|c| &c[..]), usize::MAX).unwrap();
+            for (x, s) in chans.iter().zip(&whole) {
+                let one = ChannelSpectrum::of(x).unwrap();
+                assert_eq!(one.bins, s.bins);
+                let mut want = vec![0.0; r.n_out()];
+                r.process(x, &mut want).unwrap();
+                let mut got = vec![0.0; r.n_out()];
+                r.process_spectrum(x, s, &mut got).unwrap();
+                assert_eq!(bits(&got), bits(&want), "{n} to {fs_out_hz} Hz");
+                // The first bins only: enough for a decimation, else the channel is used.
+                for keep in [r.kc + 1, r.kc, 3] {
+                    let part = ChannelSpectrum::of_each([&x[..]], keep).unwrap().remove(0);
+                    assert_eq!(part.bins[..], s.bins[..keep]);
+                    let mut got = vec![0.0; r.n_out()];
+                    r.process_spectrum(x, &part, &mut got).unwrap();
+                    assert_eq!(
+                        bits(&got),
+                        bits(&want),
+                        "{n} to {fs_out_hz} Hz, {keep} bins"
+                    );
+                }
+                // A spectrum of another length is not used.
+                let other = ChannelSpectrum::of(&x[..n - 1]).unwrap();
+                let mut got = vec![0.0; r.n_out()];
+                r.process_spectrum(x, &other, &mut got).unwrap();
+                assert_eq!(bits(&got), bits(&want));
+            }
+            let rec = Recording::new(
+                1000.0,
+                chans
+                    .iter()
+                    .enumerate()
+                    .map(|(i, c)| Channel::new(format!("c{i}"), "m/s^2", c.clone()))
+                    .collect(),
+            )
+            .unwrap();
+            let want = rec.resample(&p).unwrap();
+            let got = resample_recording(&rec, &p, Some(&whole)).unwrap();
+            for (a, b) in want.channels.iter().zip(&got.channels) {
+                assert_eq!(bits(&a.samples), bits(&b.samples));
+            }
+            assert_eq!(want.fs_hz.to_bits(), got.fs_hz.to_bits());
+        }
+        assert_eq!(kinds, ["Fold", "Full", "Fourier", "Fourier"]);
+        // A bad channel is refused as by `of`.
+        let e = ChannelSpectrum::of_each([&[1.0, f64::NAN, 2.0][..]], 4).unwrap_err();
+        assert!(e.to_string().contains("NaN"), "{e}");
     }
 
     /// The rate without planning is the planned resampler's, bit for bit, for integer and

@@ -962,6 +962,21 @@ impl BodyFit {
         rec: &Recording,
         placement: impl Fn(&Channel) -> Option<Placement>,
     ) -> Result<RecordEquations> {
+        self.record_equations_spectra(rec, placement, None)
+    }
+
+    /// As [`BodyFit::record_equations_placed`], a channel brought down to
+    /// [`EQUATION_RATE_HZ`] from its spectrum `spectra[i]` (of `rec.channels[i]`,
+    /// `vibmode_signal::ChannelSpectrum::of`) where given, so that a caller resampling the
+    /// channels to another rate too transforms them once: the same equations bit for bit.
+    /// `spectra` of another number of channels than `rec` is not used.
+    pub fn record_equations_spectra(
+        &self,
+        rec: &Recording,
+        placement: impl Fn(&Channel) -> Option<Placement>,
+        spectra: Option<&[vibmode_signal::ChannelSpectrum]>,
+    ) -> Result<RecordEquations> {
+        let spectra = spectra.filter(|s| s.len() == rec.channels.len());
         let fs = rec.fs_hz;
         if !(fs.is_finite() && fs > 0.0) {
             return Err(fit_error(
@@ -1039,7 +1054,8 @@ impl BodyFit {
         let mut of = |i: usize| {
             let x = &rec.channels[i].samples;
             if factor > 1 {
-                deriv.apply(&decimate_ideal(x, fs_in, factor)?, &instants)
+                let spectrum = spectra.map(|s| &s[i]);
+                deriv.apply(&decimate_ideal(x, spectrum, fs_in, factor)?, &instants)
             } else {
                 deriv.apply(x, &instants)
             }
@@ -1701,17 +1717,31 @@ pub fn decimation_factor(fs_hz: f64) -> usize {
 
 /// `x` at `1 / factor` of its rate by the paper's ideal DFT low-pass and decimation
 /// (`vibmode_signal::resample`, cutoff at the new Nyquist frequency; when `factor` divides the
-/// length, as `scipy.signal.resample(x, len / factor)`).
+/// length, as `scipy.signal.resample(x, len / factor)`), from `x`'s spectrum where given.
 ///
 /// Errors: only an internal FFT failure ([`VehicleError::Numerical`]).
-fn decimate_ideal(x: &[f64], fs_hz: f64, factor: usize) -> Result<Vec<f64>> {
+fn decimate_ideal(
+    x: &[f64],
+    spectrum: Option<&vibmode_signal::ChannelSpectrum>,
+    fs_hz: f64,
+    factor: usize,
+) -> Result<Vec<f64>> {
     let p = vibmode_signal::ResampleParams {
         fs_out_hz: fs_hz / factor as f64,
         cutoff_hz: None,
         filter: true,
     };
-    vibmode_signal::resample(x, fs_hz, &p)
-        .map_err(|e| VehicleError::Numerical(format!("bringing a record down by {factor}: {e}")))
+    let failed = |e: vibmode_signal::SignalError| {
+        VehicleError::Numerical(format!("bringing a record down by {factor}: {e}"))
+    };
+    let mut r = vibmode_signal::Resampler::new(x.len(), fs_hz, &p).map_err(failed)?;
+    let mut out = vec![0.0; r.n_out()];
+    match spectrum {
+        Some(s) => r.process_spectrum(x, s, &mut out),
+        None => r.process(x, &mut out),
+    }
+    .map_err(failed)?;
+    Ok(out)
 }
 
 /// The band-pass's moments `m_p = int G(f)^2 (2 pi f)^p df` for p = 0, 2, 4 (G the gain of

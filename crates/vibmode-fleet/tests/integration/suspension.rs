@@ -187,3 +187,41 @@ fn the_fleet_fits_the_model_files_bars_and_refuses_a_mix() {
     let e = model.fit_corners(&cfg.analysis, &mixed).unwrap_err();
     assert!(e.contains("unknowns") && e.lines().count() == 1, "{e}");
 }
+
+/// `record_features` (each channel transformed once for the analysis's resampling and the body
+/// equations' decimation) gives what `compute_features` and `add_body_equations` give, bit for
+/// bit: a record at 10 kHz (brought down by 2 for the equations) with the model file, one at
+/// 200 Hz (not brought down), and one without a model.
+#[test]
+fn features_with_one_transform_per_channel_are_the_two_steps() {
+    let model = VehicleModel::from_toml(CITY_BUS, "examples/city_bus.toml").unwrap();
+    let cfg = FleetConfig::default();
+    let fast = vibmode_vehicle::sim::simulate(
+        &VehicleParams::city_bus(),
+        &vibmode_vehicle::sim::SimParams {
+            fs_hz: 10_000.0,
+            records: 1,
+            seed: 7,
+            disturbances: Disturbances::in_service(),
+            ..vibmode_vehicle::sim::SimParams::default()
+        },
+    )
+    .unwrap()
+    .records
+    .remove(0)
+    .recording;
+    let slow = common::record(&VehicleParams::city_bus(), RoadClass::B, 30.0, 8);
+    let json = |f: &vibmode_fleet::RecordFeatures| serde_json::to_string(f).unwrap();
+    for (rec, model) in [(&fast, Some(&model)), (&slow, Some(&model)), (&fast, None)] {
+        let mut two_steps = vibmode_fleet::compute_features("r.csv", rec, &cfg).unwrap();
+        vibmode_fleet::add_body_equations(&mut two_steps, rec, model, &cfg);
+        let one = vibmode_fleet::record_features("r.csv", rec, model, &cfg).unwrap();
+        assert_eq!(json(&one), json(&two_steps), "{} Hz", rec.fs_hz);
+        assert_eq!(
+            one.suspension.is_some(),
+            model.is_some(),
+            "{} Hz",
+            rec.fs_hz
+        );
+    }
+}

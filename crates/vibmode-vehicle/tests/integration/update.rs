@@ -670,7 +670,8 @@ fn choose_band_by_hand() {
 /// factor with the paper's ideal filter before their equations are formed: 3 of the demo's
 /// records of the changed bus at 20 kHz give exactly the fit of the same records brought down
 /// to 5 kHz by `vibmode_signal::resample` (same equations, noise densities and parameters),
-/// and that fit finds the measured bus: heave, pitch and roll within 3 % of its modes.
+/// and that fit finds the measured bus: heave, pitch and roll within 3 % of its modes. The
+/// equations made from the channels' spectra taken before are the same bit for bit.
 #[test]
 fn records_above_the_equation_rate_are_fitted_at_it() {
     use vibmode_vehicle::update::{decimation_factor, EQUATION_RATE_HZ};
@@ -695,6 +696,18 @@ fn records_above_the_equation_rate_are_fitted_at_it() {
     for r in &sim.records {
         let rec = &r.recording;
         fast.add_record(rec).unwrap();
+        // The same equations from the channels' spectra taken before (the fleet's path: the
+        // analysis resamples the same channels), whole or up to the new Nyquist frequency's bin.
+        let json = |e: &vibmode_vehicle::update::RecordEquations| serde_json::to_string(e).unwrap();
+        let want = json(&fast.record_equations(rec).unwrap());
+        for bins in [usize::MAX, rec.len() / 8 + 2] {
+            let channels = rec.channels.iter().map(|c| &c.samples[..]);
+            let spectra = vibmode_signal::ChannelSpectrum::of_each(channels, bins).unwrap();
+            let got = fast
+                .record_equations_spectra(rec, |c| Some(c.placement), Some(&spectra))
+                .unwrap();
+            assert_eq!(json(&got), want, "spectra of {bins} bins");
+        }
         let channels = rec
             .channels
             .iter()
