@@ -417,14 +417,7 @@ impl Resampler {
                 ),
             });
         }
-        if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-            return Err(RecordingError::NonFinite {
-                channel: "input".into(),
-                index: i,
-                value: x[i],
-            }
-            .into());
-        }
+        finite_input(x)?;
         Ok(())
     }
 
@@ -580,6 +573,20 @@ impl Resampler {
     }
 }
 
+/// Every sample of `x` finite, else the first that is not (as a channel named "input": callers
+/// with a name put it in).
+fn finite_input(x: &[f64]) -> Result<()> {
+    match x.iter().position(|v| !v.is_finite()) {
+        Some(i) => Err(RecordingError::NonFinite {
+            channel: "input".into(),
+            index: i,
+            value: x[i],
+        }
+        .into()),
+        None => Ok(()),
+    }
+}
+
 /// The real DFT of one channel (its `n / 2 + 1` bins, unscaled, or the first of them), taken
 /// once so that the channel can be resampled to several rates without transforming it again
 /// ([`Resampler::process_spectrum`], [`resample_recording`]); the transform a [`Resampler`]
@@ -602,14 +609,7 @@ impl ChannelSpectrum {
                 fix: "give at least 2 samples".into(),
             });
         }
-        if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-            return Err(RecordingError::NonFinite {
-                channel: "input".into(),
-                index: i,
-                value: x[i],
-            }
-            .into());
-        }
+        finite_input(x)?;
         let fwd = vibmode_fft::forward(x.len());
         let mut buf = fwd.make_input_vec();
         buf.copy_from_slice(x);
