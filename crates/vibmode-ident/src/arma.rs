@@ -6,9 +6,9 @@ use crate::ar::{burg, burg_ladder};
 use nalgebra::DMatrix;
 
 use crate::linalg::{
-    check_signal, cholesky_solve, dot, filter_inv_c, filter_inv_c_adjoint, is_min_phase,
-    lagged_dot, lagged_gram, mirror_upper_block, predict_errors, robust_std, spd_inverse_diag,
-    Lags,
+    check_signal, cholesky_solve, dot, filter_inv_c, filter_inv_c_adjoint, filter_inv_c_each,
+    is_min_phase, lagged_dot, lagged_gram, mirror_upper_block, predict_errors, robust_std,
+    spd_inverse_diag, Lags,
 };
 use crate::model::{information_criteria, ArmaModel, Estimator, StopReason};
 use crate::outliers::OutlierCleaning;
@@ -502,17 +502,27 @@ impl<'a> Search<'a> {
     fn gram(&mut self, c: &[f64], eps: &[f64]) -> DMatrix<f64> {
         let (p, q) = (self.p, self.q);
         let k = p + q;
-        filter_inv_c(eps, c, &mut self.ef);
         let n = self.ys.len();
         let mut h = DMatrix::<f64>::zeros(k, k);
         // Exact a-columns (1/C)[y_{t-k} 1{t >= p}] when affordable; otherwise delayed copies of y/C
         // (ignores that A(q) y is only formed from t = p on: a transient-only approximation).
         let exact = (n as f64) * (p as f64) * (k as f64) <= EXACT_JACOBIAN_BUDGET;
         self.exact_cols = false;
-        if exact {
-            self.exact_ar_block(c, &mut h);
+        // The filters by 1/C this step needs, run side by side ([`filter_inv_c_each`]): eps / C,
+        // and y / C or the exact columns' first column and impulse response.
+        if exact && self.exact_buffers() {
+            let mut delta = vec![0.0; n - p];
+            delta[0] = 1.0;
+            filter_inv_c_each(
+                &[eps, &self.z, &delta],
+                c,
+                &mut [&mut self.ef, &mut self.cols[0], &mut self.g],
+            );
+            self.exact_ar_block(&mut h);
+        } else if exact {
+            filter_inv_c(eps, c, &mut self.ef);
         } else {
-            filter_inv_c(self.ys, c, &mut self.yf);
+            filter_inv_c_each(&[eps, self.ys], c, &mut [&mut self.ef, &mut self.yf]);
         }
         let (yf, ef) = (Lags::new(&self.yf, p), Lags::new(&self.ef, q));
         if !exact {
@@ -528,18 +538,19 @@ impl<'a> Search<'a> {
         h
     }
 
-    /// The exact AR columns of the Jacobian into `self.cols`, and the rows `0..p` of the Gram
-    /// (the AR block and the upper AR-MA block).
-    fn exact_ar_block(&mut self, c: &[f64], h: &mut DMatrix<f64>) {
+    /// Whether the exact AR columns apply (`p > 0` and more samples than `p`), with their
+    /// buffers made: `z`, the delayed signal; `g`, the impulse response's; `cols`.
+    ///
+    /// Column i is (1/C) z_i with z_i[t] = y[t-i] for t >= p, else 0. Since
+    /// z_{i+1} = (z_i delayed by one) + y[p-1-i] delta_p and 1/C is linear and time-invariant,
+    /// col_{i+1}[t] = col_i[t-1] + y[p-1-i] g[t-p], g the impulse response of 1/C: one filter
+    /// pass for the first column and the impulse response instead of one pass per column.
+    fn exact_buffers(&mut self) -> bool {
         let p = self.p;
         let n = self.ys.len();
         if p == 0 || n <= p {
-            return;
+            return false;
         }
-        // Column i is (1/C) z_i with z_i[t] = y[t-i] for t >= p, else 0. Since
-        // z_{i+1} = (z_i delayed by one) + y[p-1-i] delta_p and 1/C is linear and time-invariant,
-        // col_{i+1}[t] = col_i[t-1] + y[p-1-i] g[t-p], g the impulse response of 1/C: one filter
-        // pass for the first column and the impulse response instead of one pass per column.
         if self.z.len() != n {
             self.z = vec![0.0; n];
             for (t, zt) in self.z.iter_mut().enumerate().skip(p) {
@@ -548,10 +559,15 @@ impl<'a> Search<'a> {
             self.g = vec![0.0; n - p];
             self.cols = vec![vec![0.0; n]; p];
         }
-        filter_inv_c(&self.z, c, &mut self.cols[0]);
-        let mut delta = vec![0.0; n - p];
-        delta[0] = 1.0;
-        filter_inv_c(&delta, c, &mut self.g);
+        true
+    }
+
+    /// The exact AR columns of the Jacobian into `self.cols` from the first (`(1/C) z`) and the
+    /// impulse response of 1/C in `self.g` ([`Search::exact_buffers`]), and the rows `0..p`
+    /// of the Gram (the AR block and the upper AR-MA block).
+    fn exact_ar_block(&mut self, h: &mut DMatrix<f64>) {
+        let p = self.p;
+        let n = self.ys.len();
         // b[i]: the impulse's weight from column i to column i + 1.
         let b: Vec<f64> = (0..p - 1).map(|i| self.ys[p - 2 - i]).collect();
         for (i, &bi) in b.iter().enumerate() {

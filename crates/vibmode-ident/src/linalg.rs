@@ -135,6 +135,30 @@ pub(crate) fn filter_inv_c(x: &[f64], c: &[f64], out: &mut [f64]) {
     }
 }
 
+/// [`filter_inv_c`] of each `xs[i]` into `outs[i]` (lengths may differ), the filters run side
+/// by side: each output sample waits on the one before it in its own filter only, so the
+/// filters' recursions overlap instead of running one after another. Every output is
+/// [`filter_inv_c`]'s bit for bit.
+pub(crate) fn filter_inv_c_each(xs: &[&[f64]], c: &[f64], outs: &mut [&mut [f64]]) {
+    let q = c.len().saturating_sub(1);
+    let crev = reversed_tail(c);
+    let lens: Vec<usize> = xs
+        .iter()
+        .zip(outs.iter())
+        .map(|(x, o)| x.len().min(o.len()))
+        .collect();
+    let longest = lens.iter().copied().max().unwrap_or(0);
+    for t in 0..longest {
+        let kmax = q.min(t);
+        for ((x, out), &len) in xs.iter().zip(outs.iter_mut()).zip(&lens) {
+            if t < len {
+                let (done, rest) = out.split_at_mut(t);
+                rest[0] = x[t] - dot(&crev[q - kmax..], &done[t - kmax..]);
+            }
+        }
+    }
+}
+
 /// Conditional prediction errors: `eps_t = 0` for `t < p`, and for `t >= p`
 /// `eps_t = y_t + sum_{k=1}^{p} a_k y_{t-k} - sum_{k=1}^{q} c_k eps_{t-k}`, i.e. `eps = w / C` with
 /// zero initial conditions where `w_t = A(q) y_t` uses measured samples only.
