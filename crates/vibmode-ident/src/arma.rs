@@ -1306,7 +1306,12 @@ mod tests {
             let mut s = Search::new(&y, p, q, None);
             s.ef = (0..n).map(|_| uniform()).collect();
             let mut h = DMatrix::<f64>::zeros(p + q, p + q);
-            s.exact_ar_block(&c, &mut h);
+            assert!(s.exact_buffers());
+            let mut delta = vec![0.0; n - p];
+            delta[0] = 1.0;
+            filter_inv_c(&s.z, &c, &mut s.cols[0]);
+            filter_inv_c(&delta, &c, &mut s.g);
+            s.exact_ar_block(&mut h);
             assert_eq!(s.cols.len(), p);
             // The Gram blocks by their recursion against direct sums over t >= p.
             let close = |a: f64, b: f64, what: &str| {
