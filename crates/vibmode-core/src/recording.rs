@@ -524,13 +524,7 @@ mod tests {
     /// too-small channel, as one sample at a time does: 400 seeded channels of 0 to 40 samples.
     #[test]
     fn blocked_scan_names_the_first_bad_sample_as_one_at_a_time() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = crate::stats::xorshift(0x9e37_79b9_7f4a_7c15);
         let bad = [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 2e60, -1e61];
         let (mut errors, mut small) = (0, 0);
         for _ in 0..400 {

@@ -205,6 +205,18 @@ pub fn clipped(x: &[f64]) -> Option<(usize, f64)> {
     channel_health(x, HELD_MIN_SAMPLES).clipped
 }
 
+/// A seeded xorshift generator of `u64`s for the crate's tests (Marsaglia's 13/7/17 shifts).
+#[cfg(test)]
+pub(crate) fn xorshift(seed: u64) -> impl FnMut() -> u64 {
+    let mut state = seed;
+    move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    }
+}
+
 /// The rules of [`channel_health`] (constant, clipped, held) applied in one pass over a channel
 /// whose extremes are known, so that a channel read in blocks is judged as a whole one is (the
 /// first pass: `min`, `max` and the number of samples `n`). Feed every block in order with
@@ -467,13 +479,7 @@ mod tests {
         // the last value or with an extreme), constant, dead, or of 0-3 samples, cut into blocks
         // at every split of a seeded generator: the scan equals `channel_health` of the whole, and
         // that equals each rule written out from its definition (the oracles above).
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = xorshift(0x9e37_79b9_7f4a_7c15);
         let mut kinds = [0usize; 3];
         for case in 0..400 {
             let n = match case % 10 {

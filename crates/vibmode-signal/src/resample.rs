@@ -778,6 +778,8 @@ impl ResampleRecording for Recording {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
 
     /// The decimation's fold as it was first written (every bin zeroed above the cutoff, then
     /// every term `j + l num` summed, in order), on the resampler's own plans and buffers.
@@ -819,13 +821,8 @@ mod tests {
     /// cutoffs from the lowest bins to the output's Nyquist frequency.
     #[test]
     fn the_fold_over_the_kept_bins_is_the_fold_over_every_bin() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let mut next = move || rng.gen::<f64>();
         let mut folds = 0;
         for &(n_out, factor) in &[
             (2, 2),
@@ -871,13 +868,8 @@ mod tests {
     /// the spectra is `resample`'s recording.
     #[test]
     fn resampling_from_a_spectrum_is_resampling_the_channel() {
-        let mut state = 0x5851_f42d_4c95_7f2du64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rng = ChaCha8Rng::seed_from_u64(12);
+        let mut next = move || rng.gen::<f64>() - 0.5;
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         let mut kinds = Vec::new();
         for &(n, fs_out_hz, cutoff) in &[

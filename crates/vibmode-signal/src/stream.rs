@@ -1090,13 +1090,9 @@ pub(crate) mod tests {
     /// block size, with a scale and with trailing bytes of a partial frame.
     #[test]
     fn blocks_of_frames_give_the_frames_values_in_order() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut byte = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 56) as u8
-        };
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(13);
+        let mut byte = move || rng.gen::<u8>();
         for nch in 1..=7 {
             for frames in [0usize, 1, 1023, 1024, 1025, 2500] {
                 let bytes: Vec<u8> = (0..frames * 8 * nch + 3).map(|_| byte()).collect();
