@@ -296,19 +296,7 @@ impl RecordFacts {
     /// ([`check_channels_vary`]): one look at each channel for both.
     pub fn checked(r: &RecordInput) -> Result<RecordFacts, AnalysisError> {
         let health = channels_checked(r)?;
-        let (clipped, held) = crate::results::sensor_notes_of(&r.recording, &health);
-        Ok(Self::with_notes(r, clipped, held))
-    }
-
-    fn with_notes(r: &RecordInput, clipped: Vec<ClippedChannel>, held: Vec<HeldChannel>) -> Self {
-        RecordFacts {
-            name: r.name.clone(),
-            fs_hz: r.recording.fs_hz,
-            n_samples: r.recording.len(),
-            meta: None,
-            clipped,
-            held,
-        }
+        Ok(Self::of_recording_health(&r.name, &r.recording, &health))
     }
 }
 

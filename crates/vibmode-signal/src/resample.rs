@@ -383,7 +383,8 @@ impl Resampler {
     ///
     /// Errors: wrong slice lengths, non-finite input.
     pub fn process(&mut self, x: &[f64], out: &mut [f64]) -> Result<()> {
-        self.check_buffers(x, out)?;
+        self.check_lengths(x, out)?;
+        finite_input(x)?;
         match self.kind {
             Kind::Pick => {
                 for (o, v) in out.iter_mut().zip(x.iter().step_by(self.factor)) {
@@ -405,8 +406,8 @@ impl Resampler {
         }
     }
 
-    /// The buffers' lengths against the plan, and every input sample finite.
-    fn check_buffers(&self, x: &[f64], out: &[f64]) -> Result<()> {
+    /// The buffers' lengths against the plan.
+    fn check_lengths(&self, x: &[f64], out: &[f64]) -> Result<()> {
         if x.len() != self.n_in || out.len() != self.n_out {
             return Err(SignalError::InvalidParam {
                 name: "buffer lengths",
@@ -417,7 +418,6 @@ impl Resampler {
                 ),
             });
         }
-        finite_input(x)?;
         Ok(())
     }
 
@@ -455,9 +455,7 @@ impl Resampler {
         }
         // `x` itself is not read (its spectrum is), and was checked finite by
         // `ChannelSpectrum::of`: only the lengths are checked here.
-        if x.len() != self.n_in {
-            return self.check_buffers(x, out);
-        }
+        self.check_lengths(x, out)?;
         self.resample_spectrum(Some(&spectrum.bins), out)
     }
 
@@ -467,16 +465,6 @@ impl Resampler {
         let Some(inv) = self.inv.clone() else {
             return Err(fft_err(vibmode_fft::FftError::InputBuffer(0, 0)));
         };
-        if out.len() != self.n_out {
-            return Err(SignalError::InvalidParam {
-                name: "buffer lengths",
-                value: format!("{} out", out.len()),
-                fix: format!(
-                    "this Resampler was planned for {} out; plan a new one with Resampler::new",
-                    self.n_out
-                ),
-            });
-        }
         let n = self.n_in;
         let zero = Complex::new(0.0, 0.0);
         let scale = 1.0 / n as f64;
@@ -602,22 +590,10 @@ impl ChannelSpectrum {
     ///
     /// Errors: fewer than 2 samples, a non-finite sample.
     pub fn of(x: &[f64]) -> Result<ChannelSpectrum> {
-        if x.len() < 2 {
-            return Err(SignalError::TooShort {
-                what: "a channel's spectrum".into(),
-                n: x.len(),
-                fix: "give at least 2 samples".into(),
-            });
-        }
-        finite_input(x)?;
-        let fwd = vibmode_fft::forward(x.len());
-        let mut buf = fwd.make_input_vec();
-        buf.copy_from_slice(x);
-        let mut bins = fwd.make_output_vec();
-        let mut scratch = fwd.make_scratch_vec();
-        fwd.process_with_scratch(&mut buf, &mut bins, &mut scratch)
-            .map_err(fft_err)?;
-        Ok(ChannelSpectrum { n: x.len(), bins })
+        // One channel in, one spectrum out (an empty list only from a bug).
+        Self::of_each([x], usize::MAX)?
+            .pop()
+            .ok_or_else(|| fft_err(vibmode_fft::FftError::InputBuffer(0, 0)))
     }
 
     /// [`ChannelSpectrum::of`] of each channel, keeping its first `bins` bins (all of them
@@ -641,11 +617,14 @@ impl ChannelSpectrum {
         let mut out = Vec::new();
         let mut planned: Option<Planned> = None;
         for x in channels {
-            if x.len() < 2 || x.iter().any(|v| !v.is_finite()) {
-                // The one-channel path words the error.
-                out.push(ChannelSpectrum::of(x)?);
-                continue;
+            if x.len() < 2 {
+                return Err(SignalError::TooShort {
+                    what: "a channel's spectrum".into(),
+                    n: x.len(),
+                    fix: "give at least 2 samples".into(),
+                });
             }
+            finite_input(x)?;
             let (_, fwd, buf, spec, scratch) = match &mut planned {
                 Some(p) if p.0 == x.len() => p,
                 _ => {
