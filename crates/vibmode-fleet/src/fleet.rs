@@ -189,18 +189,19 @@ pub fn record_features(
     cfg: &FleetConfig,
 ) -> Result<RecordFeatures> {
     // Spectra only where the equations bring the channels down too (a 2 kHz record is not),
-    // up to the bin of their new Nyquist frequency (and one beyond), which the analysis's
-    // lower rate lies below; and only for a file that is one record (a longer one is cut for
-    // the analysis, and its spectra would be held whole for the equations alone).
-    let factor = vibmode_vehicle::update::decimation_factor(rec.fs_hz);
+    // with the bins they read (the analysis's lower rate lies below them); and only for a file
+    // that is one record (a longer one is cut for the analysis, and its spectra would be held
+    // whole for the equations alone).
     let one_record =
         vibmode_analysis::CutRecords::new(name, rec, cfg.analysis.record_length_s).len() == 1;
-    let spectra: Option<Vec<vibmode_signal::ChannelSpectrum>> =
-        model.filter(|_| factor > 1 && one_record).and_then(|_| {
-            let bins = rec.len() / (2 * factor) + 2;
+    let bins = vibmode_vehicle::update::spectrum_bins_read(rec.len(), rec.fs_hz);
+    let spectra: Option<Vec<vibmode_signal::ChannelSpectrum>> = match (model, bins) {
+        (Some(_), Some(bins)) if one_record => {
             let channels = rec.channels.iter().map(|c| &c.samples[..]);
             vibmode_signal::ChannelSpectrum::of_each(channels, bins).ok()
-        });
+        }
+        _ => None,
+    };
     let mut features =
         crate::features::compute_features_spectra(name, rec, cfg, spectra.as_deref())?;
     add_body_equations_spectra(&mut features, rec, model, cfg, spectra.as_deref());

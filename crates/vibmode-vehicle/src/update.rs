@@ -1715,6 +1715,15 @@ pub fn decimation_factor(fs_hz: f64) -> usize {
     ((fs_hz / EQUATION_RATE_HZ).floor() as usize).max(1)
 }
 
+/// How many of the first bins of a channel's spectrum (`vibmode_signal::ChannelSpectrum`) the
+/// equations of a record of `n` samples at `fs_hz` read when it is brought down
+/// ([`decimation_factor`] above 1): those up to the new Nyquist frequency's, and one beyond.
+/// `None` when the record is used at its own rate (no spectrum is read).
+pub fn spectrum_bins_read(n: usize, fs_hz: f64) -> Option<usize> {
+    let factor = decimation_factor(fs_hz);
+    (factor > 1).then(|| n / (2 * factor) + 2)
+}
+
 /// `x` at `1 / factor` of its rate by the paper's ideal DFT low-pass and decimation
 /// (`vibmode_signal::resample`, cutoff at the new Nyquist frequency; when `factor` divides the
 /// length, as `scipy.signal.resample(x, len / factor)`), from `x`'s spectrum where given.

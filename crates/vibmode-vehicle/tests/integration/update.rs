@@ -680,6 +680,11 @@ fn records_above_the_equation_rate_are_fitted_at_it() {
     assert_eq!(decimation_factor(10_000.0), 2);
     assert_eq!(decimation_factor(EQUATION_RATE_HZ), 1);
     assert_eq!(decimation_factor(500.0), 1);
+    // The bins the equations read from a spectrum: up to the 5 kHz rate's Nyquist frequency.
+    use vibmode_vehicle::update::spectrum_bins_read;
+    assert_eq!(spectrum_bins_read(204_800, 20_000.0), Some(25_602));
+    assert_eq!(spectrum_bins_read(102_400, 10_000.0), Some(25_602));
+    assert_eq!(spectrum_bins_read(20_480, 2_000.0), None);
     let sp = SimParams {
         fs_hz: 20_000.0,
         ..SimParams::demo(3, 2)
@@ -700,6 +705,8 @@ fn records_above_the_equation_rate_are_fitted_at_it() {
         // analysis resamples the same channels), whole or up to the new Nyquist frequency's bin.
         let json = |e: &vibmode_vehicle::update::RecordEquations| serde_json::to_string(e).unwrap();
         let want = json(&fast.record_equations(rec).unwrap());
+        let read = vibmode_vehicle::update::spectrum_bins_read(rec.len(), rec.fs_hz);
+        assert_eq!(read, Some(rec.len() / 8 + 2));
         for bins in [usize::MAX, rec.len() / 8 + 2] {
             let channels = rec.channels.iter().map(|c| &c.samples[..]);
             let spectra = vibmode_signal::ChannelSpectrum::of_each(channels, bins).unwrap();
