@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use vibmode_report::panels::grid;
-use vibmode_report::{HtmlReport, Marker, Panel, Series};
+use vibmode_report::{HtmlReport, Marker, Panel, Rgb, Series};
 
 use crate::error::{FleetError, Result};
 use crate::model::{Classification, Group, ModelSet};
@@ -192,7 +192,7 @@ fn vehicle_section(html: &mut HtmlReport, store: &Store, vehicle: &str) -> Resul
         return Ok(());
     };
     html.paragraph(&format!(
-        "Model set version {} from {} nominal record(s). Trends: each vehicle feature per record in ingest order (circles: nominal records, squares: test records, triangles: flagged); the horizontal lines are the nominal band, centre x exp(+-limit x spread).",
+        "Model set version {} from {} nominal record(s). Trends: each vehicle feature per record in ingest order (blue circles: nominal records, green squares: test records inside the band, red triangles: flagged); the grey lines are the nominal band, centre x exp(+-limit x spread).",
         set.version,
         set.records.len()
     ));
@@ -240,6 +240,30 @@ type RecordEntry = (
     crate::features::RecordFeatures,
     Option<crate::model::Assessment>,
 );
+
+/// Which records a trend panel's points are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum RecordPoints {
+    /// The model set's nominal records.
+    Nominal,
+    /// Test records inside the nominal band.
+    Test,
+    /// Records whose feature is flagged.
+    Flagged,
+}
+
+/// A trend panel's points of one kind of record. Red is kept for what is flagged: a test record
+/// inside the band is not an alarm, and a planner reads red as one.
+fn record_points(kind: RecordPoints, x: Vec<f64>, y: Vec<f64>) -> Series {
+    let (marker, label, color) = match kind {
+        RecordPoints::Nominal => (Marker::Circle, "nominal", Rgb::BLUE),
+        RecordPoints::Test => (Marker::Square, "test", Rgb::GREEN),
+        RecordPoints::Flagged => (Marker::Triangle, "flagged", Rgb::RED),
+    };
+    Series::points(x, y, marker)
+        .with_label(label)
+        .with_color(color)
+}
 
 fn trend_figure(html: &mut HtmlReport, set: &ModelSet, records: &[RecordEntry]) -> Result<()> {
     // ln of each feature per record (as the model set keeps them).
@@ -321,6 +345,7 @@ fn trend_figure(html: &mut HtmlReport, set: &ModelSet, records: &[RecordEntry]) 
                     vec![(f.centre + k * limit * f.sigma).exp(); 2],
                 )
                 .with_label(if k > 0.0 { "nominal band" } else { "" })
+                .with_color(Rgb::GREY)
             };
             let title = match f.meta.corner {
                 Some(c) => format!("{c}: {}", f.meta.label),
@@ -340,9 +365,9 @@ fn trend_figure(html: &mut HtmlReport, set: &ModelSet, records: &[RecordEntry]) 
             Panel::new(title, "record (ingest order)", unit)
                 .with_series(band(1.0))
                 .with_series(band(-1.0))
-                .with_series(Series::points(nx, ny, Marker::Circle).with_label("nominal"))
-                .with_series(Series::points(tx, ty, Marker::Square).with_label("test"))
-                .with_series(Series::points(fx, fy, Marker::Triangle).with_label("flagged"))
+                .with_series(record_points(RecordPoints::Nominal, nx, ny))
+                .with_series(record_points(RecordPoints::Test, tx, ty))
+                .with_series(record_points(RecordPoints::Flagged, fx, fy))
                 .without_legend()
         })
         .collect();
@@ -356,4 +381,33 @@ fn trend_figure(html: &mut HtmlReport, set: &ModelSet, records: &[RecordEntry]) 
             path: "the trend figure".into(),
             reason: e.to_string(),
         })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use vibmode_report::SeriesStyle;
+
+    #[test]
+    fn only_flagged_records_are_drawn_red_and_each_kind_apart() {
+        let kinds = [
+            RecordPoints::Nominal,
+            RecordPoints::Test,
+            RecordPoints::Flagged,
+        ];
+        let series: Vec<Series> = kinds
+            .iter()
+            .map(|&k| record_points(k, vec![1.0], vec![2.0]))
+            .collect();
+        let colors: Vec<Option<Rgb>> = series.iter().map(|s| s.color).collect();
+        assert_eq!(colors[2], Some(Rgb::RED));
+        assert!(colors[..2]
+            .iter()
+            .all(|c| c.is_some() && *c != Some(Rgb::RED)));
+        assert_ne!(colors[0], colors[1]);
+        let markers: Vec<&SeriesStyle> = series.iter().map(|s| &s.style).collect();
+        assert!(markers[0] != markers[1] && markers[1] != markers[2] && markers[0] != markers[2]);
+        assert_eq!(series[0].x, vec![1.0]);
+        assert_eq!(series[0].y, vec![2.0]);
+    }
 }
