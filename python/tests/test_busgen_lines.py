@@ -69,6 +69,37 @@ def test_the_oracle_line_test_by_hand():
     assert abs(line_evidence._fisher([0.1, 0.1]) - (1 + x / 2) * np.exp(-x / 2)) < 1e-12
 
 
+def test_role_pool_modes_by_hand():
+    """`lines.role_modes`: a wheel-hop mode (zeta 0.3: found within 15 %) and a bending mode
+    (zeta 0.03: within 3 %) seen by the sprung pool; the unsprung pool sees only the wheel hop.
+    The sprung pool's 9.3 Hz structural mode is 6.8 % above the bending (missed: its window is
+    3 %) and 3.3 % above the wheel hop (found within 15 %, error 0.033); 12.1 Hz lies on a true
+    line (not unmatched); 20 Hz matches nothing. A periodic mode is not structural."""
+    truth = {
+        "modes": [
+            {"f_n_hz": 9.0, "zeta": 0.3, "label": "rear axle bounce (L/R in phase)",
+             "observable_in": ["s_rl", "u_rl"]},
+            {"f_n_hz": 9.0 / 1.0333, "zeta": 0.03, "label": "body 1st vertical bending",
+             "observable_in": ["s_rl"]},
+        ],
+        "periodic_lines": [{"f0_hz": 12.0}],
+    }
+    res = {"roles": [
+        {"role": "sprung", "channels": ["s_rl"], "invariant_modes": [
+            {"frequency_hz": 9.3, "class": "structural"},
+            {"frequency_hz": 12.1, "class": "structural"},
+            {"frequency_hz": 20.0, "class": "structural"},
+            {"frequency_hz": 8.71, "class": "periodic-disturbance"},
+        ]},
+        {"role": "unsprung", "channels": ["u_rl"], "invariant_modes": []},
+    ]}
+    r = lines.role_modes(truth, res)
+    assert (r["judged"], r["found"]) == (3, 1)
+    assert r["per_label"] == {"rear axle bounce": [1, 2], "body 1st vertical bending": [0, 1]}
+    assert r["errors"] == pytest.approx([0.3 / 9.0])
+    assert (r["structural"], r["unmatched"]) == (3, 1)
+
+
 @pytest.fixture(scope="module")
 def measured():
     _ready()

@@ -41,6 +41,11 @@ Scores per bus:
   again over the buses where no true line lies within 2 % of the bending: busgen's README says
   a line that close to a lightly damped mode cannot be judged, and in 10 s records (resolution
   0.1 Hz) neither can the mode beside it; such a row says "not judged".
+- the role pools' modes: per role pool (the ARMA order sweeps of the sprung and of the unsprung
+  channels) and true mode its channels see, whether a structural invariant mode of the pool lies
+  within max(`POOL_MODE_REL` (3 %), zeta/2) of it, with the median relative error, per mode
+  label; and how many of the pools' structural modes lie within max(5 %, zeta) of no true mode
+  and 2 % of no true line. The summary only; it is what a change of the order sweep moves.
 
 Prints one row per bus and the summary; exit status 0 (it measures, it does not judge).
 """
@@ -65,6 +70,7 @@ MATCH_REL = 0.02
 MERGE_REL = 0.01
 BENDING_REL = 0.02
 LIGHT_ZETA = 0.1
+POOL_MODE_REL = 0.03
 
 
 def is_bending(m: Dict) -> bool:
@@ -149,8 +155,43 @@ def score(truth: Dict, res: Dict, evidence: Dict[float, float] = None,
         "lines": lines, "apart": apart, "left_out": left_out, "found": found,
         "seen": seen, "clear": clear, "evidence": evidence, "level": level,
         "reported": merged, "false": false, "structural_periodic": called_periodic,
-        "bending": bend_found,
+        "bending": bend_found, "role_modes": role_modes(truth, res),
     }
+
+
+def role_modes(truth: Dict, res: Dict) -> Dict:
+    """The role pools' (the ARMA order sweeps') structural modes against the true modes: per
+    true mode and role pool whose channels see it (`observable_in`), whether a structural
+    invariant mode of the pool lies within max(`POOL_MODE_REL`, zeta/2) of it (a broad wheel-hop
+    mode's poles scatter about as its bandwidth), and its relative error; and the pool's
+    structural modes within max(5 %, zeta) of no true mode and 2 % of no true line."""
+    lines = [l["f0_hz"] for l in truth["periodic_lines"]]
+    judged, found, errors, unmatched, n_structural = 0, 0, [], 0, 0
+    per_label: Dict[str, List[int]] = {}
+    for r in res.get("roles", []):
+        chans = set(r.get("channels", []))
+        structural = [m["frequency_hz"] for m in r.get("invariant_modes", [])
+                      if m["class"] == "structural"]
+        for m in truth["modes"]:
+            if not chans & set(m["observable_in"]):
+                continue
+            f, tol = m["f_n_hz"], max(POOL_MODE_REL, m["zeta"] / 2)
+            near = [rel(x, f) for x in structural if rel(x, f) <= tol]
+            label = m["label"].split(" (")[0]
+            counts = per_label.setdefault(label, [0, 0])
+            judged += 1
+            counts[1] += 1
+            if near:
+                found += 1
+                counts[0] += 1
+                errors.append(min(near))
+        for x in structural:
+            n_structural += 1
+            if not (any(rel(x, m["f_n_hz"]) <= max(0.05, m["zeta"]) for m in truth["modes"])
+                    or any(rel(x, f) <= MATCH_REL for f in lines)):
+                unmatched += 1
+    return {"judged": judged, "found": found, "errors": errors, "per_label": per_label,
+            "structural": n_structural, "unmatched": unmatched}
 
 
 def run_bus(bus: int, seed: int, keep: bool, extra: Tuple[str, ...] = ()) -> Tuple[int, Dict, Dict]:
@@ -206,7 +247,20 @@ def summary(results: List[Tuple[int, Dict, Dict]]) -> Dict:
     n_bend = sum(1 for s in seen if s["bending"][0][1])
     judged = [s for s in seen if not s["bending"][0][3]]
     n_bend_judged = sum(1 for s in judged if s["bending"][0][1])
-    return {"buses": len(results), "apart": n_apart, "found": n_found, "seen": n_seen,
+    rm = [s["role_modes"] for _, _, s in results]
+    errors = sorted(e for x in rm for e in x["errors"])
+    labels: Dict[str, List[int]] = {}
+    for x in rm:
+        for k, (a, b) in x["per_label"].items():
+            c = labels.setdefault(k, [0, 0])
+            c[0] += a
+            c[1] += b
+    pool = {"judged": sum(x["judged"] for x in rm), "found": sum(x["found"] for x in rm),
+            "median_error": errors[len(errors) // 2] if errors else None,
+            "per_label": labels, "structural": sum(x["structural"] for x in rm),
+            "unmatched": sum(x["unmatched"] for x in rm)}
+    return {"role_modes": pool,
+            "buses": len(results), "apart": n_apart, "found": n_found, "seen": n_seen,
             "seen_found": n_seen_found, "clear": n_clear, "clear_found": n_clear_found,
             "reported": n_rep,
             "false": n_false, "no_structural_periodic": n_clean, "bending_seen": len(seen),
@@ -230,6 +284,13 @@ def print_summary(sm: Dict) -> None:
     print(f"bending found structural within 2 % where a sensor sees it: "
           f"{r(sm['bending_structural'], sm['bending_seen'])}; where no line lies within 2 % of it "
           f"(busgen's README: neither can be judged): {r(sm['bending_judged_structural'], sm['bending_judged'])}")
+    pm = sm["role_modes"]
+    med = "-" if pm["median_error"] is None else f"{100 * pm['median_error']:.1f} %"
+    per = ", ".join(f"{k} {a}/{b}" for k, (a, b) in sorted(pm["per_label"].items()))
+    print(f"true modes found structural by the role pools (ARMA sweeps) whose channels see them, "
+          f"within max({100 * POOL_MODE_REL:.0f} %, zeta/2): {r(pm['found'], pm['judged'])}, "
+          f"median error {med} ({per}); the pools' structural modes matching no true mode or "
+          f"line: {pm['unmatched']} of {pm['structural']}")
 
 
 def measure(n_buses: int, seed: int = 1, jobs: int = 2, keep: bool = False,
