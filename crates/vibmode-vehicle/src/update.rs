@@ -1946,28 +1946,62 @@ impl Derivatives {
                 [v, v * iw, v * iw * iw]
             })
             .collect();
-        let mut out: [Vec<f64>; 3] = std::array::from_fn(|_| Vec::with_capacity(keep.len()));
-        for &n in keep {
-            // e^(2 pi i k n / m) for k = first, first + 1, ...: a start and a constant ratio
-            // (phases reduced modulo m in integers, so long records keep their precision).
-            let phase = |k: usize| {
-                let r = ((k as u128 * n as u128) % m as u128) as f64;
-                Complex64::from_polar(1.0, 2.0 * std::f64::consts::PI * r / m as f64)
-            };
-            let (mut e, step) = (phase(first), phase(1));
-            let mut acc = [0.0f64; 3];
-            for s in &scaled {
-                for (a, v) in acc.iter_mut().zip(s) {
-                    *a += (v * e).re;
+        Ok((band_sums(&scaled, first, m, keep), density))
+    }
+}
+
+/// Instants evaluated side by side by [`band_sums`]: independent recurrences, so that one
+/// instant's multiplications overlap another's.
+const INSTANTS_SIDE_BY_SIDE: usize = 4;
+
+/// `sum_k Re(s_k[j] e^(2 pi i (first + k) n / m))` for j = 0, 1, 2 at each instant `n` of
+/// `keep`: the band's bins brought back to those instants. Each instant's phase starts at
+/// `e^(2 pi i first n / m)` and turns by `e^(2 pi i n / m)` per bin (phases reduced modulo `m`
+/// in integers, so long records keep their precision). Four instants are summed side by side,
+/// each with exactly the operations of one at a time ([`Complex64`]'s product and
+/// `MulAssign`, in their order), so the sums are the same bits.
+fn band_sums(
+    scaled: &[[num_complex::Complex64; 3]],
+    first: usize,
+    m: usize,
+    keep: &[usize],
+) -> [Vec<f64>; 3] {
+    use num_complex::Complex64;
+    const L: usize = INSTANTS_SIDE_BY_SIDE;
+    let phase = |k: usize, n: usize| {
+        let r = ((k as u128 * n as u128) % m as u128) as f64;
+        Complex64::from_polar(1.0, 2.0 * std::f64::consts::PI * r / m as f64)
+    };
+    let mut out: [Vec<f64>; 3] = std::array::from_fn(|_| Vec::with_capacity(keep.len()));
+    for group in keep.chunks(L) {
+        let mut e_re = [0.0f64; L];
+        let mut e_im = [0.0f64; L];
+        let mut st_re = [0.0f64; L];
+        let mut st_im = [0.0f64; L];
+        for (l, &n) in group.iter().enumerate() {
+            let (e, st) = (phase(first, n), phase(1, n));
+            (e_re[l], e_im[l], st_re[l], st_im[l]) = (e.re, e.im, st.re, st.im);
+        }
+        let mut acc = [[0.0f64; L]; 3];
+        for s in scaled {
+            for (a, v) in acc.iter_mut().zip(s) {
+                for l in 0..L {
+                    // (v * e).re
+                    a[l] += v.re * e_re[l] - v.im * e_im[l];
                 }
-                e *= step;
             }
-            for (o, a) in out.iter_mut().zip(acc) {
-                o.push(a);
+            for l in 0..L {
+                // e *= step, as `MulAssign` does it
+                let re = e_re[l];
+                e_re[l] = e_re[l] * st_re[l] - e_im[l] * st_im[l];
+                e_im[l] = e_im[l] * st_re[l] + re * st_im[l];
             }
         }
-        Ok((out, density))
+        for (o, a) in out.iter_mut().zip(&acc) {
+            o.extend_from_slice(&a[..group.len()]);
+        }
     }
+    out
 }
 
 #[cfg(test)]
@@ -2173,6 +2207,61 @@ mod tests {
             .unwrap();
         let worst = a[500..2500].iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         assert!(worst < 1e-3, "{worst}");
+    }
+
+    /// `band_sums` (four instants side by side) against the loop it replaced, one instant at
+    /// a time with `Complex64`'s operators: the same bits, for seeded random bins, band starts,
+    /// transform lengths up to 2^21 and instant lists of every length modulo 4 (a partial last
+    /// group), including instants beyond `m` (the phase is reduced modulo `m`).
+    #[test]
+    fn band_sums_side_by_side_are_one_instant_at_a_time_bit_for_bit() {
+        use num_complex::Complex64;
+        use rand::{Rng, SeedableRng};
+        let one_at_a_time = |scaled: &[[Complex64; 3]], first: usize, m: usize, keep: &[usize]| {
+            let mut out: [Vec<f64>; 3] = std::array::from_fn(|_| Vec::new());
+            for &n in keep {
+                let phase = |k: usize| {
+                    let r = ((k as u128 * n as u128) % m as u128) as f64;
+                    Complex64::from_polar(1.0, 2.0 * std::f64::consts::PI * r / m as f64)
+                };
+                let (mut e, step) = (phase(first), phase(1));
+                let mut acc = [0.0f64; 3];
+                for s in scaled {
+                    for (a, v) in acc.iter_mut().zip(s) {
+                        *a += (v * e).re;
+                    }
+                    e *= step;
+                }
+                for (o, a) in out.iter_mut().zip(acc) {
+                    o.push(a);
+                }
+            }
+            out
+        };
+        for seed in 0..200u64 {
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+            let m = 2 * rng.gen_range(8..(1usize << 20));
+            let first = rng.gen_range(1..m / 4);
+            let bins = rng.gen_range(0..(m / 2 - first).min(300));
+            let scaled: Vec<[Complex64; 3]> = (0..bins)
+                .map(|_| {
+                    std::array::from_fn(|_| {
+                        Complex64::new(rng.gen::<f64>() - 0.5, rng.gen::<f64>() - 0.5)
+                    })
+                })
+                .collect();
+            let keep: Vec<usize> = (0..rng.gen_range(0..11))
+                .map(|_| rng.gen_range(0..2 * m))
+                .collect();
+            let got = super::band_sums(&scaled, first, m, &keep);
+            let want = one_at_a_time(&scaled, first, m, &keep);
+            for j in 0..3 {
+                assert_eq!(got[j].len(), keep.len());
+                for (g, w) in got[j].iter().zip(&want[j]) {
+                    assert_eq!(g.to_bits(), w.to_bits(), "seed {seed}, j {j}: {g} != {w}");
+                }
+            }
+        }
     }
 
     /// Identity: the band's bins summed at the kept samples equal three whole inverse FFTs of
