@@ -396,12 +396,10 @@ fn file_name(path: &Path) -> String {
 
 /// A file's bytes and their content hash.
 fn read_and_hash(path: &Path, hash: ContentHash) -> Result<(Vec<u8>, String)> {
-    let bytes = std::fs::read(path).map_err(|e| FleetError::Io {
+    hash.read_file(path).map_err(|e| FleetError::Io {
         path: path.display().to_string(),
         reason: e.to_string(),
-    })?;
-    let key = hash.hex(&bytes);
-    Ok((bytes, key))
+    })
 }
 
 /// Reads and analyses every file (a file whose bytes the vehicle already has is not analysed
