@@ -251,11 +251,10 @@ fn fleet_features(
     let opts = read_options(fs, scale, unit, allow_nonuniform, time_unit)?;
     let out = py
         .detach(|| {
-            let bytes = std::fs::read(&path).map_err(|e| FleetError::Io {
+            let (bytes, key) = kind.read_file(&path).map_err(|e| FleetError::Io {
                 path: path.display().to_string(),
                 reason: e.to_string(),
             })?;
-            let key = kind.hex(&bytes);
             let rec = vibmode_signal::read_path_bytes(&path, &bytes, &opts)?;
             drop(bytes);
             let file = vibmode_fleet::record_file_name(&path);
