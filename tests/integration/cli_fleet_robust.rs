@@ -102,7 +102,7 @@ fn store_is_safe_checks_are_all_or_nothing_and_failed_sensors_are_named() {
     // An ingest likewise, and it does not report the good file as stored.
     let e = fails_with(
         &fleet_args("ingest", db, "bus-1", &[good, missing]),
-        &["missing.csv"],
+        &["missing.csv", "check the path"],
     );
     assert!(!e.contains("stored as"), "{e}");
     let st = status(db);

@@ -355,11 +355,25 @@ pub enum FleetError {
         reason: String,
     },
     /// Reading a record file failed.
-    #[error("cannot read {}: {reason}", vibmode_core::quoted(path))]
+    #[error(
+        "cannot read {}: {reason}; check the path and its permissions",
+        vibmode_core::quoted(path)
+    )]
     Io {
         /// The file.
         path: String,
         /// The operating system's message.
+        reason: String,
+    },
+    /// Writing the fleet report (a folder, the page, or a figure in it) failed.
+    #[error(
+        "cannot write {}: {reason}; write the report to a folder you can write to",
+        vibmode_core::quoted(what)
+    )]
+    Write {
+        /// The file or folder, or the figure.
+        what: String,
+        /// The operating system's or the renderer's message.
         reason: String,
     },
     /// A settings file that cannot be read or parsed.

@@ -16,8 +16,8 @@ use crate::store::{Condition, Store};
 pub const MAX_TREND_PANELS: usize = 12;
 
 fn io(path: &Path, e: impl ToString) -> FleetError {
-    FleetError::Io {
-        path: path.display().to_string(),
+    FleetError::Write {
+        what: path.display().to_string(),
         reason: e.to_string(),
     }
 }
@@ -377,8 +377,8 @@ fn trend_figure(html: &mut HtmlReport, set: &ModelSet, records: &[RecordEntry]) 
     }
     let fig = grid(panels, 3, 420, 300);
     html.figure(&fig, "Vehicle features per record with the nominal band")
-        .map_err(|e| FleetError::Io {
-            path: "the trend figure".into(),
+        .map_err(|e| FleetError::Write {
+            what: "the trend figure".into(),
             reason: e.to_string(),
         })
 }
@@ -387,6 +387,24 @@ fn trend_figure(html: &mut HtmlReport, set: &ModelSet, records: &[RecordEntry]) 
 mod tests {
     use super::*;
     use vibmode_report::SeriesStyle;
+
+    /// A report that cannot be written says so (not "cannot read"), naming the path and the
+    /// fix: here its folder would be made inside a file.
+    #[test]
+    fn a_report_that_cannot_be_written_says_write() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let file = dir.path().join("f");
+        std::fs::write(&file, b"x").expect("write");
+        let (store, _) = Store::init(&dir.path().join("s.db")).expect("store");
+        let err = write_fleet_report(&store, &file.join("report"))
+            .expect_err("a folder inside a file")
+            .to_string();
+        assert!(err.starts_with("cannot write "), "{err}");
+        assert!(
+            err.contains("report") && err.contains("folder you can write to"),
+            "{err}"
+        );
+    }
 
     #[test]
     fn only_flagged_records_are_drawn_red_and_each_kind_apart() {
