@@ -59,6 +59,7 @@ pub fn fleet_err(e: vibmode_fleet::FleetError) -> PyErr {
     match e {
         F::Signal(s) => signal_err(s),
         F::Io { .. }
+        | F::Write { .. }
         | F::NoStore { .. }
         | F::NotAStore { .. }
         | F::NotAFile { .. }
