@@ -251,10 +251,7 @@ fn fleet_features(
     let opts = read_options(fs, scale, unit, allow_nonuniform, time_unit)?;
     let out = py
         .detach(|| {
-            let (bytes, key) = kind.read_file(&path).map_err(|e| FleetError::Io {
-                path: path.display().to_string(),
-                reason: e.to_string(),
-            })?;
+            let (bytes, key) = kind.read_file(&path)?;
             let rec = vibmode_signal::read_path_bytes(&path, &bytes, &opts)?;
             drop(bytes);
             let file = vibmode_fleet::record_file_name(&path);

@@ -394,14 +394,6 @@ fn file_name(path: &Path) -> String {
     record_file_name(path)
 }
 
-/// A file's bytes and their content hash.
-fn read_and_hash(path: &Path, hash: ContentHash) -> Result<(Vec<u8>, String)> {
-    hash.read_file(path).map_err(|e| FleetError::Io {
-        path: path.display().to_string(),
-        reason: e.to_string(),
-    })
-}
-
 /// Reads and analyses every file (a file whose bytes the vehicle already has is not analysed
 /// again; the same bytes twice in `paths` are analysed once). `layout` checks each read
 /// recording first. `progress(n)` is called as the first `n` files are done.
@@ -480,7 +472,7 @@ fn prepare_files(
     for chunk in paths.chunks(rayon::current_num_threads().max(1)) {
         // Each file is read once: hashed here (in parallel), parsed from the same bytes below.
         let read: Vec<Result<(Vec<u8>, String)>> =
-            chunk.par_iter().map(|p| read_and_hash(p, hash)).collect();
+            chunk.par_iter().map(|p| hash.read_file(p)).collect();
         let mut plans: Vec<(String, String, Plan)> = Vec::with_capacity(chunk.len());
         let mut contents: Vec<Vec<u8>> = Vec::with_capacity(chunk.len());
         for (path, r) in chunk.iter().zip(read) {

@@ -51,20 +51,27 @@ impl ContentHash {
     /// A file's bytes and their hash, hashed piece by piece as they are read (each piece of
     /// [`READ_PIECE`] bytes while it is still in the processor's cache, rather than the whole
     /// file again after reading it): the same hash as [`ContentHash::hex`] of the bytes.
-    pub fn read_file(self, path: &std::path::Path) -> std::io::Result<(Vec<u8>, String)> {
+    /// A file that cannot be read is [`FleetError::Io`], naming it.
+    pub fn read_file(self, path: &std::path::Path) -> Result<(Vec<u8>, String)> {
         use std::io::Read;
-        let mut f = std::fs::File::open(path)?;
-        let size = f.metadata().map_or(0, |m| m.len());
-        let mut bytes = Vec::with_capacity(usize::try_from(size).unwrap_or(0));
-        let mut h = Incremental::new(self);
-        loop {
-            let start = bytes.len();
-            if (&mut f).take(READ_PIECE as u64).read_to_end(&mut bytes)? == 0 {
-                break;
+        let read = || -> std::io::Result<(Vec<u8>, String)> {
+            let mut f = std::fs::File::open(path)?;
+            let size = f.metadata().map_or(0, |m| m.len());
+            let mut bytes = Vec::with_capacity(usize::try_from(size).unwrap_or(0));
+            let mut h = Incremental::new(self);
+            loop {
+                let start = bytes.len();
+                if (&mut f).take(READ_PIECE as u64).read_to_end(&mut bytes)? == 0 {
+                    break;
+                }
+                h.update(&bytes[start..]);
             }
-            h.update(&bytes[start..]);
-        }
-        Ok((bytes, h.finish()))
+            Ok((bytes, h.finish()))
+        };
+        read().map_err(|e| FleetError::Io {
+            path: path.display().to_string(),
+            reason: e.to_string(),
+        })
     }
 
     /// The hash of a recording's content (rate, channel names and samples, little-endian), for
@@ -175,9 +182,14 @@ mod tests {
                 assert_eq!(key, kind.hex(&bytes), "{kind}, {len} bytes");
             }
         }
-        assert!(ContentHash::Blake3
+        let err = ContentHash::Blake3
             .read_file(&dir.path().join("missing"))
-            .is_err());
+            .expect_err("a missing file")
+            .to_string();
+        assert!(
+            err.contains("missing") && err.contains("check the path"),
+            "{err}"
+        );
     }
 
     /// Published test vectors: FIPS 180-2 for SHA-256 ("abc"), the BLAKE3 reference

@@ -15,9 +15,10 @@ use crate::store::{Condition, Store};
 /// scores first); every mode's frequency and damping is drawn besides.
 pub const MAX_TREND_PANELS: usize = 12;
 
-fn io(path: &Path, e: impl ToString) -> FleetError {
+/// A file, folder or figure of the report that could not be written.
+fn cannot_write(what: impl std::fmt::Display, e: impl ToString) -> FleetError {
     FleetError::Write {
-        what: path.display().to_string(),
+        what: what.to_string(),
         reason: e.to_string(),
     }
 }
@@ -173,11 +174,12 @@ pub fn write_fleet_report(store: &Store, dir: &Path) -> Result<PathBuf> {
     for v in &vehicles {
         vehicle_section(&mut html, store, v)?;
     }
-    std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
+    std::fs::create_dir_all(dir).map_err(|e| cannot_write(dir.display(), e))?;
     let path = dir.join("index.html");
     let tmp = dir.join(".index.html.partial");
-    html.save(&tmp).map_err(|e| io(&tmp, e))?;
-    std::fs::rename(&tmp, &path).map_err(|e| io(&path, e))?;
+    html.save(&tmp)
+        .map_err(|e| cannot_write(tmp.display(), e))?;
+    std::fs::rename(&tmp, &path).map_err(|e| cannot_write(path.display(), e))?;
     Ok(path)
 }
 
@@ -377,10 +379,7 @@ fn trend_figure(html: &mut HtmlReport, set: &ModelSet, records: &[RecordEntry]) 
     }
     let fig = grid(panels, 3, 420, 300);
     html.figure(&fig, "Vehicle features per record with the nominal band")
-        .map_err(|e| FleetError::Write {
-            what: "the trend figure".into(),
-            reason: e.to_string(),
-        })
+        .map_err(|e| cannot_write("the trend figure", e))
 }
 
 #[cfg(test)]
